@@ -1,0 +1,1 @@
+"""Wire format: the att_msgs interfaces and the one module that converts them to numpy."""

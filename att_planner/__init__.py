@@ -1,0 +1,1 @@
+"""Flight side: maneuver planners, controllers and offline tools."""

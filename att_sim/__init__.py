@@ -1,0 +1,1 @@
+"""Truth side: attitude dynamics, environment and the simulator node."""

@@ -1,0 +1,144 @@
+"""Attitude conventions for the whole suite, written down once.
+
+Convention (used everywhere, messages included):
+
+* A quaternion is a numpy array ``[x, y, z, w]`` (geometry_msgs order, scalar last),
+  Hamilton product, unit norm.
+* It describes the attitude of the **body frame with respect to the inertial frame**
+  (body-to-inertial): ``v_inertial = dcm(q) @ v_body``. The attitude matrix of
+  Bruni & Celani / Wertz, ``C(q)`` (inertial-to-body), is ``dcm(q).T``.
+* Kinematics: ``q_dot = 0.5 * q ⊗ [omega, 0]`` with ``omega`` the body rate in body axes;
+  equivalently ``R_dot = R hat(omega)``. This equals the Olivares–Staffetti form
+  ``q_dot = 0.5 Q(omega) q`` and the Bruni–Celani form ``q_v_dot = 0.5 (q_v × ω + q4 ω)``.
+* ``q`` and ``-q`` are the same attitude; errors are computed sign-independently.
+
+All functions accept a single quaternion ``(4,)`` or a stack ``(..., 4)``.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+IDENTITY = np.array([0.0, 0.0, 0.0, 1.0])
+
+
+def hat(v: np.ndarray) -> np.ndarray:
+    """Skew-symmetric matrix ``v×`` so that ``hat(a) @ b == cross(a, b)``; works on stacks."""
+    v = np.asarray(v, dtype=float)
+    out = np.zeros(v.shape[:-1] + (3, 3))
+    out[..., 0, 1], out[..., 0, 2] = -v[..., 2], v[..., 1]
+    out[..., 1, 0], out[..., 1, 2] = v[..., 2], -v[..., 0]
+    out[..., 2, 0], out[..., 2, 1] = -v[..., 1], v[..., 0]
+    return out
+
+
+def normalize(q: np.ndarray) -> np.ndarray:
+    q = np.asarray(q, dtype=float)
+    return q / np.linalg.norm(q, axis=-1, keepdims=True)
+
+
+def multiply(p: np.ndarray, q: np.ndarray) -> np.ndarray:
+    """Hamilton product ``p ⊗ q`` (scalar last)."""
+    p, q = np.asarray(p, float), np.asarray(q, float)
+    pv, pw = p[..., :3], p[..., 3:]
+    qv, qw = q[..., :3], q[..., 3:]
+    v = pw * qv + qw * pv + np.cross(pv, qv)
+    w = pw * qw - np.sum(pv * qv, axis=-1, keepdims=True)
+    return np.concatenate([v, w], axis=-1)
+
+
+def conjugate(q: np.ndarray) -> np.ndarray:
+    q = np.array(q, dtype=float)
+    q[..., :3] *= -1.0
+    return q
+
+
+def dcm(q: np.ndarray) -> np.ndarray:
+    """Body-to-inertial rotation matrix ``R(q)`` (``v_i = R v_b``)."""
+    q = np.asarray(q, dtype=float)
+    x, y, z, w = q[..., 0], q[..., 1], q[..., 2], q[..., 3]
+    out = np.empty(q.shape[:-1] + (3, 3))
+    out[..., 0, 0] = 1 - 2 * (y * y + z * z)
+    out[..., 0, 1] = 2 * (x * y - z * w)
+    out[..., 0, 2] = 2 * (x * z + y * w)
+    out[..., 1, 0] = 2 * (x * y + z * w)
+    out[..., 1, 1] = 1 - 2 * (x * x + z * z)
+    out[..., 1, 2] = 2 * (y * z - x * w)
+    out[..., 2, 0] = 2 * (x * z - y * w)
+    out[..., 2, 1] = 2 * (y * z + x * w)
+    out[..., 2, 2] = 1 - 2 * (x * x + y * y)
+    return out
+
+
+def from_dcm(R: np.ndarray) -> np.ndarray:
+    """Quaternion of a body-to-inertial matrix (Shepperd's method, w >= 0)."""
+    R = np.asarray(R, dtype=float)
+    flat = R.reshape(-1, 3, 3)
+    out = np.empty((flat.shape[0], 4))
+    for n, m in enumerate(flat):
+        tr = np.trace(m)
+        k = int(np.argmax([m[0, 0], m[1, 1], m[2, 2], tr]))
+        if k == 3:
+            s = 2.0 * np.sqrt(1.0 + tr)
+            q = [(m[2, 1] - m[1, 2]) / s, (m[0, 2] - m[2, 0]) / s, (m[1, 0] - m[0, 1]) / s, 0.25 * s]
+        else:
+            i, j, l = k, (k + 1) % 3, (k + 2) % 3
+            s = 2.0 * np.sqrt(1.0 + m[i, i] - m[j, j] - m[l, l])
+            q = np.empty(4)
+            q[i] = 0.25 * s
+            q[j] = (m[j, i] + m[i, j]) / s
+            q[l] = (m[l, i] + m[i, l]) / s
+            q[3] = (m[l, j] - m[j, l]) / s
+        q = np.asarray(q, float)
+        out[n] = q if q[3] >= 0 else -q
+    return out.reshape(R.shape[:-2] + (4,))
+
+
+def from_axis_angle(axis: np.ndarray, angle) -> np.ndarray:
+    axis = np.asarray(axis, dtype=float)
+    axis = axis / np.linalg.norm(axis, axis=-1, keepdims=True)
+    half = 0.5 * np.asarray(angle, dtype=float)[..., None]
+    return np.concatenate([axis * np.sin(half), np.cos(half)], axis=-1)
+
+
+def to_axis_angle(q: np.ndarray) -> tuple[np.ndarray, float]:
+    """Axis and angle in [0, π] of a single quaternion (shortest rotation)."""
+    q = normalize(q)
+    if q[3] < 0:
+        q = -q
+    s = np.linalg.norm(q[:3])
+    angle = 2.0 * np.arctan2(s, q[3])
+    axis = q[:3] / s if s > 1e-15 else np.array([1.0, 0.0, 0.0])
+    return axis, float(angle)
+
+
+def exp_map(phi: np.ndarray) -> np.ndarray:
+    """Quaternion of the rotation vector ``phi`` (``exp(hat(phi))``), stable near zero."""
+    phi = np.asarray(phi, dtype=float)
+    angle = np.linalg.norm(phi, axis=-1, keepdims=True)
+    half = 0.5 * angle
+    # sin(half)/angle with its Taylor series near 0
+    k = np.where(angle > 1e-8, np.sin(half) / np.where(angle > 1e-8, angle, 1.0), 0.5 - angle**2 / 48.0)
+    return np.concatenate([phi * k, np.cos(half)], axis=-1)
+
+
+def expm_so3(phi: np.ndarray) -> np.ndarray:
+    """Rotation matrix ``exp(hat(phi))`` (Rodrigues)."""
+    return dcm(exp_map(phi))
+
+
+def angle_between(q1: np.ndarray, q2: np.ndarray) -> np.ndarray:
+    """Rotation angle (rad, in [0, π]) taking attitude q1 to q2; sign-independent."""
+    d = np.abs(np.sum(normalize(q1) * normalize(q2), axis=-1))
+    return 2.0 * np.arccos(np.clip(d, -1.0, 1.0))
+
+
+def error_vector(q: np.ndarray, q_ref: np.ndarray) -> np.ndarray:
+    """Attitude error ``q_ref^* ⊗ q`` vector part, sign chosen with w >= 0 (body frame)."""
+    e = multiply(conjugate(q_ref), q)
+    sign = np.where(e[..., 3:] < 0, -1.0, 1.0)
+    return (e * sign)[..., :3]
+
+
+def propagate_constant_rate(q: np.ndarray, omega: np.ndarray, dt: float) -> np.ndarray:
+    """Exact attitude after ``dt`` at constant body rate: ``q ⊗ exp(omega dt)``."""
+    return multiply(q, exp_map(np.asarray(omega) * dt))
