@@ -1,0 +1,55 @@
+"""``att-bench``: the one entry point for the figures the issues ask for.
+
+``att-bench <study> [options] --json PATH`` runs a study, prints a table and writes its JSON.
+Each study lives in ``att_planner/bench_<study>.py`` and provides ``configure(parser)`` and
+``run(args) -> dict`` (``run`` prints the table and returns the JSON payload).
+"""
+from __future__ import annotations
+
+import argparse
+import importlib
+import json
+import sys
+
+STUDIES = {
+    "smooth": "att_planner.bench_smooth",
+    "time-optimal": "att_planner.bench_time_optimal",
+    "schedule": "att_planner.bench_schedule",
+    "gains": "att_planner.bench_gains",
+}
+
+
+def _json_default(obj):
+    import numpy as np
+    if isinstance(obj, np.ndarray):
+        return obj.tolist()
+    if isinstance(obj, np.generic):
+        return obj.item()
+    raise TypeError(f"not JSON serialisable: {type(obj).__name__}")
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(prog="att-bench", description=__doc__.splitlines()[0])
+    sub = parser.add_subparsers(dest="study", required=True)
+    modules = {}
+    for name, modname in STUDIES.items():
+        try:
+            modules[name] = importlib.import_module(modname)
+        except ModuleNotFoundError as exc:
+            if exc.name != modname:
+                raise
+            continue
+        p = sub.add_parser(name, help=(modules[name].__doc__ or "").strip().splitlines()[0])
+        modules[name].configure(p)
+        p.add_argument("--json", metavar="PATH", help="write the study's JSON here")
+    args = parser.parse_args(argv)
+    payload = modules[args.study].run(args)
+    if args.json:
+        with open(args.json, "w") as fh:
+            json.dump(payload, fh, indent=1, default=_json_default)
+        print(f"JSON: {args.json}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
