@@ -1,0 +1,48 @@
+# Two commands from a fresh clone: `make demo` and `make test`. Each bootstraps .venv on its own:
+# pinned wheels (requirements.txt), then the att_msgs interfaces built with rosidl into the venv
+# prefix, then this package (editable). Stamps make a second run fast.
+SHELL := /bin/bash
+PYTHON ?= python3.11
+VENV := .venv
+PREFIX := $(abspath $(VENV))
+PY := $(PREFIX)/bin/python
+BUILD_ENV := PATH=$(PREFIX)/bin:$$PATH CMAKE_PREFIX_PATH=$(PREFIX) AMENT_PREFIX_PATH=$(PREFIX)
+INTERFACES := $(shell find att_msgs_py/interfaces -type f)
+PYTEST_ARGS ?=
+
+.PHONY: setup test demo bench clean
+
+setup: $(VENV)/.stamp-package
+
+$(VENV)/.stamp-venv:
+	$(PYTHON) -m venv $(VENV)
+	$(PY) -m pip install --quiet --disable-pip-version-check pip==26.3
+	touch $@
+
+$(VENV)/.stamp-deps: requirements.txt $(VENV)/.stamp-venv
+	$(PY) -m pip install --quiet --disable-pip-version-check -r requirements.txt
+	touch $@
+
+$(VENV)/.stamp-interfaces: $(INTERFACES) $(VENV)/.stamp-deps
+	rm -rf build/att_msgs && mkdir -p build
+	$(BUILD_ENV) cmake -S att_msgs_py/interfaces -B build/att_msgs -DCMAKE_INSTALL_PREFIX=$(PREFIX) \
+	  -DPython3_EXECUTABLE=$(PY) -DBUILD_TESTING=OFF > build/att_msgs.configure.log 2>&1 \
+	  || { tail -40 build/att_msgs.configure.log; exit 1; }
+	$(BUILD_ENV) cmake --build build/att_msgs -j2 > build/att_msgs.build.log 2>&1 \
+	  || { tail -40 build/att_msgs.build.log; exit 1; }
+	$(BUILD_ENV) cmake --install build/att_msgs > build/att_msgs.install.log 2>&1
+	$(PY) -c "import att_msgs.msg, att_msgs.srv, att_msgs.action"
+	touch $@
+
+$(VENV)/.stamp-package: setup.py package.xml $(VENV)/.stamp-interfaces
+	$(PY) -m pip install --quiet --disable-pip-version-check --no-deps --no-build-isolation -e .
+	touch $@
+
+test: setup
+	$(PY) -m pytest test $(PYTEST_ARGS)
+
+demo: setup
+	$(PREFIX)/bin/att-demo
+
+clean:
+	rm -rf build $(VENV) *.egg-info

@@ -1,0 +1,41 @@
+"""att_suite: one ament_python package holding att_planner, att_sim and att_msgs_py.
+
+The interfaces (att_msgs) are a separate rosidl package under att_msgs_py/interfaces, built by the
+Makefile into the venv prefix before this package is installed.
+"""
+from glob import glob
+
+from setuptools import setup
+
+PACKAGE = "att_suite"
+
+setup(
+    name=PACKAGE,
+    version="0.1.0",
+    packages=["att_planner", "att_sim", "att_msgs_py"],
+    data_files=[
+        ("share/ament_index/resource_index/packages", ["resource/" + PACKAGE]),
+        ("share/" + PACKAGE, ["package.xml"]),
+        ("share/" + PACKAGE + "/config", glob("config/*.yaml")),
+    ],
+    install_requires=["numpy", "scipy", "pyyaml", "mcap", "mcap-ros2-support", "casadi"],
+    zip_safe=True,
+    maintainer="att-suite maintainers",
+    maintainer_email="maintainers@att-suite.org",
+    description="Onboard-style spacecraft attitude planning suite for ROS 2",
+    license="Apache-2.0",
+    python_requires=">=3.11",
+    entry_points={
+        "console_scripts": [
+            "att-sim = att_sim.simulator_node:main",
+            "att-planner = att_planner.planner_node:main",
+            "att-controller = att_planner.controller_node:main",
+            "att-recorder = att_msgs_py.recorder_node:main",
+            "att-replay = att_msgs_py.replay:main",
+            "att-review = att_msgs_py.review:main",
+            "att-demo = att_planner.demo:main",
+            "att-bench = att_planner.bench:main",
+            "att-tune = att_planner.tune_cli:main",
+        ],
+    },
+)
