@@ -1,0 +1,101 @@
+"""The planner's service logic without ROS: solve with the requested method, verify, fall back.
+
+:func:`plan_maneuver` runs a validated request's method, integrates the returned torques through
+the truth dynamics (:mod:`att_planner.verify`) and accepts the plan only if it meets the
+tolerances. A method that fails, raises or runs out of budget without a plan that verifies is
+replaced by the smooth eigenaxis slew when that one verifies (status ``fallback``); otherwise the
+answer is an error. No unverified plan ever leaves.
+"""
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from att_msgs_py.errors import ErrorCode
+from att_planner import eigenaxis
+from att_planner.problem import STATUS_BUDGET, STATUS_FAILED, STATUS_FALLBACK, ManeuverPlan, ManeuverProblem
+from att_planner.requests import ValidRequest
+from att_planner.verify import Verification, verify_profile
+from att_sim import rotations as rot
+
+
+@dataclass(frozen=True)
+class Tolerances:
+    """Acceptance of a plan after integration through the dynamics."""
+
+    attitude: float = math.radians(1.0)     # rad, final attitude error
+    rate: float = 1e-3                      # rad/s, final body-rate norm
+    cone_margin: float = math.radians(0.1)  # rad of cone penetration tolerated on the dense grid
+    torque_ratio: float = 1.0 + 1e-6
+
+
+@dataclass
+class PlanOutcome:
+    code: ErrorCode
+    message: str
+    plan: ManeuverPlan | None
+    verification: Verification | None
+
+
+def verify(problem: ManeuverProblem, plan: ManeuverPlan) -> Verification:
+    ver, _ = verify_profile(problem.spacecraft, problem.q_initial, problem.q_final, plan.t, plan.torque,
+                            interpolation=plan.interpolation, sensor_axis=problem.sensor_axis,
+                            cones=problem.cones, torque_limit=problem.spacecraft.body_torque_max)
+    if problem.sensor_target is not None:
+        # semi-free goal: judge the boresight direction, not the full attitude
+        reached = rot.dcm(plan.q[-1]) @ problem.sensor_axis
+        ver.final_attitude_error = float(np.arccos(np.clip(reached @ problem.sensor_target, -1, 1)))
+    return ver
+
+
+def rejection(ver: Verification, tol: Tolerances) -> str | None:
+    """Why a verified plan is not acceptable, or None."""
+    if ver.final_attitude_error > tol.attitude:
+        return f"final attitude error {math.degrees(ver.final_attitude_error):.3f} deg > {math.degrees(tol.attitude):.3f} deg"
+    if ver.final_rate > tol.rate:
+        return f"final rate {ver.final_rate:.3g} rad/s > {tol.rate:.3g} rad/s"
+    if ver.min_cone_margin < -tol.cone_margin:
+        return f"enters a keep-out cone by {math.degrees(-ver.min_cone_margin):.3f} deg"
+    if ver.torque_ratio > tol.torque_ratio:
+        return f"torque {ver.torque_ratio:.4f} x the limit"
+    return None
+
+
+def run_method(valid: ValidRequest) -> ManeuverPlan:
+    """Call the method; exceptions become a failed plan (never an exception in the executor)."""
+    start = time.perf_counter()
+    try:
+        plan = valid.method.load()(valid.problem, **valid.method.fixed, **valid.options)
+    except Exception as exc:  # noqa: BLE001 - any solver failure is reported, the node keeps serving
+        plan = ManeuverPlan(valid.method.name, np.zeros(1), np.zeros((1, 3)), np.zeros((1, 4)), np.zeros((1, 3)),
+                            status=STATUS_FAILED, message=f"{type(exc).__name__}: {exc}")
+    plan.solve_seconds = plan.solve_seconds or time.perf_counter() - start
+    return plan
+
+
+def plan_maneuver(valid: ValidRequest, tol: Tolerances = Tolerances()) -> PlanOutcome:
+    problem = valid.problem
+    plan = run_method(valid)
+    reason = plan.message or plan.status
+    if plan.status != STATUS_FAILED and len(plan.t) >= 2:
+        ver = verify(problem, plan)
+        reason = rejection(ver, tol)
+        if reason is None:
+            return PlanOutcome(ErrorCode.OK, plan.message or plan.status, plan, ver)
+        reason = f"{valid.method.name} plan rejected by verification: {reason}"
+    # fallback: the smooth eigenaxis slew, if it is safe
+    if problem.sensor_target is None and valid.method.name != eigenaxis.METHOD:
+        fallback = eigenaxis.plan_eigenaxis_smooth(problem)
+        ver = verify(problem, fallback)
+        if fallback.status != STATUS_FAILED and rejection(ver, tol) is None:
+            fallback = replace(fallback, status=STATUS_FALLBACK,
+                               message=f"{reason}; returning the eigenaxis fallback ({fallback.message})")
+            return PlanOutcome(ErrorCode.OK, fallback.message, fallback, ver)
+    budget_note = " (time budget expired)" if plan.status == STATUS_BUDGET else ""
+    code = ErrorCode.VERIFICATION_FAILED if "verification" in reason else ErrorCode.SOLVER_FAILED
+    if problem.cones and code == ErrorCode.SOLVER_FAILED and "infeasib" in reason.lower():
+        code = ErrorCode.INFEASIBLE
+    return PlanOutcome(code, f"no verified plan{budget_note}: {reason}", plan, None)

@@ -1,0 +1,99 @@
+"""Planner node: serves ``/planner/plan_maneuver`` (PlanManeuver) and publishes every returned
+plan on the latched ``/planner/plans`` for the controller and the recorder.
+
+Callbacks only translate: message -> :class:`ManeuverRequest` -> :func:`validate_maneuver` ->
+:func:`plan_maneuver` -> message. Requests run concurrently (reentrant callback group on a
+multi-threaded executor), so a long solve never blocks a quick request; each request builds its
+own problem, nothing is shared between requests but the read-only method registry.
+"""
+from __future__ import annotations
+
+import math
+import uuid
+
+import rclpy
+from rclpy.callback_groups import ReentrantCallbackGroup
+from rclpy.executors import ExternalShutdownException, MultiThreadedExecutor
+from rclpy.node import Node
+
+from att_msgs.msg import ManeuverPlan
+from att_msgs.srv import PlanManeuver
+from att_msgs_py import convert, topics
+from att_msgs_py.errors import ErrorCode, RequestError
+from att_planner import methods as method_registry
+from att_planner.planner import Tolerances, plan_maneuver
+from att_planner.requests import ManeuverRequest, validate_maneuver
+from att_sim import scenario as scen
+
+
+class PlannerNode(Node):
+    def __init__(self):
+        super().__init__("planner")
+        self.scenario_name = self.declare_parameter("scenario", "swift_demo").value
+        scenario = scen.load(self.scenario_name)
+        p = scenario.node_params.get("planner", {})
+
+        def param(key, default):
+            return self.declare_parameter(key, p.get(key, default)).value
+
+        self.frame_id = scenario.frame_id
+        self.methods = method_registry.available()
+        self.default_method = param("default_method", "") or next(iter(self.methods))
+        self.default_budget = float(param("time_budget", 20.0))
+        self.tolerances = Tolerances(attitude=math.radians(float(param("accept_attitude_error_deg", 1.0))),
+                                     rate=float(param("accept_final_rate", 1e-3)),
+                                     cone_margin=math.radians(float(param("accept_cone_penetration_deg", 0.1))))
+        group = ReentrantCallbackGroup()
+        self.plan_pub = self.create_publisher(ManeuverPlan, topics.PLANS, topics.LATCHED_QOS)
+        self.create_service(PlanManeuver, topics.PLAN_MANEUVER, self.on_plan_maneuver, callback_group=group)
+        self.get_logger().info(f"methods: {', '.join(self.methods)} (default {self.default_method})")
+
+    def on_plan_maneuver(self, request: PlanManeuver.Request, response: PlanManeuver.Response):
+        try:
+            valid = validate_maneuver(
+                ManeuverRequest(
+                    frame_id=request.header.frame_id,
+                    q_initial=convert.from_quaternion(request.initial_attitude),
+                    q_final=convert.from_quaternion(request.final_attitude),
+                    sensor_axis=convert.from_vector3(request.sensor_axis),
+                    cones=[convert.cone_parts(c) for c in request.cones],
+                    method=request.method, time_budget=request.time_budget, spacecraft=request.spacecraft,
+                    option_names=list(request.option_names), option_values=list(request.option_values),
+                    semi_free=request.semi_free, sensor_target=convert.from_vector3(request.sensor_target)),
+                frame_id=self.frame_id, default_spacecraft=self.scenario_name,
+                default_method=self.default_method, default_budget=self.default_budget, methods=self.methods)
+        except RequestError as err:
+            self.get_logger().warning(f"request rejected [{int(err.code)} {err.code.name}]: {err.message}")
+            response.success, response.error_code, response.message = False, int(err.code), err.message
+            return response
+        outcome = plan_maneuver(valid, self.tolerances)
+        response.success = outcome.code == ErrorCode.OK
+        response.error_code, response.message = int(outcome.code), outcome.message
+        if outcome.plan is not None and len(outcome.plan.t) >= 2:
+            response.plan = convert.plan_msg(
+                outcome.plan, plan_id=uuid.uuid4().hex[:12], frame_id=self.frame_id, spacecraft=valid.spacecraft,
+                sensor_axis=valid.problem.sensor_axis, cones=valid.problem.cones, verification=outcome.verification)
+            response.plan.header.stamp = self.get_clock().now().to_msg()
+        log = self.get_logger().info if response.success else self.get_logger().warning
+        log(f"{valid.method.name}: {outcome.message} (code {response.error_code})")
+        if response.success:
+            self.plan_pub.publish(response.plan)
+        return response
+
+
+def main(args=None):
+    rclpy.init(args=args)
+    node = PlannerNode()
+    executor = MultiThreadedExecutor(num_threads=6)
+    executor.add_node(node)
+    try:
+        executor.spin()
+    except (KeyboardInterrupt, ExternalShutdownException):
+        pass
+    finally:
+        node.destroy_node()
+        rclpy.try_shutdown()
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,143 @@
+"""Simulator node: integrates the truth dynamics and publishes state and /clock.
+
+Subscribes ``/actuator/command`` (ActuatorCommand), publishes ``/spacecraft/state``
+(SpacecraftState) at ``publish_rate`` and ``/clock`` at ``clock_rate`` (Hz of sim time), serves
+``/simulator/reset``. Runs at ``real_time_factor`` × wall time (0: as fast as possible).
+Parameters come from the scenario file (``scenario`` parameter), overridable by ROS parameters.
+
+Safety: commands with NaN/Inf or of the wrong size are rejected and never integrated; when no
+valid command arrived for ``command_timeout`` s of sim time the actuator inputs are zeroed and the
+state says so; a non-finite state stops the propagation (reported, the node stays up).
+"""
+from __future__ import annotations
+
+import threading
+import time
+
+import numpy as np
+import rclpy
+from rclpy.executors import ExternalShutdownException
+from rclpy.node import Node
+from rosgraph_msgs.msg import Clock
+
+from att_msgs.msg import ActuatorCommand, SpacecraftState
+from att_msgs.srv import ResetSimulator
+from att_msgs_py import convert, topics
+from att_msgs_py.errors import ErrorCode
+from att_sim import scenario as scen
+from att_sim.simulation import Simulation
+
+
+class SimulatorNode(Node):
+    def __init__(self):
+        super().__init__("simulator")
+        name = self.declare_parameter("scenario", "swift_demo").value
+        self.scenario = scen.load(name)
+        p = self.scenario.node_params.get("simulator", {})
+
+        def param(key, default):
+            return self.declare_parameter(key, p.get(key, default)).value
+
+        self.step = float(param("step", 0.05))
+        self.publish_period = 1.0 / float(param("publish_rate", 10.0))
+        self.clock_period = 1.0 / float(param("clock_rate", 50.0))
+        self.real_time_factor = float(param("real_time_factor", 1.0))
+        self.command_timeout = float(param("command_timeout", 1.0))
+        self.sim = Simulation(
+            self.scenario.spacecraft, self.scenario.orbit,
+            q0=param("initial_attitude", [0.0, 0.0, 0.0, 1.0]),
+            omega0=param("initial_rate", [0.0, 0.0, 0.0]),
+            gravity_gradient=bool(param("gravity_gradient", False)))
+        self.lock = threading.Lock()
+        self.last_command_time = -np.inf
+        self.rejected_commands = 0
+
+        self.state_pub = self.create_publisher(SpacecraftState, topics.STATE, topics.STREAM_QOS)
+        self.clock_pub = self.create_publisher(Clock, topics.CLOCK, topics.CLOCK_QOS)
+        self.create_subscription(ActuatorCommand, topics.COMMAND, self.on_command, topics.STREAM_QOS)
+        self.create_service(ResetSimulator, topics.RESET_SIMULATOR, self.on_reset)
+        self.running = True
+        self.thread = threading.Thread(target=self.run, name="sim-loop", daemon=True)
+        self.thread.start()
+        self.get_logger().info(
+            f"scenario '{self.scenario.name}', step {self.step} s, RTF "
+            f"{self.real_time_factor or 'max'}, {self.scenario.spacecraft.n_wheels} wheels")
+
+    # -- callbacks: translate messages to Simulation calls -------------------------------------
+    def on_command(self, msg: ActuatorCommand):
+        wheel = np.asarray(msg.wheel_torques, float)
+        dipole = convert.from_vector3(msg.dipole)
+        body = convert.from_vector3(msg.body_torque)
+        with self.lock:
+            error = self.sim.set_command(msg.mode, wheel, dipole, body)
+            if error is None:
+                self.last_command_time = self.sim.t
+        if error is not None:
+            self.rejected_commands += 1
+            self.get_logger().warning(f"command rejected ({self.rejected_commands} so far): {error}",
+                                      throttle_duration_sec=1.0)
+
+    def on_reset(self, request: ResetSimulator.Request, response: ResetSimulator.Response):
+        q = convert.from_quaternion(request.attitude)
+        w = convert.from_vector3(request.body_rate)
+        with self.lock:
+            error = self.sim.reset(q, w, np.asarray(request.wheel_speeds, float), request.orbit_phase)
+        response.success = error is None
+        response.error_code = 0 if error is None else int(ErrorCode.INVALID_RESET)
+        response.message = "state reset" if error is None else error
+        return response
+
+    # -- loop ----------------------------------------------------------------------------------
+    def run(self):
+        wall0, sim0 = time.monotonic(), self.sim.t
+        next_state, next_clock = self.sim.t, self.sim.t
+        while self.running and rclpy.ok():
+            with self.lock:
+                timed_out = self.sim.t - self.last_command_time > self.command_timeout
+                self.sim.command_timeout = timed_out
+                if not self.sim.halted:
+                    self.sim.advance(self.step)
+                    if self.sim.halted:
+                        self.get_logger().error(f"propagation stopped: {self.sim.halt_reason}")
+                t = self.sim.t
+                state = self.state_message() if t >= next_state - 1e-9 else None
+            if t >= next_clock - 1e-9:
+                self.clock_pub.publish(Clock(clock=convert.time_msg(t)))
+                next_clock += self.clock_period
+            if state is not None:
+                self.state_pub.publish(state)
+                next_state += self.publish_period
+            if self.real_time_factor > 0:
+                lag = wall0 + (t - sim0) / self.real_time_factor - time.monotonic()
+                if lag > 0:
+                    time.sleep(lag)
+            elif self.sim.halted:
+                time.sleep(0.05)
+
+    def state_message(self) -> SpacecraftState:
+        s = self.sim
+        return convert.state_msg(
+            s.t, s.x, frame_id=self.scenario.frame_id, body_frame_id=self.scenario.body_frame_id,
+            wheel_torques=s.applied.wheel_torque, field_body=s.applied.field_body, dipole=s.applied.dipole,
+            applied_torque=s.applied.body_torque, position=s.position(), command_timeout=s.command_timeout)
+
+    def destroy_node(self):
+        self.running = False
+        self.thread.join(timeout=2.0)
+        super().destroy_node()
+
+
+def main(args=None):
+    rclpy.init(args=args)
+    node = SimulatorNode()
+    try:
+        rclpy.spin(node)
+    except (KeyboardInterrupt, ExternalShutdownException):
+        pass
+    finally:
+        node.destroy_node()
+        rclpy.try_shutdown()
+
+
+if __name__ == "__main__":
+    main()
