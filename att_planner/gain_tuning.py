@@ -1,0 +1,658 @@
+"""Robust magnetorquer PD gains (Bruni & Celani): batch settling-time simulation and min-max search.
+
+The problem (issue 6): choose the gains ``(κ_p, κ_d)`` of the law of
+:mod:`att_planner.magnetorquer_law` to minimise the settling time ``t_s`` (orbits) of the attitude
+``|q_i| ≤ ν`` under the worst initial condition of the set ``H`` (attitude ``(ρ, φ, θ)``, rates
+``|ω_i| ≤ 0.1 rad/s``, orbit argument ``ψ``)::
+
+    min_{κ ∈ K} max_{h ∈ H} t_s(κ, h)
+
+Building blocks, all pure numpy:
+
+* :func:`simulate_settling` — one vectorised RK4 integration of many (gain, initial condition)
+  cases at once, with the field code of :mod:`att_sim.environment` and the law of
+  :mod:`att_planner.magnetorquer_law`; finished cases are retired and the batch shrinks.
+* :class:`BatchEvaluator` — the one place simulations run: in process, or split over an executor
+  (local processes, or a Dask distributed client; :func:`make_executor`).
+* :func:`direct_batch` — DIRECT (Jones, Perttunen & Stuckman 1993) evaluating all the points of an
+  iteration as one batch; :func:`direct_scipy` wraps ``scipy.optimize.direct`` (sequential).
+* :func:`sdbox_batch` — SDBOX-style coordinate search with derivative-free line search in a box
+  (Lucidi & Sciandrone 2002), any number of starts advanced in lockstep, all polls batched.
+* :func:`worst_case` — the inner maximisation with the three options of the paper
+  (``'direct'``, ``'sdbox'`` single start, ``'sdbox-multistart'``).
+* :func:`tune_fixed` / :func:`tune_robust` — the outer problems; :func:`tune_robust` is an
+  outer-approximation min-max (Blankenship & Falk 1976): DIRECT on the gains against a growing set
+  of hard initial conditions, the inner search at the incumbent adds the worst case it finds, the
+  outer DIRECT tree is kept and only the new case is evaluated at its points.
+* :func:`thorough_worst_case` — an independent, larger search over ``H`` to re-check gains.
+"""
+from __future__ import annotations
+
+import math
+import time
+from concurrent.futures import ProcessPoolExecutor
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+
+from att_sim import environment as env
+
+# ---------------------------------------------------------------------------------------------
+# Problem data
+# ---------------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class MagnetorquerCase:
+    """Spacecraft, orbit and settling threshold of the study (defaults: the issue's case)."""
+
+    inertia: tuple = (27.0, 17.0, 25.0)           # kg m², principal (diagonal) inertia
+    m_max: float = 10.0                           # A m² per coil (m*)
+    orbit: env.OrbitParams = env.OrbitParams()    # 450 km, 87°, RAAN 0 (ψ is per case)
+    dipole: env.DipoleModel = env.DEFAULT_DIPOLE
+    nu: float = 0.05                              # settling threshold on each |q_i|
+
+    @property
+    def period(self) -> float:
+        return self.orbit.period
+
+
+# Gain box of the paper (sensor resolutions) and the log box the searches use: the DIRECT optimum
+# of the paper sits at κ_p/κ_p,max ≈ 2e-3, so a linear box wastes almost every sample.
+GAIN_BOUNDS = ((0.0, 1e8), (0.0, 1e9))
+LOG_GAIN_BOUNDS = ((3.0, 8.0), (5.0, 9.0))        # log10 κ_p, log10 κ_d
+
+# Initial-condition parameters h = (ρ, φ, θ, ω1, ω2, ω3, ψ) and the box H.
+H_NAMES = ("rho", "phi", "theta", "w1", "w2", "w3", "psi")
+H_LOWER = np.array([0.0, 0.0, 0.0, -0.1, -0.1, -0.1, 0.0])
+H_UPPER = np.array([1.0, 2 * np.pi, np.pi, 0.1, 0.1, 0.1, 2 * np.pi])
+
+PUBLISHED_ICS = {
+    "ic20": np.array([0.0, 0.0, 0.0, 0.02, 0.02, -0.03, 0.332]),
+    "ic22": np.array([0.0, 0.0, 0.0, 0.1, 0.1, 0.1, 0.332]),
+    "ic23": np.array([0.5, 0.0, 2.356194490192345, -0.1, 0.1, 0.1, 1.570796326794897]),
+}
+PUBLISHED_GAINS = {
+    "trial": (2e5, 3e8),
+    "fixed_direct": (205761.316872, 99382716.049383),
+    "robust_direct_direct": (205493.83, 117283950.62),
+    "robust_direct_sdbox": (203930.04, 154320987.65),
+    "robust_direct_sdbox_multistart": (209581.62, 117283950.62),
+}
+
+
+def multistart_points() -> np.ndarray:
+    """The paper's 8 SDBOX starts: extreme rates ±0.1 with ρ = 0.5, φ = π, θ = π/2, ψ = π."""
+    signs = np.array([[a, b, c] for a in (-1, 1) for b in (-1, 1) for c in (-1, 1)], float)
+    base = np.array([0.5, np.pi, np.pi / 2, 0.0, 0.0, 0.0, np.pi])
+    pts = np.repeat(base[None], 8, 0)
+    pts[:, 3:6] = 0.1 * signs
+    return pts
+
+
+def initial_states(h: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(q0 (N,4) [x,y,z,w], ω0 (N,3), ψ (N,))`` of parameter rows ``h`` (N, 7)."""
+    h = np.atleast_2d(np.asarray(h, float))
+    rho, phi, theta = h[:, 0], h[:, 1], h[:, 2]
+    qv = rho[:, None] * np.stack([np.sin(theta) * np.cos(phi), np.sin(theta) * np.sin(phi), np.cos(theta)], -1)
+    q4 = np.sqrt(np.clip(1.0 - np.sum(qv * qv, -1), 0.0, None))
+    return np.concatenate([qv, q4[:, None]], -1), h[:, 3:6].copy(), h[:, 6].copy()
+
+
+# ---------------------------------------------------------------------------------------------
+# Batch settling-time simulator
+# ---------------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class SimSettings:
+    """Integration and settling-detection settings (see BENCHMARKS.md, gains, for the studies).
+
+    ``dt``: fixed RK4 step (s). ``cap_orbits``: horizon; a case not confirmed settled by then is
+    reported CAPPED with ``t_s = cap`` (a lower bound, flagged, never silently clipped).
+    Early retirement (``retire``): a case is confirmed settled once, for ``quiet_orbits``, it has had
+    no |q_i| above ``quiet_fraction·ν`` and no rate above ``quiet_rate`` (checked every
+    ``check_orbits``); its last exit above ν is then its settling time.
+    """
+
+    dt: float = 10.0
+    cap_orbits: float = 12.0
+    retire: bool = True
+    quiet_orbits: float = 0.5
+    quiet_fraction: float = 0.5
+    quiet_rate: float = 2e-3
+    check_orbits: float = 0.02
+
+
+SETTLED, CAPPED, ABOVE, DROPPED = 0, 1, 2, 3
+STATUS_NAMES = {SETTLED: "settled", CAPPED: "capped", ABOVE: "above_bound", DROPPED: "dropped"}
+
+
+@dataclass
+class SettlingResult:
+    """Per-case settling times (orbits) and how each was obtained.
+
+    ``status``: SETTLED (exact ``ts``), CAPPED (not settled within the cap, ``ts = cap``), ABOVE
+    (still above ν after ``stop_above``: ``ts`` is a lower bound), DROPPED (another case of the same
+    group went ABOVE; ``ts`` is the lower bound reached so far).
+    """
+
+    ts: np.ndarray
+    status: np.ndarray
+    case_steps: int            # Σ over steps of the cases integrated (the work done)
+    steps: int
+    seconds: float
+
+    @property
+    def exact(self) -> np.ndarray:
+        return self.status == SETTLED
+
+
+class _BatchModel:
+    """Right-hand side of the Bruni–Celani closed loop for a batch, component-first ``(7, N)``.
+
+    State rows ``[q_x, q_y, q_z, q_w, ω_x, ω_y, ω_z]``; every operation is on whole rows so one
+    call advances all cases. Field: :func:`att_sim.environment.dipole_field_components`; law:
+    the expression of :func:`att_planner.magnetorquer_law.dipole_command` written out per row
+    (``m × B_b`` with ``m = −m* sat(B_b × (κ_p q_v + κ_d ω)/m*)``).
+    """
+
+    def __init__(self, case: MagnetorquerCase, kp, kd, psi):
+        self.case = case
+        self.n = case.orbit.mean_motion
+        self.set_cases(np.asarray(kp, float), np.asarray(kd, float), np.asarray(psi, float))
+        jx, jy, jz = case.inertia
+        self.euler = ((jy - jz) / jx, (jz - jx) / jy, (jx - jy) / jz)
+        self.m_over_j = (case.m_max / jx, case.m_max / jy, case.m_max / jz)
+
+    def set_cases(self, kp, kd, psi):
+        self.kp, self.kd = kp / self.case.m_max, kd / self.case.m_max
+        self.cpsi, self.spsi = np.cos(psi), np.sin(psi)
+
+    def take(self, keep: np.ndarray):
+        self.kp, self.kd, self.cpsi, self.spsi = self.kp[keep], self.kd[keep], self.cpsi[keep], self.spsi[keep]
+
+    def __call__(self, t: float, x: np.ndarray, out: np.ndarray) -> np.ndarray:
+        case = self.case
+        qx, qy, qz, qw, wx, wy, wz = x
+        c, s = math.cos(self.n * t), math.sin(self.n * t)
+        cu = c * self.cpsi - s * self.spsi
+        su = s * self.cpsi + c * self.spsi
+        m_hat = case.dipole.axis(t)
+        bx, by, bz = env.dipole_field_components(case.orbit, env.direction(case.orbit, cu, su), m_hat, case.dipole)
+        # B_b = C(q) B_i = B − 2 q_w (q_v × B) + 2 q_v × (q_v × B)
+        tx, ty, tz = 2.0 * (qy * bz - qz * by), 2.0 * (qz * bx - qx * bz), 2.0 * (qx * by - qy * bx)
+        bx = bx - qw * tx + (qy * tz - qz * ty)
+        by = by - qw * ty + (qz * tx - qx * tz)
+        bz = bz - qw * tz + (qx * ty - qy * tx)
+        # saturated demand  s = sat(B_b × (κ_p q_v + κ_d ω) / m*)
+        ax, ay, az = self.kp * qx + self.kd * wx, self.kp * qy + self.kd * wy, self.kp * qz + self.kd * wz
+        sx = np.clip(by * az - bz * ay, -1.0, 1.0)
+        sy = np.clip(bz * ax - bx * az, -1.0, 1.0)
+        sz = np.clip(bx * ay - by * ax, -1.0, 1.0)
+        # J ω̇ = −ω × Jω + m × B_b,  m × B_b = −m* (s × B_b)
+        ex, ey, ez = self.euler
+        gx, gy, gz = self.m_over_j
+        np.subtract(ex * wy * wz, gx * (sy * bz - sz * by), out=out[4])
+        np.subtract(ey * wz * wx, gy * (sz * bx - sx * bz), out=out[5])
+        np.subtract(ez * wx * wy, gz * (sx * by - sy * bx), out=out[6])
+        # q̇_v = ½ (q_v × ω + q_w ω),  q̇_w = −½ q_vᵀ ω
+        np.multiply(0.5, qy * wz - qz * wy + qw * wx, out=out[0])
+        np.multiply(0.5, qz * wx - qx * wz + qw * wy, out=out[1])
+        np.multiply(0.5, qx * wy - qy * wx + qw * wz, out=out[2])
+        np.multiply(-0.5, qx * wx + qy * wy + qz * wz, out=out[3])
+        return out
+
+
+def simulate_settling(case: MagnetorquerCase, kp, kd, h, settings: SimSettings = SimSettings(), *,
+                      group=None, stop_above=None) -> SettlingResult:
+    """Settling times (orbits) of N cases ``(κ_p[j], κ_d[j], h[j])`` integrated together.
+
+    ``kp``, ``kd`` broadcast against the N parameter rows ``h``. ``t_s`` is the last step time at
+    which some ``|q_i| > ν`` (0 if never). ``stop_above`` (orbits, per case or per ``group``):
+    a case still exceeding ν after that time cannot beat it, so it stops (ABOVE) and, when
+    ``group`` labels are given, so does its whole group (DROPPED) — the pruning the min-max uses.
+    """
+    start = time.perf_counter()
+    h = np.atleast_2d(np.asarray(h, float))
+    n_cases = h.shape[0]
+    kp = np.broadcast_to(np.asarray(kp, float), (n_cases,)).copy()
+    kd = np.broadcast_to(np.asarray(kd, float), (n_cases,)).copy()
+    q0, w0, psi = initial_states(h)
+    period = case.period
+    dt = float(settings.dt)
+    n_steps = int(math.ceil(settings.cap_orbits * period / dt - 1e-9))
+    check_every = max(1, int(round(settings.check_orbits * period / dt)))
+    group = np.arange(n_cases) if group is None else np.asarray(group)
+    bound = np.full(n_cases, np.inf) if stop_above is None else np.broadcast_to(
+        np.asarray(stop_above, float), (n_cases,)).astype(float) * period
+
+    ts = np.zeros(n_cases)
+    status = np.full(n_cases, CAPPED)
+    alive = np.arange(n_cases)                      # original indices of the integrated cases
+    x = np.concatenate([q0, w0], 1).T.copy()        # (7, N)
+    last_exit = np.where(np.any(np.abs(q0[:, :3]) > case.nu, 1), 0.0, -np.inf)
+    last_loud = np.zeros(n_cases)
+    model = _BatchModel(case, kp, kd, psi)
+    k1, k2, k3, k4, tmp = (np.empty_like(x) for _ in range(5))
+    quiet_q, quiet_time = settings.quiet_fraction * case.nu, settings.quiet_orbits * period
+    case_steps, t, step = 0, 0.0, 0
+    for step in range(1, n_steps + 1):
+        model(t, x, k1)
+        np.multiply(k1, 0.5 * dt, out=tmp); tmp += x
+        model(t + 0.5 * dt, tmp, k2)
+        np.multiply(k2, 0.5 * dt, out=tmp); tmp += x
+        model(t + 0.5 * dt, tmp, k3)
+        np.multiply(k3, dt, out=tmp); tmp += x
+        model(t + dt, tmp, k4)
+        k2 += k3; k2 *= 2.0; k2 += k1; k2 += k4
+        k2 *= dt / 6.0; x += k2
+        x[:4] /= np.sqrt(np.einsum("ij,ij->j", x[:4], x[:4]))
+        t = step * dt
+        case_steps += x.shape[1]
+        qmax = np.abs(x[:3]).max(0)
+        exceeding = qmax > case.nu
+        last_exit[exceeding] = t
+        if step % check_every and step != n_steps:
+            continue
+        # bookkeeping: prune, confirm settled, shrink the batch
+        above = exceeding & (t > bound)
+        done = above.copy()
+        if above.any():
+            status[alive[above]] = ABOVE
+            ts[alive[above]] = t / period
+            drop = np.isin(group[alive], group[alive[above]]) & ~above
+            status[alive[drop]] = DROPPED
+            ts[alive[drop]] = np.maximum(last_exit[drop], 0.0) / period
+            done |= drop
+        if settings.retire:
+            loud = (qmax > quiet_q) | (np.einsum("ij,ij->j", x[4:], x[4:]) > settings.quiet_rate**2)
+            last_loud[loud] = t
+            quiet = ~done & (t - last_loud >= quiet_time)
+            status[alive[quiet]] = SETTLED
+            ts[alive[quiet]] = np.maximum(last_exit[quiet], 0.0) / period
+            done |= quiet
+        if done.any():
+            keep = ~done
+            alive, x, bound = alive[keep], x[:, keep].copy(), bound[keep]
+            last_exit, last_loud = last_exit[keep], last_loud[keep]
+            model.take(keep)
+            k1, k2, k3, k4, tmp = (np.empty_like(x) for _ in range(5))
+            if alive.size == 0:
+                break
+    # cases still integrated at the cap: settled only if no exit above ν in the last quiet window
+    if alive.size:
+        ok = (t - last_exit) >= quiet_time
+        status[alive[ok]] = SETTLED
+        ts[alive[ok]] = np.maximum(last_exit[ok], 0.0) / period
+        ts[alive[~ok]] = settings.cap_orbits
+    return SettlingResult(ts, status, case_steps, step, time.perf_counter() - start)
+
+
+def _simulate_chunk(args) -> SettlingResult:
+    """Module-level worker entry (picklable) for executors."""
+    case, settings, kp, kd, h, group, stop_above = args
+    return simulate_settling(case, kp, kd, h, settings, group=group, stop_above=stop_above)
+
+
+# ---------------------------------------------------------------------------------------------
+# Parallel evaluation
+# ---------------------------------------------------------------------------------------------
+
+
+class SerialExecutor:
+    """Runs everything in this process."""
+
+    workers = 1
+
+    def map(self, fn, items) -> list:
+        return [fn(item) for item in items]
+
+    def close(self):
+        pass
+
+
+class ProcessExecutor:
+    """Local worker processes (``concurrent.futures``); the default parallel back end."""
+
+    def __init__(self, workers: int = 2):
+        self.workers = int(workers)
+        self._pool = ProcessPoolExecutor(max_workers=self.workers)
+
+    def map(self, fn, items) -> list:
+        return list(self._pool.map(fn, items))
+
+    def close(self):
+        self._pool.shutdown(wait=True, cancel_futures=True)
+
+
+class DaskExecutor:
+    """A Dask distributed cluster reached through its scheduler address (``tcp://host:8786``),
+    or an existing ``distributed.Client``."""
+
+    def __init__(self, scheduler):
+        from distributed import Client  # optional dependency, imported only when asked for
+
+        self._own = not hasattr(scheduler, "gather")
+        self.client = Client(scheduler) if self._own else scheduler
+        self.workers = max(1, len(self.client.scheduler_info().get("workers", {})))
+
+    def map(self, fn, items) -> list:
+        return self.client.gather(self.client.map(fn, list(items), pure=False))
+
+    def close(self):
+        if self._own:
+            self.client.close()
+
+
+def make_executor(workers: int = 2, scheduler=None):
+    """Dask when a scheduler address (or client) is given, else local processes (serial for 1)."""
+    if scheduler:
+        return DaskExecutor(scheduler)
+    if workers < 1:
+        raise ValueError("workers must be at least 1")
+    return SerialExecutor() if workers == 1 else ProcessExecutor(workers)
+
+
+class BatchEvaluator:
+    """The one place settling times are computed; counts the work and splits large batches.
+
+    Batches of at least ``2 * min_chunk`` cases are split into one chunk per executor worker
+    (groups kept whole, so pruning still sees a group together); smaller ones run in process,
+    where a vectorised batch is already cheaper than shipping it.
+    """
+
+    def __init__(self, case: MagnetorquerCase = MagnetorquerCase(), settings: SimSettings = SimSettings(),
+                 executor=None, min_chunk: int = 96):
+        self.case, self.settings = case, settings
+        self.executor = executor or SerialExecutor()
+        self.min_chunk = int(min_chunk)
+        self.evaluations = 0
+        self.case_steps = 0
+        self.batches = 0
+
+    def settling(self, kp, kd, h, *, group=None, stop_above=None) -> SettlingResult:
+        h = np.atleast_2d(np.asarray(h, float))
+        n = h.shape[0]
+        kp = np.broadcast_to(np.asarray(kp, float), (n,))
+        kd = np.broadcast_to(np.asarray(kd, float), (n,))
+        group = np.arange(n) if group is None else np.asarray(group)
+        bound = None if stop_above is None else np.broadcast_to(np.asarray(stop_above, float), (n,))
+        self.evaluations += n
+        self.batches += 1
+        workers = getattr(self.executor, "workers", 1)
+        if workers <= 1 or n < 2 * self.min_chunk:
+            res = simulate_settling(self.case, kp, kd, h, self.settings, group=group, stop_above=bound)
+            self.case_steps += res.case_steps
+            return res
+        _, g_index = np.unique(group, return_inverse=True)
+        chunk_of = (g_index * workers) // (g_index.max() + 1)
+        parts = [np.flatnonzero(chunk_of == c) for c in range(workers)]
+        parts = [p for p in parts if p.size]
+        start = time.perf_counter()
+        results = self.executor.map(_simulate_chunk, [
+            (self.case, self.settings, kp[p], kd[p], h[p], group[p], None if bound is None else bound[p])
+            for p in parts])
+        ts, status = np.empty(n), np.empty(n, int)
+        for p, r in zip(parts, results):
+            ts[p], status[p] = r.ts, r.status
+        steps = sum(r.case_steps for r in results)
+        self.case_steps += steps
+        return SettlingResult(ts, status, steps, max(r.steps for r in results), time.perf_counter() - start)
+
+
+# ---------------------------------------------------------------------------------------------
+# Derivative-free building blocks
+# ---------------------------------------------------------------------------------------------
+
+
+@dataclass
+class SearchResult:
+    """Result of a search (minimisation of ``fun``), in the style of ``scipy.optimize``."""
+
+    x: np.ndarray
+    fun: float
+    nfev: int
+    nit: int
+    status: str                 # 'converged' | 'maxfun' | 'maxiter' | 'deadline'
+    message: str
+    X: np.ndarray = field(repr=False, default=None)   # every point evaluated
+    F: np.ndarray = field(repr=False, default=None)   # their values
+
+
+class DirectSearch:
+    """DIRECT on a box (Jones, Perttunen & Stuckman 1993), one batch per iteration.
+
+    Each iteration selects the potentially optimal hyper-rectangles (lower-right convex hull of
+    (half-diagonal, value) with the ε-test ``f_j − K d_j ≤ f_min − ε |f_min|``), samples
+    ``c ± δ e_i`` along their longest sides — all of them evaluated together by ``fun_batch`` —
+    and trisects them in the order of ``min(f(c+δe_i), f(c−δe_i))``. The state (centres, side
+    levels, values) is kept, so a caller may change the objective and update ``f`` (the min-max
+    does when its set of hard initial conditions grows) and go on iterating.
+    ``scipy.optimize.direct`` implements the same method but asks for one point at a time, which
+    would waste the batch simulator (:func:`direct_scipy` wraps it for comparison).
+    """
+
+    def __init__(self, fun_batch, lower, upper, eps: float = 1e-4):
+        self.fun_batch = fun_batch
+        self.lower, self.upper = np.asarray(lower, float), np.asarray(upper, float)
+        self.eps = eps
+        self.dim = self.lower.size
+        self.centers = np.full((1, self.dim), 0.5)
+        self.levels = np.zeros((1, self.dim), int)
+        self.f = np.asarray(self.fun_batch(self.to_box(self.centers)), float).reshape(1)
+        self.nfev, self.nit = 1, 0
+
+    def to_box(self, z: np.ndarray) -> np.ndarray:
+        return self.lower + z * (self.upper - self.lower)
+
+    @property
+    def best(self) -> int:
+        return int(np.argmin(self.f))
+
+    def potentially_optimal(self) -> np.ndarray:
+        sizes = 0.5 * np.linalg.norm(3.0 ** (-self.levels.astype(float)), axis=1)
+        sizes = np.round(sizes, 12)
+        f_min = self.f.min()
+        cand = []
+        for d in np.unique(sizes):
+            idx = np.flatnonzero(sizes == d)
+            cand.append(idx[np.argmin(self.f[idx])])
+        cand = np.array(cand)                       # ascending size
+        d, fv = sizes[cand], self.f[cand]
+        start = int(np.flatnonzero(fv == fv.min())[-1])
+        hull = [start]
+        for j in range(start + 1, len(cand)):
+            while len(hull) >= 2:
+                a, b = hull[-2], hull[-1]
+                # drop b if it lies on or above the segment a→j
+                if (fv[b] - fv[a]) * (d[j] - d[a]) >= (fv[j] - fv[a]) * (d[b] - d[a]):
+                    hull.pop()
+                else:
+                    break
+            if len(hull) == 1 and fv[j] <= fv[hull[0]]:
+                hull[0] = j
+                continue
+            hull.append(j)
+        chosen = []
+        for pos, j in enumerate(hull):
+            if pos + 1 < len(hull):
+                k = hull[pos + 1]
+                slope = (fv[k] - fv[j]) / (d[k] - d[j])
+                if fv[j] - slope * d[j] > f_min - self.eps * abs(f_min):
+                    continue
+            chosen.append(cand[j])
+        return np.array(chosen, int)
+
+    def iterate(self) -> int:
+        """One DIRECT iteration; returns the number of new evaluations."""
+        chosen = self.potentially_optimal()
+        plans, points = [], []
+        for r in chosen:
+            lv = self.levels[r]
+            dims = np.flatnonzero(lv == lv.min())
+            delta = 3.0 ** (-(lv.min() + 1))
+            for i in dims:
+                for sgn in (1.0, -1.0):
+                    p = self.centers[r].copy()
+                    p[i] += sgn * delta
+                    points.append(p)
+            plans.append((r, dims))
+        points = np.array(points)
+        values = np.asarray(self.fun_batch(self.to_box(points)), float)
+        new_c, new_l, new_f = [], [], []
+        pos = 0
+        for r, dims in plans:
+            vals = values[pos:pos + 2 * len(dims)].reshape(-1, 2)
+            pts = points[pos:pos + 2 * len(dims)].reshape(-1, 2, self.dim)
+            pos += 2 * len(dims)
+            order = np.argsort(vals.min(1), kind="stable")
+            lv = self.levels[r].copy()
+            for o in order:
+                lv[dims[o]] += 1
+                for s in range(2):
+                    new_c.append(pts[o, s]); new_l.append(lv.copy()); new_f.append(vals[o, s])
+            self.levels[r] = lv
+        self.centers = np.vstack([self.centers, new_c])
+        self.levels = np.vstack([self.levels, new_l])
+        self.f = np.concatenate([self.f, new_f])
+        self.nfev += len(points)
+        self.nit += 1
+        return len(points)
+
+    def result(self, status: str, message: str) -> SearchResult:
+        b = self.best
+        return SearchResult(self.to_box(self.centers[b]), float(self.f[b]), self.nfev, self.nit, status, message,
+                            self.to_box(self.centers), self.f.copy())
+
+
+def direct_batch(fun_batch, lower, upper, *, maxfun: int = 2000, maxiter: int = 1000, eps: float = 1e-4,
+                 f_target: float = -np.inf, deadline: float | None = None, callback=None) -> SearchResult:
+    """Minimise ``fun_batch`` (rows of points → values) on the box with batched DIRECT."""
+    search = DirectSearch(fun_batch, lower, upper, eps)
+    status = "maxiter"
+    while search.nit < maxiter:
+        if search.nfev >= maxfun:
+            status = "maxfun"; break
+        if deadline is not None and time.monotonic() >= deadline:
+            status = "deadline"; break
+        if search.f.min() <= f_target:
+            status = "converged"; break
+        search.iterate()
+        if callback is not None:
+            callback(search)
+    return search.result(status, f"{status} after {search.nfev} evaluations, {search.nit} iterations")
+
+
+def direct_scipy(fun, lower, upper, *, maxfun: int = 2000, maxiter: int = 1000, eps: float = 1e-4,
+                 locally_biased: bool = False) -> SearchResult:
+    """``scipy.optimize.direct`` on a scalar objective (sequential: one point per call)."""
+    from scipy.optimize import Bounds, direct
+
+    X, F = [], []
+
+    def wrapped(x):
+        X.append(np.array(x)); F.append(float(fun(x)))
+        return F[-1]
+
+    res = direct(wrapped, Bounds(lower, upper), eps=eps, maxfun=maxfun, maxiter=maxiter,
+                 locally_biased=locally_biased)
+    return SearchResult(np.asarray(res.x), float(res.fun), int(res.nfev), int(res.nit),
+                        "converged" if res.success else "maxfun", str(res.message), np.array(X), np.array(F))
+
+
+def sdbox_batch(fun_batch, lower, upper, starts, *, maxfun: int = 2000, alpha0: float = 0.25,
+                alpha_tol: float = 1e-3, gamma: float = 1e-6, theta: float = 0.5, expansions: int = 3,
+                deadline: float | None = None, f_starts=None) -> SearchResult:
+    """SDBOX-style coordinate search in a box, several starts in lockstep (Lucidi & Sciandrone 2002).
+
+    Works on the unit cube of the box. Per start and round: poll ``x ± α_i e_i`` for every
+    coordinate (step cut to the box), a trial succeeds on sufficient decrease
+    ``f(y) ≤ f(x) − γ α²``; the best success moves the start and is followed by a derivative-free
+    line search along it (steps ``2α, 4α, …`` evaluated together, the best kept, α updated);
+    coordinates where both signs fail shrink ``α_i ← θ α_i``. A start stops when every
+    ``α_i < alpha_tol``. All pending points of all starts form one batch per round.
+    """
+    lower, upper = np.asarray(lower, float), np.asarray(upper, float)
+    span = upper - lower
+    z = np.clip((np.atleast_2d(np.asarray(starts, float)) - lower) / span, 0.0, 1.0)
+    n_starts, dim = z.shape
+    alpha = np.full((n_starts, dim), float(alpha0))
+    all_x, all_f = [], []
+
+    def evaluate(zs):
+        vals = np.asarray(fun_batch(lower + zs * span), float)
+        all_x.append(lower + zs * span); all_f.append(vals)
+        return vals
+
+    fz = evaluate(z) if f_starts is None else np.asarray(f_starts, float).copy()
+    nfev, nit, status = (n_starts if f_starts is None else 0), 0, "converged"
+    active = np.ones(n_starts, bool)
+    while True:
+        active &= alpha.max(1) >= alpha_tol
+        if not active.any():
+            break
+        if nfev >= maxfun:
+            status = "maxfun"; break
+        if deadline is not None and time.monotonic() >= deadline:
+            status = "deadline"; break
+        # poll round
+        owners, coords, signs, trial = [], [], [], []
+        for s in np.flatnonzero(active):
+            for i in range(dim):
+                for sgn in (1.0, -1.0):
+                    step = min(alpha[s, i], (1.0 - z[s, i]) if sgn > 0 else z[s, i])
+                    if step <= 0.0:
+                        continue
+                    y = z[s].copy(); y[i] += sgn * step
+                    owners.append(s); coords.append(i); signs.append(sgn * step); trial.append(y)
+        if not trial:
+            break
+        owners, coords, signs, trial = np.array(owners), np.array(coords), np.array(signs), np.array(trial)
+        vals = evaluate(trial)
+        nfev += len(trial); nit += 1
+        line = []
+        for s in np.flatnonzero(active):
+            mine = owners == s
+            gain = fz[s] - gamma * signs[mine] ** 2 - vals[mine]
+            ok_coords = set(coords[mine][gain >= 0.0])
+            for i in range(dim):
+                if i not in ok_coords:
+                    alpha[s, i] *= theta
+            if ok_coords:
+                b = np.flatnonzero(mine)[np.argmax(gain)]
+                z[s], fz[s] = trial[b], vals[b]
+                line.append((s, coords[b], signs[b]))
+        if not line:
+            continue
+        # derivative-free line search (expansion) along each start's best success
+        owners2, coords2, steps2, trial2 = [], [], [], []
+        for s, i, step in line:
+            for k in range(1, expansions + 1):
+                y = z[s].copy()
+                y[i] = np.clip(y[i] + step * (2.0**k - 1.0), 0.0, 1.0)
+                if y[i] == z[s, i]:
+                    break
+                owners2.append(s); coords2.append(i); steps2.append(abs(step) * 2.0**k); trial2.append(y)
+                if y[i] in (0.0, 1.0):
+                    break
+        if not trial2:
+            continue
+        owners2, trial2, steps2 = np.array(owners2), np.array(trial2), np.array(steps2)
+        vals2 = evaluate(trial2)
+        nfev += len(trial2)
+        for s, i, step in line:
+            mine = np.flatnonzero(owners2 == s)
+            if mine.size == 0:
+                continue
+            b = mine[np.argmin(vals2[mine])]
+            if vals2[b] <= fz[s] - gamma * steps2[b] ** 2:
+                z[s], fz[s] = trial2[b], vals2[b]
+                alpha[s, i] = steps2[b]
+            else:
+                alpha[s, i] = abs(step)
+    b = int(np.argmin(fz))
+    X = np.vstack(all_x) if all_x else np.empty((0, dim))
+    F = np.concatenate(all_f) if all_f else np.empty(0)
+    return SearchResult(lower + z[b] * span, float(fz[b]), nfev, nit, status,
+                        f"{status}: {nfev} evaluations, {nit} poll rounds, {n_starts} start(s)", X, F)
