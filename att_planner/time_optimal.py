@@ -27,7 +27,7 @@ through the truth dynamics (:func:`att_planner.verify.verify_profile`); a failur
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import casadi as ca
 import numpy as np
@@ -219,7 +219,26 @@ def candidate_routes(problem: ManeuverProblem, scaling: _Scaling, tilt_deg: floa
                      ride_margin_deg: float = 2.0) -> list[_Route]:
     """Cheap, diverse routes: eigenaxis both ways, the eigenaxis midpoint tilted about two axes
     perpendicular to it (±), and every cone-riding λ-rotation sequence. Each gets its bang-bang
-    duration estimate and its minimum cone margin."""
+    duration estimate and its minimum cone margin.
+
+    With a semi-free target whose ``q_final`` also points the sensor at it, the routes to
+    ``q_final`` are added (labelled "full goal"): every fully specified plan is feasible for the
+    semi-free problem, so they seed the semi-free search with the fully specified optima."""
+    routes = _goal_routes(problem, scaling, tilt_deg, ride_margin_deg)
+    if problem.sensor_target is not None:
+        r = np.asarray(problem.sensor_axis, float)
+        b = rot.dcm(rot.normalize(np.asarray(problem.q_final, float))) @ r
+        s = np.asarray(problem.sensor_target, float)
+        if b @ s / np.linalg.norm(b) / np.linalg.norm(s) > np.cos(np.deg2rad(0.5)):
+            full = replace(problem, sensor_target=None)
+            for rt in _goal_routes(full, scaling, tilt_deg, ride_margin_deg):
+                rt.label += " (full goal)"
+                routes.append(rt)
+    return routes
+
+
+def _goal_routes(problem: ManeuverProblem, scaling: _Scaling, tilt_deg: float,
+                 ride_margin_deg: float) -> list[_Route]:
     q0 = rot.normalize(np.asarray(problem.q_initial, float))
     q_goal = baselines.goal_attitude(problem)
     eig = baselines.eigenaxis_leg(q0, q_goal)
@@ -283,6 +302,22 @@ def _truth_violation_intervals(traj, sol: col.PhaseSolution, scaling: _Scaling, 
     return np.unique(np.clip(np.searchsorted(sol.phase.mesh, bad_t, side="right") - 1, 0, sol.phase.intervals - 1))
 
 
+def _blocked_endpoints(problem: ManeuverProblem) -> str:
+    """Why no plan can exist when the sensor starts or must end inside a keep-out cone, else ''."""
+    r = np.asarray(problem.sensor_axis, float)
+    ends = {"initial": rot.dcm(rot.normalize(np.asarray(problem.q_initial, float))) @ r}
+    if problem.sensor_target is None:
+        ends["final"] = rot.dcm(rot.normalize(np.asarray(problem.q_final, float))) @ r
+    else:
+        ends["target"] = np.asarray(problem.sensor_target, float)
+    for name, b in ends.items():
+        b = b / np.linalg.norm(b)
+        for i, c in enumerate(problem.cones):
+            if np.arccos(np.clip(b @ c.direction, -1, 1)) < c.half_angle:
+                return f"the {name} sensor direction is inside keep-out cone {c.name or i}: no plan exists"
+    return ""
+
+
 def _failed(message: str, start: float, stats: dict | None = None) -> ManeuverPlan:
     return ManeuverPlan(METHOD, np.zeros(1), np.zeros((1, 3)), np.zeros((1, 4)), np.zeros((1, 3)),
                         status=STATUS_FAILED, message=message, solve_seconds=time.monotonic() - start,
@@ -322,6 +357,9 @@ def plan_time_optimal(problem: ManeuverProblem, *, intervals: int = 30, max_inte
     T = problem.spacecraft.body_torque_max
     if not np.isfinite(T) or T <= 0:
         return _failed("the spacecraft has no finite body torque limit (body_torque_max)", start)
+    blocked = _blocked_endpoints(problem)
+    if blocked:
+        return _failed(blocked, start)
     scaling = _scaling(problem)
     opts = {"rate_max": rate_max, "wheel_momentum_max": wheel_momentum_max,
             "cone_margin": np.deg2rad(cone_margin_deg),
