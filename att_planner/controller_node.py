@@ -1,12 +1,14 @@
 """Controller node: magnetorquer PD law, plan tracking with reaction wheels, safe mode.
 
 Subscribes ``/spacecraft/state`` and the latched ``/planner/plans``; publishes
-``/actuator/command`` and ``/controller/status`` at ``control_rate`` (Hz of sim time); serves
+``/actuator/command`` and ``/controller/status`` at ``control_rate`` (Hz of sim time): a command is
+computed when a state at or after the next control instant arrives, and stamped with that state's
+time (the simulator's lockstep waits for it); serves
 ``/controller/set_mode`` and the ``/controller/execute`` action (ExecuteManeuver), which runs for
 the maneuver's duration plus ``settle_time`` and reports progress as feedback.
 
-Watchdog: when the latest state is older than ``state_timeout`` s of sim time (or no state came
-for ``wall_timeout`` s of wall time) the controller commands zero and reports ``state_stale``.
+Watchdog: when no state came for ``wall_timeout`` s of wall time the controller commands zero
+and reports ``state_stale`` until states flow again.
 """
 from __future__ import annotations
 
@@ -47,7 +49,8 @@ class ControllerNode(Node):
         def param(key, default):
             return self.declare_parameter(key, p.get(key, default)).value
 
-        self.state_timeout = float(param("state_timeout", 0.5))
+        self.control_period = 1.0 / float(param("control_rate", 10.0))
+        self.next_control = -np.inf
         self.wall_timeout = float(param("wall_timeout", 2.0))
         self.kp_track, self.kd_track = float(param("tracking_kp", 0.4)), float(param("tracking_kd", 10.0))
         self.settle_time = float(param("settle_time", 20.0))
@@ -70,7 +73,6 @@ class ControllerNode(Node):
         self.create_subscription(SpacecraftState, topics.STATE, self.on_state, topics.STREAM_QOS, callback_group=cb_fast)
         self.create_subscription(ManeuverPlan, topics.PLANS, self.on_plan, topics.LATCHED_QOS, callback_group=cb_fast)
         self.create_service(SetControllerMode, topics.SET_CONTROLLER_MODE, self.on_set_mode, callback_group=cb_fast)
-        self.create_timer(1.0 / float(param("control_rate", 10.0)), self.on_control_tick, callback_group=cb_fast)
         self.create_timer(0.5, self.on_wall_watchdog, callback_group=cb_fast, clock=Clock(clock_type=ClockType.STEADY_TIME))
         self.action = ActionServer(self, ExecuteManeuver, topics.EXECUTE_MANEUVER, execute_callback=self.execute,
                                    goal_callback=self.on_goal, cancel_callback=lambda _: CancelResponse.ACCEPT,
@@ -84,6 +86,16 @@ class ControllerNode(Node):
             return
         with self.lock:
             self.state, self.state_wall = s, time.monotonic()
+            if self.stale:
+                self.stale = False
+                self.get_logger().info("state is fresh again")
+            due = s["t"] >= self.next_control - 1e-9
+            if due:
+                self.next_control = s["t"] + self.control_period
+                cmd, status = self.control_step()
+        if due:
+            self.cmd_pub.publish(cmd)
+            self.status_pub.publish(status)
 
     def on_plan(self, msg: ManeuverPlan):
         with self.lock:
@@ -194,28 +206,13 @@ class ControllerNode(Node):
         self.mode = MODE_SAFE if code == ErrorCode.ABORTED else self.mode
 
     # -- control loop -----------------------------------------------------------------------------
-    def on_control_tick(self):
-        with self.lock:
-            cmd, status = self.control_step()
-        self.cmd_pub.publish(cmd)
-        self.status_pub.publish(status)
-
     def control_step(self):
-        now = self.get_clock().now().nanoseconds * 1e-9
-        cmd = ActuatorCommand(mode=self.mode, wheel_torques=[0.0] * self.sc.n_wheels)
-        cmd.header.stamp = self.get_clock().now().to_msg()
-        status = ControllerStatus(mode=self.mode, header=cmd.header)
+        """Command for the latest state (lock held)."""
         s = self.state
-        stale = s is None or now - s["t"] > self.state_timeout or time.monotonic() - self.state_wall > self.wall_timeout
-        if stale != self.stale:
-            log = self.get_logger().warning if stale else self.get_logger().info
-            log("state is stale: commanding zero (safe)" if stale else "state is fresh again")
-            self.stale = stale
-        status.state_stale = stale
-        if stale:
-            cmd.mode = MODE_SAFE
-            status.message = "no recent state: zero command"
-            return cmd, status
+        cmd = ActuatorCommand(mode=self.mode, wheel_torques=[0.0] * self.sc.n_wheels)
+        cmd.header.stamp = convert.time_msg(s["t"])
+        cmd.header.frame_id = self.scenario.body_frame_id
+        status = ControllerStatus(mode=self.mode, header=cmd.header)
         if self.mode == MODE_MAGNETORQUER_PD:
             m = dipole_command(s["q"], s["omega"], s["field_body"], self.kp_mag, self.kd_mag, self.sc.dipole_max)
             cmd.dipole = convert.vector3(m)

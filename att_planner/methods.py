@@ -33,9 +33,31 @@ class Method:
 
 # Best first: the default method is the first one available.
 REGISTRY = [
+    Method("slepian_minimum_time", "att_planner.slepian", "plan_slepian",
+           "smooth torque on a Slepian basis, t_f minimised exactly (issue 3); cone-aware",
+           {"M": Option(2, 12, True), "N": Option(50, 2000, True), "W": Option(1e-4, 0.25)},
+           fixed={"method": "slepian_minimum_time"}),
+    Method("time_optimal", "att_planner.time_optimal", "plan_time_optimal",
+           "minimum-time bang-bang slew by direct collocation with IPOPT (Melton 2012); cone-aware",
+           {"intervals": Option(4, 200, True), "max_intervals": Option(4, 400, True), "starts": Option(1, 20, True),
+            "refine_rounds": Option(0, 6, True), "cone_margin_deg": Option(0.0, 5.0),
+            "rate_max": Option(1e-6, 10.0), "wheel_momentum_max": Option(1e-6, 1e4)}),
+    Method("constrained_axis", "att_planner.baselines", "plan_constrained_axis",
+           "eigenaxis bang-bang, or lambda-rotations riding a cone boundary when the eigenaxis path is blocked",
+           {"ride_margin_deg": Option(0.0, 10.0)}),
     Method("eigenaxis_smooth", "att_planner.eigenaxis", "plan_eigenaxis_smooth",
            "eigenaxis slew with a quintic angle profile (C1 rate, zero torque at both ends); ignores cones",
            {"samples": Option(11, 100_000, True)}),
+    Method("eigenaxis", "att_planner.baselines", "plan_eigenaxis",
+           "eigenaxis bang-bang slew with the largest torque the per-axis limits allow; ignores cones"),
+    Method("mssa", "att_planner.slepian", "plan_slepian",
+           "Slepian basis, minimum sum of squared coefficients (Celani & Lucarelli); cone-aware",
+           {"M": Option(2, 12, True), "N": Option(50, 2000, True), "W": Option(1e-4, 0.25)},
+           fixed={"method": "mssa"}),
+    Method("dfsp", "att_planner.slepian", "plan_slepian",
+           "Slepian basis, derivative-free sequential penalty on t_f (Celani & Bruni); cone-aware, slow",
+           {"M": Option(2, 12, True), "N": Option(50, 2000, True), "W": Option(1e-4, 0.25)},
+           fixed={"method": "dfsp"}),
 ]
 
 

@@ -16,6 +16,7 @@ import numpy as np
 
 from att_msgs_py.errors import ErrorCode
 from att_planner import eigenaxis
+from att_planner.cones import Cone, margins
 from att_planner.problem import STATUS_BUDGET, STATUS_FAILED, STATUS_FALLBACK, ManeuverPlan, ManeuverProblem
 from att_planner.requests import ValidRequest
 from att_planner.verify import Verification, verify_profile
@@ -64,11 +65,26 @@ def rejection(ver: Verification, tol: Tolerances) -> str | None:
     return None
 
 
-def run_method(valid: ValidRequest) -> ManeuverPlan:
-    """Call the method; exceptions become a failed plan (never an exception in the executor)."""
+def padded(problem: ManeuverProblem, padding: float) -> ManeuverProblem:
+    """The problem with every cone widened by ``padding`` rad (execution margin for the tracking
+    controller), but never so much that the start or goal boresight would fall inside it."""
+    if padding <= 0 or not problem.cones:
+        return problem
+    goals = [problem.q_initial] + ([problem.q_final] if problem.sensor_target is None else [])
+    room = np.min([margins(q, problem.sensor_axis, problem.cones) for q in goals], axis=0)
+    if problem.sensor_target is not None:
+        room = np.minimum(room, [np.arccos(np.clip(c.direction @ problem.sensor_target, -1, 1)) - c.half_angle
+                                 for c in problem.cones])
+    cones = [Cone(c.direction, c.half_angle + min(padding, 0.5 * r), c.name) for c, r in zip(problem.cones, room)]
+    return replace(problem, cones=cones)
+
+
+def run_method(valid: ValidRequest, cone_padding: float = 0.0) -> ManeuverPlan:
+    """Call the method on the padded problem; exceptions become a failed plan (never an exception
+    in the executor)."""
     start = time.perf_counter()
     try:
-        plan = valid.method.load()(valid.problem, **valid.method.fixed, **valid.options)
+        plan = valid.method.load()(padded(valid.problem, cone_padding), **valid.method.fixed, **valid.options)
     except Exception as exc:  # noqa: BLE001 - any solver failure is reported, the node keeps serving
         plan = ManeuverPlan(valid.method.name, np.zeros(1), np.zeros((1, 3)), np.zeros((1, 4)), np.zeros((1, 3)),
                             status=STATUS_FAILED, message=f"{type(exc).__name__}: {exc}")
@@ -76,9 +92,10 @@ def run_method(valid: ValidRequest) -> ManeuverPlan:
     return plan
 
 
-def plan_maneuver(valid: ValidRequest, tol: Tolerances = Tolerances()) -> PlanOutcome:
+def plan_maneuver(valid: ValidRequest, tol: Tolerances = Tolerances(), cone_padding: float = 0.0) -> PlanOutcome:
+    """Plan with cones widened by ``cone_padding`` rad, verify against the requested cones."""
     problem = valid.problem
-    plan = run_method(valid)
+    plan = run_method(valid, cone_padding)
     reason = plan.message or plan.status
     if plan.status != STATUS_FAILED and len(plan.t) >= 2:
         ver = verify(problem, plan)

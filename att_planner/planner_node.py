@@ -43,6 +43,7 @@ class PlannerNode(Node):
         self.tolerances = Tolerances(attitude=math.radians(float(param("accept_attitude_error_deg", 1.0))),
                                      rate=float(param("accept_final_rate", 1e-3)),
                                      cone_margin=math.radians(float(param("accept_cone_penetration_deg", 0.1))))
+        self.cone_padding = math.radians(float(param("cone_padding_deg", 1.0)))
         group = ReentrantCallbackGroup()
         self.plan_pub = self.create_publisher(ManeuverPlan, topics.PLANS, topics.LATCHED_QOS)
         self.create_service(PlanManeuver, topics.PLAN_MANEUVER, self.on_plan_maneuver, callback_group=group)
@@ -66,7 +67,7 @@ class PlannerNode(Node):
             self.get_logger().warning(f"request rejected [{int(err.code)} {err.code.name}]: {err.message}")
             response.success, response.error_code, response.message = False, int(err.code), err.message
             return response
-        outcome = plan_maneuver(valid, self.tolerances)
+        outcome = plan_maneuver(valid, self.tolerances, self.cone_padding)
         response.success = outcome.code == ErrorCode.OK
         response.error_code, response.message = int(outcome.code), outcome.message
         if outcome.plan is not None and len(outcome.plan.t) >= 2:
@@ -74,10 +75,11 @@ class PlannerNode(Node):
                 outcome.plan, plan_id=uuid.uuid4().hex[:12], frame_id=self.frame_id, spacecraft=valid.spacecraft,
                 sensor_axis=valid.problem.sensor_axis, cones=valid.problem.cones, verification=outcome.verification)
             response.plan.header.stamp = self.get_clock().now().to_msg()
-        log = self.get_logger().info if response.success else self.get_logger().warning
-        log(f"{valid.method.name}: {outcome.message} (code {response.error_code})")
         if response.success:
+            self.get_logger().info(f"{valid.method.name}: {outcome.message}")
             self.plan_pub.publish(response.plan)
+        else:
+            self.get_logger().warning(f"{valid.method.name} failed (code {response.error_code}): {outcome.message}")
         return response
 
 

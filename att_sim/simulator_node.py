@@ -43,6 +43,12 @@ class SimulatorNode(Node):
         self.clock_period = 1.0 / float(param("clock_rate", 50.0))
         self.real_time_factor = float(param("real_time_factor", 1.0))
         self.command_timeout = float(param("command_timeout", 1.0))
+        # Lockstep: after each published state, wait (up to lockstep_timeout s of wall time) for
+        # the command that answers it, so the loop stays closed at any speed and under CPU load.
+        self.lockstep = bool(param("lockstep", True))
+        self.lockstep_timeout = float(param("lockstep_timeout", 0.5))
+        self.answered = threading.Event()
+        self.awaited_stamp = 0.0
         self.sim = Simulation(
             self.scenario.spacecraft, self.scenario.orbit,
             q0=param("initial_attitude", [0.0, 0.0, 0.0, 1.0]),
@@ -72,6 +78,8 @@ class SimulatorNode(Node):
             error = self.sim.set_command(msg.mode, wheel, dipole, body)
             if error is None:
                 self.last_command_time = self.sim.t
+                if convert.from_time(msg.header.stamp) >= self.awaited_stamp - 1e-9:
+                    self.answered.set()
         if error is not None:
             self.rejected_commands += 1
             self.get_logger().warning(f"command rejected ({self.rejected_commands} so far): {error}",
@@ -105,8 +113,12 @@ class SimulatorNode(Node):
                 self.clock_pub.publish(Clock(clock=convert.time_msg(t)))
                 next_clock += self.clock_period
             if state is not None:
+                self.answered.clear()
+                self.awaited_stamp = t
                 self.state_pub.publish(state)
                 next_state += self.publish_period
+                if self.lockstep:
+                    self.answered.wait(self.lockstep_timeout)
             if self.real_time_factor > 0:
                 lag = wall0 + (t - sim0) / self.real_time_factor - time.monotonic()
                 if lag > 0:
