@@ -21,6 +21,7 @@ constant over a step (zero-order hold), see :func:`rk4_step`.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from functools import cached_property
 from typing import Callable
 
 import numpy as np
@@ -49,7 +50,7 @@ class Spacecraft:
     def n_wheels(self) -> int:
         return self.wheel_axes.shape[1]
 
-    @property
+    @cached_property
     def inertia_inv(self) -> np.ndarray:
         return np.linalg.inv(self.inertia)
 
@@ -85,22 +86,39 @@ def external_torque(sc: Spacecraft, inputs: Inputs, q: np.ndarray) -> np.ndarray
     if inputs.body_torque is not None:
         tau = tau + np.asarray(inputs.body_torque, float)
     if inputs.dipole is not None and inputs.field_body is not None:
-        tau = tau + np.cross(inputs.dipole, inputs.field_body)
+        tau = tau + _cross(inputs.dipole, inputs.field_body)
     if inputs.gravity_gradient is not None:
         tau = tau + inputs.gravity_gradient
     return tau
 
 
+def _cross(a, b):
+    return np.array([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]])
+
+
 def derivative(sc: Spacecraft, x: np.ndarray, inputs: Inputs) -> np.ndarray:
     """Time derivative of the state for inputs held constant (see module docstring)."""
     q, w, ws = x[:4], x[4:7], x[7:]
-    u = np.zeros(sc.n_wheels) if inputs.wheel_torque is None else effective_wheel_torque(sc, ws, inputs.wheel_torque)
-    h = sc.inertia @ w + sc.wheel_axes @ (sc.wheel_inertia * ws)
-    tau = external_torque(sc, inputs, q)
-    w_dot = np.linalg.solve(sc.inertia, -np.cross(w, h) - sc.wheel_axes @ u + tau)
-    q_dot = 0.5 * rot.multiply(q, np.append(w, 0.0))
-    ws_dot = u / sc.wheel_inertia if sc.wheel_inertia > 0 else np.zeros_like(ws)
-    return np.concatenate([q_dot, w_dot, ws_dot])
+    out = np.empty_like(x)
+    h = sc.inertia @ w
+    torque = external_torque(sc, inputs, q)
+    if sc.n_wheels:
+        h = h + sc.wheel_axes @ (sc.wheel_inertia * ws)
+        if inputs.wheel_torque is not None:
+            u = effective_wheel_torque(sc, ws, inputs.wheel_torque)
+            torque = torque - sc.wheel_axes @ u
+            out[7:] = u / sc.wheel_inertia if sc.wheel_inertia > 0 else 0.0
+        else:
+            out[7:] = 0.0
+    out[4:7] = sc.inertia_inv @ (torque - _cross(w, h))
+    # q_dot = ½ q ⊗ [ω, 0]
+    qx, qy, qz, qw = q
+    wx, wy, wz = w
+    out[0] = 0.5 * (qw * wx + qy * wz - qz * wy)
+    out[1] = 0.5 * (qw * wy + qz * wx - qx * wz)
+    out[2] = 0.5 * (qw * wz + qx * wy - qy * wx)
+    out[3] = -0.5 * (qx * wx + qy * wy + qz * wz)
+    return out
 
 
 def rk4_step(f: Callable[[np.ndarray], np.ndarray], x: np.ndarray, dt: float) -> np.ndarray:
