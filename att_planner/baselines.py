@@ -107,7 +107,7 @@ def leg_profile(problem: ManeuverProblem, legs: list[AxisLeg], pieces_per_half: 
 
 def verify_plan(problem: ManeuverProblem, t, torque, interpolation: str, q_goal=None, *,
                 attitude_tol: float = DEFAULT_ATTITUDE_TOL, rate_tol: float | None = None,
-                margin_tol: float = DEFAULT_MARGIN_TOL, dense_steps: int = 300):
+                margin_tol: float = DEFAULT_MARGIN_TOL, dense_steps: int = 200):
     """Integrate a body-torque plan through the truth dynamics; ``(passes, verification dict, traj)``.
 
     ``q_goal`` defaults to ``problem.q_final``; with a semi-free target the caller passes the

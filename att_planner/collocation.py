@@ -402,9 +402,13 @@ def path_violations(solution: PhaseSolution, samples_per_interval: int = 8, tol:
     return np.flatnonzero(excess > tol), float(excess.max())
 
 
-def switch_intervals(solution: PhaseSolution, rel_tol: float = 0.02) -> np.ndarray:
+def switch_intervals(solution: PhaseSolution, rel_tol: float = 0.02, limit: int | None = None) -> np.ndarray:
     """Intervals of a bang-bang control where a component switches: not saturated there while
-    saturated in a neighbouring interval. Bisecting them localises the switching instants."""
+    saturated in a neighbouring interval. Bisecting them localises the switching instants.
+
+    Sorted by decreasing jump of the control across the interval's neighbours (relative to the
+    bound span); ``limit`` keeps the strongest ones only (singular or state-constrained arcs, where
+    the control is interior, would otherwise flag interval after interval)."""
     ph = solution.phase
     lb, ub = ph.control_bounds
     span = np.where(np.isfinite(ub - lb), ub - lb, np.inf)
@@ -415,4 +419,8 @@ def switch_intervals(solution: PhaseSolution, rel_tol: float = 0.02) -> np.ndarr
     nb = np.zeros_like(saturated)
     nb[1:] |= saturated[:-1]
     nb[:-1] |= saturated[1:]
-    return np.flatnonzero(np.any(~saturated & nb, axis=1))
+    flagged = np.flatnonzero(np.any(~saturated & nb, axis=1))
+    padded = np.vstack([u[:1], u, u[-1:]])
+    jump = np.max(np.abs(padded[2:] - padded[:-2]) / np.where(np.isfinite(span), span, 1.0), axis=1)
+    order = flagged[np.argsort(-jump[flagged], kind="stable")]
+    return order if limit is None else order[:limit]
