@@ -318,7 +318,7 @@ def _blocked_endpoints(problem: ManeuverProblem) -> str:
         b = b / np.linalg.norm(b)
         for i, c in enumerate(problem.cones):
             if np.arccos(np.clip(b @ c.direction, -1, 1)) < c.half_angle:
-                return f"the {name} sensor direction is inside keep-out cone {c.name or i}: no plan exists"
+                return f"infeasible request: the {name} sensor direction is inside keep-out cone {c.name or i}"
     return ""
 
 
@@ -396,7 +396,9 @@ def plan_time_optimal(problem: ManeuverProblem, *, intervals: int = 30, max_inte
             solved.append((res.objective, rt.label, res))
     stats = {"starts": start_log, "time_unit": scaling.tu}
     if not solved:
-        return _failed("no start converged" + (" before the deadline" if budget_hit else ""), start, stats)
+        statuses = sorted({s["status"] for s in start_log})
+        return _failed("no start converged" + (" before the deadline" if budget_hit else "")
+                       + (f" (IPOPT: {', '.join(statuses)})" if statuses else ""), start, stats)
     solved.sort(key=lambda s: s[0])
     _, best_label, res = solved[0]
     stats["best_start"] = best_label
