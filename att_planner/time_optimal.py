@@ -375,7 +375,9 @@ def plan_time_optimal(problem: ManeuverProblem, *, intervals: int = 30, max_inte
         return solve_deadline is not None and time.monotonic() > solve_deadline
 
     routes = select_routes(candidate_routes(problem, scaling), starts)
-    routes += [_Route(f"warm start: {p.method}", plan=p) for p in warm_starts if len(p.t) > 1]
+    routes += [_Route(f"warm start: {p.method}", plan=p, tf_estimate=p.duration / scaling.tu,
+                      min_margin=float(margins(p.q, problem.sensor_axis, problem.cones).min(initial=np.inf)))
+               for p in warm_starts if len(p.t) > 1]
     tf_scale = max(r.tf_estimate for r in routes if np.isfinite(r.tf_estimate))
     tf_bounds = (1e-2 * tf_scale, 10.0 * tf_scale)
 
@@ -462,8 +464,10 @@ def plan_time_optimal(problem: ManeuverProblem, *, intervals: int = 30, max_inte
     if expired():
         budget_hit = True
     if not ok and len(history) > 1:
-        # an earlier (coarser) solution may still pass
+        # an earlier (coarser) solution may still pass, if there is time to check it
         for s_prev, r_prev in reversed(history[:-1]):
+            if problem.time_left() <= 0:
+                break
             ok_p, info_p, _, arrays_p = verify(s_prev)
             if ok_p:
                 ok, info, arrays, res, sol = ok_p, info_p, arrays_p, r_prev, s_prev

@@ -152,6 +152,15 @@ def test_rate_and_wheel_momentum_bounds_hold_on_the_truth_trajectory_and_cost_ti
     assert plan.stats["verification"]["wheel_momentum_ratio"] <= 1.0
 
 
+def test_plans_of_other_methods_serve_as_warm_starts():
+    problem = case_problem("swift")
+    seed = plan_constrained_axis(problem)
+    plan = plan_time_optimal(problem, starts=1, warm_starts=[seed])
+    labels = [s["route"] for s in plan.stats["starts"]]
+    assert labels[-1] == "warm start: constrained_axis" and len(labels) == 2
+    assert plan.status in VALID and plan.duration < seed.duration
+
+
 def test_deadline_returns_quickly_with_a_status_that_says_so():
     problem = case_problem("swift")
     problem.deadline = time.monotonic() + 1.5
