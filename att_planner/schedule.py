@@ -275,12 +275,12 @@ class MultiphaseTranscription:
 
     Built once per (number of targets, intervals per phase); the target quaternions of an order
     and the end attitude are NLP parameters, so every order of the same set reuses the solver.
+    Either end may be at rest (h = 0) or a passage (only ω_z = 0), chosen per solve.
     """
 
     def __init__(self, sc: dyn.Spacecraft, n_targets: int, intervals: int = 12, substeps: int = 2,
                  rate_max: float = np.inf, bound_margin: float = 1e-6, tol: float = 1e-7,
-                 max_iter: int = 1500, fixed_sign: bool = False, start_at_rest: bool = True,
-                 end_at_rest: bool = True):
+                 max_iter: int = 1500, fixed_sign: bool = False):
         if intervals < 1 or substeps < 1:
             raise ValueError("intervals and substeps must be positive integers")
         self.sc, self.scale, self.fixed_sign = sc, _scaling(sc), fixed_sign
@@ -304,8 +304,8 @@ class MultiphaseTranscription:
             node = (p + 1) * N
             g += [_error_vector_ca(targets[:, p], Q[:, node]), rate_z @ H[:, node]]
         g.append(_error_vector_ca(q_end, Q[:, K]))
-        # an end not at rest is a passage: only ω_z = 0 (used by the leg lower bounds)
-        g += ([] if start_at_rest else [rate_z @ H[:, 0]]) + ([] if end_at_rest else [rate_z @ H[:, K]])
+        # ω_z = 0 at both ends: implied by rest (h = 0 bounds), the only condition at a passage
+        g += [rate_z @ H[:, 0], rate_z @ H[:, K]]
         n_eq = sum(int(gi.numel()) for gi in g)
         lbg, ubg = [0.0] * n_eq, [0.0] * n_eq
         if fixed_sign:
@@ -326,7 +326,7 @@ class MultiphaseTranscription:
         nlp = {"x": self._x, "p": ca.vertcat(ca.vec(targets), q_end), "f": ca.sum1(T), "g": ca.vertcat(*g)}
         self.ipopt_options = {"ipopt.print_level": 0, "print_time": 0, "ipopt.tol": tol,
                               "ipopt.max_iter": max_iter, "ipopt.mu_strategy": "adaptive",
-                              "ipopt.sb": "yes"}
+                              "ipopt.sb": "yes", "expand": n_targets == 0}
         self._nlp = nlp
         self._solver = ca.nlpsol("schedule", "ipopt", nlp, self.ipopt_options)
         self._solver_wall = None
@@ -339,7 +339,6 @@ class MultiphaseTranscription:
         iq0, ih0 = P, P + 4 * (K + 1)
         self._index_q0, self._index_h0 = slice(iq0, iq0 + 4), slice(ih0, ih0 + n_w)
         self._index_hf = slice(ih0 + n_w * K, ih0 + n_w * (K + 1))
-        self.start_at_rest, self.end_at_rest = start_at_rest, end_at_rest
 
     # -- guesses ----------------------------------------------------------------------------
     def initial_guess(self, q_start, targets_in_order, q_end) -> _PhaseSolution:
@@ -378,7 +377,8 @@ class MultiphaseTranscription:
 
     # -- solve ------------------------------------------------------------------------------
     def solve(self, q_start, targets_in_order, q_end, guess: _PhaseSolution | None = None,
-              max_wall_time: float | None = None) -> _PhaseSolution:
+              max_wall_time: float | None = None, start_at_rest: bool = True,
+              end_at_rest: bool = True) -> _PhaseSolution:
         """Minimum-time trajectory through ``targets_in_order`` (quaternions, any sign)."""
         if len(targets_in_order) != self.n_targets:
             raise ValueError(f"expected {self.n_targets} targets, got {len(targets_in_order)}")
@@ -392,9 +392,9 @@ class MultiphaseTranscription:
         lbx, ubx = self._lbx.copy(), self._ubx.copy()
         q0 = rot.normalize(np.asarray(q_start, float))
         lbx[self._index_q0] = ubx[self._index_q0] = q0 if np.dot(q0, guess.q[0]) >= 0 else -q0
-        if self.start_at_rest:
+        if start_at_rest:
             lbx[self._index_h0] = ubx[self._index_h0] = 0.0
-        if self.end_at_rest:
+        if end_at_rest:
             lbx[self._index_hf] = ubx[self._index_hf] = 0.0
         params = np.concatenate([np.concatenate([rot.normalize(np.asarray(q, float)) for q in targets_in_order]) if self.n_targets else np.zeros(4),
                                  rot.normalize(np.asarray(q_end, float))])
@@ -411,14 +411,13 @@ class MultiphaseTranscription:
 _TRANSCRIPTIONS: dict = {}
 
 
-def _transcription(sc: dyn.Spacecraft, n_targets: int, intervals: int, substeps: int, rate_max: float,
-                   start_at_rest: bool = True, end_at_rest: bool = True) -> MultiphaseTranscription:
+def _transcription(sc: dyn.Spacecraft, n_targets: int, intervals: int, substeps: int,
+                   rate_max: float) -> MultiphaseTranscription:
     """Solver cache: an NLP depends only on the spacecraft, the number of targets and the grid."""
     key = (sc.inertia.tobytes(), sc.wheel_axes.tobytes(), sc.wheel_inertia, sc.wheel_torque_max,
-           sc.wheel_speed_max, n_targets, intervals, substeps, rate_max, start_at_rest, end_at_rest)
+           sc.wheel_speed_max, n_targets, intervals, substeps, rate_max)
     if key not in _TRANSCRIPTIONS:
-        _TRANSCRIPTIONS[key] = MultiphaseTranscription(sc, n_targets, intervals, substeps, rate_max,
-                                                       start_at_rest=start_at_rest, end_at_rest=end_at_rest)
+        _TRANSCRIPTIONS[key] = MultiphaseTranscription(sc, n_targets, intervals, substeps, rate_max)
     return _TRANSCRIPTIONS[key]
 
 
@@ -436,28 +435,29 @@ def leg_bound_matrix(sc: dyn.Spacecraft, q_start, targets: list[np.ndarray], q_e
     restricted to one leg is feasible for that leg problem, so the sum of the entries along an
     order is a lower bound on that order's schedule time (on the same grid, if the leg NLPs reach
     their global minima). Free–free legs are symmetric under time reversal, so each pair is
-    solved once. Entries not computed before ``deadline`` are 0 (still a valid bound).
+    solved once. Entries not computed (deadline, solver failure) are 0 (still a valid bound).
     """
     n = len(targets)
     nodes = [q_start, *targets, q_end]
-    C = np.full((n + 2, n + 2), np.inf)
-    np.fill_diagonal(C, 0.0)
-    free = _transcription(sc, 0, intervals, substeps, rate_max, False, False)
-    start = _transcription(sc, 0, intervals, substeps, rate_max, True, False)
-    t_sat = free.scale.t_sat
-
-    def timed_out():
-        return deadline is not None and time.monotonic() > deadline
-
     same_ends = rot.angle_between(q_start, q_end) < 1e-9
-    for j in range(1, n + 1):
-        C[0, j] = 0.0 if timed_out() else start.solve(nodes[0], [], nodes[j]).tau_f * t_sat
-        # end legs: the time reversal of a start leg (reach q_end at rest from a passage)
-        C[j, n + 1] = C[0, j] if same_ends else (0.0 if timed_out() else
-                                                 start.solve(nodes[n + 1], [], nodes[j]).tau_f * t_sat)
-    for i in range(1, n + 1):
-        for j in range(i + 1, n + 1):
-            C[i, j] = C[j, i] = 0.0 if timed_out() else free.solve(nodes[i], [], nodes[j]).tau_f * t_sat
+    legs = [(0, j) for j in range(1, n + 1)] + [(i, j) for i in range(1, n + 1) for j in range(i + 1, n + 1)]
+    if not same_ends:
+        legs += [(n + 1, j) for j in range(1, n + 1)]   # solved reversed: from the end at rest
+    C = np.zeros((n + 2, n + 2))
+    tr = _transcription(sc, 0, intervals, substeps, rate_max)
+    for i, j in legs:
+        if deadline is not None and time.monotonic() > deadline:
+            break
+        sol = tr.solve(nodes[i], [], nodes[j], start_at_rest=i in (0, n + 1), end_at_rest=False)
+        value = sol.tau_f * tr.scale.t_sat if sol.converged else 0.0
+        if i == n + 1:
+            C[j, i] = value
+        else:
+            C[i, j] = value
+            if i > 0:
+                C[j, i] = value
+        if i == 0 and same_ends:
+            C[j, n + 1] = value
     return C
 
 
@@ -588,7 +588,11 @@ def plan_schedule(targets: dict, spacecraft: dyn.Spacecraft, q_start=rot.IDENTIT
     phase; orders in increasing bound order (:func:`orders_by_lower_bound`); the first
     ``candidates`` solved as multiphase problems; with ``prove`` every further order whose bound is
     below the incumbent is solved too (up to ``max_order_solves``), which proves the incumbent
-    optimal on that grid when the enumeration is exhausted. ``order`` (list of names) skips the
+    optimal on that grid when the enumeration is exhausted. When the start and end attitudes
+    coincide, an order and its reverse have the same minimum time (time reversal t → t_f − t,
+    Ω → −Ω, T_u(t) → T_u(t_f − t) maps one schedule onto the other), so only one of each pair is
+    solved, and the winner is solved once more reversed (a second start: the NLP is not convex).
+    ``order`` (list of names) skips the
     search. The winner is re-solved on ``intervals`` per phase (warm start) and verified.
     """
     t_begin = time.perf_counter()
@@ -619,6 +623,7 @@ def plan_schedule(targets: dict, spacecraft: dyn.Spacecraft, q_start=rot.IDENTIT
             incumbent = np.inf
             proven = False
             lower_bound = None
+            reversible = rot.angle_between(q_start, q_end) < 1e-9
             for bound, idx in orders_by_lower_bound(C):
                 lower_bound = bound
                 if lower_bound >= incumbent:
@@ -626,6 +631,8 @@ def plan_schedule(targets: dict, spacecraft: dyn.Spacecraft, q_start=rot.IDENTIT
                     break
                 if len(solved) >= (max_order_solves if prove else candidates) or expired():
                     break
+                if reversible and tuple(names[i] for i in reversed(idx)) in {s.order for s in solved}:
+                    continue  # time reversal: same schedule duration as an order already solved
                 s = _solve_order(spacecraft, q_start, q_end, quats, [names[i] for i in idx], search_intervals,
                                  substeps, rate_max, deadline=deadline)
                 solved.append(s)
@@ -637,6 +644,15 @@ def plan_schedule(targets: dict, spacecraft: dyn.Spacecraft, q_start=rot.IDENTIT
                          lower_bound=incumbent if proven else min(lower_bound, incumbent),
                          search_seconds=time.perf_counter() - t0)
             stats["candidates"] = [{"order": list(s.order), "tf": s.tf} for s in solved]
+            if reversible and solved and not expired():
+                # second start for the winner: its reverse has the same optimum but IPOPT may land
+                # in another local minimum from the reversed initial guess; keep the better one
+                best = min(solved, key=lambda s: s.tf)
+                solved.append(_solve_order(spacecraft, q_start, q_end, quats, best.order[::-1], search_intervals,
+                                           substeps, rate_max, deadline=deadline))
+                stats["reverse_of_best_tf"] = solved[-1].tf
+        if not solved:
+            return _finish(empty, STATUS_FAILED, "deadline passed before any order was solved", t_begin, stats)
         best = min(solved, key=lambda s: s.tf)
         if not np.isfinite(best.tf):
             return _finish(empty, STATUS_FAILED, "no order converged: " + best.sol.return_status,
@@ -672,3 +688,28 @@ def _finish(result: ScheduleResult, status: str, message: str, t_begin: float, s
     result.status, result.message, result.stats = status, message, stats
     result.solve_seconds = time.perf_counter() - t_begin
     return result
+
+
+def exhaustive_order_search(targets: dict, spacecraft: dyn.Spacecraft, q_start=rot.IDENTITY, q_end=None, *,
+                            rate_max: float = np.inf, intervals: int = 8, substeps: int = 2,
+                            progress=None) -> list[dict]:
+    """Solve the multiphase problem of every order (all n! of them, reversals included, as an
+    independent check of the time-reversal symmetry and of the NLP's local minima) and return
+    ``[{"order", "tf", "bound", "converged"}]`` sorted by ``tf``; ``bound`` is the leg lower bound
+    of :func:`leg_bound_matrix` on the same grid (so ``bound ≤ tf`` must hold for every order)."""
+    names = list(targets)
+    q_start = rot.normalize(np.asarray(q_start, float))
+    q_end = q_start if q_end is None else rot.normalize(np.asarray(q_end, float))
+    quats = {k: rot.normalize(np.asarray(v, float)) for k, v in targets.items()}
+    C = leg_bound_matrix(spacecraft, q_start, [quats[k] for k in names], q_end, intervals=intervals,
+                         substeps=substeps, rate_max=rate_max)
+    index = {k: i + 1 for i, k in enumerate(names)}
+    rows = []
+    for perm in itertools.permutations(names):
+        s = _solve_order(spacecraft, q_start, q_end, quats, perm, intervals, substeps, rate_max)
+        chain = [0] + [index[k] for k in perm] + [len(names) + 1]
+        bound = float(sum(C[a, b] for a, b in zip(chain[:-1], chain[1:])))
+        rows.append({"order": list(perm), "tf": float(s.tf), "bound": bound, "converged": s.sol.converged})
+        if progress is not None:
+            progress(len(rows), rows[-1])
+    return sorted(rows, key=lambda r: r["tf"])
