@@ -21,6 +21,7 @@ from att_sim.dynamics import Spacecraft
 
 METHODS = {"eigenaxis": plan_eigenaxis, "constrained_axis": plan_constrained_axis,
            "time_optimal": plan_time_optimal}
+TUNABLE = {"time_optimal": ("starts",)}
 
 # Acceptance figures of the issue.
 ATTITUDE_TOL = np.deg2rad(0.5)
@@ -53,6 +54,8 @@ def configure(parser):
                         help="method whose plan goes to the JSON (all are run and tabulated)")
     parser.add_argument("--budget", type=float, default=10.0,
                         help="time budget per method, seconds (problem.deadline)")
+    parser.add_argument("--starts", type=int, default=6,
+                        help="number of cheap routes time_optimal solves (all are listed)")
 
 
 def _verification(problem: ManeuverProblem, plan) -> dict:
@@ -69,7 +72,7 @@ def _semi_free_row(args) -> dict:
     problem = case_problem(args.case)
     problem.sensor_target = rot.dcm(problem.q_final) @ problem.sensor_axis
     problem.deadline = time.monotonic() + args.budget
-    plan = plan_time_optimal(problem)
+    plan = plan_time_optimal(problem, starts=args.starts)
     ver, traj = verify_profile(problem.spacecraft, problem.q_initial, plan.q[-1], plan.t, plan.torque,
                                interpolation=plan.interpolation, sensor_axis=problem.sensor_axis,
                                cones=problem.cones, dense_step=plan.duration / 2000.0)
@@ -86,7 +89,7 @@ def run(args) -> dict:
     for name, method in METHODS.items():
         problem = case_problem(args.case)
         problem.deadline = time.monotonic() + args.budget
-        plan = method(problem)
+        plan = method(problem, **{k: getattr(args, k) for k in TUNABLE.get(name, ())})
         ver = _verification(problem, plan) if len(plan.t) > 1 else {}
         payloads[name] = {"case": args.case, "method": name, "tf": plan.duration, "t": plan.t,
                           "torque": plan.torque, "interpolation": plan.interpolation,
@@ -112,4 +115,8 @@ def run(args) -> dict:
     if "starts" in best.stats:
         print("time_optimal starts (coarse mesh): " + "; ".join(
             f"{s['route']} → {s['tf']:.4f} ({s['status']})" for s in best.stats["starts"]))
+        minima = sorted({round(s["tf"], 2) for s in best.stats["starts"] if s["status"] == "Solve_Succeeded"})
+        print("distinct local minima reached (coarse mesh, TU): " + ", ".join(f"{m:.2f}" for m in minima))
+        print("time_optimal refinement of the best start: " + " → ".join(
+            f"{m['intervals']} intervals {m['tf']:.4f}" for m in best.stats["mesh"]))
     return payloads[args.method]

@@ -323,8 +323,12 @@ class Transcription:
     def minimize(self, expr):
         self._objective = expr
 
-    def build(self, *, tol: float = 1e-7, max_iter: int = 1000, ipopt_options: dict | None = None):
-        """Create the IPOPT instance (once per mesh; every :meth:`solve` reuses it)."""
+    def build(self, *, tol: float = 1e-7, max_iter: int = 1000, ipopt_options: dict | None = None,
+              nlpsol_options: dict | None = None):
+        """Create the IPOPT instance (once per mesh; every :meth:`solve` reuses it).
+
+        ``ipopt_options`` are IPOPT's own (e.g. ``linear_solver``); ``nlpsol_options`` CasADi's
+        (e.g. ``expand``)."""
         if self._objective is None:
             raise ValueError("set an objective with minimize() before build()")
         g = ca.vertcat(*self._g)
@@ -335,8 +339,8 @@ class Transcription:
                 "ipopt.constr_viol_tol": 1e-8, "ipopt.acceptable_constr_viol_tol": 1e-6,
                 "ipopt.mu_strategy": "adaptive", "iteration_callback": self._callback,
                 "iteration_callback_ignore_errors": False}
-        for k, v in (ipopt_options or {}).items():
-            opts[k if "." in k else f"ipopt.{k}"] = v
+        opts.update({f"ipopt.{k}": v for k, v in (ipopt_options or {}).items()})
+        opts.update(nlpsol_options or {})
         self._solver = ca.nlpsol("hermite_simpson", "ipopt", {"x": self._w, "f": self._objective, "g": g}, opts)
         return self
 
