@@ -364,6 +364,10 @@ def plan_time_optimal(problem: ManeuverProblem, *, intervals: int = 30, max_inte
     blocked = _blocked_endpoints(problem)
     if blocked:
         return _failed(blocked, start)
+    if baselines.eigenaxis_leg(problem.q_initial, baselines.goal_attitude(problem)).angle < 1e-9:
+        q0 = rot.normalize(np.asarray(problem.q_initial, float))
+        return ManeuverPlan(METHOD, np.zeros(1), np.zeros((1, 3)), q0[None], np.zeros((1, 3)), interpolation,
+                            STATUS_OPTIMAL, "already at the goal", time.monotonic() - start, {"tf": 0.0})
     scaling = _scaling(problem)
     opts = {"rate_max": rate_max, "wheel_momentum_max": wheel_momentum_max,
             "cone_margin": np.deg2rad(cone_margin_deg),

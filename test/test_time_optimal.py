@@ -182,6 +182,13 @@ def test_infeasible_request_fails_without_raising():
     assert plan.status == STATUS_FAILED and "inside keep-out cone sun" in plan.message
 
 
+def test_null_maneuver_is_answered_without_solving():
+    problem = case_problem("swift")
+    problem.q_final = -problem.q_initial                      # the same attitude
+    plan = plan_time_optimal(problem)
+    assert plan.status == STATUS_OPTIMAL and plan.duration == 0.0
+
+
 def test_solver_failure_is_reported_not_raised():
     plan = plan_time_optimal(case_problem("swift"), starts=2, max_iter=3)
     assert plan.status == STATUS_FAILED and "no start converged" in plan.message
