@@ -36,8 +36,9 @@ def from_quaternion(msg: Quaternion) -> np.ndarray:
 
 
 def time_msg(seconds: float) -> Time:
-    sec = int(np.floor(seconds))
-    return Time(sec=sec, nanosec=int(round((seconds - sec) * 1e9)) % 1_000_000_000)
+    """Rounded to the nanosecond, carrying into ``sec`` (3.9999999999 s -> 4 s 0 ns, not 3 s 0 ns)."""
+    sec, nanosec = divmod(int(round(seconds * 1e9)), 1_000_000_000)
+    return Time(sec=sec, nanosec=nanosec)
 
 
 def from_time(msg: Time) -> float:
