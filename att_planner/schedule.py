@@ -202,16 +202,15 @@ def _interval_map(scale: _Scaling, substeps: int) -> ca.Function:
     return ca.Function("interval", [q, h, u, dtau], [qk, hk])
 
 
-def eigenaxis_rest_to_rest_time(sc: dyn.Spacecraft, q_from: np.ndarray, q_to: np.ndarray,
-                                 signed: bool = False) -> float:
+def eigenaxis_rest_to_rest_time(sc: dyn.Spacecraft, q_from: np.ndarray, q_to: np.ndarray) -> float:
     """Duration of the rest-to-rest eigenaxis slew q_from → q_to at the largest rate and torque the
     wheel box allows about that axis (bang–coast–bang; a feasible, so upper-bound, transfer).
 
     About a unit body axis e, ``J ω̇ = −G T_u`` and ``J ω = −G h`` (equation (1)) limit the rate to
-    ``λ = max{s : J s e ∈ G·box(h̄)}`` and the acceleration to ``λ / t_sat``. ``signed``: reach
-    the quaternion q_to itself (not −q_to), which may be the long way round (angle > π).
+    ``λ = max{s : J s e ∈ G·box(h̄)}`` and the acceleration to ``λ / t_sat``. Used for the initial
+    guess of the phase durations.
     """
-    axis, angle = _relative_rotation(q_from, q_to, signed)
+    axis, angle = _relative_rotation(q_from, q_to)
     if angle < 1e-12:
         return 0.0
     scale = _scaling(sc)
@@ -223,11 +222,10 @@ def eigenaxis_rest_to_rest_time(sc: dyn.Spacecraft, q_from: np.ndarray, q_to: np
     return float(2.0 * np.sqrt(angle / accel))
 
 
-def _relative_rotation(q_from, q_to, signed: bool = False) -> tuple[np.ndarray, float]:
-    """Body axis and angle of q_from* ⊗ q_to; the shortest (angle ≤ π) unless ``signed``, when
-    the angle is that of the quaternion arc itself (in [0, 2π])."""
+def _relative_rotation(q_from, q_to) -> tuple[np.ndarray, float]:
+    """Body axis and angle (≤ π, the shortest rotation) of q_from* ⊗ q_to."""
     rel = rot.multiply(rot.conjugate(rot.normalize(q_from)), rot.normalize(q_to))
-    if not signed and rel[3] < 0:
+    if rel[3] < 0:
         rel = -rel
     s = np.linalg.norm(rel[:3])
     axis = rel[:3] / s if s > 1e-15 else np.array([0.0, 0.0, 1.0])
@@ -280,10 +278,10 @@ class MultiphaseTranscription:
 
     def __init__(self, sc: dyn.Spacecraft, n_targets: int, intervals: int = 12, substeps: int = 2,
                  rate_max: float = np.inf, bound_margin: float = 1e-6, tol: float = 1e-7,
-                 max_iter: int = 1500, fixed_sign: bool = False):
+                 max_iter: int = 1500, expand: bool | None = None):
         if intervals < 1 or substeps < 1:
             raise ValueError("intervals and substeps must be positive integers")
-        self.sc, self.scale, self.fixed_sign = sc, _scaling(sc), fixed_sign
+        self.sc, self.scale = sc, _scaling(sc)
         self.n_targets, self.n_phases, self.intervals = n_targets, n_targets + 1, intervals
         n_w = sc.n_wheels
         P, N = self.n_phases, intervals
@@ -308,11 +306,6 @@ class MultiphaseTranscription:
         g += [rate_z @ H[:, 0], rate_z @ H[:, K]]
         n_eq = sum(int(gi.numel()) for gi in g)
         lbg, ubg = [0.0] * n_eq, [0.0] * n_eq
-        if fixed_sign:
-            # the listed quaternion itself, not its negative: q · q_target ≥ 0 at every passage
-            g += [ca.dot(targets[:, p], Q[:, (p + 1) * N]) for p in range(n_targets)] + [ca.dot(q_end, Q[:, K])]
-            lbg += [0.0] * (n_targets + 1)
-            ubg += [np.inf] * (n_targets + 1)
         # body-rate box, only where the wheel box does not already imply it (rates are linear in h)
         rate_rows = [i for i in range(3) if np.abs(self.scale.rate_per_h[i]).sum() > rate_max]
         if rate_rows:
@@ -326,7 +319,10 @@ class MultiphaseTranscription:
         nlp = {"x": self._x, "p": ca.vertcat(ca.vec(targets), q_end), "f": ca.sum1(T), "g": ca.vertcat(*g)}
         self.ipopt_options = {"ipopt.print_level": 0, "print_time": 0, "ipopt.tol": tol,
                               "ipopt.max_iter": max_iter, "ipopt.mu_strategy": "adaptive",
-                              "ipopt.sb": "yes", "expand": n_targets == 0}
+                              "ipopt.sb": "yes",
+                              # SX expansion: slower to build, faster to evaluate; worth it for
+                              # small NLPs (legs) or when one NLP is solved for many orders
+                              "expand": n_targets == 0 if expand is None else bool(expand)}
         self._nlp = nlp
         self._solver = ca.nlpsol("schedule", "ipopt", nlp, self.ipopt_options)
         self._solver_wall = None
@@ -345,16 +341,14 @@ class MultiphaseTranscription:
         """Slerp between consecutive (sign-aligned) attitudes with eigenaxis durations; wheel
         momentum from the slerp rate by (1), clipped to the box; zero torque."""
         P, N, n_w = self.n_phases, self.intervals, self.sc.n_wheels
-        chain = [q_start, *targets_in_order, q_end]
-        chain = [rot.normalize(np.asarray(q, float)) for q in chain] if self.fixed_sign else _aligned(chain)
-        signed = self.fixed_sign
-        dur = np.array([max(eigenaxis_rest_to_rest_time(self.sc, a, b, signed), 1.0) for a, b in zip(chain[:-1], chain[1:])])
+        chain = _aligned([q_start, *targets_in_order, q_end])
+        dur = np.array([max(eigenaxis_rest_to_rest_time(self.sc, a, b), 1.0) for a, b in zip(chain[:-1], chain[1:])])
         dur = dur / self.scale.t_sat
         qs, hs = [chain[0][None, :]], [np.zeros((1, n_w))]
         for p in range(P):
             s = np.arange(1, N + 1) / N
             qs.append(_slerp(chain[p], chain[p + 1], s))
-            axis, angle = _relative_rotation(chain[p], chain[p + 1], signed)
+            axis, angle = _relative_rotation(chain[p], chain[p + 1])
             w_tau = axis * angle / dur[p]
             h = np.clip(np.linalg.lstsq(self.scale.rate_matrix, w_tau, rcond=None)[0], -0.9, 0.9)
             hs.append(np.tile(h, (N, 1)))
@@ -412,12 +406,12 @@ _TRANSCRIPTIONS: dict = {}
 
 
 def _transcription(sc: dyn.Spacecraft, n_targets: int, intervals: int, substeps: int,
-                   rate_max: float) -> MultiphaseTranscription:
+                   rate_max: float, expand: bool | None = None) -> MultiphaseTranscription:
     """Solver cache: an NLP depends only on the spacecraft, the number of targets and the grid."""
     key = (sc.inertia.tobytes(), sc.wheel_axes.tobytes(), sc.wheel_inertia, sc.wheel_torque_max,
-           sc.wheel_speed_max, n_targets, intervals, substeps, rate_max)
+           sc.wheel_speed_max, n_targets, intervals, substeps, rate_max, expand)
     if key not in _TRANSCRIPTIONS:
-        _TRANSCRIPTIONS[key] = MultiphaseTranscription(sc, n_targets, intervals, substeps, rate_max)
+        _TRANSCRIPTIONS[key] = MultiphaseTranscription(sc, n_targets, intervals, substeps, rate_max, expand=expand)
     return _TRANSCRIPTIONS[key]
 
 
@@ -562,8 +556,8 @@ class _Solved:
 
 
 def _solve_order(sc, q_start, q_end, targets: dict, order, intervals, substeps, rate_max,
-                 guess: _Solved | None = None, deadline=None) -> _Solved:
-    tr = _transcription(sc, len(order), intervals, substeps, rate_max)
+                 guess: _Solved | None = None, deadline=None, expand: bool | None = None) -> _Solved:
+    tr = _transcription(sc, len(order), intervals, substeps, rate_max, expand)
     wall = None if deadline is None else deadline - time.monotonic()
     start_guess = tr.resample(guess.sol) if guess is not None else None
     sol = tr.solve(q_start, [targets[k] for k in order], q_end, guess=start_guess, max_wall_time=wall)
@@ -574,7 +568,7 @@ def _solve_order(sc, q_start, q_end, targets: dict, order, intervals, substeps, 
 def plan_schedule(targets: dict, spacecraft: dyn.Spacecraft, q_start=rot.IDENTITY, q_end=None,
                   deadline: float | None = None, *, rate_max: float = np.inf, order=None,
                   search_intervals: int = 8, intervals: int = 24, substeps: int = 2,
-                  candidates: int = 3, prove: bool = False, max_order_solves: int = 1000,
+                  candidates: int = 2, prove: bool = False, max_order_solves: int = 1000,
                   verify: bool = True) -> ScheduleResult:
     """Fastest rest-to-rest schedule through every target attitude, in the best order found.
 
@@ -595,7 +589,7 @@ def plan_schedule(targets: dict, spacecraft: dyn.Spacecraft, q_start=rot.IDENTIT
     ``order`` (list of names) skips the
     search. The winner is re-solved on ``intervals`` per phase (warm start) and verified.
     """
-    t_begin = time.perf_counter()
+    t_begin, cpu_begin = time.perf_counter(), time.process_time()
     names = list(targets)
     if order is not None and sorted(order) != sorted(names):
         raise ValueError("order must list every target name exactly once")
@@ -604,7 +598,8 @@ def plan_schedule(targets: dict, spacecraft: dyn.Spacecraft, q_start=rot.IDENTIT
     q_start = rot.normalize(np.asarray(q_start, float))
     q_end = q_start if q_end is None else rot.normalize(np.asarray(q_end, float))
     quats = {k: rot.normalize(np.asarray(v, float)) for k, v in targets.items()}
-    stats: dict = {"orders_solved": 0, "search_intervals": search_intervals, "intervals": intervals}
+    stats: dict = {"orders_solved": 0, "search_intervals": search_intervals, "intervals": intervals,
+                   "_cpu_begin": cpu_begin}
     expired = lambda: deadline is not None and time.monotonic() > deadline  # noqa: E731
     empty = ScheduleResult([], np.zeros(0), np.zeros(0), np.zeros((0, spacecraft.n_wheels)), np.zeros((0, 4)),
                            np.zeros((0, 3)), np.zeros((0, spacecraft.n_wheels)))
@@ -621,15 +616,11 @@ def plan_schedule(targets: dict, spacecraft: dyn.Spacecraft, q_start=rot.IDENTIT
             stats["leg_bound_seconds"] = time.perf_counter() - t0
             stats["leg_bounds"] = C
             incumbent = np.inf
-            proven = False
-            lower_bound = None
+            unsolved_bound = np.inf   # smallest leg bound among the orders not solved
             reversible = rot.angle_between(q_start, q_end) < 1e-9
             for bound, idx in orders_by_lower_bound(C):
-                lower_bound = bound
-                if lower_bound >= incumbent:
-                    proven = True
-                    break
-                if len(solved) >= (max_order_solves if prove else candidates) or expired():
+                if bound >= incumbent or len(solved) >= (max_order_solves if prove else candidates) or expired():
+                    unsolved_bound = bound
                     break
                 if reversible and tuple(names[i] for i in reversed(idx)) in {s.order for s in solved}:
                     continue  # time reversal: same schedule duration as an order already solved
@@ -637,20 +628,18 @@ def plan_schedule(targets: dict, spacecraft: dyn.Spacecraft, q_start=rot.IDENTIT
                                  substeps, rate_max, deadline=deadline)
                 solved.append(s)
                 incumbent = min(incumbent, s.tf)
-            else:
-                proven = True
-            # every order not solved has a leg bound ≥ lower_bound: optimality gap on the search grid
-            stats.update(orders_solved=len(solved), order_proven=bool(proven),
-                         lower_bound=incumbent if proven else min(lower_bound, incumbent),
-                         search_seconds=time.perf_counter() - t0)
-            stats["candidates"] = [{"order": list(s.order), "tf": s.tf} for s in solved]
             if reversible and solved and not expired():
                 # second start for the winner: its reverse has the same optimum but IPOPT may land
                 # in another local minimum from the reversed initial guess; keep the better one
                 best = min(solved, key=lambda s: s.tf)
                 solved.append(_solve_order(spacecraft, q_start, q_end, quats, best.order[::-1], search_intervals,
                                            substeps, rate_max, deadline=deadline))
-                stats["reverse_of_best_tf"] = solved[-1].tf
+            # every order not solved costs at least unsolved_bound on the search grid
+            incumbent = min(s.tf for s in solved) if solved else np.inf
+            stats.update(orders_solved=len(solved), lower_bound=min(unsolved_bound, incumbent),
+                         unsolved_orders_bound=unsolved_bound,
+                         order_proven=bool(unsolved_bound >= incumbent), search_seconds=time.perf_counter() - t0,
+                         candidates=[{"order": list(s.order), "tf": s.tf} for s in solved])
         if not solved:
             return _finish(empty, STATUS_FAILED, "deadline passed before any order was solved", t_begin, stats)
         best = min(solved, key=lambda s: s.tf)
@@ -685,8 +674,11 @@ def plan_schedule(targets: dict, spacecraft: dyn.Spacecraft, q_start=rot.IDENTIT
 
 
 def _finish(result: ScheduleResult, status: str, message: str, t_begin: float, stats: dict) -> ScheduleResult:
+    """Fill status and timing: ``solve_seconds`` is wall time, ``stats['cpu_seconds']`` the
+    process CPU time (the fairer figure on a shared machine)."""
     result.status, result.message, result.stats = status, message, stats
     result.solve_seconds = time.perf_counter() - t_begin
+    stats["cpu_seconds"] = time.process_time() - stats.pop("_cpu_begin", time.process_time())
     return result
 
 
@@ -706,7 +698,7 @@ def exhaustive_order_search(targets: dict, spacecraft: dyn.Spacecraft, q_start=r
     index = {k: i + 1 for i, k in enumerate(names)}
     rows = []
     for perm in itertools.permutations(names):
-        s = _solve_order(spacecraft, q_start, q_end, quats, perm, intervals, substeps, rate_max)
+        s = _solve_order(spacecraft, q_start, q_end, quats, perm, intervals, substeps, rate_max, expand=True)
         chain = [0] + [index[k] for k in perm] + [len(names) + 1]
         bound = float(sum(C[a, b] for a, b in zip(chain[:-1], chain[1:])))
         rows.append({"order": list(perm), "tf": float(s.tf), "bound": bound, "converged": s.sol.converged})
