@@ -26,6 +26,7 @@ class Method:
     description: str
     options: dict = field(default_factory=dict)
     fixed: dict = field(default_factory=dict)     # keyword arguments always passed
+    cheap: bool = False                           # closed form: run in-process, no child process
 
     def load(self) -> Callable:
         return getattr(importlib.import_module(self.module), self.function)
@@ -44,12 +45,12 @@ REGISTRY = [
             "rate_max": Option(1e-6, 10.0), "wheel_momentum_max": Option(1e-6, 1e4)}),
     Method("constrained_axis", "att_planner.baselines", "plan_constrained_axis",
            "eigenaxis bang-bang, or lambda-rotations riding a cone boundary when the eigenaxis path is blocked",
-           {"ride_margin_deg": Option(0.0, 10.0)}),
+           {"ride_margin_deg": Option(0.0, 10.0)}, cheap=True),
     Method("eigenaxis_smooth", "att_planner.eigenaxis", "plan_eigenaxis_smooth",
            "eigenaxis slew with a quintic angle profile (C1 rate, zero torque at both ends); ignores cones",
-           {"samples": Option(11, 100_000, True)}),
+           {"samples": Option(11, 100_000, True)}, cheap=True),
     Method("eigenaxis", "att_planner.baselines", "plan_eigenaxis",
-           "eigenaxis bang-bang slew with the largest torque the per-axis limits allow; ignores cones"),
+           "eigenaxis bang-bang slew with the largest torque the per-axis limits allow; ignores cones", cheap=True),
     Method("mssa", "att_planner.slepian", "plan_slepian",
            "Slepian basis, minimum sum of squared coefficients (Celani & Lucarelli); cone-aware",
            {"M": Option(2, 12, True), "N": Option(50, 2000, True), "W": Option(1e-4, 0.25)},

@@ -11,6 +11,7 @@ from __future__ import annotations
 import math
 import time
 from dataclasses import dataclass, replace
+from typing import Callable
 
 import numpy as np
 
@@ -18,9 +19,14 @@ from att_msgs_py.errors import ErrorCode
 from att_planner import eigenaxis
 from att_planner.cones import Cone, margins
 from att_planner.problem import STATUS_BUDGET, STATUS_FAILED, STATUS_FALLBACK, ManeuverPlan, ManeuverProblem
+from att_planner.methods import Method
 from att_planner.requests import ValidRequest
 from att_planner.verify import Verification, verify_profile
 from att_sim import rotations as rot
+
+
+VERIFY_RESERVE = 0.2        # fraction of the time budget kept for verification and fallback
+VERIFY_RESERVE_MAX = 3.0    # s
 
 
 @dataclass(frozen=True)
@@ -79,23 +85,42 @@ def padded(problem: ManeuverProblem, padding: float) -> ManeuverProblem:
     return replace(problem, cones=cones)
 
 
-def run_method(valid: ValidRequest, cone_padding: float = 0.0) -> ManeuverPlan:
-    """Call the method on the padded problem; exceptions become a failed plan (never an exception
-    in the executor)."""
+def failed_plan(method: str, message: str) -> ManeuverPlan:
+    return ManeuverPlan(method, np.zeros(1), np.zeros((1, 3)), np.zeros((1, 4)), np.zeros((1, 3)),
+                        status=STATUS_FAILED, message=message)
+
+
+def run_method(method: Method, problem: ManeuverProblem, options: dict, wait: float | None = None) -> ManeuverPlan:
+    """Call the method in this process; exceptions become a failed plan (never an exception in the
+    executor). ``wait`` is unused here: an in-process method is trusted to honour the deadline."""
     start = time.perf_counter()
     try:
-        plan = valid.method.load()(padded(valid.problem, cone_padding), **valid.method.fixed, **valid.options)
+        plan = method.load()(problem, **method.fixed, **options)
     except Exception as exc:  # noqa: BLE001 - any solver failure is reported, the node keeps serving
-        plan = ManeuverPlan(valid.method.name, np.zeros(1), np.zeros((1, 3)), np.zeros((1, 4)), np.zeros((1, 3)),
-                            status=STATUS_FAILED, message=f"{type(exc).__name__}: {exc}")
+        plan = failed_plan(method.name, f"{type(exc).__name__}: {exc}")
     plan.solve_seconds = plan.solve_seconds or time.perf_counter() - start
     return plan
 
 
-def plan_maneuver(valid: ValidRequest, tol: Tolerances = Tolerances(), cone_padding: float = 0.0) -> PlanOutcome:
-    """Plan with cones widened by ``cone_padding`` rad, verify against the requested cones."""
+def plan_maneuver(valid: ValidRequest, tol: Tolerances = Tolerances(), cone_padding: float = 0.0,
+                  runner: Callable = run_method) -> PlanOutcome:
+    """Plan with cones widened by ``cone_padding`` rad, verify against the requested cones, fall
+    back to the eigenaxis slew when that is safe.
+
+    The method gets the request's deadline minus a reserve for verification and fallback
+    (:data:`VERIFY_RESERVE` of the budget, at most :data:`VERIFY_RESERVE_MAX` s). ``runner``
+    executes it (:func:`run_method` in-process, or :func:`att_planner.worker.run_isolated` in a
+    child process that is killed if it overruns); ``None`` from the runner means it overran.
+    """
     problem = valid.problem
-    plan = run_method(valid, cone_padding)
+    reserve = min(VERIFY_RESERVE * valid.time_budget, VERIFY_RESERVE_MAX)
+    method_deadline = problem.deadline - reserve if problem.deadline is not None else None
+    wait = None if method_deadline is None else max(0.0, method_deadline - time.monotonic())
+    plan = runner(valid.method, replace(padded(problem, cone_padding), deadline=method_deadline), valid.options, wait)
+    if plan is None:
+        plan = failed_plan(valid.method.name, f"time budget of {valid.time_budget:g} s expired before "
+                                              f"{valid.method.name} returned a plan")
+        plan.status = STATUS_BUDGET
     reason = plan.message or plan.status
     if plan.status != STATUS_FAILED and len(plan.t) >= 2:
         ver = verify(problem, plan)

@@ -21,8 +21,9 @@ from att_msgs.srv import PlanManeuver
 from att_msgs_py import convert, topics
 from att_msgs_py.errors import ErrorCode, RequestError
 from att_planner import methods as method_registry
-from att_planner.planner import Tolerances, plan_maneuver
+from att_planner.planner import Tolerances, plan_maneuver, run_method
 from att_planner.requests import ManeuverRequest, validate_maneuver
+from att_planner.worker import run_isolated, set_max_parallel, warm_up
 from att_sim import scenario as scen
 
 
@@ -44,6 +45,8 @@ class PlannerNode(Node):
                                      rate=float(param("accept_final_rate", 1e-3)),
                                      cone_margin=math.radians(float(param("accept_cone_penetration_deg", 0.1))))
         self.cone_padding = math.radians(float(param("cone_padding_deg", 1.0)))
+        set_max_parallel(int(param("max_parallel_solves", 2)))
+        warm_up()
         group = ReentrantCallbackGroup()
         self.plan_pub = self.create_publisher(ManeuverPlan, topics.PLANS, topics.LATCHED_QOS)
         self.create_service(PlanManeuver, topics.PLAN_MANEUVER, self.on_plan_maneuver, callback_group=group)
@@ -67,7 +70,8 @@ class PlannerNode(Node):
             self.get_logger().warning(f"request rejected [{int(err.code)} {err.code.name}]: {err.message}")
             response.success, response.error_code, response.message = False, int(err.code), err.message
             return response
-        outcome = plan_maneuver(valid, self.tolerances, self.cone_padding)
+        runner = run_method if valid.method.cheap else run_isolated
+        outcome = plan_maneuver(valid, self.tolerances, self.cone_padding, runner)
         response.success = outcome.code == ErrorCode.OK
         response.error_code, response.message = int(outcome.code), outcome.message
         if outcome.plan is not None and len(outcome.plan.t) >= 2:
@@ -86,7 +90,7 @@ class PlannerNode(Node):
 def main(args=None):
     rclpy.init(args=args)
     node = PlannerNode()
-    executor = MultiThreadedExecutor(num_threads=6)
+    executor = MultiThreadedExecutor(num_threads=16)   # waiting requests hold a thread, not a core
     executor.add_node(node)
     try:
         executor.spin()

@@ -1,0 +1,71 @@
+"""Run a planning method in a child process that is killed if it overruns its time.
+
+Flight-software style isolation for the planner node: a solver that ignores its deadline, hangs
+or crashes (a segfault in a native solver) costs one child process, never the node. Children are
+forked from a ``forkserver`` that has already imported the numerics, so starting one is cheap;
+at most ``max_parallel`` solve at once (the rest wait, within their own budget).
+"""
+from __future__ import annotations
+
+import multiprocessing
+import os
+import threading
+import time
+
+from att_planner.methods import Method
+from att_planner.planner import failed_plan, run_method
+from att_planner.problem import ManeuverPlan, ManeuverProblem
+
+_CONTEXT = multiprocessing.get_context("forkserver")
+_CONTEXT.set_forkserver_preload(["att_planner.planner", "numpy", "scipy.optimize"])
+_SLOTS = threading.BoundedSemaphore(max(1, os.cpu_count() or 1))
+KILL_GRACE = 0.5            # s after the wait before the child is terminated
+
+
+def set_max_parallel(n: int) -> None:
+    global _SLOTS
+    _SLOTS = threading.BoundedSemaphore(max(1, int(n)))
+
+
+def warm_up() -> None:
+    """Start the fork server now (it imports the numerics once), not on the first request."""
+    child = _CONTEXT.Process(target=int, daemon=True)
+    child.start()
+    child.join()
+
+
+def _child(conn, method: Method, problem: ManeuverProblem, options: dict) -> None:
+    conn.send(run_method(method, problem, options))
+    conn.close()
+
+
+def run_isolated(method: Method, problem: ManeuverProblem, options: dict, wait: float | None) -> ManeuverPlan | None:
+    """Run ``method`` in a child; ``None`` when it has not answered within ``wait`` s (+ grace)."""
+    start = time.monotonic()
+    if not _SLOTS.acquire(timeout=wait):
+        return None
+    try:
+        remaining = None if wait is None else max(0.0, wait - (time.monotonic() - start))
+        receiver, sender = _CONTEXT.Pipe(duplex=False)
+        child = _CONTEXT.Process(target=_child, args=(sender, method, problem, options), daemon=True)
+        child.start()
+        sender.close()
+        try:
+            if receiver.poll(None if remaining is None else remaining + KILL_GRACE):
+                return receiver.recv()
+            if not child.is_alive():
+                return failed_plan(method.name, f"solver process died (exit code {child.exitcode})")
+            return None
+        except EOFError:
+            child.join(1.0)
+            return failed_plan(method.name, f"solver process died (exit code {child.exitcode})")
+        finally:
+            if child.is_alive():
+                child.terminate()
+                child.join(1.0)
+                if child.is_alive():
+                    child.kill()
+            child.join()
+            receiver.close()
+    finally:
+        _SLOTS.release()
