@@ -164,6 +164,7 @@ class _BatchModel:
         jx, jy, jz = case.inertia
         self.euler = ((jy - jz) / jx, (jz - jx) / jy, (jx - jy) / jz)
         self.m_over_j = (case.m_max / jx, case.m_max / jy, case.m_max / jz)
+        self.plane = case.orbit.plane_matrix().tolist()
 
     def set_cases(self, kp, kd, psi):
         self.kp, self.kd = kp / self.case.m_max, kd / self.case.m_max
@@ -178,8 +179,8 @@ class _BatchModel:
         c, s = math.cos(self.n * t), math.sin(self.n * t)
         cu = c * self.cpsi - s * self.spsi
         su = s * self.cpsi + c * self.spsi
-        m_hat = case.dipole.axis(t)
-        bx, by, bz = env.dipole_field_components(case.orbit, env.direction(case.orbit, cu, su), m_hat, case.dipole)
+        r_hat = env.direction(case.orbit, cu, su, self.plane)
+        bx, by, bz = env.dipole_field_components(case.orbit, r_hat, case.dipole.axis_at(t), case.dipole)
         # B_b = C(q) B_i = B − 2 q_w (q_v × B) + 2 q_v × (q_v × B)
         tx, ty, tz = 2.0 * (qy * bz - qz * by), 2.0 * (qz * bx - qx * bz), 2.0 * (qx * by - qy * bx)
         bx = bx - qw * tx + (qy * tz - qz * ty)
@@ -187,9 +188,9 @@ class _BatchModel:
         bz = bz - qw * tz + (qx * ty - qy * tx)
         # saturated demand  s = sat(B_b × (κ_p q_v + κ_d ω) / m*)
         ax, ay, az = self.kp * qx + self.kd * wx, self.kp * qy + self.kd * wy, self.kp * qz + self.kd * wz
-        sx = np.clip(by * az - bz * ay, -1.0, 1.0)
-        sy = np.clip(bz * ax - bx * az, -1.0, 1.0)
-        sz = np.clip(bx * ay - by * ax, -1.0, 1.0)
+        sx, sy, sz = by * az - bz * ay, bz * ax - bx * az, bx * ay - by * ax
+        for v in (sx, sy, sz):
+            np.minimum(np.maximum(v, -1.0, out=v), 1.0, out=v)
         # J ω̇ = −ω × Jω + m × B_b,  m × B_b = −m* (s × B_b)
         ex, ey, ez = self.euler
         gx, gy, gz = self.m_over_j
@@ -205,13 +206,15 @@ class _BatchModel:
 
 
 def simulate_settling(case: MagnetorquerCase, kp, kd, h, settings: SimSettings = SimSettings(), *,
-                      group=None, stop_above=None) -> SettlingResult:
+                      group=None, stop_above=None, race: bool = False) -> SettlingResult:
     """Settling times (orbits) of N cases ``(κ_p[j], κ_d[j], h[j])`` integrated together.
 
     ``kp``, ``kd`` broadcast against the N parameter rows ``h``. ``t_s`` is the last step time at
     which some ``|q_i| > ν`` (0 if never). ``stop_above`` (orbits, per case or per ``group``):
     a case still exceeding ν after that time cannot beat it, so it stops (ABOVE) and, when
     ``group`` labels are given, so does its whole group (DROPPED) — the pruning the min-max uses.
+    ``race``: the groups compete for the smallest ``max t_s``; as soon as a group is complete its
+    value becomes the bound for all the others (a minimisation needs nothing more of them).
     """
     start = time.perf_counter()
     h = np.atleast_2d(np.asarray(h, float))
@@ -223,7 +226,12 @@ def simulate_settling(case: MagnetorquerCase, kp, kd, h, settings: SimSettings =
     dt = float(settings.dt)
     n_steps = int(math.ceil(settings.cap_orbits * period / dt - 1e-9))
     check_every = max(1, int(round(settings.check_orbits * period / dt)))
-    group = np.arange(n_cases) if group is None else np.asarray(group)
+    group = np.unique(np.arange(n_cases) if group is None else np.asarray(group), return_inverse=True)[1].ravel()
+    n_groups = int(group.max()) + 1 if n_cases else 0
+    group_left = np.bincount(group, minlength=n_groups)
+    group_max = np.zeros(n_groups)
+    group_out = np.zeros(n_groups, bool)            # pruned: no longer a candidate
+    incumbent = np.inf                              # best complete group (seconds), race only
     bound = np.full(n_cases, np.inf) if stop_above is None else np.broadcast_to(
         np.asarray(stop_above, float), (n_cases,)).astype(float) * period
 
@@ -256,12 +264,14 @@ def simulate_settling(case: MagnetorquerCase, kp, kd, h, settings: SimSettings =
         if step % check_every and step != n_steps:
             continue
         # bookkeeping: prune, confirm settled, shrink the batch
-        above = exceeding & (t > bound)
+        above = exceeding & (t > np.minimum(bound, incumbent))
         done = above.copy()
         if above.any():
             status[alive[above]] = ABOVE
             ts[alive[above]] = t / period
-            drop = np.isin(group[alive], group[alive[above]]) & ~above
+            out_groups = np.unique(group[alive[above]])
+            group_out[out_groups] = True
+            drop = np.isin(group[alive], out_groups) & ~above
             status[alive[drop]] = DROPPED
             ts[alive[drop]] = np.maximum(last_exit[drop], 0.0) / period
             done |= drop
@@ -272,6 +282,13 @@ def simulate_settling(case: MagnetorquerCase, kp, kd, h, settings: SimSettings =
             status[alive[quiet]] = SETTLED
             ts[alive[quiet]] = np.maximum(last_exit[quiet], 0.0) / period
             done |= quiet
+            if race and quiet.any():
+                g = group[alive[quiet]]
+                np.maximum.at(group_max, g, np.maximum(last_exit[quiet], 0.0))
+                np.subtract.at(group_left, g, 1)
+                complete = (group_left == 0) & ~group_out
+                if complete.any():
+                    incumbent = min(incumbent, float(group_max[complete].min()))
         if done.any():
             keep = ~done
             alive, x, bound = alive[keep], x[:, keep].copy(), bound[keep]
@@ -291,8 +308,8 @@ def simulate_settling(case: MagnetorquerCase, kp, kd, h, settings: SimSettings =
 
 def _simulate_chunk(args) -> SettlingResult:
     """Module-level worker entry (picklable) for executors."""
-    case, settings, kp, kd, h, group, stop_above = args
-    return simulate_settling(case, kp, kd, h, settings, group=group, stop_above=stop_above)
+    case, settings, kp, kd, h, group, stop_above, race = args
+    return simulate_settling(case, kp, kd, h, settings, group=group, stop_above=stop_above, race=race)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -370,8 +387,16 @@ class BatchEvaluator:
         self.evaluations = 0
         self.case_steps = 0
         self.batches = 0
+        self.on_batch = None        # optional hook (evaluator, result) after every batch: progress
 
-    def settling(self, kp, kd, h, *, group=None, stop_above=None) -> SettlingResult:
+    def _done(self, res: SettlingResult) -> SettlingResult:
+        self.case_steps += res.case_steps
+        if self.on_batch is not None:
+            self.on_batch(self, res)
+        return res
+
+    def settling(self, kp, kd, h, *, group=None, stop_above=None, race: bool = False) -> SettlingResult:
+        """:func:`simulate_settling` of the batch, split over the executor when large."""
         h = np.atleast_2d(np.asarray(h, float))
         n = h.shape[0]
         kp = np.broadcast_to(np.asarray(kp, float), (n,))
@@ -382,23 +407,21 @@ class BatchEvaluator:
         self.batches += 1
         workers = getattr(self.executor, "workers", 1)
         if workers <= 1 or n < 2 * self.min_chunk:
-            res = simulate_settling(self.case, kp, kd, h, self.settings, group=group, stop_above=bound)
-            self.case_steps += res.case_steps
-            return res
+            return self._done(simulate_settling(self.case, kp, kd, h, self.settings, group=group,
+                                                stop_above=bound, race=race))
         _, g_index = np.unique(group, return_inverse=True)
         chunk_of = (g_index * workers) // (g_index.max() + 1)
         parts = [np.flatnonzero(chunk_of == c) for c in range(workers)]
         parts = [p for p in parts if p.size]
         start = time.perf_counter()
         results = self.executor.map(_simulate_chunk, [
-            (self.case, self.settings, kp[p], kd[p], h[p], group[p], None if bound is None else bound[p])
+            (self.case, self.settings, kp[p], kd[p], h[p], group[p], None if bound is None else bound[p], race)
             for p in parts])
         ts, status = np.empty(n), np.empty(n, int)
         for p, r in zip(parts, results):
             ts[p], status[p] = r.ts, r.status
-        steps = sum(r.case_steps for r in results)
-        self.case_steps += steps
-        return SettlingResult(ts, status, steps, max(r.steps for r in results), time.perf_counter() - start)
+        return self._done(SettlingResult(ts, status, sum(r.case_steps for r in results),
+                                         max(r.steps for r in results), time.perf_counter() - start))
 
 
 # ---------------------------------------------------------------------------------------------
@@ -433,15 +456,18 @@ class DirectSearch:
     would waste the batch simulator (:func:`direct_scipy` wraps it for comparison).
     """
 
-    def __init__(self, fun_batch, lower, upper, eps: float = 1e-4):
+    def __init__(self, fun_batch, lower, upper, eps: float = 1e-4, initial_level: int = 0):
         self.fun_batch = fun_batch
         self.lower, self.upper = np.asarray(lower, float), np.asarray(upper, float)
         self.eps = eps
         self.dim = self.lower.size
-        self.centers = np.full((1, self.dim), 0.5)
-        self.levels = np.zeros((1, self.dim), int)
-        self.f = np.asarray(self.fun_batch(self.to_box(self.centers)), float).reshape(1)
-        self.nfev, self.nit = 1, 0
+        # initial_level L > 0 starts from the uniform partition into 3^L cells per side (the
+        # rectangles DIRECT would reach by dividing everything L times), evaluated as one batch
+        ticks = (np.arange(3**initial_level) + 0.5) / 3**initial_level
+        self.centers = np.stack(np.meshgrid(*[ticks] * self.dim, indexing="ij"), -1).reshape(-1, self.dim)
+        self.levels = np.full(self.centers.shape, int(initial_level))
+        self.f = np.asarray(self.fun_batch(self.to_box(self.centers)), float).reshape(len(self.centers))
+        self.nfev, self.nit = len(self.centers), 0
 
     def to_box(self, z: np.ndarray) -> np.ndarray:
         return self.lower + z * (self.upper - self.lower)
@@ -527,9 +553,10 @@ class DirectSearch:
 
 
 def direct_batch(fun_batch, lower, upper, *, maxfun: int = 2000, maxiter: int = 1000, eps: float = 1e-4,
-                 f_target: float = -np.inf, deadline: float | None = None, callback=None) -> SearchResult:
+                 initial_level: int = 0, f_target: float = -np.inf, deadline: float | None = None,
+                 callback=None) -> SearchResult:
     """Minimise ``fun_batch`` (rows of points → values) on the box with batched DIRECT."""
-    search = DirectSearch(fun_batch, lower, upper, eps)
+    search = DirectSearch(fun_batch, lower, upper, eps, initial_level)
     status = "maxiter"
     while search.nit < maxiter:
         if search.nfev >= maxfun:
@@ -812,7 +839,7 @@ class _GainTable:
             return
         ii, jj = np.array(pairs).T
         g = 10.0 ** self.gains[ii]
-        res = self.evaluator.settling(g[:, 0], g[:, 1], self.hard[jj], group=ii,
+        res = self.evaluator.settling(g[:, 0], g[:, 1], self.hard[jj], group=ii, race=True,
                                       stop_above=None if not np.isfinite(bound) else bound)
         self.T[ii, jj] = res.ts
         self.exact[ii, jj] = (res.status == SETTLED) | (res.status == CAPPED)
@@ -824,7 +851,7 @@ def _log_gains_result(log_g) -> tuple[float, float]:
 
 
 def tune_fixed(h=PUBLISHED_ICS["ic20"], evaluator: BatchEvaluator | None = None, *, maxfun: int = 400,
-               bounds=LOG_GAIN_BOUNDS, deadline: float | None = None, f_target: float = -np.inf,
+               bounds=LOG_GAIN_BOUNDS, initial_level: int = 3, deadline: float | None = None, f_target: float = -np.inf,
                progress=None) -> TuningResult:
     """Gains minimising the settling time at one initial condition: batched DIRECT on log gains.
 
@@ -840,7 +867,7 @@ def tune_fixed(h=PUBLISHED_ICS["ic20"], evaluator: BatchEvaluator | None = None,
 
     def fun(log_g):
         g = 10.0 ** np.atleast_2d(log_g)
-        res = evaluator.settling(g[:, 0], g[:, 1], np.repeat(h[None], len(g), 0),
+        res = evaluator.settling(g[:, 0], g[:, 1], np.repeat(h[None], len(g), 0), race=True,
                                  stop_above=best[0] if np.isfinite(best[0]) else None)
         exact = res.exact | (res.status == CAPPED)
         if exact.any():
@@ -851,7 +878,8 @@ def tune_fixed(h=PUBLISHED_ICS["ic20"], evaluator: BatchEvaluator | None = None,
         return res.ts
 
     lo, hi = np.array(bounds, float).T
-    res = direct_batch(fun, lo, hi, maxfun=maxfun, f_target=f_target, deadline=deadline)
+    res = direct_batch(fun, lo, hi, maxfun=maxfun, initial_level=initial_level, f_target=f_target,
+                       deadline=deadline)
     kp, kd = _log_gains_result(res.x)
     return TuningResult("fixed", kp, kd, res.fun, h, evaluator.evaluations, time.perf_counter() - t0,
                         res.status, res.message, history,
@@ -952,3 +980,39 @@ def thorough_worst_case(evaluator: BatchEvaluator, kp: float, kd: float, *, samp
     b = int(np.argmax(T))
     return WorstCase(X[b].copy(), float(T[b]), bool(T[b] >= evaluator.settings.cap_orbits), len(T),
                      "thorough", time.perf_counter() - t0, X, T)
+
+
+def truth_settling_time(case: MagnetorquerCase, kp: float, kd: float, h, *, dt: float = 1.0,
+                        settings: SimSettings = SimSettings()) -> tuple[float, int]:
+    """Settling time (orbits) and status of one case through the simulator's truth path.
+
+    :func:`att_sim.dynamics.step` (RK4, inputs held over the step like the simulator node) with
+    ``Inputs(dipole=m, field_body=B_b)``, ``B_b`` from :func:`att_sim.environment.field_body` and
+    ``m`` from :func:`att_planner.magnetorquer_law.dipole_command` — none of the batch code. The
+    same settling rule as :func:`simulate_settling` (cap, quiet window).
+    """
+    from att_planner.magnetorquer_law import dipole_command
+    from att_sim import dynamics as dyn
+
+    q0, w0, psi = initial_states(h)
+    sc = dyn.Spacecraft(inertia=np.diag(case.inertia), dipole_max=case.m_max)
+    x = dyn.initial_state(sc, q0[0], w0[0])
+    period = case.period
+    last_exit = 0.0 if np.any(np.abs(q0[0, :3]) > case.nu) else -np.inf
+    last_loud, t = 0.0, 0.0
+    quiet_q, quiet_time = settings.quiet_fraction * case.nu, settings.quiet_orbits * period
+    for k in range(1, int(math.ceil(settings.cap_orbits * period / dt)) + 1):
+        b_body = env.field_body(case.orbit, t, x[:4], psi[0], case.dipole)
+        m = dipole_command(x[:4], x[4:7], b_body, kp, kd, case.m_max)
+        x = dyn.step(sc, x, dyn.Inputs(dipole=m, field_body=b_body), dt)
+        t = k * dt
+        qmax = np.max(np.abs(x[:3]))
+        if qmax > case.nu:
+            last_exit = t
+        if qmax > quiet_q or x[4:7] @ x[4:7] > settings.quiet_rate**2:
+            last_loud = t
+        if settings.retire and t - last_loud >= quiet_time:
+            return max(last_exit, 0.0) / period, SETTLED
+    if t - last_exit >= quiet_time:
+        return max(last_exit, 0.0) / period, SETTLED
+    return settings.cap_orbits, CAPPED

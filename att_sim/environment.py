@@ -79,6 +79,12 @@ class DipoleModel:
         s = math.sin(self.coelevation)
         return np.stack([s * np.cos(a), s * np.sin(a), np.full_like(a, math.cos(self.coelevation))], -1)
 
+    def axis_at(self, t: float) -> tuple[float, float, float]:
+        """m̂ at one scalar time as plain floats (the batch simulator's per-stage call)."""
+        a = self.earth_rate * t + self.right_ascension0
+        s = math.sin(self.coelevation)
+        return (s * math.cos(a), s * math.sin(a), math.cos(self.coelevation))
+
 
 DEFAULT_DIPOLE = DipoleModel()
 
@@ -87,10 +93,11 @@ def _arg0(orbit: OrbitParams, arg0):
     return orbit.arg0 if arg0 is None else np.asarray(arg0, float)
 
 
-def direction(orbit: OrbitParams, cos_u, sin_u) -> tuple:
-    """Unit position components ``(r̂x, r̂y, r̂z)`` from cos/sin of the argument of latitude."""
-    p = orbit.plane_matrix()
-    return (p[0, 0] * cos_u + p[0, 1] * sin_u, p[1, 0] * cos_u + p[1, 1] * sin_u, p[2, 1] * sin_u)
+def direction(orbit: OrbitParams, cos_u, sin_u, plane: np.ndarray | None = None) -> tuple:
+    """Unit position components ``(r̂x, r̂y, r̂z)`` from cos/sin of the argument of latitude
+    (``plane``: :meth:`OrbitParams.plane_matrix`, passed in by callers that reuse it)."""
+    p = orbit.plane_matrix().tolist() if plane is None else plane
+    return (p[0][0] * cos_u + p[0][1] * sin_u, p[1][0] * cos_u + p[1][1] * sin_u, p[2][1] * sin_u)
 
 
 def dipole_field_components(orbit: OrbitParams, r_hat: tuple, m_hat, dipole: DipoleModel = DEFAULT_DIPOLE) -> tuple:
