@@ -78,6 +78,10 @@ def test_schedule_passes_each_target_and_respects_bounds(small_search):
     assert np.abs(r.wheel_torque).max() <= SC.wheel_torque_max
     assert np.abs(r.wheel_speed).max() <= SC.wheel_speed_max
     assert np.allclose(r.wheel_torque[-1], 0.0)
+    # the verification catches a plan that misses: the same torques 2 % stronger
+    bad = sch.verify_schedule(SC, rot.IDENTITY, rot.IDENTITY, [SMALL[k] for k in r.order], r.passage_times,
+                              r.t, 1.02 * r.wheel_torque, rate_max=sch.OLIVARES_RATE_MAX)
+    assert not bad.passed and bad.torque_ratio > 1.0
     # the planner's own prediction agrees with ω = −J⁻¹ I_w Ω (zero total momentum)
     assert np.allclose(r.omega, -(r.wheel_speed * SC.wheel_inertia) / np.diag(SC.inertia), atol=1e-12)
 
