@@ -40,8 +40,8 @@ def maneuver_request(q_initial, q_final, sensor_axis, cones: list[Cone], *, meth
 class SuiteClient(Node):
     def __init__(self, name: str = "suite_client"):
         super().__init__(name)
-        self.plan_client = self.create_client(PlanManeuver, topics.PLAN_MANEUVER)
-        self.schedule_client = self.create_client(PlanSchedule, topics.PLAN_SCHEDULE)
+        self.plan_client = self.create_client(PlanManeuver, topics.PLAN_MANEUVER, qos_profile=topics.SERVICE_QOS)
+        self.schedule_client = self.create_client(PlanSchedule, topics.PLAN_SCHEDULE, qos_profile=topics.SERVICE_QOS)
         self.mode_client = self.create_client(SetControllerMode, topics.SET_CONTROLLER_MODE)
         self.execute_client = ActionClient(self, ExecuteManeuver, topics.EXECUTE_MANEUVER)
 

@@ -49,7 +49,8 @@ class PlannerNode(Node):
         warm_up()
         group = ReentrantCallbackGroup()
         self.plan_pub = self.create_publisher(ManeuverPlan, topics.PLANS, topics.LATCHED_QOS)
-        self.create_service(PlanManeuver, topics.PLAN_MANEUVER, self.on_plan_maneuver, callback_group=group)
+        self.create_service(PlanManeuver, topics.PLAN_MANEUVER, self.on_plan_maneuver, qos_profile=topics.SERVICE_QOS,
+                            callback_group=group)
         self.get_logger().info(f"methods: {', '.join(self.methods)} (default {self.default_method})")
 
     def on_plan_maneuver(self, request: PlanManeuver.Request, response: PlanManeuver.Response):
