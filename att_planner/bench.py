@@ -16,6 +16,7 @@ STUDIES = {
     "time-optimal": "att_planner.bench_time_optimal",
     "schedule": "att_planner.bench_schedule",
     "gains": "att_planner.bench_gains",
+    "soak": "att_planner.bench_soak",
 }
 
 

@@ -43,6 +43,7 @@ class SimulatorNode(Node):
         self.clock_period = 1.0 / float(param("clock_rate", 50.0))
         self.real_time_factor = float(param("real_time_factor", 1.0))
         self.command_timeout = float(param("command_timeout", 1.0))
+        self.end_time = float(param("end_time", 0.0))      # s of sim time; 0: run until stopped
         # Lockstep: after each published state, wait (up to lockstep_timeout s of wall time) for
         # the command that answers it, so the loop stays closed at any speed and under CPU load.
         self.lockstep = bool(param("lockstep", True))
@@ -100,6 +101,9 @@ class SimulatorNode(Node):
         wall0, sim0 = time.monotonic(), self.sim.t
         next_state, next_clock = self.sim.t, self.sim.t
         while self.running and rclpy.ok():
+            if self.end_time > 0 and self.sim.t >= self.end_time - 1e-9:
+                self.get_logger().info(f"end_time reached at t = {self.sim.t:.3f} s; propagation stopped")
+                break
             with self.lock:
                 timed_out = self.sim.t - self.last_command_time > self.command_timeout
                 self.sim.command_timeout = timed_out
