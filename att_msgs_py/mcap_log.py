@@ -230,10 +230,16 @@ def iter_records(path: str | Path):
 
 
 def read_log(path: str | Path, topics: list[str] | None = None, keep_messages: bool = False) -> dict[str, TopicLog]:
-    """Read an MCAP log into ``{topic: TopicLog}`` (see :class:`TopicLog`).
+    """Read an MCAP log into ``{topic: TopicLog}``: the replay library of tools and tests.
 
-    Every message is decoded from its own schema (so this also checks the log is self-describing);
-    ``topics`` limits the topics read; ``keep_messages`` keeps the decoded message objects too.
+    Per topic, in log-time order: ``log_time`` (s, the recorder's receive time, wall clock) and one
+    array per field named by its dotted path with the message index first (see :func:`flatten`):
+    ``log["/spacecraft/state"]["header.stamp"]`` (n,) sim time in s, ``["attitude"]`` (n, 4) xyzw,
+    ``["wheel_speeds"]`` (n, W); strings give string arrays, sequences of varying length or of
+    messages give lists (``log["/planner/plans"]["cones"][i]`` is a list of dicts). Every message
+    is decoded from its own schema (so this also checks the log is self-describing); ``topics``
+    limits the topics read; ``keep_messages`` keeps the decoded message objects too. A file whose
+    writer was killed is read up to its last complete chunk.
     """
     factory = DecoderFactory()
     decoders, rows = {}, {}

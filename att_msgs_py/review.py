@@ -192,8 +192,8 @@ def summarize(log: dict[str, TopicLog], spacecraft: Spacecraft | None = None, pl
     """Summary of the reviewed segment of a read log (see :func:`extract_run`).
 
     Keys: kind, plan (id, method, status, spacecraft), maneuver_time_s (planned duration),
-    executed_time_s (segment length), final_attitude_error_deg and final_rate_rad_s at the end of
-    the segment, min_margin_deg and closest_approach_s per cone, peak body torque / wheel torque /
+    executed_time_s (segment length), final_attitude_error_deg (to ``goal``: the plan's final
+    attitude, identity for magnetorquer runs) and final_rate_rad_s at the end of the segment, min_margin_deg and closest_approach_s per cone, peak body torque / wheel torque /
     wheel speed / dipole with their limits and ratios (limits None without ``spacecraft``),
     settling_time_s (magnetorquer runs: Bruni & Celani's ν = 0.05 criterion on q_v), command_timeouts.
     """
@@ -212,6 +212,8 @@ def summary_of(run: Run, spacecraft: Spacecraft | None = None) -> dict:
         out["plan"]["verified_min_margin_deg"] = math.degrees(p["verified_min_margin"])
         if run.kind == "maneuver":
             out["maneuver_time_s"] = p["duration"]
+    out["goal"] = None if run.goal is None else {"maneuver": "the plan's final attitude", "magnetorquer": "identity",
+                                                   "log": "the last plan's final attitude"}[run.kind]
     if run.goal is not None:
         out["final_attitude_error_deg"] = float(np.degrees(rot.angle_between(run.q[-1], run.goal)))
     else:
@@ -272,7 +274,8 @@ def format_summary(s: dict) -> str:
                      "(with hold)")
     else:
         lines.append(f"segment length        {s['executed_time_s']:.2f} s")
-    lines.append(f"final attitude error  {deg(s['final_attitude_error_deg'], 4)}, final rate {s['final_rate_rad_s']:.2e} rad/s")
+    lines.append(f"final attitude error  {deg(s['final_attitude_error_deg'], 4)} (to {s['goal'] or 'no goal known'}), "
+                 f"final rate {s['final_rate_rad_s']:.2e} rad/s")
     for name, v in s["min_margin_deg"].items():
         lines.append(f"min margin {name:<10} {deg(v, 2)} at t = {s['closest_approach_s'][name]:.1f} s")
     lines.append(f"peak body torque      {ratio('body_torque_Nm', 'N m')}")

@@ -3,7 +3,8 @@
 Starts recorder, simulator, controller and planner as separate processes on an isolated ROS
 domain, asks the planner for the scenario's keep-out maneuver, executes it on the simulator
 through the controller, stops everything cleanly and prints a summary measured from the recorded
-MCAP. The last line printed is ``MCAP: <path>``.
+MCAP, writes the ``att-review`` figures and HTML page next to it (``review/``). The last line
+printed is ``MCAP: <path>``.
 """
 from __future__ import annotations
 
@@ -18,6 +19,7 @@ from pathlib import Path
 import numpy as np
 
 from att_msgs_py.mcap_log import read_log
+from att_msgs_py.review import review
 from att_planner.cones import Cone, margins
 from att_planner.launch import isolated_env, start_suite
 from att_sim import rotations as rot
@@ -106,6 +108,10 @@ def main(argv=None) -> int:
           f"{summary['final_rate']:.2e} rad/s")
     print(f"[demo]   minimum cone margin {summary['min_cone_margin_deg']:.2f} deg "
           f"({', '.join(f'{k} {v:.2f}' for k, v in summary['min_margin_per_cone_deg'].items())})")
+    try:
+        print(f"[demo] review (figures, summary, HTML): {review(mcap_path, run_dir / 'review').html}")
+    except (ValueError, OSError) as err:
+        print(f"[demo] review failed: {err}")
     print(f"MCAP: {mcap_path}")
     return 0 if ok else 1
 
