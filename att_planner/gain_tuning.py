@@ -205,6 +205,37 @@ class _BatchModel:
         return out
 
 
+def _rk4_step(model: _BatchModel, x: np.ndarray, t: float, dt: float, work: tuple) -> None:
+    """Classic RK4 step of the batch in place (work arrays reused), quaternions renormalised
+    like :func:`att_sim.dynamics.rk4_step`."""
+    k1, k2, k3, k4, tmp = work
+    model(t, x, k1)
+    np.multiply(k1, 0.5 * dt, out=tmp); tmp += x
+    model(t + 0.5 * dt, tmp, k2)
+    np.multiply(k2, 0.5 * dt, out=tmp); tmp += x
+    model(t + 0.5 * dt, tmp, k3)
+    np.multiply(k3, dt, out=tmp); tmp += x
+    model(t + dt, tmp, k4)
+    k2 += k3; k2 *= 2.0; k2 += k1; k2 += k4
+    k2 *= dt / 6.0; x += k2
+    x[:4] /= np.sqrt(np.einsum("ij,ij->j", x[:4], x[:4]))
+
+
+def propagate(case: MagnetorquerCase, kp, kd, h, t_end: float, dt: float) -> np.ndarray:
+    """States ``(N, 7)`` ``[q, ω]`` at ``t_end`` of the batch closed loop (same step as the
+    settling simulator); used to check it against the truth dynamics."""
+    h = np.atleast_2d(np.asarray(h, float))
+    q0, w0, psi = initial_states(h)
+    n = h.shape[0]
+    model = _BatchModel(case, np.broadcast_to(kp, (n,)).astype(float), np.broadcast_to(kd, (n,)).astype(float), psi)
+    x = np.concatenate([q0, w0], 1).T.copy()
+    work = tuple(np.empty_like(x) for _ in range(5))
+    steps = int(round(t_end / dt))
+    for k in range(steps):
+        _rk4_step(model, x, k * dt, dt, work)
+    return x.T.copy()
+
+
 def simulate_settling(case: MagnetorquerCase, kp, kd, h, settings: SimSettings = SimSettings(), *,
                       group=None, stop_above=None, race: bool = False) -> SettlingResult:
     """Settling times (orbits) of N cases ``(κ_p[j], κ_d[j], h[j])`` integrated together.
@@ -246,16 +277,7 @@ def simulate_settling(case: MagnetorquerCase, kp, kd, h, settings: SimSettings =
     quiet_q, quiet_time = settings.quiet_fraction * case.nu, settings.quiet_orbits * period
     case_steps, t, step = 0, 0.0, 0
     for step in range(1, n_steps + 1):
-        model(t, x, k1)
-        np.multiply(k1, 0.5 * dt, out=tmp); tmp += x
-        model(t + 0.5 * dt, tmp, k2)
-        np.multiply(k2, 0.5 * dt, out=tmp); tmp += x
-        model(t + 0.5 * dt, tmp, k3)
-        np.multiply(k3, dt, out=tmp); tmp += x
-        model(t + dt, tmp, k4)
-        k2 += k3; k2 *= 2.0; k2 += k1; k2 += k4
-        k2 *= dt / 6.0; x += k2
-        x[:4] /= np.sqrt(np.einsum("ij,ij->j", x[:4], x[:4]))
+        _rk4_step(model, x, t, dt, (k1, k2, k3, k4, tmp))
         t = step * dt
         case_steps += x.shape[1]
         qmax = np.abs(x[:3]).max(0)
@@ -890,7 +912,7 @@ def tune_fixed(h=PUBLISHED_ICS["ic20"], evaluator: BatchEvaluator | None = None,
 def tune_robust(evaluator: BatchEvaluator | None = None, *, inner: str = "sdbox-multistart",
                 seeds=None, outer_iterations: int = 8, outer_maxfun: int = 400, inner_maxfun: int = 400,
                 new_cases: int = 2, tol: float = 0.02, max_cycles: int = 12, bounds=LOG_GAIN_BOUNDS,
-                deadline: float | None = None, inner_reserve: float = 0.0, progress=None) -> TuningResult:
+                initial_level: int = 2, deadline: float | None = None, inner_reserve: float = 0.0, progress=None) -> TuningResult:
     """Min-max gains ``min_κ max_{h∈H} t_s`` by outer approximation with DIRECT outside.
 
     Cycle: (1) ``outer_iterations`` batched DIRECT iterations on log gains against the hard set
@@ -917,7 +939,7 @@ def tune_robust(evaluator: BatchEvaluator | None = None, *, inner: str = "sdbox-
         return table.values()[0][rows]
 
     lo, hi = np.array(bounds, float).T
-    search = DirectSearch(outer_fun, lo, hi)
+    search = DirectSearch(outer_fun, lo, hi, initial_level=initial_level)
     status, message = "maxcycles", ""
 
     def time_left():
