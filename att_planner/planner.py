@@ -141,3 +141,18 @@ def plan_maneuver(valid: ValidRequest, tol: Tolerances = Tolerances(), cone_padd
     if problem.cones and code == ErrorCode.SOLVER_FAILED and "infeasib" in reason.lower():
         code = ErrorCode.INFEASIBLE
     return PlanOutcome(code, f"no verified plan{budget_note}: {reason}", plan, None)
+
+
+def schedule_plan(result) -> ManeuverPlan:
+    """A :class:`~att_planner.schedule.ScheduleResult` as a plan whose controls are wheel torques."""
+    return ManeuverPlan("schedule", result.t, result.wheel_torque, result.q, result.omega, result.interpolation,
+                        result.status, result.message, result.solve_seconds, result.stats)
+
+
+def schedule_verification(result) -> Verification:
+    """The schedule's truth verification in the plan's verification figures (no cones)."""
+    v = result.verification
+    return Verification(final_attitude_error=v.final_attitude_error, final_rate=v.final_rate,
+                        min_cone_margin=float("inf"), cone_margins=[], torque_ratio=v.torque_ratio,
+                        wheel_speed_ratio=v.wheel_speed_ratio, rate_max=float("nan"),
+                        duration=float(result.tf), dense_samples=0)

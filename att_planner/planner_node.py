@@ -9,6 +9,7 @@ own problem, nothing is shared between requests but the read-only method registr
 from __future__ import annotations
 
 import math
+import time
 import uuid
 
 import rclpy
@@ -17,13 +18,14 @@ from rclpy.executors import ExternalShutdownException, MultiThreadedExecutor
 from rclpy.node import Node
 
 from att_msgs.msg import ManeuverPlan
-from att_msgs.srv import PlanManeuver
+from att_msgs.srv import PlanManeuver, PlanSchedule
 from att_msgs_py import convert, topics
 from att_msgs_py.errors import ErrorCode, RequestError
 from att_planner import methods as method_registry
-from att_planner.planner import Tolerances, plan_maneuver, run_method
-from att_planner.requests import ManeuverRequest, validate_maneuver
-from att_planner.worker import run_isolated, set_max_parallel, warm_up
+from att_planner.planner import Tolerances, plan_maneuver, run_method, schedule_plan, schedule_verification
+from att_planner.requests import ManeuverRequest, validate_maneuver, validate_schedule
+from att_planner.schedule import plan_schedule
+from att_planner.worker import call_isolated, run_isolated, set_max_parallel, warm_up
 from att_sim import scenario as scen
 
 
@@ -49,7 +51,10 @@ class PlannerNode(Node):
         warm_up()
         group = ReentrantCallbackGroup()
         self.plan_pub = self.create_publisher(ManeuverPlan, topics.PLANS, topics.LATCHED_QOS)
+        self.schedule_rate_max = float(param("schedule_rate_max", float("inf")))
         self.create_service(PlanManeuver, topics.PLAN_MANEUVER, self.on_plan_maneuver, qos_profile=topics.SERVICE_QOS,
+                            callback_group=group)
+        self.create_service(PlanSchedule, topics.PLAN_SCHEDULE, self.on_plan_schedule, qos_profile=topics.SERVICE_QOS,
                             callback_group=group)
         self.get_logger().info(f"methods: {', '.join(self.methods)} (default {self.default_method})")
 
@@ -85,6 +90,44 @@ class PlannerNode(Node):
             self.plan_pub.publish(response.plan)
         else:
             self.get_logger().warning(f"{valid.method.name} failed (code {response.error_code}): {outcome.message}")
+        return response
+
+    def on_plan_schedule(self, request: PlanSchedule.Request, response: PlanSchedule.Response):
+        try:
+            valid = validate_schedule(
+                list(request.target_names), [convert.from_quaternion(q) for q in request.targets],
+                convert.from_quaternion(request.start_attitude), request.spacecraft, request.time_budget,
+                frame_id=self.frame_id, request_frame=request.header.frame_id,
+                default_spacecraft=self.scenario_name, default_budget=self.default_budget)
+        except RequestError as err:
+            self.get_logger().warning(f"schedule rejected [{int(err.code)} {err.code.name}]: {err.message}")
+            response.success, response.error_code, response.message = False, int(err.code), err.message
+            return response
+        wait = max(0.0, valid.time_budget - min(0.2 * valid.time_budget, 3.0))
+        result = call_isolated(plan_schedule, (valid.targets, valid.spacecraft),
+                               {"q_start": valid.q_start, "rate_max": self.schedule_rate_max,
+                                "deadline": time.monotonic() + wait}, wait, on_death=lambda message: message)
+        if result is None or isinstance(result, str):
+            response.error_code = int(ErrorCode.SOLVER_FAILED)
+            response.message = result or f"time budget of {valid.time_budget:g} s expired without a schedule"
+        elif not (result.success or result.status == "budget_expired") or result.verification is None \
+                or not result.verification.passed:
+            response.error_code = int(ErrorCode.VERIFICATION_FAILED if result.verification else ErrorCode.SOLVER_FAILED)
+            response.message = f"no verified schedule: {result.message}"
+        else:
+            response.success, response.message = True, result.message
+            response.order = list(result.order)
+            response.passage_times = [float(v) for v in result.passage_times]
+            response.plan = convert.plan_msg(
+                schedule_plan(result), plan_id=uuid.uuid4().hex[:12], frame_id=self.frame_id,
+                spacecraft=valid.spacecraft_name, sensor_axis=(1.0, 0.0, 0.0), cones=[],
+                verification=schedule_verification(result), control_kind="wheel_torque")
+            response.plan.header.stamp = self.get_clock().now().to_msg()
+            self.plan_pub.publish(response.plan)
+        if response.success:
+            self.get_logger().info(f"schedule of {len(valid.targets)} targets: {response.message}")
+        else:
+            self.get_logger().warning(f"schedule of {len(valid.targets)} targets failed: {response.message}")
         return response
 
 

@@ -25,6 +25,7 @@ MAX_CONES = 16
 MAX_OPTIONS = 16
 MAX_TIME_BUDGET = 600.0        # s
 MAX_NAME_LENGTH = 128
+MAX_TARGETS = 20               # schedule targets (the order search is exponential in their number)
 
 
 @dataclass
@@ -157,6 +158,28 @@ def validate_maneuver(req: ManeuverRequest, *, frame_id: str, default_spacecraft
                 raise RequestError(ErrorCode.SENSOR_IN_CONE,
                                    f"the sensor_target direction is inside cone '{cones[k].name}' by {np.degrees(-ang[k]):.3f} deg")
     name = req.spacecraft or default_spacecraft
+    sc = load_spacecraft(name)
+    method_name = req.method or default_method
+    method = methods.get(method_name)
+    if method is None:
+        raise RequestError(ErrorCode.UNKNOWN_METHOD,
+                           f"method '{method_name[:MAX_NAME_LENGTH]}' is unknown (available: {', '.join(methods)})")
+    options = check_options(method, list(req.option_names), [float(v) for v in req.option_values])
+    budget = check_budget(float(req.time_budget), default_budget)
+    problem = ManeuverProblem(sc, q0, qf, r, cones, deadline=time.monotonic() + budget, sensor_target=sensor_target)
+    return ValidRequest(problem, method, options, name, budget)
+
+
+@dataclass
+class ValidSchedule:
+    targets: dict                    # name -> unit quaternion
+    q_start: np.ndarray
+    spacecraft: Spacecraft
+    spacecraft_name: str
+    time_budget: float
+
+
+def load_spacecraft(name: str) -> Spacecraft:
     if len(name) > MAX_NAME_LENGTH or not all(ch.isalnum() or ch in "_-" for ch in name):
         raise RequestError(ErrorCode.UNKNOWN_SPACECRAFT,
                            "spacecraft must be a configuration name (letters, digits, '_' and '-')")
@@ -167,16 +190,35 @@ def validate_maneuver(req: ManeuverRequest, *, frame_id: str, default_spacecraft
     except (ValueError, TypeError) as exc:
         raise RequestError(ErrorCode.INVALID_SPACECRAFT, f"spacecraft '{name}': {exc}") from None
     check_spacecraft(sc, name)
-    method_name = req.method or default_method
-    method = methods.get(method_name)
-    if method is None:
-        raise RequestError(ErrorCode.UNKNOWN_METHOD,
-                           f"method '{method_name[:MAX_NAME_LENGTH]}' is unknown (available: {', '.join(methods)})")
-    options = check_options(method, list(req.option_names), [float(v) for v in req.option_values])
-    budget = float(req.time_budget)
+    return sc
+
+
+def check_budget(budget: float, default: float) -> float:
     if not math.isfinite(budget) or budget < 0 or budget > MAX_TIME_BUDGET:
         raise RequestError(ErrorCode.INVALID_TIME_BUDGET,
                            f"time_budget = {budget} s is outside [0, {MAX_TIME_BUDGET}] (0: the default)")
-    budget = budget or default_budget
-    problem = ManeuverProblem(sc, q0, qf, r, cones, deadline=time.monotonic() + budget, sensor_target=sensor_target)
-    return ValidRequest(problem, method, options, name, budget)
+    return budget or default
+
+
+def validate_schedule(names: list, targets: list, q_start, spacecraft: str, time_budget: float, *,
+                      frame_id: str, request_frame: str, default_spacecraft: str, default_budget: float) -> ValidSchedule:
+    """Check a PlanSchedule request: names match targets, unit quaternions, a wheeled spacecraft."""
+    if request_frame not in ("", frame_id):
+        raise RequestError(ErrorCode.INVALID_FRAME,
+                           f"header.frame_id '{request_frame[:MAX_NAME_LENGTH]}' is not the planner's inertial frame '{frame_id}'")
+    if len(targets) > MAX_TARGETS or len(names) > MAX_TARGETS:
+        raise RequestError(ErrorCode.SIZE_LIMIT, f"{max(len(targets), len(names))} targets given; at most {MAX_TARGETS}")
+    if not targets:
+        raise RequestError(ErrorCode.INVALID_ATTITUDE, "targets is empty")
+    if len(names) != len(targets):
+        raise RequestError(ErrorCode.INVALID_ATTITUDE, f"{len(names)} target_names for {len(targets)} targets")
+    if len(set(names)) != len(names) or any(not n or len(n) > MAX_NAME_LENGTH for n in names):
+        raise RequestError(ErrorCode.INVALID_ATTITUDE, "target_names must be distinct, non-empty and short")
+    checked = {n: unit_quaternion(q, f"targets[{i}] ('{n}')") for i, (n, q) in enumerate(zip(names, targets))}
+    q0 = unit_quaternion(q_start, "start_attitude")
+    name = spacecraft or default_spacecraft
+    sc = load_spacecraft(name)
+    if sc.n_wheels < 3 or not (np.isfinite(sc.wheel_torque_max) and np.isfinite(sc.wheel_speed_max)):
+        raise RequestError(ErrorCode.INVALID_SPACECRAFT,
+                           f"spacecraft '{name}' needs three or more reaction wheels with finite torque and speed limits")
+    return ValidSchedule(checked, q0, sc, name, check_budget(float(time_budget), default_budget))

@@ -34,31 +34,35 @@ def warm_up() -> None:
     child.join()
 
 
-def _child(conn, method: Method, problem: ManeuverProblem, options: dict) -> None:
-    conn.send(run_method(method, problem, options))
+def _child(conn, function, args: tuple, kwargs: dict) -> None:
+    conn.send(function(*args, **kwargs))
     conn.close()
 
 
-def run_isolated(method: Method, problem: ManeuverProblem, options: dict, wait: float | None) -> ManeuverPlan | None:
-    """Run ``method`` in a child; ``None`` when it has not answered within ``wait`` s (+ grace)."""
+def call_isolated(function, args: tuple, kwargs: dict, wait: float | None, *, on_death):
+    """``function(*args, **kwargs)`` in a child process (``function`` importable by name).
+
+    Returns its result, ``None`` when it has not answered within ``wait`` s (+ grace; the child
+    is then killed), or ``on_death(message)`` when the child died without answering.
+    """
     start = time.monotonic()
     if not _SLOTS.acquire(timeout=wait):
         return None
     try:
         remaining = None if wait is None else max(0.0, wait - (time.monotonic() - start))
         receiver, sender = _CONTEXT.Pipe(duplex=False)
-        child = _CONTEXT.Process(target=_child, args=(sender, method, problem, options), daemon=True)
+        child = _CONTEXT.Process(target=_child, args=(sender, function, args, kwargs), daemon=True)
         child.start()
         sender.close()
         try:
             if receiver.poll(None if remaining is None else remaining + KILL_GRACE):
                 return receiver.recv()
             if not child.is_alive():
-                return failed_plan(method.name, f"solver process died (exit code {child.exitcode})")
+                return on_death(f"solver process died (exit code {child.exitcode})")
             return None
         except EOFError:
             child.join(1.0)
-            return failed_plan(method.name, f"solver process died (exit code {child.exitcode})")
+            return on_death(f"solver process died (exit code {child.exitcode})")
         finally:
             if child.is_alive():
                 child.terminate()
@@ -69,3 +73,9 @@ def run_isolated(method: Method, problem: ManeuverProblem, options: dict, wait: 
             receiver.close()
     finally:
         _SLOTS.release()
+
+
+def run_isolated(method: Method, problem: ManeuverProblem, options: dict, wait: float | None) -> ManeuverPlan | None:
+    """A planning method in a child; ``None`` when it has not answered within ``wait`` s (+ grace)."""
+    return call_isolated(run_method, (method, problem, options), {}, wait,
+                         on_death=lambda message: failed_plan(method.name, message))
