@@ -48,6 +48,7 @@ from att_planner.cones import Cone
 from att_planner.problem import (STATUS_BUDGET, STATUS_FAILED, STATUS_FEASIBLE, STATUS_OPTIMAL,
                                  ManeuverPlan, ManeuverProblem)
 from att_sim import rotations as rot
+from att_sim import dynamics as dyn
 from att_sim.dynamics import Spacecraft
 
 PAPER_M, PAPER_N, PAPER_W = 4, 500, 0.015
@@ -64,9 +65,23 @@ def _vee(S: np.ndarray) -> np.ndarray:
 
 
 def _log_so3(R: np.ndarray) -> np.ndarray:
-    """Rotation vector of a single rotation matrix (angle in [0, π])."""
-    axis, angle = rot.to_axis_angle(rot.from_dcm(R))
-    return axis * angle
+    """Rotation vector of a single rotation matrix (angle in [0, π))."""
+    c = np.clip(0.5 * (np.trace(R) - 1.0), -1.0, 1.0)
+    th = float(np.arccos(c))
+    w = 0.5 * _vee(R - R.T)                   # sin θ · axis
+    if th < 1e-6:
+        return w * (1.0 + th * th / 6.0)
+    if th > np.pi - 1e-6:                     # θ ≈ π: axis from the symmetric part
+        axis = rot.to_axis_angle(rot.from_dcm(R))[0]
+        return axis * th
+    return w * (th / np.sin(th))
+
+
+def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """a × b on the last axis with broadcasting (np.cross is slow on small stacks)."""
+    a0, a1, a2 = a[..., 0], a[..., 1], a[..., 2]
+    b0, b1, b2 = b[..., 0], b[..., 1], b[..., 2]
+    return np.stack([a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0], axis=-1)
 
 
 def _right_jacobian(phi: np.ndarray) -> np.ndarray:
@@ -218,9 +233,11 @@ def evaluate(man: SmoothManeuver, alpha: np.ndarray, jac: bool = False) -> Evalu
     A = np.asarray(alpha, float).reshape(3, M)
     w = V @ A.T                                           # (N, 3)
     J = man.inertia
-    dw = np.vstack([np.zeros((1, 3)), np.diff(w, axis=0)]) / dt
+    dw = np.empty_like(w)
+    dw[0] = 0.0
+    dw[1:] = (w[1:] - w[:-1]) / dt
     Jw = w @ J.T
-    torque = dw @ J.T + np.cross(w, Jw)
+    torque = dw @ J.T + _cross(w, Jw)
     phi = dt * w
     E = _expm_stack(phi)
     R = np.concatenate([man.R_initial[None], man.R_initial @ _cumulative_product(E)])
@@ -244,12 +261,12 @@ def evaluate(man: SmoothManeuver, alpha: np.ndarray, jac: bool = False) -> Evalu
     G = R[1:] @ _right_jacobian(phi)                      # (N, 3, 3)
     H = (dt * G[..., None] * V[:, None, None, :]).reshape(N, 3, P)
     eta = np.concatenate([np.zeros((1, 3, P)), np.cumsum(H, axis=0)])   # (N+1, 3, P)
-    bw = np.cross(b[:, None, :], man.cone_dirs[None, :, :])             # (N+1, C, 3)
+    bw = _cross(b[:, None, :], man.cone_dirs[None, :, :])             # (N+1, C, 3)
     ev.cones_jac = np.einsum("nxp,ncx->ncp", eta, bw)
     if man.sensor_target is None:
         ev.final_jac = _left_jacobian_inv(final) @ man.R_final.T @ eta[N]
     else:
-        bu = np.cross(b[N][None, :], man.target_basis)                 # (2, 3)
+        bu = _cross(b[N][None, :], man.target_basis)                 # (2, 3)
         ev.final_jac = bu @ eta[N]
     return ev
 
@@ -407,11 +424,14 @@ def _slsqp_status(res, stopped_by_deadline: bool, feasible: bool) -> str:
 
 
 def _sqp(man: SmoothManeuver, x0: np.ndarray, *, min_time: bool, maxiter: int, ftol: float, feas_tol: float,
-         deadline: float | None, max_rounds: int = 8, peak_limit: float = np.inf, end_ratio: float | None = None):
+         deadline: float | None, max_rounds: int = 8, peak_limit: float = np.inf, end_ratio: float | None = None,
+         max_total_iterations: int | None = None, all_rows: bool = False):
     """SLSQP with exact Jacobians on a growing working set; returns (x, stats, status, message).
 
     ``min_time``: variables (x, s), min s s.t. s ∓ T*_jℓ ≥ 0 (epigraph of max |T*|); otherwise
-    min ½‖x‖² (MSSA). Both with final attitude = 0 and cones ≤ 0. x = α/√N.
+    min ½‖x‖² (MSSA). Both with final attitude = 0 and cones ≤ 0. x = α/√N. Each working-set
+    round is a fresh SLSQP run of up to ``maxiter`` iterations (which also resets its quasi-Newton
+    matrix); rounds stop at ``max_total_iterations`` (default: ``maxiter``·``max_rounds``).
 
     ``end_ratio`` ρ (min-time only) keeps the ends smooth for any basis size:
     |T*_jℓ| ≤ ρ s at ℓ ∈ {1, 2, N−1, N} and |ω*_j(τ_1)|, |ω*_j(τ_N)| ≤ ρ (rad per unit τ). The
@@ -421,7 +441,12 @@ def _sqp(man: SmoothManeuver, x0: np.ndarray, *, min_time: bool, maxiter: int, f
     cache = _Cache(man)
     sc = cache.alpha_scale
     P = man.n_params
-    ws = _WorkingSet(man)
+    ws = _WorkingSet(man, stride=1 if all_rows else 10)
+    if all_rows:
+        ws.torque[:] = min_time
+        ws.cones[:] = True
+    if max_total_iterations is None:
+        max_total_iterations = maxiter * max_rounds
     ev0 = cache(x0)
     ws.add_near_active(ev0, ev0.peak_torque)
     z = np.append(x0, ev0.peak_torque) if min_time else np.array(x0, float)
@@ -492,7 +517,8 @@ def _sqp(man: SmoothManeuver, x0: np.ndarray, *, min_time: bool, maxiter: int, f
         stopped = deadline is not None and time.monotonic() > deadline
         ev = cache(z[:P])
         peak = z[P] if min_time else ev.peak_torque
-        if stopped or ev.peak_torque > peak_limit or not ws.add_violated(ev, peak, feas_tol):
+        if (stopped or ev.peak_torque > peak_limit or nit >= max_total_iterations
+                or not ws.add_violated(ev, peak, feas_tol)):
             break
         if min_time:
             z[P] = ev.peak_torque       # restart from a point of the epigraph
@@ -508,24 +534,37 @@ def _sqp(man: SmoothManeuver, x0: np.ndarray, *, min_time: bool, maxiter: int, f
 
 
 def solve_mssa(man: SmoothManeuver, alpha0: np.ndarray | None = None, *, maxiter: int = 300,
-               ftol: float = 1e-10, feas_tol: float = 1e-6, deadline: float | None = None) -> SlepianResult:
+               ftol: float = 1e-10, feas_tol: float = 1e-6, deadline: float | None = None,
+               restarts: int = 0, seed: int = 0, start_scale: float = 1.0) -> SlepianResult:
     """Celani–Lucarelli: min ½ Σ α_jk² s.t. final attitude and cones (SLSQP, exact gradients).
 
     ``alpha0 = None`` starts from α = 0 as in the paper (the rest attitude R_i). There the
     right-Jacobian derivative is regular (J_r(0) = I) where the spectral formula for the derivative
     of exp is degenerate (triple zero eigenvalue); SQP's first step is the eigenaxis rotation,
-    which then has to bend around the cones.
+    which then has to bend around the cones. If that start ends infeasible, up to ``restarts``
+    seeded Gaussian starts (x = α/√N ~ N(0, start_scale²)) are tried (not in the paper). All
+    (N+1)·C cone rows are handed to SLSQP, as in the paper.
     """
     t0 = time.perf_counter()
     x0 = np.zeros(man.n_params) if alpha0 is None else np.ravel(alpha0) / np.sqrt(man.N)
-    alpha, stats, status, message = _sqp(man, x0, min_time=False, maxiter=maxiter, ftol=ftol,
-                                         feas_tol=feas_tol, deadline=deadline)
-    return _result(man, alpha, status, message, t0, feas_tol, energy=0.5 * float(np.sum(alpha ** 2)), **stats)
+    rng = np.random.default_rng(seed)
+    tried = []
+    for attempt in range(restarts + 1):
+        if attempt:   # seeded random restart, only when the previous attempt found no feasible point
+            x0 = rng.normal(size=man.n_params) * start_scale
+        alpha, stats, status, message = _sqp(man, x0, min_time=False, maxiter=maxiter, ftol=ftol,
+                                             feas_tol=feas_tol, deadline=deadline, max_rounds=1, all_rows=True)
+        tried.append(status)
+        if status != STATUS_FAILED or (deadline is not None and time.monotonic() > deadline):
+            break
+    return _result(man, alpha, status, message, t0, feas_tol, energy=0.5 * float(np.sum(alpha ** 2)),
+                   attempts=tried, **stats)
 
 
 def solve_min_time_local(man: SmoothManeuver, alpha0: np.ndarray, *, maxiter: int = 300, ftol: float = 1e-10,
                          feas_tol: float = 1e-6, deadline: float | None = None,
-                         peak_limit: float = np.inf, end_ratio: float | None = None) -> SlepianResult:
+                         peak_limit: float = np.inf, end_ratio: float | None = None,
+                         max_total_iterations: int | None = None) -> SlepianResult:
     """Ours, one local solve: min s s.t. −s ≤ T*_jℓ(α) ≤ s, final attitude, cones (SLSQP).
 
     The epigraph form makes the non-smooth max |T*| a smooth program whose optimum is exactly the
@@ -534,7 +573,7 @@ def solve_min_time_local(man: SmoothManeuver, alpha0: np.ndarray, *, maxiter: in
     t0 = time.perf_counter()
     alpha, stats, status, message = _sqp(man, np.ravel(alpha0) / np.sqrt(man.N), min_time=True, maxiter=maxiter,
                                          ftol=ftol, feas_tol=feas_tol, deadline=deadline, peak_limit=peak_limit,
-                                         end_ratio=end_ratio)
+                                         end_ratio=end_ratio, max_total_iterations=max_total_iterations)
     return _result(man, alpha, status, message, t0, feas_tol, **stats)
 
 
@@ -549,9 +588,9 @@ def solve_dfsp(man: SmoothManeuver, alpha0: np.ndarray | None = None, *,
                phases: tuple = ("mmt", "mssa", "mmt", "mssa", "mmt"),
                iterations: tuple = (10_000, 10_000, 10_000, 10_000, 30_000),
                time_budget: float | None = 60.0, deadline: float | None = None,
-               eps0: float = 1e-2, q: float = 1.1, gamma: float = 1e-6, theta: float = 0.5,
+               eps0: float = 1e-1, q: float = 2.0, gamma: float = 1e-6, theta: float = 0.5,
                delta: float = 0.5, p: float = 1.5, step0: float = 0.5, step_min: float = 1e-9,
-               feas_tol: float = 1e-4) -> SlepianResult:
+               feas_tol: float = 5e-4) -> SlepianResult:
     """Celani–Bruni: derivative-free sequential penalty with objective alternation.
 
     Each phase minimises the merit Z(x; ε) = f(x)/f_ref + (1/ε)(Σ max(0, g_i)^q + Σ |h_j|^q)
@@ -560,9 +599,13 @@ def solve_dfsp(man: SmoothManeuver, alpha0: np.ndarray | None = None, *,
     decrease Z(x + a d) ≤ Z(x) − γa², expand by 1/δ while it keeps decreasing, otherwise shrink the
     tentative step by θ; ε ← θε (penalty driven up) when every tentative step is below ε^p.
     f is t_f (MMT, not differentiable, evaluated by simulation) or ½Σα² (MSSA). One iteration is
-    one sweep over all 2·3M directions. The published run is 10,000 iterations per phase (30,000
+    one sweep over all 2·3M directions; a phase also ends when every step is below ``step_min``.
+    Penalty exponent q = 2 (smooth merit: with q near 1 coordinate moves off the curved
+    final-attitude manifold are never accepted once ε is small). The published run is 10,000 iterations per phase (30,000
     in the last) — about an hour; ``time_budget`` (seconds, split over phases in proportion to
-    their iterations) keeps the default run short. The result is the best feasible MMT point.
+    their iterations) keeps the default run short. The result is the best feasible point met
+    (a penalty method approaches feasibility from outside: ``feas_tol`` 5e-4 rad of final
+    attitude / cone cosine, covered by the planner's cone margin of 1e-3 rad).
     """
     t0 = time.perf_counter()
     if len(phases) != len(iterations):
@@ -598,6 +641,7 @@ def solve_dfsp(man: SmoothManeuver, alpha0: np.ndarray | None = None, *,
             raise ValueError(f"phases must be 'mmt' or 'mssa', got {phase!r}")
         phase_end = None if end is None else phase_start + (end - phase_start) * n_iter / total_iterations
         total_iterations -= n_iter
+        state.steps[:] = step0          # each phase restarts its coordinate step sizes
         obj_index = 0 if phase == "mmt" else 1
         # objective scale: the time unit sqrt(J_max/T̄) for MMT, the phase's starting energy for MSSA
         ref = t_unit if phase == "mmt" else max(measure(state.x)[1], t_unit)
@@ -661,8 +705,9 @@ def _pad_alpha(alpha: np.ndarray, N_from: int, N_to: int, M_to: int) -> np.ndarr
     return out * np.sqrt(N_to)
 
 
-def solve_min_time(man: SmoothManeuver, *, basis_sizes: tuple = (4, 8), starts: int = 8, seed: int = 0,
-                   start_scale: float = 1.0, explore_N: int = 100, explore_maxiter: int = 100,
+def solve_min_time(man: SmoothManeuver, *, basis_sizes: tuple = (4, 8), starts: int = 6, seed: int = 0,
+                   start_scale: float = 0.5, explore_N: int = 60, explore_maxiter: int = 60,
+                   explore_total_iterations: int = 150,
                    end_ratio: float = 1e-3, alpha0: np.ndarray | None = None, time_budget: float | None = None,
                    deadline: float | None = None, feas_tol: float = 1e-6) -> SlepianResult:
     """Ours: minimum t_f, exactly (epigraph SQP with exact gradients), with global search.
@@ -695,7 +740,8 @@ def solve_min_time(man: SmoothManeuver, *, basis_sizes: tuple = (4, 8), starts: 
             break
         limit = 50.0 * best.stats["peak"] if best is not None else np.inf
         r = solve_min_time_local(coarse, a0, maxiter=explore_maxiter, feas_tol=feas_tol, deadline=end,
-                                 peak_limit=limit, end_ratio=end_ratio if M0 > PAPER_M else None)
+                                 peak_limit=limit, end_ratio=end_ratio if M0 > PAPER_M else None,
+                                 max_total_iterations=explore_total_iterations)
         r.stats["peak"] = evaluate(coarse, r.alpha).peak_torque
         explored.append(round(r.tf, 6) if r.feasible else None)
         if r.feasible and (best is None or r.tf < best.tf):
@@ -727,3 +773,142 @@ def solve_min_time(man: SmoothManeuver, *, basis_sizes: tuple = (4, 8), starts: 
         status = STATUS_BUDGET
     return _result(fine, r.alpha, status, r.message, t0, feas_tol, explored=explored, continuation=path,
                    iterations=r.stats.get("iterations"))
+
+
+# ---------------------------------------------------------------------------------------------
+# Planner entry point
+# ---------------------------------------------------------------------------------------------
+
+_METHOD_OPTIONS = {
+    "slepian_minimum_time": {"starts", "seed", "start_scale", "explore_N", "explore_maxiter",
+                             "explore_total_iterations", "end_ratio", "time_budget", "feas_tol"},
+    "mssa": {"maxiter", "ftol", "feas_tol", "restarts", "seed", "start_scale"},
+    "dfsp": {"phases", "iterations", "time_budget", "eps0", "q", "gamma", "theta", "delta", "p", "step0",
+             "step_min", "feas_tol", "seed_with_mssa"},
+}
+DEFAULT_M = {"slepian_minimum_time": 8, "mssa": PAPER_M, "dfsp": PAPER_M}
+
+
+def _validate(method: str, M: int | None, N: int, W: float, cone_margin: float, options: dict) -> int:
+    if method not in METHODS:
+        raise ValueError(f"method must be one of {METHODS}, got {method!r}")
+    if not isinstance(N, (int, np.integer)) or not 20 <= N <= 20_000:
+        raise ValueError(f"N (samples) must be an integer in [20, 20000], got {N!r}")
+    if not (isinstance(W, (int, float)) and 0.0 < W < 0.5 and N * W >= 1.0):
+        raise ValueError(f"W (half-bandwidth) must be in (0, 0.5) with N·W ≥ 1, got {W!r} for N = {N}")
+    M = DEFAULT_M[method] if M is None else M
+    max_M = int(np.floor(2 * N * W))
+    if not isinstance(M, (int, np.integer)) or not 1 <= M <= max_M:
+        raise ValueError(f"M (basis size) must be an integer in [1, 2·N·W = {max_M}] (well-concentrated "
+                         f"Slepian sequences), got {M!r}")
+    if not (isinstance(cone_margin, (int, float)) and 0.0 <= cone_margin < 0.2):
+        raise ValueError(f"cone_margin must be in [0, 0.2) rad, got {cone_margin!r}")
+    unknown = set(options) - _METHOD_OPTIONS[method]
+    if unknown:
+        raise ValueError(f"option(s) {sorted(unknown)} not understood by method {method!r} "
+                         f"(valid: {sorted(_METHOD_OPTIONS[method])})")
+    return int(M)
+
+
+def _reject_cone_endpoints(problem: ManeuverProblem) -> str | None:
+    """A sentence naming the cone that contains the start or goal sensor direction, else None."""
+    r = np.asarray(problem.sensor_axis, float)
+    r = r / np.linalg.norm(r)
+    ends = {"start": rot.dcm(problem.q_initial) @ r}
+    if problem.sensor_target is not None:
+        ends["goal"] = np.asarray(problem.sensor_target, float) / np.linalg.norm(problem.sensor_target)
+    else:
+        ends["goal"] = rot.dcm(problem.q_final) @ r
+    for which, b in ends.items():
+        for i, c in enumerate(problem.cones):
+            margin = float(np.arccos(np.clip(b @ c.direction, -1.0, 1.0)) - c.half_angle)
+            if margin < 0.0:
+                name = c.name or f"#{i}"
+                return (f"infeasible request: the {which} sensor direction is inside keep-out cone {name} "
+                        f"({np.degrees(-margin):.2f} deg inside its {np.degrees(c.half_angle):.1f} deg half-angle)")
+    return None
+
+
+def _empty_plan(method: str, status: str, message: str, seconds: float, stats: dict) -> ManeuverPlan:
+    return ManeuverPlan(method=method, t=np.zeros(0), torque=np.zeros((0, 3)), q=np.zeros((0, 4)),
+                        omega=np.zeros((0, 3)), interpolation="zoh", status=status, message=message,
+                        solve_seconds=seconds, stats=stats)
+
+
+def physical_profile(man: SmoothManeuver, alpha: np.ndarray, spacecraft: Spacecraft | None = None) -> dict:
+    """Physical-time plan of α: knots t_k = τ_k t_f (K = N+1) and ZOH body torque
+    T_k = T*(τ_k)/t_f² (the last one zero, T_k held on [t_k, t_{k+1})).
+
+    The q/ω references at the knots are the rigid-body response to exactly this torque from rest
+    (one RK4 step per sample, :func:`att_sim.dynamics.simulate_profile`), so the controller tracks
+    what the torque does; the ZOH model attitudes R_k lead it by about half a sample.
+    Without ``spacecraft`` the references are the model's R_k and ω*(τ_{k−1})/t_f.
+    """
+    ev = evaluate(man, alpha)
+    tf = man.tf_from_peak(ev.peak_torque)
+    N = man.N
+    t = np.arange(N + 1) / N * tf
+    torque = np.zeros((N + 1, 3))
+    torque[:N] = ev.torque * man.inertia_scale / tf**2
+    if spacecraft is None:
+        q = rot.from_dcm(ev.R)
+        omega = np.zeros((N + 1, 3))
+        omega[1:] = ev.omega / tf
+    else:
+        x0 = dyn.initial_state(spacecraft, rot.from_dcm(man.R_initial))
+        traj = dyn.simulate_profile(spacecraft, x0, t, torque, kind="body_torque", interpolation="zoh",
+                                    max_step=tf / N)
+        q, omega = traj.q, traj.omega
+    return {"t": t, "torque": torque, "q": q, "omega": omega, "tf": tf, "evaluation": ev}
+
+
+def plan_slepian(problem: ManeuverProblem, method: str = DEFAULT_METHOD, M: int | None = None,
+                 N: int = PAPER_N, W: float = PAPER_W, cone_margin: float = 1e-3, **options) -> ManeuverPlan:
+    """Smooth rest-to-rest keep-out-cone plan (Slepian rate basis), body torque with ZOH.
+
+    ``method``: 'slepian_minimum_time' (ours, default; M is the final basis size of the
+    continuation 4 → … → M, default 8), 'mssa' (Celani–Lucarelli) or 'dfsp' (Celani–Bruni), both
+    with the paper basis M = 4 by default. N, W: DPSS length and half-bandwidth (paper 500,
+    0.015). ``cone_margin`` (rad) is kept from every cone by the optimiser so that the truth
+    integration between samples stays outside. Other options go to the method's solver
+    (:func:`solve_min_time`, :func:`solve_mssa`, :func:`solve_dfsp`); unknown ones raise
+    ValueError. Refuses (STATUS_FAILED) when the start or goal sensor direction is in a cone.
+    Honours ``problem.deadline`` (best feasible plan so far, STATUS_BUDGET).
+    """
+    t0 = time.perf_counter()
+    M = _validate(method, M, N, W, cone_margin, options)
+    base = {"method_variant": method, "M": M, "N": N, "W": W}
+    reason = _reject_cone_endpoints(problem)
+    if reason:
+        return _empty_plan(method, STATUS_FAILED, reason, time.perf_counter() - t0, base)
+    tmax = problem.spacecraft.body_torque_max
+    if not (np.isfinite(tmax) and tmax > 0):
+        return _empty_plan(method, STATUS_FAILED, "spacecraft.body_torque_max must be finite and positive "
+                           "(T̄ sets the maneuver time)", time.perf_counter() - t0, base)
+    man = build_maneuver(problem, M=M if method != "slepian_minimum_time" else PAPER_M, N=N, W=W,
+                         cone_margin=cone_margin)
+    deadline = problem.deadline
+    if method == "slepian_minimum_time":
+        sizes = tuple(sorted({min(PAPER_M, M), *range(PAPER_M * 2, M, PAPER_M), M}))
+        res = solve_min_time(man, basis_sizes=sizes, deadline=deadline, **options)
+    elif method == "mssa":
+        res = solve_mssa(man, deadline=deadline, **options)
+    else:
+        opts = dict(options)
+        alpha0 = None
+        if opts.pop("seed_with_mssa", True):
+            seed_res = solve_mssa(man, deadline=deadline, restarts=4)
+            alpha0 = seed_res.alpha if seed_res.feasible else None
+        res = solve_dfsp(man, alpha0, deadline=deadline, **opts)
+    final_man = man.resized(M=res.alpha.shape[1])
+    stats = dict(base, M=int(res.alpha.shape[1]), alpha=res.alpha.tolist(), tf=res.tf, feasible=res.feasible,
+                 **{k: v for k, v in res.stats.items()})
+    seconds = time.perf_counter() - t0
+    if not res.feasible:
+        status = STATUS_BUDGET if res.status == STATUS_BUDGET else STATUS_FAILED
+        return _empty_plan(method, STATUS_FAILED, f"no feasible smooth plan ({res.message}; status {status})",
+                           seconds, stats)
+    prof = physical_profile(final_man, res.alpha, problem.spacecraft)
+    return ManeuverPlan(method=method, t=prof["t"], torque=prof["torque"], q=prof["q"], omega=prof["omega"],
+                        interpolation="zoh", status=res.status, message=res.message, solve_seconds=seconds,
+                        stats=stats)
