@@ -205,6 +205,7 @@ def summary_of(run: Run, spacecraft: Spacecraft | None = None) -> dict:
     sc = spacecraft
     out = {"kind": run.kind, "start_sim_time_s": run.t0, "executed_time_s": float(run.t[-1] - run.t[0]),
            "state_samples": int(len(run.t)), "command_timeouts": int(np.sum(run.command_timeout)),
+           "wheels": int(run.wheel_speeds.shape[1]),
            "plan": None, "maneuver_time_s": None}
     if run.plan is not None:
         p = run.plan
@@ -279,8 +280,11 @@ def format_summary(s: dict) -> str:
     for name, v in s["min_margin_deg"].items():
         lines.append(f"min margin {name:<10} {deg(v, 2)} at t = {s['closest_approach_s'][name]:.1f} s")
     lines.append(f"peak body torque      {ratio('body_torque_Nm', 'N m')}")
-    lines.append(f"peak wheel torque     {ratio('wheel_torque_Nm', 'N m')}")
-    lines.append(f"peak wheel speed      {ratio('wheel_speed_rad_s', 'rad/s')}")
+    if s["wheels"]:
+        lines.append(f"peak wheel torque     {ratio('wheel_torque_Nm', 'N m')}")
+        lines.append(f"peak wheel speed      {ratio('wheel_speed_rad_s', 'rad/s')}")
+    else:
+        lines.append("wheels                none")
     lines.append(f"peak dipole           {ratio('dipole_Am2', 'A m^2')}")
     if s["kind"] == "magnetorquer":
         st = s["settling_time_s"]
@@ -391,7 +395,8 @@ def plot_sky(ax, run: Run, summary: dict) -> None:
     ax.set_aspect("equal")
     ax.axis("off")
     ax.legend(loc="lower left", fontsize=7, frameon=False, bbox_to_anchor=(-0.02, -0.04))
-    ax.set_title("Boresight on the sky (equal-area, closest approach ×)", fontsize=10)
+    ax.set_title("Boresight on the sky (equal-area, closest approach ×)" if plan is not None
+                 else "Body x axis on the sky (no plan in the log)", fontsize=10)
 
 
 def _limits(ax, limit, label=None):
@@ -451,7 +456,10 @@ def plot_wheel_torque(ax, run: Run, sc: Spacecraft | None) -> None:
             ax.plot(run.cmd_t, run.cmd_wheel_torques[:, i], ls="--", lw=0.8, color=line.get_color())
     _limits(ax, _limit(sc.wheel_torque_max) if sc else None, "limit")
     ax.set_ylabel("wheel torque [N m]\n(— applied, -- cmd)")
-    ax.legend(loc="upper right", fontsize=7, ncol=2)
+    if run.wheel_speeds.shape[1] == 0:
+        ax.text(0.5, 0.5, "no reaction wheels", ha="center", va="center", transform=ax.transAxes)
+    else:
+        ax.legend(loc="upper right", fontsize=7, ncol=2)
 
 
 def plot_wheel_speeds(ax, run: Run, sc: Spacecraft | None) -> None:
@@ -459,7 +467,10 @@ def plot_wheel_speeds(ax, run: Run, sc: Spacecraft | None) -> None:
         ax.plot(run.t, run.wheel_speeds[:, i], label=f"wheel {i + 1}")
     _limits(ax, _limit(sc.wheel_speed_max) if sc else None, "limit")
     ax.set_ylabel("wheel speed [rad/s]")
-    ax.legend(loc="upper right", fontsize=7, ncol=2)
+    if run.wheel_speeds.shape[1] == 0:
+        ax.text(0.5, 0.5, "no reaction wheels", ha="center", va="center", transform=ax.transAxes)
+    else:
+        ax.legend(loc="upper right", fontsize=7, ncol=2)
 
 
 def plot_dipole(ax, run: Run, sc: Spacecraft | None) -> None:
