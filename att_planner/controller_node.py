@@ -55,6 +55,7 @@ class ControllerNode(Node):
         self.kp_track, self.kd_track = float(param("tracking_kp", 0.4)), float(param("tracking_kd", 10.0))
         self.settle_time = float(param("settle_time", 20.0))
         self.kp_mag, self.kd_mag = float(param("kp", 2e5)), float(param("kd", 1e8))
+        self.m_max = float(param("m_max", self.sc.dipole_max))
         self.safe_kd = float(param("safe_kd", self.kd_track))
         self.mode = int(param("initial_mode", MODE_IDLE))
 
@@ -77,6 +78,8 @@ class ControllerNode(Node):
         self.action = ActionServer(self, ExecuteManeuver, topics.EXECUTE_MANEUVER, execute_callback=self.execute,
                                    goal_callback=self.on_goal, cancel_callback=lambda _: CancelResponse.ACCEPT,
                                    callback_group=cb_action)
+        self.get_logger().info(f"scenario '{self.scenario.name}', mode {self.mode}; magnetorquer gains "
+                               f"kp={self.kp_mag:.6g} kd={self.kd_mag:.6g} m_max={self.m_max:g}")
 
     # -- inputs ---------------------------------------------------------------------------------
     def on_state(self, msg: SpacecraftState):
@@ -214,7 +217,7 @@ class ControllerNode(Node):
         cmd.header.frame_id = self.scenario.body_frame_id
         status = ControllerStatus(mode=self.mode, header=cmd.header)
         if self.mode == MODE_MAGNETORQUER_PD:
-            m = dipole_command(s["q"], s["omega"], s["field_body"], self.kp_mag, self.kd_mag, self.sc.dipole_max)
+            m = dipole_command(s["q"], s["omega"], s["field_body"], self.kp_mag, self.kd_mag, self.m_max)
             cmd.dipole = convert.vector3(m)
         elif self.mode == MODE_SAFE:
             tau = -self.safe_kd * s["omega"]

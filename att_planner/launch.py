@@ -39,8 +39,12 @@ class Suite:
     log_dir: Path
     procs: dict = field(default_factory=dict)
 
-    def start(self, name: str, params: dict | None = None) -> subprocess.Popen:
+    def start(self, name: str, params: dict | None = None, params_files: tuple = ()) -> subprocess.Popen:
+        """Start node ``name`` with ``-p key:=value`` parameters and ``--params-file`` files
+        (files override the scenario defaults, ``params`` override both)."""
         args = [sys.executable, "-m", NODE_MODULES[name], "--ros-args"]
+        for path in params_files:
+            args += ["--params-file", str(path)]
         for key, value in (params or {}).items():
             args += ["-p", f"{key}:={value}"]
         self.log_dir.mkdir(parents=True, exist_ok=True)

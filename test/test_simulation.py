@@ -84,3 +84,23 @@ def test_idle_mode_applies_nothing(sim):
     sim.set_command(MODE_IDLE, [0.1, 0.1, 0.1], [1, 1, 1], [0.1, 0, 0])
     sim.advance(0.5)
     assert np.allclose(sim.x[4:7], 0) and np.allclose(sim.applied.body_torque, 0)
+
+
+def test_tuned_gains_file_is_loaded_by_the_controller_node(tmp_path):
+    """att-tune writes controller.ros__parameters.{kp, kd, m_max}; --params-file loads them."""
+    import time
+
+    from att_planner.launch import Suite, isolated_env
+    from att_planner.tune_cli import write_gains
+
+    gains = tmp_path / "controller_gains.yaml"
+    write_gains(str(gains), 123456.5, 98765432.25, 7.5)
+    suite = Suite(isolated_env(), tmp_path)
+    suite.start("controller", {"scenario": "bruni_celani"}, params_files=(gains,))
+    try:
+        end = time.monotonic() + 60
+        while time.monotonic() < end and "magnetorquer gains" not in suite.log_text("controller"):
+            time.sleep(0.2)
+    finally:
+        suite.stop()
+    assert "kp=123456 kd=9.87654e+07 m_max=7.5" in suite.log_text("controller")
