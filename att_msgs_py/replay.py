@@ -96,7 +96,7 @@ def schedule(records: list[Record], clock: bool, clock_recorded: bool) -> list[R
 
 
 def play(path: str | Path, *, rate: float = 1.0, topics: list[str] | None = None, clock: bool = False,
-         wait: float = 2.0, linger: float = 5.0, node_name: str = "att_replay", log=print) -> dict[str, int]:
+         wait: float = 5.0, linger: float = 5.0, node_name: str = "att_replay", log=print) -> dict[str, int]:
     """Republish the log; returns messages published per topic. Needs ``rclpy`` initialised."""
     from rclpy.duration import Duration
     from rclpy.node import Node
@@ -126,8 +126,9 @@ def play(path: str | Path, *, rate: float = 1.0, topics: list[str] | None = None
         while time.monotonic() < deadline and any(p.get_subscription_count() == 0 for p in pubs.values()):
             time.sleep(0.05)
         counts = {t: 0 for t in pubs}
-        log(f"replaying {len(records)} messages on {len(pubs)} topics "
-            f"({'as fast as possible' if rate == 0 else f'rate {rate:g}'})")
+        listened = sum(p.get_subscription_count() > 0 for p in pubs.values())
+        log(f"replaying {len(records)} messages on {len(pubs)} topics ({listened} with subscribers), "
+            f"{'as fast as possible' if rate == 0 else f'rate {rate:g}'}")
         t_start, wall_start = (records[0].log_time_ns if records else 0), time.monotonic()
         for r in records:
             if rate > 0:
@@ -150,7 +151,7 @@ def main(argv=None) -> int:
     parser.add_argument("--rate", type=float, default=1.0, help="playback speed factor; 0 = as fast as possible")
     parser.add_argument("--topics", nargs="+", default=None, help="topics to replay (default: all but /clock)")
     parser.add_argument("--clock", action="store_true", help="also publish /clock from the log")
-    parser.add_argument("--wait", type=float, default=2.0, help="s to wait for subscribers before playing")
+    parser.add_argument("--wait", type=float, default=5.0, help="s to wait for subscribers before playing")
     parser.add_argument("--linger", type=float, default=5.0,
                         help="at most this many s waited after the last message for reliable subscribers to acknowledge")
     args, ros_args = parser.parse_known_args(argv)

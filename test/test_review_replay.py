@@ -196,7 +196,8 @@ def test_replay_republishes_the_fixture_with_its_types(log):
 
     spinner = threading.Thread(target=spin)
     spinner.start()
-    proc = subprocess.Popen([sys.executable, "-m", "att_msgs_py.replay", str(FIXTURE), "--rate", "0", "--clock"],
+    proc = subprocess.Popen([sys.executable, "-m", "att_msgs_py.replay", str(FIXTURE), "--rate", "0", "--clock",
+                             "--wait", "30"],
                             env=isolated_env(domain), stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
     try:
         out, _ = proc.communicate(timeout=40)
@@ -219,3 +220,19 @@ def test_replay_republishes_the_fixture_with_its_types(log):
     stamps = [m.header.stamp.sec + 1e-9 * m.header.stamp.nanosec for m in received["/spacecraft/state"]]
     assert np.allclose(stamps, log["/spacecraft/state"]["header.stamp"])       # in order, unchanged
     assert received["/planner/plans"][0].plan_id == log["/planner/plans"]["plan_id"][0]
+
+
+def test_replay_builds_a_clock_from_log_times_when_the_log_has_none():
+    from rclpy.serialization import deserialize_message
+    from rosgraph_msgs.msg import Clock
+
+    from att_msgs_py.replay import CLOCK, Record, schedule
+
+    records = [Record(1_500_000_000, "/a", "t", b"1"), Record(1_500_000_000, "/b", "t", b"2"),
+               Record(2_999_999_999, "/a", "t", b"3")]
+    assert schedule(records, clock=False, clock_recorded=False) == records
+    assert schedule(records, clock=True, clock_recorded=True) == records
+    out = schedule(records, clock=True, clock_recorded=False)
+    assert [r.topic for r in out] == [CLOCK, "/a", "/b", CLOCK, "/a"]
+    stamps = [deserialize_message(r.data, Clock).clock for r in out if r.topic == CLOCK]
+    assert [(s.sec, s.nanosec) for s in stamps] == [(1, 500_000_000), (2, 999_999_999)]
