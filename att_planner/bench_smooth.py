@@ -21,7 +21,7 @@ from att_sim import rotations as rot
 UNITS = {"earth_obs": "s", "swift": "TU"}
 PUBLISHED_KEY = {"slepian_minimum_time": None, "mssa": "mssa", "dfsp": "dfsp"}
 ATTITUDE_TOL = 1e-3          # 3 − tr(R_fᵀ R(t_f)), the issue's bound
-RATE_TOL_RELATIVE = 1e-3     # ‖ω(t_f)‖ ≤ 1e-3 · max ‖ω‖ ("final rate small")
+RATE_TOL_RELATIVE = 1e-2     # ‖ω(t_f)‖ ≤ 1 % of max ‖ω‖ ("final rate small")
 DENSE_PER_SAMPLE = 4         # RK4 substeps per torque sample in the verification
 
 
@@ -33,6 +33,8 @@ def configure(parser):
     parser.add_argument("--M", type=int, default=None, help="basis size of --method (default per method)")
     parser.add_argument("--N", type=int, default=S.PAPER_N)
     parser.add_argument("--W", type=float, default=S.PAPER_W)
+    parser.add_argument("--also-M", default="4,12",
+                        help="comma-separated extra basis sizes for ours (rows of the table and 'runs')")
     parser.add_argument("--dfsp-budget", type=float, default=60.0,
                         help="DFSP time budget in seconds (the published run took ~1 h)")
     parser.add_argument("--dfsp-paper", action="store_true",
@@ -58,9 +60,9 @@ def verification(problem, plan) -> dict:
     return out
 
 
-def run_method(case: str, method: str, args) -> dict:
+def run_method(case: str, method: str, args, M: int | None = None) -> dict:
     problem = S.benchmark_problem(case)
-    M = args.M if method == args.method else None
+    M = args.M if M is None and method == args.method else M
     options = {}
     if method == "dfsp":
         options = {"time_budget": None} if args.dfsp_paper else {"time_budget": args.dfsp_budget}
@@ -77,6 +79,8 @@ def run(args) -> dict:
     case = args.case
     methods = [args.method] if args.only else [args.method] + [m for m in S.METHODS if m != args.method]
     runs = [run_method(case, m, args) for m in methods]
+    if S.DEFAULT_METHOD in methods and not args.only:
+        runs += [run_method(case, S.DEFAULT_METHOD, args, M=int(m)) for m in args.also_M.split(",") if m.strip()]
     pub = S.PUBLISHED[case]
     unit = UNITS[case]
     print(f"smooth / {case}: t_f in {unit} (conventions of issue 3: N={args.N}, W={args.W}); "

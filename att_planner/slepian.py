@@ -709,15 +709,18 @@ def solve_min_time(man: SmoothManeuver, *, basis_sizes: tuple = (4, 8), starts: 
                    start_scale: float = 0.5, explore_N: int = 60, explore_maxiter: int = 60,
                    explore_total_iterations: int = 150,
                    end_ratio: float = 1e-3, alpha0: np.ndarray | None = None, time_budget: float | None = None,
-                   deadline: float | None = None, feas_tol: float = 1e-6) -> SlepianResult:
+                   deadline: float | None = None, feas_tol: float = 1e-6, budget_tol: float = 5e-4) -> SlepianResult:
     """Ours: minimum t_f, exactly (epigraph SQP with exact gradients), with global search.
 
     1. Multistart on a coarse grid (``explore_N`` samples, same N·W so the same Slepian
-       functions; x = α/√N carries over): α = 0 (eigenaxis-like), ``alpha0`` if given, and
-       ``starts`` seeded Gaussian starts, each a local epigraph solve; runaway starts are cut.
+       functions; x = α/√N carries over): ``alpha0`` if given, ``starts`` seeded Gaussian starts
+       x ~ N(0, start_scale²), then α = 0 (eigenaxis-like); each a local epigraph solve, runaway
+       starts are cut.
     2. Continuation of the best coarse solution over ``basis_sizes`` (zero-padded α), still coarse.
     3. Refinement at the full N with the final basis size: t_f and α follow the issue's
        conventions exactly. ``end_ratio`` keeps torque and rate ≈ 0 at both ends for M > 4.
+    With a deadline (``time_budget`` or ``deadline``) stage 1 stops at half the budget and stage
+    2 at three quarters, so the refinement always gets its turn.
     ``man`` fixes N and W (its own M is ignored in favour of ``basis_sizes``).
     """
     t0 = time.perf_counter()
@@ -729,17 +732,21 @@ def solve_min_time(man: SmoothManeuver, *, basis_sizes: tuple = (4, 8), starts: 
     M0 = basis_sizes[0]
     coarse = man.resized(N=Nc, M=M0)
     rng = np.random.default_rng(seed)
-    candidates = [np.zeros((3, M0))]
-    if alpha0 is not None:
-        candidates.append(_pad_alpha(alpha0, N, Nc, M0))
+    candidates = [] if alpha0 is None else [_pad_alpha(alpha0, N, Nc, M0)]
     candidates += [rng.normal(size=(3, M0)) * start_scale * np.sqrt(Nc) for _ in range(starts)]
+    candidates.append(np.zeros((3, M0)))
     explored = []
     best = None
-    for k, a0 in enumerate(candidates):
-        if end is not None and time.monotonic() > end:
+    start_clock = time.monotonic()
+
+    def share(fraction):   # stage deadlines: exploration ≤ 50 %, continuation ≤ 75 % of the budget
+        return None if end is None else start_clock + fraction * (end - start_clock)
+
+    for a0 in candidates:
+        if end is not None and time.monotonic() > share(0.5):
             break
         limit = 50.0 * best.stats["peak"] if best is not None else np.inf
-        r = solve_min_time_local(coarse, a0, maxiter=explore_maxiter, feas_tol=feas_tol, deadline=end,
+        r = solve_min_time_local(coarse, a0, maxiter=explore_maxiter, feas_tol=feas_tol, deadline=share(0.5),
                                  peak_limit=limit, end_ratio=end_ratio if M0 > PAPER_M else None,
                                  max_total_iterations=explore_total_iterations)
         r.stats["peak"] = evaluate(coarse, r.alpha).peak_torque
@@ -752,11 +759,10 @@ def solve_min_time(man: SmoothManeuver, *, basis_sizes: tuple = (4, 8), starts: 
                        explored=explored)
     alpha, Mc, path = best.alpha, M0, [("coarse", M0, best.tf)]
     for M in basis_sizes[1:]:
-        if end is not None and time.monotonic() > end:
+        if end is not None and time.monotonic() > share(0.75):
             break
-        mc = coarse.resized(M=M)
-        r = solve_min_time_local(mc, _pad_alpha(alpha, Nc, Nc, M), feas_tol=feas_tol, deadline=end,
-                                 end_ratio=end_ratio)
+        r = solve_min_time_local(coarse.resized(M=M), _pad_alpha(alpha, Nc, Nc, M), feas_tol=feas_tol,
+                                 deadline=share(0.75), end_ratio=end_ratio)
         if r.feasible:
             alpha, Mc = r.alpha, M
             path.append(("coarse", M, r.tf))
@@ -765,14 +771,18 @@ def solve_min_time(man: SmoothManeuver, *, basis_sizes: tuple = (4, 8), starts: 
     r = solve_min_time_local(fine, start, feas_tol=feas_tol, deadline=end,
                              end_ratio=end_ratio if Mc > PAPER_M else None)
     path.append(("fine", Mc, r.tf))
-    if not r.feasible:   # keep the coarse solution carried over if the refinement failed
-        r = _result(fine, start, r.status, r.message, t0, feas_tol)
-    stopped = end is not None and time.monotonic() > end
-    status = STATUS_BUDGET if stopped and not r.feasible else r.status
-    if stopped and deadline is not None and time.monotonic() > deadline:
-        status = STATUS_BUDGET
-    return _result(fine, r.alpha, status, r.message, t0, feas_tol, explored=explored, continuation=path,
-                   iterations=r.stats.get("iterations"))
+    stats = dict(explored=explored, continuation=path, iterations=r.stats.get("iterations"))
+    if r.feasible:
+        return _result(fine, r.alpha, r.status, r.message, t0, feas_tol, **stats)
+    # Refinement unfinished (deadline) or failed: the best of its last iterate and the coarse solution
+    # carried over, accepted if it meets the constraints to ``budget_tol`` (well inside the
+    # verification's bounds and the cone margin).
+    status = STATUS_BUDGET if end is not None and time.monotonic() > end else STATUS_FAILED
+    fallback = min((_result(fine, a, status, r.message, t0, budget_tol, **stats) for a in (r.alpha, start)),
+                   key=lambda res: (not res.feasible, res.tf))
+    if fallback.feasible:
+        fallback.message = f"refinement unfinished ({r.message}); constraints met to {budget_tol:g}"
+    return fallback
 
 
 # ---------------------------------------------------------------------------------------------
@@ -781,7 +791,7 @@ def solve_min_time(man: SmoothManeuver, *, basis_sizes: tuple = (4, 8), starts: 
 
 _METHOD_OPTIONS = {
     "slepian_minimum_time": {"starts", "seed", "start_scale", "explore_N", "explore_maxiter",
-                             "explore_total_iterations", "end_ratio", "time_budget", "feas_tol"},
+                             "explore_total_iterations", "end_ratio", "time_budget", "feas_tol", "budget_tol"},
     "mssa": {"maxiter", "ftol", "feas_tol", "restarts", "seed", "start_scale"},
     "dfsp": {"phases", "iterations", "time_budget", "eps0", "q", "gamma", "theta", "delta", "p", "step0",
              "step_min", "feas_tol", "seed_with_mssa"},
@@ -908,6 +918,11 @@ def plan_slepian(problem: ManeuverProblem, method: str = DEFAULT_METHOD, M: int 
         status = STATUS_BUDGET if res.status == STATUS_BUDGET else STATUS_FAILED
         return _empty_plan(method, STATUS_FAILED, f"no feasible smooth plan ({res.message}; status {status})",
                            seconds, stats)
+    if final_man.sensor_target is not None:
+        b_end = evaluate(final_man, res.alpha).R[-1] @ final_man.sensor_axis
+        if b_end @ final_man.sensor_target < 0.0:   # the 2-row residual also vanishes at the antipode
+            return _empty_plan(method, STATUS_FAILED, "converged to the antipode of sensor_target",
+                               seconds, stats)
     prof = physical_profile(final_man, res.alpha, problem.spacecraft)
     return ManeuverPlan(method=method, t=prof["t"], torque=prof["torque"], q=prof["q"], omega=prof["omega"],
                         interpolation="zoh", status=res.status, message=res.message, solve_seconds=seconds,
