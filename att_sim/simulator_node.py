@@ -98,37 +98,45 @@ class SimulatorNode(Node):
 
     # -- loop ----------------------------------------------------------------------------------
     def run(self):
-        wall0, sim0 = time.monotonic(), self.sim.t
-        next_state, next_clock = self.sim.t, self.sim.t
+        """Step, publish /clock every ``clock_every`` steps and the state every ``state_every``
+        steps (rates rounded to whole steps, counted in steps so they never drift), pace to the
+        real-time factor, and in lockstep wait for the command answering each state."""
+        state_every = max(1, round(self.publish_period / self.step))
+        clock_every = max(1, round(self.clock_period / self.step))
+        wall0, sim0, k = time.monotonic(), self.sim.t, 0
+        self.publish(k, state_every, clock_every)
         while self.running and rclpy.ok():
             if self.end_time > 0 and self.sim.t >= self.end_time - 1e-9:
                 self.get_logger().info(f"end_time reached at t = {self.sim.t:.3f} s; propagation stopped")
                 break
+            if self.sim.halted:
+                time.sleep(0.1)
+                continue
             with self.lock:
-                timed_out = self.sim.t - self.last_command_time > self.command_timeout
-                self.sim.command_timeout = timed_out
-                if not self.sim.halted:
-                    self.sim.advance(self.step)
-                    if self.sim.halted:
-                        self.get_logger().error(f"propagation stopped: {self.sim.halt_reason}")
-                t = self.sim.t
-                state = self.state_message() if t >= next_state - 1e-9 else None
-            if t >= next_clock - 1e-9:
-                self.clock_pub.publish(Clock(clock=convert.time_msg(t)))
-                next_clock += self.clock_period
-            if state is not None:
-                self.answered.clear()
-                self.awaited_stamp = t
-                self.state_pub.publish(state)
-                next_state += self.publish_period
-                if self.lockstep:
-                    self.answered.wait(self.lockstep_timeout)
+                self.sim.command_timeout = self.sim.t - self.last_command_time > self.command_timeout
+                self.sim.advance(self.step)
+            if self.sim.halted:
+                self.get_logger().error(f"propagation stopped: {self.sim.halt_reason}")
+                continue
+            k += 1
+            self.publish(k, state_every, clock_every)
             if self.real_time_factor > 0:
-                lag = wall0 + (t - sim0) / self.real_time_factor - time.monotonic()
+                lag = wall0 + (self.sim.t - sim0) / self.real_time_factor - time.monotonic()
                 if lag > 0:
                     time.sleep(lag)
-            elif self.sim.halted:
-                time.sleep(0.05)
+
+    def publish(self, k: int, state_every: int, clock_every: int):
+        with self.lock:
+            t = self.sim.t
+            state = self.state_message() if k % state_every == 0 else None
+        if k % clock_every == 0:
+            self.clock_pub.publish(Clock(clock=convert.time_msg(t)))
+        if state is not None:
+            self.answered.clear()
+            self.awaited_stamp = t
+            self.state_pub.publish(state)
+            if self.lockstep:
+                self.answered.wait(self.lockstep_timeout)
 
     def state_message(self) -> SpacecraftState:
         s = self.sim
