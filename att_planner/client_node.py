@@ -10,6 +10,7 @@ Used by ``att-demo``, the integration tests and user scripts::
 from __future__ import annotations
 
 import time
+from contextlib import contextmanager
 
 import rclpy
 from rclpy.action import ActionClient
@@ -93,3 +94,15 @@ class SuiteClient(Node):
             time.sleep(0.5)
         return result
 
+
+
+@contextmanager
+def client_session(name: str = "suite_client"):
+    """``rclpy.init()``, a :class:`SuiteClient`, and a clean shutdown whatever happens."""
+    rclpy.init()
+    client = SuiteClient(name)
+    try:
+        yield client
+    finally:
+        client.destroy_node()
+        rclpy.try_shutdown()

@@ -20,6 +20,7 @@ import numpy as np
 
 from att_msgs_py.mcap_log import read_log
 from att_msgs_py.review import review
+from att_planner.client_node import client_session, maneuver_request
 from att_planner.cones import Cone, margins
 from att_planner.launch import isolated_env, start_suite
 from att_sim import rotations as rot
@@ -48,6 +49,36 @@ def summarize(mcap_path: Path, maneuver: dict) -> dict:
             "min_margin_per_cone_deg": {c.name: float(np.degrees(v)) for c, v in zip(maneuver["cones"], m.min(axis=0))}}
 
 
+def request_and_execute(client, scenario: scen.Scenario, maneuver: dict):
+    """Plan the maneuver over the service and execute it; (success, plan message or None)."""
+    client.wait_for_servers(timeout=60)
+    print("[demo] nodes up; requesting the maneuver")
+    response = client.plan(maneuver_request(maneuver["q0"], maneuver["qf"], maneuver["sensor"], maneuver["cones"],
+                                            method=maneuver["method"], time_budget=maneuver["time_budget"],
+                                            frame_id=scenario.frame_id))
+    plan = response.plan
+    if not response.success:
+        print(f"[demo] planner refused: code {response.error_code}: {response.message}")
+        return False, None
+    v = plan.verification
+    print(f"[demo] plan {plan.plan_id}: method {plan.method}, status {plan.status}, duration {plan.duration:.1f} s, "
+          f"solved in {plan.solve_seconds:.2f} s; verified: final error {math.degrees(v.final_attitude_error):.4f} deg, "
+          f"min cone margin {math.degrees(v.min_cone_margin):.2f} deg, torque/limit {v.torque_ratio:.3f}")
+    last = [0.0]
+
+    def on_feedback(msg):
+        fb = msg.feedback
+        if time.monotonic() - last[0] > 2.0:
+            last[0] = time.monotonic()
+            print(f"[demo]   t = {fb.elapsed:6.1f} s  progress {100 * fb.progress:5.1f} %  "
+                  f"tracking error {math.degrees(fb.attitude_error):6.3f} deg  cone margin "
+                  f"{math.degrees(fb.min_cone_margin):6.2f} deg")
+
+    result = client.execute(plan.plan_id, on_feedback=on_feedback)
+    print(f"[demo] execution: {result.message} (code {result.error_code}) after {result.duration:.1f} s of sim time")
+    return result.success, plan
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(prog="att-demo", description=__doc__.splitlines()[0])
     parser.add_argument("--scenario", default="swift_demo")
@@ -63,47 +94,17 @@ def main(argv=None) -> int:
     print(f"[demo] scenario {scenario.name}, ROS_DOMAIN_ID {env['ROS_DOMAIN_ID']} (localhost only), logs in {run_dir}")
     suite = start_suite(scenario.name, mcap_path, run_dir, env=env)
 
-    import rclpy
-    from att_planner.client_node import SuiteClient, maneuver_request
-
-    rclpy.init()
-    client = SuiteClient("demo")
-    ok = False
+    ok, plan = False, None
     try:
-        client.wait_for_servers(timeout=60)
-        print("[demo] nodes up; requesting the maneuver")
-        response = client.plan(maneuver_request(maneuver["q0"], maneuver["qf"], maneuver["sensor"], maneuver["cones"],
-                                                method=maneuver["method"], time_budget=maneuver["time_budget"],
-                                                frame_id=scenario.frame_id))
-        plan = response.plan
-        if not response.success:
-            print(f"[demo] planner refused: code {response.error_code}: {response.message}")
-            return 1
-        v = plan.verification
-        print(f"[demo] plan {plan.plan_id}: method {plan.method}, status {plan.status}, duration {plan.duration:.1f} s, "
-              f"solved in {plan.solve_seconds:.2f} s; verified: final error {math.degrees(v.final_attitude_error):.4f} deg, "
-              f"min cone margin {math.degrees(v.min_cone_margin):.2f} deg, torque/limit {v.torque_ratio:.3f}")
-        last = [0.0]
-
-        def on_feedback(msg):
-            fb = msg.feedback
-            if time.monotonic() - last[0] > 2.0:
-                last[0] = time.monotonic()
-                print(f"[demo]   t = {fb.elapsed:6.1f} s  progress {100 * fb.progress:5.1f} %  "
-                      f"tracking error {math.degrees(fb.attitude_error):6.3f} deg  cone margin "
-                      f"{math.degrees(fb.min_cone_margin):6.2f} deg")
-
-        result = client.execute(plan.plan_id, on_feedback=on_feedback)
-        print(f"[demo] execution: {result.message} (code {result.error_code}) after {result.duration:.1f} s of sim time")
-        ok = result.success
+        with client_session("demo") as client:
+            ok, plan = request_and_execute(client, scenario, maneuver)
     finally:
-        client.destroy_node()
-        rclpy.try_shutdown()
         codes = suite.stop()
         print(f"[demo] nodes stopped: {codes}")
     summary = summarize(mcap_path, maneuver)
     print(f"[demo] summary from the recorded state ({summary['state_messages']} messages, {summary['sim_time']:.1f} s):")
-    print(f"[demo]   method {plan.method}, maneuver time {plan.duration:.1f} s")
+    if plan is not None:
+        print(f"[demo]   method {plan.method}, maneuver time {plan.duration:.1f} s")
     print(f"[demo]   final attitude error {summary['final_attitude_error_deg']:.4f} deg, final rate "
           f"{summary['final_rate']:.2e} rad/s")
     print(f"[demo]   minimum cone margin {summary['min_cone_margin_deg']:.2f} deg "
