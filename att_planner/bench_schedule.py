@@ -126,7 +126,11 @@ def run(args) -> dict:
             key = min(tuple(r["order"]), tuple(reversed(r["order"])))
             best_by_pair[key] = min(best_by_pair.get(key, np.inf), r["tf"])
         mismatch = [r for r in rows if r["tf"] > best_by_pair[min(tuple(r["order"]), tuple(reversed(r["order"])))] * 1.001]
-        payload["exhaustive"] = {"orders": len(rows), "seconds": seconds, "top": rows[:10],
+        pair_best = sorted(best_by_pair.values())
+        payload["exhaustive"] = {"orders": len(rows), "seconds": seconds, "top": rows[:10], "rows": rows,
+                                 "pairs": len(best_by_pair),
+                                 "pairs_without_converged_solution": int(sum(not np.isfinite(v) for v in pair_best)),
+                                 "best_pair_tf": pair_best[:5],
                                  "all_converged": all(r["converged"] for r in rows),
                                  "bound_below_tf_everywhere": bound_ok,
                                  "orders_worse_than_their_reverse_by_0.1pct": len(mismatch),

@@ -576,6 +576,7 @@ def plan_schedule(targets: dict, spacecraft: dyn.Spacecraft, q_start=rot.IDENTIT
                   deadline: float | None = None, *, rate_max: float = np.inf, order=None,
                   search_intervals: int = 8, intervals: int = 24, substeps: int = 2,
                   candidates: int = 2, prove: bool = False, max_order_solves: int = 1000,
+                  second_start_margin: float = 0.01,
                   verify: bool = True) -> ScheduleResult:
     """Fastest rest-to-rest schedule through every target attitude, in the best order found.
 
@@ -592,7 +593,8 @@ def plan_schedule(targets: dict, spacecraft: dyn.Spacecraft, q_start=rot.IDENTIT
     optimal on that grid when the enumeration is exhausted. When the start and end attitudes
     coincide, an order and its reverse have the same minimum time (time reversal t → t_f − t,
     Ω → −Ω, T_u(t) → T_u(t_f − t) maps one schedule onto the other), so only one of each pair is
-    solved, and the winner is solved once more reversed (a second start: the NLP is not convex).
+    solved, and the winner (with ``prove``: every order within ``second_start_margin`` of it) is
+    solved once more reversed (a second start: the NLP is not convex).
     ``order`` (list of names) skips the
     search. The winner is re-solved on ``intervals`` per phase (warm start) and verified.
     """
@@ -635,12 +637,19 @@ def plan_schedule(targets: dict, spacecraft: dyn.Spacecraft, q_start=rot.IDENTIT
                                  substeps, rate_max, deadline=deadline, expand=prove or None)
                 solved.append(s)
                 incumbent = min(incumbent, s.tf)
-            if reversible and solved and not expired():
-                # second start for the winner: its reverse has the same optimum but IPOPT may land
-                # in another local minimum from the reversed initial guess; keep the better one
-                best = min(solved, key=lambda s: s.tf)
-                solved.append(_solve_order(spacecraft, q_start, q_end, quats, best.order[::-1], search_intervals,
-                                           substeps, rate_max, deadline=deadline, expand=prove or None))
+            if reversible and solved:
+                # second start: an order's reverse has the same optimum but IPOPT may land in another
+                # local minimum from the reversed initial guess. For the winner, and with ``prove``
+                # for every order within ``second_start_margin`` of it (near-ties), keep the better.
+                best_tf = min(s.tf for s in solved)
+                margin = second_start_margin if prove else 0.0
+                seen = {s.order for s in solved}
+                for s in [s for s in solved if s.tf <= best_tf * (1 + margin)]:
+                    if s.order[::-1] not in seen and not expired():
+                        seen.add(s.order[::-1])
+                        solved.append(_solve_order(spacecraft, q_start, q_end, quats, s.order[::-1],
+                                                   search_intervals, substeps, rate_max, deadline=deadline,
+                                                   expand=prove or None))
             # every order not solved costs at least unsolved_bound on the search grid
             incumbent = min(s.tf for s in solved) if solved else np.inf
             stats.update(orders_solved=len(solved), lower_bound=min(unsolved_bound, incumbent),
