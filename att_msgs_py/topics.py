@@ -17,8 +17,9 @@ SET_CONTROLLER_MODE = "/controller/set_mode"
 RESET_SIMULATOR = "/simulator/reset"
 EXECUTE_MANEUVER = "/controller/execute"
 
-# Streams: reliable, keep the last 100 (the recorder must not drop messages at the configured rates).
-STREAM_QOS = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=100, reliability=ReliabilityPolicy.RELIABLE,
+# Streams: reliable, keep the last 1000 (about 10 s of every stream at full speed on a loaded machine: a
+# recorder starved of CPU for a while catches up instead of dropping messages).
+STREAM_QOS = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=1000, reliability=ReliabilityPolicy.RELIABLE,
                         durability=DurabilityPolicy.VOLATILE)
 # Plans: latched so that a controller or recorder that starts later still receives them.
 LATCHED_QOS = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=20, reliability=ReliabilityPolicy.RELIABLE,
@@ -27,7 +28,7 @@ LATCHED_QOS = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=20, reliability=
 # not dropped (the ROS default keeps 10).
 SERVICE_QOS = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=500, reliability=ReliabilityPolicy.RELIABLE,
                          durability=DurabilityPolicy.VOLATILE)
-CLOCK_QOS = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=100, reliability=ReliabilityPolicy.RELIABLE,
+CLOCK_QOS = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=1000, reliability=ReliabilityPolicy.RELIABLE,
                        durability=DurabilityPolicy.VOLATILE)
 
 

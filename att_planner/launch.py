@@ -12,7 +12,6 @@ import random
 import signal
 import subprocess
 import sys
-import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -77,13 +76,18 @@ class Suite:
 
 def start_suite(scenario: str, mcap_path: str | Path, log_dir: str | Path, *, env: dict | None = None,
                 nodes=("recorder", "simulator", "controller", "planner"), params: dict | None = None) -> Suite:
-    """Start ``nodes`` for ``scenario``; ``params`` maps node name -> extra ROS parameters."""
+    """Start ``nodes`` for ``scenario``; ``params`` maps node name -> extra ROS parameters.
+
+    The simulator holds sim time at zero until the recorder and the controller (those started)
+    subscribe to its state, so every run is recorded and controlled from t = 0.
+    """
     suite = Suite(env or isolated_env(), Path(log_dir))
+    consumers = sum(n in nodes for n in ("recorder", "controller"))
     for name in nodes:
-        p = {"scenario": scenario, **(params or {}).get(name, {})}
+        p = {"scenario": scenario}
         if name == "recorder":
-            p = {"output": str(mcap_path), **(params or {}).get(name, {})}
-        suite.start(name, p)
-        if name == "recorder":
-            time.sleep(0.3)   # let the recorder subscribe before the publishers start
+            p = {"output": str(mcap_path)}
+        if name == "simulator":
+            p["wait_for_subscribers"] = consumers
+        suite.start(name, {**p, **(params or {}).get(name, {})})
     return suite

@@ -44,6 +44,10 @@ class SimulatorNode(Node):
         self.real_time_factor = float(param("real_time_factor", 1.0))
         self.command_timeout = float(param("command_timeout", 1.0))
         self.end_time = float(param("end_time", 0.0))      # s of sim time; 0: run until stopped
+        # Hold sim time at zero until this many subscribers (recorder, controller) see the state,
+        # so that no run starts before it is recorded and controlled; at most start_timeout s.
+        self.wait_for_subscribers = int(param("wait_for_subscribers", 0))
+        self.start_timeout = float(param("start_timeout", 60.0))
         # Lockstep: after each published state, wait (up to lockstep_timeout s of wall time) for
         # the command that answers it, so the loop stays closed at any speed and under CPU load.
         self.lockstep = bool(param("lockstep", True))
@@ -103,6 +107,13 @@ class SimulatorNode(Node):
         real-time factor, and in lockstep wait for the command answering each state."""
         state_every = max(1, round(self.publish_period / self.step))
         clock_every = max(1, round(self.clock_period / self.step))
+        give_up = time.monotonic() + self.start_timeout
+        while self.running and self.state_pub.get_subscription_count() < self.wait_for_subscribers:
+            if time.monotonic() > give_up:
+                self.get_logger().warning(f"starting with {self.state_pub.get_subscription_count()} of "
+                                          f"{self.wait_for_subscribers} expected state subscribers")
+                break
+            time.sleep(0.05)
         wall0, sim0, k = time.monotonic(), self.sim.t, 0
         self.publish(k, state_every, clock_every)
         while self.running and rclpy.ok():
