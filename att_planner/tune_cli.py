@@ -46,8 +46,10 @@ class ProgressBar:
         self.stream.flush()
 
 
-def write_gains(path: str, kp: float, kd: float, m_max: float, node: str = "controller") -> dict:
-    """Set ``<node>.ros__parameters.{kp, kd, m_max}`` in the YAML at ``path`` (created if missing)."""
+def write_gains(path: str, kp: float, kd: float, m_max: float, node: str = "controller",
+                comment: str = "") -> dict:
+    """Set ``<node>.ros__parameters.{kp, kd, m_max}`` in the YAML at ``path`` (created if missing);
+    ``comment`` lines head the file (YAML comments of an existing file are not kept)."""
     doc = {}
     if os.path.exists(path):
         with open(path) as fh:
@@ -56,6 +58,7 @@ def write_gains(path: str, kp: float, kd: float, m_max: float, node: str = "cont
     params.update({"kp": float(kp), "kd": float(kd), "m_max": float(m_max)})
     os.makedirs(os.path.dirname(os.path.abspath(path)), exist_ok=True)
     with open(path, "w") as fh:
+        fh.writelines(f"# {line}\n" for line in comment.splitlines())
         yaml.safe_dump(doc, fh, sort_keys=False)
     return doc
 
@@ -129,7 +132,9 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--no-progress", action="store_true")
     args = parser.parse_args(argv)
     res = run_tuning(args, None if args.no_progress else ProgressBar())
-    write_gains(args.out, res.kp, res.kd, gt.MagnetorquerCase().m_max)
+    write_gains(args.out, res.kp, res.kd, gt.MagnetorquerCase().m_max,
+                comment=f"att-tune --mode {res.mode}: t_s = {res.ts:.4f} orbits ({res.status}), "
+                        f"{res.evaluations} simulations in {res.solve_seconds:.0f} s")
     print(f"{res.mode}: kp = {res.kp:.6g}, kd = {res.kd:.6g}, t_s = {res.ts:.4f} orbits "
           f"({res.evaluations} simulations, {res.solve_seconds:.1f} s, {res.status}); wrote {args.out}")
     return 0
