@@ -17,7 +17,8 @@ moves every attitude by a left (inertial) rotation, dR_n = (η_n×) R_n, with
 
 a cumulative sum, so all N+1 attitude Jacobians cost O(N M). This is the exact derivative of the
 product of exponentials (equivalent to the spectral formula for ∂exp(A + xB)/∂x used by Celani &
-Lucarelli, and well defined at α = 0 where that formula is degenerate).
+Lucarelli, and regular at α = 0, where an eigen-decomposition formula meets the triple zero
+eigenvalue of 0× and needs its confluent limit; here J_r(0) = I).
 
 The final-attitude equality tr(R_fᵀ R_{N+1}) = 3 of the papers has a vanishing gradient at its
 solution (it is a maximum of the trace), which breaks the constraint qualification of any SQP/IP
@@ -30,7 +31,8 @@ Three methods (all return a :class:`SlepianResult`):
 * :func:`solve_dfsp` — Celani–Bruni: derivative-free sequential penalty (Liuzzi–Lucidi–Sciandrone
   2010) on t_f, alternating MMT (min t_f) and MSSA (min Σα²) phases.
 * :func:`solve_min_time` — ours: min s s.t. −s ≤ T*_jℓ ≤ s, final attitude and cones, exact
-  gradients, warm-started from MSSA and continued over basis sizes.
+  gradients (SLSQP on a working set of rows), seeded multistart on a coarse grid, continuation
+  over basis sizes M = 4 → 8 (→ 12) with the ends kept smooth, refinement at the full N.
 
 :func:`plan_slepian` turns a :class:`ManeuverProblem` into a :class:`ManeuverPlan` (physical time,
 ZOH body torque); :func:`benchmark_problem` gives the published cases.
@@ -538,10 +540,10 @@ def solve_mssa(man: SmoothManeuver, alpha0: np.ndarray | None = None, *, maxiter
                restarts: int = 0, seed: int = 0, start_scale: float = 1.0) -> SlepianResult:
     """Celani–Lucarelli: min ½ Σ α_jk² s.t. final attitude and cones (SLSQP, exact gradients).
 
-    ``alpha0 = None`` starts from α = 0 as in the paper (the rest attitude R_i). There the
-    right-Jacobian derivative is regular (J_r(0) = I) where the spectral formula for the derivative
-    of exp is degenerate (triple zero eigenvalue); SQP's first step is the eigenaxis rotation,
-    which then has to bend around the cones. If that start ends infeasible, up to ``restarts``
+    ``alpha0 = None`` starts from α = 0 as in the paper (the rest attitude R_i, every exp is the
+    identity). There the right-Jacobian derivative is regular (J_r(0) = I) while an
+    eigen-decomposition formula for the derivative of exp needs its confluent limit; SQP's first
+    step is the eigenaxis rotation, which then has to bend around the cones. If that start ends infeasible, up to ``restarts``
     seeded Gaussian starts (x = α/√N ~ N(0, start_scale²)) are tried (not in the paper). All
     (N+1)·C cone rows are handed to SLSQP, as in the paper.
     """
