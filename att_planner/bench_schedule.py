@@ -20,6 +20,7 @@ def configure(parser) -> None:
     parser.add_argument("--experiment", choices=["A", "B", "C"], default="A")
     parser.add_argument("--intervals", type=int, default=24, help="ZOH intervals per phase of the final plan")
     parser.add_argument("--search-intervals", type=int, default=8, help="intervals per phase in the order search")
+    parser.add_argument("--substeps", type=int, default=1, help="RK4 steps per ZOH interval in the NLP")
     parser.add_argument("--candidates", type=int, default=2, help="orders solved in the fast search (plus the reverse of the best)")
     parser.add_argument("--prove", action="store_true",
                         help="solve every order whose leg lower bound is below the incumbent")
@@ -39,14 +40,14 @@ def _rest_to_rest_ab(sc) -> dict:
             "published": sch.PUBLISHED_REST_TO_REST_AB}
 
 
-def _published_order_here(sc, targets, order, intervals) -> dict:
+def _published_order_here(sc, targets, order, intervals, substeps) -> dict:
     """The published order solved here, and the schedule that stops (ω = 0, Ω = 0) at every target,
     an upper bound for that order (sum of rest-to-rest legs)."""
     r = sch.plan_schedule(targets, sc, rot.IDENTITY, rate_max=sch.OLIVARES_RATE_MAX, order=order,
-                          search_intervals=intervals, intervals=intervals)
+                          search_intervals=intervals, intervals=intervals, substeps=substeps)
     chain = [rot.IDENTITY] + [targets[k] for k in order] + [rot.IDENTITY]
     legs = [sch.plan_schedule({}, sc, a, b, rate_max=sch.OLIVARES_RATE_MAX, order=[], search_intervals=intervals,
-                              intervals=intervals, verify=False).tf for a, b in zip(chain[:-1], chain[1:])]
+                              intervals=intervals, substeps=substeps, verify=False).tf for a, b in zip(chain[:-1], chain[1:])]
     return {"order": order, "tf": r.tf, "verified": bool(r.verification and r.verification.passed),
             "rest_to_rest_legs_tf": float(sum(legs)), "rest_to_rest_legs": legs}
 
@@ -57,7 +58,7 @@ def run(args) -> dict:
     published = sch.PUBLISHED[args.experiment]
     result = sch.plan_schedule(targets, sc, rot.IDENTITY, rate_max=sch.OLIVARES_RATE_MAX,
                                search_intervals=args.search_intervals, intervals=args.intervals,
-                               candidates=args.candidates, prove=args.prove,
+                               candidates=args.candidates, prove=args.prove, substeps=args.substeps,
                                max_order_solves=args.max_order_solves)
     ver = result.verification
     stats = {k: v for k, v in result.stats.items() if k != "leg_bounds"}
@@ -99,7 +100,8 @@ def run(args) -> dict:
     print(f"a->b rest-to-rest: {ab['tf']:.2f} s (48 intervals; published 57.05 collocation, 57.59 DIDO)")
 
     if published["order"]:
-        payload["published_order_here"] = _published_order_here(sc, targets, published["order"], args.intervals)
+        payload["published_order_here"] = _published_order_here(sc, targets, published["order"], args.intervals,
+                                                                args.substeps)
         po = payload["published_order_here"]
         print(f"published order {''.join(published['order'])} under this model: t_f {po['tf']:.2f} s "
               f"(verified {po['verified']}); stopping at every target instead: {po['rest_to_rest_legs_tf']:.2f} s")
@@ -109,7 +111,7 @@ def run(args) -> dict:
         for n in [int(v) for v in args.grid_study.split(",") if v]:
             t0 = time.perf_counter()
             r = sch.plan_schedule(targets, sc, rot.IDENTITY, rate_max=sch.OLIVARES_RATE_MAX, order=result.order,
-                                  search_intervals=n, intervals=n)
+                                  search_intervals=n, intervals=n, substeps=args.substeps)
             rows.append({"intervals": n, "tf": r.tf, "seconds": time.perf_counter() - t0,
                          "verified": bool(r.verification and r.verification.passed)})
             print(f"  grid {n:3d} intervals/phase: t_f {r.tf:8.2f} s  ({rows[-1]['seconds']:.1f} s, verified {rows[-1]['verified']})")
@@ -118,7 +120,7 @@ def run(args) -> dict:
     if args.exhaustive:
         t0 = time.perf_counter()
         rows = sch.exhaustive_order_search(targets, sc, rot.IDENTITY, rate_max=sch.OLIVARES_RATE_MAX,
-                                           intervals=args.search_intervals)
+                                           intervals=args.search_intervals, substeps=args.substeps)
         seconds = time.perf_counter() - t0
         bound_ok = all(r["bound"] <= r["tf"] * (1 + 1e-6) for r in rows)
         best_by_pair = {}

@@ -428,7 +428,7 @@ def _transcription(sc: dyn.Spacecraft, n_targets: int, intervals: int, substeps:
 # ---------------------------------------------------------------------------------------------
 
 def leg_bound_matrix(sc: dyn.Spacecraft, q_start, targets: list[np.ndarray], q_end, *, intervals: int = 12,
-                     substeps: int = 2, rate_max: float = np.inf, deadline: float | None = None) -> np.ndarray:
+                     substeps: int = 1, rate_max: float = np.inf, deadline: float | None = None) -> np.ndarray:
     """Minimum leg times with the boundary rates relaxed, as a (n+2)×(n+2) matrix.
 
     Node 0 is the start (at rest), 1..n the targets, n+1 the end (at rest). Entry (i, j) is the
@@ -574,7 +574,7 @@ def _solve_order(sc, q_start, q_end, targets: dict, order, intervals, substeps, 
 
 def plan_schedule(targets: dict, spacecraft: dyn.Spacecraft, q_start=rot.IDENTITY, q_end=None,
                   deadline: float | None = None, *, rate_max: float = np.inf, order=None,
-                  search_intervals: int = 8, intervals: int = 24, substeps: int = 2,
+                  search_intervals: int = 8, intervals: int = 24, substeps: int = 1,
                   candidates: int = 2, prove: bool = False, max_order_solves: int = 1000,
                   second_start_margin: float = 0.01,
                   verify: bool = True) -> ScheduleResult:
@@ -607,7 +607,7 @@ def plan_schedule(targets: dict, spacecraft: dyn.Spacecraft, q_start=rot.IDENTIT
     q_start = rot.normalize(np.asarray(q_start, float))
     q_end = q_start if q_end is None else rot.normalize(np.asarray(q_end, float))
     quats = {k: rot.normalize(np.asarray(v, float)) for k, v in targets.items()}
-    stats: dict = {"orders_solved": 0, "search_intervals": search_intervals, "intervals": intervals,
+    stats: dict = {"orders_solved": 0, "search_intervals": search_intervals, "intervals": intervals, "substeps": substeps,
                    "_cpu_begin": cpu_begin}
     expired = lambda: deadline is not None and time.monotonic() > deadline  # noqa: E731
     empty = ScheduleResult([], np.zeros(0), np.zeros(0), np.zeros((0, spacecraft.n_wheels)), np.zeros((0, 4)),
@@ -699,7 +699,7 @@ def _finish(result: ScheduleResult, status: str, message: str, t_begin: float, s
 
 
 def exhaustive_order_search(targets: dict, spacecraft: dyn.Spacecraft, q_start=rot.IDENTITY, q_end=None, *,
-                            rate_max: float = np.inf, intervals: int = 8, substeps: int = 2,
+                            rate_max: float = np.inf, intervals: int = 8, substeps: int = 1,
                             progress=None) -> list[dict]:
     """Solve the multiphase problem of every order (all n! of them, reversals included, as an
     independent check of the time-reversal symmetry and of the NLP's local minima) and return
