@@ -88,16 +88,16 @@ def test_published_ic20_figures_reproduce():
 def test_batch_integration_agrees_with_truth_dynamics_stepping():
     """Same gains and ICs through att_sim.dynamics.step (the simulator node's integration, inputs
     held over each 1 s step) and through the batch RK4 (inputs evaluated at the RK4 stages): after
-    600 s of tumbling the states differ only by the hold's first-order effect (< 0.3°)."""
+    400 s of tumbling the states differ only by the hold's first-order effect (< 0.3°)."""
     rng = np.random.default_rng(3)
-    h = gt.H_LOWER + rng.random((3, 7)) * (gt.H_UPPER - gt.H_LOWER)
+    h = gt.H_LOWER + rng.random((2, 7)) * (gt.H_UPPER - gt.H_LOWER)
     kp, kd = gt.PUBLISHED_GAINS["robust_direct_direct"]
-    batch = gt.propagate(CASE, kp, kd, h, 600.0, 1.0)
+    batch = gt.propagate(CASE, kp, kd, h, 400.0, 1.0)
     sc = dyn.Spacecraft(inertia=np.diag(CASE.inertia), dipole_max=CASE.m_max)
     q0, w0, psi = gt.initial_states(h)
-    for j in range(3):
+    for j in range(2):
         x = dyn.initial_state(sc, q0[j], w0[j])
-        for k in range(600):
+        for k in range(400):
             b_body = env.field_body(CASE.orbit, float(k), x[:4], psi[j])
             m = dipole_command(x[:4], x[4:7], b_body, kp, kd, CASE.m_max)
             x = dyn.step(sc, x, dyn.Inputs(dipole=m, field_body=b_body), 1.0)
@@ -183,7 +183,7 @@ def analytic_worst(kp, kd):
     return 1.0 + max(abs(lk - 5.0), abs(lk - 5.5)) + 0.1 * abs(math.log10(kd) - 8.0)
 
 
-@pytest.mark.parametrize("inner, maxfun, tol", [("direct", 2000, 0.1), ("sdbox", 300, 0.01),
+@pytest.mark.parametrize("inner, maxfun, tol", [("direct", 600, 0.1), ("sdbox", 300, 0.01),
                                                 ("sdbox-multistart", 1500, 0.01)])
 def test_inner_worst_case_searches(inner, maxfun, tol):
     ev = AnalyticEvaluator()
@@ -230,7 +230,9 @@ def test_dask_executor_on_a_local_two_worker_cluster():
     kp, kd = [2e5, 2e5, 1e5, 1e5], [3e8, 1e8, 3e8, 1e8]
     settings = gt.SimSettings(dt=20.0, cap_orbits=0.5)
     serial = gt.BatchEvaluator(CASE, settings).settling(kp, kd, h)
-    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+    # in-process workers start in a second instead of ~20 s on a loaded machine; the client path
+    # (map, gather, scheduler address) is the one a remote cluster uses
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=False,
                                   dashboard_address=None) as cluster:
         ex = gt.make_executor(scheduler=cluster.scheduler_address)
         try:
