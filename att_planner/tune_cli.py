@@ -103,8 +103,9 @@ def run_tuning(args, progress_bar: ProgressBar | None = None) -> gt.TuningResult
 
     def on_batch(ev: gt.BatchEvaluator, result: gt.SettlingResult):
         if progress_bar is not None:
+            best_text = f"{best[0]:.3f} orbits" if np.isfinite(best[0]) else "—"
             progress_bar.update((time.monotonic() - start) / budget,
-                                f"evals {ev.evaluations:6d}  best t_s {best[0]:.3f} orbits")
+                                f"evals {ev.evaluations:6d}  best t_s {best_text}")
 
     evaluator.on_batch = on_batch
     try:
