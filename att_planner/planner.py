@@ -47,13 +47,18 @@ class PlanOutcome:
     verification: Verification | None
 
 
+VERIFY_SAMPLES = 2000       # RK4 steps over the maneuver (at least one per control sample)
+
+
 def verify(problem: ManeuverProblem, plan: ManeuverPlan) -> Verification:
-    ver, _ = verify_profile(problem.spacecraft, problem.q_initial, problem.q_final, plan.t, plan.torque,
-                            interpolation=plan.interpolation, sensor_axis=problem.sensor_axis,
-                            cones=problem.cones, torque_limit=problem.spacecraft.body_torque_max)
+    """Integrate the plan's torques from the request's start; figures against the request."""
+    ver, traj = verify_profile(problem.spacecraft, problem.q_initial, problem.q_final, plan.t, plan.torque,
+                               interpolation=plan.interpolation, sensor_axis=problem.sensor_axis,
+                               cones=problem.cones, torque_limit=problem.spacecraft.body_torque_max,
+                               dense_step=max(plan.duration, 1e-9) / VERIFY_SAMPLES)
     if problem.sensor_target is not None:
-        # semi-free goal: judge the boresight direction, not the full attitude
-        reached = rot.dcm(plan.q[-1]) @ problem.sensor_axis
+        # semi-free goal: judge where the integrated boresight ends, not the full attitude
+        reached = rot.dcm(traj.q[-1]) @ problem.sensor_axis
         ver.final_attitude_error = float(np.arccos(np.clip(reached @ problem.sensor_target, -1, 1)))
     return ver
 

@@ -155,3 +155,14 @@ def test_budget_expiry_is_reported_as_such():
     valid = replace(validate(request(cones=[], time_budget=1.0)), method=misbehaving("plan_ignores_deadline"))
     outcome = plan_maneuver(valid, Tolerances(), runner=run_isolated)
     assert outcome.plan.status == STATUS_FALLBACK and "time budget" in outcome.message
+
+
+def test_semi_free_plan_is_judged_on_the_integrated_boresight():
+    target = np.array([0.0, 1.0, 0.0])         # sensor x_b must end along inertial y; roll free
+    valid = validate(request(cones=[EARTH], semi_free=True, sensor_target=target, method="time_optimal",
+                             time_budget=30.0))
+    outcome = plan_maneuver(valid, Tolerances(), runner=run_method)
+    assert outcome.code == ErrorCode.OK, outcome.message
+    assert outcome.verification.final_attitude_error < math.radians(0.5)      # boresight error here
+    reached = rot.dcm(outcome.plan.q[-1]) @ np.array([1.0, 0, 0])
+    assert reached @ target > math.cos(math.radians(0.5))
