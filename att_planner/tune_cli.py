@@ -2,7 +2,7 @@
 
     att-tune --mode robust --budget 600 --out config/controller_gains.yaml
     att-tune --mode fixed --ic 0,0,0,0.02,0.02,-0.03,0.332
-    att-tune --mode robust --scheduler tcp://10.0.0.5:8786      # evaluate on a Dask cluster
+    att-tune --mode robust --scheduler tcp://scheduler-host:8786      # evaluate on a Dask cluster
 
 Writes ``controller.ros__parameters.{kp, kd, m_max}`` (other keys of an existing file are kept),
 the file the controller node loads. A progress bar with the elapsed time, ETA and the best
