@@ -36,6 +36,7 @@ import numpy as np
 from att_planner import baselines
 from att_planner import collocation as col
 from att_planner.cones import margins
+from att_planner.slepian import plan_slepian
 from att_planner.problem import (STATUS_BUDGET, STATUS_FAILED, STATUS_FEASIBLE, STATUS_OPTIMAL,
                                  ManeuverPlan, ManeuverProblem)
 from att_sim import rotations as rot
@@ -332,7 +333,7 @@ def plan_time_optimal(problem: ManeuverProblem, *, intervals: int = 30, max_inte
                       starts: int = 6, refine_rounds: int = 3, interpolation: str = "zoh",
                       cone_margin_deg: float = 0.05, rate_max: float | None = None,
                       wheel_momentum_max: float | None = None, warm_starts: tuple = (),
-                      explore_tol: float = 1e-5, tol: float = 1e-7, max_iter: int = 400,
+                      smooth_warm_start: bool = False, explore_tol: float = 1e-5, tol: float = 1e-7, max_iter: int = 400,
                       attitude_tol_deg: float = 0.5, verify_reserve: float = 1.0) -> ManeuverPlan:
     """Minimum-time rest-to-rest slew with per-axis torque limits and keep-out cones.
 
@@ -343,6 +344,8 @@ def plan_time_optimal(problem: ManeuverProblem, *, intervals: int = 30, max_inte
     between nodes); ``cone_margin_deg`` tightening of every cone at the collocation points;
     ``rate_max`` body-rate bound (rad/s per axis); ``wheel_momentum_max`` per-wheel momentum bound
     (N m s); ``warm_starts`` plans of other methods used as extra starting routes;
+    ``smooth_warm_start`` adds the smooth Slepian plan (:func:`att_planner.slepian.plan_slepian`,
+    paper basis M = 4, at most a third of the remaining budget) to them;
     ``explore_tol``/``tol`` IPOPT tolerances of the two stages; ``max_iter`` per solve;
     ``attitude_tol_deg`` verification tolerance; ``verify_reserve`` seconds kept before
     ``problem.deadline`` for the final verification.
@@ -380,6 +383,12 @@ def plan_time_optimal(problem: ManeuverProblem, *, intervals: int = 30, max_inte
 
     phase_seconds = {}
     lap = time.monotonic()
+    if smooth_warm_start:
+        share = None if problem.deadline is None else time.monotonic() + (problem.deadline - time.monotonic()) / 3
+        smooth = plan_slepian(replace(problem, deadline=share), M=4)
+        warm_starts = tuple(warm_starts) + ((smooth,) if smooth.status != STATUS_FAILED else ())
+        phase_seconds["smooth_warm_start"] = time.monotonic() - lap
+        lap = time.monotonic()
     routes = select_routes(candidate_routes(problem, scaling), starts)
     routes += [_Route(f"warm start: {p.method}", plan=p, tf_estimate=p.duration / scaling.tu,
                       min_margin=float(margins(p.q, problem.sensor_axis, problem.cones).min(initial=np.inf)))

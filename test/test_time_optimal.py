@@ -225,3 +225,11 @@ def test_eigenaxis_with_a_gyroscopic_term_stays_within_limits_and_arrives():
     assert plan.status == STATUS_FEASIBLE
     assert ver.torque_ratio <= 1.0 + 1e-9 and ver.final_attitude_error <= np.deg2rad(0.5)
     assert ver.final_rate <= 1e-2
+
+
+def test_smooth_plan_warm_starts_the_collocation():
+    problem = case_problem("swift")
+    plan = plan_time_optimal(replace(problem, deadline=time.monotonic() + 40), starts=1, smooth_warm_start=True)
+    labels = [start["route"] for start in plan.stats["starts"]]
+    assert any("slepian" in label for label in labels), labels
+    assert plan.status in ("optimal", "feasible") and plan.duration < 3.5
