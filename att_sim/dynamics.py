@@ -6,7 +6,8 @@ State ``x = [q (4, xyzw body-to-inertial), omega (3, rad/s body), wheel_speed (N
 Momentum model (Olivares & Staffetti 2018, generalised to a mounting matrix ``G`` (3×N) whose
 columns are the wheel spin axes in body axes)::
 
-    H_b   = J ω + G I_w Ω                       (J: total inertia, wheels included)
+    H_b   = J ω + G I_w Ω                       (J: I_s, everything but the wheels' spin inertia;
+                                                 Ω: wheel spin rates in inertial space)
     J ω̇  = −ω × (J ω + G I_w Ω) − G u + τ_ext   (u: wheel motor torques, reaction on the body −G u)
     I_w Ω̇ = u
     q̇    = ½ q ⊗ [ω, 0]
@@ -33,7 +34,7 @@ from att_sim import rotations as rot
 class Spacecraft:
     """Mass properties and actuator limits (SI units)."""
 
-    inertia: np.ndarray                                   # (3, 3) kg m², total (wheels included)
+    inertia: np.ndarray                                   # (3, 3) kg m², I_s (see module docstring)
     wheel_axes: np.ndarray = field(default_factory=lambda: np.eye(3))  # (3, N) unit spin axes
     wheel_inertia: float = 0.0                            # kg m² about each spin axis
     wheel_torque_max: float = np.inf                      # N m per wheel
@@ -53,9 +54,6 @@ class Spacecraft:
     @cached_property
     def inertia_inv(self) -> np.ndarray:
         return np.linalg.inv(self.inertia)
-
-    def state_size(self) -> int:
-        return 7 + self.n_wheels
 
 
 @dataclass
@@ -142,16 +140,11 @@ def angular_momentum_inertial(sc: Spacecraft, x: np.ndarray) -> np.ndarray:
     return rot.dcm(x[:4]) @ h_b
 
 
-def kinetic_energy(sc: Spacecraft, x: np.ndarray) -> np.ndarray:
-    """Rotational kinetic energy of body + wheels.
-
-    With J the total inertia and Ω the wheel speed measured so that ``H = Jω + G I_w Ω``,
-    the energy is ``½ ωᵀ(J − G I_w Gᵀ)ω + ½ I_w |Gᵀω + Ω|²`` ... which for this momentum model
-    reduces to ``½ ωᵀ J ω + ½ I_w |Ω|² + I_w ωᵀ G Ω``; conserved when no torque acts on the
-    system and the motors are idle.
-    """
+def kinetic_energy(sc: Spacecraft, x: np.ndarray) -> float:
+    """Rotational kinetic energy ``½ ωᵀ J ω + ½ I_w |Ω|²`` of body and wheels (Ω measured in
+    inertial space, as in the momentum model); conserved when no torque acts and motors are idle."""
     w, ws = x[4:7], x[7:]
-    return 0.5 * w @ sc.inertia @ w + 0.5 * sc.wheel_inertia * ws @ ws + sc.wheel_inertia * w @ (sc.wheel_axes @ ws)
+    return 0.5 * w @ sc.inertia @ w + 0.5 * sc.wheel_inertia * ws @ ws
 
 
 # ---------------------------------------------------------------------------------------------
@@ -164,19 +157,6 @@ class Trajectory:
     q: np.ndarray          # (K, 4)
     omega: np.ndarray      # (K, 3)
     wheel_speed: np.ndarray  # (K, N)
-
-
-def sample_profile(t_knots: np.ndarray, values: np.ndarray, t: float, interpolation: str) -> np.ndarray:
-    """Value of a sampled input at time ``t``: 'zoh' holds ``values[k]`` on [t_k, t_{k+1}),
-    'linear' interpolates between knots. Outside the knots the input is zero."""
-    if t < t_knots[0] or t > t_knots[-1]:
-        return np.zeros(values.shape[1])
-    if interpolation == "zoh":
-        k = min(np.searchsorted(t_knots, t, side="right") - 1, len(t_knots) - 1)
-        return values[k]
-    if interpolation == "linear":
-        return np.array([np.interp(t, t_knots, values[:, j]) for j in range(values.shape[1])])
-    raise ValueError(f"unknown interpolation '{interpolation}' (use 'zoh' or 'linear')")
 
 
 def simulate_profile(

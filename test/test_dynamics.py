@@ -23,6 +23,16 @@ def test_torque_free_conserves_energy_and_momentum_over_ten_orbits():
     assert abs(np.linalg.norm(x[:4]) - 1.0) < 1e-12
 
 
+def test_spinning_wheels_torque_free_conserve_energy_and_momentum():
+    sc = dyn.Spacecraft(inertia=np.diag([10.0, 12.0, 14.0]), wheel_inertia=0.05)
+    x = dyn.initial_state(sc, rot.IDENTITY, [0.01, -0.02, 0.03], wheel_speed=[100.0, -50.0, 20.0])
+    e0, h0 = dyn.kinetic_energy(sc, x), dyn.angular_momentum_inertial(sc, x)
+    for _ in range(5000):
+        x = dyn.step(sc, x, dyn.Inputs(wheel_torque=np.zeros(3)), 0.05)
+    assert abs(dyn.kinetic_energy(sc, x) - e0) / e0 < 1e-9
+    assert np.linalg.norm(dyn.angular_momentum_inertial(sc, x) - h0) / np.linalg.norm(h0) < 1e-9
+
+
 def test_wheels_exchange_momentum_without_changing_the_total():
     sc = dyn.Spacecraft(inertia=np.diag([10.0, 12.0, 14.0]), wheel_inertia=0.02, wheel_torque_max=0.5)
     x = dyn.initial_state(sc, rot.IDENTITY, [0.01, 0.0, -0.01])
