@@ -96,7 +96,9 @@ class PlannerNode(Node):
         try:
             valid = validate_schedule(
                 list(request.target_names), [convert.from_quaternion(q) for q in request.targets],
-                convert.from_quaternion(request.start_attitude), request.spacecraft, request.time_budget,
+                convert.from_quaternion(request.start_attitude),
+                None if request.return_to_start else convert.from_quaternion(request.end_attitude),
+                request.spacecraft, request.time_budget,
                 frame_id=self.frame_id, request_frame=request.header.frame_id,
                 default_spacecraft=self.scenario_name, default_budget=self.default_budget)
         except RequestError as err:
@@ -105,7 +107,7 @@ class PlannerNode(Node):
             return response
         wait = max(0.0, valid.time_budget - min(0.2 * valid.time_budget, 3.0))
         result = call_isolated(plan_schedule, (valid.targets, valid.spacecraft),
-                               {"q_start": valid.q_start, "rate_max": self.schedule_rate_max,
+                               {"q_start": valid.q_start, "q_end": valid.q_end, "rate_max": self.schedule_rate_max,
                                 "deadline": time.monotonic() + wait}, wait, on_death=lambda message: message)
         if result is None or isinstance(result, str):
             response.error_code = int(ErrorCode.SOLVER_FAILED)

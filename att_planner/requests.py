@@ -174,6 +174,7 @@ def validate_maneuver(req: ManeuverRequest, *, frame_id: str, default_spacecraft
 class ValidSchedule:
     targets: dict                    # name -> unit quaternion
     q_start: np.ndarray
+    q_end: np.ndarray
     spacecraft: Spacecraft
     spacecraft_name: str
     time_budget: float
@@ -200,9 +201,10 @@ def check_budget(budget: float, default: float) -> float:
     return budget or default
 
 
-def validate_schedule(names: list, targets: list, q_start, spacecraft: str, time_budget: float, *,
+def validate_schedule(names: list, targets: list, q_start, q_end, spacecraft: str, time_budget: float, *,
                       frame_id: str, request_frame: str, default_spacecraft: str, default_budget: float) -> ValidSchedule:
-    """Check a PlanSchedule request: names match targets, unit quaternions, a wheeled spacecraft."""
+    """Check a PlanSchedule request: names match targets, unit quaternions, a wheeled spacecraft.
+    ``q_end`` None: end where the schedule started."""
     if request_frame not in ("", frame_id):
         raise RequestError(ErrorCode.INVALID_FRAME,
                            f"header.frame_id '{request_frame[:MAX_NAME_LENGTH]}' is not the planner's inertial frame '{frame_id}'")
@@ -216,9 +218,10 @@ def validate_schedule(names: list, targets: list, q_start, spacecraft: str, time
         raise RequestError(ErrorCode.INVALID_ATTITUDE, "target_names must be distinct, non-empty and short")
     checked = {n: unit_quaternion(q, f"targets[{i}] ('{n}')") for i, (n, q) in enumerate(zip(names, targets))}
     q0 = unit_quaternion(q_start, "start_attitude")
+    q1 = q0 if q_end is None else unit_quaternion(q_end, "end_attitude")
     name = spacecraft or default_spacecraft
     sc = load_spacecraft(name)
     if sc.n_wheels < 3 or not (np.isfinite(sc.wheel_torque_max) and np.isfinite(sc.wheel_speed_max)):
         raise RequestError(ErrorCode.INVALID_SPACECRAFT,
                            f"spacecraft '{name}' needs three or more reaction wheels with finite torque and speed limits")
-    return ValidSchedule(checked, q0, sc, name, check_budget(float(time_budget), default_budget))
+    return ValidSchedule(checked, q0, q1, sc, name, check_budget(float(time_budget), default_budget))
