@@ -12,15 +12,14 @@ and reports ``state_stale`` until states flow again.
 """
 from __future__ import annotations
 
-import threading
 import time
 
 import numpy as np
 import rclpy
 from rclpy.action import ActionServer, CancelResponse, GoalResponse
-from rclpy.callback_groups import MutuallyExclusiveCallbackGroup, ReentrantCallbackGroup
 from rclpy.clock import Clock, ClockType
-from rclpy.executors import ExternalShutdownException, MultiThreadedExecutor
+from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
+from rclpy.task import Future
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 
@@ -50,6 +49,7 @@ class ControllerNode(Node):
             return self.declare_parameter(key, p.get(key, default)).value
 
         self.control_period = 1.0 / float(param("control_rate", 10.0))
+        self.feedback_every = max(1, round(0.5 / self.control_period))   # feedback every 0.5 s of sim time
         self.next_control = -np.inf
         self.wall_timeout = float(param("wall_timeout", 2.0))
         self.kp_track, self.kd_track = float(param("tracking_kp", 0.4)), float(param("tracking_kd", 10.0))
@@ -59,7 +59,6 @@ class ControllerNode(Node):
         self.safe_kd = float(param("safe_kd", self.kd_track))
         self.mode = int(param("initial_mode", MODE_IDLE))
 
-        self.lock = threading.Lock()
         self.state = None            # latest state arrays
         self.state_wall = -np.inf    # wall time it arrived
         self.stale = False
@@ -67,17 +66,14 @@ class ControllerNode(Node):
         self.active = None           # {"plan":..., "t0":..., "done": Event}
         self.hold_q = None           # final attitude held after a maneuver
 
-        cb_fast = MutuallyExclusiveCallbackGroup()
-        cb_action = ReentrantCallbackGroup()
         self.cmd_pub = self.create_publisher(ActuatorCommand, topics.COMMAND, topics.STREAM_QOS)
         self.status_pub = self.create_publisher(ControllerStatus, topics.CONTROLLER_STATUS, topics.STREAM_QOS)
-        self.create_subscription(SpacecraftState, topics.STATE, self.on_state, topics.STREAM_QOS, callback_group=cb_fast)
-        self.create_subscription(ManeuverPlan, topics.PLANS, self.on_plan, topics.LATCHED_QOS, callback_group=cb_fast)
-        self.create_service(SetControllerMode, topics.SET_CONTROLLER_MODE, self.on_set_mode, callback_group=cb_fast)
-        self.create_timer(0.5, self.on_wall_watchdog, callback_group=cb_fast, clock=Clock(clock_type=ClockType.STEADY_TIME))
+        self.create_subscription(SpacecraftState, topics.STATE, self.on_state, topics.STREAM_QOS)
+        self.create_subscription(ManeuverPlan, topics.PLANS, self.on_plan, topics.LATCHED_QOS)
+        self.create_service(SetControllerMode, topics.SET_CONTROLLER_MODE, self.on_set_mode)
+        self.create_timer(0.5, self.on_wall_watchdog, clock=Clock(clock_type=ClockType.STEADY_TIME))
         self.action = ActionServer(self, ExecuteManeuver, topics.EXECUTE_MANEUVER, execute_callback=self.execute,
-                                   goal_callback=self.on_goal, cancel_callback=lambda _: CancelResponse.ACCEPT,
-                                   callback_group=cb_action)
+                                   goal_callback=self.on_goal, cancel_callback=lambda _: CancelResponse.ACCEPT)
         self.get_logger().info(f"scenario '{self.scenario.name}', mode {self.mode}; magnetorquer gains "
                                f"kp={self.kp_mag:.6g} kd={self.kd_mag:.6g} m_max={self.m_max:g}")
 
@@ -87,28 +83,23 @@ class ControllerNode(Node):
         if not (np.all(np.isfinite(s["q"])) and np.all(np.isfinite(s["omega"]))):
             self.get_logger().error("non-finite state received; ignored", throttle_duration_sec=1.0)
             return
-        with self.lock:
-            self.state, self.state_wall = s, time.monotonic()
-            if self.stale:
-                self.stale = False
-                self.get_logger().info("state is fresh again")
-            due = s["t"] >= self.next_control - 1e-9
-            if due:
-                self.next_control = s["t"] + self.control_period
-                cmd, status = self.control_step()
-        if due:
+        self.state, self.state_wall = s, time.monotonic()
+        if self.stale:
+            self.stale = False
+            self.get_logger().info("state is fresh again")
+        if s["t"] >= self.next_control - 1e-9:
+            self.next_control = s["t"] + self.control_period
+            cmd, status = self.control_step()
             self.cmd_pub.publish(cmd)
             self.status_pub.publish(status)
 
     def on_plan(self, msg: ManeuverPlan):
-        with self.lock:
-            self.plans[msg.plan_id] = convert.plan_arrays(msg)
-            while len(self.plans) > MAX_CACHED_PLANS:
-                self.plans.pop(next(iter(self.plans)))
+        self.plans[msg.plan_id] = convert.plan_arrays(msg)
+        while len(self.plans) > MAX_CACHED_PLANS:
+            self.plans.pop(next(iter(self.plans)))
 
     def on_set_mode(self, request, response):
-        with self.lock:
-            code, message = self.change_mode(int(request.mode))
+        code, message = self.change_mode(int(request.mode))
         response.success, response.error_code, response.message = code == ErrorCode.OK, int(code), message
         return response
 
@@ -127,8 +118,7 @@ class ControllerNode(Node):
 
     # -- action -----------------------------------------------------------------------------------
     def on_goal(self, goal: ExecuteManeuver.Goal):
-        with self.lock:
-            return GoalResponse.REJECT if self.active is not None else GoalResponse.ACCEPT
+        return GoalResponse.REJECT if self.active is not None else GoalResponse.ACCEPT
 
     def resolve_plan(self, goal) -> tuple[dict | None, ErrorCode, str]:
         if goal.use_inline_plan:
@@ -148,31 +138,22 @@ class ControllerNode(Node):
             return None, ErrorCode.INVALID_PLAN, "plan status is 'failed'"
         return plan, ErrorCode.OK, ""
 
-    def execute(self, goal_handle):
+    async def execute(self, goal_handle):
+        """Start tracking and wait (without blocking the executor) until the control loop ends
+        the maneuver; feedback and cancellation are handled by the control loop."""
         result = ExecuteManeuver.Result()
         plan, code, message = self.resolve_plan(goal_handle.request)
-        with self.lock:
-            if plan is not None and self.state is None:
-                code, message = ErrorCode.NO_STATE, "no spacecraft state received yet"
-            if code != ErrorCode.OK:
-                goal_handle.abort()
-                result.error_code, result.message = int(code), message
-                return result
-            done = threading.Event()
-            self.active = {"plan": plan, "t0": self.state["t"], "done": done, "result": None}
-            self.mode = MODE_PLAN_TRACKING
+        if plan is not None and self.state is None:
+            code, message = ErrorCode.NO_STATE, "no spacecraft state received yet"
+        if code != ErrorCode.OK:
+            goal_handle.abort()
+            result.error_code, result.message = int(code), message
+            return result
+        done = Future(executor=self.executor)
+        self.active = {"plan": plan, "t0": self.state["t"], "done": done, "goal": goal_handle, "ticks": 0}
+        self.mode = MODE_PLAN_TRACKING
         self.get_logger().info(f"executing plan '{plan['plan_id']}' ({plan['method']}, {plan['duration']:.1f} s)")
-        while not done.wait(0.2):
-            if goal_handle.is_cancel_requested:
-                with self.lock:
-                    self.finish_active(False, ErrorCode.ABORTED, "cancelled")
-                break
-            with self.lock:
-                fb = self.feedback()
-            if fb is not None:
-                goal_handle.publish_feedback(fb)
-        with self.lock:
-            success, code, message, metrics = self.active_result
+        success, code, message, metrics = await done
         result.success, result.error_code, result.message = success, int(code), message
         result.duration, result.final_attitude_error, result.final_rate = metrics
         if goal_handle.is_cancel_requested:
@@ -197,20 +178,19 @@ class ControllerNode(Node):
         return fb
 
     def finish_active(self, success: bool, code: ErrorCode, message: str):
-        """Close the running maneuver (lock held) and hand its result to the action thread."""
+        """Close the running maneuver and hand its result to the waiting action callback."""
         s, plan = self.state, self.active["plan"]
         elapsed = s["t"] - self.active["t0"] if s is not None else 0.0
         err = float(rot.angle_between(s["q"], plan["q"][-1])) if s is not None else float("nan")
         rate = float(np.linalg.norm(s["omega"])) if s is not None else float("nan")
-        self.active_result = (success, code, message, (float(elapsed), err, rate))
-        self.active["done"].set()
+        self.active["done"].set_result((success, code, message, (float(elapsed), err, rate)))
         self.hold_q = plan["q"][-1] if success else None
         self.active = None
         self.mode = MODE_SAFE if code == ErrorCode.ABORTED else self.mode
 
     # -- control loop -----------------------------------------------------------------------------
     def control_step(self):
-        """Command for the latest state (lock held)."""
+        """Command (and status) for the latest state."""
         s = self.state
         cmd = ActuatorCommand(mode=self.mode, wheel_torques=[0.0] * self.sc.n_wheels)
         cmd.header.stamp = convert.time_msg(s["t"])
@@ -236,6 +216,12 @@ class ControllerNode(Node):
                 u = tracking.wheel_torques(self.sc, tau, s["omega"], s["wheel_speeds"])
             cmd.wheel_torques = u.tolist()
             cmd.plan_id = status.plan_id = plan["plan_id"]
+            self.active["ticks"] += 1
+            if self.active["ticks"] % self.feedback_every == 0:
+                self.active["goal"].publish_feedback(self.feedback())
+            if self.active["goal"].is_cancel_requested:
+                self.finish_active(False, ErrorCode.ABORTED, "cancelled")
+                return cmd, status
             status.plan_progress = float(min(1.0, elapsed / max(plan["duration"], 1e-9)))
             if elapsed >= plan["duration"] + self.settle_time:
                 self.finish_active(True, ErrorCode.OK, "maneuver complete")
@@ -249,8 +235,7 @@ class ControllerNode(Node):
         return cmd, status
 
     def on_wall_watchdog(self):
-        with self.lock:
-            silent = time.monotonic() - self.state_wall > self.wall_timeout
+        silent = time.monotonic() - self.state_wall > self.wall_timeout
         if silent and not self.stale:
             self.stale = True
             self.get_logger().warning("no state for %.1f s of wall time: commanding zero" % self.wall_timeout)
@@ -262,7 +247,7 @@ class ControllerNode(Node):
 def main(args=None):
     rclpy.init(args=args)
     node = ControllerNode()
-    executor = MultiThreadedExecutor(num_threads=3)
+    executor = SingleThreadedExecutor()
     executor.add_node(node)
     try:
         executor.spin()

@@ -1,5 +1,9 @@
 """Simulator node: integrates the truth dynamics and publishes state and /clock.
 
+One thread: the loop steps the dynamics and, between steps, lets the executor run the node's
+callbacks (commands, reset) with ``spin_once``, so a command is handled the moment it arrives and
+no lock or cross-thread wake-up sits in the control loop.
+
 Subscribes ``/actuator/command`` (ActuatorCommand), publishes ``/spacecraft/state``
 (SpacecraftState) at ``publish_rate`` and ``/clock`` at ``clock_rate`` (Hz of sim time), serves
 ``/simulator/reset``. Runs at ``real_time_factor`` × wall time (0: as fast as possible).
@@ -11,12 +15,11 @@ state says so; a non-finite state stops the propagation (reported, the node stay
 """
 from __future__ import annotations
 
-import threading
 import time
 
 import numpy as np
 import rclpy
-from rclpy.executors import ExternalShutdownException
+from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
 from rclpy.node import Node
 from rosgraph_msgs.msg import Clock
 
@@ -52,14 +55,13 @@ class SimulatorNode(Node):
         # the command that answers it, so the loop stays closed at any speed and under CPU load.
         self.lockstep = bool(param("lockstep", True))
         self.lockstep_timeout = float(param("lockstep_timeout", 0.5))
-        self.answered = threading.Event()
+        self.answered = False
         self.awaited_stamp = 0.0
         self.sim = Simulation(
             self.scenario.spacecraft, self.scenario.orbit,
             q0=param("initial_attitude", [0.0, 0.0, 0.0, 1.0]),
             omega0=param("initial_rate", [0.0, 0.0, 0.0]),
             gravity_gradient=bool(param("gravity_gradient", False)))
-        self.lock = threading.Lock()
         self.last_command_time = -np.inf
         self.rejected_commands = 0
 
@@ -67,9 +69,6 @@ class SimulatorNode(Node):
         self.clock_pub = self.create_publisher(Clock, topics.CLOCK, topics.CLOCK_QOS)
         self.create_subscription(ActuatorCommand, topics.COMMAND, self.on_command, topics.STREAM_QOS)
         self.create_service(ResetSimulator, topics.RESET_SIMULATOR, self.on_reset)
-        self.running = True
-        self.thread = threading.Thread(target=self.run, name="sim-loop", daemon=True)
-        self.thread.start()
         self.get_logger().info(
             f"scenario '{self.scenario.name}', step {self.step} s, RTF "
             f"{self.real_time_factor or 'max'}, {self.scenario.spacecraft.n_wheels} wheels")
@@ -79,12 +78,11 @@ class SimulatorNode(Node):
         wheel = np.asarray(msg.wheel_torques, float)
         dipole = convert.from_vector3(msg.dipole)
         body = convert.from_vector3(msg.body_torque)
-        with self.lock:
-            error = self.sim.set_command(msg.mode, wheel, dipole, body)
-            if error is None:
-                self.last_command_time = self.sim.t
-                if convert.from_time(msg.header.stamp) >= self.awaited_stamp - 1e-9:
-                    self.answered.set()
+        error = self.sim.set_command(msg.mode, wheel, dipole, body)
+        if error is None:
+            self.last_command_time = self.sim.t
+            if convert.from_time(msg.header.stamp) >= self.awaited_stamp - 1e-9:
+                self.answered = True
         if error is not None:
             self.rejected_commands += 1
             self.get_logger().warning(f"command rejected ({self.rejected_commands} so far): {error}",
@@ -93,61 +91,66 @@ class SimulatorNode(Node):
     def on_reset(self, request: ResetSimulator.Request, response: ResetSimulator.Response):
         q = convert.from_quaternion(request.attitude)
         w = convert.from_vector3(request.body_rate)
-        with self.lock:
-            error = self.sim.reset(q, w, np.asarray(request.wheel_speeds, float), request.orbit_phase)
+        error = self.sim.reset(q, w, np.asarray(request.wheel_speeds, float), request.orbit_phase)
         response.success = error is None
         response.error_code = 0 if error is None else int(ErrorCode.INVALID_RESET)
         response.message = "state reset" if error is None else error
         return response
 
     # -- loop ----------------------------------------------------------------------------------
-    def run(self):
+    def run(self, executor) -> None:
         """Step, publish /clock every ``clock_every`` steps and the state every ``state_every``
         steps (rates rounded to whole steps, counted in steps so they never drift), pace to the
-        real-time factor, and in lockstep wait for the command answering each state."""
+        real-time factor, and in lockstep wait for the command answering each state; callbacks
+        run through ``executor.spin_once`` in between."""
+        self.executor = executor
         state_every = max(1, round(self.publish_period / self.step))
         clock_every = max(1, round(self.clock_period / self.step))
         give_up = time.monotonic() + self.start_timeout
-        while self.running and self.state_pub.get_subscription_count() < self.wait_for_subscribers:
+        while self.state_pub.get_subscription_count() < self.wait_for_subscribers:
             if time.monotonic() > give_up:
                 self.get_logger().warning(f"starting with {self.state_pub.get_subscription_count()} of "
                                           f"{self.wait_for_subscribers} expected state subscribers")
                 break
-            time.sleep(0.05)
+            executor.spin_once(timeout_sec=0.05)
         wall0, sim0, k = time.monotonic(), self.sim.t, 0
         self.publish(k, state_every, clock_every)
-        while self.running and rclpy.ok():
+        while rclpy.ok():
             if self.end_time > 0 and self.sim.t >= self.end_time - 1e-9:
                 self.get_logger().info(f"end_time reached at t = {self.sim.t:.3f} s; propagation stopped")
-                break
+                executor.spin()
+                return
             if self.sim.halted:
-                time.sleep(0.1)
+                executor.spin_once(timeout_sec=0.1)
                 continue
-            with self.lock:
-                self.sim.command_timeout = self.sim.t - self.last_command_time > self.command_timeout
-                self.sim.advance(self.step)
+            self.sim.command_timeout = self.sim.t - self.last_command_time > self.command_timeout
+            self.sim.advance(self.step)
             if self.sim.halted:
                 self.get_logger().error(f"propagation stopped: {self.sim.halt_reason}")
                 continue
             k += 1
             self.publish(k, state_every, clock_every)
+            executor.spin_once(timeout_sec=0.0)
             if self.real_time_factor > 0:
-                lag = wall0 + (self.sim.t - sim0) / self.real_time_factor - time.monotonic()
-                if lag > 0:
-                    time.sleep(lag)
+                self.spin_until(lambda: False, wall0 + (self.sim.t - sim0) / self.real_time_factor)
+
+    def spin_until(self, done, deadline: float) -> None:
+        """Run callbacks until ``done()`` or the monotonic ``deadline``."""
+        while not done():
+            remaining = deadline - time.monotonic()
+            if remaining <= 0:
+                return
+            self.executor.spin_once(timeout_sec=remaining)
 
     def publish(self, k: int, state_every: int, clock_every: int):
-        with self.lock:
-            t = self.sim.t
-            state = self.state_message() if k % state_every == 0 else None
+        t = self.sim.t
         if k % clock_every == 0:
             self.clock_pub.publish(Clock(clock=convert.time_msg(t)))
-        if state is not None:
-            self.answered.clear()
-            self.awaited_stamp = t
-            self.state_pub.publish(state)
+        if k % state_every == 0:
+            self.answered, self.awaited_stamp = False, t
+            self.state_pub.publish(self.state_message())
             if self.lockstep:
-                self.answered.wait(self.lockstep_timeout)
+                self.spin_until(lambda: self.answered, time.monotonic() + self.lockstep_timeout)
 
     def state_message(self) -> SpacecraftState:
         s = self.sim
@@ -156,17 +159,14 @@ class SimulatorNode(Node):
             wheel_torques=s.applied.wheel_torque, field_body=s.applied.field_body, dipole=s.applied.dipole,
             applied_torque=s.applied.body_torque, position=s.position(), command_timeout=s.command_timeout)
 
-    def destroy_node(self):
-        self.running = False
-        self.thread.join(timeout=2.0)
-        super().destroy_node()
-
 
 def main(args=None):
     rclpy.init(args=args)
     node = SimulatorNode()
+    executor = SingleThreadedExecutor()
+    executor.add_node(node)
     try:
-        rclpy.spin(node)
+        node.run(executor)
     except (KeyboardInterrupt, ExternalShutdownException):
         pass
     finally:
