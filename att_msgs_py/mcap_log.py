@@ -21,7 +21,7 @@ import numpy as np
 from mcap.exceptions import McapError
 from mcap.reader import make_reader
 from mcap.stream_reader import StreamReader
-from mcap.records import Channel, Chunk, Message, Schema
+from mcap.records import Channel, Message, Schema
 from mcap.writer import CompressionType, Writer
 from mcap_ros2.decoder import DecoderFactory
 

@@ -11,12 +11,11 @@ from __future__ import annotations
 import time
 from datetime import datetime, timezone
 
-import rclpy
-from rclpy.executors import ExternalShutdownException
 from rclpy.node import Node
 
 from att_msgs_py import topics
 from att_msgs_py.mcap_log import LogWriter
+from att_msgs_py.node_runner import run_node
 
 
 class RecorderNode(Node):
@@ -44,16 +43,7 @@ class RecorderNode(Node):
 
 
 def main(args=None):
-    rclpy.init(args=args)
-    node = RecorderNode()
-    try:
-        rclpy.spin(node)
-    except (KeyboardInterrupt, ExternalShutdownException):
-        pass
-    finally:
-        node.close()
-        node.destroy_node()
-        rclpy.try_shutdown()
+    run_node(RecorderNode, args)
 
 
 if __name__ == "__main__":

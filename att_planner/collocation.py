@@ -282,7 +282,6 @@ class Transcription:
             lbg += [np.zeros(2 * nx * N)]
             ubg += [np.zeros(2 * nx * N)]
             if ph.path is not None:
-                ng = ph.path.size1_out(0)
                 # Nodes see the control of the interval they start (the last node: the last one).
                 U_nodes = ca.horzcat(U, U[:, -1]) if ph.control == "constant" else U
                 Gn = ph.path.map(N + 1)(X, U_nodes)

@@ -15,19 +15,18 @@ from __future__ import annotations
 import time
 
 import numpy as np
-import rclpy
 from rclpy.action import ActionServer, CancelResponse, GoalResponse
 from rclpy.clock import Clock, ClockType
-from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
-from rclpy.task import Future
 from rclpy.node import Node
 from rclpy.parameter import Parameter
+from rclpy.task import Future
 
 from att_msgs.action import ExecuteManeuver
 from att_msgs.msg import ActuatorCommand, ControllerStatus, ManeuverPlan, SpacecraftState
 from att_msgs.srv import SetControllerMode
 from att_msgs_py import convert, topics
 from att_msgs_py.errors import ErrorCode
+from att_msgs_py.node_runner import run_node
 from att_planner import tracking
 from att_planner.cones import min_margin
 from att_planner.magnetorquer_law import dipole_command
@@ -245,17 +244,7 @@ class ControllerNode(Node):
 
 
 def main(args=None):
-    rclpy.init(args=args)
-    node = ControllerNode()
-    executor = SingleThreadedExecutor()
-    executor.add_node(node)
-    try:
-        executor.spin()
-    except (KeyboardInterrupt, ExternalShutdownException):
-        pass
-    finally:
-        node.destroy_node()
-        rclpy.try_shutdown()
+    run_node(ControllerNode, args)
 
 
 if __name__ == "__main__":

@@ -12,15 +12,15 @@ import math
 import time
 import uuid
 
-import rclpy
 from rclpy.callback_groups import ReentrantCallbackGroup
-from rclpy.executors import ExternalShutdownException, MultiThreadedExecutor
+from rclpy.executors import MultiThreadedExecutor
 from rclpy.node import Node
 
 from att_msgs.msg import ManeuverPlan
 from att_msgs.srv import PlanManeuver, PlanSchedule
 from att_msgs_py import convert, topics
 from att_msgs_py.errors import ErrorCode, RequestError
+from att_msgs_py.node_runner import run_node
 from att_planner import methods as method_registry
 from att_planner.planner import Tolerances, plan_maneuver, run_method, schedule_plan, schedule_verification
 from att_planner.requests import ManeuverRequest, validate_maneuver, validate_schedule
@@ -134,17 +134,8 @@ class PlannerNode(Node):
 
 
 def main(args=None):
-    rclpy.init(args=args)
-    node = PlannerNode()
-    executor = MultiThreadedExecutor(num_threads=16)   # waiting requests hold a thread, not a core
-    executor.add_node(node)
-    try:
-        executor.spin()
-    except (KeyboardInterrupt, ExternalShutdownException):
-        pass
-    finally:
-        node.destroy_node()
-        rclpy.try_shutdown()
+    # waiting requests hold a thread, not a core: many threads so quick requests never queue
+    run_node(PlannerNode, args, make_executor=lambda: MultiThreadedExecutor(num_threads=16))
 
 
 if __name__ == "__main__":

@@ -19,7 +19,6 @@ import time
 
 import numpy as np
 import rclpy
-from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
 from rclpy.node import Node
 from rosgraph_msgs.msg import Clock
 
@@ -27,6 +26,7 @@ from att_msgs.msg import ActuatorCommand, SpacecraftState
 from att_msgs.srv import ResetSimulator
 from att_msgs_py import convert, topics
 from att_msgs_py.errors import ErrorCode
+from att_msgs_py.node_runner import run_node
 from att_sim import scenario as scen
 from att_sim.simulation import Simulation
 
@@ -161,17 +161,7 @@ class SimulatorNode(Node):
 
 
 def main(args=None):
-    rclpy.init(args=args)
-    node = SimulatorNode()
-    executor = SingleThreadedExecutor()
-    executor.add_node(node)
-    try:
-        node.run(executor)
-    except (KeyboardInterrupt, ExternalShutdownException):
-        pass
-    finally:
-        node.destroy_node()
-        rclpy.try_shutdown()
+    run_node(SimulatorNode, args, loop=lambda node, executor: node.run(executor))
 
 
 if __name__ == "__main__":

@@ -10,7 +10,6 @@ import pytest
 
 from att_msgs_py.errors import ErrorCode, RequestError
 from att_planner import methods
-from att_planner.cones import Cone
 from att_planner.methods import Method
 from att_planner.planner import Tolerances, plan_maneuver, run_method
 from att_planner.problem import STATUS_FALLBACK
