@@ -29,16 +29,20 @@ def boresight(q: np.ndarray, sensor_axis: np.ndarray) -> np.ndarray:
     return rot.dcm(q) @ np.asarray(sensor_axis, float)
 
 
-def margins(q: np.ndarray, sensor_axis: np.ndarray, cones: list[Cone]) -> np.ndarray:
-    """Cone margins (rad), shape ``q.shape[:-1] + (len(cones),)``."""
-    b = boresight(q, sensor_axis)
+def direction_margins(direction: np.ndarray, cones: list[Cone]) -> np.ndarray:
+    """Margins (rad) of inertial direction(s) ``(..., 3)``, shape ``(..., len(cones))``."""
+    b = np.asarray(direction, float)
     b = b / np.linalg.norm(b, axis=-1, keepdims=True)
     if not cones:
         return np.zeros(b.shape[:-1] + (0,))
     W = np.stack([c.direction for c in cones])           # (C, 3)
     theta = np.array([c.half_angle for c in cones])       # (C,)
-    ang = np.arccos(np.clip(b @ W.T, -1.0, 1.0))
-    return ang - theta
+    return np.arccos(np.clip(b @ W.T, -1.0, 1.0)) - theta
+
+
+def margins(q: np.ndarray, sensor_axis: np.ndarray, cones: list[Cone]) -> np.ndarray:
+    """Cone margins (rad) of the boresight at attitude(s) ``q``, shape ``q.shape[:-1] + (len(cones),)``."""
+    return direction_margins(boresight(q, sensor_axis), cones)
 
 
 def min_margin(q: np.ndarray, sensor_axis: np.ndarray, cones: list[Cone]) -> float:

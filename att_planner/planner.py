@@ -17,7 +17,7 @@ import numpy as np
 
 from att_msgs_py.errors import ErrorCode
 from att_planner import eigenaxis
-from att_planner.cones import Cone, margins
+from att_planner.cones import Cone, boresight, direction_margins
 from att_planner.problem import STATUS_BUDGET, STATUS_FAILED, STATUS_FALLBACK, ManeuverPlan, ManeuverProblem
 from att_planner.methods import Method
 from att_planner.requests import ValidRequest
@@ -81,11 +81,11 @@ def padded(problem: ManeuverProblem, padding: float) -> ManeuverProblem:
     controller), but never so much that the start or goal boresight would fall inside it."""
     if padding <= 0 or not problem.cones:
         return problem
-    goals = [problem.q_initial] + ([problem.q_final] if problem.sensor_target is None else [])
-    room = np.min([margins(q, problem.sensor_axis, problem.cones) for q in goals], axis=0)
+    ends = [problem.q_initial] + ([problem.q_final] if problem.sensor_target is None else [])
+    directions = [boresight(q, problem.sensor_axis) for q in ends]
     if problem.sensor_target is not None:
-        room = np.minimum(room, [np.arccos(np.clip(c.direction @ problem.sensor_target, -1, 1)) - c.half_angle
-                                 for c in problem.cones])
+        directions.append(problem.sensor_target)
+    room = np.min(direction_margins(np.array(directions), problem.cones), axis=0)
     cones = [Cone(c.direction, c.half_angle + min(padding, 0.5 * r), c.name) for c, r in zip(problem.cones, room)]
     return replace(problem, cones=cones)
 

@@ -14,7 +14,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from att_msgs_py.errors import ErrorCode, RequestError
-from att_planner.cones import Cone, margins
+from att_planner.cones import Cone, boresight, direction_margins
 from att_planner.methods import Method
 from att_planner.problem import ManeuverProblem
 from att_sim import scenario as scen
@@ -142,21 +142,17 @@ def validate_maneuver(req: ManeuverRequest, *, frame_id: str, default_spacecraft
     sensor_target = None
     if req.semi_free:
         sensor_target = unit_vector(req.sensor_target, "sensor_target", ErrorCode.INVALID_SENSOR_AXIS)
-    if cones:
-        m0 = margins(q0, r, cones)
-        goal = qf if sensor_target is None else None
-        for label, m in (("start", m0), ("goal", margins(goal, r, cones) if goal is not None else None)):
-            if m is not None and m.min() < 0:
-                k = int(np.argmin(m))
-                raise RequestError(ErrorCode.SENSOR_IN_CONE,
-                                   f"the {label} sensor direction is inside cone '{cones[k].name}' by "
-                                   f"{np.degrees(-m[k]):.3f} deg")
-        if sensor_target is not None:
-            ang = np.arccos(np.clip([c.direction @ sensor_target for c in cones], -1, 1)) - [c.half_angle for c in cones]
-            if ang.min() < 0:
-                k = int(np.argmin(ang))
-                raise RequestError(ErrorCode.SENSOR_IN_CONE,
-                                   f"the sensor_target direction is inside cone '{cones[k].name}' by {np.degrees(-ang[k]):.3f} deg")
+    endpoints = {"start sensor direction": boresight(q0, r)}
+    if sensor_target is None:
+        endpoints["goal sensor direction"] = boresight(qf, r)
+    else:
+        endpoints["sensor_target direction"] = sensor_target
+    for label, direction in endpoints.items():
+        m = direction_margins(direction, cones)
+        if m.size and m.min() < 0:
+            k = int(np.argmin(m))
+            raise RequestError(ErrorCode.SENSOR_IN_CONE,
+                               f"the {label} is inside cone '{cones[k].name}' by {np.degrees(-m[k]):.3f} deg")
     name = req.spacecraft or default_spacecraft
     sc = load_spacecraft(name)
     method_name = req.method or default_method
