@@ -449,6 +449,14 @@ def plot_body_torque(ax, run: Run, sc: Spacecraft | None) -> None:
     ax.legend(loc="upper right", fontsize=7, ncol=2)
 
 
+def _wheel_legend(ax, run: Run) -> None:
+    """Legend of the per-wheel lines, or a note that the spacecraft has no wheels."""
+    if run.wheel_speeds.shape[1] == 0:
+        ax.text(0.5, 0.5, "no reaction wheels", ha="center", va="center", transform=ax.transAxes)
+    else:
+        ax.legend(loc="upper right", fontsize=7, ncol=2)
+
+
 def plot_wheel_torque(ax, run: Run, sc: Spacecraft | None) -> None:
     for i in range(run.wheel_torques.shape[1]):
         line, = ax.plot(run.t, run.wheel_torques[:, i], lw=1.0, label=f"wheel {i + 1}")
@@ -456,10 +464,7 @@ def plot_wheel_torque(ax, run: Run, sc: Spacecraft | None) -> None:
             ax.plot(run.cmd_t, run.cmd_wheel_torques[:, i], ls="--", lw=0.8, color=line.get_color())
     _limits(ax, _limit(sc.wheel_torque_max) if sc else None, "limit")
     ax.set_ylabel("wheel torque [N m]\n(— applied, -- cmd)")
-    if run.wheel_speeds.shape[1] == 0:
-        ax.text(0.5, 0.5, "no reaction wheels", ha="center", va="center", transform=ax.transAxes)
-    else:
-        ax.legend(loc="upper right", fontsize=7, ncol=2)
+    _wheel_legend(ax, run)
 
 
 def plot_wheel_speeds(ax, run: Run, sc: Spacecraft | None) -> None:
@@ -467,10 +472,7 @@ def plot_wheel_speeds(ax, run: Run, sc: Spacecraft | None) -> None:
         ax.plot(run.t, run.wheel_speeds[:, i], label=f"wheel {i + 1}")
     _limits(ax, _limit(sc.wheel_speed_max) if sc else None, "limit")
     ax.set_ylabel("wheel speed [rad/s]")
-    if run.wheel_speeds.shape[1] == 0:
-        ax.text(0.5, 0.5, "no reaction wheels", ha="center", va="center", transform=ax.transAxes)
-    else:
-        ax.legend(loc="upper right", fontsize=7, ncol=2)
+    _wheel_legend(ax, run)
 
 
 def plot_dipole(ax, run: Run, sc: Spacecraft | None) -> None:

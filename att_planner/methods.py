@@ -32,11 +32,14 @@ class Method:
         return getattr(importlib.import_module(self.module), self.function)
 
 
+# Basis size, DPSS length and half-bandwidth of the Slepian methods (issue 3).
+SLEPIAN_OPTIONS = {"M": Option(2, 12, True), "N": Option(50, 2000, True), "W": Option(1e-4, 0.25)}
+
 # Best first: the default method is the first one available.
 REGISTRY = [
     Method("slepian_minimum_time", "att_planner.slepian", "plan_slepian",
            "smooth torque on a Slepian basis, t_f minimised exactly (issue 3); cone-aware",
-           {"M": Option(2, 12, True), "N": Option(50, 2000, True), "W": Option(1e-4, 0.25)},
+           SLEPIAN_OPTIONS,
            fixed={"method": "slepian_minimum_time"}),
     Method("time_optimal", "att_planner.time_optimal", "plan_time_optimal",
            "minimum-time bang-bang slew by direct collocation with IPOPT (Melton 2012); cone-aware",
@@ -54,11 +57,11 @@ REGISTRY = [
            "eigenaxis bang-bang slew with the largest torque the per-axis limits allow; ignores cones", cheap=True),
     Method("mssa", "att_planner.slepian", "plan_slepian",
            "Slepian basis, minimum sum of squared coefficients (Celani & Lucarelli); cone-aware",
-           {"M": Option(2, 12, True), "N": Option(50, 2000, True), "W": Option(1e-4, 0.25)},
+           SLEPIAN_OPTIONS,
            fixed={"method": "mssa"}),
     Method("dfsp", "att_planner.slepian", "plan_slepian",
            "Slepian basis, derivative-free sequential penalty on t_f (Celani & Bruni); cone-aware, slow",
-           {"M": Option(2, 12, True), "N": Option(50, 2000, True), "W": Option(1e-4, 0.25)},
+           SLEPIAN_OPTIONS,
            fixed={"method": "dfsp"}),
 ]
 
