@@ -1,30 +1,55 @@
 """The one ``main()`` body of every suite node: init, spin until SIGINT/SIGTERM, clean up.
 
-``rclpy.init`` installs the SIGINT/SIGTERM handlers; either signal ends the spin with
-``KeyboardInterrupt`` or ``ExternalShutdownException``, after which the node's ``close()`` (if it
-has one, e.g. the recorder finalising its log) runs before the node is destroyed.
+Stopping is done by rclpy alone: its signal handler shuts the context down and wakes the executors,
+so ``spin`` ends with ``ExternalShutdownException`` and loops that test ``rclpy.ok()`` leave.
+Python's own SIGINT handler would also raise ``KeyboardInterrupt`` a moment later at whatever line
+runs then (a ``publish`` already failing on the dead context, or the recorder's ``close()``), so
+it is replaced by one that only notes the request (which matters when the signal comes before
+``rclpy.init`` has installed rclpy's handler: the node then stops right after init). An error raised after the context is shut down is the
+stop itself, not a fault; the node's ``close()`` (e.g. the recorder finalising its log) then runs
+before the node is destroyed, and the process exits 0.
 """
 from __future__ import annotations
 
+import signal
 from typing import Callable
 
 import rclpy
 from rclpy.executors import Executor, ExternalShutdownException, SingleThreadedExecutor
 
 
+_stop_signalled = False
+
+
+def _stop_requested(_signum, _frame) -> None:
+    """Python-level handler that rclpy's SIGINT/SIGTERM handler chains to. After ``rclpy.init``
+    rclpy has already shut the context down; before it, only this flag knows."""
+    global _stop_signalled
+    _stop_signalled = True
+
+
 def run_node(make_node: Callable, args=None, make_executor: Callable[[], Executor] = SingleThreadedExecutor,
              loop: Callable | None = None) -> None:
     """Create node and executor after ``rclpy.init`` and run ``loop(node, executor)`` (default: spin)."""
+    for signum in (signal.SIGINT, signal.SIGTERM):
+        signal.signal(signum, _stop_requested)      # before rclpy.init, which chains to it
     rclpy.init(args=args)
-    node = make_node()
-    executor = make_executor()
-    executor.add_node(node)
+    node = None
     try:
+        if _stop_signalled:
+            return
+        node = make_node()
+        executor = make_executor()
+        executor.add_node(node)
         (loop or (lambda _node, ex: ex.spin()))(node, executor)
-    except (KeyboardInterrupt, ExternalShutdownException):
+    except ExternalShutdownException:
         pass
+    except Exception:
+        if rclpy.ok():
+            raise
     finally:
-        if hasattr(node, "close"):
-            node.close()
-        node.destroy_node()
+        if node is not None:
+            if hasattr(node, "close"):
+                node.close()
+            node.destroy_node()
         rclpy.try_shutdown()

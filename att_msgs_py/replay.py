@@ -169,7 +169,12 @@ def main(argv=None) -> int:
     except ValueError as err:
         print(f"att-replay: {err}", file=sys.stderr)
         return 2
-    except (KeyboardInterrupt, ExternalShutdownException):
+    except Exception as err:
+        if rclpy.ok() and not isinstance(err, ExternalShutdownException):
+            raise
+        print("att-replay: interrupted", file=sys.stderr)     # Ctrl-C: rclpy shut the context down
+        return 130
+    except KeyboardInterrupt:
         print("att-replay: interrupted", file=sys.stderr)
         return 130
     finally:
