@@ -26,7 +26,7 @@ from att_msgs.msg import ActuatorCommand, SpacecraftState
 from att_msgs.srv import ResetSimulator
 from att_msgs_py import convert, topics
 from att_msgs_py.errors import ErrorCode
-from att_msgs_py.node_runner import run_node
+from att_msgs_py.node_runner import run_node, spin_until_shutdown
 from att_sim import scenario as scen
 from att_sim.simulation import Simulation
 
@@ -118,7 +118,7 @@ class SimulatorNode(Node):
         while rclpy.ok():
             if self.end_time > 0 and self.sim.t >= self.end_time - 1e-9:
                 self.get_logger().info(f"end_time reached at t = {self.sim.t:.3f} s; propagation stopped")
-                executor.spin()
+                spin_until_shutdown(executor)
                 return
             if self.sim.halted:
                 executor.spin_once(timeout_sec=0.1)

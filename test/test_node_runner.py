@@ -6,6 +6,8 @@ other than the main one (a DDS thread, say), a loop that publishes sees ``publis
 context first (this made the simulator exit 1 on a CI run). The cases below signal a loop that
 publishes until ``publish`` fails and an idle spin, from another thread of the node's process and from outside, at
 different moments, and require exit status 0 with the node's ``close()`` run to its end.
+(The other half of the race, an executor that waits again after rclpy's wake-up and before its
+shutdown, hung the planner; the integration tests' exit-status checks catch that one.)
 """
 from __future__ import annotations
 
