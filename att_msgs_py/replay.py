@@ -169,12 +169,10 @@ def main(argv=None) -> int:
     except ValueError as err:
         print(f"att-replay: {err}", file=sys.stderr)
         return 2
-    except Exception as err:
-        if rclpy.ok() and not isinstance(err, ExternalShutdownException):
+    except (KeyboardInterrupt, Exception) as err:
+        # Ctrl-C: KeyboardInterrupt, or any error once rclpy's handler has shut the context down
+        if not isinstance(err, (KeyboardInterrupt, ExternalShutdownException)) and rclpy.ok():
             raise
-        print("att-replay: interrupted", file=sys.stderr)     # Ctrl-C: rclpy shut the context down
-        return 130
-    except KeyboardInterrupt:
         print("att-replay: interrupted", file=sys.stderr)
         return 130
     finally:
