@@ -26,7 +26,7 @@ NODE_SCRIPT = textwrap.dedent("""
     import rclpy
     from rclpy.node import Node
     from std_msgs.msg import String
-    from att_msgs_py.node_runner import run_node
+    from att_msgs_py.node_runner import run_node, spin_until_shutdown
 
     loop_kind, signum, delay = sys.argv[1], int(sys.argv[2]), float(sys.argv[3])
 
@@ -43,8 +43,9 @@ NODE_SCRIPT = textwrap.dedent("""
         print("running", flush=True)
         if signum:                          # delivered to this helper thread, not the main one
             threading.Timer(delay, os.kill, (os.getpid(), signum)).start()
-        if loop_kind == "idle":
-            executor.spin()
+        if loop_kind == "idle":             # what every node's default loop does
+            spin_until_shutdown(executor)
+            return
         while True:                         # publishes until publish fails on the dead context
             node.pub.publish(String(data="x"))
 
