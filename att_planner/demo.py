@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import argparse
 import math
-import os
 import sys
 import time
 from datetime import datetime, timezone
@@ -22,7 +21,7 @@ from att_msgs_py.mcap_log import read_log
 from att_msgs_py.review import review
 from att_planner.client_node import client_session, maneuver_request
 from att_planner.cones import Cone, margins
-from att_planner.launch import isolated_env, start_suite
+from att_planner.launch import isolated_env, join_env, start_suite
 from att_sim import rotations as rot
 from att_sim import scenario as scen
 
@@ -90,7 +89,7 @@ def main(argv=None) -> int:
     run_dir = Path(args.out) / f"{scenario.name}_{datetime.now(timezone.utc).strftime('%Y%m%d_%H%M%S')}"
     mcap_path = run_dir / "run.mcap"
     env = isolated_env()
-    os.environ.update({k: env[k] for k in ("ROS_DOMAIN_ID", "ROS_AUTOMATIC_DISCOVERY_RANGE")})
+    join_env(env)
     print(f"[demo] scenario {scenario.name}, ROS_DOMAIN_ID {env['ROS_DOMAIN_ID']} (localhost only), logs in {run_dir}")
     suite = start_suite(scenario.name, mcap_path, run_dir, env=env)
 

@@ -32,6 +32,12 @@ def isolated_env(domain_id: int | None = None, base: dict | None = None) -> dict
     return env
 
 
+def join_env(env: dict) -> None:
+    """Put this process on ``env``'s domain and discovery range, so that its own rclpy client
+    (demo, tests) talks to the nodes started with ``env``."""
+    os.environ.update({k: env[k] for k in ("ROS_DOMAIN_ID", "ROS_AUTOMATIC_DISCOVERY_RANGE")})
+
+
 @dataclass
 class Suite:
     env: dict

@@ -3,7 +3,6 @@ watchdogs, and a recorder that is killed or stopped."""
 from __future__ import annotations
 
 import math
-import os
 import signal
 import threading
 import time
@@ -16,13 +15,14 @@ from hypothesis import strategies as st
 from mcap.reader import make_reader
 from rclpy.executors import MultiThreadedExecutor
 
+from att_msgs.action import ExecuteManeuver
 from att_msgs.msg import ActuatorCommand, ControllerStatus, KeepOutCone, SpacecraftState
 from att_msgs.srv import PlanManeuver
 from att_msgs_py import convert, topics
 from att_msgs_py.errors import ErrorCode
 from att_msgs_py.mcap_log import read_log
-from att_planner.client_node import SuiteClient, maneuver_request
-from att_planner.launch import Suite, isolated_env, start_suite
+from att_planner.client_node import SuiteClient, client_session, maneuver_request
+from att_planner.launch import Suite, isolated_env, join_env, start_suite
 from att_sim import rotations as rot
 from att_sim.simulation import MODE_IDLE, MODE_MAGNETORQUER_PD
 
@@ -33,17 +33,14 @@ GOAL = rot.from_axis_angle([0, 0, 1], 0.4)
 def suite(tmp_path_factory):
     out = tmp_path_factory.mktemp("reliability")
     env = isolated_env()
-    os.environ.update({k: env[k] for k in ("ROS_DOMAIN_ID", "ROS_AUTOMATIC_DISCOVERY_RANGE")})
+    join_env(env)
     s = start_suite("swift_demo", out / "run.mcap", out, env=env, nodes=("simulator", "controller", "planner"),
                     params={"simulator": {"real_time_factor": 4.0}})
-    rclpy.init()
-    client = SuiteClient("reliability_test")
     try:
-        client.wait_for_servers(timeout=60)
-        yield s, client, out
+        with client_session("reliability_test") as client:
+            client.wait_for_servers(timeout=60)
+            yield s, client, out
     finally:
-        client.destroy_node()
-        rclpy.try_shutdown()
         s.stop()
 
 
@@ -145,7 +142,7 @@ def test_controller_refuses_unknown_plan_and_mode_change_mid_maneuver(suite):
     assert client.set_mode(42).error_code == ErrorCode.INVALID_MODE
     plan = client.plan(maneuver_request(rot.IDENTITY, GOAL, [1, 0, 0], [], method="eigenaxis_smooth")).plan
     goal = client.execute_client.send_goal_async(
-        __import__("att_msgs.action", fromlist=["ExecuteManeuver"]).ExecuteManeuver.Goal(plan_id=plan.plan_id))
+        ExecuteManeuver.Goal(plan_id=plan.plan_id))
     rclpy.spin_until_future_complete(client, goal, timeout_sec=20)
     handle = goal.result()
     assert handle.accepted

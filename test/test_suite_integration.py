@@ -3,17 +3,15 @@ executed on the simulator, and the recorded MCAP checked by replay."""
 from __future__ import annotations
 
 import math
-import os
 
 import numpy as np
 import pytest
-import rclpy
 
 from att_msgs_py.errors import ErrorCode
 from att_msgs_py.mcap_log import read_log
-from att_planner.client_node import SuiteClient, maneuver_request
+from att_planner.client_node import client_session, maneuver_request
 from att_planner.cones import Cone, margins
-from att_planner.launch import isolated_env, start_suite
+from att_planner.launch import isolated_env, join_env, start_suite
 from att_sim import rotations as rot
 
 SENSOR = np.array([1.0, 0.0, 0.0])
@@ -26,17 +24,14 @@ GOAL = rot.from_axis_angle([0, 0, 1], math.radians(135))
 def suite(tmp_path_factory):
     out = tmp_path_factory.mktemp("suite")
     env = isolated_env()
-    os.environ.update({k: env[k] for k in ("ROS_DOMAIN_ID", "ROS_AUTOMATIC_DISCOVERY_RANGE")})
+    join_env(env)
     s = start_suite("swift_demo", out / "run.mcap", out, env=env,
                     params={"simulator": {"real_time_factor": 0.0}})
-    rclpy.init()
-    client = SuiteClient("integration_test")
     try:
-        client.wait_for_servers(timeout=60)
-        yield s, client, out / "run.mcap"
+        with client_session("integration_test") as client:
+            client.wait_for_servers(timeout=60)
+            yield s, client, out / "run.mcap"
     finally:
-        client.destroy_node()
-        rclpy.try_shutdown()
         s.stop()
         assert all(p.poll() is not None for p in s.procs.values())
 

@@ -13,7 +13,6 @@ and commit the new file (it must stay under 300 KB).
 from __future__ import annotations
 
 import math
-import os
 import shutil
 import sys
 import tempfile
@@ -26,7 +25,7 @@ HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE.parents[1]))
 
 from att_planner.cones import Cone  # noqa: E402
-from att_planner.launch import isolated_env, start_suite  # noqa: E402
+from att_planner.launch import isolated_env, join_env, start_suite  # noqa: E402
 from att_sim import rotations as rot  # noqa: E402
 
 FIXTURE = HERE / "swift_short.mcap"
@@ -42,34 +41,30 @@ PARAMS = {"simulator": {"real_time_factor": 0.0, "publish_rate": 10.0, "clock_ra
 def main() -> int:
     work = Path(tempfile.mkdtemp(prefix="att_fixture_"))
     env = isolated_env()
-    os.environ.update({k: env[k] for k in ("ROS_DOMAIN_ID", "ROS_AUTOMATIC_DISCOVERY_RANGE")})
+    join_env(env)
     # the simulator starts once the plan is ready, so the log holds little idle time before the maneuver
     suite = start_suite("swift_demo", work / "run.mcap", work, env=env, params=PARAMS,
                         nodes=("recorder", "controller", "planner"))
-    import rclpy
     from att_msgs_py.errors import ErrorCode
-    from att_planner.client_node import SuiteClient, maneuver_request
+    from att_planner.client_node import client_session, maneuver_request
 
-    rclpy.init()
-    client = SuiteClient("make_fixture")
     try:
-        client.wait_for_servers(timeout=60)
-        response = client.plan(maneuver_request(rot.IDENTITY, GOAL, SENSOR, CONES, method=METHOD, time_budget=20))
-        if not response.success:
-            print(f"planner refused: {response.message}")
-            return 1
-        suite.start("simulator", {"scenario": "swift_demo", **PARAMS["simulator"]})
-        for _ in range(40):
-            result = client.execute(response.plan.plan_id)
-            if result.error_code != ErrorCode.NO_STATE:
-                break
-            time.sleep(0.25)
-        print(f"plan {response.plan.plan_id} ({response.plan.method}, {response.plan.duration:.1f} s): {result.message}")
-        if not result.success:
-            return 1
+        with client_session("make_fixture") as client:
+            client.wait_for_servers(timeout=60)
+            response = client.plan(maneuver_request(rot.IDENTITY, GOAL, SENSOR, CONES, method=METHOD, time_budget=20))
+            if not response.success:
+                print(f"planner refused: {response.message}")
+                return 1
+            suite.start("simulator", {"scenario": "swift_demo", **PARAMS["simulator"]})
+            for _ in range(40):
+                result = client.execute(response.plan.plan_id)
+                if result.error_code != ErrorCode.NO_STATE:
+                    break
+                time.sleep(0.25)
+            print(f"plan {response.plan.plan_id} ({response.plan.method}, {response.plan.duration:.1f} s): {result.message}")
+            if not result.success:
+                return 1
     finally:
-        client.destroy_node()
-        rclpy.try_shutdown()
         codes = suite.stop()
     if any(codes.values()):
         print(f"a node exited with an error: {codes} (logs in {work})")
