@@ -29,6 +29,11 @@ VERIFY_RESERVE = 0.2        # fraction of the time budget kept for verification 
 VERIFY_RESERVE_MAX = 3.0    # s
 
 
+def verify_reserve(time_budget: float) -> float:
+    """Seconds of a request's budget kept back from the solver for verification and fallback."""
+    return min(VERIFY_RESERVE * time_budget, VERIFY_RESERVE_MAX)
+
+
 @dataclass(frozen=True)
 class Tolerances:
     """Acceptance of a plan after integration through the dynamics."""
@@ -118,8 +123,7 @@ def plan_maneuver(valid: ValidRequest, tol: Tolerances = Tolerances(), cone_padd
     child process that is killed if it overruns); ``None`` from the runner means it overran.
     """
     problem = valid.problem
-    reserve = min(VERIFY_RESERVE * valid.time_budget, VERIFY_RESERVE_MAX)
-    method_deadline = problem.deadline - reserve if problem.deadline is not None else None
+    method_deadline = problem.deadline - verify_reserve(valid.time_budget) if problem.deadline is not None else None
     wait = None if method_deadline is None else max(0.0, method_deadline - time.monotonic())
     plan = runner(valid.method, replace(padded(problem, cone_padding), deadline=method_deadline), valid.options, wait)
     if plan is None:

@@ -22,7 +22,8 @@ from att_msgs_py import convert, topics
 from att_msgs_py.errors import ErrorCode, RequestError
 from att_msgs_py.node_runner import run_node
 from att_planner import methods as method_registry
-from att_planner.planner import Tolerances, plan_maneuver, run_method, schedule_plan, schedule_verification
+from att_planner.planner import (Tolerances, plan_maneuver, run_method, schedule_plan, schedule_verification,
+                                 verify_reserve)
 from att_planner.requests import ManeuverRequest, validate_maneuver, validate_schedule
 from att_planner.schedule import plan_schedule
 from att_planner.worker import call_isolated, run_isolated, set_max_parallel, warm_up
@@ -105,7 +106,7 @@ class PlannerNode(Node):
             self.get_logger().warning(f"schedule rejected [{int(err.code)} {err.code.name}]: {err.message}")
             response.success, response.error_code, response.message = False, int(err.code), err.message
             return response
-        wait = max(0.0, valid.time_budget - min(0.2 * valid.time_budget, 3.0))
+        wait = max(0.0, valid.time_budget - verify_reserve(valid.time_budget))
         result = call_isolated(plan_schedule, (valid.targets, valid.spacecraft),
                                {"q_start": valid.q_start, "q_end": valid.q_end, "rate_max": self.schedule_rate_max,
                                 "deadline": time.monotonic() + wait}, wait, on_death=lambda message: message)

@@ -120,12 +120,17 @@ def check_options(method: Method, names, values) -> dict:
     return options
 
 
+def check_frame(request_frame: str, frame_id: str) -> None:
+    """The request's header frame is empty (meaning ours) or the planner's inertial frame."""
+    if request_frame not in ("", frame_id):
+        raise RequestError(ErrorCode.INVALID_FRAME,
+                           f"header.frame_id '{request_frame[:MAX_NAME_LENGTH]}' is not the planner's inertial frame '{frame_id}'")
+
+
 def validate_maneuver(req: ManeuverRequest, *, frame_id: str, default_spacecraft: str, default_method: str,
                       default_budget: float, methods: dict[str, Method]) -> ValidRequest:
     """Check every field of a maneuver request; return the problem or raise RequestError."""
-    if req.frame_id not in ("", frame_id):
-        raise RequestError(ErrorCode.INVALID_FRAME,
-                           f"header.frame_id '{req.frame_id[:MAX_NAME_LENGTH]}' is not the planner's inertial frame '{frame_id}'")
+    check_frame(req.frame_id, frame_id)
     q0 = unit_quaternion(req.q_initial, "initial_attitude")
     qf = unit_quaternion(req.q_final, "final_attitude")
     r = unit_vector(req.sensor_axis, "sensor_axis", ErrorCode.INVALID_SENSOR_AXIS)
@@ -201,9 +206,7 @@ def validate_schedule(names: list, targets: list, q_start, q_end, spacecraft: st
                       frame_id: str, request_frame: str, default_spacecraft: str, default_budget: float) -> ValidSchedule:
     """Check a PlanSchedule request: names match targets, unit quaternions, a wheeled spacecraft.
     ``q_end`` None: end where the schedule started."""
-    if request_frame not in ("", frame_id):
-        raise RequestError(ErrorCode.INVALID_FRAME,
-                           f"header.frame_id '{request_frame[:MAX_NAME_LENGTH]}' is not the planner's inertial frame '{frame_id}'")
+    check_frame(request_frame, frame_id)
     if len(targets) > MAX_TARGETS or len(names) > MAX_TARGETS:
         raise RequestError(ErrorCode.SIZE_LIMIT, f"{max(len(targets), len(names))} targets given; at most {MAX_TARGETS}")
     if not targets:
