@@ -163,16 +163,13 @@ class ControllerNode(Node):
             goal_handle.abort()
         return result
 
-    def feedback(self):
-        if self.active is None or self.state is None:
-            return None
+    def feedback(self, elapsed: float, ref_q: np.ndarray) -> ExecuteManeuver.Feedback:
+        """Action feedback for the running maneuver at ``elapsed`` s, reference attitude ``ref_q``."""
         plan, s = self.active["plan"], self.state
-        elapsed = s["t"] - self.active["t0"]
-        ref = tracking.reference(plan["t"], plan["q"], plan["omega"], plan["torque"], plan["interpolation"], elapsed)
         fb = ExecuteManeuver.Feedback()
         fb.elapsed = float(elapsed)
         fb.progress = float(min(1.0, elapsed / max(plan["duration"] + self.settle_time, 1e-9)))
-        fb.attitude_error = float(rot.angle_between(s["q"], ref.q))
+        fb.attitude_error = float(rot.angle_between(s["q"], ref_q))
         fb.min_cone_margin = min_margin(s["q"], plan["sensor_axis"], plan["cones"]) if plan["cones"] else float("inf")
         return fb
 
@@ -217,7 +214,7 @@ class ControllerNode(Node):
             cmd.plan_id = status.plan_id = plan["plan_id"]
             self.active["ticks"] += 1
             if self.active["ticks"] % self.feedback_every == 0:
-                self.active["goal"].publish_feedback(self.feedback())
+                self.active["goal"].publish_feedback(self.feedback(elapsed, ref.q))
             if self.active["goal"].is_cancel_requested:
                 self.finish_active(False, ErrorCode.ABORTED, "cancelled")
                 return cmd, status

@@ -102,8 +102,8 @@ class SimulatorNode(Node):
         """Step, publish /clock every ``clock_every`` steps and the state every ``state_every``
         steps (rates rounded to whole steps, counted in steps so they never drift), pace to the
         real-time factor, and in lockstep wait for the command answering each state; callbacks
-        run through ``executor.spin_once`` in between."""
-        self.executor = executor
+        run through ``executor.spin_once`` in between (``executor`` is also ``self.executor``,
+        set when the node was added to it)."""
         state_every = max(1, round(self.publish_period / self.step))
         clock_every = max(1, round(self.clock_period / self.step))
         give_up = time.monotonic() + self.start_timeout
