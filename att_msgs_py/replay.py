@@ -33,20 +33,17 @@ MIN_DEPTH = 1000
 class Record:
     log_time_ns: int
     topic: str
-    type_name: str
     data: bytes
 
 
-def read_records(path: str | Path, topics: list[str] | None = None) -> tuple[list[Record], dict[str, tuple[str, str]]]:
-    """Records of ``topics`` (all when None) in log-time order, and topic -> (type, QoS metadata)."""
+def read_records(path: str | Path) -> tuple[list[Record], dict[str, tuple[str, str]]]:
+    """All cdr records in log-time order, and topic -> (type, QoS metadata)."""
     records, channels = [], {}
     for schema, channel, message in iter_records(path):
-        if topics is not None and channel.topic not in topics:
-            continue
         if schema is None or channel.message_encoding != "cdr":
             continue
         channels.setdefault(channel.topic, (schema.name, channel.metadata.get("offered_qos_profiles", "")))
-        records.append(Record(message.log_time, channel.topic, schema.name, bytes(message.data)))
+        records.append(Record(message.log_time, channel.topic, bytes(message.data)))
     records.sort(key=lambda r: r.log_time_ns)      # stable: keeps the recorded order of equal times
     return records, channels
 
@@ -89,7 +86,7 @@ def schedule(records: list[Record], clock: bool, clock_recorded: bool) -> list[R
     out, last = [], None
     for r in records:
         if r.log_time_ns != last:
-            out.append(Record(r.log_time_ns, CLOCK, CLOCK_TYPE, clock_bytes(r.log_time_ns)))
+            out.append(Record(r.log_time_ns, CLOCK, clock_bytes(r.log_time_ns)))
             last = r.log_time_ns
         out.append(r)
     return out
@@ -105,7 +102,7 @@ def play(path: str | Path, *, rate: float = 1.0, topics: list[str] | None = None
 
     if rate < 0:
         raise ValueError(f"--rate must be >= 0 (0: as fast as possible), got {rate}")
-    all_records, channels = read_records(path, None)
+    all_records, channels = read_records(path)
     selected = set(topics) if topics else {t for t in channels if t != CLOCK}
     if clock:
         selected.add(CLOCK)
@@ -113,7 +110,7 @@ def play(path: str | Path, *, rate: float = 1.0, topics: list[str] | None = None
     if unknown:
         raise ValueError(f"--topics names topics the log does not have: {', '.join(unknown)} "
                          f"(it has {', '.join(sorted(channels))})")
-    records = schedule([r for r in all_records if r.topic in selected], clock and CLOCK in selected,
+    records = schedule([r for r in all_records if r.topic in selected], clock,
                        CLOCK in channels)
     types = {t: channels[t] for t in selected if t in channels}
     if CLOCK in selected and CLOCK not in types:
@@ -157,8 +154,6 @@ def main(argv=None) -> int:
     args, ros_args = parser.parse_known_args(argv)
     if not Path(args.log).is_file():
         parser.error(f"log file '{args.log}' does not exist")
-    if args.rate < 0:
-        parser.error(f"--rate must be >= 0 (0: as fast as possible), got {args.rate}")
     import rclpy
     from rclpy.executors import ExternalShutdownException
 

@@ -26,7 +26,7 @@ import html
 import json
 import math
 import sys
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -36,9 +36,9 @@ from att_planner import tracking
 from att_planner.cones import Cone, boresight, margins
 from att_sim import rotations as rot
 from att_sim.dynamics import Spacecraft
+from att_sim.simulation import MODE_IDLE, MODE_MAGNETORQUER_PD, MODE_PLAN_TRACKING, MODE_SAFE
 
 STATE, COMMAND, PLANS = "/spacecraft/state", "/actuator/command", "/planner/plans"
-MODE_IDLE, MODE_MAGNETORQUER_PD, MODE_PLAN_TRACKING, MODE_SAFE = 0, 1, 2, 3   # ActuatorCommand.MODE_*
 MODE_NAMES = {MODE_IDLE: "idle", MODE_MAGNETORQUER_PD: "magnetorquer PD", MODE_PLAN_TRACKING: "plan tracking",
               MODE_SAFE: "safe"}
 SETTLING_THRESHOLD = 0.05        # ν of Bruni & Celani: settled when every |q_i| (vector part) stays ≤ ν
@@ -69,7 +69,6 @@ class Run:
     goal: np.ndarray | None        # (4,) goal attitude (plan end; identity for magnetorquer runs)
     plan: dict | None = None       # plan_id, method, status, spacecraft, duration, t, q, omega, torque,
     #                                interpolation, sensor_axis, cones, verification
-    executed_plan_ids: list = field(default_factory=list)
 
 
 def _rows(array_or_list, i):
@@ -89,7 +88,6 @@ def plans_from_log(plans: TopicLog) -> list[dict]:
             "omega": _rows(plans["rates"], i).reshape(-1, 3), "torque": _rows(plans["torques"], i).reshape(-1, 3),
             "sensor_axis": _rows(plans["sensor_axis"], i), "cones": cones,
             "verified_min_margin": float(plans["verification.min_cone_margin"][i]),
-            "verified_final_error": float(plans["verification.final_attitude_error"][i]),
         })
     return out
 
@@ -152,7 +150,7 @@ def extract_run(log: dict[str, TopicLog], plan_id: str | None = None) -> Run:
         body_torque=np.asarray(state["applied_torque"], float)[keep],
         command_timeout=np.asarray(state["command_timeout"], bool)[keep],
         cmd_t=cmd_t[ckeep] - t0, cmd_mode=cmd_mode[ckeep], cmd_wheel_torques=cmd_wheels[ckeep],
-        cmd_dipole=cmd_dipole[ckeep], goal=goal, plan=plan, executed_plan_ids=executed)
+        cmd_dipole=cmd_dipole[ckeep], goal=goal, plan=plan)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -333,7 +331,7 @@ def _planned_path(plan: dict, n: int = 400) -> np.ndarray:
 CONE_COLORS = ["#d62728", "#1f77b4", "#7f7f7f", "#9467bd", "#8c564b", "#e377c2", "#bcbd22", "#17becf"]
 
 
-def plot_sky(ax, run: Run, summary: dict) -> None:
+def plot_sky(ax, run: Run) -> None:
     """Boresight path on the celestial sphere with cones, start/goal and closest approaches."""
     from matplotlib.patches import Circle, PathPatch
     from matplotlib.path import Path as MplPath
@@ -543,20 +541,20 @@ def figure_time_histories(run: Run, sc: Spacecraft | None, path: Path) -> Path:
     return path
 
 
-def figure_sky(run: Run, summary: dict, path: Path) -> Path:
+def figure_sky(run: Run, path: Path) -> Path:
     plt, fig = _figure(figsize=(7.5, 7.5))
-    plot_sky(fig.add_subplot(1, 1, 1), run, summary)
+    plot_sky(fig.add_subplot(1, 1, 1), run)
     fig.tight_layout()
     fig.savefig(path, dpi=100)
     plt.close(fig)
     return path
 
 
-def figure_overview(run: Run, summary: dict, sc: Spacecraft | None, path: Path) -> Path:
+def figure_overview(run: Run, sc: Spacecraft | None, path: Path) -> Path:
     """Screenshot-sized digest: the sky on the left; margins, body torque, wheel speeds on the right."""
     plt, fig = _figure(figsize=(12, 6.2))
     grid = fig.add_gridspec(3, 2, width_ratios=[1.0, 1.15])
-    plot_sky(fig.add_subplot(grid[:, 0]), run, summary)
+    plot_sky(fig.add_subplot(grid[:, 0]), run)
     right = [fig.add_subplot(grid[0, 1])]
     right += [fig.add_subplot(grid[i, 1], sharex=right[0]) for i in (1, 2)]
     plot_margins(right[0], run)
@@ -614,8 +612,8 @@ def review(log_path: str | Path, out_dir: str | Path | None = None, *, plan_id: 
     sc = spacecraft_for(run, scenario)
     summary = summary_of(run, sc)
     text = format_summary(summary)
-    figures = {"overview": figure_overview(run, summary, sc, out / "overview.png"),
-               "sky": figure_sky(run, summary, out / "sky.png"),
+    figures = {"overview": figure_overview(run, sc, out / "overview.png"),
+               "sky": figure_sky(run, out / "sky.png"),
                "time histories": figure_time_histories(run, sc, out / "time_histories.png")}
     (out / "summary.txt").write_text(text + "\n")
     (out / "summary.json").write_text(json.dumps(summary, indent=2) + "\n")

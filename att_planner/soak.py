@@ -13,6 +13,7 @@ from pathlib import Path
 import numpy as np
 
 from att_msgs_py.mcap_log import read_log
+from att_msgs_py.review import settling_time
 from att_planner.launch import isolated_env, start_suite
 from att_sim import scenario as scen
 
@@ -59,15 +60,8 @@ def run_soak(scenario: str, orbits: float, out_dir: str | Path, sample_period: f
         n = len(series)
         growth[name] = {"start_mib": float(np.nanmean(series[n // 4: n // 2])) if n >= 4 else float(series[0]),
                         "end_mib": float(np.nanmean(series[-max(1, n // 4):]))}
-    # settling (Bruni & Celani): time after which every |q_i| stays <= 0.05 (None: not within the run)
-    q = state["attitude"]
-    outside = np.flatnonzero(np.abs(q[:, :3] * np.where(q[:, 3:4] < 0, -1.0, 1.0)).max(axis=1) > 0.05)
-    if not outside.size:
-        settling_orbits = 0.0
-    elif outside[-1] + 1 < len(state):
-        settling_orbits = float(state["header.stamp"][outside[-1] + 1]) / s.orbit.period
-    else:
-        settling_orbits = None
+    settled_at = settling_time(state["header.stamp"], state["attitude"])       # None: not within the run
+    settling_orbits = None if settled_at is None else settled_at / s.orbit.period
     return {"scenario": scenario, "orbits": orbits, "sim_time": sim_time, "wall_seconds": wall,
             "real_time_factor": sim_time / wall, "state_messages": len(state), "state_expected": expected,
             "command_messages": len(command), "dropped_state": expected - len(state),

@@ -228,8 +228,8 @@ def test_replay_builds_a_clock_from_log_times_when_the_log_has_none():
 
     from att_msgs_py.replay import CLOCK, Record, schedule
 
-    records = [Record(1_500_000_000, "/a", "t", b"1"), Record(1_500_000_000, "/b", "t", b"2"),
-               Record(2_999_999_999, "/a", "t", b"3")]
+    records = [Record(1_500_000_000, "/a", b"1"), Record(1_500_000_000, "/b", b"2"),
+               Record(2_999_999_999, "/a", b"3")]
     assert schedule(records, clock=False, clock_recorded=False) == records
     assert schedule(records, clock=True, clock_recorded=True) == records
     out = schedule(records, clock=True, clock_recorded=False)
