@@ -20,7 +20,7 @@ def configure(parser) -> None:
     parser.add_argument("--experiment", choices=["A", "B", "C"], default="A")
     parser.add_argument("--intervals", type=int, default=24, help="ZOH intervals per phase of the final plan")
     parser.add_argument("--search-intervals", type=int, default=8, help="intervals per phase in the order search")
-    parser.add_argument("--substeps", type=int, default=1, help="RK4 steps per ZOH interval in the NLP")
+    parser.add_argument("--substeps", type=int, default=sch.SUBSTEPS, help="RK4 steps per ZOH interval in the NLP")
     parser.add_argument("--candidates", type=int, default=2, help="orders solved in the fast search (plus the reverse of the best)")
     parser.add_argument("--prove", action="store_true",
                         help="solve every order whose leg lower bound is below the incumbent")

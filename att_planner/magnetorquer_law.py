@@ -14,15 +14,7 @@ from __future__ import annotations
 
 import numpy as np
 
-_NEXT = (1, 2, 0)
-_PREV = (2, 0, 1)
-
-
-def cross(a: np.ndarray, b: np.ndarray, axis: int = -1) -> np.ndarray:
-    """``a × b`` along ``axis`` (cheaper than ``np.cross`` on component-first batches)."""
-    a1, a2 = np.take(a, _NEXT, axis), np.take(a, _PREV, axis)
-    b1, b2 = np.take(b, _NEXT, axis), np.take(b, _PREV, axis)
-    return a1 * b2 - a2 * b1
+from att_sim.rotations import cross
 
 
 def _gain(k, axis: int):

@@ -87,6 +87,7 @@ def olivares_spacecraft() -> dyn.Spacecraft:
 
 
 OLIVARES_RATE_MAX = 0.04  # rad/s per body axis
+SUBSTEPS = 1              # RK4 steps per ZOH interval in the schedule NLPs (default everywhere)
 
 
 def olivares_targets(experiment: str = "C") -> dict[str, np.ndarray]:
@@ -284,7 +285,7 @@ class MultiphaseTranscription:
     Either end may be at rest (h = 0) or a passage (only ω_z = 0), chosen per solve.
     """
 
-    def __init__(self, sc: dyn.Spacecraft, n_targets: int, intervals: int = 12, substeps: int = 2,
+    def __init__(self, sc: dyn.Spacecraft, n_targets: int, intervals: int = 12, substeps: int = SUBSTEPS,
                  rate_max: float = np.inf, bound_margin: float = 1e-6, tol: float = 1e-7,
                  max_iter: int = 1500, expand: bool | None = None):
         if intervals < 1 or substeps < 1:
@@ -428,7 +429,7 @@ def _transcription(sc: dyn.Spacecraft, n_targets: int, intervals: int, substeps:
 # ---------------------------------------------------------------------------------------------
 
 def leg_bound_matrix(sc: dyn.Spacecraft, q_start, targets: list[np.ndarray], q_end, *, intervals: int = 12,
-                     substeps: int = 1, rate_max: float = np.inf, deadline: float | None = None) -> np.ndarray:
+                     substeps: int = SUBSTEPS, rate_max: float = np.inf, deadline: float | None = None) -> np.ndarray:
     """Minimum leg times with the boundary rates relaxed, as a (n+2)×(n+2) matrix.
 
     Node 0 is the start (at rest), 1..n the targets, n+1 the end (at rest). Entry (i, j) is the
@@ -574,7 +575,7 @@ def _solve_order(sc, q_start, q_end, targets: dict, order, intervals, substeps, 
 
 def plan_schedule(targets: dict, spacecraft: dyn.Spacecraft, q_start=rot.IDENTITY, q_end=None,
                   deadline: float | None = None, *, rate_max: float = np.inf, order=None,
-                  search_intervals: int = 8, intervals: int = 24, substeps: int = 1,
+                  search_intervals: int = 8, intervals: int = 24, substeps: int = SUBSTEPS,
                   candidates: int = 2, prove: bool = False, max_order_solves: int = 1000,
                   second_start_margin: float = 0.01,
                   verify: bool = True) -> ScheduleResult:
@@ -699,7 +700,7 @@ def _finish(result: ScheduleResult, status: str, message: str, t_begin: float, s
 
 
 def exhaustive_order_search(targets: dict, spacecraft: dyn.Spacecraft, q_start=rot.IDENTITY, q_end=None, *,
-                            rate_max: float = np.inf, intervals: int = 8, substeps: int = 1,
+                            rate_max: float = np.inf, intervals: int = 8, substeps: int = SUBSTEPS,
                             progress=None) -> list[dict]:
     """Solve the multiphase problem of every order (all n! of them, reversals included, as an
     independent check of the time-reversal symmetry and of the NLP's local minima) and return

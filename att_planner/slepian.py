@@ -79,13 +79,6 @@ def _log_so3(R: np.ndarray) -> np.ndarray:
     return w * (th / np.sin(th))
 
 
-def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """a × b on the last axis with broadcasting (np.cross is slow on small stacks)."""
-    a0, a1, a2 = a[..., 0], a[..., 1], a[..., 2]
-    b0, b1, b2 = b[..., 0], b[..., 1], b[..., 2]
-    return np.stack([a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0], axis=-1)
-
-
 def _right_jacobian(phi: np.ndarray) -> np.ndarray:
     """J_r(φ) = I − (1 − cos θ)/θ² φ× + (θ − sin θ)/θ³ (φ×)², stacked, series near θ = 0."""
     th2 = np.sum(phi * phi, axis=-1)
@@ -239,7 +232,7 @@ def evaluate(man: SmoothManeuver, alpha: np.ndarray, jac: bool = False) -> Evalu
     dw[0] = 0.0
     dw[1:] = (w[1:] - w[:-1]) / dt
     Jw = w @ J.T
-    torque = dw @ J.T + _cross(w, Jw)
+    torque = dw @ J.T + rot.cross(w, Jw)
     phi = dt * w
     E = _expm_stack(phi)
     R = np.concatenate([man.R_initial[None], man.R_initial @ _cumulative_product(E)])
@@ -263,12 +256,12 @@ def evaluate(man: SmoothManeuver, alpha: np.ndarray, jac: bool = False) -> Evalu
     G = R[1:] @ _right_jacobian(phi)                      # (N, 3, 3)
     H = (dt * G[..., None] * V[:, None, None, :]).reshape(N, 3, P)
     eta = np.concatenate([np.zeros((1, 3, P)), np.cumsum(H, axis=0)])   # (N+1, 3, P)
-    bw = _cross(b[:, None, :], man.cone_dirs[None, :, :])             # (N+1, C, 3)
+    bw = rot.cross(b[:, None, :], man.cone_dirs[None, :, :])             # (N+1, C, 3)
     ev.cones_jac = np.einsum("nxp,ncx->ncp", eta, bw)
     if man.sensor_target is None:
         ev.final_jac = _left_jacobian_inv(final) @ man.R_final.T @ eta[N]
     else:
-        bu = _cross(b[N][None, :], man.target_basis)                 # (2, 3)
+        bu = rot.cross(b[N][None, :], man.target_basis)                 # (2, 3)
         ev.final_jac = bu @ eta[N]
     return ev
 

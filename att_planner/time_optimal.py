@@ -36,7 +36,6 @@ import numpy as np
 from att_planner import baselines
 from att_planner import collocation as col
 from att_planner.cones import margins
-from att_planner.slepian import plan_slepian
 from att_planner.problem import (STATUS_BUDGET, STATUS_FAILED, STATUS_FEASIBLE, STATUS_OPTIMAL,
                                  ManeuverPlan, ManeuverProblem)
 from att_sim import rotations as rot
@@ -385,8 +384,10 @@ def plan_time_optimal(problem: ManeuverProblem, *, intervals: int = 30, max_inte
     lap = time.monotonic()
     if smooth_warm_start:
         share = None if problem.deadline is None else time.monotonic() + (problem.deadline - time.monotonic()) / 3
+        from att_planner.slepian import plan_slepian   # only here: keeps scipy.signal out of plain solves
+
         smooth = plan_slepian(replace(problem, deadline=share), M=4)
-        warm_starts = tuple(warm_starts) + ((smooth,) if smooth.status != STATUS_FAILED else ())
+        warm_starts = (*warm_starts, smooth)           # a failed plan is empty and dropped below
         phase_seconds["smooth_warm_start"] = time.monotonic() - lap
         lap = time.monotonic()
     routes = select_routes(candidate_routes(problem, scaling), starts)
