@@ -5,14 +5,14 @@ Makefile into the venv prefix before this package is installed.
 """
 from glob import glob
 
-from setuptools import setup
+from setuptools import find_packages, setup
 
 PACKAGE = "att_suite"
 
 setup(
     name=PACKAGE,
     version="0.1.0",
-    packages=["att_planner", "att_sim", "att_msgs_py"],
+    packages=find_packages(include=["att_planner*", "att_sim*", "att_msgs_py*"]),
     data_files=[
         ("share/ament_index/resource_index/packages", ["resource/" + PACKAGE]),
         ("share/" + PACKAGE, ["package.xml"]),
@@ -28,14 +28,14 @@ setup(
     entry_points={
         "console_scripts": [
             "att-sim = att_sim.simulator_node:main",
-            "att-planner = att_planner.planner_node:main",
-            "att-controller = att_planner.controller_node:main",
-            "att-recorder = att_msgs_py.recorder_node:main",
-            "att-replay = att_msgs_py.replay:main",
-            "att-review = att_msgs_py.review:main",
-            "att-demo = att_planner.demo:main",
-            "att-bench = att_planner.bench:main",
-            "att-tune = att_planner.tune_cli:main",
+            "att-planner = att_planner.nodes.planner_node:main",
+            "att-controller = att_planner.nodes.controller_node:main",
+            "att-recorder = att_msgs_py.log.recorder_node:main",
+            "att-replay = att_msgs_py.log.replay:main",
+            "att-review = att_planner.tools.review:main",
+            "att-demo = att_planner.tools.demo:main",
+            "att-bench = att_planner.tools.bench:main",
+            "att-tune = att_planner.tools.tune:main",
         ],
     },
 )

@@ -1,6 +1,9 @@
-"""The one place that converts between att_msgs / geometry_msgs messages and numpy.
+"""The one place that converts between messages and the plain types of :mod:`att_msgs_py.types`.
 
-Nodes call these functions; no other module builds or reads message fields by hand.
+Nodes call these functions; no other module builds or reads message fields by hand. Reading
+functions take any object with the message's attributes (rclpy messages, or the objects the
+MCAP decoder returns), so logs and live topics go through the same code. They return raw values:
+deciding whether a value is acceptable is the receiver's job.
 Quaternions are geometry_msgs order (x, y, z, w) = numpy order, body-to-inertial.
 """
 from __future__ import annotations
@@ -9,11 +12,9 @@ import numpy as np
 from builtin_interfaces.msg import Time
 from geometry_msgs.msg import Quaternion, Vector3
 
-from att_msgs.msg import KeepOutCone, ManeuverPlan, PlanVerification, SpacecraftState
-
-from att_planner.cones import Cone
-from att_planner.problem import ManeuverPlan as PlanData
-from att_planner.verify import Verification
+from att_msgs.action import ExecuteManeuver
+from att_msgs.msg import ActuatorCommand, ControllerStatus, KeepOutCone, ManeuverPlan, PlanVerification, SpacecraftState
+from att_msgs_py import types
 
 
 def vector3(v) -> Vector3:
@@ -21,8 +22,8 @@ def vector3(v) -> Vector3:
     return Vector3(x=x, y=y, z=z)
 
 
-def from_vector3(msg: Vector3) -> np.ndarray:
-    return np.array([msg.x, msg.y, msg.z])
+def from_vector3(msg) -> np.ndarray:
+    return np.array([msg.x, msg.y, msg.z], float)
 
 
 def quaternion(q) -> Quaternion:
@@ -30,9 +31,9 @@ def quaternion(q) -> Quaternion:
     return Quaternion(x=x, y=y, z=z, w=w)
 
 
-def from_quaternion(msg: Quaternion) -> np.ndarray:
+def from_quaternion(msg) -> np.ndarray:
     """Raw components (not normalised: validation decides what to do with the norm)."""
-    return np.array([msg.x, msg.y, msg.z, msg.w])
+    return np.array([msg.x, msg.y, msg.z, msg.w], float)
 
 
 def time_msg(seconds: float) -> Time:
@@ -41,98 +42,125 @@ def time_msg(seconds: float) -> Time:
     return Time(sec=sec, nanosec=nanosec)
 
 
-def from_time(msg: Time) -> float:
+def from_time(msg) -> float:
     return msg.sec + msg.nanosec * 1e-9
 
 
-def cone_msg(cone: Cone) -> KeepOutCone:
+def cone_msg(cone: types.Cone) -> KeepOutCone:
     return KeepOutCone(name=cone.name, direction=vector3(cone.direction), half_angle=float(cone.half_angle))
 
 
-def cone_parts(msg: KeepOutCone) -> tuple[np.ndarray, float, str]:
+def cone_parts(msg) -> tuple[np.ndarray, float, str]:
     """Raw (direction, half_angle, name) of a cone message, for validation before a Cone is built."""
     return from_vector3(msg.direction), float(msg.half_angle), msg.name
 
 
-def state_msg(t: float, x: np.ndarray, *, frame_id: str, body_frame_id: str, wheel_torques=(),
-              field_body=(0, 0, 0), dipole=(0, 0, 0), applied_torque=(0, 0, 0), position=(0, 0, 0),
-              command_timeout: bool = False) -> SpacecraftState:
-    msg = SpacecraftState()
-    msg.header.stamp = time_msg(t)
-    msg.header.frame_id = frame_id
-    msg.body_frame_id = body_frame_id
-    msg.attitude = quaternion(x[:4])
-    msg.body_rate = vector3(x[4:7])
-    msg.wheel_speeds = [float(v) for v in x[7:]]
-    msg.wheel_torques = [float(v) for v in wheel_torques]
-    msg.magnetic_field_body = vector3(field_body)
-    msg.dipole = vector3(dipole)
-    msg.applied_torque = vector3(applied_torque)
-    msg.position = vector3(position)
-    msg.command_timeout = bool(command_timeout)
+# -- state and commands ------------------------------------------------------------------------
+
+def state_msg(s: types.State) -> SpacecraftState:
+    msg = SpacecraftState(body_frame_id=s.body_frame_id, command_timeout=bool(s.command_timeout))
+    msg.header.stamp = time_msg(s.t)
+    msg.header.frame_id = s.frame_id
+    msg.attitude = quaternion(s.q)
+    msg.body_rate = vector3(s.omega)
+    msg.wheel_speeds = [float(v) for v in s.wheel_speeds]
+    msg.wheel_torques = [float(v) for v in s.wheel_torques]
+    msg.magnetic_field_body = vector3(s.field_body)
+    msg.dipole = vector3(s.dipole)
+    msg.applied_torque = vector3(s.applied_torque)
+    msg.position = vector3(s.position)
     return msg
 
 
-def state_arrays(msg: SpacecraftState) -> dict:
-    """Numpy view of a state message: t, q, omega, wheel_speeds, field_body, dipole, ..."""
-    return {
-        "t": from_time(msg.header.stamp),
-        "q": from_quaternion(msg.attitude),
-        "omega": from_vector3(msg.body_rate),
-        "wheel_speeds": np.asarray(msg.wheel_speeds, float),
-        "wheel_torques": np.asarray(msg.wheel_torques, float),
-        "field_body": from_vector3(msg.magnetic_field_body),
-        "dipole": from_vector3(msg.dipole),
-        "applied_torque": from_vector3(msg.applied_torque),
-        "position": from_vector3(msg.position),
-    }
+def state_from_msg(msg) -> types.State:
+    return types.State(
+        t=from_time(msg.header.stamp), q=from_quaternion(msg.attitude), omega=from_vector3(msg.body_rate),
+        wheel_speeds=np.asarray(msg.wheel_speeds, float), wheel_torques=np.asarray(msg.wheel_torques, float),
+        field_body=from_vector3(msg.magnetic_field_body), dipole=from_vector3(msg.dipole),
+        applied_torque=from_vector3(msg.applied_torque), position=from_vector3(msg.position),
+        command_timeout=bool(msg.command_timeout), frame_id=msg.header.frame_id, body_frame_id=msg.body_frame_id)
 
 
-def verification_msg(v: Verification) -> PlanVerification:
+def command_msg(c: types.Command) -> ActuatorCommand:
+    msg = ActuatorCommand(mode=int(c.mode), wheel_torques=[float(v) for v in c.wheel_torques],
+                          dipole=vector3(c.dipole), body_torque=vector3(c.body_torque), plan_id=c.plan_id)
+    msg.header.stamp = time_msg(c.t)
+    msg.header.frame_id = c.frame_id
+    return msg
+
+
+def command_from_msg(msg) -> types.Command:
+    return types.Command(mode=int(msg.mode), wheel_torques=np.asarray(msg.wheel_torques, float),
+                         dipole=from_vector3(msg.dipole), body_torque=from_vector3(msg.body_torque),
+                         plan_id=msg.plan_id, t=from_time(msg.header.stamp), frame_id=msg.header.frame_id)
+
+
+def controller_status_msg(s: types.ControllerStatus) -> ControllerStatus:
+    msg = ControllerStatus(mode=int(s.mode), plan_id=s.plan_id, plan_progress=float(s.plan_progress),
+                           state_stale=bool(s.state_stale), message=s.message)
+    msg.header.stamp = time_msg(s.t)
+    msg.header.frame_id = s.frame_id
+    return msg
+
+
+# -- plans -------------------------------------------------------------------------------------
+
+def verification_msg(v: types.Verification) -> PlanVerification:
     return PlanVerification(
-        final_attitude_error=v.final_attitude_error, final_rate=v.final_rate,
-        min_cone_margin=v.min_cone_margin, cone_margins=[float(m) for m in v.cone_margins],
-        torque_ratio=v.torque_ratio, wheel_speed_ratio=v.wheel_speed_ratio, rate_max=v.rate_max,
-        dense_samples=int(v.dense_samples))
+        final_attitude_error=float(v.final_attitude_error), final_rate=float(v.final_rate),
+        min_cone_margin=float(v.min_cone_margin), cone_margins=[float(m) for m in v.cone_margins],
+        torque_ratio=float(v.torque_ratio), wheel_speed_ratio=float(v.wheel_speed_ratio),
+        rate_max=float(v.rate_max), dense_samples=int(v.dense_samples))
 
 
-def plan_msg(plan: PlanData, *, plan_id: str, frame_id: str, spacecraft: str, sensor_axis, cones,
-             verification: Verification | None, control_kind: str = "body_torque") -> ManeuverPlan:
-    msg = ManeuverPlan()
-    msg.header.frame_id = frame_id
-    msg.plan_id = plan_id
-    msg.method = plan.method
-    msg.status = plan.status
-    msg.message = plan.message
-    msg.spacecraft = spacecraft
-    msg.duration = float(plan.duration)
-    msg.control_kind = control_kind
-    msg.interpolation = plan.interpolation
+def verification_from_msg(msg) -> types.Verification:
+    return types.Verification(
+        final_attitude_error=float(msg.final_attitude_error), final_rate=float(msg.final_rate),
+        min_cone_margin=float(msg.min_cone_margin), cone_margins=[float(m) for m in msg.cone_margins],
+        torque_ratio=float(msg.torque_ratio), wheel_speed_ratio=float(msg.wheel_speed_ratio),
+        rate_max=float(msg.rate_max), dense_samples=int(msg.dense_samples))
+
+
+def plan_msg(plan: types.Plan) -> ManeuverPlan:
+    msg = ManeuverPlan(plan_id=plan.plan_id, method=plan.method, status=str(plan.status), message=plan.message,
+                       spacecraft=plan.spacecraft, duration=float(plan.duration),
+                       control_kind=str(plan.control_kind), interpolation=str(plan.interpolation),
+                       solve_seconds=float(plan.wall_time))
+    msg.header.frame_id = plan.frame_id
     msg.times = [float(v) for v in plan.t]
     msg.attitudes = [quaternion(q) for q in plan.q]
     msg.rates = [vector3(w) for w in plan.omega]
     msg.torques = [vector3(u) for u in plan.torque]
-    msg.sensor_axis = vector3(sensor_axis)
-    msg.cones = [cone_msg(c) for c in cones]
-    if verification is not None:
-        msg.verification = verification_msg(verification)
-    msg.solve_seconds = float(plan.solve_seconds)
+    msg.sensor_axis = vector3(plan.sensor_axis)
+    msg.cones = [cone_msg(c) for c in plan.cones]
+    if plan.verification is not None:
+        msg.verification = verification_msg(plan.verification)
     return msg
 
 
-def plan_arrays(msg: ManeuverPlan) -> dict:
-    """Numpy view of a plan message: t (K,), q (K,4), omega (K,3), torque (K,3) and metadata."""
-    return {
-        "plan_id": msg.plan_id,
-        "method": msg.method,
-        "status": msg.status,
-        "control_kind": msg.control_kind,
-        "interpolation": msg.interpolation,
-        "duration": msg.duration,
-        "t": np.asarray(msg.times, float),
-        "q": np.array([from_quaternion(q) for q in msg.attitudes]).reshape(-1, 4),
-        "omega": np.array([from_vector3(w) for w in msg.rates]).reshape(-1, 3),
-        "torque": np.array([from_vector3(u) for u in msg.torques]).reshape(-1, 3),
-        "sensor_axis": from_vector3(msg.sensor_axis),
-        "cones": [Cone(*cone_parts(c)[:2], c.name) for c in msg.cones],
-    }
+def plan_from_msg(msg) -> types.Plan:
+    """The plan of a message, arrays as sent: t (K,), q (K, 4), omega (K, 3), torque (K, 3).
+    ``status``, ``control_kind`` and ``interpolation`` stay the strings sent (they compare equal
+    to the vocabularies' members when they are one of them)."""
+    return types.Plan(
+        t=np.asarray(msg.times, float),
+        torque=np.array([from_vector3(u) for u in msg.torques], float).reshape(-1, 3),
+        q=np.array([from_quaternion(q) for q in msg.attitudes], float).reshape(-1, 4),
+        omega=np.array([from_vector3(w) for w in msg.rates], float).reshape(-1, 3),
+        control_kind=msg.control_kind, interpolation=msg.interpolation, method=msg.method, status=msg.status,
+        message=msg.message, wall_time=float(msg.solve_seconds), plan_id=msg.plan_id, spacecraft=msg.spacecraft,
+        frame_id=msg.header.frame_id, sensor_axis=from_vector3(msg.sensor_axis),
+        cones=[types.Cone(*cone_parts(c)) for c in msg.cones], verification=verification_from_msg(msg.verification))
+
+
+# -- the ExecuteManeuver action -----------------------------------------------------------------
+
+def feedback_msg(f: types.ManeuverFeedback) -> ExecuteManeuver.Feedback:
+    return ExecuteManeuver.Feedback(elapsed=float(f.elapsed), progress=float(f.progress),
+                                    attitude_error=float(f.attitude_error), min_cone_margin=float(f.min_cone_margin))
+
+
+def result_msg(r: types.ManeuverResult) -> ExecuteManeuver.Result:
+    return ExecuteManeuver.Result(success=bool(r.success), error_code=int(r.error_code), message=r.message,
+                                  duration=float(r.duration), final_attitude_error=float(r.final_attitude_error),
+                                  final_rate=float(r.final_rate))

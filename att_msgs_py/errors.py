@@ -36,8 +36,8 @@ class ErrorCode(IntEnum):
     INVALID_RESET = 400
 
 
-class RequestError(Exception):
-    """A request rejected before any numerics: an error code and a sentence."""
+class RequestError(ValueError):
+    """A request rejected before any numerics: an error code and a sentence naming the field."""
 
     def __init__(self, code: ErrorCode, message: str):
         super().__init__(message)

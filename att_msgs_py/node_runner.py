@@ -17,11 +17,10 @@ process exits 0.
 from __future__ import annotations
 
 import signal
-from typing import Callable
+from collections.abc import Callable
 
 import rclpy
 from rclpy.executors import Executor, ExternalShutdownException, SingleThreadedExecutor
-
 
 _stop_signalled = False
 
@@ -37,6 +36,15 @@ def spin_until_shutdown(executor: Executor, poll: float = 0.2) -> None:
     """``executor.spin()`` that re-checks the context at least every ``poll`` s (see above)."""
     while executor.context.ok():
         executor.spin_once(timeout_sec=poll)
+
+
+def parameter_reader(node, scenario_values: dict) -> Callable:
+    """``read(name, default)`` for a node: declares ROS parameter ``name`` with the value of its
+    scenario-file section (``scenario_values``) or else ``default``, and returns the parameter's
+    value, so ``-p`` and ``--params-file`` overrides win over both."""
+    def read(name: str, default):
+        return node.declare_parameter(name, scenario_values.get(name, default)).value
+    return read
 
 
 def run_node(make_node: Callable, args=None, make_executor: Callable[[], Executor] = SingleThreadedExecutor,

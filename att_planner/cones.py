@@ -1,27 +1,16 @@
-"""Keep-out cones for a body-fixed sensor (inertial directions, body-to-inertial attitude).
+"""Keep-out cone geometry for a body-fixed sensor (inertial directions, body-to-inertial attitude).
 
 The sensor boresight ``r`` (body) points along ``R(q) r`` in inertial axes. Cone ``i`` with unit
-axis ``w_i`` and half-angle ``θ_i`` is respected when ``rᵀ Rᵀ w_i ≤ cos θ_i``. The *margin* is the
-angle between boresight and cone axis minus the half-angle (rad): ≥ 0 means outside the cone.
+axis ``w_i`` and half-angle ``θ_i`` (:class:`att_msgs_py.types.Cone`) is respected when
+``rᵀ Rᵀ w_i ≤ cos θ_i``. The *margin* is the angle between boresight and cone axis minus the
+half-angle (rad): ≥ 0 means outside the cone.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 
+from att_msgs_py.types import Cone
 from att_sim import rotations as rot
-
-
-@dataclass(frozen=True)
-class Cone:
-    direction: np.ndarray   # (3,) inertial unit vector
-    half_angle: float       # rad, in (0, π/2)
-    name: str = ""
-
-    def __post_init__(self):
-        d = np.asarray(self.direction, dtype=float)
-        object.__setattr__(self, "direction", d / np.linalg.norm(d))
 
 
 def boresight(q: np.ndarray, sensor_axis: np.ndarray) -> np.ndarray:
@@ -49,3 +38,36 @@ def min_margin(q: np.ndarray, sensor_axis: np.ndarray, cones: list[Cone]) -> flo
     """Smallest margin over all samples and cones (rad); +inf without cones."""
     m = margins(q, sensor_axis, cones)
     return float(m.min()) if m.size else float("inf")
+
+
+def endpoint_directions(q_initial, q_final, sensor_axis, sensor_target=None) -> dict[str, np.ndarray]:
+    """The sensor directions a maneuver must start and end at, by name."""
+    ends = {"start sensor direction": boresight(q_initial, sensor_axis)}
+    if sensor_target is None:
+        ends["goal sensor direction"] = boresight(q_final, sensor_axis)
+    else:
+        ends["sensor_target direction"] = np.asarray(sensor_target, float)
+    return ends
+
+
+def endpoint_in_cone(q_initial, q_final, sensor_axis, cones: list[Cone],
+                     sensor_target=None) -> tuple[str, Cone, float] | None:
+    """``(name of the end, cone, depth in rad)`` of the first end direction inside a cone, else
+    None: no plan can exist then."""
+    for label, direction in endpoint_directions(q_initial, q_final, sensor_axis, sensor_target).items():
+        m = direction_margins(direction, cones)
+        if m.size and m.min() < 0:
+            k = int(np.argmin(m))
+            return label, cones[k], float(-m[k])
+    return None
+
+
+def blocked_endpoint(problem) -> str:
+    """Why a problem (``ManeuverProblem``) has no plan because an end lies inside a cone, or ''."""
+    hit = endpoint_in_cone(problem.q_initial, problem.q_final, problem.sensor_axis, problem.cones,
+                           problem.sensor_target)
+    if hit is None:
+        return ""
+    label, cone, depth = hit
+    return (f"infeasible request: the {label} is inside keep-out cone {cone.name or '(unnamed)'} "
+            f"({np.degrees(depth):.2f} deg inside its {np.degrees(cone.half_angle):.1f} deg half-angle)")

@@ -1,29 +1,40 @@
-"""The planner's plain-data request and result types (no ROS).
+"""The planner's problem type (no ROS): what every planning method is asked.
 
-Every maneuver method is a pure function ``plan(problem: ManeuverProblem, **options) ->
-ManeuverPlan``, in the style of ``scipy.optimize``: it takes a problem and options and returns a
-result object with the solution, a status, a message and statistics. The planner node converts
-messages to a :class:`ManeuverProblem`, calls the method, verifies the plan with
-:mod:`att_planner.verify` and converts back.
+Every method is a pure function ``plan(problem: ManeuverProblem, **options) -> Plan`` in the style
+of ``scipy.optimize``: a problem and options in, one result type out
+(:class:`att_msgs_py.types.Plan`: samples, status, message, iterations, wall time, statistics).
+The registry of :mod:`att_planner.methods` names them and their options; the planner service
+(:mod:`att_planner.service`) validates requests into problems, runs a method, verifies its plan
+(:mod:`att_planner.verification`) and answers.
 """
 from __future__ import annotations
 
+import math
 import time
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from att_planner.cones import Cone
+from att_msgs_py.types import Cone
 from att_sim.dynamics import Spacecraft
 
 
 @dataclass
 class ManeuverProblem:
-    """Rest-to-rest reorientation of a body-fixed sensor among keep-out cones.
+    """Reorientation of a body-fixed sensor among keep-out cones, from rest to rest.
 
     Attitudes are body-to-inertial quaternions [x, y, z, w]. ``spacecraft.body_torque_max`` is the
     per-axis torque bound T̄ (N m). ``deadline`` is a ``time.monotonic()`` instant after which a
     method must stop and return its best plan so far (``None``: no limit).
+
+    * ``sensor_target``: semi-free final attitude, only the sensor must reach this inertial
+      direction (rotation about it free); None: the full final attitude ``q_final`` is imposed.
+    * ``targets``: name → attitude, every one to be passed through once, in any order, on the way
+      from ``q_initial`` to ``q_final`` (a schedule; Olivares & Staffetti 2018: at a passage the
+      attitude is the target's and the body rate about body z is zero).
+    * ``rate_max`` (rad/s per body axis) and ``wheel_momentum_max`` (N m s per wheel, the momentum
+      the wheels store producing a body-torque plan with zero total momentum): bounds a plan must
+      keep, checked by the verification; infinite when not imposed.
     """
 
     spacecraft: Spacecraft
@@ -32,42 +43,13 @@ class ManeuverProblem:
     sensor_axis: np.ndarray = field(default_factory=lambda: np.array([1.0, 0.0, 0.0]))
     cones: list[Cone] = field(default_factory=list)
     deadline: float | None = None
-    # Semi-free final attitude: only the sensor must reach this inertial direction (rotation
-    # about it free). None: the full final attitude q_final is imposed.
     sensor_target: np.ndarray | None = None
+    targets: dict = field(default_factory=dict)
+    rate_max: float = math.inf
+    wheel_momentum_max: float = math.inf
 
     def time_left(self) -> float:
         return np.inf if self.deadline is None else self.deadline - time.monotonic()
 
-
-# Status values shared by every method (also the wire values of ManeuverPlan.status).
-STATUS_OPTIMAL = "optimal"            # converged to a (local) optimum
-STATUS_FEASIBLE = "feasible"          # a valid plan, optimality not proven / iteration limit
-STATUS_BUDGET = "budget_expired"      # time budget ran out; best plan so far returned
-STATUS_FALLBACK = "fallback"          # method failed; a safe fallback plan is returned
-STATUS_FAILED = "failed"              # no plan
-
-
-@dataclass
-class ManeuverPlan:
-    """A rest-to-rest plan as sampled body torques, with the planner's own reference states.
-
-    ``torque[k]`` is applied from ``t[k]`` to ``t[k+1]`` ('zoh') or interpolated linearly
-    ('linear'); ``t[0] = 0``, ``t[-1]`` is the maneuver duration. ``q``/``omega`` are the
-    planner's predicted attitude and rate at ``t`` (the controller tracks them).
-    """
-
-    method: str
-    t: np.ndarray
-    torque: np.ndarray
-    q: np.ndarray
-    omega: np.ndarray
-    interpolation: str = "zoh"
-    status: str = STATUS_FEASIBLE
-    message: str = ""
-    solve_seconds: float = 0.0
-    stats: dict = field(default_factory=dict)
-
-    @property
-    def duration(self) -> float:
-        return float(self.t[-1] - self.t[0])
+    def expired(self) -> bool:
+        return self.deadline is not None and time.monotonic() > self.deadline

@@ -16,14 +16,14 @@ A wheel at its speed limit cannot accelerate further: the motor torque pushing i
 ``wheel_speed_max`` is cut (the same thing a wheel drive does). ``τ_ext`` adds the direct body
 torque input, magnetorquer torque ``m × B_b`` and optional gravity-gradient torque.
 
-Integration: classic RK4 with quaternion renormalisation after every step, inputs held
-constant over a step (zero-order hold), see :func:`rk4_step`.
+Integration: classic RK4 (:func:`rk4`, the suite's one Runge–Kutta step) with quaternion
+renormalisation after every step, inputs held constant over a step (zero-order hold), see :func:`step`.
 """
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from functools import cached_property
-from typing import Callable
 
 import numpy as np
 
@@ -84,14 +84,10 @@ def external_torque(sc: Spacecraft, inputs: Inputs, q: np.ndarray) -> np.ndarray
     if inputs.body_torque is not None:
         tau = tau + np.asarray(inputs.body_torque, float)
     if inputs.dipole is not None and inputs.field_body is not None:
-        tau = tau + _cross(inputs.dipole, inputs.field_body)
+        tau = tau + rot.cross(inputs.dipole, inputs.field_body)
     if inputs.gravity_gradient is not None:
         tau = tau + inputs.gravity_gradient
     return tau
-
-
-def _cross(a, b):
-    return np.array([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]])
 
 
 def derivative(sc: Spacecraft, x: np.ndarray, inputs: Inputs) -> np.ndarray:
@@ -108,31 +104,35 @@ def derivative(sc: Spacecraft, x: np.ndarray, inputs: Inputs) -> np.ndarray:
             out[7:] = u / sc.wheel_inertia if sc.wheel_inertia > 0 else 0.0
         else:
             out[7:] = 0.0
-    out[4:7] = sc.inertia_inv @ (torque - _cross(w, h))
-    # q_dot = ½ q ⊗ [ω, 0]
-    qx, qy, qz, qw = q
-    wx, wy, wz = w
-    out[0] = 0.5 * (qw * wx + qy * wz - qz * wy)
-    out[1] = 0.5 * (qw * wy + qz * wx - qx * wz)
-    out[2] = 0.5 * (qw * wz + qx * wy - qy * wx)
-    out[3] = -0.5 * (qx * wx + qy * wy + qz * wz)
+    out[4:7] = sc.inertia_inv @ (torque - rot.cross(w, h))
+    # q_dot = ½ q ⊗ [ω, 0], on Python floats (a fraction of the cost of numpy scalars)
+    qx, qy, qz, qw = q.tolist()
+    wx, wy, wz = w.tolist()
+    out[:4] = (0.5 * (qw * wx + qy * wz - qz * wy), 0.5 * (qw * wy + qz * wx - qx * wz),
+               0.5 * (qw * wz + qx * wy - qy * wx), -0.5 * (qx * wx + qy * wy + qz * wz))
     return out
 
 
-def rk4_step(f: Callable[[np.ndarray], np.ndarray], x: np.ndarray, dt: float) -> np.ndarray:
-    """One classic Runge–Kutta step of ``x' = f(x)`` followed by quaternion renormalisation."""
-    k1 = f(x)
-    k2 = f(x + 0.5 * dt * k1)
-    k3 = f(x + 0.5 * dt * k2)
-    k4 = f(x + dt * k3)
-    out = x + dt / 6.0 * (k1 + 2 * k2 + 2 * k3 + k4)
-    out[:4] /= np.linalg.norm(out[:4])
-    return out
+def rk4(f: Callable, t, x, dt):
+    """One classic Runge–Kutta step of ``x' = f(t, x)``. Plain arithmetic on ``x``, so the same
+    step serves numpy states, batches of states and CasADi expressions."""
+    k1 = f(t, x)
+    k2 = f(t + 0.5 * dt, x + 0.5 * dt * k1)
+    k3 = f(t + 0.5 * dt, x + 0.5 * dt * k2)
+    k4 = f(t + dt, x + dt * k3)
+    return x + dt / 6.0 * (k1 + 2 * k2 + 2 * k3 + k4)
+
+
+def renormalised(x: np.ndarray) -> np.ndarray:
+    """The state with its quaternion (first four rows) scaled back to unit norm, in place."""
+    x[:4] /= np.linalg.norm(x[:4], axis=0)
+    return x
 
 
 def step(sc: Spacecraft, x: np.ndarray, inputs: Inputs, dt: float) -> np.ndarray:
-    """Advance the state by ``dt`` with inputs held constant (ZOH)."""
-    return rk4_step(lambda s: derivative(sc, s, inputs), x, dt)
+    """Advance the state by ``dt`` with inputs held constant (ZOH): RK4, then the quaternion
+    renormalised."""
+    return renormalised(rk4(lambda _t, s: derivative(sc, s, inputs), 0.0, x, dt))
 
 
 def angular_momentum_inertial(sc: Spacecraft, x: np.ndarray) -> np.ndarray:
@@ -199,16 +199,9 @@ def simulate_profile(
             t0 = a + i * h
             if interpolation == "zoh":
                 x = step(sc, x, Inputs(**{kind: u_a}), h)
-            else:
-                # linear: RK4 with the input evaluated at the stage times
-                u0 = u_a + slope * (t0 - t_knots[k])
-                um, u1 = u0 + slope * (0.5 * h), u0 + slope * h
-                k1 = derivative(sc, x, Inputs(**{kind: u0}))
-                k2 = derivative(sc, x + 0.5 * h * k1, Inputs(**{kind: um}))
-                k3 = derivative(sc, x + 0.5 * h * k2, Inputs(**{kind: um}))
-                k4 = derivative(sc, x + h * k3, Inputs(**{kind: u1}))
-                x = x + h / 6.0 * (k1 + 2 * k2 + 2 * k3 + k4)
-                x[:4] /= np.linalg.norm(x[:4])
+            else:       # linear: the input evaluated at the RK4 stage times
+                x = renormalised(rk4(lambda tt, xx, u=u_a, du=slope, tk=t_knots[k]:
+                                     derivative(sc, xx, Inputs(**{kind: u + du * (tt - tk)})), t0, x, h))
             ts.append(t0 + h)
             xs.append(x.copy())
     X = np.array(xs)

@@ -27,7 +27,9 @@ _PREV_AXIS = (2, 0, 1)
 
 def cross(a: np.ndarray, b: np.ndarray, axis: int = -1) -> np.ndarray:
     """``a × b`` along ``axis``, broadcasting (cheaper than ``np.cross`` on small stacks and on
-    component-first batches)."""
+    component-first batches; two single vectors take the scalar formula, the dynamics' hot path)."""
+    if np.ndim(a) == 1 and np.ndim(b) == 1:
+        return np.array([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]])
     a1, a2 = np.take(a, _NEXT_AXIS, axis), np.take(a, _PREV_AXIS, axis)
     b1, b2 = np.take(b, _NEXT_AXIS, axis), np.take(b, _PREV_AXIS, axis)
     return a1 * b2 - a2 * b1
@@ -121,6 +123,27 @@ def to_axis_angle(q: np.ndarray) -> tuple[np.ndarray, float]:
     angle = 2.0 * np.arctan2(s, q[3])
     axis = q[:3] / s if s > 1e-15 else np.array([1.0, 0.0, 0.0])
     return axis, float(angle)
+
+
+def slerp(q0: np.ndarray, q1: np.ndarray, s) -> np.ndarray:
+    """Attitude(s) a fraction ``s`` (scalar or array) of the way from q0 to q1 along the shortest
+    rotation: ``q0 ⊗ (q0* ⊗ q1)^s``; shape ``(4,)`` or ``s.shape + (4,)``."""
+    axis, angle = to_axis_angle(multiply(conjugate(q0), q1))
+    s = np.asarray(s, dtype=float)
+    return multiply(q0, from_axis_angle(np.broadcast_to(axis, s.shape + (3,)), s * angle))
+
+
+def orthonormal_basis(v: np.ndarray, references=((1.0, 0.0, 0.0), (0.0, 1.0, 0.0))) -> tuple[np.ndarray, np.ndarray]:
+    """Unit vectors ``(e1, e2)`` completing the unit ``v`` to a right-handed frame (e1, e2, v):
+    ``e1 = v × a / |v × a|``, ``e2 = v × e1``, with ``a`` the first of ``references`` that is not
+    within about 25° of ``v`` (the second otherwise)."""
+    v = np.asarray(v, dtype=float)
+    v = v / np.linalg.norm(v)
+    first, second = (np.asarray(r, dtype=float) for r in references)
+    a = first if abs(v @ first) < 0.9 else second
+    e1 = np.cross(v, a)
+    e1 /= np.linalg.norm(e1)
+    return e1, np.cross(v, e1)
 
 
 def exp_map(phi: np.ndarray) -> np.ndarray:

@@ -11,13 +11,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from att_msgs_py.types import Command, ControlMode, State
 from att_sim import dynamics as dyn
 from att_sim import environment as env
 from att_sim import rotations as rot
-
-# Actuator modes (same values as att_msgs/ActuatorCommand.MODE_*).
-MODE_IDLE, MODE_MAGNETORQUER_PD, MODE_PLAN_TRACKING, MODE_SAFE = 0, 1, 2, 3
-MODES = (MODE_IDLE, MODE_MAGNETORQUER_PD, MODE_PLAN_TRACKING, MODE_SAFE)
 
 
 @dataclass
@@ -44,20 +41,22 @@ class Simulation:
         self.halted, self.halt_reason = False, ""
         self.applied = Applied(np.zeros(sc.n_wheels))
 
-    def set_command(self, mode: int, wheel_torque, dipole, body_torque) -> str | None:
+    def set_command(self, command: Command) -> str | None:
         """Accept a command (None) or say why it is rejected; a rejected command changes nothing."""
-        if mode not in MODES:
-            return f"mode {mode} is not one of {MODES}"
-        wheel_torque = np.asarray(wheel_torque, float)
+        modes = tuple(int(m) for m in ControlMode)
+        if command.mode not in modes:
+            return f"mode {command.mode} is not one of {modes}"
+        wheel_torque = np.asarray(command.wheel_torques, float)
         if wheel_torque.size not in (0, self.sc.n_wheels):
             return f"wheel_torques has {wheel_torque.size} entries, the spacecraft has {self.sc.n_wheels} wheels"
-        for name, v in (("wheel_torques", wheel_torque), ("dipole", dipole), ("body_torque", body_torque)):
+        for name, v in (("wheel_torques", wheel_torque), ("dipole", command.dipole),
+                        ("body_torque", command.body_torque)):
             if not np.all(np.isfinite(v)):
                 return f"{name} contains NaN or Inf"
-        idle = mode == MODE_IDLE
+        idle = command.mode == ControlMode.IDLE
         self.wheel_cmd = np.zeros(self.sc.n_wheels) if idle or wheel_torque.size == 0 else wheel_torque
-        self.dipole_cmd = np.zeros(3) if idle else np.asarray(dipole, float)
-        self.body_cmd = np.zeros(3) if idle else np.asarray(body_torque, float)
+        self.dipole_cmd = np.zeros(3) if idle else np.asarray(command.dipole, float)
+        self.body_cmd = np.zeros(3) if idle else np.asarray(command.body_torque, float)
         return None
 
     def reset(self, q, omega, wheel_speed, orbit_phase: float) -> str | None:
@@ -78,6 +77,14 @@ class Simulation:
     def position(self) -> np.ndarray:
         return env.position(self.orbit, self.t, self.arg0)
 
+    def state(self, frame_id: str = "", body_frame_id: str = "") -> State:
+        """The truth state now, with what acted during the last step."""
+        x, a = self.x, self.applied
+        return State(t=self.t, q=x[:4].copy(), omega=x[4:7].copy(), wheel_speeds=x[7:].copy(),
+                     wheel_torques=a.wheel_torque, field_body=a.field_body, dipole=a.dipole,
+                     applied_torque=a.body_torque, position=self.position(), command_timeout=self.command_timeout,
+                     frame_id=frame_id, body_frame_id=body_frame_id)
+
     def inputs(self) -> dyn.Inputs:
         """Inputs for the next step: limits applied, zero while the command watchdog is tripped."""
         q, ws = self.x[:4], self.x[7:]
@@ -86,7 +93,8 @@ class Simulation:
         m = np.clip(self.dipole_cmd, -self.sc.dipole_max, self.sc.dipole_max) if active else np.zeros(3)
         tau = np.clip(self.body_cmd, -self.sc.body_torque_max, self.sc.body_torque_max) if active else np.zeros(3)
         b_body = env.field_body(self.orbit, self.t, q, self.arg0)
-        gg = env.gravity_gradient_torque(self.orbit, self.t, q, self.sc.inertia, self.arg0) if self.gravity_gradient else None
+        gg = (env.gravity_gradient_torque(self.orbit, self.t, q, self.sc.inertia, self.arg0)
+              if self.gravity_gradient else None)
         return dyn.Inputs(wheel_torque=u, body_torque=tau, dipole=m, field_body=b_body, gravity_gradient=gg)
 
     def advance(self, dt: float) -> None:

@@ -24,9 +24,9 @@ from rosgraph_msgs.msg import Clock
 
 from att_msgs.msg import ActuatorCommand, SpacecraftState
 from att_msgs.srv import ResetSimulator
-from att_msgs_py import convert, topics
+from att_msgs_py import convert, qos, topics
 from att_msgs_py.errors import ErrorCode
-from att_msgs_py.node_runner import run_node, spin_until_shutdown
+from att_msgs_py.node_runner import parameter_reader, run_node, spin_until_shutdown
 from att_sim import scenario as scen
 from att_sim.simulation import Simulation
 
@@ -36,11 +36,7 @@ class SimulatorNode(Node):
         super().__init__("simulator")
         name = self.declare_parameter("scenario", "swift_demo").value
         self.scenario = scen.load(name)
-        p = self.scenario.node_params.get("simulator", {})
-
-        def param(key, default):
-            return self.declare_parameter(key, p.get(key, default)).value
-
+        param = parameter_reader(self, self.scenario.node_params.get("simulator", {}))
         self.step = float(param("step", 0.05))
         self.publish_period = 1.0 / float(param("publish_rate", 10.0))
         self.clock_period = 1.0 / float(param("clock_rate", 50.0))
@@ -65,9 +61,9 @@ class SimulatorNode(Node):
         self.last_command_time = -np.inf
         self.rejected_commands = 0
 
-        self.state_pub = self.create_publisher(SpacecraftState, topics.STATE, topics.STREAM_QOS)
-        self.clock_pub = self.create_publisher(Clock, topics.CLOCK, topics.CLOCK_QOS)
-        self.create_subscription(ActuatorCommand, topics.COMMAND, self.on_command, topics.STREAM_QOS)
+        self.state_pub = self.create_publisher(SpacecraftState, topics.STATE, qos.STREAM_QOS)
+        self.clock_pub = self.create_publisher(Clock, topics.CLOCK, qos.CLOCK_QOS)
+        self.create_subscription(ActuatorCommand, topics.COMMAND, self.on_command, qos.STREAM_QOS)
         self.create_service(ResetSimulator, topics.RESET_SIMULATOR, self.on_reset)
         self.get_logger().info(
             f"scenario '{self.scenario.name}', step {self.step} s, RTF "
@@ -75,15 +71,13 @@ class SimulatorNode(Node):
 
     # -- callbacks: translate messages to Simulation calls -------------------------------------
     def on_command(self, msg: ActuatorCommand):
-        wheel = np.asarray(msg.wheel_torques, float)
-        dipole = convert.from_vector3(msg.dipole)
-        body = convert.from_vector3(msg.body_torque)
-        error = self.sim.set_command(msg.mode, wheel, dipole, body)
+        command = convert.command_from_msg(msg)
+        error = self.sim.set_command(command)
         if error is None:
             self.last_command_time = self.sim.t
-            if convert.from_time(msg.header.stamp) >= self.awaited_stamp - 1e-9:
+            if command.t >= self.awaited_stamp - 1e-9:
                 self.answered = True
-        if error is not None:
+        else:
             self.rejected_commands += 1
             self.get_logger().warning(f"command rejected ({self.rejected_commands} so far): {error}",
                                       throttle_duration_sec=1.0)
@@ -153,11 +147,7 @@ class SimulatorNode(Node):
                 self.spin_until(lambda: self.answered, time.monotonic() + self.lockstep_timeout)
 
     def state_message(self) -> SpacecraftState:
-        s = self.sim
-        return convert.state_msg(
-            s.t, s.x, frame_id=self.scenario.frame_id, body_frame_id=self.scenario.body_frame_id,
-            wheel_torques=s.applied.wheel_torque, field_body=s.applied.field_body, dipole=s.applied.dipole,
-            applied_torque=s.applied.body_torque, position=s.position(), command_timeout=s.command_timeout)
+        return convert.state_msg(self.sim.state(self.scenario.frame_id, self.scenario.body_frame_id))
 
 
 def main(args=None):

@@ -1,10 +1,17 @@
-"""Shared test fixtures: an isolated ROS 2 suite started as processes, torn down after use."""
+"""Shared test fixtures: an isolated ROS 2 domain per test process, and the one factory that
+starts the suite's nodes as processes and tears them down (:func:`ros_suite`)."""
 from __future__ import annotations
 
 import os
 import random
+from contextlib import contextmanager
+from dataclasses import dataclass, field
+from pathlib import Path
 
 import pytest
+
+from att_planner.nodes.client import SuiteClient, client_session
+from att_planner.tools.launch import Suite, isolated_env, join_env, start_suite
 
 
 @pytest.fixture(scope="session", autouse=True)
@@ -13,3 +20,46 @@ def isolated_ros_domain():
     os.environ["ROS_DOMAIN_ID"] = str(random.randint(1, 200))
     os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
     yield
+
+
+@dataclass
+class RosSuite:
+    """Nodes started by :func:`ros_suite`, a client joined to their domain, the run's log."""
+
+    suite: Suite
+    client: SuiteClient
+    mcap: Path
+    exit_codes: dict = field(default_factory=dict)     # filled when the nodes are stopped
+
+    def stop(self) -> dict:
+        """Stop every node now (the log is then finalised); their exit codes."""
+        self.exit_codes = self.exit_codes or self.suite.stop()
+        return self.exit_codes
+
+
+@pytest.fixture(scope="session")
+def ros_suite(tmp_path_factory):
+    """Factory of running suites: ``with ros_suite("swift_demo", params=...) as s:`` starts the
+    ``nodes`` of a scenario on a fresh isolated domain (simulator held at t = 0 until the recorder
+    and controller listen), joins a :class:`SuiteClient` to it and waits for the services; on exit
+    every node is stopped and must have ended."""
+
+    @contextmanager
+    def start(scenario: str, *, nodes=("recorder", "simulator", "controller", "planner"), params=None,
+              schedule: bool = False, name: str = "test_client"):
+        out = tmp_path_factory.mktemp(name)
+        env = isolated_env()
+        join_env(env)
+        suite = start_suite(scenario, out / "run.mcap", out, env=env, nodes=nodes, params=params)
+        running = None
+        try:
+            with client_session(name) as client:
+                if "planner" in nodes and "controller" in nodes:
+                    client.wait_for_servers(timeout=60, schedule=schedule)
+                running = RosSuite(suite, client, out / "run.mcap")
+                yield running
+        finally:
+            codes = running.stop() if running is not None else suite.stop()
+            assert all(p.poll() is not None for p in suite.procs.values()), codes
+
+    return start

@@ -24,8 +24,8 @@ import numpy as np
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE.parents[1]))
 
-from att_planner.cones import Cone  # noqa: E402
-from att_planner.launch import isolated_env, join_env, start_suite  # noqa: E402
+from att_msgs_py.types import Cone  # noqa: E402
+from att_planner.tools.launch import isolated_env, join_env, start_suite  # noqa: E402
 from att_sim import rotations as rot  # noqa: E402
 
 FIXTURE = HERE / "swift_short.mcap"
@@ -46,7 +46,7 @@ def main() -> int:
     suite = start_suite("swift_demo", work / "run.mcap", work, env=env, params=PARAMS,
                         nodes=("recorder", "controller", "planner"))
     from att_msgs_py.errors import ErrorCode
-    from att_planner.client_node import client_session, maneuver_request
+    from att_planner.nodes.client import client_session, maneuver_request
 
     try:
         with client_session("make_fixture") as client:
@@ -61,7 +61,8 @@ def main() -> int:
                 if result.error_code != ErrorCode.NO_STATE:
                     break
                 time.sleep(0.25)
-            print(f"plan {response.plan.plan_id} ({response.plan.method}, {response.plan.duration:.1f} s): {result.message}")
+            plan = response.plan
+            print(f"plan {plan.plan_id} ({plan.method}, {plan.duration:.1f} s): {result.message}")
             if not result.success:
                 return 1
     finally:

@@ -1,0 +1,139 @@
+"""The one reader of the suite's MCAP logs, for tools and tests.
+
+:func:`read_log` returns per-topic arrays with timestamps; it also reads a file whose end is
+missing (killed writer) up to its last complete chunk.
+"""
+from __future__ import annotations
+
+from collections.abc import Collection
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+from mcap.exceptions import McapError
+from mcap.reader import make_reader
+from mcap.records import Channel, Message, Schema
+from mcap.stream_reader import StreamReader
+from mcap_ros2.decoder import DecoderFactory
+
+from att_msgs_py import topics as suite_topics
+
+
+@dataclass
+class TopicLog:
+    """All messages of one topic: ``log_time`` (s, (n,)), ``fields`` (dotted name -> array with
+    the message index first, or a list where sizes vary) and the decoded ``messages``."""
+
+    topic: str
+    type_name: str
+    log_time: np.ndarray
+    fields: dict = field(default_factory=dict)
+    messages: list = field(default_factory=list)
+
+    def __len__(self) -> int:
+        return len(self.log_time)
+
+    def __getitem__(self, name: str):
+        return self.fields[name]
+
+
+def flatten(msg, prefix: str = "") -> dict:
+    """Dotted-name view of a decoded message: Vector3 -> (3,), Quaternion -> (4,) xyzw,
+    Time -> float s, numeric sequences -> arrays, nested messages recursed."""
+    slots = getattr(msg, "__slots__", None) or [k for k in vars(msg) if not k.startswith("_")]
+    names = set(slots)
+    if names == {"x", "y", "z"}:
+        return {prefix: np.array([msg.x, msg.y, msg.z])}
+    if names == {"x", "y", "z", "w"}:
+        return {prefix: np.array([msg.x, msg.y, msg.z, msg.w])}
+    if names == {"sec", "nanosec"}:
+        return {prefix: msg.sec + msg.nanosec * 1e-9}
+    out = {}
+    for name in slots:
+        value = getattr(msg, name)
+        key = f"{prefix}.{name}" if prefix else name
+        if isinstance(value, (bool, int, float, str, bytes)):
+            out[key] = value
+        elif isinstance(value, (list, tuple)) or isinstance(value, np.ndarray):
+            if len(value) and not isinstance(value[0], (bool, int, float, np.generic)):
+                items = [flatten(v) for v in value]
+                out[key] = [item.get("", item) for item in items]
+                if items and "" in items[0]:
+                    out[key] = np.array(out[key])
+            else:
+                out[key] = np.asarray(value, dtype=float) if len(value) else np.zeros(0)
+        else:
+            out.update(flatten(value, key))
+    return out
+
+
+def _stack(values: list):
+    try:
+        arr = np.asarray(values)
+        if arr.dtype != object:
+            return arr
+    except ValueError:
+        pass
+    return list(values)
+
+
+def iter_records(path: str | Path):
+    """(schema, channel, message) of every message; tolerant of a missing end (killed writer)."""
+    with open(path, "rb") as fh:
+        try:
+            reader = make_reader(fh)
+            summary = reader.get_summary()
+            if summary is not None and summary.chunk_indexes:
+                yield from reader.iter_messages(log_time_order=True)
+                return
+        except McapError:
+            pass
+    schemas, channels = {}, {}
+    with open(path, "rb") as fh:
+        try:
+            for record in StreamReader(fh, emit_chunks=False).records:
+                if isinstance(record, Schema):
+                    schemas[record.id] = record
+                elif isinstance(record, Channel):
+                    channels[record.id] = record
+                elif isinstance(record, Message):
+                    ch = channels[record.channel_id]
+                    yield schemas.get(ch.schema_id), ch, record
+        except (McapError, EOFError, ValueError, KeyError) as exc:  # truncated tail: stop there
+            del exc
+
+
+def read_log(path: str | Path, topics: list[str] | None = None,
+             keep_messages: bool | Collection[str] = (suite_topics.PLANS,)) -> dict[str, TopicLog]:
+    """Read an MCAP log into ``{topic: TopicLog}``: the replay library of tools and tests.
+
+    Per topic, in log-time order: ``log_time`` (s, the recorder's receive time, wall clock) and one
+    array per field named by its dotted path with the message index first (see :func:`flatten`):
+    ``log["/spacecraft/state"]["header.stamp"]`` (n,) sim time in s, ``["attitude"]`` (n, 4) xyzw,
+    ``["wheel_speeds"]`` (n, W); strings give string arrays, sequences of varying length or of
+    messages give lists (``log["/planner/plans"]["cones"][i]`` is a list of dicts). Every message
+    is decoded from its own schema (so this also checks the log is self-describing); ``topics``
+    limits the topics read; the decoded message objects are kept too (``TopicLog.messages``) for
+    the topics in ``keep_messages`` (True: all; default: the plans, which tools turn into
+    :class:`~att_msgs_py.types.Plan` with :func:`att_msgs_py.convert.plan_from_msg`). A file whose
+    writer was killed is read up to its last complete chunk.
+    """
+    factory = DecoderFactory()
+    decoders, rows = {}, {}
+    for schema, channel, message in iter_records(path):
+        if topics is not None and channel.topic not in topics:
+            continue
+        if schema.id not in decoders:
+            decoders[schema.id] = factory.decoder_for(channel.message_encoding, schema)
+        decoded = decoders[schema.id](message.data)
+        entry = rows.setdefault(channel.topic, (schema.name, [], [], []))
+        entry[1].append(message.log_time * 1e-9)
+        entry[2].append(flatten(decoded))
+        if keep_messages is True or (keep_messages and channel.topic in keep_messages):
+            entry[3].append(decoded)
+    out = {}
+    for topic, (type_name, times, flats, msgs) in rows.items():
+        keys = flats[0].keys()
+        out[topic] = TopicLog(topic, type_name, np.asarray(times),
+                              {k: _stack([f[k] for f in flats]) for k in keys}, msgs)
+    return out

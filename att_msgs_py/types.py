@@ -1,0 +1,213 @@
+"""Plain numpy mirror types of the att_msgs interfaces, and the vocabularies they use.
+
+Every module of the suite speaks these types; only :mod:`att_msgs_py.convert` turns them into
+messages and back. Conventions (the whole suite): SI units, quaternions ``[x, y, z, w]``
+(geometry_msgs order) describing the body frame with respect to the inertial frame
+(body-to-inertial), body rates in body axes.
+
+The vocabularies (:class:`Status`, :class:`ControlMode`, :class:`ControlKind`,
+:class:`Interpolation`) are written here once; the constants of the .msg files carry the same
+values, which a test checks.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from enum import IntEnum, StrEnum
+
+import numpy as np
+
+
+class Status(StrEnum):
+    """How a plan (or any search of the suite) ended: ``att_msgs/ManeuverPlan.STATUS_*``."""
+
+    OPTIMAL = "optimal"                # converged to a (local) optimum
+    FEASIBLE = "feasible"              # a valid answer, optimality not proven (iteration limit)
+    BUDGET_EXPIRED = "budget_expired"  # the time budget ran out; the best answer so far
+    FALLBACK = "fallback"              # the method failed; a safe fallback plan is returned
+    FAILED = "failed"                  # no answer
+
+
+class ControlMode(IntEnum):
+    """Controller / actuator modes: ``att_msgs/ActuatorCommand.MODE_*``."""
+
+    IDLE = 0
+    MAGNETORQUER_PD = 1
+    PLAN_TRACKING = 2
+    SAFE = 3
+
+
+class ControlKind(StrEnum):
+    """What a plan's control samples are: ``att_msgs/ManeuverPlan.control_kind``."""
+
+    BODY_TORQUE = "body_torque"        # N m, body axes
+    WHEEL_TORQUE = "wheel_torque"      # N m, one motor torque per wheel
+
+
+class Interpolation(StrEnum):
+    """How control samples are applied between knots: ``att_msgs/ManeuverPlan.interpolation``."""
+
+    ZOH = "zoh"                        # sample k held on [t_k, t_k+1)
+    LINEAR = "linear"                  # linear between the knots
+
+
+@dataclass(frozen=True)
+class Cone:
+    """Keep-out cone (``att_msgs/KeepOutCone``): the sensor boresight stays at least
+    ``half_angle`` (rad) away from the inertial unit ``direction``."""
+
+    direction: np.ndarray
+    half_angle: float
+    name: str = ""
+
+    def __post_init__(self):
+        d = np.asarray(self.direction, dtype=float)
+        object.__setattr__(self, "direction", d / np.linalg.norm(d))
+
+
+@dataclass
+class Verification:
+    """A plan integrated through the truth dynamics (``att_msgs/PlanVerification``).
+
+    The fields from ``duration`` on are not on the wire.
+    """
+
+    final_attitude_error: float        # rad, to the goal attitude (semi-free: boresight to target)
+    final_rate: float                  # rad/s, ‖ω(t_f)‖
+    min_cone_margin: float             # rad over the dense grid (+inf without cones)
+    cone_margins: list                 # rad, minimum per cone (request order)
+    torque_ratio: float                # max |control| / its limit over the applied samples
+    wheel_speed_ratio: float           # max |Ω_i| / limit over the dense grid (0 without wheels)
+    rate_max: float                    # rad/s, largest ‖ω‖ over the dense grid
+    dense_samples: int                 # integration samples the figures are taken over
+    duration: float = math.nan         # s
+    body_rate_ratio: float = 0.0       # max |ω_j| / the problem's rate bound (0 without one)
+    wheel_momentum_ratio: float = 0.0  # max |h_w,i| / the problem's momentum bound (0 without one)
+    passage_attitude_errors: list = field(default_factory=list)   # rad, per passage
+    passage_rates_z: list = field(default_factory=list)           # rad/s, |ω_z| per passage
+
+
+@dataclass(frozen=True)
+class Passage:
+    """A target a plan passes through: its name, the passage time (s from the plan start) and
+    the target attitude."""
+
+    name: str
+    time: float
+    attitude: np.ndarray
+
+
+def _empty(*shape):
+    return field(default_factory=lambda: np.zeros(shape))
+
+
+@dataclass
+class Plan:
+    """A maneuver plan (``att_msgs/ManeuverPlan``), in the style of ``scipy.optimize.OptimizeResult``.
+
+    Samples: ``torque[k]`` (body torque, (K, 3), or one motor torque per wheel, (K, N), as
+    ``control_kind`` says) is applied from ``t[k]`` as ``interpolation`` says; ``t[0] = 0`` and
+    ``t[-1]`` is the duration; ``q``/``omega`` are the planner's reference states at ``t`` (what the
+    controller tracks). Outcome: ``status``, ``message``, ``nit``/``nfev`` (solver iterations and
+    function evaluations, 0 where they do not apply), ``wall_time`` (s) and free-form ``stats``.
+    Context, filled by the planner service: ``plan_id``, ``spacecraft``, ``frame_id``,
+    ``sensor_axis``, ``cones``, ``verification`` and, for a schedule, the ``passages``. A method
+    that finds nothing returns a plan without samples and status FAILED (or BUDGET_EXPIRED).
+    ``nit``, ``nfev``, ``stats`` and ``passages`` are not on the wire.
+    """
+
+    t: np.ndarray = _empty(0)
+    torque: np.ndarray = _empty(0, 3)
+    q: np.ndarray = _empty(0, 4)
+    omega: np.ndarray = _empty(0, 3)
+    control_kind: ControlKind = ControlKind.BODY_TORQUE
+    interpolation: Interpolation = Interpolation.ZOH
+    method: str = ""
+    status: Status = Status.FAILED
+    message: str = ""
+    nit: int = 0
+    nfev: int = 0
+    wall_time: float = 0.0
+    stats: dict = field(default_factory=dict)
+    plan_id: str = ""
+    spacecraft: str = ""
+    frame_id: str = ""
+    sensor_axis: np.ndarray = field(default_factory=lambda: np.array([1.0, 0.0, 0.0]))
+    cones: list = field(default_factory=list)
+    verification: Verification | None = None
+    passages: list = field(default_factory=list)
+
+    @property
+    def duration(self) -> float:
+        return float(self.t[-1] - self.t[0]) if len(self.t) else 0.0
+
+    @property
+    def success(self) -> bool:
+        """A usable plan: at least two samples and a status other than FAILED."""
+        return self.status != Status.FAILED and len(self.t) >= 2
+
+
+@dataclass
+class State:
+    """Spacecraft truth state (``att_msgs/SpacecraftState``)."""
+
+    t: float                           # s of sim time
+    q: np.ndarray                      # (4,) body-to-inertial
+    omega: np.ndarray                  # (3,) rad/s, body axes
+    wheel_speeds: np.ndarray           # (N,) rad/s
+    wheel_torques: np.ndarray = _empty(0)       # (N,) N m, applied motor torques
+    field_body: np.ndarray = _empty(3)          # T, body axes
+    dipole: np.ndarray = _empty(3)              # A m², applied
+    applied_torque: np.ndarray = _empty(3)      # N m, body axes
+    position: np.ndarray = _empty(3)            # m, inertial
+    command_timeout: bool = False
+    frame_id: str = ""
+    body_frame_id: str = ""
+
+
+@dataclass
+class Command:
+    """Actuator command (``att_msgs/ActuatorCommand``); only the fields of ``mode`` are used."""
+
+    mode: int
+    wheel_torques: np.ndarray          # (N,) or empty, N m
+    dipole: np.ndarray = _empty(3)     # A m², body axes
+    body_torque: np.ndarray = _empty(3)  # N m, body axes
+    plan_id: str = ""
+    t: float = 0.0                     # s of sim time: the state this command answers
+    frame_id: str = ""
+
+
+@dataclass
+class ControllerStatus:
+    """Controller status (``att_msgs/ControllerStatus``)."""
+
+    mode: int
+    t: float = 0.0
+    plan_id: str = ""
+    plan_progress: float = 0.0
+    state_stale: bool = False
+    message: str = ""
+    frame_id: str = ""
+
+
+@dataclass
+class ManeuverFeedback:
+    """Feedback of ``att_msgs/action/ExecuteManeuver``."""
+
+    elapsed: float                     # s of sim time
+    progress: float                    # 0..1
+    attitude_error: float              # rad, to the plan reference
+    min_cone_margin: float             # rad, now
+
+
+@dataclass
+class ManeuverResult:
+    """Result of ``att_msgs/action/ExecuteManeuver``."""
+
+    success: bool
+    error_code: int
+    message: str
+    duration: float = 0.0              # s of sim time
+    final_attitude_error: float = math.nan   # rad, to the plan's final attitude
+    final_rate: float = math.nan       # rad/s

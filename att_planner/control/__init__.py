@@ -1,0 +1,1 @@
+"""Control laws (:mod:`.tracking`, :mod:`.magnetorquer`) and the controller core (:mod:`.controller`), no ROS."""

@@ -1,0 +1,232 @@
+"""The controller's numerics without ROS: mode, plan cache, the maneuver being flown, one step at a time.
+
+:class:`Controller` holds what the controller node used to keep in dictionaries: the latest state,
+the mode, the received plans, the :class:`Maneuver` being executed and the attitude held after it.
+Its inputs are plain types (:mod:`att_msgs_py.types`), its outputs a :class:`StepOutput` per
+control instant (actuator command, status, action feedback, the result of a maneuver that ended).
+The node (:mod:`att_planner.nodes.controller_node`) only translates messages; tests drive the
+core directly, like :class:`att_sim.simulation.Simulation`.
+
+Laws per mode: IDLE commands nothing; MAGNETORQUER_PD the PD-like law of Bruni & Celani
+(:mod:`.magnetorquer`); SAFE rate damping through the wheels (τ = −k_d ω); PLAN_TRACKING the plan's
+feedforward plus quaternion PD feedback (:mod:`.tracking`) for the plan's duration plus a settle
+time, then a hold of its final attitude.
+"""
+from __future__ import annotations
+
+import math
+from collections import OrderedDict
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from att_msgs_py.errors import ErrorCode
+from att_msgs_py.types import (
+    Command,
+    ControlKind,
+    ControllerStatus,
+    ControlMode,
+    ManeuverFeedback,
+    ManeuverResult,
+    Plan,
+    State,
+    Status,
+)
+from att_planner.cones import min_margin
+from att_planner.control import tracking
+from att_planner.control.magnetorquer import dipole_command
+from att_sim import rotations as rot
+from att_sim.dynamics import Spacecraft
+
+MODES = tuple(int(m) for m in ControlMode)
+
+
+@dataclass(frozen=True)
+class ControllerConfig:
+    """Gains and timing (the controller node's parameters)."""
+
+    control_period: float = 0.1        # s of sim time between commands
+    settle_time: float = 20.0          # s held on the final attitude after the plan ends
+    tracking_kp: float = 0.4           # N m / rad, attitude feedback around the plan reference
+    tracking_kd: float = 10.0          # N m s / rad
+    kp: float = 2e5                    # magnetorquer PD-like law (Bruni & Celani)
+    kd: float = 1e8
+    m_max: float = math.inf            # A m² per coil (default: the spacecraft's dipole limit)
+    safe_kd: float = 10.0              # N m s / rad, rate damping of the safe mode
+    feedback_period: float = 0.5       # s of sim time between action feedbacks
+    max_cached_plans: int = 50
+
+
+@dataclass
+class Maneuver:
+    """The plan being executed, from sim time ``t0``."""
+
+    plan: Plan
+    t0: float
+    ticks: int = 0
+
+
+@dataclass
+class StepOutput:
+    """What one control instant produces."""
+
+    command: Command
+    status: ControllerStatus
+    feedback: ManeuverFeedback | None = None
+    result: ManeuverResult | None = None       # the maneuver that ended at this step
+
+
+@dataclass
+class Controller:
+    spacecraft: Spacecraft
+    config: ControllerConfig = ControllerConfig()
+    mode: int = ControlMode.IDLE
+    body_frame_id: str = ""
+    state: State | None = None
+    next_control: float = -math.inf
+    maneuver: Maneuver | None = None
+    hold_q: np.ndarray | None = None           # final attitude held after a maneuver
+    plans: OrderedDict = field(default_factory=OrderedDict)
+
+    @property
+    def m_max(self) -> float:
+        return self.config.m_max if math.isfinite(self.config.m_max) else self.spacecraft.dipole_max
+
+    # -- inputs ---------------------------------------------------------------------------------
+    def accept_state(self, state: State) -> str | None:
+        """Keep ``state`` as the latest, or say why it is ignored."""
+        if not (np.all(np.isfinite(state.q)) and np.all(np.isfinite(state.omega))):
+            return "non-finite state received; ignored"
+        self.state = state
+        return None
+
+    def receive_plan(self, plan: Plan) -> None:
+        """Cache a published plan (the oldest are dropped beyond ``max_cached_plans``)."""
+        self.plans[plan.plan_id] = plan
+        while len(self.plans) > self.config.max_cached_plans:
+            self.plans.popitem(last=False)
+
+    def set_mode(self, mode: int) -> tuple[ErrorCode, str, ManeuverResult | None]:
+        """Change the mode; the result of a maneuver this aborts comes back too."""
+        if mode not in MODES:
+            return ErrorCode.INVALID_MODE, f"mode {mode} is not one of {MODES} (ActuatorCommand.MODE_*)", None
+        if mode == ControlMode.PLAN_TRACKING:
+            return ErrorCode.INVALID_MODE, "plan tracking starts with the execute action, not with set_mode", None
+        if self.maneuver is not None and mode != ControlMode.SAFE:
+            return ErrorCode.BUSY, (f"maneuver '{self.maneuver.plan.plan_id}' is executing: only MODE_SAFE "
+                                    "(abort) is accepted until it ends or is cancelled"), None
+        ended = self.abort("aborted by a switch to safe mode") if self.maneuver is not None else None
+        self.mode = mode
+        return ErrorCode.OK, f"mode set to {mode}", ended
+
+    def resolve(self, plan_id: str, inline: Plan | None = None) -> tuple[Plan | None, ErrorCode, str]:
+        """The plan to execute (``inline``, or the cached ``plan_id``), or why there is none."""
+        plan = inline if inline is not None else self.plans.get(plan_id)
+        if plan is None:
+            return None, ErrorCode.UNKNOWN_PLAN, f"plan_id '{plan_id}' is not a plan this controller received"
+        t, torque = plan.t, plan.torque
+        if len(t) < 2 or len(plan.q) != len(t) or len(torque) != len(t) or np.any(np.diff(t) <= 0):
+            return None, ErrorCode.INVALID_PLAN, "plan times must increase and match attitudes, rates and torques"
+        if not all(np.all(np.isfinite(a)) for a in (plan.t, plan.q, plan.omega, plan.torque)):
+            return None, ErrorCode.INVALID_PLAN, "plan contains NaN or Inf"
+        if plan.control_kind not in (*tuple(ControlKind), ""):
+            return None, ErrorCode.INVALID_PLAN, f"control_kind '{plan.control_kind}' is not supported"
+        if plan.status == Status.FAILED:
+            return None, ErrorCode.INVALID_PLAN, "plan status is 'failed'"
+        return plan, ErrorCode.OK, ""
+
+    def start(self, plan: Plan) -> tuple[ErrorCode, str]:
+        """Start flying ``plan`` (resolved) from the latest state."""
+        if self.state is None:
+            return ErrorCode.NO_STATE, "no spacecraft state received yet"
+        self.maneuver = Maneuver(plan, self.state.t)
+        self.mode = ControlMode.PLAN_TRACKING
+        return ErrorCode.OK, ""
+
+    def abort(self, message: str) -> ManeuverResult:
+        """End the running maneuver unsuccessfully (cancelled, or safe mode); safe mode follows."""
+        return self._end(False, ErrorCode.ABORTED, message)
+
+    # -- the control loop -------------------------------------------------------------------------
+    def due(self) -> bool:
+        """Whether the latest state is at or after the next control instant (then it becomes the
+        current one)."""
+        if self.state is None or self.state.t < self.next_control - 1e-9:
+            return False
+        self.next_control = self.state.t + self.config.control_period
+        return True
+
+    def step(self, cancel_requested: bool = False) -> StepOutput:
+        """Command and status for the latest state; ``cancel_requested`` aborts a running maneuver."""
+        s = self.state
+        cmd = Command(mode=self.mode, wheel_torques=np.zeros(self.spacecraft.n_wheels), t=s.t,
+                      frame_id=self.body_frame_id)
+        status = ControllerStatus(mode=self.mode, t=s.t, frame_id=self.body_frame_id)
+        out = StepOutput(cmd, status)
+        if self.mode == ControlMode.MAGNETORQUER_PD:
+            cmd.dipole = dipole_command(s.q, s.omega, s.field_body, self.config.kp, self.config.kd, self.m_max)
+        elif self.mode == ControlMode.SAFE:
+            cmd.wheel_torques = tracking.wheel_torques(self.spacecraft, -self.config.safe_kd * s.omega, s.omega,
+                                                       s.wheel_speeds)
+        elif self.mode == ControlMode.PLAN_TRACKING and self.maneuver is not None:
+            self._track(out, cancel_requested)
+        elif self.mode == ControlMode.PLAN_TRACKING and self.hold_q is not None:
+            cmd.wheel_torques = self._wheel_command(tracking.Reference(self.hold_q, np.zeros(3), np.zeros(3)))
+            status.message = "holding the final attitude of the last maneuver"
+        return out
+
+    def stale_command(self) -> tuple[Command, ControllerStatus]:
+        """What the watchdog sends when no state arrives: zero wheel torques in safe mode."""
+        return (Command(mode=ControlMode.SAFE, wheel_torques=np.zeros(self.spacecraft.n_wheels)),
+                ControllerStatus(mode=self.mode, state_stale=True, message="no state (wall clock)"))
+
+    def _wheel_command(self, ref: tracking.Reference) -> np.ndarray:
+        """Wheel torques of the tracking law about a body-torque reference."""
+        s, c = self.state, self.config
+        tau = tracking.tracking_torque(s.q, s.omega, ref, c.tracking_kp, c.tracking_kd)
+        return tracking.wheel_torques(self.spacecraft, tau, s.omega, s.wheel_speeds)
+
+    def _track(self, out: StepOutput, cancel_requested: bool) -> None:
+        """One plan-tracking step: command, feedback every ``feedback_period``, the end."""
+        s, m, sc = self.state, self.maneuver, self.spacecraft
+        plan = m.plan
+        elapsed = s.t - m.t0
+        ref = tracking.plan_reference(plan, elapsed)
+        if plan.control_kind == ControlKind.WHEEL_TORQUE:
+            # the plan's wheel torques as feedforward, PD feedback about its reference states
+            fb = tracking.tracking_torque(s.q, s.omega, tracking.Reference(ref.q, ref.omega, np.zeros(3)),
+                                          self.config.tracking_kp, self.config.tracking_kd)
+            u = ref.torque + tracking.wheel_torques(sc, fb, s.omega, np.zeros(sc.n_wheels))
+            u = np.clip(u, -sc.wheel_torque_max, sc.wheel_torque_max)
+        else:
+            u = self._wheel_command(ref)
+        out.command.wheel_torques = u
+        out.command.plan_id = out.status.plan_id = plan.plan_id
+        m.ticks += 1
+        if m.ticks % max(1, round(self.config.feedback_period / self.config.control_period)) == 0:
+            span = max(plan.duration + self.config.settle_time, 1e-9)
+            out.feedback = ManeuverFeedback(
+                elapsed=float(elapsed), progress=float(min(1.0, elapsed / span)),
+                attitude_error=float(rot.angle_between(s.q, ref.q)),
+                min_cone_margin=min_margin(s.q, plan.sensor_axis, plan.cones) if plan.cones else math.inf)
+        if cancel_requested:
+            out.result = self.abort("cancelled")
+            return
+        out.status.plan_progress = float(min(1.0, elapsed / max(plan.duration, 1e-9)))
+        if elapsed >= plan.duration + self.config.settle_time:
+            out.result = self._end(True, ErrorCode.OK, "maneuver complete")
+            out.status.message = "maneuver complete; holding the final attitude"
+
+    def _end(self, success: bool, code: ErrorCode, message: str) -> ManeuverResult:
+        """Close the running maneuver; its figures are those of the latest state."""
+        s, plan = self.state, self.maneuver.plan
+        result = ManeuverResult(
+            success=success, error_code=int(code), message=message,
+            duration=float(s.t - self.maneuver.t0) if s is not None else 0.0,
+            final_attitude_error=float(rot.angle_between(s.q, plan.q[-1])) if s is not None else math.nan,
+            final_rate=float(np.linalg.norm(s.omega)) if s is not None else math.nan)
+        self.hold_q = plan.q[-1] if success else None
+        self.maneuver = None
+        if code == ErrorCode.ABORTED:
+            self.mode = ControlMode.SAFE
+        return result

@@ -1,0 +1,140 @@
+"""The planning methods served by ``PlanManeuver``: name -> function, options and their ranges.
+
+This registry is the only place option ranges are written. Each entry names a pure function
+``plan(problem, **options) -> Plan`` (:mod:`att_planner.problem`), the options a request may give
+with their ranges, and a per-method hook that refuses the combinations the method cannot run.
+:meth:`Method.validate` applies all of it before any numerics run (``INVALID_OPTION``, 131).
+Options marked ``limit`` are bounds of the maneuver, not tuning knobs: they become fields of the
+problem (and are verified), the others are passed to the function.
+
+A new method: write ``plan_<name>(problem, **options) -> Plan`` in a module of this package and
+add an entry to :data:`REGISTRY` (its options, ranges and, if some combinations cannot run, a hook).
+"""
+from __future__ import annotations
+
+import importlib
+import math
+from collections.abc import Callable
+from dataclasses import dataclass, field, replace
+
+from att_msgs_py.errors import ErrorCode, RequestError
+from att_msgs_py.types import Plan
+
+
+@dataclass(frozen=True)
+class Option:
+    low: float
+    high: float
+    integer: bool = False
+    limit: bool = False          # a bound of the maneuver (the ManeuverProblem field of that name)
+    doc: str = ""
+
+    def label(self, name: str) -> str:
+        return f"{name} ({self.doc})" if self.doc else name
+
+
+@dataclass(frozen=True)
+class Method:
+    name: str
+    module: str
+    function: str
+    description: str
+    options: dict = field(default_factory=dict)
+    fixed: dict = field(default_factory=dict)     # keyword arguments always passed
+    cheap: bool = False                           # closed form: run in-process, no child process
+    check: Callable[[dict], str | None] | None = None   # combinations the method cannot run ...
+    combined: tuple = ()                                # ... of these options
+
+    def load(self) -> Callable:
+        return getattr(importlib.import_module(self.module), self.function)
+
+    def validate(self, options: dict) -> dict:
+        """The options converted (integers as int), or RequestError: unknown name, outside its
+        range, not an integer, or a combination the hook refuses."""
+        out = {}
+        for name, value in options.items():
+            spec = self.options.get(name)
+            if spec is None:
+                known = ", ".join(sorted(self.options)) or "none"
+                raise RequestError(ErrorCode.INVALID_OPTION,
+                                   f"option {name} is not an option of method '{self.name}' (known: {known})")
+            value = float(value)
+            if not math.isfinite(value) or not spec.low <= value <= spec.high:
+                raise RequestError(ErrorCode.INVALID_OPTION,
+                                   f"option {spec.label(name)} = {value} is outside [{spec.low}, {spec.high}]")
+            if spec.integer and value != int(value):
+                raise RequestError(ErrorCode.INVALID_OPTION, f"option {spec.label(name)} = {value} must be an integer")
+            out[name] = int(value) if spec.integer else value
+        why = self.check(out) if self.check is not None else None
+        if why:
+            raise RequestError(ErrorCode.INVALID_OPTION, f"method '{self.name}' cannot run these options: {why}")
+        return out
+
+    def split(self, options: dict) -> tuple[dict, dict]:
+        """Validated options as (keyword arguments of the function, maneuver limits)."""
+        limits = {k: v for k, v in options.items() if self.options[k].limit}
+        return {k: v for k, v in options.items() if k not in limits}, limits
+
+    def run(self, problem, **options) -> Plan:
+        """Validate ``options`` and plan: the registry's checks, then the function."""
+        kwargs, limits = self.split(self.validate(options))
+        return self.load()(replace(problem, **limits), **self.fixed, **kwargs)
+
+
+def _slepian_check(options: dict) -> str | None:
+    from att_planner.methods.slepian.planner import option_problem
+    return option_problem(options)
+
+
+def _time_optimal_check(options: dict) -> str | None:
+    from att_planner.methods.time_optimal.planner import option_problem
+    return option_problem(options)
+
+
+def _slepian(variant: str, description: str) -> Method:
+    return Method(variant, "att_planner.methods.slepian.planner", "plan_slepian", description, SLEPIAN_OPTIONS,
+                  fixed={"method": variant}, check=lambda o: _slepian_check(dict(o, method=variant)),
+                  combined=("M", "N", "W"))
+
+
+# Basis size, DPSS length and half-bandwidth of the Slepian methods (issue 3).
+SLEPIAN_OPTIONS = {"M": Option(2, 12, True, doc="basis size"), "N": Option(50, 2000, True, doc="samples"),
+                   "W": Option(1e-4, 0.25, doc="half-bandwidth")}
+
+# Best first: the default method is the first one.
+REGISTRY = [
+    _slepian("slepian_minimum_time", "smooth torque on a Slepian basis, t_f minimised exactly (issue 3); cone-aware"),
+    Method("time_optimal", "att_planner.methods.time_optimal.planner", "plan_time_optimal",
+           "minimum-time bang-bang slew by direct collocation with IPOPT (Melton 2012); cone-aware",
+           {"intervals": Option(4, 200, True), "max_intervals": Option(4, 400, True), "starts": Option(1, 20, True),
+            "refine_rounds": Option(0, 6, True), "cone_margin_deg": Option(0.0, 5.0),
+            "rate_max": Option(1e-6, 10.0, limit=True, doc="rad/s per body axis"),
+            "wheel_momentum_max": Option(1e-6, 1e4, limit=True, doc="N m s per wheel"),
+            "smooth_warm_start": Option(0, 1, True)}, check=_time_optimal_check,
+           combined=("intervals", "max_intervals")),
+    Method("constrained_axis", "att_planner.methods.constrained_axis", "plan_constrained_axis",
+           "eigenaxis bang-bang, or lambda-rotations riding a cone boundary when the eigenaxis path is blocked",
+           {"ride_margin_deg": Option(0.0, 10.0)}, cheap=True),
+    Method("eigenaxis_smooth", "att_planner.methods.eigenaxis", "plan_eigenaxis_smooth",
+           "eigenaxis slew with a quintic angle profile (C1 rate, zero torque at both ends); ignores cones",
+           {"samples": Option(61, 100_000, True, doc="knots of the linear torque profile")}, cheap=True),
+    Method("eigenaxis", "att_planner.methods.eigenaxis", "plan_eigenaxis",
+           "eigenaxis bang-bang slew with the largest torque the per-axis limits allow; ignores cones", cheap=True),
+    _slepian("mssa", "Slepian basis, minimum sum of squared coefficients (Celani & Lucarelli); cone-aware"),
+    _slepian("dfsp", "Slepian basis, derivative-free sequential penalty on t_f (Celani & Bruni); cone-aware, slow"),
+]
+METHODS = {m.name: m for m in REGISTRY}
+
+
+def get(name: str) -> Method:
+    """The registered method ``name`` or RequestError UNKNOWN_METHOD."""
+    method = METHODS.get(name)
+    if method is None:
+        raise RequestError(ErrorCode.UNKNOWN_METHOD,
+                           f"method '{name[:128]}' is unknown (available: {', '.join(METHODS)})")
+    return method
+
+
+def run(name: str, problem, **options) -> Plan:
+    """``get(name).run(problem, **options)``: plan with a registered method, options validated."""
+    return get(name).run(problem, **options)

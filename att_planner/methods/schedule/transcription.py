@@ -1,0 +1,248 @@
+"""The multiple-shooting NLP of a minimum-time schedule for a fixed order of targets (model of
+:mod:`att_planner.methods.schedule`): normalisation, one ZOH interval, the multiphase transcription
+and its solver cache."""
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+
+import casadi as ca
+import numpy as np
+
+from att_planner.methods import symbolic
+from att_sim import dynamics as dyn
+from att_sim import rotations as rot
+
+SUBSTEPS = 1              # RK4 steps per ZOH interval in the schedule NLPs (default everywhere)
+
+
+@dataclass(frozen=True)
+class _Scaling:
+    """Normalised units: wheel momentum h = I_w Ω / h̄ ∈ [−1, 1] (h̄ = I_w Ω̄), torque
+    u = T_u / T̄ ∈ [−1, 1], time τ = t / t_sat with t_sat = h̄ / T̄ (so dh/dτ = u).
+    ``rate_matrix`` W maps h to the body rate per unit τ, ω t_sat = W h (equation (1))."""
+
+    t_sat: float
+    h_max: float
+    rate_matrix: np.ndarray        # (3, N) rad per τ per unit h
+    rate_per_h: np.ndarray         # (3, N) rad/s per unit h: ω = rate_per_h @ h
+
+
+def _scaling(sc: dyn.Spacecraft) -> _Scaling:
+    if not (np.isfinite(sc.wheel_torque_max) and np.isfinite(sc.wheel_speed_max) and sc.wheel_inertia > 0):
+        raise ValueError("spacecraft must have finite wheel_torque_max, wheel_speed_max and a positive wheel_inertia")
+    h_max = sc.wheel_inertia * sc.wheel_speed_max
+    t_sat = h_max / sc.wheel_torque_max
+    rate_per_h = -np.linalg.solve(sc.inertia, sc.wheel_axes) * h_max
+    return _Scaling(t_sat, h_max, rate_per_h * t_sat, rate_per_h)
+
+
+def _interval_map(scale: _Scaling, substeps: int) -> ca.Function:
+    """One ZOH interval: (q, h, u, dτ) -> (q⁺, h⁺). h is linear in τ (exact), q by RK4
+    (:func:`att_sim.dynamics.rk4` on the CasADi expressions)."""
+    n_w = scale.rate_matrix.shape[1]
+    q, h, u, dtau = ca.SX.sym("q", 4), ca.SX.sym("h", n_w), ca.SX.sym("u", n_w), ca.SX.sym("dtau")
+    W = ca.DM(scale.rate_matrix)
+    step = dtau / substeps
+    qk, hk = q, h
+    for _ in range(substeps):
+        def qdot(tau, qq, h0=hk):
+            return 0.5 * symbolic.quat_mul(qq, ca.vertcat(W @ (h0 + tau * u), 0))
+        qk = dyn.rk4(qdot, 0.0, qk, step)
+        hk = hk + step * u
+    return ca.Function("interval", [q, h, u, dtau], [qk, hk])
+
+
+def eigenaxis_rest_to_rest_time(sc: dyn.Spacecraft, q_from: np.ndarray, q_to: np.ndarray) -> float:
+    """Duration of the rest-to-rest eigenaxis slew q_from → q_to at the largest rate and torque the
+    wheel box allows about that axis (bang–coast–bang; a feasible, so upper-bound, transfer).
+
+    About a unit body axis e, ``J ω̇ = −G T_u`` and ``J ω = −G h`` (equation (1)) limit the rate to
+    ``λ = max{s : J s e ∈ G·box(h̄)}`` and the acceleration to ``λ / t_sat``. Used for the initial
+    guess of the phase durations.
+    """
+    axis, angle = rot.to_axis_angle(rot.multiply(rot.conjugate(rot.normalize(q_from)), rot.normalize(q_to)))
+    if angle < 1e-12:
+        return 0.0
+    scale = _scaling(sc)
+    need = np.linalg.pinv(sc.wheel_axes) @ (sc.inertia @ axis)
+    rate = scale.h_max / np.abs(need).max()
+    accel = rate / scale.t_sat
+    if angle >= rate * rate / accel:
+        return float(angle / rate + rate / accel)
+    return float(2.0 * np.sqrt(angle / accel))
+
+
+def _aligned(quats: list[np.ndarray]) -> list[np.ndarray]:
+    """Flip signs so consecutive quaternions have a non-negative dot product (nearest sign)."""
+    out = [rot.normalize(np.asarray(quats[0], float))]
+    for q in quats[1:]:
+        q = rot.normalize(np.asarray(q, float))
+        out.append(q if np.dot(q, out[-1]) >= 0 else -q)
+    return out
+
+
+@dataclass
+class _PhaseSolution:
+    """Raw multiphase NLP solution in normalised units (see :class:`_Scaling`)."""
+
+    durations: np.ndarray   # (P,) τ
+    q: np.ndarray           # (K+1, 4)
+    h: np.ndarray           # (K+1, N)
+    u: np.ndarray           # (K, N)
+    converged: bool
+    return_status: str
+    nit: int
+    wall_time: float
+
+    @property
+    def tau_f(self) -> float:
+        return float(self.durations.sum())
+
+
+class MultiphaseTranscription:
+    """Multiple-shooting NLP of the minimum-time schedule for a fixed number of targets.
+
+    Built once per (number of targets, intervals per phase); the target quaternions of an order
+    and the end attitude are NLP parameters, so every order of the same set reuses the solver.
+    Either end may be at rest (h = 0) or a passage (only ω_z = 0), chosen per solve.
+    """
+
+    def __init__(self, sc: dyn.Spacecraft, n_targets: int, intervals: int = 12, substeps: int = SUBSTEPS,
+                 rate_max: float = np.inf, bound_margin: float = 1e-6, tol: float = 1e-7,
+                 max_iter: int = 1500, expand: bool | None = None):
+        if intervals < 1 or substeps < 1:
+            raise ValueError("intervals and substeps must be positive integers")
+        self.sc, self.scale = sc, _scaling(sc)
+        self.n_targets, self.n_phases, self.intervals = n_targets, n_targets + 1, intervals
+        n_w = sc.n_wheels
+        P, N = self.n_phases, intervals
+        K = P * N
+        self.n_nodes = K + 1
+        T = ca.MX.sym("T", P)
+        Q = ca.MX.sym("Q", 4, K + 1)
+        H = ca.MX.sym("H", n_w, K + 1)
+        U = ca.MX.sym("U", n_w, K)
+        targets = ca.MX.sym("targets", 4, max(n_targets, 1))
+        q_end = ca.MX.sym("q_end", 4)
+        dtau = ca.repmat(T.T / N, N, 1).reshape((1, K))  # phase p's dτ on intervals p*N ... p*N+N-1
+        step = _interval_map(self.scale, substeps).map(K)
+        q_next, h_next = step(Q[:, :K], H[:, :K], U, dtau)
+        g = [ca.vec(Q[:, 1:] - q_next), ca.vec(H[:, 1:] - h_next)]
+        rate_z = ca.DM(self.scale.rate_per_h[2:3, :])
+        for p in range(n_targets):
+            node = (p + 1) * N
+            g += [symbolic.error_vector(targets[:, p], Q[:, node]), rate_z @ H[:, node]]
+        g.append(symbolic.error_vector(q_end, Q[:, K]))
+        # ω_z = 0 at both ends: implied by rest (h = 0 bounds), the only condition at a passage
+        g += [rate_z @ H[:, 0], rate_z @ H[:, K]]
+        n_eq = sum(int(gi.numel()) for gi in g)
+        lbg, ubg = [0.0] * n_eq, [0.0] * n_eq
+        # body-rate box, only where the wheel box does not already imply it (rates are linear in h)
+        rate_rows = [i for i in range(3) if np.abs(self.scale.rate_per_h[i]).sum() > rate_max]
+        if rate_rows:
+            R = ca.DM(self.scale.rate_per_h[rate_rows, :] / rate_max)
+            g.append(ca.vec(R @ H))
+            lbg += [-1.0] * (len(rate_rows) * (K + 1))
+            ubg += [1.0] * (len(rate_rows) * (K + 1))
+        self._x = ca.vertcat(T, ca.vec(Q), ca.vec(H), ca.vec(U))
+        self._split = ca.Function("split", [self._x], [T, Q, H, U])
+        self._lbg, self._ubg = np.array(lbg), np.array(ubg)
+        nlp = {"x": self._x, "p": ca.vertcat(ca.vec(targets), q_end), "f": ca.sum1(T), "g": ca.vertcat(*g)}
+        self.ipopt_options = {"ipopt.print_level": 0, "print_time": 0, "ipopt.tol": tol,
+                              "ipopt.max_iter": max_iter, "ipopt.mu_strategy": "adaptive",
+                              "ipopt.sb": "yes",
+                              # SX expansion: slower to build, faster to evaluate; worth it for
+                              # small NLPs (legs) or when one NLP is solved for many orders
+                              "expand": n_targets == 0 if expand is None else bool(expand)}
+        self._nlp = nlp
+        self._solver = ca.nlpsol("schedule", "ipopt", nlp, self.ipopt_options)
+        self._solver_wall = None
+        limit = 1.0 - bound_margin
+        lbx = ca.vertcat(np.full(P, 1e-3), np.full(4 * (K + 1), -1.5), np.full(n_w * (K + 1), -limit),
+                         np.full(n_w * K, -limit))
+        self._lbx = np.array(lbx).ravel()
+        self._ubx = -self._lbx
+        self._ubx[:P] = 1e4
+        iq0, ih0 = P, P + 4 * (K + 1)
+        self._index_q0, self._index_h0 = slice(iq0, iq0 + 4), slice(ih0, ih0 + n_w)
+        self._index_hf = slice(ih0 + n_w * K, ih0 + n_w * (K + 1))
+
+    # -- guesses ----------------------------------------------------------------------------
+    def initial_guess(self, q_start, targets_in_order, q_end) -> _PhaseSolution:
+        """Slerp between consecutive (sign-aligned) attitudes with eigenaxis durations; wheel
+        momentum from the slerp rate by (1), clipped to the box; zero torque."""
+        P, N, n_w = self.n_phases, self.intervals, self.sc.n_wheels
+        chain = _aligned([q_start, *targets_in_order, q_end])
+        dur = np.array([max(eigenaxis_rest_to_rest_time(self.sc, a, b), 1.0) for a, b in zip(chain[:-1], chain[1:])])
+        dur = dur / self.scale.t_sat
+        qs, hs = [chain[0][None, :]], [np.zeros((1, n_w))]
+        for p in range(P):
+            s = np.arange(1, N + 1) / N
+            qs.append(rot.slerp(chain[p], chain[p + 1], s))
+            axis, angle = rot.to_axis_angle(rot.multiply(rot.conjugate(chain[p]), chain[p + 1]))
+            w_tau = axis * angle / dur[p]
+            h = np.clip(np.linalg.lstsq(self.scale.rate_matrix, w_tau, rcond=None)[0], -0.9, 0.9)
+            hs.append(np.tile(h, (N, 1)))
+        hs[-1][-1] = 0.0
+        return _PhaseSolution(dur, np.vstack(qs), np.vstack(hs), np.zeros((P * N, n_w)), False, "guess", 0, 0.0)
+
+    def resample(self, sol: _PhaseSolution) -> _PhaseSolution:
+        """Interpolate a solution with another number of intervals per phase onto this grid."""
+        P, N = self.n_phases, self.intervals
+        N0 = (len(sol.q) - 1) // P
+        s_old = np.concatenate([[0.0], np.concatenate([p + np.arange(1, N0 + 1) / N0 for p in range(P)])])
+        s_new = np.concatenate([[0.0], np.concatenate([p + np.arange(1, N + 1) / N for p in range(P)])])
+        q = np.column_stack([np.interp(s_new, s_old, sol.q[:, j]) for j in range(4)])
+        q = rot.normalize(q)
+        h = np.column_stack([np.interp(s_new, s_old, sol.h[:, j]) for j in range(sol.h.shape[1])])
+        mid_old = np.concatenate([p + (np.arange(N0) + 0.5) / N0 for p in range(P)])
+        mid_new = np.concatenate([p + (np.arange(N) + 0.5) / N for p in range(P)])
+        u = np.column_stack([np.interp(mid_new, mid_old, sol.u[:, j]) for j in range(sol.u.shape[1])])
+        return _PhaseSolution(sol.durations.copy(), q, h, u, False, "resampled", 0, 0.0)
+
+    # -- solve ------------------------------------------------------------------------------
+    def solve(self, q_start, targets_in_order, q_end, guess: _PhaseSolution | None = None,
+              max_wall_time: float | None = None, start_at_rest: bool = True,
+              end_at_rest: bool = True) -> _PhaseSolution:
+        """Minimum-time trajectory through ``targets_in_order`` (quaternions, any sign)."""
+        if len(targets_in_order) != self.n_targets:
+            raise ValueError(f"expected {self.n_targets} targets, got {len(targets_in_order)}")
+        if guess is None:
+            guess = self.initial_guess(q_start, targets_in_order, q_end)
+        solver = self._solver
+        if max_wall_time is not None:
+            solver = ca.nlpsol("schedule", "ipopt", self._nlp,
+                               {**self.ipopt_options, "ipopt.max_wall_time": max(float(max_wall_time), 0.01)})
+        x0 = np.concatenate([guess.durations, guess.q.ravel(), guess.h.ravel(), guess.u.ravel()])
+        lbx, ubx = self._lbx.copy(), self._ubx.copy()
+        q0 = rot.normalize(np.asarray(q_start, float))
+        lbx[self._index_q0] = ubx[self._index_q0] = q0 if np.dot(q0, guess.q[0]) >= 0 else -q0
+        if start_at_rest:
+            lbx[self._index_h0] = ubx[self._index_h0] = 0.0
+        if end_at_rest:
+            lbx[self._index_hf] = ubx[self._index_hf] = 0.0
+        targets = ([rot.normalize(np.asarray(q, float)) for q in targets_in_order] if self.n_targets
+                   else [np.zeros(4)])
+        params = np.concatenate([*targets, rot.normalize(np.asarray(q_end, float))])
+        x0 = np.clip(x0, lbx, ubx)
+        start = time.perf_counter()
+        out = solver(x0=x0, lbx=lbx, ubx=ubx, lbg=self._lbg, ubg=self._ubg, p=params)
+        seconds = time.perf_counter() - start
+        stats = solver.stats()
+        T, Q, H, U = (np.array(v) for v in self._split(out["x"]))
+        return _PhaseSolution(T.ravel(), Q.T, H.T, U.T, bool(stats["success"]), str(stats["return_status"]),
+                              int(stats.get("iter_count", 0)), seconds)
+
+
+_TRANSCRIPTIONS: dict = {}
+
+
+def _transcription(sc: dyn.Spacecraft, n_targets: int, intervals: int, substeps: int,
+                   rate_max: float, expand: bool | None = None) -> MultiphaseTranscription:
+    """Solver cache: an NLP depends only on the spacecraft, the number of targets and the grid."""
+    key = (sc.inertia.tobytes(), sc.wheel_axes.tobytes(), sc.wheel_inertia, sc.wheel_torque_max,
+           sc.wheel_speed_max, n_targets, intervals, substeps, rate_max, expand)
+    if key not in _TRANSCRIPTIONS:
+        _TRANSCRIPTIONS[key] = MultiphaseTranscription(sc, n_targets, intervals, substeps, rate_max, expand=expand)
+    return _TRANSCRIPTIONS[key]

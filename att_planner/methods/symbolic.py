@@ -1,0 +1,26 @@
+"""Quaternion algebra for CasADi expressions (SX or MX), the symbolic twins of
+:mod:`att_sim.rotations` used by the collocation and multiple-shooting transcriptions.
+Quaternions ``[x, y, z, w]``, Hamilton product, body-to-inertial (the suite's convention)."""
+from __future__ import annotations
+
+import casadi as ca
+
+
+def quat_mul(p, q):
+    """Hamilton product ``p ⊗ q`` (scalar last)."""
+    pv, pw, qv, qw = p[:3], p[3], q[:3], q[3]
+    return ca.vertcat(pw * qv + qw * pv + ca.cross(pv, qv), pw * qw - ca.dot(pv, qv))
+
+
+def error_vector(q_ref, q):
+    """Vector part of ``q_ref* ⊗ q``: zero iff q = ±q_ref (unit quaternions)."""
+    return q_ref[3] * q[:3] - q[3] * q_ref[:3] - ca.cross(q_ref[:3], q[:3])
+
+
+def dcm(q):
+    """Body-to-inertial rotation matrix ``R(q)``."""
+    x, y, z, w = q[0], q[1], q[2], q[3]
+    return ca.vertcat(
+        ca.horzcat(1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)),
+        ca.horzcat(2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)),
+        ca.horzcat(2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)))

@@ -1,0 +1,432 @@
+"""Direct collocation toolkit: Hermite–Simpson transcription of multiphase optimal control (CasADi + IPOPT).
+
+A *phase* is ``ẋ = f(x, u)`` on ``t ∈ [t0, t0 + T]`` with ``T`` a decision variable (free time) or
+fixed by its bounds. Time is normalised per phase, ``τ = (t − t0)/T ∈ [0, 1]``, and discretised on a
+mesh ``0 = τ_0 < … < τ_N = 1``. The transcription is Hermite–Simpson in separated form (Betts,
+*Practical Methods for Optimal Control*, 2nd ed., §4.5): with ``h_k = T (τ_{k+1} − τ_k)``::
+
+    x_m     = (x_k + x_{k+1})/2 + h_k/8 (f_k − f_{k+1})
+    x_{k+1} = x_k + h_k/6 (f_k + 4 f_m + f_{k+1})
+
+Two control representations, chosen so that a simulator reproduces the plan exactly:
+
+* ``'constant'``: one control per interval, used in ``f_k, f_m, f_{k+1}`` of that interval —
+  zero-order hold (the state is smooth inside each interval, so the 4th-order accuracy holds up
+  to the switching instants of a bang-bang solution, which sit on mesh nodes).
+* ``'linear'``: a control per node, ``u_m = (u_k + u_{k+1})/2`` — linear interpolation.
+
+Path constraints ``g(x, u)`` are imposed at nodes and midpoints; :func:`path_violations` checks them
+between those points on the Hermite cubic interpolant and :func:`refine_mesh` bisects the intervals
+where they fail (or where a bang-bang control switches, :func:`switch_intervals`).
+
+Phases are joined, bounded and scored through :class:`Transcription` (``add_constraint``,
+``minimize``), so the same machinery serves a single free-time slew and a multiphase schedule.
+"""
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+
+import casadi as ca
+import numpy as np
+
+CONTROL_KINDS = ("constant", "linear")
+
+
+def uniform_mesh(intervals: int) -> np.ndarray:
+    """Mesh fractions ``τ_k = k/N`` for ``N`` equal intervals."""
+    if intervals < 1:
+        raise ValueError("intervals must be a positive integer")
+    return np.linspace(0.0, 1.0, intervals + 1)
+
+
+def refine_mesh(mesh: np.ndarray, intervals, max_intervals: int | None = None) -> np.ndarray:
+    """Bisect the listed intervals of ``mesh`` (at most up to ``max_intervals`` intervals in all)."""
+    mesh = np.asarray(mesh, float)
+    chosen = sorted({int(k) for k in intervals})
+    if max_intervals is not None:
+        chosen = chosen[: max(0, max_intervals - (len(mesh) - 1))]
+    mids = [(mesh[k] + mesh[k + 1]) / 2 for k in chosen]
+    return np.unique(np.concatenate([mesh, mids]))
+
+
+class Phase:
+    """A phase ``ẋ = f(x, u)`` on a mesh, with box bounds and optional path constraints.
+
+    ``dynamics`` and ``path`` are CasADi Functions ``(x, u) -> ẋ`` and ``(x, u) -> g`` (usable both
+    symbolically and numerically). Bounds are arrays (or scalars) broadcast to the sizes.
+    """
+
+    def __init__(self, dynamics: ca.Function, mesh, *, control: str = "constant",
+                 state_bounds=(-np.inf, np.inf), control_bounds=(-np.inf, np.inf),
+                 duration_bounds=(0.0, np.inf), path: ca.Function | None = None,
+                 path_bounds=(-np.inf, 0.0), name: str = "phase"):
+        if control not in CONTROL_KINDS:
+            raise ValueError(f"control must be one of {CONTROL_KINDS}, not '{control}'")
+        self.dynamics = dynamics
+        self.n_state = dynamics.size1_in(0)
+        self.n_control = dynamics.size1_in(1)
+        self.mesh = np.asarray(mesh, float)
+        if self.mesh[0] != 0.0 or self.mesh[-1] != 1.0 or np.any(np.diff(self.mesh) <= 0):
+            raise ValueError("mesh must increase strictly from 0 to 1")
+        self.control = control
+        self.state_bounds = tuple(np.broadcast_to(np.asarray(b, float), (self.n_state,)).copy() for b in state_bounds)
+        self.control_bounds = tuple(np.broadcast_to(np.asarray(b, float), (self.n_control,)).copy()
+                                    for b in control_bounds)
+        self.duration_bounds = (float(duration_bounds[0]), float(duration_bounds[1]))
+        self.path = path
+        n_path = path.size1_out(0) if path is not None else 0
+        self.path_bounds = tuple(np.broadcast_to(np.asarray(b, float), (n_path,)).copy() for b in path_bounds)
+        self.name = name
+
+    @property
+    def intervals(self) -> int:
+        return len(self.mesh) - 1
+
+    @property
+    def n_control_samples(self) -> int:
+        return self.intervals if self.control == "constant" else self.intervals + 1
+
+    def with_mesh(self, mesh) -> Phase:
+        """The same phase on another mesh."""
+        return Phase(self.dynamics, mesh, control=self.control, state_bounds=self.state_bounds,
+                     control_bounds=self.control_bounds, duration_bounds=self.duration_bounds,
+                     path=self.path, path_bounds=self.path_bounds, name=self.name)
+
+
+@dataclass
+class PhaseVariables:
+    """Symbolic decision variables of one phase (columns are nodes / midpoints / control samples)."""
+
+    duration: ca.SX
+    X: ca.SX        # (nx, N+1)
+    Xm: ca.SX       # (nx, N)
+    U: ca.SX        # (nu, N) or (nu, N+1)
+
+    @property
+    def x_start(self):
+        return self.X[:, 0]
+
+    @property
+    def x_end(self):
+        return self.X[:, -1]
+
+
+@dataclass
+class PhaseSolution:
+    """Numeric solution of one phase; ``t`` are the node times from the phase start."""
+
+    phase: Phase
+    duration: float
+    x: np.ndarray       # (N+1, nx)
+    xm: np.ndarray      # (N, nx)
+    u: np.ndarray       # (N, nu) constant, (N+1, nu) linear
+
+    @property
+    def t(self) -> np.ndarray:
+        return self.duration * self.phase.mesh
+
+    def control_samples(self) -> np.ndarray:
+        """Controls at the node times ``t`` for the simulator: ZOH repeats the last interval."""
+        return np.vstack([self.u, self.u[-1:]]) if self.phase.control == "constant" else self.u
+
+    def control_at(self, tau: np.ndarray) -> np.ndarray:
+        tau = np.atleast_1d(np.asarray(tau, float))
+        mesh = self.phase.mesh
+        if self.phase.control == "constant":
+            k = np.clip(np.searchsorted(mesh, tau, side="right") - 1, 0, self.phase.intervals - 1)
+            return self.u[k]
+        return np.stack([np.interp(tau, mesh, self.u[:, j]) for j in range(self.u.shape[1])], axis=-1)
+
+    def state_at(self, tau: np.ndarray) -> np.ndarray:
+        """Hermite cubic interpolant of the states (the one Hermite–Simpson collocates)."""
+        tau = np.atleast_1d(np.asarray(tau, float))
+        mesh = self.phase.mesh
+        k = np.clip(np.searchsorted(mesh, tau, side="right") - 1, 0, self.phase.intervals - 1)
+        f = self.phase.dynamics
+        u_left = self.u[k]
+        u_right = self.u[k] if self.phase.control == "constant" else self.u[k + 1]
+        fk = np.array(f(self.x[k].T, u_left.T)).T
+        fk1 = np.array(f(self.x[k + 1].T, u_right.T)).T
+        h = (self.duration * (mesh[k + 1] - mesh[k]))[:, None]
+        s = ((tau - mesh[k]) / (mesh[k + 1] - mesh[k]))[:, None]
+        h00, h10 = 2 * s**3 - 3 * s**2 + 1, s**3 - 2 * s**2 + s
+        h01, h11 = -2 * s**3 + 3 * s**2, s**3 - s**2
+        return h00 * self.x[k] + h10 * h * fk + h01 * self.x[k + 1] + h11 * h * fk1
+
+    def resample(self, phase: Phase) -> PhaseGuess:
+        """This solution as a warm start on another mesh (e.g. after :func:`refine_mesh`)."""
+        mesh = phase.mesh
+        mids = (mesh[:-1] + mesh[1:]) / 2
+        u = self.control_at(mids if phase.control == "constant" else mesh)
+        return PhaseGuess(self.duration, self.state_at(mesh), self.state_at(mids), u)
+
+
+@dataclass
+class PhaseGuess:
+    duration: float
+    x: np.ndarray       # (N+1, nx)
+    xm: np.ndarray      # (N, nx)
+    u: np.ndarray       # (N or N+1, nu)
+
+
+def guess_from_functions(phase: Phase, duration: float, state, control) -> PhaseGuess:
+    """Warm start from callables ``state(t) -> (K, nx)`` and ``control(t) -> (K, nu)`` (phase time)."""
+    mesh = phase.mesh
+    mids = (mesh[:-1] + mesh[1:]) / 2
+    t_u = mids if phase.control == "constant" else mesh
+    return PhaseGuess(duration, np.asarray(state(duration * mesh)), np.asarray(state(duration * mids)),
+                      np.asarray(control(duration * t_u)))
+
+
+@dataclass
+class NlpResult:
+    """Outcome of one IPOPT solve (the suite's result fields, scipy-like; ``status`` is IPOPT's)."""
+
+    w: np.ndarray
+    objective: float
+    success: bool             # IPOPT converged (to the requested or the acceptable tolerance)
+    status: str               # IPOPT return status
+    nit: int                  # IPOPT iterations
+    wall_time: float          # s
+    constraint_violation: float
+    nfev: int = 0             # objective evaluations
+    lam_g: np.ndarray = field(repr=False, default=None)
+    lam_x: np.ndarray = field(repr=False, default=None)
+
+
+class _DeadlineCallback(ca.Callback):
+    """IPOPT iteration callback that stops the solve once ``time.monotonic()`` passes a deadline."""
+
+    def __init__(self, nx: int, ng: int):
+        ca.Callback.__init__(self)
+        self.nx, self.ng = nx, ng
+        self.deadline: float | None = None
+        self.construct("deadline_callback", {})
+
+    def get_n_in(self):
+        return ca.nlpsol_n_out()
+
+    def get_n_out(self):
+        return 1
+
+    def get_name_in(self, i):
+        return ca.nlpsol_out(i)
+
+    def get_name_out(self, i):
+        return "ret"
+
+    def get_sparsity_in(self, i):
+        name = ca.nlpsol_out(i)
+        if name == "f":
+            return ca.Sparsity.scalar()
+        if name in ("x", "lam_x"):
+            return ca.Sparsity.dense(self.nx)
+        if name in ("g", "lam_g"):
+            return ca.Sparsity.dense(self.ng)
+        return ca.Sparsity(0, 0)
+
+    def eval(self, arg):
+        expired = self.deadline is not None and time.monotonic() > self.deadline
+        return [1.0 if expired else 0.0]
+
+
+class Transcription:
+    """Hermite–Simpson NLP over one or more phases.
+
+    Usage: create with phases, read their symbolic variables (:meth:`variables`), fix or bound
+    boundary states (:meth:`bound_state`), add boundary / linkage constraints
+    (:meth:`add_constraint`), set the objective (:meth:`minimize`), :meth:`build` once, then
+    :meth:`solve` from as many initial guesses as wanted (the IPOPT instance is reused).
+    ``symbolic='MX'`` keeps the mapped dynamics as function calls (builds in tens of ms);
+    ``'SX'`` inlines them (faster evaluations, but a build grows to ~1 s at 60 intervals).
+    """
+
+    def __init__(self, phases: list[Phase], symbolic: str = "MX"):
+        if symbolic not in ("SX", "MX"):
+            raise ValueError("symbolic must be 'SX' or 'MX'")
+        sym = ca.SX.sym if symbolic == "SX" else ca.MX.sym
+        self.phases = list(phases)
+        self._vars: list[PhaseVariables] = []
+        self._slices: list[dict] = []
+        w, lbw, ubw = [], [], []
+        g, lbg, ubg = [], [], []
+        offset = 0
+        for p, ph in enumerate(self.phases):
+            nx, nu, N = ph.n_state, ph.n_control, ph.intervals
+            T = sym(f"T{p}")
+            X = sym(f"X{p}", nx, N + 1)
+            Xm = sym(f"Xm{p}", nx, N)
+            U = sym(f"U{p}", nu, ph.n_control_samples)
+            self._vars.append(PhaseVariables(T, X, Xm, U))
+            sizes = {"T": 1, "X": nx * (N + 1), "Xm": nx * N, "U": nu * ph.n_control_samples}
+            sl = {}
+            for key, n in sizes.items():
+                sl[key] = slice(offset, offset + n)
+                offset += n
+            self._slices.append(sl)
+            w += [T, ca.vec(X), ca.vec(Xm), ca.vec(U)]
+            for bounds, side in ((lbw, 0), (ubw, 1)):
+                bounds += [[ph.duration_bounds[side]], np.tile(ph.state_bounds[side], 2 * N + 1),
+                           np.tile(ph.control_bounds[side], ph.n_control_samples)]
+            # Defects, vectorised over intervals with map().
+            h = T * ca.DM(np.diff(ph.mesh)).T                       # (1, N)
+            U_left = U if ph.control == "constant" else U[:, :-1]
+            U_right = U if ph.control == "constant" else U[:, 1:]
+            U_mid = U if ph.control == "constant" else (U_left + U_right) / 2
+            fmap = ph.dynamics.map(N)
+            Fk = fmap(X[:, :-1], U_left)
+            Fk1 = fmap(X[:, 1:], U_right)
+            Fm = fmap(Xm, U_mid)
+            H = ca.repmat(h, nx, 1)
+            mid_defect = Xm - (X[:, :-1] + X[:, 1:]) / 2 - H / 8 * (Fk - Fk1)
+            simpson_defect = X[:, 1:] - X[:, :-1] - H / 6 * (Fk + 4 * Fm + Fk1)
+            g += [ca.vec(mid_defect), ca.vec(simpson_defect)]
+            lbg += [np.zeros(2 * nx * N)]
+            ubg += [np.zeros(2 * nx * N)]
+            if ph.path is not None:
+                # Nodes see the control of the interval they start (the last node: the last one).
+                U_nodes = ca.horzcat(U, U[:, -1]) if ph.control == "constant" else U
+                Gn = ph.path.map(N + 1)(X, U_nodes)
+                Gm = ph.path.map(N)(Xm, U_mid)
+                g += [ca.vec(Gn), ca.vec(Gm)]
+                lbg += [np.tile(ph.path_bounds[0], 2 * N + 1)]
+                ubg += [np.tile(ph.path_bounds[1], 2 * N + 1)]
+        self._w = ca.vertcat(*w)
+        self.lbw = np.concatenate([np.ravel(v) for v in lbw]).astype(float)
+        self.ubw = np.concatenate([np.ravel(v) for v in ubw]).astype(float)
+        self._g = g
+        self._lbg = [np.asarray(v, float).ravel() for v in lbg]
+        self._ubg = [np.asarray(v, float).ravel() for v in ubg]
+        self._objective = None
+        self._solver = None
+        self._callback = None
+
+    # -- problem definition --------------------------------------------------------------------
+    def variables(self, phase: int = 0) -> PhaseVariables:
+        return self._vars[phase]
+
+    def bound_state(self, phase: int, node: int, lower, upper=None):
+        """Bound (or with ``upper=None`` fix) the state at one node (``-1``: the last)."""
+        ph = self.phases[phase]
+        node = node % (ph.intervals + 1)
+        sl = self._slices[phase]["X"]
+        idx = np.arange(sl.start, sl.stop).reshape(ph.intervals + 1, ph.n_state)[node]
+        lower = np.broadcast_to(np.asarray(lower, float), (ph.n_state,))
+        upper = lower if upper is None else np.broadcast_to(np.asarray(upper, float), (ph.n_state,))
+        self.lbw[idx], self.ubw[idx] = lower, upper
+
+    def add_constraint(self, expr, lower, upper):
+        n = expr.shape[0]
+        self._g.append(ca.vec(expr))
+        self._lbg.append(np.broadcast_to(np.asarray(lower, float), (n,)).copy())
+        self._ubg.append(np.broadcast_to(np.asarray(upper, float), (n,)).copy())
+
+    def minimize(self, expr):
+        self._objective = expr
+
+    def build(self, *, tol: float = 1e-7, max_iter: int = 1000, ipopt_options: dict | None = None,
+              nlpsol_options: dict | None = None):
+        """Create the IPOPT instance (once per mesh; every :meth:`solve` reuses it).
+
+        ``ipopt_options`` are IPOPT's own (e.g. ``linear_solver``); ``nlpsol_options`` CasADi's
+        (e.g. ``expand``)."""
+        if self._objective is None:
+            raise ValueError("set an objective with minimize() before build()")
+        g = ca.vertcat(*self._g)
+        self.lbg, self.ubg = np.concatenate(self._lbg), np.concatenate(self._ubg)
+        self._callback = _DeadlineCallback(self._w.shape[0], g.shape[0])
+        opts = {"ipopt.print_level": 0, "ipopt.sb": "yes", "print_time": False,
+                "ipopt.tol": tol, "ipopt.acceptable_tol": 10 * tol, "ipopt.max_iter": max_iter,
+                "ipopt.constr_viol_tol": 1e-8, "ipopt.acceptable_constr_viol_tol": 1e-6,
+                "ipopt.mu_strategy": "adaptive", "iteration_callback": self._callback,
+                "iteration_callback_ignore_errors": False}
+        opts.update({f"ipopt.{k}": v for k, v in (ipopt_options or {}).items()})
+        opts.update(nlpsol_options or {})
+        self._solver = ca.nlpsol("hermite_simpson", "ipopt", {"x": self._w, "f": self._objective, "g": g}, opts)
+        return self
+
+    # -- solving ----------------------------------------------------------------------------
+    def pack(self, guesses: list[PhaseGuess]) -> np.ndarray:
+        """Flat initial-guess vector from one guess per phase (clipped into the variable bounds)."""
+        parts = []
+        for ph, gs in zip(self.phases, guesses):
+            parts += [[gs.duration], np.asarray(gs.x, float).ravel(), np.asarray(gs.xm, float).ravel(),
+                      np.asarray(gs.u, float).reshape(ph.n_control_samples, ph.n_control).ravel()]
+        w0 = np.concatenate([np.ravel(p) for p in parts])
+        return np.clip(w0, self.lbw, self.ubw)
+
+    def solve(self, w0: np.ndarray, *, deadline: float | None = None, lam_g0=None, lam_x0=None) -> NlpResult:
+        """Run IPOPT from ``w0``; stops at ``deadline`` (a ``time.monotonic()`` instant)."""
+        if self._solver is None:
+            self.build()
+        self._callback.deadline = deadline
+        args = dict(x0=w0, lbx=self.lbw, ubx=self.ubw, lbg=self.lbg, ubg=self.ubg)
+        if lam_g0 is not None:
+            args["lam_g0"] = lam_g0
+        if lam_x0 is not None:
+            args["lam_x0"] = lam_x0
+        start = time.monotonic()
+        try:
+            out = self._solver(**args)
+        except RuntimeError as exc:      # evaluation errors surface here; report, never raise
+            return NlpResult(np.asarray(w0, float), np.inf, False, f"error: {exc}", 0,
+                             time.monotonic() - start, np.inf)
+        stats = self._solver.stats()
+        w = np.array(out["x"]).ravel()
+        g = np.array(out["g"]).ravel()
+        viol = float(max(np.max(self.lbg - g, initial=0.0), np.max(g - self.ubg, initial=0.0)))
+        status = stats.get("return_status", "unknown")
+        success = status in ("Solve_Succeeded", "Solved_To_Acceptable_Level")
+        return NlpResult(w, float(out["f"]), success, status, int(stats.get("iter_count", 0)),
+                         time.monotonic() - start, viol, int(stats.get("n_call_nlp_f", 0)),
+                         np.array(out["lam_g"]).ravel(), np.array(out["lam_x"]).ravel())
+
+    def phase_solution(self, w: np.ndarray, phase: int = 0) -> PhaseSolution:
+        ph, sl = self.phases[phase], self._slices[phase]
+        N, nx, nu = ph.intervals, ph.n_state, ph.n_control
+        return PhaseSolution(ph, float(w[sl["T"]][0]), w[sl["X"]].reshape(N + 1, nx),
+                             w[sl["Xm"]].reshape(N, nx), w[sl["U"]].reshape(ph.n_control_samples, nu))
+
+
+def path_violations(solution: PhaseSolution, samples_per_interval: int = 8, tol: float = 0.0):
+    """Check the path constraints between collocation points on the Hermite interpolant.
+
+    Returns ``(intervals, worst)``: the indices of intervals where some ``g`` leaves its bounds by
+    more than ``tol`` and the largest excess found (≤ 0 when everything holds).
+    """
+    ph = solution.phase
+    if ph.path is None:
+        return np.array([], int), -np.inf
+    s = (np.arange(1, samples_per_interval + 1) / (samples_per_interval + 1))
+    tau = (ph.mesh[:-1, None] + np.diff(ph.mesh)[:, None] * s[None, :]).ravel()
+    x = solution.state_at(tau)
+    u = solution.control_at(tau)
+    gval = np.array(ph.path(x.T, u.T)).T
+    lb, ub = ph.path_bounds
+    excess = np.maximum(lb - gval, gval - ub).max(axis=1).reshape(ph.intervals, samples_per_interval).max(axis=1)
+    return np.flatnonzero(excess > tol), float(excess.max())
+
+
+def switch_intervals(solution: PhaseSolution, rel_tol: float = 0.02, limit: int | None = None) -> np.ndarray:
+    """Intervals of a bang-bang control where a component switches: not saturated there while
+    saturated in a neighbouring interval. Bisecting them localises the switching instants.
+
+    Sorted by decreasing jump of the control across the interval's neighbours (relative to the
+    bound span); ``limit`` keeps the strongest ones only (singular or state-constrained arcs, where
+    the control is interior, would otherwise flag interval after interval)."""
+    ph = solution.phase
+    lb, ub = ph.control_bounds
+    span = np.where(np.isfinite(ub - lb), ub - lb, np.inf)
+    u = solution.u
+    saturated = (u <= lb + rel_tol * span) | (u >= ub - rel_tol * span)      # (K, nu)
+    if ph.control == "linear":
+        saturated = saturated[:-1] & saturated[1:]
+    nb = np.zeros_like(saturated)
+    nb[1:] |= saturated[:-1]
+    nb[:-1] |= saturated[1:]
+    flagged = np.flatnonzero(np.any(~saturated & nb, axis=1))
+    padded = np.vstack([u[:1], u, u[-1:]])
+    jump = np.max(np.abs(padded[2:] - padded[:-2]) / np.where(np.isfinite(span), span, 1.0), axis=1)
+    order = flagged[np.argsort(-jump[flagged], kind="stable")]
+    return order if limit is None else order[:limit]

@@ -1,0 +1,299 @@
+"""Time-optimal rest-to-rest slews among keep-out cones (Melton 2012) by direct collocation.
+
+Problem (normalised: time unit ``τ = sqrt(J0/T̄)``, J0 the largest principal inertia, ``J̃ = J/J0``,
+torque ``u = T/T̄``, rate ``ω̃ = ω τ``)::
+
+    min t_f   s.t.  q̇ = ½ q ⊗ [ω̃, 0] + ½ (1 − |q|²) q,    J̃ ω̃̇ = u − ω̃ × J̃ ω̃,    |u_j| ≤ 1,
+                    q(0) = q_0,  ω̃(0) = ω̃(t_f) = 0,
+                    wᵢᵀ R(q) r ≤ cos(θᵢ + δ)        (keep-out cone i, tightened by δ),
+                    final attitude: vec(q_fᶜ ⊗ q(t_f)) = 0     (q(t_f) = ±q_f: q and −q alike),
+                    or semi-free: R(q(t_f)) r ⟂ e₁, e₂ and R(q(t_f)) r · s ≥ 0 (sensor on target s),
+                    optional |ω_j| ≤ ω̄ and per-wheel momentum |G⁺ J ω|_i ≤ h̄ (the momentum the
+                    wheels would store producing the torque with zero total momentum), both
+                    tightened by BOUND_MARGIN at the collocation points.
+
+The ``½(1 − |q|²) q`` term vanishes on unit quaternions and makes the unit sphere attracting, so the
+discretised norm cannot drift. Transcription: Hermite–Simpson (:mod:`.collocation`, the model in :mod:`.model`)
+with one torque per mesh interval (zero-order hold), so that the simulator reproduces the plan
+with ``interpolation='zoh'`` and bang-bang switches land on mesh nodes.
+
+Solution process (Melton's two stages, with multi-start because the problem has many local
+minima): (1) cheap routes — eigenaxis both ways round, tilted two-leg routes and the cone-riding
+λ-rotation routes of :mod:`att_planner.methods.constrained_axis`, optional plans of other
+methods (:mod:`.routes`) — each turned into a continuous bang-bang guess and solved on a coarse
+mesh; (2) the best converged solution is refined: intervals where the torque switches or a cone
+constraint fails between collocation points are bisected and the NLP re-solved from the
+interpolated solution; (3) the torque is integrated
+through the truth dynamics (:mod:`att_planner.verification`); a failure refines again.
+"""
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+
+from att_msgs_py.types import Interpolation, Plan, Status
+from att_planner.cones import blocked_endpoint, margins
+from att_planner.methods.axis_rotations import eigenaxis_leg, goal_attitude, no_torque_limit
+from att_planner.methods.time_optimal import collocation as col
+from att_planner.methods.time_optimal.model import Scaling, plan_arrays, scaling, transcription
+from att_planner.methods.time_optimal.routes import Route, candidate_routes, route_guess, select_routes
+from att_planner.problem import ManeuverProblem
+from att_planner.verification import integrate, measure, rejection
+from att_sim import rotations as rot
+
+METHOD = "time_optimal"
+CONVERGED_VIOLATION = 1e-5      # an IPOPT answer counts as solved below this constraint violation
+
+
+DEFAULT_INTERVALS, DEFAULT_MAX_INTERVALS = 30, 120
+
+
+def _mesh_sizes(options: dict) -> tuple[int, int]:
+    """(intervals, max_intervals): the refinement cap defaults to 120, or to ``intervals`` above it."""
+    intervals = options.get("intervals") or DEFAULT_INTERVALS
+    max_intervals = options.get("max_intervals") or max(DEFAULT_MAX_INTERVALS, intervals)
+    return intervals, max_intervals
+
+
+def option_problem(options: dict) -> str | None:
+    """Why the time-optimal ``options`` cannot run (the registry's hook), or None."""
+    intervals, max_intervals = _mesh_sizes(options)
+    if max_intervals < intervals:
+        return f"max_intervals = {max_intervals} is below intervals = {intervals} (the refinement cap)"
+    return None
+
+
+@dataclass
+class _Solve:
+    """What the three stages of one solve share: the problem, its scaling, NLP settings, budget."""
+
+    problem: ManeuverProblem
+    scaling: Scaling
+    control: str
+    cone_margin: float
+    tf_bounds: tuple
+    tol: float
+    max_iter: int
+    max_intervals: int
+    deadline: float | None
+    interpolation: str
+    budget_hit: bool = False
+    seconds: dict = field(default_factory=dict)
+    nit: int = 0
+    nfev: int = 0
+
+    def expired(self) -> bool:
+        if self.deadline is not None and time.monotonic() > self.deadline:
+            self.budget_hit = True
+        return self.budget_hit
+
+    def solve(self, tr: col.Transcription, guess: col.PhaseGuess) -> col.NlpResult:
+        res = tr.solve(tr.pack([guess]), deadline=self.deadline)
+        self.nit += res.nit
+        self.nfev += res.nfev
+        return res
+
+    def transcription(self, mesh: np.ndarray) -> col.Transcription:
+        return transcription(self.problem, self.scaling, mesh, self.control, self.cone_margin, self.tf_bounds)
+
+    def plan(self, sol: col.PhaseSolution) -> Plan:
+        t, torque, q, omega = plan_arrays(sol, self.scaling)
+        return Plan(t=t, torque=torque, q=q, omega=omega, interpolation=self.interpolation, method=METHOD)
+
+
+class _Incumbent:
+    """The best solution and its mesh, re-solved on refined meshes (stages 2 and 3)."""
+
+    def __init__(self, run: _Solve, tr: col.Transcription, res: col.NlpResult):
+        self.run, self.tr, self.res = run, tr, res
+        self.sol = tr.phase_solution(res.w)
+        self.history = [(self.sol, res)]
+        self.mesh_log = [{"intervals": tr.phases[0].intervals, "tf": res.objective * run.scaling.tu,
+                          "status": res.status, "seconds": res.wall_time}]
+
+    def resolve(self, new_mesh) -> bool:
+        """Re-solve on ``new_mesh`` from the interpolated incumbent; keep it if it converged."""
+        run = self.run
+        new_tr = run.transcription(new_mesh).build(tol=run.tol, max_iter=run.max_iter)
+        new_res = run.solve(new_tr, self.sol.resample(new_tr.phases[0]))
+        self.mesh_log.append({"intervals": new_tr.phases[0].intervals, "tf": new_res.objective * run.scaling.tu,
+                              "status": new_res.status, "seconds": new_res.wall_time})
+        if new_res.success and new_res.constraint_violation < CONVERGED_VIOLATION:
+            self.tr, self.res = new_tr, new_res
+            self.sol = new_tr.phase_solution(new_res.w)
+            self.history.append((self.sol, new_res))
+            return True
+        return False
+
+    def refine(self, rounds: int) -> None:
+        """Stage 2: bisect the intervals where the torque switches or a path constraint fails
+        between collocation points, ``rounds`` times at most."""
+        for _ in range(rounds):
+            if self.run.expired():
+                return
+            sol = self.sol
+            bad, _ = col.path_violations(sol, tol=1e-4)
+            split = np.union1d(bad, col.switch_intervals(sol, limit=max(4, sol.phase.intervals // 4)))
+            if not len(split) or sol.phase.intervals >= self.run.max_intervals:
+                return
+            if not self.resolve(col.refine_mesh(sol.phase.mesh, split, self.run.max_intervals)):
+                return
+
+    def check(self, sol: col.PhaseSolution):
+        """Truth verification of ``sol``: (accepted, plan with its verification, trajectory)."""
+        plan = self.run.plan(sol)
+        traj = integrate(self.run.problem, plan)
+        plan.verification = measure(self.run.problem, plan, traj)
+        return rejection(plan.verification) is None, plan, traj
+
+    def verified(self, extra: list) -> tuple[bool, Plan]:
+        """Stage 3: verify; refine where the dense truth grid leaves a cone (``extra`` logs the
+        intervals split); fall back to an earlier, coarser solution that passes."""
+        run = self.run
+        ok, plan, traj = self.check(self.sol)
+        while not ok and not run.expired() and self.sol.phase.intervals < run.max_intervals:
+            bad = _truth_violation_intervals(traj, self.sol, run.scaling, run.problem)
+            if not len(bad):
+                bad = np.arange(self.sol.phase.intervals)
+            extra.append(len(bad))
+            if not self.resolve(col.refine_mesh(self.sol.phase.mesh, bad, run.max_intervals)):
+                break
+            ok, plan, traj = self.check(self.sol)
+        run.expired()
+        if not ok and len(self.history) > 1:
+            # an earlier (coarser) solution may still pass, if there is time to check it
+            for s_prev, r_prev in reversed(self.history[:-1]):
+                if run.problem.time_left() <= 0:
+                    break
+                ok_prev, plan_prev, _ = self.check(s_prev)
+                if ok_prev:
+                    ok, plan, self.res, self.sol = ok_prev, plan_prev, r_prev, s_prev
+                    break
+        return ok, plan
+
+
+def _truth_violation_intervals(traj, sol: col.PhaseSolution, s: Scaling, problem) -> np.ndarray:
+    """Mesh intervals containing dense truth samples with a negative cone margin."""
+    m = margins(traj.q, problem.sensor_axis, problem.cones)
+    if not m.size:
+        return np.array([], int)
+    bad_t = traj.t[m.min(axis=1) < 0] / s.tu / sol.duration
+    return np.unique(np.clip(np.searchsorted(sol.phase.mesh, bad_t, side="right") - 1, 0, sol.phase.intervals - 1))
+
+
+def _explore(run: _Solve, routes: list[Route], intervals: int, explore_tol: float):
+    """Stage 1: every route solved on the coarse mesh; ``(transcription, solved, log)`` with
+    ``solved`` a list of (t_f, route label, result) of the converged ones."""
+    # expand=True (SX evaluation) costs ~0.5 s to build but halves every solve: worth it for the
+    # several starts of this stage, not for the single solve per refined mesh below.
+    tr = run.transcription(col.uniform_mesh(intervals)).build(
+        tol=explore_tol, max_iter=run.max_iter, nlpsol_options={"expand": len(routes) > 2})
+    log, solved = [], []
+    for rt in routes:
+        if run.expired():
+            break
+        res = run.solve(tr, route_guess(run.problem, run.scaling, rt, tr.phases[0]))
+        log.append({"route": rt.label, "tf_guess": rt.tf_estimate * run.scaling.tu,
+                    "route_min_margin": rt.min_margin, "tf": res.objective * run.scaling.tu,
+                    "status": res.status, "iterations": res.nit, "seconds": res.wall_time})
+        if res.success and res.constraint_violation < CONVERGED_VIOLATION:
+            solved.append((res.objective, rt.label, res))
+    return tr, sorted(solved, key=lambda s: s[0]), log
+
+
+def _routes(problem: ManeuverProblem, s: Scaling, starts: int, warm_starts, smooth_warm_start: bool,
+            seconds: dict) -> list[Route]:
+    """The cheap routes to solve, then the warm starts (other methods' plans)."""
+    if smooth_warm_start:
+        lap = time.monotonic()
+        share = None if problem.deadline is None else lap + (problem.deadline - lap) / 3
+        from att_planner.methods.slepian.planner import plan_slepian  # only here: keeps scipy.signal out
+
+        warm_starts = (*warm_starts, plan_slepian(replace(problem, deadline=share), M=4))   # a failed plan is dropped
+        seconds["smooth_warm_start"] = time.monotonic() - lap
+    routes = select_routes(candidate_routes(problem, s), starts)
+    return routes + [Route(f"warm start: {p.method}", plan=p, tf_estimate=p.duration / s.tu,
+                           min_margin=float(margins(p.q, problem.sensor_axis, problem.cones).min(initial=np.inf)))
+                     for p in warm_starts if len(p.t) > 1]
+
+
+def plan_time_optimal(problem: ManeuverProblem, *, intervals: int = DEFAULT_INTERVALS, max_intervals: int | None = None,
+                      starts: int = 6, refine_rounds: int = 3, interpolation: str = "zoh",
+                      cone_margin_deg: float = 0.05, warm_starts: tuple = (),
+                      smooth_warm_start: bool = False, explore_tol: float = 1e-5, tol: float = 1e-7,
+                      max_iter: int = 400, verify_reserve: float = 1.0) -> Plan:
+    """Minimum-time rest-to-rest slew with per-axis torque limits and keep-out cones.
+
+    Options: ``intervals`` coarse mesh for the multi-start stage; ``max_intervals`` cap on mesh
+    refinement (default 120, or ``intervals`` when larger); ``starts`` number of cheap routes solved
+    (best kept, all reported in ``stats['starts']``); ``refine_rounds`` bisection rounds around
+    switches / between-node cone violations; ``interpolation`` 'zoh' (torque constant per interval)
+    or 'linear' (torque linear between nodes); ``cone_margin_deg`` tightening of every cone at the collocation points;
+    ``warm_starts`` plans of other methods used as extra starting routes;
+    ``smooth_warm_start`` adds the smooth Slepian plan (:func:`att_planner.methods.slepian.plan_slepian`,
+    paper basis M = 4, at most a third of the remaining budget) to them;
+    ``explore_tol``/``tol`` IPOPT tolerances of the two stages; ``max_iter`` per solve;
+    ``verify_reserve`` seconds kept before ``problem.deadline`` for the final verification.
+    The bounds ``problem.rate_max`` and ``problem.wheel_momentum_max`` are imposed when finite.
+    ``nit`` and ``nfev`` count IPOPT iterations and objective evaluations over every NLP solved.
+    """
+    start = time.monotonic()
+    why = option_problem({"intervals": intervals, "max_intervals": max_intervals})
+    if why:
+        raise ValueError(why)
+    intervals, max_intervals = _mesh_sizes({"intervals": intervals, "max_intervals": max_intervals})
+    if interpolation not in tuple(Interpolation):
+        raise ValueError(f"interpolation must be one of {[str(i) for i in Interpolation]}, not {interpolation!r}")
+    why = no_torque_limit(problem) or blocked_endpoint(problem)
+    if why:
+        return Plan(method=METHOD, status=Status.FAILED, message=why, wall_time=time.monotonic() - start)
+    if eigenaxis_leg(problem.q_initial, goal_attitude(problem)).angle < 1e-9:
+        q0 = rot.normalize(np.asarray(problem.q_initial, float))
+        return Plan(t=np.zeros(1), torque=np.zeros((1, 3)), q=q0[None], omega=np.zeros((1, 3)),
+                    interpolation=interpolation, method=METHOD, status=Status.OPTIMAL, message="already at the goal",
+                    wall_time=time.monotonic() - start, stats={"tf": 0.0})
+    s = scaling(problem)
+    seconds: dict = {}
+    lap = time.monotonic()
+    routes = _routes(problem, s, starts, warm_starts, smooth_warm_start, seconds)
+    tf_scale = max(r.tf_estimate for r in routes if np.isfinite(r.tf_estimate))
+    run = _Solve(problem, s, "constant" if interpolation == "zoh" else "linear", np.deg2rad(cone_margin_deg),
+                 (1e-2 * tf_scale, 10.0 * tf_scale), tol, max_iter, max_intervals,
+                 None if problem.deadline is None else problem.deadline - verify_reserve, interpolation,
+                 seconds=seconds)
+    tr, solved, start_log = _explore(run, routes, intervals, explore_tol)
+    stats = {"starts": start_log, "time_unit": s.tu, "seconds": seconds}
+    seconds["routes_and_starts"], lap = time.monotonic() - lap, time.monotonic()
+    outcome = dict(method=METHOD, stats=stats)
+    if not solved:
+        statuses = sorted({entry["status"] for entry in start_log})
+        message = ("no start converged" + (" before the deadline" if run.budget_hit else "")
+                   + (f" (IPOPT: {', '.join(statuses)})" if statuses else ""))
+        return Plan(status=Status.FAILED, message=message, wall_time=time.monotonic() - start,
+                    nit=run.nit, nfev=run.nfev, **outcome)
+    _, best_label, res = solved[0]
+    stats["best_start"] = best_label
+    incumbent = _Incumbent(run, tr, res)
+    incumbent.refine(refine_rounds)
+    seconds["refinement"], lap = time.monotonic() - lap, time.monotonic()
+    extra: list = []
+    ok, plan = incumbent.verified(extra)
+    seconds["verification"] = time.monotonic() - lap
+    ver = plan.verification
+    stats.update({"tf": float(plan.t[-1]), "mesh": incumbent.mesh_log, "truth_refinements": extra,
+                  "intervals": incumbent.sol.phase.intervals, "ipopt_status": incumbent.res.status})
+    if not ok:
+        status = Status.FAILED
+        message = (f"best solution (t_f = {plan.t[-1]:.4g} s) fails truth verification: {rejection(ver)} (final error "
+                   f"{np.rad2deg(ver.final_attitude_error):.3f} deg, min cone margin "
+                   f"{np.rad2deg(ver.min_cone_margin):.3f} deg)")
+    elif run.budget_hit:
+        status, message = Status.BUDGET_EXPIRED, "time budget expired; best verified plan returned"
+    else:
+        status = Status.OPTIMAL if incumbent.res.status == "Solve_Succeeded" else Status.FEASIBLE
+        message = f"best of {len(start_log)} starts: {best_label}; {incumbent.sol.phase.intervals} intervals"
+    plan.status, plan.message, plan.stats = status, message, stats
+    plan.nit, plan.nfev, plan.wall_time = run.nit, run.nfev, time.monotonic() - start
+    return plan

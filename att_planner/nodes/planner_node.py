@@ -1,0 +1,136 @@
+"""Planner node: serves ``/planner/plan_maneuver`` (PlanManeuver) and publishes every returned
+plan on the latched ``/planner/plans`` for the controller and the recorder.
+
+Callbacks only translate: message -> :class:`ManeuverRequest` -> :func:`validate_maneuver` ->
+:func:`plan_maneuver` -> message (:mod:`att_planner.service` holds the logic). Requests run
+concurrently (reentrant callback group on a multi-threaded executor), so a long solve never
+blocks a quick request; each request builds its own problem, nothing is shared between requests
+but the read-only method registry.
+"""
+from __future__ import annotations
+
+import math
+import uuid
+
+from rclpy.callback_groups import ReentrantCallbackGroup
+from rclpy.executors import MultiThreadedExecutor
+from rclpy.node import Node
+
+from att_msgs.msg import ManeuverPlan
+from att_msgs.srv import PlanManeuver, PlanSchedule
+from att_msgs_py import convert, qos, topics
+from att_msgs_py.errors import ErrorCode, RequestError
+from att_msgs_py.node_runner import parameter_reader, run_node
+from att_msgs_py.types import Plan
+from att_planner import methods
+from att_planner.methods.schedule import plan_schedule
+from att_planner.service.planning import PlanOutcome, plan_maneuver, plan_schedule_request, run_method
+from att_planner.service.requests import ManeuverRequest, validate_maneuver, validate_schedule
+from att_planner.service.worker import call_isolated, run_isolated, set_max_parallel, warm_up
+from att_planner.verification import TOLERANCES, Tolerances
+from att_sim import scenario as scen
+
+
+class PlannerNode(Node):
+    def __init__(self):
+        super().__init__("planner")
+        self._scenario_name = self.declare_parameter("scenario", "swift_demo").value
+        scenario = scen.load(self._scenario_name)
+        param = parameter_reader(self, scenario.node_params.get("planner", {}))
+        self._frame_id = scenario.frame_id
+        self._default_method = param("default_method", "") or methods.REGISTRY[0].name
+        self._default_budget = float(param("time_budget", 20.0))
+        self._tolerances = Tolerances(
+            attitude=math.radians(float(param("accept_attitude_error_deg", math.degrees(TOLERANCES.attitude)))),
+            rate=float(param("accept_final_rate", TOLERANCES.rate)),
+            cone_penetration=math.radians(float(param("accept_cone_penetration_deg",
+                                                      math.degrees(TOLERANCES.cone_penetration)))))
+        self._cone_padding = math.radians(float(param("cone_padding_deg", 1.0)))
+        self._schedule_rate_max = float(param("schedule_rate_max", float("inf")))
+        set_max_parallel(int(param("max_parallel_solves", 2)))
+        warm_up()
+        group = ReentrantCallbackGroup()
+        self._plan_pub = self.create_publisher(ManeuverPlan, topics.PLANS, qos.LATCHED_QOS)
+        self.create_service(PlanManeuver, topics.PLAN_MANEUVER, self.on_plan_maneuver, qos_profile=qos.SERVICE_QOS,
+                            callback_group=group)
+        self.create_service(PlanSchedule, topics.PLAN_SCHEDULE, self.on_plan_schedule, qos_profile=qos.SERVICE_QOS,
+                            callback_group=group)
+        self.get_logger().info(f"methods: {', '.join(methods.METHODS)} (default {self._default_method})")
+
+    def on_plan_maneuver(self, request: PlanManeuver.Request, response: PlanManeuver.Response):
+        try:
+            valid = validate_maneuver(
+                ManeuverRequest(
+                    frame_id=request.header.frame_id,
+                    q_initial=convert.from_quaternion(request.initial_attitude),
+                    q_final=convert.from_quaternion(request.final_attitude),
+                    sensor_axis=convert.from_vector3(request.sensor_axis),
+                    cones=[convert.cone_parts(c) for c in request.cones],
+                    method=request.method, time_budget=request.time_budget, spacecraft=request.spacecraft,
+                    option_names=list(request.option_names), option_values=list(request.option_values),
+                    semi_free=request.semi_free, sensor_target=convert.from_vector3(request.sensor_target)),
+                frame_id=self._frame_id, default_spacecraft=self._scenario_name,
+                default_method=self._default_method, default_budget=self._default_budget)
+        except RequestError as err:
+            return self.refuse(response, err, "request")
+        runner = run_method if valid.method.cheap else run_isolated
+        outcome = plan_maneuver(valid, self._tolerances, self._cone_padding, runner)
+        self.answer(response, outcome, valid.spacecraft, f"{valid.method.name}",
+                    sensor_axis=valid.problem.sensor_axis, cones=valid.problem.cones)
+        return response
+
+    def on_plan_schedule(self, request: PlanSchedule.Request, response: PlanSchedule.Response):
+        try:
+            valid = validate_schedule(
+                list(request.target_names), [convert.from_quaternion(q) for q in request.targets],
+                convert.from_quaternion(request.start_attitude),
+                None if request.return_to_start else convert.from_quaternion(request.end_attitude),
+                request.spacecraft, request.time_budget,
+                frame_id=self._frame_id, request_frame=request.header.frame_id,
+                default_spacecraft=self._scenario_name, default_budget=self._default_budget,
+                rate_max=self._schedule_rate_max)
+        except RequestError as err:
+            return self.refuse(response, err, "schedule")
+
+        def runner(problem, wait):
+            return call_isolated(plan_schedule, (problem,), {}, wait, on_death=lambda message: message)
+
+        outcome = plan_schedule_request(valid, self._tolerances, runner=runner)
+        if outcome.code == ErrorCode.OK:
+            response.order = [p.name for p in outcome.plan.passages]
+            response.passage_times = [float(p.time) for p in outcome.plan.passages]
+        self.answer(response, outcome, valid.spacecraft_name, f"schedule of {len(valid.problem.targets)} targets")
+        return response
+
+    def refuse(self, response, err: RequestError, what: str):
+        self.get_logger().warning(f"{what} rejected [{int(err.code)} {err.code.name}]: {err.message}")
+        response.success, response.error_code, response.message = False, int(err.code), err.message
+        return response
+
+    def answer(self, response, outcome: PlanOutcome, spacecraft: str, what: str, **context):
+        """Fill the response from ``outcome``; an accepted plan gets an id and is published."""
+        response.success = outcome.code == ErrorCode.OK
+        response.error_code, response.message = int(outcome.code), outcome.message
+        plan: Plan | None = outcome.plan
+        if plan is not None and len(plan.t) >= 2:
+            plan.plan_id, plan.frame_id, plan.spacecraft = uuid.uuid4().hex[:12], self._frame_id, spacecraft
+            for key, value in context.items():
+                setattr(plan, key, value)
+            if not response.success:
+                plan.verification = None
+            response.plan = convert.plan_msg(plan)
+            response.plan.header.stamp = self.get_clock().now().to_msg()
+        if response.success:
+            self.get_logger().info(f"{what}: {outcome.message}")
+            self._plan_pub.publish(response.plan)
+        else:
+            self.get_logger().warning(f"{what} failed (code {response.error_code}): {outcome.message}")
+
+
+def main(args=None):
+    # waiting requests hold a thread, not a core: many threads so quick requests never queue
+    run_node(PlannerNode, args, make_executor=lambda: MultiThreadedExecutor(num_threads=16))
+
+
+if __name__ == "__main__":
+    main()

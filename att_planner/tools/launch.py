@@ -1,0 +1,112 @@
+"""Start the suite's nodes as separate processes (there is no ros2 launch from PyPI).
+
+Used by ``att-demo`` and the integration tests. :func:`isolated_env` gives a process environment
+on a random ``ROS_DOMAIN_ID`` with localhost-only discovery, so runs never see each other or the
+network. :meth:`Suite.stop` stops the nodes with SIGINT (recorder last, so it sees everything),
+waits, and kills what does not exit.
+"""
+from __future__ import annotations
+
+import os
+import random
+import signal
+import subprocess
+import sys
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+NODE_MODULES = {
+    "simulator": "att_sim.simulator_node",
+    "controller": "att_planner.nodes.controller_node",
+    "planner": "att_planner.nodes.planner_node",
+    "recorder": "att_msgs_py.log.recorder_node",
+}
+
+
+def isolated_env(domain_id: int | None = None, base: dict | None = None) -> dict:
+    env = dict(os.environ if base is None else base)
+    env["ROS_DOMAIN_ID"] = str(domain_id if domain_id is not None else random.randint(1, 200))
+    env["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
+    env.setdefault("RCUTILS_COLORIZED_OUTPUT", "0")
+    env["PYTHONUNBUFFERED"] = "1"
+    return env
+
+
+def join_env(env: dict) -> None:
+    """Put this process on ``env``'s domain and discovery range, so that its own rclpy client
+    (demo, tests) talks to the nodes started with ``env``."""
+    os.environ.update({k: env[k] for k in ("ROS_DOMAIN_ID", "ROS_AUTOMATIC_DISCOVERY_RANGE")})
+
+
+@dataclass
+class Suite:
+    env: dict
+    log_dir: Path
+    procs: dict = field(default_factory=dict)
+
+    def start(self, name: str, params: dict | None = None, params_files: tuple = ()) -> subprocess.Popen:
+        """Start node ``name`` with ``-p key:=value`` parameters and ``--params-file`` files
+        (files override the scenario defaults, ``params`` override both)."""
+        args = [sys.executable, "-m", NODE_MODULES[name], "--ros-args"]
+        for path in params_files:
+            args += ["--params-file", str(path)]
+        for key, value in (params or {}).items():
+            args += ["-p", f"{key}:={value}"]
+        self.log_dir.mkdir(parents=True, exist_ok=True)
+        out = open(self.log_dir / f"{name}.log", "w")
+        self.procs[name] = subprocess.Popen(args, env=self.env, stdout=out, stderr=subprocess.STDOUT)
+        return self.procs[name]
+
+    def alive(self) -> dict[str, bool]:
+        return {n: p.poll() is None for n, p in self.procs.items()}
+
+    def stop(self, timeout: float = 10.0) -> dict[str, int]:
+        """SIGINT every node (recorder last), wait up to ``timeout`` s each, kill stragglers."""
+        order = [n for n in self.procs if n != "recorder"] + (["recorder"] if "recorder" in self.procs else [])
+        codes = {}
+        for name in order:
+            proc = self.procs[name]
+            if proc.poll() is None:
+                proc.send_signal(signal.SIGINT)
+                try:
+                    proc.wait(timeout)
+                except subprocess.TimeoutExpired:
+                    proc.kill()
+                    proc.wait()
+            codes[name] = proc.returncode
+        return codes
+
+    def log_text(self, name: str) -> str:
+        return (self.log_dir / f"{name}.log").read_text()
+
+    def wait_for_output(self, name: str, text: str, timeout: float, poll: float = 0.2) -> bool:
+        """Wait until node ``name`` has printed ``text``; False at the timeout or as soon as the
+        process has exited without printing it."""
+        end = time.monotonic() + timeout
+        while time.monotonic() < end:
+            if text in self.log_text(name):
+                return True
+            if self.procs[name].poll() is not None:
+                return text in self.log_text(name)
+            time.sleep(poll)
+        return False
+
+
+def start_suite(scenario: str, mcap_path: str | Path, log_dir: str | Path, *, env: dict | None = None,
+                nodes=("recorder", "simulator", "controller", "planner"), params: dict | None = None) -> Suite:
+    """Start ``nodes`` for ``scenario``; ``params`` maps node name -> extra ROS parameters.
+
+    The simulator holds sim time at zero until the recorder and the controller (those started)
+    subscribe to its state, so every run is recorded and controlled from t = 0.
+    """
+    suite = Suite(env or isolated_env(), Path(log_dir))
+    consumers = sum(n in nodes for n in ("recorder", "controller"))
+    for name in nodes:
+        p = {"scenario": scenario}
+        if name == "recorder":
+            p = {"output": str(mcap_path)}
+        if name == "simulator":
+            p["wait_for_subscribers"] = consumers
+        suite.start(name, {**p, **(params or {}).get(name, {})})
+    return suite

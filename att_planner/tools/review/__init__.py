@@ -1,0 +1,105 @@
+"""``att-review LOG.mcap [--out DIR]``: look at a recorded run without ROS running.
+
+Reads the log with :func:`att_msgs_py.log.read_log`, picks the reviewed segment (the last
+executed plan, else the last magnetorquer-PD run, else the whole log), and writes into ``DIR``
+(default: ``review/`` next to the log):
+
+* ``sky.png`` — the sensor boresight on the celestial sphere (Lambert azimuthal equal-area
+  projection centred on the path), every keep-out cone of the recorded ``ManeuverPlan`` drawn and
+  shaded, start and goal marked, the closest approach to each cone annotated;
+* ``time_histories.png`` — attitude error to goal and to the plan reference, body rates, body
+  torque (applied vs planned) and wheel torques (commanded vs applied) with their limits, wheel
+  speeds with their limit, magnetorquer dipoles (commanded vs applied) with saturation, cone
+  margins, controller mode;
+* ``overview.png`` — a screenshot-sized digest (sky, margins, torque, wheel speeds);
+* ``summary.txt``, ``summary.json`` and ``index.html`` (summary table, figures embedded).
+
+Limits come from the scenario named by the plan (``att_sim.scenario.load(plan.spacecraft)``) or
+``--scenario``. Modules: :mod:`.run` (the reviewed segment), :mod:`.summary` (the pure
+:func:`summarize` of a read log), :mod:`.figures` (matplotlib, Agg, in the ``plot_*`` functions).
+"""
+from __future__ import annotations
+
+import argparse
+import base64
+import html
+import json
+import sys
+from dataclasses import dataclass
+from pathlib import Path
+
+from att_msgs_py.log import read_log
+from att_msgs_py.topics import COMMAND, PLANS, STATE
+from att_planner.tools.review.figures import figure_overview, figure_sky, figure_time_histories
+from att_planner.tools.review.run import extract_run, settling_time
+from att_planner.tools.review.summary import format_summary, spacecraft_for, summarize, summary_of
+
+__all__ = ["Review", "extract_run", "format_summary", "main", "review", "settling_time", "summarize"]
+
+
+@dataclass
+class Review:
+    out_dir: Path
+    summary: dict
+    text: str
+    figures: dict          # name -> png path
+    html: Path
+
+
+def _html(log_path: Path, text: str, figures: dict) -> str:
+    imgs = "\n".join(
+        f'<h2>{html.escape(name)}</h2>\n<img alt="{html.escape(name)}" style="max-width:100%" '
+        f'src="data:image/png;base64,{base64.b64encode(Path(p).read_bytes()).decode()}">'
+        for name, p in figures.items())
+    return ("<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\">"
+            f"<title>Review of {html.escape(log_path.name)}</title>"
+            "<style>body{font-family:sans-serif;margin:2em}pre{background:#f4f4f4;padding:1em}</style></head><body>\n"
+            f"<h1>Review of {html.escape(str(log_path))}</h1>\n<pre>{html.escape(text)}</pre>\n{imgs}\n"
+            "</body></html>\n")
+
+
+def review(log_path: str | Path, out_dir: str | Path | None = None, *, plan_id: str | None = None,
+           scenario: str | None = None) -> Review:
+    """Read ``log_path`` and write figures, summary and HTML page into ``out_dir``."""
+    log_path = Path(log_path)
+    out = Path(out_dir) if out_dir is not None else log_path.parent / "review"
+    out.mkdir(parents=True, exist_ok=True)
+    log = read_log(log_path, topics=[STATE, COMMAND, PLANS])
+    run = extract_run(log, plan_id)
+    sc = spacecraft_for(run, scenario)
+    summary = summary_of(run, sc)
+    text = format_summary(summary)
+    figures = {"overview": figure_overview(run, sc, out / "overview.png"),
+               "sky": figure_sky(run, out / "sky.png"),
+               "time histories": figure_time_histories(run, sc, out / "time_histories.png")}
+    (out / "summary.txt").write_text(text + "\n")
+    (out / "summary.json").write_text(json.dumps(summary, indent=2) + "\n")
+    page = out / "index.html"
+    page.write_text(_html(log_path, text, figures))
+    return Review(out, summary, text, figures, page)
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(prog="att-review", description=__doc__.splitlines()[0])
+    parser.add_argument("log", help="MCAP file written by the suite's recorder")
+    parser.add_argument("--out", default=None, help="output directory (default: review/ next to the log)")
+    parser.add_argument("--plan-id", default=None, help="review this executed plan (default: the last one)")
+    parser.add_argument("--scenario", default=None,
+                        help="scenario for the limits (default: the one the plan names)")
+    args = parser.parse_args(argv)
+    if not Path(args.log).is_file():
+        parser.error(f"log file '{args.log}' does not exist")
+    try:
+        result = review(args.log, args.out, plan_id=args.plan_id, scenario=args.scenario)
+    except ValueError as err:
+        print(f"att-review: {err}", file=sys.stderr)
+        return 1
+    print(result.text)
+    for name, p in result.figures.items():
+        print(f"figure ({name}): {p}")
+    print(f"HTML: {result.html}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,121 @@
+"""The one verification of a plan: integrate its controls through the truth dynamics and measure
+it against its problem, with one named set of tolerances (:data:`TOLERANCES`).
+
+Every plan the planner returns carries these figures, and the methods and the benchmarks judge
+plans by them; nothing is taken from a planner's own model. The integration is
+:func:`att_sim.dynamics.simulate_profile` (RK4 with inputs switched exactly at the knots for
+zero-order hold, :data:`VERIFY_STEPS` steps over the plan at least), from the problem's initial
+attitude at rest with the wheels stopped. Checked: the final attitude (semi-free: the boresight
+on its target) and rate, every passage of a schedule (attitude, rate about body z), every cone at
+every dense sample, and the control, wheel-speed, body-rate and wheel-momentum limits.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from att_msgs_py.types import ControlKind, Plan, Verification
+from att_planner.cones import margins
+from att_planner.problem import ManeuverProblem
+from att_sim import dynamics as dyn
+from att_sim import rotations as rot
+
+VERIFY_STEPS = 2000         # RK4 steps over the plan (at least one per control interval)
+
+
+@dataclass(frozen=True)
+class Tolerances:
+    """Acceptance of a plan after integration through the dynamics."""
+
+    attitude: float = math.radians(0.5)    # rad: final (semi-free: boresight) and passage attitude error
+    rate: float = 1e-3                     # rad/s: final ‖ω‖ and |ω_z| at each passage
+    cone_penetration: float = 0.0          # rad a dense sample may lie inside a cone
+    limit_ratio: float = 1.0 + 1e-6        # control, wheel speed, body rate, wheel momentum / their limits
+
+
+TOLERANCES = Tolerances()
+
+
+def integrate(problem: ManeuverProblem, plan: Plan, steps: int = VERIFY_STEPS) -> dyn.Trajectory:
+    """The plan's controls integrated from the problem's start (at rest, wheels stopped)."""
+    sc = problem.spacecraft
+    x0 = dyn.initial_state(sc, problem.q_initial)
+    return dyn.simulate_profile(sc, x0, plan.t, plan.torque, kind=str(plan.control_kind),
+                                interpolation=str(plan.interpolation),
+                                max_step=max(plan.duration, 1e-9) / steps)
+
+
+def measure(problem: ManeuverProblem, plan: Plan, traj: dyn.Trajectory) -> Verification:
+    """The verification figures of ``plan`` from its integrated trajectory ``traj``."""
+    sc = problem.spacecraft
+    wheels = plan.control_kind == ControlKind.WHEEL_TORQUE
+    controls = np.asarray(plan.torque, float).reshape(len(plan.t), -1)
+    applied = controls[:-1] if plan.interpolation == "zoh" and len(controls) > 1 else controls
+    limit = sc.wheel_torque_max if wheels else sc.body_torque_max
+    m = margins(traj.q, problem.sensor_axis, problem.cones)
+    if problem.sensor_target is None:
+        final_error = float(rot.angle_between(traj.q[-1], problem.q_final))
+    else:
+        reached = rot.dcm(traj.q[-1]) @ np.asarray(problem.sensor_axis, float)
+        target = np.asarray(problem.sensor_target, float)
+        final_error = float(np.arccos(np.clip(reached @ target / np.linalg.norm(target), -1.0, 1.0)))
+    passage_errors, passage_rates = [], []
+    for passage in plan.passages:
+        k = int(np.argmin(np.abs(traj.t - passage.time)))
+        passage_errors.append(float(rot.angle_between(traj.q[k], passage.attitude)))
+        passage_rates.append(float(abs(traj.omega[k, 2])))
+    return Verification(
+        final_attitude_error=final_error,
+        final_rate=float(np.linalg.norm(traj.omega[-1])),
+        min_cone_margin=float(m.min()) if m.size else math.inf,
+        cone_margins=[float(v) for v in m.min(axis=0)] if m.size else [],
+        torque_ratio=_ratio(np.abs(applied).max() if applied.size else 0.0, limit),
+        wheel_speed_ratio=_ratio(np.abs(traj.wheel_speed).max() if traj.wheel_speed.size else 0.0,
+                                 sc.wheel_speed_max),
+        rate_max=float(np.linalg.norm(traj.omega, axis=1).max()),
+        dense_samples=len(traj.t),
+        duration=plan.duration,
+        body_rate_ratio=_ratio(np.abs(traj.omega).max(), problem.rate_max),
+        wheel_momentum_ratio=_ratio(np.abs(_wheel_momentum(sc, traj, wheels)).max(), problem.wheel_momentum_max)
+        if math.isfinite(problem.wheel_momentum_max) else 0.0,
+        passage_attitude_errors=passage_errors,
+        passage_rates_z=passage_rates,
+    )
+
+
+def verify(problem: ManeuverProblem, plan: Plan, steps: int = VERIFY_STEPS) -> Verification:
+    """Integrate the plan through the truth dynamics and measure it against its problem."""
+    return measure(problem, plan, integrate(problem, plan, steps))
+
+
+def rejection(ver: Verification, tol: Tolerances = TOLERANCES) -> str | None:
+    """Why a verified plan is not acceptable, or None."""
+    if ver.final_attitude_error > tol.attitude:
+        return (f"final attitude error {math.degrees(ver.final_attitude_error):.3f} deg > "
+                f"{math.degrees(tol.attitude):.3f} deg")
+    if ver.final_rate > tol.rate:
+        return f"final rate {ver.final_rate:.3g} rad/s > {tol.rate:.3g} rad/s"
+    if ver.min_cone_margin < -tol.cone_penetration:
+        return f"enters a keep-out cone by {math.degrees(-ver.min_cone_margin):.3f} deg"
+    for name in ("torque_ratio", "wheel_speed_ratio", "body_rate_ratio", "wheel_momentum_ratio"):
+        if getattr(ver, name) > tol.limit_ratio:
+            return f"{name.replace('_ratio', '').replace('_', ' ')} {getattr(ver, name):.6f} x the limit"
+    for k, (err, rate) in enumerate(zip(ver.passage_attitude_errors, ver.passage_rates_z)):
+        if err > tol.attitude or rate > tol.rate:
+            return (f"passage {k} missed: attitude error {math.degrees(err):.3f} deg, "
+                    f"|w_z| {rate:.3g} rad/s")
+    return None
+
+
+def _ratio(peak: float, limit: float) -> float:
+    return float(peak / limit) if math.isfinite(limit) and limit > 0 else 0.0
+
+
+def _wheel_momentum(sc: dyn.Spacecraft, traj: dyn.Trajectory, wheels: bool) -> np.ndarray:
+    """Per-wheel momentum (N m s) along the trajectory: ``I_w Ω`` for a wheel-torque plan, else the
+    momentum ``G⁺ J ω`` the wheels would hold producing the body torque with zero total momentum."""
+    if wheels:
+        return sc.wheel_inertia * traj.wheel_speed
+    return traj.omega @ (np.linalg.pinv(sc.wheel_axes) @ sc.inertia).T

@@ -1,0 +1,140 @@
+"""The controller core without ROS: modes, plan checks, a maneuver flown closed loop on the simulator."""
+import math
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from att_msgs_py.errors import ErrorCode
+from att_msgs_py.types import ControlKind, ControlMode, Plan, Status
+from att_planner.control.controller import Controller, ControllerConfig
+from att_planner.methods.eigenaxis import plan_eigenaxis_smooth
+from att_planner.problem import ManeuverProblem
+from att_sim import rotations as rot
+from att_sim import scenario
+from att_sim.simulation import Simulation
+
+GOAL = rot.from_axis_angle([0.3, -0.5, 1.0], 1.2)
+CONFIG = ControllerConfig(control_period=0.1, settle_time=10.0, tracking_kp=1.0, tracking_kd=16.0)
+
+
+@pytest.fixture
+def world():
+    s = scenario.load("swift_demo")
+    sim = Simulation(s.spacecraft, s.orbit)
+    plan = plan_eigenaxis_smooth(ManeuverProblem(s.spacecraft, rot.IDENTITY, GOAL))
+    plan.plan_id = "p1"
+    return sim, Controller(s.spacecraft, CONFIG, body_frame_id="body"), plan
+
+
+def fly(sim, core, seconds, dt=0.05):
+    """Closed loop: the simulator's state into the core, its command back, as the nodes do."""
+    outputs = []
+    for _ in range(int(round(seconds / dt))):
+        assert core.accept_state(sim.state()) is None
+        if core.due():
+            out = core.step()
+            assert sim.set_command(out.command) is None
+            outputs.append(out)
+            if out.result is not None:
+                return outputs
+        sim.advance(dt)
+    return outputs
+
+
+def test_a_plan_is_flown_to_its_goal_with_feedback_then_held(world):
+    sim, core, plan = world
+    core.receive_plan(plan)
+    core.accept_state(sim.state())
+    resolved, code, _ = core.resolve("p1")
+    assert code == ErrorCode.OK and core.start(resolved) == (ErrorCode.OK, "")
+    assert core.mode == ControlMode.PLAN_TRACKING
+    outputs = fly(sim, core, plan.duration + CONFIG.settle_time + 5)
+    result = outputs[-1].result
+    assert result is not None and result.success and result.error_code == ErrorCode.OK
+    assert result.duration == pytest.approx(plan.duration + CONFIG.settle_time, abs=CONFIG.control_period + 1e-9)
+    assert result.final_attitude_error < math.radians(0.05) and result.final_rate < 1e-3
+    feedback = [o.feedback for o in outputs if o.feedback is not None]
+    assert len(feedback) == pytest.approx(result.duration / CONFIG.feedback_period, abs=1)
+    assert all(np.diff([f.elapsed for f in feedback]) > 0) and feedback[-1].progress <= 1.0
+    assert all(o.command.plan_id == "p1" and o.command.mode == ControlMode.PLAN_TRACKING for o in outputs)
+    assert all(o.command.frame_id == "body" for o in outputs)
+    # after the maneuver: the final attitude is held
+    held = fly(sim, core, 5.0)
+    assert core.maneuver is None and held[-1].status.message.startswith("holding")
+    assert rot.angle_between(sim.x[:4], GOAL) < math.radians(0.05)
+
+
+def test_mode_changes_are_checked_and_safe_mode_aborts_a_maneuver(world):
+    sim, core, plan = world
+    assert core.set_mode(7)[0] == ErrorCode.INVALID_MODE
+    assert core.set_mode(ControlMode.PLAN_TRACKING)[0] == ErrorCode.INVALID_MODE
+    assert core.start(plan) == (ErrorCode.NO_STATE, "no spacecraft state received yet")
+    fly(sim, core, 0.2)
+    assert core.start(plan)[0] == ErrorCode.OK
+    fly(sim, core, 2.0)
+    code, message, ended = core.set_mode(ControlMode.MAGNETORQUER_PD)
+    assert code == ErrorCode.BUSY and "'p1' is executing" in message and ended is None
+    code, _, ended = core.set_mode(ControlMode.SAFE)
+    assert code == ErrorCode.OK and not ended.success and ended.error_code == ErrorCode.ABORTED
+    assert core.mode == ControlMode.SAFE and core.maneuver is None
+    # safe mode damps the rate through the wheels
+    w0 = np.linalg.norm(sim.x[4:7])
+    fly(sim, core, 20.0)
+    assert np.linalg.norm(sim.x[4:7]) < 0.2 * w0
+
+
+def test_cancellation_ends_the_maneuver_in_safe_mode(world):
+    sim, core, plan = world
+    fly(sim, core, 0.2)
+    core.start(plan)
+    core.accept_state(sim.state())
+    core.next_control = -math.inf
+    out = core.step(cancel_requested=True)
+    assert out.result.error_code == ErrorCode.ABORTED and out.result.message == "cancelled"
+    assert core.mode == ControlMode.SAFE and core.hold_q is None
+
+
+@pytest.mark.parametrize("change, words", [
+    (dict(t=np.array([0.0, 2.0, 1.0])), "times must increase"),
+    (dict(q=np.zeros((2, 4))), "match attitudes"),
+    (dict(torque=np.full((3, 3), np.nan)), "NaN or Inf"),
+    (dict(control_kind="warp_drive"), "control_kind 'warp_drive'"),
+    (dict(status=Status.FAILED), "status is 'failed'"),
+])
+def test_bad_inline_plans_are_refused(world, change, words):
+    _, core, _ = world
+    good = Plan(t=np.array([0.0, 1.0, 2.0]), torque=np.zeros((3, 3)), q=np.tile(rot.IDENTITY, (3, 1)),
+                omega=np.zeros((3, 3)), control_kind=ControlKind.BODY_TORQUE, status=Status.OPTIMAL)
+    assert core.resolve("", good)[1] == ErrorCode.OK
+    plan, code, message = core.resolve("", replace(good, **change))
+    assert plan is None and code == ErrorCode.INVALID_PLAN and words in message
+
+
+def test_unknown_plans_and_the_cache_bound(world):
+    _, core, plan = world
+    assert core.resolve("nope")[1] == ErrorCode.UNKNOWN_PLAN
+    for i in range(CONFIG.max_cached_plans + 5):
+        core.receive_plan(replace(plan, plan_id=f"p{i}"))
+    assert len(core.plans) == CONFIG.max_cached_plans
+    assert core.resolve("p0")[1] == ErrorCode.UNKNOWN_PLAN and core.resolve(f"p{CONFIG.max_cached_plans + 4}")[1] == 0
+
+
+def test_control_instants_follow_the_control_period(world):
+    sim, core, _ = world
+    outputs = fly(sim, core, 1.0, dt=0.025)
+    assert len(outputs) == pytest.approx(1.0 / CONFIG.control_period, abs=1)
+    assert np.allclose(np.diff([o.command.t for o in outputs]), CONFIG.control_period)
+    assert all(o.command.mode == ControlMode.IDLE and not np.any(o.command.wheel_torques) for o in outputs)
+
+
+def test_magnetorquer_mode_commands_the_pd_law_and_non_finite_states_are_ignored():
+    s = scenario.load("bruni_celani")
+    core = Controller(s.spacecraft, ControllerConfig(kp=2e5, kd=1e8, control_period=1.0), ControlMode.MAGNETORQUER_PD)
+    sim = Simulation(s.spacecraft, s.orbit, omega0=[0.02, 0.02, -0.03])
+    sim.advance(0.5)
+    state = sim.state()
+    assert core.accept_state(replace(state, q=np.array([np.nan, 0, 0, 1]))) == "non-finite state received; ignored"
+    assert core.accept_state(state) is None and core.due()
+    m = core.step().command.dipole
+    assert np.all(np.abs(m) <= s.spacecraft.dipole_max) and np.any(m)

@@ -1,0 +1,44 @@
+"""The Hermite–Simpson collocation toolkit on problems with known answers."""
+import casadi as ca
+import numpy as np
+import pytest
+
+from att_planner.methods.time_optimal import collocation as col
+
+
+def _double_integrator(control, intervals=10):
+    x, u = ca.SX.sym("x", 2), ca.SX.sym("u", 1)
+    f = ca.Function("f", [x, u], [ca.vertcat(x[1], u)])
+    phase = col.Phase(f, col.uniform_mesh(intervals), control=control, control_bounds=(-1, 1),
+                      duration_bounds=(0.1, 10))
+    tr = col.Transcription([phase])
+    tr.bound_state(0, 0, [0, 0])
+    tr.bound_state(0, -1, [1, 0])
+    tr.minimize(tr.variables(0).duration)
+    tr.build()
+    guess = col.guess_from_functions(phase, 3.0, lambda t: np.stack([t / 3, np.full_like(t, 1 / 3)], -1),
+                                     lambda t: np.zeros((len(t), 1)))
+    return tr, tr.solve(tr.pack([guess]))
+
+
+def test_collocation_double_integrator_minimum_time_is_exact_with_zoh_control():
+    # rest-to-rest over a unit distance with |u| ≤ 1: t_f = 2 sqrt(1) = 2, switch at mid-time
+    tr, res = _double_integrator("constant")
+    assert res.success
+    sol = tr.phase_solution(res.w)
+    assert sol.duration == pytest.approx(2.0, abs=1e-6)
+    assert np.allclose(sol.u[:5], 1.0, atol=1e-5) and np.allclose(sol.u[5:], -1.0, atol=1e-5)
+    # the Hermite interpolant reproduces x = t²/2 on the first half
+    assert sol.state_at(np.array([0.25]))[0, 0] == pytest.approx(0.5 * 0.5**2, abs=1e-9)
+
+
+def test_collocation_linear_control_cannot_beat_the_bang_bang_bound():
+    tr, res = _double_integrator("linear")
+    assert res.success
+    assert 2.0 - 1e-6 <= tr.phase_solution(res.w).duration < 2.1
+
+
+def test_refine_mesh_bisects_only_the_listed_intervals_within_the_cap():
+    mesh = col.uniform_mesh(4)
+    assert np.allclose(col.refine_mesh(mesh, [1, 3]), [0, 0.25, 0.375, 0.5, 0.75, 0.875, 1])
+    assert len(col.refine_mesh(mesh, [0, 1, 2, 3], max_intervals=6)) == 7

@@ -1,0 +1,18 @@
+"""Soak (short): simulator + controller + recorder as fast as possible; nothing dropped, memory
+flat, the log replays. ``att-bench soak`` runs the full 10 orbits."""
+import pytest
+
+from att_planner.tools.soak import run_soak
+
+pytestmark = [pytest.mark.ros, pytest.mark.slow]
+MAX_GROWTH = 0.10      # resident memory may grow by 10 % of its start (first half of the run) at most
+
+
+def test_half_orbit_as_fast_as_possible(tmp_path):
+    r = run_soak("bruni_celani", 0.5, tmp_path)
+    assert r["reached_end"] and r["real_time_factor"] > 5
+    assert r["dropped_state"] == 0 and r["state_messages"] == r["state_expected"]
+    assert r["command_messages"] >= r["state_messages"] - 2       # one command answers each state
+    assert all(code == 0 for code in r["exit_codes"].values()), r["exit_codes"]
+    for name, m in r["memory"].items():
+        assert m["end_mib"] <= m["start_mib"] * (1 + MAX_GROWTH), f"{name} memory grew: {m}"

@@ -1,0 +1,62 @@
+"""End to end: nodes as processes on an isolated domain, a maneuver planned over the service,
+executed on the simulator, and the recorded MCAP checked by replay."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from att_msgs_py.errors import ErrorCode
+from att_msgs_py.log import read_log
+from att_msgs_py.topics import COMMAND, PLANS, STATE
+from att_msgs_py.types import Cone
+from att_planner.cones import margins
+from att_planner.nodes.client import maneuver_request
+from att_sim import rotations as rot
+
+pytestmark = pytest.mark.ros
+
+SENSOR = np.array([1.0, 0.0, 0.0])
+CONES = [Cone([0.5, 0.866, 0.0], math.radians(47), "sun"), Cone([0.0, 0.0, -1.0], math.radians(33), "earth"),
+         Cone([0.1795, 0.3109, 0.9333], math.radians(23), "moon")]
+GOAL = rot.from_axis_angle([0, 0, 1], math.radians(135))
+
+
+@pytest.fixture(scope="module")
+def suite(ros_suite):
+    with ros_suite("swift_demo", params={"simulator": {"real_time_factor": 0.0}}, name="integration_test") as s:
+        yield s
+
+
+def test_bad_request_is_refused_and_the_next_good_one_is_served(suite):
+    client = suite.client
+    bad = client.plan(maneuver_request([0, 0, 0, 0], GOAL, SENSOR, CONES))
+    assert not bad.success and bad.error_code == ErrorCode.INVALID_ATTITUDE and "initial_attitude" in bad.message
+    inside = client.plan(maneuver_request(rot.IDENTITY, GOAL, [0.5, 0.866, 0.0], CONES))
+    assert inside.error_code == ErrorCode.SENSOR_IN_CONE and "sun" in inside.message
+    good = client.plan(maneuver_request(rot.IDENTITY, rot.from_axis_angle([0, 0, 1], 0.3), SENSOR, [],
+                                        method="eigenaxis_smooth"))
+    assert good.success, good.message
+    assert all(suite.suite.alive().values())
+
+
+def test_maneuver_is_planned_executed_and_recorded(suite):
+    client = suite.client
+    response = client.plan(maneuver_request(rot.IDENTITY, GOAL, SENSOR, CONES, time_budget=60))
+    assert response.success, response.message
+    plan = response.plan
+    assert plan.verification.min_cone_margin >= 0 and plan.verification.final_attitude_error < math.radians(1)
+    result = client.execute(plan.plan_id)
+    assert result.success, result.message
+    assert result.final_attitude_error < math.radians(0.5)
+    codes = suite.stop()          # flush and finalise the log before replaying it
+    assert all(code == 0 for code in codes.values()), codes
+    log = read_log(suite.mcap)
+    state = log[STATE]
+    assert len(state) > 100 and len(log[COMMAND]) > 50 and len(log[PLANS]) >= 1
+    assert state["header.stamp"][-1] > plan.duration
+    m = margins(state["attitude"], SENSOR, CONES)
+    assert m.min() >= 0.0, f"recorded path enters a cone by {np.degrees(-m.min()):.3f} deg"
+    assert rot.angle_between(state["attitude"][-1], GOAL) < math.radians(0.5)
+    assert np.linalg.norm(state["body_rate"][-1]) < 1e-3

@@ -1,0 +1,49 @@
+"""PlanSchedule over ROS: a 2-target tour planned by the planner node, verified, executed."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from att_msgs.srv import PlanSchedule
+from att_msgs_py import convert
+from att_msgs_py.errors import ErrorCode
+from att_msgs_py.log import read_log
+from att_msgs_py.topics import STATE
+from att_planner.reference.olivares_staffetti import olivares_targets
+from att_sim import rotations as rot
+
+pytestmark = pytest.mark.ros
+
+
+def schedule_request(names, targets, budget=120.0):
+    req = PlanSchedule.Request(target_names=list(names), spacecraft="olivares_staffetti", time_budget=budget)
+    req.targets = [convert.quaternion(q) for q in targets]
+    req.start_attitude = convert.quaternion(rot.IDENTITY)
+    return req
+
+
+def test_schedule_is_planned_verified_and_executed(ros_suite):
+    with ros_suite("olivares_staffetti", schedule=True, name="schedule_test") as s:
+        client = s.client
+        bad = client.schedule(schedule_request(["a", "a"], [rot.IDENTITY, rot.IDENTITY]))
+        assert not bad.success and bad.error_code == ErrorCode.INVALID_ATTITUDE and "distinct" in bad.message
+        targets = olivares_targets("A")
+        names = ["a", "b"]
+        response = client.schedule(schedule_request(names, [targets[n] for n in names]))
+        assert response.success, response.message
+        assert sorted(response.order) == names and len(response.passage_times) == 2
+        plan = response.plan
+        assert plan.control_kind == "wheel_torque" and plan.verification.final_attitude_error < math.radians(0.5)
+        result = client.execute(plan.plan_id)
+        assert result.success, result.message
+        assert result.final_attitude_error < math.radians(0.5)
+        codes = s.stop()
+    assert all(c == 0 for c in codes.values()), codes
+    state = read_log(s.mcap, topics=[STATE])[STATE]
+    t, q = state["header.stamp"], state["attitude"]
+    t0 = t[-1] - (plan.duration + 10.0)          # the execution started settle_time + duration before the end
+    for name, tp in zip(response.order, response.passage_times):
+        k = int(np.argmin(np.abs(t - (t0 + tp))))
+        assert rot.angle_between(q[k], targets[name]) < math.radians(2.0), name
