@@ -10,7 +10,7 @@ BUILD_ENV := PATH=$(PREFIX)/bin:$$PATH CMAKE_PREFIX_PATH=$(PREFIX) AMENT_PREFIX_
 INTERFACES := $(shell find att_msgs_py/interfaces -type f)
 PYTEST_ARGS ?=
 
-.PHONY: setup test demo bench clean
+.PHONY: setup test test-fast lint demo clean
 
 setup: $(VENV)/.stamp-package
 
@@ -34,12 +34,21 @@ $(VENV)/.stamp-interfaces: $(INTERFACES) $(VENV)/.stamp-deps
 	$(PY) -c "import att_msgs.msg, att_msgs.srv, att_msgs.action"
 	touch $@
 
-$(VENV)/.stamp-package: setup.py package.xml $(VENV)/.stamp-interfaces
+$(VENV)/.stamp-package: setup.py package.xml pyproject.toml $(VENV)/.stamp-interfaces
 	$(PY) -m pip install --quiet --disable-pip-version-check --no-deps --no-build-isolation -e .
 	touch $@
 
-test: setup
+# the habits first (seconds): ruff's rules and the import contracts (pyproject.toml), then every test
+test: lint
 	$(PY) -m pytest test $(PYTEST_ARGS)
+
+# the ROS-free unit tests only: no nodes, no DDS, nothing slow (a quick check while working)
+test-fast: lint
+	$(PY) -m pytest test -m "not ros and not slow" $(PYTEST_ARGS)
+
+lint: setup
+	$(PREFIX)/bin/ruff check .
+	$(PREFIX)/bin/lint-imports
 
 demo: setup
 	$(PREFIX)/bin/att-demo

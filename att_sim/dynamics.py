@@ -113,14 +113,28 @@ def derivative(sc: Spacecraft, x: np.ndarray, inputs: Inputs) -> np.ndarray:
     return out
 
 
-def rk4(f: Callable, t, x, dt):
+def rk4(f: Callable, t, x, dt, work: tuple | None = None):
     """One classic Runge–Kutta step of ``x' = f(t, x)``. Plain arithmetic on ``x``, so the same
-    step serves numpy states, batches of states and CasADi expressions."""
-    k1 = f(t, x)
-    k2 = f(t + 0.5 * dt, x + 0.5 * dt * k1)
-    k3 = f(t + 0.5 * dt, x + 0.5 * dt * k2)
-    k4 = f(t + dt, x + dt * k3)
-    return x + dt / 6.0 * (k1 + 2 * k2 + 2 * k3 + k4)
+    step serves numpy states, batches of states and CasADi expressions.
+
+    ``work`` (numpy, large batches): five arrays shaped like ``x`` (``k1..k4`` and a stage state);
+    ``f`` is then called as ``f(t, x, out)`` writing the derivative into ``out``, and ``x`` is
+    advanced in place — the same operations, in the same order, without temporaries."""
+    if work is None:
+        k1 = f(t, x)
+        k2 = f(t + 0.5 * dt, x + 0.5 * dt * k1)
+        k3 = f(t + 0.5 * dt, x + 0.5 * dt * k2)
+        k4 = f(t + dt, x + dt * k3)
+        return x + dt / 6.0 * (k1 + 2 * k2 + 2 * k3 + k4)
+    k1, k2, k3, k4, stage = work
+    f(t, x, k1)
+    f(t + 0.5 * dt, np.add(x, np.multiply(0.5 * dt, k1, out=stage), out=stage), k2)
+    f(t + 0.5 * dt, np.add(x, np.multiply(0.5 * dt, k2, out=stage), out=stage), k3)
+    f(t + dt, np.add(x, np.multiply(dt, k3, out=stage), out=stage), k4)
+    total = np.add(k1, np.multiply(2, k2, out=k2), out=k2)
+    total = np.add(total, np.multiply(2, k3, out=k3), out=k2)
+    total = np.add(total, k4, out=k2)
+    return np.add(x, np.multiply(dt / 6.0, total, out=k2), out=x)
 
 
 def renormalised(x: np.ndarray) -> np.ndarray:

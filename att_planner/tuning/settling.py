@@ -141,7 +141,8 @@ class _BatchModel:
     def take(self, keep: np.ndarray):
         self.kp, self.kd, self.cpsi, self.spsi = self.kp[keep], self.kd[keep], self.cpsi[keep], self.spsi[keep]
 
-    def __call__(self, t: float, x: np.ndarray) -> np.ndarray:
+    def __call__(self, t: float, x: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
+        """``ẋ`` at ``t``, written into ``out`` when given (the work-array path of :func:`att_sim.dynamics.rk4`)."""
         case = self.case
         qx, qy, qz, qw, wx, wy, wz = x
         c, s = math.cos(self.n * t), math.sin(self.n * t)
@@ -162,7 +163,7 @@ class _BatchModel:
         # J ω̇ = −ω × Jω + m × B_b,  m × B_b = −m* (s × B_b)
         ex, ey, ez = self.euler
         gx, gy, gz = self.m_over_j
-        out = np.empty_like(x)
+        out = np.empty_like(x) if out is None else out
         np.subtract(ex * wy * wz, gx * (sy * bz - sz * by), out=out[4])
         np.subtract(ey * wz * wx, gy * (sz * bx - sx * bz), out=out[5])
         np.subtract(ez * wx * wy, gz * (sx * by - sy * bx), out=out[6])
@@ -174,9 +175,14 @@ class _BatchModel:
         return out
 
 
-def _step(model: _BatchModel, t: float, x: np.ndarray, dt: float) -> np.ndarray:
-    """The batch advanced by one :func:`att_sim.dynamics.rk4` step, quaternions renormalised."""
-    return dyn.renormalised(dyn.rk4(model, t, x, dt))
+def _work(x: np.ndarray) -> tuple:
+    """Work arrays of :func:`att_sim.dynamics.rk4` for the batch ``x``."""
+    return tuple(np.empty_like(x) for _ in range(5))
+
+
+def _step(model: _BatchModel, t: float, x: np.ndarray, dt: float, work: tuple) -> np.ndarray:
+    """The batch advanced in place by one :func:`att_sim.dynamics.rk4` step, quaternions renormalised."""
+    return dyn.renormalised(dyn.rk4(model, t, x, dt, work))
 
 
 def propagate(case: MagnetorquerCase, kp, kd, h, t_end: float, dt: float) -> np.ndarray:
@@ -187,8 +193,9 @@ def propagate(case: MagnetorquerCase, kp, kd, h, t_end: float, dt: float) -> np.
     n = h.shape[0]
     model = _BatchModel(case, np.broadcast_to(kp, (n,)).astype(float), np.broadcast_to(kd, (n,)).astype(float), psi)
     x = np.concatenate([q0, w0], 1).T.copy()
+    work = _work(x)
     for k in range(int(round(t_end / dt))):
-        x = _step(model, k * dt, x, dt)
+        _step(model, k * dt, x, dt, work)
     return x.T.copy()
 
 
@@ -217,6 +224,7 @@ class _SettlingBatch:
         self.last_exit = np.where(np.any(np.abs(q0[:, :3]) > case.nu, 1), 0.0, -np.inf)
         self.last_loud = np.zeros(n_cases)
         self.model = _BatchModel(case, kp, kd, psi)
+        self.work = _work(self.x)
 
     def _close(self, which: np.ndarray, status: int):
         """Record the live cases ``which`` (mask) as ``status`` with their last exit as ``t_s``."""
@@ -258,9 +266,11 @@ class _SettlingBatch:
 
     def keep(self, keep: np.ndarray):
         """Shrink the integrated batch to the cases ``keep`` (mask)."""
-        self.alive, self.x, self.bound = self.alive[keep], self.x[:, keep], self.bound[keep]
+        self.alive, self.bound = self.alive[keep], self.bound[keep]
+        self.x = np.ascontiguousarray(self.x[:, keep])      # the index returns columns contiguous: rows again
         self.last_exit, self.last_loud = self.last_exit[keep], self.last_loud[keep]
         self.model.take(keep)
+        self.work = _work(self.x)
 
     def close_at_cap(self, t: float):
         """Cases still integrated at the cap: settled only if no exit above ν in the last quiet window."""
@@ -292,7 +302,7 @@ def simulate_settling(case: MagnetorquerCase, kp, kd, h, settings: SimSettings =
     check_every = max(1, int(round(settings.check_orbits * case.period / dt)))
     case_steps, t, step = 0, 0.0, 0
     for step in range(1, n_steps + 1):
-        batch.x = _step(batch.model, t, batch.x, dt)
+        _step(batch.model, t, batch.x, dt, batch.work)
         t = step * dt
         case_steps += batch.x.shape[1]
         qmax = np.abs(batch.x[:3]).max(0)

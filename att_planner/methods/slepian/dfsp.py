@@ -45,6 +45,45 @@ def _sweep(state: _PenaltyState, merit, z: float, gamma: float, delta: float, th
     return z
 
 
+class _Measure:
+    """The figures of a point x = α/√N: (t_f, ½Σα², penalty Σ max(0, g)^q + Σ |h|^q); counts the
+    evaluations and keeps the best feasible t_f met (violation ≤ ``feas_tol``) and its x."""
+
+    def __init__(self, man: SmoothManeuver, q: float, feas_tol: float):
+        self.man, self.q, self.feas_tol = man, q, feas_tol
+        self.scale = float(np.sqrt(man.N))
+        self.evaluations = 0
+        self.best_tf, self.best_x = np.inf, None
+
+    def __call__(self, x: np.ndarray) -> tuple[float, float, float]:
+        man, q, s = self.man, self.q, self.scale
+        self.evaluations += 1
+        ev = evaluate(man, x * s)
+        tf = man.tf_from_peak(ev.peak_torque)
+        infeas = (np.sum(np.maximum(ev.cones, 0.0) ** q) if ev.cones.size else 0.0) + np.sum(np.abs(ev.final) ** q)
+        if violation(man, ev) <= self.feas_tol and tf < self.best_tf:
+            self.best_tf, self.best_x = tf, x.copy()
+        return tf, 0.5 * float(x @ x) * s * s, infeas
+
+
+def _phase(state: _PenaltyState, merit, n_iter: int, phase_end: float | None, *, gamma: float, delta: float,
+           theta: float, p: float, step_min: float) -> int:
+    """One phase: up to ``n_iter`` sweeps, the penalty driven up (ε ← θε) when every step is below
+    ε^p; stops early when every step is below ``step_min`` or at ``phase_end``. Returns the sweeps done."""
+    z = merit(state.x)
+    done = 0
+    for done in range(1, n_iter + 1):  # noqa: B007 - the count is reported after the loop
+        z = _sweep(state, merit, z, gamma, delta, theta)
+        if state.steps.max() <= state.eps ** p:
+            state.eps *= theta
+            z = merit(state.x)
+        if state.steps.max() < step_min:
+            break
+        if phase_end is not None and time.monotonic() > phase_end:
+            break
+    return done
+
+
 def solve_dfsp(man: SmoothManeuver, alpha0: np.ndarray | None = None, *,
                phases: tuple = ("mmt", "mssa", "mmt", "mssa", "mmt"),
                iterations: tuple = (10_000, 10_000, 10_000, 10_000, 30_000),
@@ -71,30 +110,15 @@ def solve_dfsp(man: SmoothManeuver, alpha0: np.ndarray | None = None, *,
     t0 = time.perf_counter()
     if len(phases) != len(iterations):
         raise ValueError("iterations must give one count per phase")
-    s = float(np.sqrt(man.N))
     P = man.n_params
-    x = np.zeros(P) if alpha0 is None else np.ravel(alpha0) / s
-    state = _PenaltyState(x, np.full(P, step0), eps0)
-    evals = 0
-    best = [np.inf, None]           # best feasible t_f and its x
+    measure = _Measure(man, q, feas_tol)
+    state = _PenaltyState(np.zeros(P) if alpha0 is None else np.ravel(alpha0) / measure.scale, np.full(P, step0), eps0)
     history = []
     total_iterations = float(sum(iterations))
     end = None if time_budget is None else time.monotonic() + time_budget
     if deadline is not None:
         end = deadline if end is None else min(end, deadline)
     stopped = False
-
-    def measure(x):
-        nonlocal evals
-        evals += 1
-        ev = evaluate(man, x * s)
-        tf = man.tf_from_peak(ev.peak_torque)
-        infeas = (np.sum(np.maximum(ev.cones, 0.0) ** q) if ev.cones.size else 0.0) + np.sum(np.abs(ev.final) ** q)
-        viol = violation(man, ev)
-        if viol <= feas_tol and tf < best[0]:
-            best[0], best[1] = tf, x.copy()
-        return tf, 0.5 * float(x @ x) * s * s, infeas
-
     t_unit = float(np.sqrt(man.inertia_scale / man.torque_max))
     phase_start = time.monotonic()
     for phase, n_iter in zip(phases, iterations):
@@ -111,28 +135,19 @@ def solve_dfsp(man: SmoothManeuver, alpha0: np.ndarray | None = None, *,
             vals = measure(x)
             return vals[obj_index] / ref + vals[2] / state.eps
 
-        z = merit(state.x)
-        done = 0
-        for done in range(1, n_iter + 1):  # noqa: B007 - the count is reported after the loop
-            z = _sweep(state, merit, z, gamma, delta, theta)
-            if state.steps.max() <= state.eps ** p:
-                state.eps *= theta
-                z = merit(state.x)
-            if state.steps.max() < step_min:
-                break
-            if phase_end is not None and time.monotonic() > phase_end:
-                break
+        done = _phase(state, merit, n_iter, phase_end, gamma=gamma, delta=delta, theta=theta, p=p,
+                      step_min=step_min)
         phase_start = time.monotonic()
         tf, energy, infeas = measure(state.x)
         history.append({"phase": phase, "iterations": done, "tf": tf, "energy": energy, "infeasibility": infeas,
-                        "eps": state.eps, "best_feasible_tf": best[0]})
+                        "eps": state.eps, "best_feasible_tf": measure.best_tf})
         if deadline is not None and time.monotonic() > deadline:
             stopped = True
             break
-    if best[1] is None:
-        return _result(man, state.x * s, Status.BUDGET_EXPIRED if stopped else Status.FAILED,
+    if measure.best_x is None:
+        return _result(man, state.x * measure.scale, Status.BUDGET_EXPIRED if stopped else Status.FAILED,
                        "no feasible point found within the iterations/time budget", t0, feas_tol,
-                       evaluations=evals, phases=history)
+                       evaluations=measure.evaluations, phases=history)
     status = Status.BUDGET_EXPIRED if stopped else Status.FEASIBLE
-    return _result(man, best[1] * s, status, "best feasible point of the last MMT phases", t0, feas_tol,
-                   evaluations=evals, phases=history)
+    return _result(man, measure.best_x * measure.scale, status, "best feasible point of the last MMT phases", t0,
+                   feas_tol, evaluations=measure.evaluations, phases=history)

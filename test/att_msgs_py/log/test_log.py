@@ -7,7 +7,6 @@ swift_demo spacecraft, states and commands at 10 Hz.
 """
 from __future__ import annotations
 
-import math
 from pathlib import Path
 
 import numpy as np
@@ -15,14 +14,7 @@ import pytest
 
 from att_msgs_py.log import LogWriter, iter_records, read_log
 from att_sim import rotations as rot
-
-FIXTURE = Path(__file__).parents[2] / "data" / "swift_short.mcap"   # the regression log (see data/make_fixture.py)
-TOPIC_TYPES = {"/clock": "rosgraph_msgs/msg/Clock", "/spacecraft/state": "att_msgs/msg/SpacecraftState",
-               "/actuator/command": "att_msgs/msg/ActuatorCommand",
-               "/controller/status": "att_msgs/msg/ControllerStatus", "/planner/plans": "att_msgs/msg/ManeuverPlan"}
-STATE_FIELDS = {"header.stamp", "header.frame_id", "body_frame_id", "attitude", "body_rate", "wheel_speeds",
-                "wheel_torques", "magnetic_field_body", "dipole", "applied_torque", "position", "command_timeout"}
-GOAL = rot.from_axis_angle([0, 1, 0], math.radians(-45))      # the fixture's maneuver (make_fixture.py)
+from helpers.regression_log import FIXTURE, GOAL, STATE_FIELDS, TOPIC_TYPES
 
 
 @pytest.fixture(scope="module")

@@ -7,18 +7,14 @@ import subprocess
 import sys
 import threading
 import time
-from pathlib import Path
 
 import numpy as np
 import pytest
 
 from att_msgs_py.log import read_log
+from helpers.regression_log import FIXTURE, TOPIC_TYPES
 
 pytestmark = pytest.mark.ros
-FIXTURE = Path(__file__).parents[2] / "data" / "swift_short.mcap"   # the regression log (see data/make_fixture.py)
-TOPIC_TYPES = {"/clock": "rosgraph_msgs/msg/Clock", "/spacecraft/state": "att_msgs/msg/SpacecraftState",
-               "/actuator/command": "att_msgs/msg/ActuatorCommand",
-               "/controller/status": "att_msgs/msg/ControllerStatus", "/planner/plans": "att_msgs/msg/ManeuverPlan"}
 
 
 @pytest.fixture(scope="module")

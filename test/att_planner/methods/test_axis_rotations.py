@@ -1,7 +1,6 @@
 """The λ-rotation baselines: eigenaxis bang-bang and the constrained rotation axis, verified."""
 import numpy as np
 import pytest
-from truth import truth_check
 
 from att_msgs_py.types import Status
 from att_planner.methods.constrained_axis import plan_constrained_axis
@@ -9,6 +8,7 @@ from att_planner.methods.eigenaxis import plan_eigenaxis
 from att_planner.problem import ManeuverProblem
 from att_sim import rotations as rot
 from att_sim.dynamics import Spacecraft
+from helpers.truth import truth_check
 
 
 def test_constrained_axis_rides_a_cone_and_verifies(swift_plan):

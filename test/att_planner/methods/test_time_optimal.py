@@ -7,7 +7,6 @@ from dataclasses import replace
 
 import numpy as np
 import pytest
-from truth import truth_check
 
 from att_msgs_py.types import Cone, Status
 from att_planner import methods
@@ -16,6 +15,7 @@ from att_planner.methods.eigenaxis import plan_eigenaxis
 from att_planner.methods.time_optimal import plan_time_optimal
 from att_planner.reference.time_optimal_cases import case_problem
 from att_sim import rotations as rot
+from helpers.truth import truth_check
 
 VALID = (Status.OPTIMAL, Status.FEASIBLE)
 

@@ -8,7 +8,6 @@ from dataclasses import replace
 
 import numpy as np
 import pytest
-from maneuver_requests import EARTH, request, validate
 
 from att_msgs_py.errors import ErrorCode
 from att_msgs_py.types import Status
@@ -17,6 +16,7 @@ from att_planner.service.planning import plan_maneuver, run_method
 from att_planner.service.worker import run_isolated, warm_up
 from att_planner.verification import TOLERANCES
 from att_sim import rotations as rot
+from helpers.maneuver_requests import EARTH, request, validate
 
 
 @pytest.fixture(scope="module", autouse=True)
@@ -25,7 +25,7 @@ def fork_server():
 
 
 def misbehaving(function: str) -> Method:
-    return Method(function, "misbehaving_methods", function, "test")
+    return Method(function, "helpers.misbehaving_methods", function, "test")
 
 
 @pytest.mark.parametrize("function", ["plan_ignores_deadline", "plan_crashes", "plan_raises"])

@@ -5,11 +5,11 @@ import math
 
 import numpy as np
 import pytest
-from maneuver_requests import INF, NAN, request, validate
 
 from att_msgs_py.errors import ErrorCode, RequestError
 from att_planner.service.requests import MAX_CONES
 from att_sim import rotations as rot
+from helpers.maneuver_requests import INF, NAN, request, validate
 
 BAD_REQUESTS = {
     # attitudes

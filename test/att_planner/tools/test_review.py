@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import json
 import math
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -16,14 +15,7 @@ from att_planner.tools.review import extract_run, settling_time, summarize
 from att_planner.tools.review import main as review_main
 from att_sim import rotations as rot
 from att_sim import scenario as scen
-
-FIXTURE = Path(__file__).parents[2] / "data" / "swift_short.mcap"   # the regression log (see data/make_fixture.py)
-TOPIC_TYPES = {"/clock": "rosgraph_msgs/msg/Clock", "/spacecraft/state": "att_msgs/msg/SpacecraftState",
-               "/actuator/command": "att_msgs/msg/ActuatorCommand",
-               "/controller/status": "att_msgs/msg/ControllerStatus", "/planner/plans": "att_msgs/msg/ManeuverPlan"}
-STATE_FIELDS = {"header.stamp", "header.frame_id", "body_frame_id", "attitude", "body_rate", "wheel_speeds",
-                "wheel_torques", "magnetic_field_body", "dipole", "applied_torque", "position", "command_timeout"}
-GOAL = rot.from_axis_angle([0, 1, 0], math.radians(-45))      # the fixture's maneuver (make_fixture.py)
+from helpers.regression_log import FIXTURE, GOAL, TOPIC_TYPES
 
 
 @pytest.fixture(scope="module")

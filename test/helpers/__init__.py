@@ -1,0 +1,1 @@
+"""Test helpers: shared data and the modules child processes import by name."""

@@ -1,0 +1,16 @@
+"""The regression log ``test/data/swift_short.mcap`` and what it holds.
+
+Recorded by the suite (``test/data/make_fixture.py`` regenerates it when the format changes on
+purpose): a 45° keep-out maneuver of the swift_demo spacecraft, states and commands at 10 Hz.
+"""
+import math
+from pathlib import Path
+
+from att_msgs_py import topics
+from att_sim import rotations as rot
+
+FIXTURE = Path(__file__).parents[1] / "data" / "swift_short.mcap"
+TOPIC_TYPES = dict(topics.RECORDED)
+STATE_FIELDS = {"header.stamp", "header.frame_id", "body_frame_id", "attitude", "body_rate", "wheel_speeds",
+                "wheel_torques", "magnetic_field_body", "dipole", "applied_torque", "position", "command_timeout"}
+GOAL = rot.from_axis_angle([0, 1, 0], math.radians(-45))      # the fixture's maneuver (make_fixture.py)
