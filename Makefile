@@ -48,7 +48,7 @@ test-fast: lint
 
 lint: setup
 	$(PREFIX)/bin/ruff check .
-	$(PREFIX)/bin/lint-imports
+	$(PREFIX)/bin/lint-imports --no-logo --no-cache
 
 demo: setup
 	$(PREFIX)/bin/att-demo

@@ -105,7 +105,7 @@ def dipole_field_components(orbit: OrbitParams, r_hat: tuple, m_hat, dipole: Dip
 
     ``r_hat`` is a tuple of component arrays, ``m_hat`` a 3-sequence (scalars or arrays). This is the
     one field routine: :func:`field_inertial` and the batch simulator of
-    :mod:`att_planner.gain_tuning` both call it.
+    :mod:`att_planner.tuning` both call it.
     """
     k = dipole.strength / orbit.radius**3
     rx, ry, rz = r_hat

@@ -36,7 +36,8 @@ class ProgressBar:
         eta = elapsed * (1.0 - fraction) / fraction if fraction > 0 else float("nan")
         filled = int(round(self.width * fraction))
         eta_s = "--" if not np.isfinite(eta) else f"{eta:5.0f}s"
-        return f"[{'#' * filled}{'-' * (self.width - filled)}] {100 * fraction:3.0f}% {elapsed:5.0f}s ETA {eta_s} {text}"
+        bar = f"[{'#' * filled}{'-' * (self.width - filled)}]"
+        return f"{bar} {100 * fraction:3.0f}% {elapsed:5.0f}s ETA {eta_s} {text}"
 
     def update(self, fraction: float, text: str = ""):
         self.stream.write("\r" + self.line(fraction, text))

@@ -33,13 +33,37 @@ The paper's initial conditions, gains and figures are in :mod:`att_planner.refer
 the callers pass them in (``tune_fixed(h, ...)``, ``tune_robust(seeds=...)``).
 """
 from att_planner.tuning.evaluation import BatchEvaluator, DaskExecutor, ProcessExecutor, SerialExecutor, make_executor
-from att_planner.tuning.minmax import (INNER_METHODS, TuningResult, WorstCase, distinct_worst, thorough_worst_case,
-                                       tune_fixed, tune_robust, worst_case)
+from att_planner.tuning.minmax import (
+    INNER_METHODS,
+    TuningResult,
+    WorstCase,
+    distinct_worst,
+    thorough_worst_case,
+    tune_fixed,
+    tune_robust,
+    worst_case,
+)
 from att_planner.tuning.search import DirectSearch, SearchResult, direct_batch, direct_scipy, sdbox_batch
-from att_planner.tuning.settling import (ABOVE, CAPPED, DROPPED, GAIN_BOUNDS, H_LOWER, H_NAMES, H_UPPER,
-                                         LOG_GAIN_BOUNDS, SETTLED, STATUS_NAMES, MagnetorquerCase, SettlingResult,
-                                         SimSettings, initial_states, multistart_points, propagate, simulate_settling,
-                                         truth_settling_time)
+from att_planner.tuning.settling import (
+    ABOVE,
+    CAPPED,
+    DROPPED,
+    GAIN_BOUNDS,
+    H_LOWER,
+    H_NAMES,
+    H_UPPER,
+    LOG_GAIN_BOUNDS,
+    SETTLED,
+    STATUS_NAMES,
+    MagnetorquerCase,
+    SettlingResult,
+    SimSettings,
+    initial_states,
+    multistart_points,
+    propagate,
+    simulate_settling,
+    truth_settling_time,
+)
 
 __all__ = [
     "ABOVE", "CAPPED", "DROPPED", "GAIN_BOUNDS", "H_LOWER", "H_NAMES", "H_UPPER", "INNER_METHODS", "LOG_GAIN_BOUNDS",

@@ -7,8 +7,13 @@ from concurrent.futures import ProcessPoolExecutor
 
 import numpy as np
 
-from att_planner.tuning.settling import (MagnetorquerCase, SettlingResult, SimSettings, _simulate_chunk,
-                                         simulate_settling)
+from att_planner.tuning.settling import (
+    MagnetorquerCase,
+    SettlingResult,
+    SimSettings,
+    _simulate_chunk,
+    simulate_settling,
+)
 
 
 class SerialExecutor:

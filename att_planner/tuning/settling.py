@@ -267,7 +267,7 @@ class _SettlingBatch:
     def keep(self, keep: np.ndarray):
         """Shrink the integrated batch to the cases ``keep`` (mask)."""
         self.alive, self.bound = self.alive[keep], self.bound[keep]
-        self.x = np.ascontiguousarray(self.x[:, keep])      # the index returns columns contiguous: rows again
+        self.x = np.ascontiguousarray(self.x[:, keep])   # x[:, mask] is column-major; the model works on rows
         self.last_exit, self.last_loud = self.last_exit[keep], self.last_loud[keep]
         self.model.take(keep)
         self.work = _work(self.x)

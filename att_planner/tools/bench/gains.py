@@ -18,11 +18,11 @@ import numpy as np
 
 from att_planner import tuning as gt
 from att_planner.reference.bruni_celani import PUBLISHED_GAINS, PUBLISHED_ICS, PUBLISHED_TABLE
-from att_planner.tools import tune as tune_cli
+from att_planner.tools import tune
 
 
 def configure(parser):
-    tune_cli.add_tuning_options(parser)
+    tune.add_tuning_options(parser)
     parser.add_argument("--check-dt", type=float, default=5.0, help="reference step of the re-checks (s)")
     parser.add_argument("--check-samples", type=int, default=1024, help="Sobol points of the thorough check")
     parser.add_argument("--truth-dt", type=float, default=1.0, help="step of the truth-path check (s)")
@@ -37,7 +37,7 @@ def _fmt(v, digits=3):
 
 def run(args) -> dict:
     case = gt.MagnetorquerCase()
-    res = tune_cli.run_tuning(args, tune_cli.ProgressBar())
+    res = tune.run_tuning(args, tune.ProgressBar())
     ref = gt.SimSettings(dt=args.check_dt, cap_orbits=12.0)
     rows = [("ours", res.kp, res.kd)]
     rows += [(name, *PUBLISHED_GAINS[name]) for name in
@@ -74,7 +74,8 @@ def run(args) -> dict:
 
     print(f"\ngains ({args.mode}): search step {args.dt} s, margin {args.margin}, checks at {args.check_dt} s, "
           f"truth path at {args.truth_dt} s; t_s in orbits (period {case.period:.1f} s)")
-    head = f"{'gains':24s} {'kp':>12s} {'kd':>14s} {'IC(20)':>13s} {'IC(22)':>13s} {'IC(23)':>13s} {'thorough worst':>16s} {'time s':>10s}"
+    head = (f"{'gains':24s} {'kp':>12s} {'kd':>14s} {'IC(20)':>13s} {'IC(22)':>13s} {'IC(23)':>13s} "
+            f"{'thorough worst':>16s} {'time s':>10s}")
     print(head)
     print("-" * len(head))
     for i, (name, a, b) in enumerate(rows):
