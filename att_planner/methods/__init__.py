@@ -9,6 +9,8 @@ problem (and are verified), the others are passed to the function.
 
 A new method: write ``plan_<name>(problem, **options) -> Plan`` in a module of this package and
 add an entry to :data:`REGISTRY` (its options, ranges and, if some combinations cannot run, a hook).
+Entries travel to the planner's child processes, so they must pickle: hooks are module-level
+functions, never lambdas.
 """
 from __future__ import annotations
 
@@ -42,8 +44,9 @@ class Method:
     options: dict = field(default_factory=dict)
     fixed: dict = field(default_factory=dict)     # keyword arguments always passed
     cheap: bool = False                           # closed form: run in-process, no child process
-    check: Callable[[dict], str | None] | None = None   # combinations the method cannot run ...
-    combined: tuple = ()                                # ... of these options
+    # combinations the method cannot run: check(options with ``fixed``) -> why, of the ``combined`` options
+    check: Callable[[dict], str | None] | None = None
+    combined: tuple = ()
 
     def load(self) -> Callable:
         return getattr(importlib.import_module(self.module), self.function)
@@ -65,7 +68,7 @@ class Method:
             if spec.integer and value != int(value):
                 raise RequestError(ErrorCode.INVALID_OPTION, f"option {spec.label(name)} = {value} must be an integer")
             out[name] = int(value) if spec.integer else value
-        why = self.check(out) if self.check is not None else None
+        why = self.check({**out, **self.fixed}) if self.check is not None else None
         if why:
             raise RequestError(ErrorCode.INVALID_OPTION, f"method '{self.name}' cannot run these options: {why}")
         return out
@@ -82,6 +85,7 @@ class Method:
 
 
 def _slepian_check(options: dict) -> str | None:
+    """:func:`att_planner.methods.slepian.planner.option_problem` (``options["method"]``: the variant)."""
     from att_planner.methods.slepian.planner import option_problem
     return option_problem(options)
 
@@ -93,7 +97,7 @@ def _time_optimal_check(options: dict) -> str | None:
 
 def _slepian(variant: str, description: str) -> Method:
     return Method(variant, "att_planner.methods.slepian.planner", "plan_slepian", description, SLEPIAN_OPTIONS,
-                  fixed={"method": variant}, check=lambda o: _slepian_check(dict(o, method=variant)),
+                  fixed={"method": variant}, check=_slepian_check,
                   combined=("M", "N", "W"))
 
 

@@ -74,7 +74,10 @@ class PlannerNode(Node):
         except RequestError as err:
             return self.refuse(response, err, "request")
         runner = run_method if valid.method.cheap else run_isolated
-        outcome = plan_maneuver(valid, self._tolerances, self._cone_padding, runner)
+        try:
+            outcome = plan_maneuver(valid, self._tolerances, self._cone_padding, runner)
+        except Exception as exc:  # a fault of the service itself is answered, never left hanging
+            outcome = self.internal_error(exc)
         self.answer(response, outcome, valid.spacecraft, f"{valid.method.name}",
                     sensor_axis=valid.problem.sensor_axis, cones=valid.problem.cones)
         return response
@@ -95,12 +98,20 @@ class PlannerNode(Node):
         def runner(problem, wait):
             return call_isolated(plan_schedule, (problem,), {}, wait, on_death=lambda message: message)
 
-        outcome = plan_schedule_request(valid, self._tolerances, runner=runner)
+        try:
+            outcome = plan_schedule_request(valid, self._tolerances, runner=runner)
+        except Exception as exc:  # a fault of the service itself is answered, never left hanging
+            outcome = self.internal_error(exc)
         if outcome.code == ErrorCode.OK:
             response.order = [p.name for p in outcome.plan.passages]
             response.passage_times = [float(p.time) for p in outcome.plan.passages]
         self.answer(response, outcome, valid.spacecraft_name, f"schedule of {len(valid.problem.targets)} targets")
         return response
+
+    def internal_error(self, exc: Exception) -> PlanOutcome:
+        self.get_logger().error(f"planning failed unexpectedly: {type(exc).__name__}: {exc}")
+        return PlanOutcome(ErrorCode.SOLVER_FAILED, f"internal error while planning: {type(exc).__name__}: {exc}",
+                           None)
 
     def refuse(self, response, err: RequestError, what: str):
         self.get_logger().warning(f"{what} rejected [{int(err.code)} {err.code.name}]: {err.message}")

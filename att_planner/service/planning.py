@@ -69,7 +69,7 @@ def run_method(method: Method, problem: ManeuverProblem, options: dict, wait: fl
     start = time.perf_counter()
     try:
         plan = method.load()(problem, **method.fixed, **options)
-    except Exception as exc:
+    except Exception as exc:  # any solver failure is reported, the node keeps serving
         plan = Plan(method=method.name, status=Status.FAILED, message=f"{type(exc).__name__}: {exc}",
                     stats={"exception": repr(exc)})
     plan.wall_time = plan.wall_time or time.perf_counter() - start

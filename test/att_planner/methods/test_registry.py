@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import itertools
 import math
+import pickle
 
 import numpy as np
 import pytest
@@ -37,10 +38,11 @@ def request(method: str, options: dict) -> ManeuverRequest:
                            option_values=[float(v) for v in options.values()])
 
 
-def test_every_method_has_its_ranges_in_the_registry():
+def test_every_method_has_its_ranges_in_the_registry_and_travels_to_child_processes():
     assert [m.name for m in methods.REGISTRY][:2] == ["slepian_minimum_time", "time_optimal"]
     for m in methods.REGISTRY:
         assert callable(m.load())
+        assert pickle.loads(pickle.dumps(m)) == m       # the planner sends it to a child solver
         for name, spec in m.options.items():
             assert spec.low <= spec.high and (not spec.integer or float(spec.low).is_integer()), (m.name, name)
 
