@@ -16,7 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from att_msgs_py.types import ControlKind, Plan, Verification
+from att_msgs_py.types import ControlKind, Interpolation, Plan, Verification
 from att_planner.cones import margins
 from att_planner.problem import ManeuverProblem
 from att_sim import dynamics as dyn
@@ -52,7 +52,7 @@ def measure(problem: ManeuverProblem, plan: Plan, traj: dyn.Trajectory) -> Verif
     sc = problem.spacecraft
     wheels = plan.control_kind == ControlKind.WHEEL_TORQUE
     controls = np.asarray(plan.torque, float).reshape(len(plan.t), -1)
-    applied = controls[:-1] if plan.interpolation == "zoh" and len(controls) > 1 else controls
+    applied = controls[:-1] if plan.interpolation == Interpolation.ZOH and len(controls) > 1 else controls
     limit = sc.wheel_torque_max if wheels else sc.body_torque_max
     m = margins(traj.q, problem.sensor_axis, problem.cones)
     if problem.sensor_target is None:

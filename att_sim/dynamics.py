@@ -27,6 +27,7 @@ from functools import cached_property
 
 import numpy as np
 
+from att_msgs_py.types import ControlKind, Interpolation
 from att_sim import rotations as rot
 
 
@@ -80,9 +81,7 @@ def effective_wheel_torque(sc: Spacecraft, wheel_speed: np.ndarray, u: np.ndarra
 
 
 def external_torque(sc: Spacecraft, inputs: Inputs, q: np.ndarray) -> np.ndarray:
-    tau = np.zeros(3)
-    if inputs.body_torque is not None:
-        tau = tau + np.asarray(inputs.body_torque, float)
+    tau = np.zeros(3) if inputs.body_torque is None else np.array(inputs.body_torque, float)
     if inputs.dipole is not None and inputs.field_body is not None:
         tau = tau + rot.cross(inputs.dipole, inputs.field_body)
     if inputs.gravity_gradient is not None:
@@ -179,8 +178,8 @@ def simulate_profile(
     t_knots: np.ndarray,
     values: np.ndarray,
     *,
-    kind: str = "body_torque",
-    interpolation: str = "zoh",
+    kind: str = ControlKind.BODY_TORQUE,
+    interpolation: str = Interpolation.ZOH,
     max_step: float | None = None,
     t_end: float | None = None,
 ) -> Trajectory:
@@ -198,8 +197,9 @@ def simulate_profile(
     if max_step is None:
         dts = np.diff(grid)
         max_step = max((grid[-1] - grid[0]) / 400.0, 1e-6) if len(dts) else 1.0
-    if interpolation not in ("zoh", "linear"):
+    if interpolation not in tuple(Interpolation):
         raise ValueError(f"unknown interpolation '{interpolation}' (use 'zoh' or 'linear')")
+    kind = str(ControlKind(kind))           # the Inputs field the values go to
     ts, xs = [grid[0]], [np.array(x0, float)]
     x = np.array(x0, float)
     for a, b in zip(grid[:-1], grid[1:]):
@@ -208,10 +208,10 @@ def simulate_profile(
         k = min(np.searchsorted(t_knots, a, side="right") - 1, len(t_knots) - 1)
         u_a = values[k] if a <= t_knots[-1] else np.zeros(values.shape[1])
         slope = ((values[k + 1] - values[k]) / (t_knots[k + 1] - t_knots[k])
-                 if interpolation == "linear" and k + 1 < len(t_knots) else np.zeros_like(u_a))
+                 if interpolation == Interpolation.LINEAR and k + 1 < len(t_knots) else np.zeros_like(u_a))
         for i in range(n):
             t0 = a + i * h
-            if interpolation == "zoh":
+            if interpolation == Interpolation.ZOH:
                 x = step(sc, x, Inputs(**{kind: u_a}), h)
             else:       # linear: the input evaluated at the RK4 stage times
                 x = renormalised(rk4(lambda tt, xx, u=u_a, du=slope, tk=t_knots[k]:

@@ -28,8 +28,9 @@ _PREV_AXIS = (2, 0, 1)
 def cross(a: np.ndarray, b: np.ndarray, axis: int = -1) -> np.ndarray:
     """``a × b`` along ``axis``, broadcasting (cheaper than ``np.cross`` on small stacks and on
     component-first batches; two single vectors take the scalar formula, the dynamics' hot path)."""
-    if np.ndim(a) == 1 and np.ndim(b) == 1:
-        return np.array([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]])
+    if len(np.shape(a)) == 1 and len(np.shape(b)) == 1:
+        (a0, a1, a2), (b0, b1, b2) = np.asarray(a, float).tolist(), np.asarray(b, float).tolist()
+        return np.array([a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0])
     a1, a2 = np.take(a, _NEXT_AXIS, axis), np.take(a, _PREV_AXIS, axis)
     b1, b2 = np.take(b, _NEXT_AXIS, axis), np.take(b, _PREV_AXIS, axis)
     return a1 * b2 - a2 * b1

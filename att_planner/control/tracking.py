@@ -15,7 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from att_msgs_py.types import Plan
+from att_msgs_py.types import Interpolation, Plan
 from att_sim import rotations as rot
 from att_sim.dynamics import Spacecraft
 
@@ -36,7 +36,7 @@ def reference(t_knots, q, omega, torque, interpolation: str, t: float) -> Refere
     s = (t - t_knots[k]) / (t_knots[k + 1] - t_knots[k])
     q_ref = rot.slerp(q[k], q[k + 1], s)
     w_ref = (1 - s) * omega[k] + s * omega[k + 1]
-    tau = torque[k] if interpolation == "zoh" else (1 - s) * torque[k] + s * torque[k + 1]
+    tau = torque[k] if interpolation == Interpolation.ZOH else (1 - s) * torque[k] + s * torque[k + 1]
     return Reference(q_ref, w_ref, tau)
 
 

@@ -5,7 +5,7 @@ import time
 
 import numpy as np
 
-from att_msgs_py.types import Plan, Status
+from att_msgs_py.types import ControlKind, Interpolation, Plan, Status
 from att_planner.cones import blocked_endpoint
 from att_planner.methods.slepian.dfsp import solve_dfsp
 from att_planner.methods.slepian.model import (
@@ -152,8 +152,8 @@ def physical_profile(man: SmoothManeuver, alpha: np.ndarray, spacecraft: Spacecr
         omega[1:] = ev.omega / tf
     else:
         x0 = dyn.initial_state(spacecraft, rot.from_dcm(man.R_initial))
-        traj = dyn.simulate_profile(spacecraft, x0, t, torque, kind="body_torque", interpolation="zoh",
-                                    max_step=tf / N)
+        traj = dyn.simulate_profile(spacecraft, x0, t, torque, kind=ControlKind.BODY_TORQUE,
+                                    interpolation=Interpolation.ZOH, max_step=tf / N)
         q, omega = traj.q, traj.omega
     return {"t": t, "torque": torque, "q": q, "omega": omega, "tf": tf, "evaluation": ev}
 

@@ -220,7 +220,7 @@ def _routes(problem: ManeuverProblem, s: Scaling, starts: int, warm_starts, smoo
 
 
 def plan_time_optimal(problem: ManeuverProblem, *, intervals: int = DEFAULT_INTERVALS, max_intervals: int | None = None,
-                      starts: int = 6, refine_rounds: int = 3, interpolation: str = "zoh",
+                      starts: int = 6, refine_rounds: int = 3, interpolation: str = Interpolation.ZOH,
                       cone_margin_deg: float = 0.05, warm_starts: tuple = (),
                       smooth_warm_start: bool = False, explore_tol: float = 1e-5, tol: float = 1e-7,
                       max_iter: int = 400, verify_reserve: float = 1.0) -> Plan:
@@ -259,10 +259,10 @@ def plan_time_optimal(problem: ManeuverProblem, *, intervals: int = DEFAULT_INTE
     lap = time.monotonic()
     routes = _routes(problem, s, starts, warm_starts, smooth_warm_start, seconds)
     tf_scale = max(r.tf_estimate for r in routes if np.isfinite(r.tf_estimate))
-    run = _Solve(problem, s, "constant" if interpolation == "zoh" else "linear", np.deg2rad(cone_margin_deg),
-                 (1e-2 * tf_scale, 10.0 * tf_scale), tol, max_iter, max_intervals,
-                 None if problem.deadline is None else problem.deadline - verify_reserve, interpolation,
-                 seconds=seconds)
+    control = "constant" if interpolation == Interpolation.ZOH else "linear"
+    run = _Solve(problem, s, control, np.deg2rad(cone_margin_deg), (1e-2 * tf_scale, 10.0 * tf_scale), tol, max_iter,
+                 max_intervals, None if problem.deadline is None else problem.deadline - verify_reserve,
+                 interpolation, seconds=seconds)
     tr, solved, start_log = _explore(run, routes, intervals, explore_tol)
     stats = {"starts": start_log, "time_unit": s.tu, "seconds": seconds}
     seconds["routes_and_starts"], lap = time.monotonic() - lap, time.monotonic()

@@ -6,7 +6,7 @@ from pathlib import Path
 
 import numpy as np
 
-from att_msgs_py.types import Plan
+from att_msgs_py.types import ControlKind, Interpolation, Plan
 from att_planner.cones import boresight, margins
 from att_planner.control import tracking
 from att_planner.tools.review.run import MODE_NAMES, Run, reference_error
@@ -151,9 +151,9 @@ def plot_rates(ax, run: Run) -> None:
 def plot_body_torque(ax, run: Run, sc: Spacecraft | None) -> None:
     for i in range(3):
         ax.plot(run.t, run.body_torque[:, i], lw=1.0, label=f"applied {AXES[i]}")
-    if run.kind == "maneuver" and run.plan.control_kind != "wheel_torque":
+    if run.kind == "maneuver" and run.plan.control_kind != ControlKind.WHEEL_TORQUE:
         ax.set_prop_cycle(None)
-        step = "post" if run.plan.interpolation == "zoh" else None
+        step = "post" if run.plan.interpolation == Interpolation.ZOH else None
         for i in range(3):
             if step:
                 ax.step(run.plan.t, run.plan.torque[:, i], where="post", ls="--", lw=0.8)
