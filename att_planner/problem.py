@@ -50,6 +50,3 @@ class ManeuverProblem:
 
     def time_left(self) -> float:
         return np.inf if self.deadline is None else self.deadline - time.monotonic()
-
-    def expired(self) -> bool:
-        return self.deadline is not None and time.monotonic() > self.deadline

@@ -105,7 +105,7 @@ class PlannerNode(Node):
         if outcome.code == ErrorCode.OK:
             response.order = [p.name for p in outcome.plan.passages]
             response.passage_times = [float(p.time) for p in outcome.plan.passages]
-        self.answer(response, outcome, valid.spacecraft_name, f"schedule of {len(valid.problem.targets)} targets")
+        self.answer(response, outcome, valid.spacecraft, f"schedule of {len(valid.problem.targets)} targets")
         return response
 
     def internal_error(self, exc: Exception) -> PlanOutcome:

@@ -157,7 +157,7 @@ def validate_maneuver(req: ManeuverRequest, *, frame_id: str, default_spacecraft
 @dataclass
 class ValidSchedule:
     problem: ManeuverProblem         # targets, start, end, rate bound; no deadline (the service sets it)
-    spacecraft_name: str
+    spacecraft: str                  # its configuration name
     time_budget: float
 
 
