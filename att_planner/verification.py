@@ -71,15 +71,13 @@ def measure(problem: ManeuverProblem, plan: Plan, traj: dyn.Trajectory) -> Verif
         final_rate=float(np.linalg.norm(traj.omega[-1])),
         min_cone_margin=float(m.min()) if m.size else math.inf,
         cone_margins=[float(v) for v in m.min(axis=0)] if m.size else [],
-        torque_ratio=_ratio(np.abs(applied).max() if applied.size else 0.0, limit),
-        wheel_speed_ratio=_ratio(np.abs(traj.wheel_speed).max() if traj.wheel_speed.size else 0.0,
-                                 sc.wheel_speed_max),
+        torque_ratio=_ratio(_peak(applied), limit),
+        wheel_speed_ratio=_ratio(_peak(traj.wheel_speed), sc.wheel_speed_max),
         rate_max=float(np.linalg.norm(traj.omega, axis=1).max()),
         dense_samples=len(traj.t),
         duration=plan.duration,
-        body_rate_ratio=_ratio(np.abs(traj.omega).max(), problem.rate_max),
-        wheel_momentum_ratio=_ratio(np.abs(_wheel_momentum(sc, traj, wheels)).max(), problem.wheel_momentum_max)
-        if math.isfinite(problem.wheel_momentum_max) else 0.0,
+        body_rate_ratio=_ratio(_peak(traj.omega), problem.rate_max),
+        wheel_momentum_ratio=_ratio(_peak(_wheel_momentum(sc, traj, wheels)), problem.wheel_momentum_max),
         passage_attitude_errors=passage_errors,
         passage_rates_z=passage_rates,
     )
@@ -107,6 +105,10 @@ def rejection(ver: Verification, tol: Tolerances = TOLERANCES) -> str | None:
             return (f"passage {k} missed: attitude error {math.degrees(err):.3f} deg, "
                     f"|w_z| {rate:.3g} rad/s")
     return None
+
+
+def _peak(values: np.ndarray) -> float:
+    return float(np.abs(values).max()) if np.size(values) else 0.0
 
 
 def _ratio(peak: float, limit: float) -> float:
