@@ -37,6 +37,9 @@ class ControlMode(IntEnum):
     SAFE = 3
 
 
+CONTROL_MODES = tuple(int(m) for m in ControlMode)   # the values a command or set_mode may carry
+
+
 class ControlKind(StrEnum):
     """What a plan's control samples are: ``att_msgs/ManeuverPlan.control_kind``."""
 
@@ -140,6 +143,11 @@ class Plan:
     @property
     def duration(self) -> float:
         return float(self.t[-1] - self.t[0]) if len(self.t) else 0.0
+
+    @property
+    def order(self) -> list[str]:
+        """The names of the passages, in the order they are flown (a schedule's visiting order)."""
+        return [p.name for p in self.passages]
 
     @property
     def success(self) -> bool:

@@ -71,13 +71,13 @@ def measure(problem: ManeuverProblem, plan: Plan, traj: dyn.Trajectory) -> Verif
         final_rate=float(np.linalg.norm(traj.omega[-1])),
         min_cone_margin=float(m.min()) if m.size else math.inf,
         cone_margins=[float(v) for v in m.min(axis=0)] if m.size else [],
-        torque_ratio=_ratio(_peak(applied), limit),
-        wheel_speed_ratio=_ratio(_peak(traj.wheel_speed), sc.wheel_speed_max),
+        torque_ratio=_ratio(peak_magnitude(applied), limit),
+        wheel_speed_ratio=_ratio(peak_magnitude(traj.wheel_speed), sc.wheel_speed_max),
         rate_max=float(np.linalg.norm(traj.omega, axis=1).max()),
         dense_samples=len(traj.t),
         duration=plan.duration,
-        body_rate_ratio=_ratio(_peak(traj.omega), problem.rate_max),
-        wheel_momentum_ratio=_ratio(_peak(_wheel_momentum(sc, traj, wheels)), problem.wheel_momentum_max),
+        body_rate_ratio=_ratio(peak_magnitude(traj.omega), problem.rate_max),
+        wheel_momentum_ratio=_ratio(peak_magnitude(_wheel_momentum(sc, traj, wheels)), problem.wheel_momentum_max),
         passage_attitude_errors=passage_errors,
         passage_rates_z=passage_rates,
     )
@@ -107,7 +107,8 @@ def rejection(ver: Verification, tol: Tolerances = TOLERANCES) -> str | None:
     return None
 
 
-def _peak(values: np.ndarray) -> float:
+def peak_magnitude(values: np.ndarray) -> float:
+    """Largest ``|value|`` of an array, 0 when it is empty."""
     return float(np.abs(values).max()) if np.size(values) else 0.0
 
 
@@ -120,4 +121,4 @@ def _wheel_momentum(sc: dyn.Spacecraft, traj: dyn.Trajectory, wheels: bool) -> n
     momentum ``G⁺ J ω`` the wheels would hold producing the body torque with zero total momentum."""
     if wheels:
         return sc.wheel_inertia * traj.wheel_speed
-    return traj.omega @ (np.linalg.pinv(sc.wheel_axes) @ sc.inertia).T
+    return traj.omega @ (sc.wheel_axes_pinv @ sc.inertia).T

@@ -56,6 +56,11 @@ class Spacecraft:
     def inertia_inv(self) -> np.ndarray:
         return np.linalg.inv(self.inertia)
 
+    @cached_property
+    def wheel_axes_pinv(self) -> np.ndarray:
+        """``G⁺`` (N, 3): the least-norm wheel quantities that produce a body vector."""
+        return np.linalg.pinv(self.wheel_axes)
+
 
 @dataclass
 class Inputs:

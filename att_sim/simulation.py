@@ -11,7 +11,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from att_msgs_py.types import Command, ControlMode, State
+from att_msgs_py.types import CONTROL_MODES, Command, ControlMode, State
 from att_sim import dynamics as dyn
 from att_sim import environment as env
 from att_sim import rotations as rot
@@ -43,9 +43,8 @@ class Simulation:
 
     def set_command(self, command: Command) -> str | None:
         """Accept a command (None) or say why it is rejected; a rejected command changes nothing."""
-        modes = tuple(int(m) for m in ControlMode)
-        if command.mode not in modes:
-            return f"mode {command.mode} is not one of {modes}"
+        if command.mode not in CONTROL_MODES:
+            return f"mode {command.mode} is not one of {CONTROL_MODES}"
         wheel_torque = np.asarray(command.wheel_torques, float)
         if wheel_torque.size not in (0, self.sc.n_wheels):
             return f"wheel_torques has {wheel_torque.size} entries, the spacecraft has {self.sc.n_wheels} wheels"

@@ -22,6 +22,7 @@ import numpy as np
 
 from att_msgs_py.errors import ErrorCode
 from att_msgs_py.types import (
+    CONTROL_MODES,
     Command,
     ControlKind,
     ControllerStatus,
@@ -38,8 +39,6 @@ from att_planner.control.magnetorquer import dipole_command
 from att_sim import rotations as rot
 from att_sim.dynamics import Spacecraft
 
-MODES = tuple(int(m) for m in ControlMode)
-
 
 @dataclass(frozen=True)
 class ControllerConfig:
@@ -55,6 +54,11 @@ class ControllerConfig:
     safe_kd: float = 10.0              # N m s / rad, rate damping of the safe mode
     feedback_period: float = 0.5       # s of sim time between action feedbacks
     max_cached_plans: int = 50
+
+    @property
+    def feedback_every(self) -> int:
+        """Control steps between action feedbacks."""
+        return max(1, round(self.feedback_period / self.control_period))
 
 
 @dataclass
@@ -108,8 +112,8 @@ class Controller:
 
     def set_mode(self, mode: int) -> tuple[ErrorCode, str, ManeuverResult | None]:
         """Change the mode; the result of a maneuver this aborts comes back too."""
-        if mode not in MODES:
-            return ErrorCode.INVALID_MODE, f"mode {mode} is not one of {MODES} (ActuatorCommand.MODE_*)", None
+        if mode not in CONTROL_MODES:
+            return ErrorCode.INVALID_MODE, f"mode {mode} is not one of {CONTROL_MODES} (ActuatorCommand.MODE_*)", None
         if mode == ControlMode.PLAN_TRACKING:
             return ErrorCode.INVALID_MODE, "plan tracking starts with the execute action, not with set_mode", None
         if self.maneuver is not None and mode != ControlMode.SAFE:
@@ -203,12 +207,12 @@ class Controller:
         out.command.wheel_torques = u
         out.command.plan_id = out.status.plan_id = plan.plan_id
         m.ticks += 1
-        if m.ticks % max(1, round(self.config.feedback_period / self.config.control_period)) == 0:
+        if m.ticks % self.config.feedback_every == 0:
             span = max(plan.duration + self.config.settle_time, 1e-9)
             out.feedback = ManeuverFeedback(
                 elapsed=float(elapsed), progress=float(min(1.0, elapsed / span)),
                 attitude_error=float(rot.angle_between(s.q, ref.q)),
-                min_cone_margin=min_margin(s.q, plan.sensor_axis, plan.cones) if plan.cones else math.inf)
+                min_cone_margin=min_margin(s.q, plan.sensor_axis, plan.cones))
         if cancel_requested:
             out.result = self.abort("cancelled")
             return
@@ -218,13 +222,14 @@ class Controller:
             out.status.message = "maneuver complete; holding the final attitude"
 
     def _end(self, success: bool, code: ErrorCode, message: str) -> ManeuverResult:
-        """Close the running maneuver; its figures are those of the latest state."""
+        """Close the running maneuver; its figures are those of the latest state (there is one:
+        :meth:`start` needs it)."""
         s, plan = self.state, self.maneuver.plan
         result = ManeuverResult(
             success=success, error_code=int(code), message=message,
-            duration=float(s.t - self.maneuver.t0) if s is not None else 0.0,
-            final_attitude_error=float(rot.angle_between(s.q, plan.q[-1])) if s is not None else math.nan,
-            final_rate=float(np.linalg.norm(s.omega)) if s is not None else math.nan)
+            duration=float(s.t - self.maneuver.t0),
+            final_attitude_error=float(rot.angle_between(s.q, plan.q[-1])),
+            final_rate=float(np.linalg.norm(s.omega)))
         self.hold_q = plan.q[-1] if success else None
         self.maneuver = None
         if code == ErrorCode.ABORTED:

@@ -1,7 +1,7 @@
 """Plan tracking law of the controller (no ROS): feedforward plan torque + quaternion PD feedback.
 
-Reference at time t from the plan samples (attitude by slerp, rate and torque by the plan's
-interpolation; :func:`plan_reference` for a :class:`~att_msgs_py.types.Plan`). Body torque demand::
+Reference at time t from the plan samples (:func:`plan_reference`: attitude by slerp, rate and
+torque by the plan's interpolation). Body torque demand::
 
     τ = τ_ff(t) − K_p · 2 sign(e_w) e_v − K_d (ω − ω_ref)      with e = q_ref* ⊗ q
 
@@ -27,8 +27,10 @@ class Reference:
     torque: np.ndarray
 
 
-def reference(t_knots, q, omega, torque, interpolation: str, t: float) -> Reference:
-    """Plan reference at ``t`` (clamped to the plan; after the end: final attitude, zero rate and torque)."""
+def plan_reference(plan: Plan, t: float) -> Reference:
+    """The reference of ``plan`` at ``t`` s from its start (clamped to the plan; after the end:
+    final attitude, zero rate and torque)."""
+    t_knots, q, omega, torque = plan.t, plan.q, plan.omega, plan.torque
     if t >= t_knots[-1]:
         return Reference(q[-1], np.zeros(3), np.zeros(3))
     t = max(t, t_knots[0])
@@ -36,7 +38,7 @@ def reference(t_knots, q, omega, torque, interpolation: str, t: float) -> Refere
     s = (t - t_knots[k]) / (t_knots[k + 1] - t_knots[k])
     q_ref = rot.slerp(q[k], q[k + 1], s)
     w_ref = (1 - s) * omega[k] + s * omega[k + 1]
-    tau = torque[k] if interpolation == Interpolation.ZOH else (1 - s) * torque[k] + s * torque[k + 1]
+    tau = torque[k] if plan.interpolation == Interpolation.ZOH else (1 - s) * torque[k] + s * torque[k + 1]
     return Reference(q_ref, w_ref, tau)
 
 
@@ -49,10 +51,5 @@ def wheel_torques(sc: Spacecraft, body_torque, omega, wheel_speed) -> np.ndarray
     """Motor torques u that put ``body_torque`` on the body (gyroscopic wheel term compensated)."""
     h_w = sc.wheel_axes @ (sc.wheel_inertia * np.asarray(wheel_speed, float))
     demand = np.asarray(body_torque, float) + np.cross(omega, h_w)
-    u = -np.linalg.pinv(sc.wheel_axes) @ demand
+    u = -sc.wheel_axes_pinv @ demand
     return np.clip(u, -sc.wheel_torque_max, sc.wheel_torque_max)
-
-
-def plan_reference(plan: Plan, t: float) -> Reference:
-    """:func:`reference` of a plan at ``t`` s from its start."""
-    return reference(plan.t, plan.q, plan.omega, plan.torque, plan.interpolation, t)

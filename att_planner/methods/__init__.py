@@ -51,6 +51,10 @@ class Method:
     def load(self) -> Callable:
         return getattr(importlib.import_module(self.module), self.function)
 
+    def call(self, problem, **options) -> Plan:
+        """The function on ``problem`` with the ``fixed`` arguments and ``options`` (already validated)."""
+        return self.load()(problem, **self.fixed, **options)
+
     def validate(self, options: dict) -> dict:
         """The options converted (integers as int), or RequestError: unknown name, outside its
         range, not an integer, or a combination the hook refuses."""
@@ -81,7 +85,7 @@ class Method:
     def run(self, problem, **options) -> Plan:
         """Validate ``options`` and plan: the registry's checks, then the function."""
         kwargs, limits = self.split(self.validate(options))
-        return self.load()(replace(problem, **limits), **self.fixed, **kwargs)
+        return self.call(replace(problem, **limits), **kwargs)
 
 
 def _slepian_check(options: dict) -> str | None:

@@ -103,7 +103,7 @@ def _semi_free_goal(problem: ManeuverProblem) -> np.ndarray:
     s = np.asarray(problem.sensor_target, float) / np.linalg.norm(problem.sensor_target)
     axis = np.cross(b0, s)
     if np.linalg.norm(axis) < 1e-12:
-        axis = np.cross(b0, [1.0, 0.0, 0.0]) if abs(b0[0]) < 0.9 else np.cross(b0, [0.0, 1.0, 0.0])
+        axis = rot.orthonormal_basis(b0)[0]          # on the antipode: any axis normal to b0
     angle = np.arccos(np.clip(b0 @ s, -1.0, 1.0))
     return rot.multiply(rot.from_axis_angle(axis, angle), q0)
 

@@ -15,7 +15,7 @@ import time
 import numpy as np
 
 from att_msgs_py.types import Plan, Status
-from att_planner.cones import margins
+from att_planner.cones import min_margin
 from att_planner.methods.axis_rotations import (
     AxisLeg,
     eigenaxis_leg,
@@ -95,8 +95,7 @@ def cone_riding_legs(problem: ManeuverProblem, cone_index: int, side: int, ride_
 def _legs_time(problem: ManeuverProblem, legs: list[AxisLeg]) -> tuple[float, float]:
     """(duration, min cone margin along the path) of a leg sequence, without simulation."""
     t, _, _, _, _, q_dense = leg_profile(problem, legs, pieces_per_half=1)
-    m = margins(q_dense, problem.sensor_axis, problem.cones)
-    return float(t[-1]), float(m.min()) if m.size else np.inf
+    return float(t[-1]), min_margin(q_dense, problem.sensor_axis, problem.cones)
 
 
 def plan_constrained_axis(problem: ManeuverProblem, *, ride_margin_deg: float = 0.5) -> Plan:

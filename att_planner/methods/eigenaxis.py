@@ -20,7 +20,7 @@ import time
 import numpy as np
 
 from att_msgs_py.types import Interpolation, Plan, Status
-from att_planner.cones import margins
+from att_planner.cones import min_margin
 from att_planner.methods.axis_rotations import eigenaxis_leg, goal_attitude, legs_plan, no_torque_limit
 from att_planner.problem import ManeuverProblem
 from att_sim import rotations as rot
@@ -43,7 +43,7 @@ def _rate_limited_duration(problem: ManeuverProblem, axis: np.ndarray, peak_angl
         duration = peak_angle_rate * np.abs(axis).max() / (problem.rate_max * (1 - BOUND_MARGIN))
     sc = problem.spacecraft
     if np.isfinite(problem.wheel_momentum_max) and sc.n_wheels:
-        per_rate = np.abs(np.linalg.pinv(sc.wheel_axes) @ sc.inertia @ axis).max()
+        per_rate = np.abs(sc.wheel_axes_pinv @ sc.inertia @ axis).max()
         duration = max(duration, peak_angle_rate * per_rate / (problem.wheel_momentum_max * (1 - BOUND_MARGIN)))
     return duration
 
@@ -64,7 +64,7 @@ def plan_eigenaxis_smooth(problem: ManeuverProblem, samples: int = 401) -> Plan:
     shape = J @ axis * ddp[:, None] + phi * dp[:, None] ** 2 * np.cross(axis, J @ axis)
     duration = max(np.sqrt(phi * np.abs(shape).max() / tmax), _rate_limited_duration(problem, axis, phi * dp.max()))
     q = rot.multiply(problem.q_initial, rot.from_axis_angle(np.tile(axis, (samples, 1)), phi * p))
-    worst = margins(q, problem.sensor_axis, problem.cones).min() if problem.cones else np.inf
+    worst = min_margin(q, problem.sensor_axis, problem.cones)
     status = Status.OPTIMAL
     message = f"eigenaxis slew of {np.degrees(phi):.2f} deg about body {np.round(axis, 4).tolist()}"
     if worst < 0:

@@ -12,8 +12,9 @@ def quat_mul(p, q):
     return ca.vertcat(pw * qv + qw * pv + ca.cross(pv, qv), pw * qw - ca.dot(pv, qv))
 
 
-def error_vector(q_ref, q):
-    """Vector part of ``q_ref* ⊗ q``: zero iff q = ±q_ref (unit quaternions)."""
+def error_vector(q, q_ref):
+    """Vector part of ``q_ref* ⊗ q``: zero iff q = ±q_ref (unit quaternions); the argument order
+    of :func:`att_sim.rotations.error_vector`, without its sign choice."""
     return q_ref[3] * q[:3] - q[3] * q_ref[:3] - ca.cross(q_ref[:3], q[:3])
 
 

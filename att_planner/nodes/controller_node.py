@@ -38,11 +38,13 @@ class ControllerNode(Node):
         self._scenario = scen.load(self.declare_parameter("scenario", "swift_demo").value)
         sc = self._scenario.spacecraft
         param = parameter_reader(self, self._scenario.node_params.get("controller", {}))
-        tracking_kd = float(param("tracking_kd", 10.0))
+        d = ControllerConfig()
+        tracking_kd = float(param("tracking_kd", d.tracking_kd))
         config = ControllerConfig(
-            control_period=1.0 / float(param("control_rate", 10.0)), settle_time=float(param("settle_time", 20.0)),
-            tracking_kp=float(param("tracking_kp", 0.4)), tracking_kd=tracking_kd,
-            kp=float(param("kp", 2e5)), kd=float(param("kd", 1e8)), m_max=float(param("m_max", sc.dipole_max)),
+            control_period=1.0 / float(param("control_rate", 1.0 / d.control_period)),
+            settle_time=float(param("settle_time", d.settle_time)),
+            tracking_kp=float(param("tracking_kp", d.tracking_kp)), tracking_kd=tracking_kd,
+            kp=float(param("kp", d.kp)), kd=float(param("kd", d.kd)), m_max=float(param("m_max", sc.dipole_max)),
             safe_kd=float(param("safe_kd", tracking_kd)))
         self._core = Controller(sc, config, int(param("initial_mode", ControlMode.IDLE)),
                                 self._scenario.body_frame_id)

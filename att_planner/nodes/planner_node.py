@@ -78,7 +78,7 @@ class PlannerNode(Node):
             outcome = plan_maneuver(valid, self._tolerances, self._cone_padding, runner)
         except Exception as exc:  # a fault of the service itself is answered, never left hanging
             outcome = self.internal_error(exc)
-        self.answer(response, outcome, valid.spacecraft, f"{valid.method.name}",
+        self.answer(response, outcome, valid.spacecraft, valid.method.name,
                     sensor_axis=valid.problem.sensor_axis, cones=valid.problem.cones)
         return response
 
@@ -103,7 +103,7 @@ class PlannerNode(Node):
         except Exception as exc:  # a fault of the service itself is answered, never left hanging
             outcome = self.internal_error(exc)
         if outcome.code == ErrorCode.OK:
-            response.order = [p.name for p in outcome.plan.passages]
+            response.order = outcome.plan.order
             response.passage_times = [float(p.time) for p in outcome.plan.passages]
         self.answer(response, outcome, valid.spacecraft, f"schedule of {len(valid.problem.targets)} targets")
         return response
@@ -127,8 +127,7 @@ class PlannerNode(Node):
             plan.plan_id, plan.frame_id, plan.spacecraft = uuid.uuid4().hex[:12], self._frame_id, spacecraft
             for key, value in context.items():
                 setattr(plan, key, value)
-            if not response.success:
-                plan.verification = None
+            plan.verification = outcome.verification      # a refused plan goes out unverified
             response.plan = convert.plan_msg(plan)
             response.plan.header.stamp = self.get_clock().now().to_msg()
         if response.success:

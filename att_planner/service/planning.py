@@ -17,7 +17,7 @@ import numpy as np
 
 from att_msgs_py.errors import ErrorCode
 from att_msgs_py.types import Cone, Plan, Status, Verification
-from att_planner.cones import boresight, direction_margins
+from att_planner.cones import direction_margins, endpoint_directions
 from att_planner.methods import Method
 from att_planner.methods.eigenaxis import METHOD as FALLBACK_METHOD
 from att_planner.methods.eigenaxis import plan_eigenaxis_smooth
@@ -53,11 +53,8 @@ def padded(problem: ManeuverProblem, padding: float) -> ManeuverProblem:
     controller), but never so much that the start or goal boresight would fall inside it."""
     if padding <= 0 or not problem.cones:
         return problem
-    ends = [problem.q_initial] + ([problem.q_final] if problem.sensor_target is None else [])
-    directions = [boresight(q, problem.sensor_axis) for q in ends]
-    if problem.sensor_target is not None:
-        directions.append(problem.sensor_target)
-    room = np.min(direction_margins(np.array(directions), problem.cones), axis=0)
+    ends = endpoint_directions(problem.q_initial, problem.q_final, problem.sensor_axis, problem.sensor_target)
+    room = np.min(direction_margins(np.array(list(ends.values())), problem.cones), axis=0)
     cones = [Cone(c.direction, c.half_angle + min(padding, 0.5 * r), c.name) for c, r in zip(problem.cones, room)]
     return replace(problem, cones=cones)
 
@@ -68,7 +65,7 @@ def run_method(method: Method, problem: ManeuverProblem, options: dict, wait: fl
     to honour the deadline."""
     start = time.perf_counter()
     try:
-        plan = method.load()(problem, **method.fixed, **options)
+        plan = method.call(problem, **options)
     except Exception as exc:  # any solver failure is reported, the node keeps serving
         plan = Plan(method=method.name, status=Status.FAILED, message=f"{type(exc).__name__}: {exc}",
                     stats={"exception": repr(exc)})

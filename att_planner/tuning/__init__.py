@@ -48,7 +48,6 @@ from att_planner.tuning.settling import (
     ABOVE,
     CAPPED,
     DROPPED,
-    GAIN_BOUNDS,
     H_LOWER,
     H_NAMES,
     H_UPPER,
@@ -66,7 +65,7 @@ from att_planner.tuning.settling import (
 )
 
 __all__ = [
-    "ABOVE", "CAPPED", "DROPPED", "GAIN_BOUNDS", "H_LOWER", "H_NAMES", "H_UPPER", "INNER_METHODS", "LOG_GAIN_BOUNDS",
+    "ABOVE", "CAPPED", "DROPPED", "H_LOWER", "H_NAMES", "H_UPPER", "INNER_METHODS", "LOG_GAIN_BOUNDS",
     "SETTLED", "STATUS_NAMES", "BatchEvaluator", "DaskExecutor", "DirectSearch", "MagnetorquerCase", "ProcessExecutor",
     "SearchResult", "SerialExecutor", "SettlingResult", "SimSettings", "TuningResult", "WorstCase", "direct_batch",
     "direct_scipy", "distinct_worst", "initial_states", "make_executor", "multistart_points", "propagate",

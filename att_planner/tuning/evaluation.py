@@ -11,9 +11,14 @@ from att_planner.tuning.settling import (
     MagnetorquerCase,
     SettlingResult,
     SimSettings,
-    _simulate_chunk,
     simulate_settling,
 )
+
+
+def _simulate_chunk(args) -> SettlingResult:
+    """Module-level worker entry (picklable) for executors."""
+    case, settings, kp, kd, h, group, stop_above, race = args
+    return simulate_settling(case, kp, kd, h, settings, group=group, stop_above=stop_above, race=race)
 
 
 class SerialExecutor:

@@ -35,7 +35,6 @@ class MagnetorquerCase:
 
 # Gain box of the paper (sensor resolutions) and the log box the searches use: the DIRECT optimum
 # of the paper sits at κ_p/κ_p,max ≈ 2e-3, so a linear box wastes almost every sample.
-GAIN_BOUNDS = ((0.0, 1e8), (0.0, 1e9))
 LOG_GAIN_BOUNDS = ((3.0, 8.0), (5.0, 9.0))        # log10 κ_p, log10 κ_d
 
 # Initial-condition parameters h = (ρ, φ, θ, ω1, ω2, ω3, ψ) and the box H.
@@ -319,12 +318,6 @@ def simulate_settling(case: MagnetorquerCase, kp, kd, h, settings: SimSettings =
                 break
     batch.close_at_cap(t)
     return SettlingResult(batch.ts, batch.status, case_steps, step, time.perf_counter() - start)
-
-
-def _simulate_chunk(args) -> SettlingResult:
-    """Module-level worker entry (picklable) for executors."""
-    case, settings, kp, kd, h, group, stop_above, race = args
-    return simulate_settling(case, kp, kd, h, settings, group=group, stop_above=stop_above, race=race)
 
 
 def truth_settling_time(case: MagnetorquerCase, kp: float, kd: float, h, *, dt: float = 1.0,

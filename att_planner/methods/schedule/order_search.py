@@ -10,7 +10,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from att_planner.methods.schedule.transcription import SUBSTEPS, MultiphaseTranscription, _PhaseSolution, _transcription
+from att_planner.methods.schedule.transcription import (
+    SUBSTEPS,
+    MultiphaseTranscription,
+    ScheduleSolution,
+    cached_transcription,
+)
 from att_planner.problem import ManeuverProblem
 from att_sim import dynamics as dyn
 from att_sim import rotations as rot
@@ -35,7 +40,7 @@ def leg_bound_matrix(sc: dyn.Spacecraft, q_start, targets: list[np.ndarray], q_e
     if not same_ends:
         legs += [(n + 1, j) for j in range(1, n + 1)]   # solved reversed: from the end at rest
     C = np.zeros((n + 2, n + 2))
-    tr = _transcription(sc, 0, intervals, substeps, rate_max)
+    tr = cached_transcription(sc, 0, intervals, substeps, rate_max)
     for i, j in legs:
         if deadline is not None and time.monotonic() > deadline:
             break
@@ -108,7 +113,7 @@ def orders_by_lower_bound(C: np.ndarray):
 class Solved:
     order: tuple
     tf: float
-    sol: _PhaseSolution
+    sol: ScheduleSolution
     transcription: MultiphaseTranscription
 
 
@@ -135,7 +140,7 @@ class OrderSolver:
         return self.deadline is not None and time.monotonic() > self.deadline
 
     def solve(self, order, intervals: int, guess: Solved | None = None, expand: bool | None = None) -> Solved:
-        tr = _transcription(self.sc, len(order), intervals, self.substeps, self.rate_max, expand)
+        tr = cached_transcription(self.sc, len(order), intervals, self.substeps, self.rate_max, expand)
         wall = None if self.deadline is None else self.deadline - time.monotonic()
         start_guess = tr.resample(guess.sol) if guess is not None else None
         sol = tr.solve(self.q_start, [self.targets[k] for k in order], self.q_end, guess=start_guess,

@@ -89,7 +89,7 @@ def plan_schedule(problem: ManeuverProblem, *, order=None, search_intervals: int
         final = best
         if intervals != search_intervals and not solver.expired():
             fine = solver.solve(best.order, intervals, guess=best)
-            if fine.tf <= best.tf * (1 + 1e-6) or not np.isfinite(best.tf):
+            if fine.tf <= best.tf * (1 + 1e-6):
                 final = fine
             stats["refine_status"] = fine.sol.return_status
         plan = _plan(solver, final)

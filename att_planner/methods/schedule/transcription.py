@@ -65,7 +65,7 @@ def eigenaxis_rest_to_rest_time(sc: dyn.Spacecraft, q_from: np.ndarray, q_to: np
     if angle < 1e-12:
         return 0.0
     scale = _scaling(sc)
-    need = np.linalg.pinv(sc.wheel_axes) @ (sc.inertia @ axis)
+    need = sc.wheel_axes_pinv @ (sc.inertia @ axis)
     rate = scale.h_max / np.abs(need).max()
     accel = rate / scale.t_sat
     if angle >= rate * rate / accel:
@@ -83,7 +83,7 @@ def _aligned(quats: list[np.ndarray]) -> list[np.ndarray]:
 
 
 @dataclass
-class _PhaseSolution:
+class ScheduleSolution:
     """Raw multiphase NLP solution in normalised units (see :class:`_Scaling`)."""
 
     durations: np.ndarray   # (P,) τ
@@ -132,8 +132,8 @@ class MultiphaseTranscription:
         rate_z = ca.DM(self.scale.rate_per_h[2:3, :])
         for p in range(n_targets):
             node = (p + 1) * N
-            g += [symbolic.error_vector(targets[:, p], Q[:, node]), rate_z @ H[:, node]]
-        g.append(symbolic.error_vector(q_end, Q[:, K]))
+            g += [symbolic.error_vector(Q[:, node], targets[:, p]), rate_z @ H[:, node]]
+        g.append(symbolic.error_vector(Q[:, K], q_end))
         # ω_z = 0 at both ends: implied by rest (h = 0 bounds), the only condition at a passage
         g += [rate_z @ H[:, 0], rate_z @ H[:, K]]
         n_eq = sum(int(gi.numel()) for gi in g)
@@ -169,7 +169,7 @@ class MultiphaseTranscription:
         self._index_hf = slice(ih0 + n_w * K, ih0 + n_w * (K + 1))
 
     # -- guesses ----------------------------------------------------------------------------
-    def initial_guess(self, q_start, targets_in_order, q_end) -> _PhaseSolution:
+    def initial_guess(self, q_start, targets_in_order, q_end) -> ScheduleSolution:
         """Slerp between consecutive (sign-aligned) attitudes with eigenaxis durations; wheel
         momentum from the slerp rate by (1), clipped to the box; zero torque."""
         P, N, n_w = self.n_phases, self.intervals, self.sc.n_wheels
@@ -185,9 +185,9 @@ class MultiphaseTranscription:
             h = np.clip(np.linalg.lstsq(self.scale.rate_matrix, w_tau, rcond=None)[0], -0.9, 0.9)
             hs.append(np.tile(h, (N, 1)))
         hs[-1][-1] = 0.0
-        return _PhaseSolution(dur, np.vstack(qs), np.vstack(hs), np.zeros((P * N, n_w)), False, "guess", 0, 0.0)
+        return ScheduleSolution(dur, np.vstack(qs), np.vstack(hs), np.zeros((P * N, n_w)), False, "guess", 0, 0.0)
 
-    def resample(self, sol: _PhaseSolution) -> _PhaseSolution:
+    def resample(self, sol: ScheduleSolution) -> ScheduleSolution:
         """Interpolate a solution with another number of intervals per phase onto this grid."""
         P, N = self.n_phases, self.intervals
         N0 = (len(sol.q) - 1) // P
@@ -199,12 +199,12 @@ class MultiphaseTranscription:
         mid_old = np.concatenate([p + (np.arange(N0) + 0.5) / N0 for p in range(P)])
         mid_new = np.concatenate([p + (np.arange(N) + 0.5) / N for p in range(P)])
         u = np.column_stack([np.interp(mid_new, mid_old, sol.u[:, j]) for j in range(sol.u.shape[1])])
-        return _PhaseSolution(sol.durations.copy(), q, h, u, False, "resampled", 0, 0.0)
+        return ScheduleSolution(sol.durations.copy(), q, h, u, False, "resampled", 0, 0.0)
 
     # -- solve ------------------------------------------------------------------------------
-    def solve(self, q_start, targets_in_order, q_end, guess: _PhaseSolution | None = None,
+    def solve(self, q_start, targets_in_order, q_end, guess: ScheduleSolution | None = None,
               max_wall_time: float | None = None, start_at_rest: bool = True,
-              end_at_rest: bool = True) -> _PhaseSolution:
+              end_at_rest: bool = True) -> ScheduleSolution:
         """Minimum-time trajectory through ``targets_in_order`` (quaternions, any sign)."""
         if len(targets_in_order) != self.n_targets:
             raise ValueError(f"expected {self.n_targets} targets, got {len(targets_in_order)}")
@@ -231,15 +231,15 @@ class MultiphaseTranscription:
         seconds = time.perf_counter() - start
         stats = solver.stats()
         T, Q, H, U = (np.array(v) for v in self._split(out["x"]))
-        return _PhaseSolution(T.ravel(), Q.T, H.T, U.T, bool(stats["success"]), str(stats["return_status"]),
-                              int(stats.get("iter_count", 0)), seconds)
+        return ScheduleSolution(T.ravel(), Q.T, H.T, U.T, bool(stats["success"]), str(stats["return_status"]),
+                                int(stats.get("iter_count", 0)), seconds)
 
 
 _TRANSCRIPTIONS: dict = {}
 
 
-def _transcription(sc: dyn.Spacecraft, n_targets: int, intervals: int, substeps: int,
-                   rate_max: float, expand: bool | None = None) -> MultiphaseTranscription:
+def cached_transcription(sc: dyn.Spacecraft, n_targets: int, intervals: int, substeps: int,
+                         rate_max: float, expand: bool | None = None) -> MultiphaseTranscription:
     """Solver cache: an NLP depends only on the spacecraft, the number of targets and the grid."""
     key = (sc.inertia.tobytes(), sc.wheel_axes.tobytes(), sc.wheel_inertia, sc.wheel_torque_max,
            sc.wheel_speed_max, n_targets, intervals, substeps, rate_max, expand)

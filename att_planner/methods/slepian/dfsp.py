@@ -8,7 +8,7 @@ import numpy as np
 
 from att_msgs_py.types import Status
 from att_planner.methods.slepian.model import SmoothManeuver, evaluate
-from att_planner.methods.slepian.sqp import SlepianResult, _result, violation
+from att_planner.methods.slepian.sqp import SlepianResult, slepian_result, violation
 
 
 @dataclass
@@ -145,9 +145,9 @@ def solve_dfsp(man: SmoothManeuver, alpha0: np.ndarray | None = None, *,
             stopped = True
             break
     if measure.best_x is None:
-        return _result(man, state.x * measure.scale, Status.BUDGET_EXPIRED if stopped else Status.FAILED,
-                       "no feasible point found within the iterations/time budget", t0, feas_tol,
-                       evaluations=measure.evaluations, phases=history)
+        return slepian_result(man, state.x * measure.scale, Status.BUDGET_EXPIRED if stopped else Status.FAILED,
+                              "no feasible point found within the iterations/time budget", t0, feas_tol,
+                              evaluations=measure.evaluations, phases=history)
     status = Status.BUDGET_EXPIRED if stopped else Status.FEASIBLE
-    return _result(man, measure.best_x * measure.scale, status, "best feasible point of the last MMT phases", t0,
-                   feas_tol, evaluations=measure.evaluations, phases=history)
+    return slepian_result(man, measure.best_x * measure.scale, status, "best feasible point of the last MMT phases",
+                          t0, feas_tol, evaluations=measure.evaluations, phases=history)

@@ -10,6 +10,7 @@ from att_planner.cones import blocked_endpoint
 from att_planner.methods.slepian.dfsp import solve_dfsp
 from att_planner.methods.slepian.model import (
     DEFAULT_METHOD,
+    METHODS,
     PAPER_M,
     PAPER_N,
     PAPER_W,
@@ -17,7 +18,7 @@ from att_planner.methods.slepian.model import (
     build_maneuver,
     evaluate,
 )
-from att_planner.methods.slepian.sqp import SlepianResult, _result, solve_min_time_local, solve_mssa
+from att_planner.methods.slepian.sqp import SlepianResult, slepian_result, solve_min_time_local, solve_mssa
 from att_planner.problem import ManeuverProblem
 from att_sim import dynamics as dyn
 from att_sim import rotations as rot
@@ -100,9 +101,9 @@ def solve_min_time(man: SmoothManeuver, *, basis_sizes: tuple = (4, 8), starts: 
         if r.feasible and (best is None or r.tf < best.tf):
             best = r
     if best is None:
-        return _result(man.resized(M=M0), np.zeros((3, M0)), Status.BUDGET_EXPIRED if end and time.monotonic() > end
-                       else Status.FAILED, "no feasible start found by the coarse multistart", t0, feas_tol,
-                       explored=explored)
+        status = Status.BUDGET_EXPIRED if end and time.monotonic() > end else Status.FAILED
+        return slepian_result(man.resized(M=M0), np.zeros((3, M0)), status,
+                              "no feasible start found by the coarse multistart", t0, feas_tol, explored=explored)
     alpha, Mc, path = best.alpha, M0, [("coarse", M0, best.tf)]
     for M in basis_sizes[1:]:
         if end is not None and time.monotonic() > share(0.75):
@@ -119,12 +120,12 @@ def solve_min_time(man: SmoothManeuver, *, basis_sizes: tuple = (4, 8), starts: 
     path.append(("fine", Mc, r.tf))
     stats = dict(explored=explored, continuation=path, iterations=r.stats.get("iterations"))
     if r.feasible:
-        return _result(fine, r.alpha, r.status, r.message, t0, feas_tol, **stats)
+        return slepian_result(fine, r.alpha, r.status, r.message, t0, feas_tol, **stats)
     # Refinement unfinished (deadline) or failed: the best of its last iterate and the coarse solution
     # carried over, accepted if it meets the constraints to ``budget_tol`` (well inside the
     # verification's bounds and the cone margin).
     status = Status.BUDGET_EXPIRED if end is not None and time.monotonic() > end else Status.FAILED
-    fallback = min((_result(fine, a, status, r.message, t0, budget_tol, **stats) for a in (r.alpha, start)),
+    fallback = min((slepian_result(fine, a, status, r.message, t0, budget_tol, **stats) for a in (r.alpha, start)),
                    key=lambda res: (not res.feasible, res.tf))
     if fallback.feasible:
         fallback.message = f"refinement unfinished ({r.message}); constraints met to {budget_tol:g}"
@@ -173,8 +174,8 @@ def plan_slepian(problem: ManeuverProblem, method: str = DEFAULT_METHOD, M: int 
     Honours ``problem.deadline`` (best feasible plan so far, BUDGET_EXPIRED).
     """
     t0 = time.perf_counter()
-    if method not in DEFAULT_M:
-        raise ValueError(f"method must be one of {tuple(DEFAULT_M)}, got {method!r}")
+    if method not in METHODS:
+        raise ValueError(f"method must be one of {METHODS}, got {method!r}")
     M = DEFAULT_M[method] if M is None else int(M)
     base = {"method_variant": method, "M": M, "N": N, "W": W}
     reason = blocked_endpoint(problem)

@@ -54,8 +54,10 @@ def violation(man: SmoothManeuver, ev: Evaluation) -> float:
     return max(float(np.linalg.norm(ev.final)), cone)
 
 
-def _result(man: SmoothManeuver, alpha: np.ndarray, status: str, message: str, t0: float, feas_tol: float,
-            **stats) -> SlepianResult:
+def slepian_result(man: SmoothManeuver, alpha: np.ndarray, status: str, message: str, t0: float, feas_tol: float,
+                   **stats) -> SlepianResult:
+    """The result of α on ``man``: t_f from its peak torque, feasible when the constraints hold to
+    ``feas_tol``; ``stats`` gain the violation and the trace residual."""
     ev = evaluate(man, alpha)
     viol = violation(man, ev)
     return SlepianResult(np.asarray(alpha, float).reshape(3, man.M), man.tf_from_peak(ev.peak_torque),
@@ -74,7 +76,7 @@ class _WorkingSet:
     """
 
     def __init__(self, man: SmoothManeuver, stride: int = 10, torque_band: float = 0.6, cone_band: float = 0.15):
-        self.man, self.stride, self.torque_band, self.cone_band = man, stride, torque_band, cone_band
+        self.stride, self.torque_band, self.cone_band = stride, torque_band, cone_band
         N, C = man.N, man.cone_dirs.shape[0]
         self.torque = np.zeros((N, 3), bool)
         self.cones = np.zeros((N + 1, C), bool)
@@ -127,7 +129,7 @@ class _Rows:
 
     def __init__(self, man: SmoothManeuver, cache: _Cache, ws: _WorkingSet, min_time: bool,
                  end_ratio: float | None):
-        self.man, self.cache, self.ws, self.min_time, self.end_ratio = man, cache, ws, min_time, end_ratio
+        self.cache, self.ws, self.min_time, self.end_ratio = cache, ws, min_time, end_ratio
         self.P, self.sc = man.n_params, cache.alpha_scale
         self.ends = [0, 1, man.N - 2, man.N - 1]
         self.end_rates = np.kron(np.eye(3), man.basis[[0, -1]] * self.sc)   # ω*(τ_1), ω*(τ_N) = end_rates @ x
@@ -270,8 +272,8 @@ def solve_mssa(man: SmoothManeuver, alpha0: np.ndarray | None = None, *, maxiter
         tried.append(status)
         if status != Status.FAILED or (deadline is not None and time.monotonic() > deadline):
             break
-    return _result(man, alpha, status, message, t0, feas_tol, energy=0.5 * float(np.sum(alpha ** 2)),
-                   attempts=tried, **stats)
+    return slepian_result(man, alpha, status, message, t0, feas_tol, energy=0.5 * float(np.sum(alpha ** 2)),
+                          attempts=tried, **stats)
 
 
 def solve_min_time_local(man: SmoothManeuver, alpha0: np.ndarray, *, maxiter: int = 300, ftol: float = 1e-10,
@@ -287,4 +289,4 @@ def solve_min_time_local(man: SmoothManeuver, alpha0: np.ndarray, *, maxiter: in
     alpha, stats, status, message = _sqp(man, np.ravel(alpha0) / np.sqrt(man.N), min_time=True, maxiter=maxiter,
                                          ftol=ftol, feas_tol=feas_tol, deadline=deadline, peak_limit=peak_limit,
                                          end_ratio=end_ratio, max_total_iterations=max_total_iterations)
-    return _result(man, alpha, status, message, t0, feas_tol, **stats)
+    return slepian_result(man, alpha, status, message, t0, feas_tol, **stats)

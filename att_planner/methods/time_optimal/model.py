@@ -53,9 +53,8 @@ def path_function(problem: ManeuverProblem, s: Scaling, cone_margin: float):
         for c in problem.cones:
             g.append(ca.dot(ca.DM(c.direction), b) - np.cos(c.half_angle + cone_margin))
     if math.isfinite(problem.wheel_momentum_max):
-        G = problem.spacecraft.wheel_axes
         h_per_rate = s.J0 / s.tu / (problem.wheel_momentum_max * (1 - BOUND_MARGIN))
-        h_w = ca.mtimes(ca.DM(np.linalg.pinv(G) @ s.Jn * h_per_rate), x[4:])
+        h_w = ca.mtimes(ca.DM(problem.spacecraft.wheel_axes_pinv @ s.Jn * h_per_rate), x[4:])
         g += [h_w - 1, -h_w - 1]
     if not g:
         return None
@@ -78,8 +77,7 @@ def transcription(problem: ManeuverProblem, s: Scaling, mesh: np.ndarray, contro
     q_end = v.x_end[:4]
     if problem.sensor_target is None:
         qf = rot.normalize(np.asarray(problem.q_final, float))
-        err = symbolic.quat_mul(ca.DM(rot.conjugate(qf)), q_end)
-        tr.add_constraint(err[:3], 0.0, 0.0)
+        tr.add_constraint(symbolic.error_vector(q_end, ca.DM(qf)), 0.0, 0.0)
     else:
         target = np.asarray(problem.sensor_target, float) / np.linalg.norm(problem.sensor_target)
         r = np.asarray(problem.sensor_axis, float) / np.linalg.norm(problem.sensor_axis)

@@ -29,12 +29,12 @@ through the truth dynamics (:mod:`att_planner.verification`); a failure refines 
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, replace
 
 import numpy as np
 
 from att_msgs_py.types import Interpolation, Plan, Status
-from att_planner.cones import blocked_endpoint, margins
+from att_planner.cones import blocked_endpoint, margins, min_margin
 from att_planner.methods.axis_rotations import eigenaxis_leg, goal_attitude, no_torque_limit
 from att_planner.methods.time_optimal import collocation as col
 from att_planner.methods.time_optimal.model import Scaling, plan_arrays, scaling, transcription
@@ -71,7 +71,6 @@ class _Solve:
 
     problem: ManeuverProblem
     scaling: Scaling
-    control: str
     cone_margin: float
     tf_bounds: tuple
     tol: float
@@ -80,9 +79,13 @@ class _Solve:
     deadline: float | None
     interpolation: str
     budget_hit: bool = False
-    seconds: dict = field(default_factory=dict)
     nit: int = 0
     nfev: int = 0
+
+    @property
+    def control(self) -> str:
+        """The collocation control parametrisation of the plan's interpolation."""
+        return "constant" if self.interpolation == Interpolation.ZOH else "linear"
 
     def expired(self) -> bool:
         if self.deadline is not None and time.monotonic() > self.deadline:
@@ -107,7 +110,7 @@ class _Incumbent:
     """The best solution and its mesh, re-solved on refined meshes (stages 2 and 3)."""
 
     def __init__(self, run: _Solve, tr: col.Transcription, res: col.NlpResult):
-        self.run, self.tr, self.res = run, tr, res
+        self.run, self.res = run, res
         self.sol = tr.phase_solution(res.w)
         self.history = [(self.sol, res)]
         self.mesh_log = [{"intervals": tr.phases[0].intervals, "tf": res.objective * run.scaling.tu,
@@ -121,7 +124,7 @@ class _Incumbent:
         self.mesh_log.append({"intervals": new_tr.phases[0].intervals, "tf": new_res.objective * run.scaling.tu,
                               "status": new_res.status, "seconds": new_res.wall_time})
         if new_res.success and new_res.constraint_violation < CONVERGED_VIOLATION:
-            self.tr, self.res = new_tr, new_res
+            self.res = new_res
             self.sol = new_tr.phase_solution(new_res.w)
             self.history.append((self.sol, new_res))
             return True
@@ -215,7 +218,7 @@ def _routes(problem: ManeuverProblem, s: Scaling, starts: int, warm_starts, smoo
         seconds["smooth_warm_start"] = time.monotonic() - lap
     routes = select_routes(candidate_routes(problem, s), starts)
     return routes + [Route(f"warm start: {p.method}", plan=p, tf_estimate=p.duration / s.tu,
-                           min_margin=float(margins(p.q, problem.sensor_axis, problem.cones).min(initial=np.inf)))
+                           min_margin=min_margin(p.q, problem.sensor_axis, problem.cones))
                      for p in warm_starts if len(p.t) > 1]
 
 
@@ -259,10 +262,8 @@ def plan_time_optimal(problem: ManeuverProblem, *, intervals: int = DEFAULT_INTE
     lap = time.monotonic()
     routes = _routes(problem, s, starts, warm_starts, smooth_warm_start, seconds)
     tf_scale = max(r.tf_estimate for r in routes if np.isfinite(r.tf_estimate))
-    control = "constant" if interpolation == Interpolation.ZOH else "linear"
-    run = _Solve(problem, s, control, np.deg2rad(cone_margin_deg), (1e-2 * tf_scale, 10.0 * tf_scale), tol, max_iter,
-                 max_intervals, None if problem.deadline is None else problem.deadline - verify_reserve,
-                 interpolation, seconds=seconds)
+    run = _Solve(problem, s, np.deg2rad(cone_margin_deg), (1e-2 * tf_scale, 10.0 * tf_scale), tol, max_iter,
+                 max_intervals, None if problem.deadline is None else problem.deadline - verify_reserve, interpolation)
     tr, solved, start_log = _explore(run, routes, intervals, explore_tol)
     stats = {"starts": start_log, "time_unit": s.tu, "seconds": seconds}
     seconds["routes_and_starts"], lap = time.monotonic() - lap, time.monotonic()

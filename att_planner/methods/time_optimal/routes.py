@@ -11,7 +11,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from att_msgs_py.types import Plan
-from att_planner.cones import margins
+from att_planner.cones import min_margin
 from att_planner.methods.axis_rotations import AxisLeg, axis_acceleration, eigenaxis_leg, goal_attitude
 from att_planner.methods.constrained_axis import cone_riding_legs
 from att_planner.methods.time_optimal import collocation as col
@@ -38,8 +38,7 @@ def _peak_rate(problem: ManeuverProblem, scaling: Scaling, e_body: np.ndarray) -
     if np.isfinite(problem.rate_max):
         limit = problem.rate_max * scaling.tu * (1 - BOUND_MARGIN) / np.abs(e_body).max()
     if np.isfinite(problem.wheel_momentum_max):
-        wheels = np.linalg.pinv(problem.spacecraft.wheel_axes)
-        per_rate = np.abs(wheels @ scaling.Jn @ e_body).max() * scaling.J0 / scaling.tu
+        per_rate = np.abs(problem.spacecraft.wheel_axes_pinv @ scaling.Jn @ e_body).max() * scaling.J0 / scaling.tu
         limit = min(limit, problem.wheel_momentum_max * (1 - BOUND_MARGIN) / per_rate)
     return limit
 
@@ -171,8 +170,7 @@ def _goal_routes(problem: ManeuverProblem, scaling: Scaling, tilt_deg: float,
     for rt in routes:
         tf, state, _ = _leg_route_functions(problem, scaling, rt.legs)
         rt.tf_estimate = tf
-        m = margins(state(np.linspace(0.0, tf, 400))[:, :4], problem.sensor_axis, problem.cones)
-        rt.min_margin = float(m.min()) if m.size else np.inf
+        rt.min_margin = min_margin(state(np.linspace(0.0, tf, 400))[:, :4], problem.sensor_axis, problem.cones)
     return routes
 
 

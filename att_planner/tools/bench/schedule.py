@@ -35,19 +35,20 @@ def configure(parser) -> None:
                         help="re-solve the winning order with these intervals per phase")
 
 
-def _order(plan) -> list:
-    return [p.name for p in plan.passages]
-
-
 def _verified(plan) -> bool:
     return plan.verification is not None and rejection(plan.verification) is None
+
+
+def _rest_to_rest(q_from, q_to, intervals: int, **options):
+    """The rest-to-rest slew ``q_from`` → ``q_to`` (a schedule without targets)."""
+    return sch.plan_schedule(ref.problem(targets={}, q_start=q_from, q_end=q_to), order=[],
+                             search_intervals=intervals, intervals=intervals, **options)
 
 
 def _rest_to_rest_ab() -> dict:
     """The a→b rest-to-rest slew (no intermediate target) on a fine grid, verified."""
     targets = ref.olivares_targets("A")
-    r = sch.plan_schedule(ref.problem(targets={}, q_start=targets["a"], q_end=targets["b"]), order=[],
-                          search_intervals=48, intervals=48)
+    r = _rest_to_rest(targets["a"], targets["b"], 48)
     return {"tf": r.duration, "intervals": 48, "status": r.status, "verified": _verified(r),
             "final_attitude_error_deg": float(np.degrees(r.verification.final_attitude_error)),
             "published": ref.PUBLISHED_REST_TO_REST_AB}
@@ -59,8 +60,7 @@ def _published_order_here(experiment, order, intervals, substeps) -> dict:
     problem = ref.problem(experiment)
     r = sch.plan_schedule(problem, order=order, search_intervals=intervals, intervals=intervals, substeps=substeps)
     chain = [rot.IDENTITY] + [problem.targets[k] for k in order] + [rot.IDENTITY]
-    legs = [sch.plan_schedule(ref.problem(targets={}, q_start=a, q_end=b), order=[], search_intervals=intervals,
-                              intervals=intervals, substeps=substeps, verify=False).duration
+    legs = [_rest_to_rest(a, b, intervals, substeps=substeps, verify=False).duration
             for a, b in zip(chain[:-1], chain[1:])]
     return {"order": order, "tf": r.duration, "verified": _verified(r),
             "rest_to_rest_legs_tf": float(sum(legs)), "rest_to_rest_legs": legs}
@@ -75,7 +75,7 @@ def _print_result(args, result, published) -> None:
     print(f"{'compute [s] wall':24}{result.wall_time:14.2f}{published['solve_seconds']:12.2f}")
     print(f"{'compute [s] CPU':24}{stats.get('cpu_seconds', float('nan')):14.2f}")
     pub_order = "".join(published["order"]) if published["order"] else "-"
-    print(f"{'order':24}{''.join(_order(result)):>14}{pub_order:>12}")
+    print(f"{'order':24}{''.join(result.order):>14}{pub_order:>12}")
     print(f"status {result.status}: {result.message}")
     print(f"order search: {stats.get('orders_solved')} orders solved, "
           f"lower bound {stats.get('lower_bound', float('nan')):.2f} s"
@@ -107,11 +107,14 @@ def _exhaustive(args, problem) -> dict:
     rows = sch.exhaustive_order_search(problem, intervals=args.search_intervals, substeps=args.substeps)
     seconds = time.perf_counter() - t0
     bound_ok = all(r["bound"] <= r["tf"] * (1 + 1e-6) for r in rows)
+
+    def pair(row) -> tuple:     # an order and its reverse
+        return min(tuple(row["order"]), tuple(reversed(row["order"])))
+
     best_by_pair = {}
-    for r in rows:  # an order and its reverse: keep the better local minimum
-        key = min(tuple(r["order"]), tuple(reversed(r["order"])))
-        best_by_pair[key] = min(best_by_pair.get(key, np.inf), r["tf"])
-    mismatch = [r for r in rows if r["tf"] > best_by_pair[min(tuple(r["order"]), tuple(reversed(r["order"])))] * 1.001]
+    for r in rows:  # keep the better local minimum of each pair
+        best_by_pair[pair(r)] = min(best_by_pair.get(pair(r), np.inf), r["tf"])
+    mismatch = [r for r in rows if r["tf"] > best_by_pair[pair(r)] * 1.001]
     pair_best = sorted(best_by_pair.values())
     out = {"orders": len(rows), "seconds": seconds, "top": rows[:10], "rows": rows, "pairs": len(best_by_pair),
            "pairs_without_converged_solution": int(sum(not np.isfinite(v) for v in pair_best)),
@@ -137,7 +140,7 @@ def run(args) -> dict:
     ver = result.verification
     payload = {
         "experiment": args.experiment,
-        "order": _order(result),
+        "order": result.order,
         "tf": result.duration,
         "passage_times": [p.time for p in result.passages],
         "t": result.t,
@@ -160,7 +163,7 @@ def run(args) -> dict:
         print(f"published order {''.join(published['order'])} under this model: t_f {po['tf']:.2f} s "
               f"(verified {po['verified']}); stopping at every target instead: {po['rest_to_rest_legs_tf']:.2f} s")
     if args.grid_study:
-        payload["grid_study"] = _grid_study(args, problem, _order(result))
+        payload["grid_study"] = _grid_study(args, problem, result.order)
     if args.exhaustive:
         payload["exhaustive"] = _exhaustive(args, problem)
     return payload

@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import tempfile
 
+from att_planner.tools.review.run import SETTLING_THRESHOLD
 from att_planner.tools.soak import run_soak
 
 
@@ -22,6 +23,6 @@ def run(args) -> dict:
     for name, m in r["memory"].items():
         print(f"  {name:10s} RSS {m['start_mib']:7.1f} -> {m['end_mib']:7.1f} MiB")
     settling = "not within the run" if r["settling_orbits"] is None else f"{r['settling_orbits']:.3f} orbits"
-    print(f"  magnetorquer settling (|q_i| <= 0.05): {settling}; exit codes {r['exit_codes']}")
+    print(f"  magnetorquer settling (|q_i| <= {SETTLING_THRESHOLD}): {settling}; exit codes {r['exit_codes']}")
     print(f"  log: {out}/soak.mcap")
     return r

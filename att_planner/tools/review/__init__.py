@@ -99,7 +99,3 @@ def main(argv=None) -> int:
         print(f"figure ({name}): {p}")
     print(f"HTML: {result.html}")
     return 0
-
-
-if __name__ == "__main__":
-    sys.exit(main())

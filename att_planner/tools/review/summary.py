@@ -8,6 +8,7 @@ import numpy as np
 from att_msgs_py.log import TopicLog
 from att_planner.cones import margins
 from att_planner.tools.review.run import SETTLING_THRESHOLD, Run, extract_run, settling_time
+from att_planner.verification import peak_magnitude
 from att_sim import rotations as rot
 from att_sim import scenario as scen
 from att_sim.dynamics import Spacecraft
@@ -66,7 +67,7 @@ def summary_of(run: Run, spacecraft: Spacecraft | None = None) -> dict:
     out["min_cone_margin_deg"] = min(out["min_margin_deg"].values()) if cones else None
 
     def peak(name, values, limit):
-        v = float(np.max(np.abs(values))) if np.size(values) else 0.0
+        v = peak_magnitude(values)
         lim = finite_limit(limit)
         out[f"peak_{name}"], out[f"{name}_limit"], out[f"{name}_ratio"] = v, lim, _ratio(v, lim)
 
