@@ -142,7 +142,8 @@ def build_maneuver(problem: ManeuverProblem, M: int = PAPER_M, N: int = PAPER_N,
     if problem.sensor_target is not None:
         target = np.asarray(problem.sensor_target, float)
         target = target / np.linalg.norm(target)
-        tbasis = np.stack(rot.orthonormal_basis(target))
+        smallest = np.eye(3)[np.argmin(np.abs(target))]    # never within 25° of the target
+        tbasis = np.stack(rot.orthonormal_basis(target, references=(smallest, smallest)))
     return SmoothManeuver(slepian_basis(N, W, M), J / scale, scale, float(problem.spacecraft.body_torque_max),
                           rot.dcm(problem.q_initial), rot.dcm(problem.q_final), r / np.linalg.norm(r),
                           dirs, cos, target, tbasis, W)
