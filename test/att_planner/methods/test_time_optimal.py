@@ -137,6 +137,8 @@ def test_invalid_options_raise_value_error():
     problem = case_problem("bilimoria_wie")
     with pytest.raises(ValueError, match="interpolation"):
         plan_time_optimal(problem, interpolation="cubic")
+    with pytest.raises(ValueError, match="intervals"):
+        plan_time_optimal(problem, intervals=0)                 # not silently the default 30
     with pytest.raises(ValueError, match="rate_max"):
         methods.run("time_optimal", problem, rate_max=-1.0)      # the registry holds the ranges
 
