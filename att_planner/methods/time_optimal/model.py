@@ -52,7 +52,7 @@ def path_function(problem: ManeuverProblem, s: Scaling, cone_margin: float):
         b = ca.mtimes(symbolic.dcm(x[:4]), ca.DM(r))
         for c in problem.cones:
             g.append(ca.dot(ca.DM(c.direction), b) - np.cos(c.half_angle + cone_margin))
-    if math.isfinite(problem.wheel_momentum_max):
+    if math.isfinite(problem.wheel_momentum_max) and problem.spacecraft.n_wheels:   # no wheels: no momentum
         h_per_rate = s.J0 / s.tu / (problem.wheel_momentum_max * (1 - BOUND_MARGIN))
         h_w = ca.mtimes(ca.DM(problem.spacecraft.wheel_axes_pinv @ s.Jn * h_per_rate), x[4:])
         g += [h_w - 1, -h_w - 1]

@@ -33,11 +33,12 @@ class Route:
 
 def _peak_rate(problem: ManeuverProblem, scaling: Scaling, e_body: np.ndarray) -> float:
     """Largest path rate (rad per TU) about body axis ``e`` within the problem's body-rate and
-    wheel-momentum bounds (tightened like the NLP's, :data:`~.model.BOUND_MARGIN`); inf without."""
+    wheel-momentum bounds (tightened like the NLP's, :data:`~.model.BOUND_MARGIN`); inf without
+    (a spacecraft without wheels holds no wheel momentum)."""
     limit = np.inf
     if np.isfinite(problem.rate_max):
         limit = problem.rate_max * scaling.tu * (1 - BOUND_MARGIN) / np.abs(e_body).max()
-    if np.isfinite(problem.wheel_momentum_max):
+    if np.isfinite(problem.wheel_momentum_max) and problem.spacecraft.n_wheels:
         per_rate = np.abs(problem.spacecraft.wheel_axes_pinv @ scaling.Jn @ e_body).max() * scaling.J0 / scaling.tu
         limit = min(limit, problem.wheel_momentum_max * (1 - BOUND_MARGIN) / per_rate)
     return limit

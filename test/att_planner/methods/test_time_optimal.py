@@ -90,6 +90,18 @@ def test_rate_and_wheel_momentum_bounds_hold_on_the_truth_trajectory_and_cost_ti
     assert plan.verification.wheel_momentum_ratio <= 1.0
 
 
+def test_momentum_bound_on_a_spacecraft_without_wheels_binds_nothing():
+    """No wheels hold no wheel momentum: the bound neither constrains the NLP nor breaks the
+    route warm starts (they raised on the empty G⁺)."""
+    problem = case_problem("bilimoria_wie")
+    wheelless = replace(problem, spacecraft=replace(problem.spacecraft, wheel_axes=np.zeros((3, 0))))
+    free = plan_time_optimal(wheelless, starts=1)
+    bounded = plan_time_optimal(replace(wheelless, wheel_momentum_max=1e-3), starts=1)
+    assert bounded.status in VALID, bounded.message
+    assert bounded.verification.wheel_momentum_ratio == 0.0
+    assert bounded.duration == pytest.approx(free.duration, rel=1e-9)
+
+
 def test_plans_of_other_methods_serve_as_warm_starts():
     problem = case_problem("swift")
     seed = plan_constrained_axis(problem)
