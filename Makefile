@@ -1,6 +1,7 @@
 # Two commands from a fresh clone: `make demo` and `make test`. Each bootstraps .venv on its own:
 # pinned wheels (requirements.txt), then the att_msgs interfaces built with rosidl into the venv
-# prefix, then this package (editable). Stamps make a second run fast.
+# prefix, then this package (editable) and the demo's plan-signing key pair (att-keygen). Stamps make
+# a second run fast.
 SHELL := /bin/bash
 PYTHON ?= python3.11
 VENV := .venv
@@ -36,6 +37,7 @@ $(VENV)/.stamp-interfaces: $(INTERFACES) $(VENV)/.stamp-deps
 
 $(VENV)/.stamp-package: setup.py package.xml pyproject.toml $(VENV)/.stamp-interfaces
 	$(PY) -m pip install --quiet --disable-pip-version-check --no-deps --no-build-isolation -e .
+	$(PREFIX)/bin/att-keygen --if-missing
 	touch $@
 
 # the habits first (seconds): ruff's rules and the import contracts (pyproject.toml), then every test

@@ -36,6 +36,8 @@ setup(
             "att-demo = att_planner.tools.demo:main",
             "att-bench = att_planner.tools.bench:main",
             "att-tune = att_planner.tools.tune:main",
+            "att-keygen = att_planner.tools.keygen:main",
+            "att-log = att_msgs_py.log.cli:main",
         ],
     },
 )

@@ -125,7 +125,8 @@ def plan_msg(plan: types.Plan) -> ManeuverPlan:
     msg = ManeuverPlan(plan_id=plan.plan_id, method=plan.method, status=str(plan.status), message=plan.message,
                        spacecraft=plan.spacecraft, duration=float(plan.duration),
                        control_kind=str(plan.control_kind), interpolation=str(plan.interpolation),
-                       solve_seconds=float(plan.wall_time))
+                       solve_seconds=float(plan.wall_time), spacecraft_digest=plan.spacecraft_digest,
+                       key_id=plan.key_id, signature=bytes(plan.signature))
     msg.header.frame_id = plan.frame_id
     msg.times = [float(v) for v in plan.t]
     msg.attitudes = [quaternion(q) for q in plan.q]
@@ -150,7 +151,10 @@ def plan_from_msg(msg) -> types.Plan:
         control_kind=msg.control_kind, interpolation=msg.interpolation, method=msg.method, status=msg.status,
         message=msg.message, wall_time=float(msg.solve_seconds), plan_id=msg.plan_id, spacecraft=msg.spacecraft,
         frame_id=msg.header.frame_id, sensor_axis=from_vector3(msg.sensor_axis),
-        cones=[types.Cone(*cone_parts(c)) for c in msg.cones], verification=verification_from_msg(msg.verification))
+        cones=[types.Cone(*cone_parts(c)) for c in msg.cones], verification=verification_from_msg(msg.verification),
+        # logs recorded before plans were signed have none of the last three fields
+        spacecraft_digest=getattr(msg, "spacecraft_digest", ""), key_id=getattr(msg, "key_id", ""),
+        signature=bytes(getattr(msg, "signature", b"")))
 
 
 # -- the ExecuteManeuver action -----------------------------------------------------------------

@@ -20,7 +20,8 @@ class ErrorCode(IntEnum):
     UNKNOWN_SPACECRAFT = 121      # no such configuration
     UNKNOWN_METHOD = 130
     INVALID_OPTION = 131          # option name unknown or value out of range
-    SIZE_LIMIT = 132              # arrays or cone lists above the documented caps
+    SIZE_LIMIT = 132              # arrays, samples, cone lists or strings above the documented caps
+    INVALID_TEXT = 133            # a string with control characters (or not UTF-8)
     INVALID_TIME_BUDGET = 140
     # planner: solving
     SOLVER_FAILED = 200           # the method failed and no fallback plan was possible
@@ -31,15 +32,41 @@ class ErrorCode(IntEnum):
     BUSY = 302                    # a maneuver is executing: mode change or second goal refused
     INVALID_MODE = 303
     NO_STATE = 304                # no recent spacecraft state
-    ABORTED = 305                 # maneuver cancelled or stopped by safe mode
+    ABORTED = 305                 # maneuver cancelled, stopped by safe mode, or its controller fell silent
+    PLAN_NOT_AUTHENTIC = 306      # no signature, an unknown key, or a signature that does not verify
+    PLAN_ID_REUSED = 307          # a plan id already taken by a different plan
+    WRONG_SPACECRAFT = 308        # a plan made for another spacecraft configuration
+    PLAN_CONTEXT = 309            # the plan starts far from the current attitude or rate
+    INVALID_STATE = 310           # a state message with a bad field (discarded, reported)
+    STATE_TIME_JUMP = 311         # a state stamp backward or far forward (discarded, reported)
     # simulator
     INVALID_RESET = 400
+    INVALID_COMMAND = 401         # actuator command with a bad field or stamp (refused, reported)
+    COMMAND_LIMIT = 402           # actuator command far beyond its limit (refused, reported)
+    # nodes and tools: configuration
+    INVALID_PARAMETER = 500       # a parameter of the wrong type or out of range
+    INVALID_CONFIG = 501          # an unknown scenario, a YAML that is not a scenario, a missing file
+
+
+MAX_MESSAGE_LENGTH = 400       # characters of a refusal message or a log line (longer: clipped)
+
+
+def clip(text: str, limit: int = MAX_MESSAGE_LENGTH) -> str:
+    """``text`` cut to ``limit`` characters (a refusal or log line never grows with its input)."""
+    text = str(text)
+    return text if len(text) <= limit else text[: limit - 15] + f"... (+{len(text) - limit + 15} chars)"
 
 
 class RequestError(ValueError):
     """A request rejected before any numerics: an error code and a sentence naming the field."""
 
     def __init__(self, code: ErrorCode, message: str):
+        message = clip(message)
         super().__init__(message)
         self.code = ErrorCode(code)
         self.message = message
+
+
+class ConfigError(RequestError):
+    """A parameter or configuration file that cannot be used: one line naming it and what is
+    expected (nodes print it and exit 2, without a traceback)."""

@@ -16,11 +16,18 @@ process exits 0.
 """
 from __future__ import annotations
 
+import math
 import signal
+import sys
 from collections.abc import Callable
+from pathlib import Path
 
 import rclpy
+from rcl_interfaces.msg import ParameterDescriptor
 from rclpy.executors import Executor, ExternalShutdownException, SingleThreadedExecutor
+
+from att_msgs_py.errors import ConfigError, ErrorCode, RequestError, clip
+from att_msgs_py.validation import number, text
 
 _stop_signalled = False
 
@@ -38,13 +45,73 @@ def spin_until_shutdown(executor: Executor, poll: float = 0.2) -> None:
         executor.spin_once(timeout_sec=poll)
 
 
-def parameter_reader(node, scenario_values: dict) -> Callable:
-    """``read(name, default)`` for a node: declares ROS parameter ``name`` with the value of its
-    scenario-file section (``scenario_values``) or else ``default``, and returns the parameter's
-    value, so ``-p`` and ``--params-file`` overrides win over both."""
-    def read(name: str, default):
-        return node.declare_parameter(name, scenario_values.get(name, default)).value
+def _coerce(name: str, value, default, where: str):
+    """``value`` as the type of ``default`` (an integer is a valid float), or ConfigError."""
+    kind = type(default)
+    if kind is float and isinstance(value, int) and not isinstance(value, bool):
+        value = float(value)
+    if kind is list:
+        if not isinstance(value, (list, tuple)) or not all(
+                isinstance(v, (int, float)) and not isinstance(v, bool) for v in value):
+            raise ConfigError(ErrorCode.INVALID_PARAMETER,
+                              f"parameter '{name}'{where}: expected a list of numbers, got {clip(repr(value), 80)}")
+        return [float(v) for v in value]
+    if not isinstance(value, kind) or (kind is int and isinstance(value, bool)):
+        expected = {float: "a number", int: "an integer", bool: "true or false", str: "a string"}[kind]
+        raise ConfigError(ErrorCode.INVALID_PARAMETER, f"parameter '{name}'{where}: expected {expected}, got "
+                                                       f"{type(value).__name__} {clip(repr(value), 80)}")
+    return value
+
+
+def parameter_reader(node, scenario_values: dict, source: str = "") -> Callable:
+    """``read(name, default, low=, high=, low_open=, length=, choices=)`` for a node: declares ROS
+    parameter ``name`` with the value of its scenario-file section (``scenario_values``) or else
+    ``default``, so ``-p`` and ``--params-file`` overrides win over both, and returns the value
+    checked against the type of ``default`` (an integer is accepted for a float), the range
+    [``low``, ``high``] (``(low, high]`` with ``low_open``; NaN and Inf never pass for a bounded
+    number), the list ``length`` and the ``choices``. Anything else raises :class:`ConfigError`
+    with one line naming the parameter, where it came from and what is expected."""
+    def read(name: str, default, low: float | None = None, high: float | None = None, *, low_open: bool = False,
+             length: int | None = None, choices=None):
+        in_file = name in scenario_values
+        where = f" (from {source})" if in_file and source else ""
+        initial = _coerce(name, scenario_values[name], default, where) if in_file else default
+        descriptor = ParameterDescriptor(dynamic_typing=True)
+        value = node.declare_parameter(name, initial, descriptor).value
+        if value != initial or type(value) is not type(initial):
+            where = " (from the command line or a --params-file)"
+        value = _coerce(name, value, default, where)
+        label = f"parameter '{name}'{where}"
+        if low is not None or high is not None:
+            for v in (value if isinstance(value, list) else [value]):
+                try:
+                    number(v, label, ErrorCode.INVALID_PARAMETER, -math.inf if low is None else low,
+                           math.inf if high is None else high, low_open=low_open)
+                except RequestError as err:
+                    raise ConfigError(err.code, err.message) from None
+        if length is not None and len(value) != length:
+            raise ConfigError(ErrorCode.INVALID_PARAMETER, f"{label}: expected {length} numbers, got {len(value)}")
+        if choices is not None and value not in choices:
+            raise ConfigError(ErrorCode.INVALID_PARAMETER,
+                              f"{label}: expected one of {', '.join(map(str, choices))}, got {clip(repr(value), 80)}")
+        if isinstance(value, str):
+            try:
+                text(value, label, ErrorCode.INVALID_PARAMETER, max_length=4096)
+            except RequestError as err:
+                raise ConfigError(ErrorCode.INVALID_PARAMETER, err.message) from None
+        return value
     return read
+
+
+def _check_params_files(args) -> None:
+    """``--params-file PATH`` arguments name readable files (paths relative to the current
+    directory), checked before rcl reads them."""
+    args = list(sys.argv if args is None else args)
+    for flag, path in zip(args, args[1:]):
+        if flag == "--params-file" and not Path(path).is_file():
+            raise ConfigError(ErrorCode.INVALID_CONFIG,
+                              f"--params-file '{clip(path, 200)}': no such file (relative paths are taken from the "
+                              f"current directory, {Path.cwd()})")
 
 
 def run_node(make_node: Callable, args=None, make_executor: Callable[[], Executor] = SingleThreadedExecutor,
@@ -53,9 +120,13 @@ def run_node(make_node: Callable, args=None, make_executor: Callable[[], Executo
     :func:`spin_until_shutdown`)."""
     for signum in (signal.SIGINT, signal.SIGTERM):
         signal.signal(signum, _stop_requested)      # before rclpy.init, which chains to it
-    rclpy.init(args=args)
-    node = None
+    node, exit_code = None, 0
     try:
+        _check_params_files(args)
+        try:
+            rclpy.init(args=args)
+        except Exception as exc:         # rcl's own parse errors (a params file that is not YAML, ...)
+            raise ConfigError(ErrorCode.INVALID_CONFIG, f"ROS arguments refused: {clip(exc, 300)}") from None
         if _stop_signalled:
             return
         node = make_node()
@@ -67,6 +138,9 @@ def run_node(make_node: Callable, args=None, make_executor: Callable[[], Executo
             loop(node, executor)
     except ExternalShutdownException:
         pass
+    except ConfigError as err:
+        print(f"{Path(sys.argv[0]).name}: [{int(err.code)} {err.code.name}] {err.message}", file=sys.stderr, flush=True)
+        exit_code = 2
     except Exception:
         if rclpy.ok():
             raise
@@ -76,3 +150,5 @@ def run_node(make_node: Callable, args=None, make_executor: Callable[[], Executo
                 node.close()
             node.destroy_node()
         rclpy.try_shutdown()
+    if exit_code:
+        sys.exit(exit_code)

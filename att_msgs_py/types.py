@@ -114,7 +114,8 @@ class Plan:
     controller tracks). Outcome: ``status``, ``message``, ``nit``/``nfev`` (solver iterations and
     function evaluations, 0 where they do not apply), ``wall_time`` (s) and free-form ``stats``.
     Context, filled by the planner service: ``plan_id``, ``spacecraft``, ``frame_id``,
-    ``sensor_axis``, ``cones``, ``verification`` and, for a schedule, the ``passages``. A method
+    ``sensor_axis``, ``cones``, ``verification`` and, for a schedule, the ``passages``; then
+    ``spacecraft_digest``, ``key_id`` and the Ed25519 ``signature`` (:mod:`att_msgs_py.signing`). A method
     that finds nothing returns a plan without samples and status FAILED (or BUDGET_EXPIRED).
     ``nit``, ``nfev``, ``stats`` and ``passages`` are not on the wire.
     """
@@ -139,6 +140,9 @@ class Plan:
     cones: list = field(default_factory=list)
     verification: Verification | None = None
     passages: list = field(default_factory=list)
+    spacecraft_digest: str = ""
+    key_id: str = ""
+    signature: bytes = b""
 
     @property
     def duration(self) -> float:

@@ -21,6 +21,7 @@ renormalisation after every step, inputs held constant over a step (zero-order h
 """
 from __future__ import annotations
 
+import hashlib
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from functools import cached_property
@@ -60,6 +61,17 @@ class Spacecraft:
     def wheel_axes_pinv(self) -> np.ndarray:
         """``G⁺`` (N, 3): the least-norm wheel quantities that produce a body vector."""
         return np.linalg.pinv(self.wheel_axes)
+
+    @cached_property
+    def digest(self) -> str:
+        """SHA-256 (hex) of every physical parameter: a plan names the configuration it was made
+        for by this, and a controller of another configuration refuses it."""
+        h = hashlib.sha256(b"att_suite.spacecraft.v1")
+        for a in (self.inertia, self.wheel_axes, self.wheel_inertia, self.wheel_torque_max, self.wheel_speed_max,
+                  self.body_torque_max, self.dipole_max):
+            a = np.ascontiguousarray(a, dtype="<f8")
+            h.update(str(a.shape).encode() + a.tobytes())
+        return h.hexdigest()
 
 
 @dataclass

@@ -16,6 +16,7 @@ from pathlib import Path
 import numpy as np
 import yaml
 
+from att_msgs_py.errors import ConfigError, ErrorCode, clip
 from att_sim.dynamics import Spacecraft
 from att_sim.environment import OrbitParams
 
@@ -99,3 +100,16 @@ def load(name: str) -> Scenario:
         orbit=orbit_from_params(shared.get("orbit", {})),
         frame_id=shared.get("frame_id", "eci"), body_frame_id=shared.get("body_frame_id", "body"),
         node_params=nodes)
+
+
+def load_checked(name: str) -> Scenario:
+    """:func:`load` for a node's ``scenario`` parameter: every failure is one :class:`ConfigError`
+    line naming the scenario or file and what is expected."""
+    try:
+        return load(name)
+    except KeyError as exc:
+        raise ConfigError(ErrorCode.INVALID_CONFIG, f"parameter 'scenario': {exc.args[0]}") from None
+    except ConfigError:
+        raise
+    except (ValueError, TypeError, OSError, yaml.YAMLError) as exc:
+        raise ConfigError(ErrorCode.INVALID_CONFIG, f"scenario '{clip(name, 200)}': {clip(exc, 300)}") from None
