@@ -4,9 +4,10 @@ DDS Security is not available from the PyPI Fast DDS build, so the suite authent
 itself: the planner signs every ``ManeuverPlan`` it issues and the controller flies only plans
 whose signature verifies against its configured public key (``cryptography``'s Ed25519, RFC 8032).
 
-What is signed is the CDR serialization of the message with ``signature`` emptied
-(:func:`payload`): every field the controller reads, the header stamp and the ``key_id`` included,
-and exactly what arrives (floats are never re-normalised on the way). Keys are PEM files: a
+What is signed is a canonical encoding of every field of the message but ``signature``
+(:func:`payload`): the header stamp and the ``key_id`` included, values exactly as they travel
+(floats are never re-normalised on the way). Not the CDR bytes themselves: Fast CDR leaves its
+alignment padding uninitialised, so the same message serializes to different bytes. Keys are PEM files: a
 PKCS#8 private key (mode 0600) and its SubjectPublicKeyInfo public key, made by ``att-keygen``;
 the bootstrap makes a pair for the demo under ``<venv>/share/att_suite/keys``
 (:func:`default_key_dir`; ``$ATT_KEY_DIR`` overrides).
@@ -15,13 +16,15 @@ from __future__ import annotations
 
 import hashlib
 import os
+import struct
 import sys
 from pathlib import Path
+
+import numpy as np
 
 from cryptography.exceptions import InvalidSignature
 from cryptography.hazmat.primitives import serialization
 from cryptography.hazmat.primitives.asymmetric.ed25519 import Ed25519PrivateKey, Ed25519PublicKey
-from rclpy.serialization import serialize_message
 
 KEY_DIR_ENV = "ATT_KEY_DIR"
 PRIVATE_NAME, PUBLIC_NAME = "plan_signing.key", "plan_signing.pub"
@@ -70,14 +73,49 @@ def load_public_key(path: str | Path) -> Ed25519PublicKey:
     return key
 
 
+_NUMBERS = {"double": "<f8", "float": "<f4", "int8": "<i1", "uint8": "<u1", "octet": "<u1", "char": "<u1",
+            "int16": "<i2", "uint16": "<u2", "int32": "<i4", "uint32": "<u4", "int64": "<i8", "uint64": "<u8",
+            "boolean": "<u1"}
+
+
+def _element(kind: str) -> str | None:
+    """The element type of a sequence or array type (``sequence<double, 3>``, ``double[3]``)."""
+    if kind.startswith("sequence<"):
+        return kind[len("sequence<"):-1].split(",")[0].strip()
+    return kind[:kind.index("[")] if kind.endswith("]") else None
+
+
+def _encode(value, kind: str, out: list) -> None:
+    element = _element(kind)
+    if element is not None:
+        out.append(struct.pack("<Q", len(value)))
+        if element in _NUMBERS:
+            out.append(np.asarray(value, dtype=_NUMBERS[element]).tobytes())
+            return
+        fields = type(value[0]).get_fields_and_field_types() if len(value) else {}
+        if fields and all(k == "double" for k in fields.values()):      # Vector3, Quaternion, ...
+            out.append(np.array([[getattr(item, n) for n in fields] for item in value], "<f8").tobytes())
+            return
+        for item in value:
+            _encode(item, element, out)
+    elif kind in _NUMBERS:
+        out.append(np.asarray(value, dtype=_NUMBERS[kind]).tobytes())
+    elif kind in ("string", "wstring") or kind.startswith("string<"):
+        data = value.encode("utf-8")
+        out.append(struct.pack("<Q", len(data)) + data)
+    else:
+        for name, field_kind in value.get_fields_and_field_types().items():
+            _encode(getattr(value, name), field_kind, out)
+
+
 def payload(msg) -> bytes:
-    """The bytes a signature covers: the message serialized with an empty ``signature``."""
-    signature = msg.signature
-    msg.signature = b""
-    try:
-        return serialize_message(msg)
-    finally:
-        msg.signature = signature
+    """The bytes a signature covers: every field of ``msg`` but ``signature``, in declaration
+    order (numbers little-endian, strings and sequences length-prefixed)."""
+    out = [type(msg).__name__.encode()]
+    for name, kind in msg.get_fields_and_field_types().items():
+        if name != "signature":
+            _encode(getattr(msg, name), kind, out)
+    return b"".join(out)
 
 
 def sign(msg, private_key: Ed25519PrivateKey) -> None:

@@ -17,6 +17,9 @@ from att_msgs_py.errors import ErrorCode, RequestError
 UNIT_TOLERANCE = 1e-3          # |‖q‖ − 1| (and unit vectors) accepted and normalised below this
 MAX_NAME_LENGTH = 128          # names, ids and frames
 MAX_TEXT_LENGTH = 1000         # free text (plan messages)
+MAX_PLAN_SAMPLES = 20_000      # knots of a plan (about 1.8 MB on the wire)
+MAX_PLAN_BYTES = 4 * 1024 * 1024   # serialized ManeuverPlan
+MAX_PLAN_DURATION = 86_400.0   # s
 
 
 def text(value, name: str, code: ErrorCode = ErrorCode.INVALID_TEXT, max_length: int = MAX_NAME_LENGTH) -> str:

@@ -7,6 +7,13 @@ control instant (actuator command, status, action feedback, the result of a mane
 The node (:mod:`att_planner.nodes.controller_node`) only translates messages; tests drive the
 core directly, like :class:`att_sim.simulation.Simulation`.
 
+Inputs are hostile until checked: a state passes :class:`~.state_gate.StateGate` (fields, time,
+source) or changes nothing; a plan passes :func:`~.plan_checks.check_plan` (fields, spacecraft,
+signature) before it is cached or flown, its id can never be taken by a different plan, and it
+starts only near the current state (:func:`~.plan_checks.check_start`). The cache is bounded by
+count and bytes (oldest first, never the plan being flown). A controller whose first state shows
+the spacecraft rotating faster than ``safe_rate_threshold`` goes to safe mode by itself.
+
 Laws per mode: IDLE commands nothing; MAGNETORQUER_PD the PD-like law of Bruni & Celani
 (:mod:`.magnetorquer`); SAFE rate damping through the wheels (τ = −k_d ω); PLAN_TRACKING the plan's
 feedforward plus quaternion PD feedback (:mod:`.tracking`) for the plan's duration plus a settle
@@ -14,13 +21,15 @@ time, then a hold of its final attitude.
 """
 from __future__ import annotations
 
+import hashlib
 import math
 from collections import OrderedDict
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
-from att_msgs_py.errors import ErrorCode
+from att_msgs_py import validation
+from att_msgs_py.errors import ErrorCode, RequestError
 from att_msgs_py.types import (
     CONTROL_MODES,
     Command,
@@ -31,11 +40,12 @@ from att_msgs_py.types import (
     ManeuverResult,
     Plan,
     State,
-    Status,
 )
 from att_planner.cones import min_margin
 from att_planner.control import tracking
 from att_planner.control.magnetorquer import dipole_command
+from att_planner.control.plan_checks import PlanContext, check_plan, check_start
+from att_planner.control.state_gate import GateConfig, StateGate
 from att_sim import rotations as rot
 from att_sim.dynamics import Spacecraft
 
@@ -54,6 +64,8 @@ class ControllerConfig:
     safe_kd: float = 10.0              # N m s / rad, rate damping of the safe mode
     feedback_period: float = 0.5       # s of sim time between action feedbacks
     max_cached_plans: int = 50
+    max_cache_bytes: int = 64 * 1024 * 1024   # serialized plans kept
+    safe_rate_threshold: float = 0.005  # rad/s: found rotating faster at start, the controller damps (safe mode)
 
     @property
     def feedback_every(self) -> int:
@@ -81,34 +93,105 @@ class StepOutput:
 
 
 @dataclass
+class StateOutcome:
+    """What one received state did: ``refused`` (discarded, why), a ``note`` to report (a new
+    timeline, safe mode at start) and the result of a maneuver that this ended."""
+
+    refused: RequestError | None = None
+    note: str | None = None
+    ended: ManeuverResult | None = None
+
+
+@dataclass
+class CachedPlan:
+    plan: Plan
+    size: int                                  # bytes of its message
+
+
+MAX_REMEMBERED_IDS = 100_000                   # plan ids whose content is remembered (32 bytes each)
+
+
 class Controller:
-    spacecraft: Spacecraft
-    config: ControllerConfig = ControllerConfig()
-    mode: int = ControlMode.IDLE
-    body_frame_id: str = ""
-    state: State | None = None
-    next_control: float = -math.inf
-    maneuver: Maneuver | None = None
-    hold_q: np.ndarray | None = None           # final attitude held after a maneuver
-    plans: OrderedDict = field(default_factory=OrderedDict)
+    def __init__(self, context: PlanContext, config: ControllerConfig = ControllerConfig(),
+                 mode: int = ControlMode.IDLE, body_frame_id: str = "body", gate: GateConfig | None = None):
+        self.context, self.config, self.mode, self.body_frame_id = context, config, mode, body_frame_id
+        self.gate = StateGate(context.spacecraft, context.frame_id, body_frame_id, gate or GateConfig())
+        self.next_control = -math.inf
+        self.maneuver: Maneuver | None = None
+        self.hold_q: np.ndarray | None = None          # final attitude held after a maneuver
+        self.plans: OrderedDict[str, CachedPlan] = OrderedDict()
+        self.seen: OrderedDict[str, bytes] = OrderedDict()   # plan id -> SHA-256 of its signed bytes
+
+    @property
+    def spacecraft(self) -> Spacecraft:
+        return self.context.spacecraft
+
+    @property
+    def state(self) -> State | None:
+        return self.gate.last
 
     @property
     def m_max(self) -> float:
-        return self.config.m_max if math.isfinite(self.config.m_max) else self.spacecraft.dipole_max
+        return min(self.config.m_max, self.spacecraft.dipole_max)
+
+    @property
+    def cache_bytes(self) -> int:
+        return sum(c.size for c in self.plans.values())
 
     # -- inputs ---------------------------------------------------------------------------------
-    def accept_state(self, state: State) -> str | None:
-        """Keep ``state`` as the latest, or say why it is ignored."""
-        if not (np.all(np.isfinite(state.q)) and np.all(np.isfinite(state.omega))):
-            return "non-finite state received; ignored"
-        self.state = state
+    def accept_state(self, state: State, wall: float = 0.0, clock: float | None = None,
+                     source: bytes | None = None) -> StateOutcome:
+        """Keep ``state`` (received at monotonic ``wall`` s, node clock ``clock``, from publisher
+        ``source``) as the latest if :class:`StateGate` admits it; what it changed."""
+        first = self.gate.last is None
+        admission = self.gate.admit(state, wall, clock, source)
+        if admission.error is not None:
+            return StateOutcome(refused=admission.error)
+        out = StateOutcome()
+        if admission.resynced:
+            out.note = f"state timeline restarted: {admission.previous_t:.3f} s then {state.t:.3f} s"
+            if self.maneuver is not None:
+                out.ended = self.abort(f"aborted: {out.note}")
+            self.next_control = -math.inf
+        rate = float(np.linalg.norm(admission.state.omega))
+        if first and self.mode == ControlMode.IDLE and rate > self.config.safe_rate_threshold:
+            self.mode = ControlMode.SAFE
+            out.note = (f"the spacecraft rotates at {rate:.4g} rad/s (above safe_rate_threshold "
+                        f"{self.config.safe_rate_threshold:g} rad/s): rate damping (safe mode)")
+        return out
+
+    def _remember(self, plan: Plan, payload: bytes) -> RequestError | None:
+        """Record ``plan``'s id with its content; refuse a different plan under a known id."""
+        digest = hashlib.sha256(payload).digest()
+        known = self.seen.get(plan.plan_id)
+        if known is not None and known != digest:
+            return RequestError(ErrorCode.PLAN_ID_REUSED,
+                                f"plan id '{plan.plan_id}' belongs to a different plan this controller received "
+                                "before; refused")
+        self.seen[plan.plan_id] = digest
+        self.seen.move_to_end(plan.plan_id)
+        while len(self.seen) > MAX_REMEMBERED_IDS:
+            self.seen.popitem(last=False)
         return None
 
-    def receive_plan(self, plan: Plan) -> None:
-        """Cache a published plan (the oldest are dropped beyond ``max_cached_plans``)."""
-        self.plans[plan.plan_id] = plan
-        while len(self.plans) > self.config.max_cached_plans:
-            self.plans.popitem(last=False)
+    def admit_plan(self, plan: Plan, payload: bytes) -> RequestError | None:
+        """Check a received plan (:func:`check_plan`) and its id; None when it is usable."""
+        return check_plan(plan, payload, self.context) or self._remember(plan, payload)
+
+    def receive_plan(self, plan: Plan, payload: bytes) -> RequestError | None:
+        """Cache a published plan once it passes :meth:`admit_plan`; the oldest plans go beyond
+        ``max_cached_plans`` or ``max_cache_bytes``, never the one being flown."""
+        refused = self.admit_plan(plan, payload)
+        if refused is not None or plan.plan_id in self.plans:
+            return refused
+        self.plans[plan.plan_id] = CachedPlan(plan, len(payload))
+        flying = self.maneuver.plan.plan_id if self.maneuver is not None else None
+        for plan_id in list(self.plans):
+            if len(self.plans) <= self.config.max_cached_plans and self.cache_bytes <= self.config.max_cache_bytes:
+                break
+            if plan_id != flying:
+                del self.plans[plan_id]
+        return None
 
     def set_mode(self, mode: int) -> tuple[ErrorCode, str, ManeuverResult | None]:
         """Change the mode; the result of a maneuver this aborts comes back too."""
@@ -123,29 +206,33 @@ class Controller:
         self.mode = mode
         return ErrorCode.OK, f"mode set to {mode}", ended
 
-    def resolve(self, plan_id: str, inline: Plan | None = None) -> tuple[Plan | None, ErrorCode, str]:
-        """The plan to execute (``inline``, or the cached ``plan_id``), or why there is none."""
-        plan = inline if inline is not None else self.plans.get(plan_id)
-        if plan is None:
-            return None, ErrorCode.UNKNOWN_PLAN, f"plan_id '{plan_id}' is not a plan this controller received"
-        t, torque = plan.t, plan.torque
-        if len(t) < 2 or len(plan.q) != len(t) or len(torque) != len(t) or np.any(np.diff(t) <= 0):
-            return None, ErrorCode.INVALID_PLAN, "plan times must increase and match attitudes, rates and torques"
-        if not all(np.all(np.isfinite(a)) for a in (plan.t, plan.q, plan.omega, plan.torque)):
-            return None, ErrorCode.INVALID_PLAN, "plan contains NaN or Inf"
-        if plan.control_kind not in (*tuple(ControlKind), ""):
-            return None, ErrorCode.INVALID_PLAN, f"control_kind '{plan.control_kind}' is not supported"
-        if plan.status == Status.FAILED:
-            return None, ErrorCode.INVALID_PLAN, "plan status is 'failed'"
-        return plan, ErrorCode.OK, ""
+    def resolve(self, plan_id: str, inline: Plan | None = None,
+                payload: bytes = b"") -> tuple[Plan | None, RequestError | None]:
+        """The plan to execute (``inline`` with its signed ``payload``, or the cached ``plan_id``),
+        or why there is none."""
+        if inline is not None:
+            refused = self.admit_plan(inline, payload)
+            return (None, refused) if refused is not None else (inline, None)
+        try:
+            validation.text(plan_id, "plan_id")
+        except RequestError as err:
+            return None, err
+        cached = self.plans.get(plan_id)
+        if cached is None:
+            return None, RequestError(ErrorCode.UNKNOWN_PLAN,
+                                      f"plan_id '{plan_id[:128]}' is not a plan this controller received")
+        return cached.plan, None
 
-    def start(self, plan: Plan) -> tuple[ErrorCode, str]:
-        """Start flying ``plan`` (resolved) from the latest state."""
+    def start(self, plan: Plan) -> RequestError | None:
+        """Start flying ``plan`` (resolved) from the latest state, if it starts there."""
         if self.state is None:
-            return ErrorCode.NO_STATE, "no spacecraft state received yet"
+            return RequestError(ErrorCode.NO_STATE, "no spacecraft state received yet")
+        refused = check_start(plan, self.state, self.context)
+        if refused is not None:
+            return refused
         self.maneuver = Maneuver(plan, self.state.t)
         self.mode = ControlMode.PLAN_TRACKING
-        return ErrorCode.OK, ""
+        return None
 
     def abort(self, message: str) -> ManeuverResult:
         """End the running maneuver unsuccessfully (cancelled, or safe mode); safe mode follows."""

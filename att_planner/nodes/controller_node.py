@@ -7,6 +7,11 @@ time (the simulator's lockstep waits for it); serves ``/controller/set_mode`` an
 ``/controller/execute`` action (ExecuteManeuver), which runs for the maneuver's duration plus
 ``settle_time`` and reports progress as feedback.
 
+Nothing received is trusted (the core's checks, :mod:`att_planner.control.plan_checks` and
+:mod:`att_planner.control.state_gate`): a refused state or plan is logged (at most once a second
+per kind, clipped, with a running count) and changes nothing. Plans must verify against the
+Ed25519 public key ``plan_public_key`` (:mod:`att_msgs_py.signing`).
+
 Watchdog: when no state came for ``wall_timeout`` s of wall time the controller commands zero
 and reports ``state_stale`` until states flow again.
 """
@@ -14,6 +19,7 @@ from __future__ import annotations
 
 import math
 import time
+from collections import Counter
 
 from rclpy.action import ActionServer, CancelResponse, GoalResponse
 from rclpy.clock import Clock, ClockType
@@ -24,34 +30,36 @@ from rclpy.task import Future
 from att_msgs.action import ExecuteManeuver
 from att_msgs.msg import ActuatorCommand, ControllerStatus, ManeuverPlan, SpacecraftState
 from att_msgs.srv import SetControllerMode
-from att_msgs_py import convert, qos, topics
-from att_msgs_py.errors import ErrorCode
+from att_msgs_py import convert, qos, signing, topics
+from att_msgs_py.errors import ConfigError, ErrorCode, RequestError, clip
 from att_msgs_py.node_runner import parameter_reader, run_node
 from att_msgs_py.types import ControlMode, ManeuverResult
 from att_planner.control.controller import Controller, ControllerConfig
+from att_planner.control.plan_checks import PlanContext
+from att_planner.control.state_gate import GateConfig
 from att_sim import scenario as scen
+
+
+def publisher_of(info) -> bytes | None:
+    """The publisher GID of a received message (None when the middleware does not say)."""
+    gid = (info or {}).get("publisher_gid")
+    return bytes(gid["data"]) if isinstance(gid, dict) and gid.get("data") is not None else None
 
 
 class ControllerNode(Node):
     def __init__(self):
         super().__init__("controller", parameter_overrides=[Parameter("use_sim_time", value=True)])
-        self._scenario = scen.load(self.declare_parameter("scenario", "swift_demo").value)
-        sc = self._scenario.spacecraft
-        param = parameter_reader(self, self._scenario.node_params.get("controller", {}))
-        d = ControllerConfig()
-        tracking_kd = float(param("tracking_kd", d.tracking_kd))
-        config = ControllerConfig(
-            control_period=1.0 / float(param("control_rate", 1.0 / d.control_period)),
-            settle_time=float(param("settle_time", d.settle_time)),
-            tracking_kp=float(param("tracking_kp", d.tracking_kp)), tracking_kd=tracking_kd,
-            kp=float(param("kp", d.kp)), kd=float(param("kd", d.kd)), m_max=float(param("m_max", sc.dipole_max)),
-            safe_kd=float(param("safe_kd", tracking_kd)))
-        self._core = Controller(sc, config, int(param("initial_mode", ControlMode.IDLE)),
-                                self._scenario.body_frame_id)
-        self._wall_timeout = float(param("wall_timeout", 2.0))
-        self._state_wall = -math.inf     # wall time the latest state arrived
+        self._scenario = scen.load_checked(parameter_reader(self, {})("scenario", "swift_demo"))
+        param = parameter_reader(self, self._scenario.node_params.get("controller", {}), str(self._scenario.path))
+        self._core = Controller(self._plan_context(param), self._config(param),
+                                param("initial_mode", int(ControlMode.IDLE),
+                                      choices=[int(m) for m in ControlMode if m != ControlMode.PLAN_TRACKING]),
+                                self._scenario.body_frame_id, self._gate_config(param))
+        self._wall_timeout = param("wall_timeout", 2.0, 0.0, 3600.0, low_open=True)
+        self._state_wall = time.monotonic()   # no "no state" warning before wall_timeout has passed
         self._stale = False
-        self._goal = None                # the goal handle of the running maneuver
+        self._refused = Counter()             # refused inputs per kind, for the throttled log lines
+        self._goal = None                     # the goal handle of the running maneuver
         self._done: Future | None = None
 
         self._cmd_pub = self.create_publisher(ActuatorCommand, topics.COMMAND, qos.STREAM_QOS)
@@ -62,15 +70,67 @@ class ControllerNode(Node):
         self.create_timer(0.5, self.on_wall_watchdog, clock=Clock(clock_type=ClockType.STEADY_TIME))
         self._action = ActionServer(self, ExecuteManeuver, topics.EXECUTE_MANEUVER, execute_callback=self.execute,
                                     goal_callback=self.on_goal, cancel_callback=lambda _: CancelResponse.ACCEPT)
-        self.get_logger().info(f"scenario '{self._scenario.name}', mode {self._core.mode}; magnetorquer gains "
-                               f"kp={config.kp:.6g} kd={config.kd:.6g} m_max={self._core.m_max:g}")
+        c = self._core.config
+        self.get_logger().info(f"scenario '{self._scenario.name}', mode {self._core.mode}, plan key "
+                               f"{signing.key_id(self._core.context.public_key)}; magnetorquer gains "
+                               f"kp={c.kp:.6g} kd={c.kd:.6g} m_max={self._core.m_max:g}")
+
+    def _config(self, param) -> ControllerConfig:
+        d = ControllerConfig()
+        tracking_kd = param("tracking_kd", d.tracking_kd, 0.0)
+        m_max = param("m_max", self._scenario.spacecraft.dipole_max)
+        if not m_max > 0:
+            raise ConfigError(ErrorCode.INVALID_PARAMETER, f"parameter 'm_max': expected a dipole > 0 A m², "
+                                                           f"got {m_max}")
+        return ControllerConfig(
+            control_period=1.0 / param("control_rate", 1.0 / d.control_period, 0.0, 1000.0, low_open=True),
+            settle_time=param("settle_time", d.settle_time, 0.0, 86_400.0),
+            tracking_kp=param("tracking_kp", d.tracking_kp, 0.0), tracking_kd=tracking_kd,
+            kp=param("kp", d.kp, 0.0), kd=param("kd", d.kd, 0.0), m_max=m_max,
+            safe_kd=param("safe_kd", tracking_kd, 0.0),
+            max_cached_plans=param("max_cached_plans", d.max_cached_plans, 1, 10_000),
+            max_cache_bytes=int(param("max_cache_mb", d.max_cache_bytes / 2**20, 0.0, 4096.0, low_open=True) * 2**20),
+            safe_rate_threshold=param("safe_rate_threshold", d.safe_rate_threshold, 0.0, 10.0, low_open=True))
+
+    def _plan_context(self, param) -> PlanContext:
+        path = param("plan_public_key", str(signing.default_key_dir() / signing.PUBLIC_NAME))
+        try:
+            key = signing.load_public_key(path)
+        except (OSError, ValueError) as exc:
+            raise ConfigError(ErrorCode.INVALID_CONFIG, f"parameter 'plan_public_key': no Ed25519 public key at "
+                                                        f"'{clip(path, 200)}' ({clip(exc, 120)}): run att-keygen, or "
+                                                        "copy the planner's plan_signing.pub") from None
+        return PlanContext(
+            self._scenario.spacecraft, self._scenario.name, self._scenario.frame_id, key,
+            max_start_attitude_error=math.radians(param("max_start_attitude_error_deg", 5.0, 0.0, 180.0,
+                                                        low_open=True)),
+            max_start_rate_error=param("max_start_rate_error", 0.01, 0.0, 10.0, low_open=True))
+
+    @staticmethod
+    def _gate_config(param) -> GateConfig:
+        d = GateConfig()
+        return GateConfig(max_state_gap=param("max_state_gap", d.max_state_gap, 0.0, 3600.0, low_open=True),
+                          max_clock_skew=param("max_clock_skew", d.max_clock_skew, 0.0, 3600.0, low_open=True),
+                          resync_timeout=param("resync_timeout", d.resync_timeout, 0.0, 3600.0, low_open=True))
+
+    def _report_refusal(self, what: str, err: RequestError) -> None:
+        """One clipped log line per second at most per kind of input, with the running count."""
+        self._refused[what] += 1
+        self.get_logger().warning(clip(f"{what} refused ({self._refused[what]} so far) [{int(err.code)} "
+                                       f"{err.code.name}]: {err.message}"), throttle_duration_sec=1.0)
 
     # -- inputs ---------------------------------------------------------------------------------
-    def on_state(self, msg: SpacecraftState):
-        error = self._core.accept_state(convert.state_from_msg(msg))
-        if error:
-            self.get_logger().error(error, throttle_duration_sec=1.0)
+    def on_state(self, msg: SpacecraftState, info=None):
+        clock = self.get_clock().now().nanoseconds * 1e-9
+        outcome = self._core.accept_state(convert.state_from_msg(msg), time.monotonic(), clock or None,
+                                          publisher_of(info))
+        if outcome.refused is not None:
+            self._report_refusal("state", outcome.refused)
             return
+        if outcome.note:
+            self.get_logger().warning(outcome.note)
+        if outcome.ended is not None:
+            self.finish(outcome.ended)
         self._state_wall = time.monotonic()
         if self._stale:
             self._stale = False
@@ -85,7 +145,9 @@ class ControllerNode(Node):
                 self.finish(out.result)
 
     def on_plan(self, msg: ManeuverPlan):
-        self._core.receive_plan(convert.plan_from_msg(msg))
+        refused = self._core.receive_plan(convert.plan_from_msg(msg), signing.payload(msg))
+        if refused is not None:
+            self._report_refusal("published plan", refused)
 
     def on_set_mode(self, request, response):
         code, message, ended = self._core.set_mode(int(request.mode))
@@ -103,12 +165,13 @@ class ControllerNode(Node):
         the maneuver; feedback and cancellation are handled by the control loop."""
         goal = goal_handle.request
         inline = convert.plan_from_msg(goal.plan) if goal.use_inline_plan else None
-        plan, code, message = self._core.resolve(goal.plan_id, inline)
+        plan, refused = self._core.resolve(goal.plan_id, inline, signing.payload(goal.plan) if inline else b"")
         if plan is not None:
-            code, message = self._core.start(plan)
-        if code != ErrorCode.OK:
+            refused = self._core.start(plan)
+        if refused is not None:
+            self._report_refusal("execute goal", refused)
             goal_handle.abort()
-            return convert.result_msg(ManeuverResult(False, int(code), message))
+            return convert.result_msg(ManeuverResult(False, int(refused.code), refused.message))
         self._goal, self._done = goal_handle, Future(executor=self.executor)
         self.get_logger().info(f"executing plan '{plan.plan_id}' ({plan.method}, {plan.duration:.1f} s)")
         result = await self._done

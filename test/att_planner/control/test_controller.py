@@ -8,6 +8,7 @@ import pytest
 from att_msgs_py.errors import ErrorCode
 from att_msgs_py.types import ControlKind, ControlMode, Plan, Status
 from att_planner.control.controller import Controller, ControllerConfig
+from helpers.signed_plans import context, issue
 from att_planner.methods.eigenaxis import plan_eigenaxis_smooth
 from att_planner.problem import ManeuverProblem
 from att_sim import rotations as rot
@@ -22,32 +23,32 @@ CONFIG = ControllerConfig(control_period=0.1, settle_time=10.0, tracking_kp=1.0,
 def world():
     s = scenario.load("swift_demo")
     sim = Simulation(s.spacecraft, s.orbit)
-    plan = plan_eigenaxis_smooth(ManeuverProblem(s.spacecraft, rot.IDENTITY, GOAL))
-    plan.plan_id = "p1"
-    return sim, Controller(s.spacecraft, CONFIG, body_frame_id="body"), plan
+    ctx = context()
+    plan, payload = issue(plan_eigenaxis_smooth(ManeuverProblem(s.spacecraft, rot.IDENTITY, GOAL)), ctx)
+    return sim, Controller(ctx, CONFIG, body_frame_id="body"), (plan, payload)
 
 
 def fly(sim, core, seconds, dt=0.05):
     """Closed loop: the simulator's state into the core, its command back, as the nodes do."""
     outputs = []
     for _ in range(int(round(seconds / dt))):
-        assert core.accept_state(sim.state()) is None
+        assert core.accept_state(sim.state("eci", "body"), wall=sim.t).refused is None
         if core.due():
             out = core.step()
             assert sim.set_command(out.command) is None
             outputs.append(out)
-            if out.result is not None:
-                return outputs
         sim.advance(dt)
+        if outputs and outputs[-1].result is not None:
+            return outputs
     return outputs
 
 
 def test_a_plan_is_flown_to_its_goal_with_feedback_then_held(world):
-    sim, core, plan = world
-    core.receive_plan(plan)
-    core.accept_state(sim.state())
-    resolved, code, _ = core.resolve("p1")
-    assert code == ErrorCode.OK and core.start(resolved) == (ErrorCode.OK, "")
+    sim, core, (plan, payload) = world
+    assert core.receive_plan(plan, payload) is None
+    fly(sim, core, 0.05)
+    resolved, refused = core.resolve("p1")
+    assert refused is None and core.start(resolved) is None
     assert core.mode == ControlMode.PLAN_TRACKING
     outputs = fly(sim, core, plan.duration + CONFIG.settle_time + 5)
     result = outputs[-1].result
@@ -66,12 +67,12 @@ def test_a_plan_is_flown_to_its_goal_with_feedback_then_held(world):
 
 
 def test_mode_changes_are_checked_and_safe_mode_aborts_a_maneuver(world):
-    sim, core, plan = world
+    sim, core, (plan, _) = world
     assert core.set_mode(7)[0] == ErrorCode.INVALID_MODE
     assert core.set_mode(ControlMode.PLAN_TRACKING)[0] == ErrorCode.INVALID_MODE
-    assert core.start(plan) == (ErrorCode.NO_STATE, "no spacecraft state received yet")
+    assert core.start(plan).code == ErrorCode.NO_STATE
     fly(sim, core, 0.2)
-    assert core.start(plan)[0] == ErrorCode.OK
+    assert core.start(plan) is None
     fly(sim, core, 2.0)
     code, message, ended = core.set_mode(ControlMode.MAGNETORQUER_PD)
     assert code == ErrorCode.BUSY and "'p1' is executing" in message and ended is None
@@ -85,39 +86,44 @@ def test_mode_changes_are_checked_and_safe_mode_aborts_a_maneuver(world):
 
 
 def test_cancellation_ends_the_maneuver_in_safe_mode(world):
-    sim, core, plan = world
+    sim, core, (plan, _) = world
     fly(sim, core, 0.2)
     core.start(plan)
-    core.accept_state(sim.state())
     core.next_control = -math.inf
     out = core.step(cancel_requested=True)
     assert out.result.error_code == ErrorCode.ABORTED and out.result.message == "cancelled"
     assert core.mode == ControlMode.SAFE and core.hold_q is None
 
 
-@pytest.mark.parametrize("change, words", [
-    (dict(t=np.array([0.0, 2.0, 1.0])), "times must increase"),
-    (dict(q=np.zeros((2, 4))), "match attitudes"),
-    (dict(torque=np.full((3, 3), np.nan)), "NaN or Inf"),
-    (dict(control_kind="warp_drive"), "control_kind 'warp_drive'"),
-    (dict(status=Status.FAILED), "status is 'failed'"),
+@pytest.mark.parametrize("change, code, words", [
+    (dict(t=np.array([0.0, 2.0, 1.0])), ErrorCode.INVALID_PLAN, "do not increase"),
+    (dict(q=np.zeros((2, 4))), ErrorCode.INVALID_PLAN, "attitudes has 2 entries"),
+    (dict(torque=np.full((3, 3), np.nan)), ErrorCode.INVALID_PLAN, "NaN or Inf"),
+    (dict(control_kind="warp_drive"), ErrorCode.INVALID_PLAN, "control_kind 'warp_drive'"),
+    (dict(status=Status.FAILED), ErrorCode.INVALID_PLAN, "status 'failed'"),
 ])
-def test_bad_inline_plans_are_refused(world, change, words):
+def test_bad_inline_plans_are_refused(world, change, code, words):
     _, core, _ = world
     good = Plan(t=np.array([0.0, 1.0, 2.0]), torque=np.zeros((3, 3)), q=np.tile(rot.IDENTITY, (3, 1)),
                 omega=np.zeros((3, 3)), control_kind=ControlKind.BODY_TORQUE, status=Status.OPTIMAL)
-    assert core.resolve("", good)[1] == ErrorCode.OK
-    plan, code, message = core.resolve("", replace(good, **change))
-    assert plan is None and code == ErrorCode.INVALID_PLAN and words in message
+    assert core.resolve("", *issue(good, core.context, "good"))[1] is None
+    plan, refused = core.resolve("", *issue(replace(good, **change), core.context, "bad"))
+    assert plan is None and refused.code == code and words in refused.message
 
 
-def test_unknown_plans_and_the_cache_bound(world):
-    _, core, plan = world
-    assert core.resolve("nope")[1] == ErrorCode.UNKNOWN_PLAN
-    for i in range(CONFIG.max_cached_plans + 5):
-        core.receive_plan(replace(plan, plan_id=f"p{i}"))
-    assert len(core.plans) == CONFIG.max_cached_plans
-    assert core.resolve("p0")[1] == ErrorCode.UNKNOWN_PLAN and core.resolve(f"p{CONFIG.max_cached_plans + 4}")[1] == 0
+def test_unknown_plans_and_the_cache_bounds(world):
+    _, core, (plan, _) = world
+    assert core.resolve("nope")[1].code == ErrorCode.UNKNOWN_PLAN
+    n = CONFIG.max_cached_plans
+    for i in range(n + 5):
+        assert core.receive_plan(*issue(replace(plan), core.context, f"p{i}")) is None
+    assert len(core.plans) == n
+    assert core.resolve("p0")[1].code == ErrorCode.UNKNOWN_PLAN and core.resolve(f"p{n + 4}")[1] is None
+    size = next(iter(core.plans.values())).size
+    small = Controller(core.context, replace(CONFIG, max_cache_bytes=3 * size))
+    for i in range(6):
+        small.receive_plan(*issue(replace(plan), core.context, f"q{i}"))
+    assert list(small.plans) == ["q3", "q4", "q5"] and small.cache_bytes <= 3 * size
 
 
 def test_control_instants_follow_the_control_period(world):
@@ -130,11 +136,13 @@ def test_control_instants_follow_the_control_period(world):
 
 def test_magnetorquer_mode_commands_the_pd_law_and_non_finite_states_are_ignored():
     s = scenario.load("bruni_celani")
-    core = Controller(s.spacecraft, ControllerConfig(kp=2e5, kd=1e8, control_period=1.0), ControlMode.MAGNETORQUER_PD)
+    core = Controller(context("bruni_celani"), ControllerConfig(kp=2e5, kd=1e8, control_period=1.0),
+                      ControlMode.MAGNETORQUER_PD, s.body_frame_id)
     sim = Simulation(s.spacecraft, s.orbit, omega0=[0.02, 0.02, -0.03])
     sim.advance(0.5)
-    state = sim.state()
-    assert core.accept_state(replace(state, q=np.array([np.nan, 0, 0, 1]))) == "non-finite state received; ignored"
-    assert core.accept_state(state) is None and core.due()
+    state = sim.state(s.frame_id, s.body_frame_id)
+    refused = core.accept_state(replace(state, q=np.array([np.nan, 0, 0, 1]))).refused
+    assert refused.code == ErrorCode.INVALID_STATE and "state.attitude" in refused.message
+    assert core.accept_state(state).refused is None and core.due()
     m = core.step().command.dipole
     assert np.all(np.abs(m) <= s.spacecraft.dipole_max) and np.any(m)

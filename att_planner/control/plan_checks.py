@@ -1,0 +1,139 @@
+"""What the controller checks before it keeps or flies a plan (no ROS).
+
+:func:`check_plan` looks at every field of a received plan (cached from ``/planner/plans`` or
+inline in an ``ExecuteManeuver`` goal): sizes and lengths against each other, finiteness, unit
+quaternions, times from 0 strictly increasing and bounded, controls within the spacecraft's
+limits, known vocabularies, bounded strings; then its context: made for this spacecraft
+configuration (name and :attr:`~att_sim.dynamics.Spacecraft.digest`) and signed by the configured
+key (:mod:`att_msgs_py.signing`). :func:`check_start` compares a plan's first sample with the
+current state. Each returns ``None`` or a :class:`RequestError` (code and sentence).
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from att_msgs_py import signing, validation
+from att_msgs_py.errors import ErrorCode, RequestError
+from att_msgs_py.types import ControlKind, Interpolation, Plan, State, Status
+from att_sim import rotations as rot
+from att_sim.dynamics import Spacecraft
+
+LIMIT_TOLERANCE = 1e-6       # relative: plan controls may touch their limit, not exceed it
+MAX_PLAN_RATE = 10.0         # rad/s, any body axis: beyond it a plan is not a slew
+MAX_CONES = 16
+
+
+@dataclass(frozen=True)
+class PlanContext:
+    """What a plan must match: the controller's spacecraft, frames and key, and the start tolerances."""
+
+    spacecraft: Spacecraft
+    spacecraft_name: str
+    frame_id: str
+    public_key: object                      # Ed25519PublicKey
+    max_start_attitude_error: float = math.radians(5.0)   # rad
+    max_start_rate_error: float = 0.01                    # rad/s
+
+
+def _fields(plan: Plan, sc: Spacecraft, frame_id: str) -> Plan:
+    """The plan with checked arrays (quaternions normalised); raises RequestError."""
+    code = ErrorCode.INVALID_PLAN
+    for name, value, limit in (("plan_id", plan.plan_id, validation.MAX_NAME_LENGTH),
+                               ("method", plan.method, validation.MAX_NAME_LENGTH),
+                               ("spacecraft", plan.spacecraft, validation.MAX_NAME_LENGTH),
+                               ("header.frame_id", plan.frame_id, validation.MAX_NAME_LENGTH),
+                               ("message", plan.message, validation.MAX_TEXT_LENGTH)):
+        validation.text(value, f"plan.{name}", max_length=limit)
+    if not plan.plan_id:
+        raise RequestError(code, "plan.plan_id is empty")
+    if plan.frame_id != frame_id:
+        raise RequestError(ErrorCode.INVALID_FRAME,
+                           f"plan.header.frame_id '{plan.frame_id}' is not the controller's frame '{frame_id}'")
+    if plan.status not in tuple(Status) or plan.status == Status.FAILED:
+        raise RequestError(code, f"plan.status '{plan.status}' is not one a plan can be flown with "
+                                 f"({', '.join(s for s in Status if s != Status.FAILED)})")
+    if plan.control_kind not in tuple(ControlKind):
+        raise RequestError(code, f"plan.control_kind '{plan.control_kind}' is not one of {', '.join(ControlKind)}")
+    if plan.interpolation not in tuple(Interpolation):
+        raise RequestError(code, f"plan.interpolation '{plan.interpolation}' is not one of {', '.join(Interpolation)}")
+    k = len(plan.t)
+    if k > validation.MAX_PLAN_SAMPLES:
+        raise RequestError(ErrorCode.SIZE_LIMIT, f"plan.times has {k} samples; at most {validation.MAX_PLAN_SAMPLES}")
+    if k < 2:
+        raise RequestError(code, f"plan.times has {k} samples; a plan needs at least 2")
+    for name, a in (("attitudes", plan.q), ("rates", plan.omega), ("torques", plan.torque)):
+        if len(a) != k:
+            raise RequestError(code, f"plan.{name} has {len(a)} entries for {k} times")
+    t = validation.finite_array(plan.t, "plan.times", code, (-1,))
+    if t[0] != 0.0:
+        raise RequestError(code, f"plan.times[0] = {t[0]!r}; a plan starts at 0")
+    step = np.diff(t)
+    if np.any(step <= 0):
+        i = int(np.flatnonzero(step <= 0)[0])
+        raise RequestError(code, f"plan.times do not increase at index {i + 1} ({t[i]!r} then {t[i + 1]!r})")
+    if t[-1] > validation.MAX_PLAN_DURATION:
+        raise RequestError(code, f"plan duration {t[-1]:.6g} s is above {validation.MAX_PLAN_DURATION:g} s")
+    q = validation.unit_quaternions(plan.q, "plan.attitudes", code)
+    omega = validation.finite_array(plan.omega, "plan.rates", code, (-1, 3))
+    if np.max(np.abs(omega)) > MAX_PLAN_RATE:
+        raise RequestError(code, f"plan.rates reach {np.max(np.abs(omega)):.6g} rad/s; at most {MAX_PLAN_RATE} rad/s")
+    torque = validation.finite_array(plan.torque, "plan.torques", code, (-1, 3))
+    if plan.control_kind == ControlKind.WHEEL_TORQUE:
+        if sc.n_wheels != 3:
+            raise RequestError(code, f"a wheel_torque plan carries 3 wheels; this spacecraft has {sc.n_wheels}")
+        limit, what = sc.wheel_torque_max, "wheel_torque_max"
+    else:
+        limit, what = sc.body_torque_max, "torque_max"
+    peak = float(np.max(np.abs(torque)))
+    if peak > limit * (1 + LIMIT_TOLERANCE):
+        raise RequestError(code, f"plan.torques reach {peak:.6g} N m, above the spacecraft's {what} {limit:.6g} N m")
+    axis = validation.unit_vector(plan.sensor_axis, "plan.sensor_axis", code)
+    if len(plan.cones) > MAX_CONES:
+        raise RequestError(ErrorCode.SIZE_LIMIT, f"plan.cones has {len(plan.cones)} cones; at most {MAX_CONES}")
+    for i, c in enumerate(plan.cones):
+        validation.text(c.name, f"plan.cones[{i}].name")
+        validation.unit_vector(c.direction, f"plan.cones[{i}].direction", code)
+        if not (math.isfinite(c.half_angle) and 0.0 < c.half_angle < math.pi / 2):
+            raise RequestError(code, f"plan.cones[{i}].half_angle = {c.half_angle!r} rad is outside (0, pi/2)")
+    plan.t, plan.q, plan.omega, plan.torque, plan.sensor_axis = t, q, omega, torque, axis
+    return plan
+
+
+def check_plan(plan: Plan, payload: bytes, ctx: PlanContext) -> RequestError | None:
+    """Why ``plan`` (whose signed bytes are ``payload``) may not be kept or flown; None when it may.
+    On success the plan's arrays are the checked ones (quaternions normalised)."""
+    if len(payload) > validation.MAX_PLAN_BYTES:
+        return RequestError(ErrorCode.SIZE_LIMIT, f"the plan message has {len(payload)} bytes; at most "
+                                                  f"{validation.MAX_PLAN_BYTES}")
+    try:
+        _fields(plan, ctx.spacecraft, ctx.frame_id)
+    except RequestError as err:
+        return err
+    if plan.spacecraft != ctx.spacecraft_name or plan.spacecraft_digest != ctx.spacecraft.digest:
+        which = "name" if plan.spacecraft != ctx.spacecraft_name else "physical parameters (digest)"
+        return RequestError(ErrorCode.WRONG_SPACECRAFT,
+                            f"plan '{plan.plan_id}' was made for spacecraft '{plan.spacecraft}', not for this "
+                            f"controller's '{ctx.spacecraft_name}' (the {which} differ)")
+    why = signing.check(payload, plan.signature, plan.key_id, ctx.public_key)
+    if why is not None:
+        return RequestError(ErrorCode.PLAN_NOT_AUTHENTIC, f"plan '{plan.plan_id}': {why}")
+    return None
+
+
+def check_start(plan: Plan, state: State, ctx: PlanContext) -> RequestError | None:
+    """Why ``plan`` cannot start from ``state`` (its first attitude or rate too far away)."""
+    angle = rot.angle_between(state.q, plan.q[0])
+    if angle > ctx.max_start_attitude_error:
+        return RequestError(ErrorCode.PLAN_CONTEXT,
+                            f"plan '{plan.plan_id}' starts {math.degrees(angle):.2f} deg from the current attitude "
+                            f"(at most {math.degrees(ctx.max_start_attitude_error):.2f} deg, parameter "
+                            "max_start_attitude_error_deg)")
+    rate_error = float(np.linalg.norm(state.omega - plan.omega[0]))
+    if rate_error > ctx.max_start_rate_error:
+        return RequestError(ErrorCode.PLAN_CONTEXT,
+                            f"plan '{plan.plan_id}' starts at a rate {rate_error:.4g} rad/s from the current one "
+                            f"(at most {ctx.max_start_rate_error:g} rad/s, parameter max_start_rate_error)")
+    return None
