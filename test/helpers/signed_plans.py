@@ -17,13 +17,13 @@ def context(name: str = "swift_demo", key: Ed25519PrivateKey = KEY, **tolerances
 
 
 def issue(plan: Plan, ctx: PlanContext, plan_id: str = "p1", key: Ed25519PrivateKey | None = KEY,
-          **fields) -> tuple[Plan, bytes]:
+          fields: dict | None = None) -> tuple[Plan, bytes]:
     """``plan`` with the planner's context, through the wire and signed: (received plan, payload).
     ``fields`` change the message after the context is filled, before signing (``key=None``: unsigned)."""
     plan.plan_id, plan.spacecraft, plan.frame_id = plan_id, ctx.spacecraft_name, ctx.frame_id
     plan.spacecraft_digest = ctx.spacecraft.digest
     msg = convert.plan_msg(plan)
-    for name, value in fields.items():
+    for name, value in (fields or {}).items():
         setattr(msg, name, value)
     if key is not None:
         signing.sign(msg, key)

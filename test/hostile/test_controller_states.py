@@ -1,0 +1,146 @@
+"""Hostile spacecraft states and mode requests to the controller core (no ROS): a state that
+fails a field, time or source check changes nothing; recovery from a new timeline; safe mode at start."""
+from __future__ import annotations
+
+import math
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from att_msgs_py.errors import ErrorCode
+from att_msgs_py.types import ControlMode
+from att_planner.control.controller import Controller, ControllerConfig
+from att_planner.methods.eigenaxis import plan_eigenaxis_smooth
+from att_planner.problem import ManeuverProblem
+from att_sim import rotations as rot
+from att_sim import scenario
+from att_sim.simulation import Simulation
+from helpers.signed_plans import context, issue
+
+SWIFT = scenario.load("swift_demo")
+SIM_A, SIM_B = b"simulator-gid", b"intruder-gid"
+
+
+@pytest.fixture
+def loop():
+    """A core that has accepted states at t = 0 .. 1 s from the simulator (wall time = sim time)."""
+    core = Controller(context(), ControllerConfig(control_period=0.1), body_frame_id="body")
+    sim = Simulation(SWIFT.spacecraft, SWIFT.orbit)
+    for _ in range(21):
+        assert core.accept_state(sim.state("eci", "body"), wall=sim.t, clock=sim.t, source=SIM_A).refused is None
+        sim.advance(0.05)
+    return core, sim
+
+
+def base(sim):
+    return sim.state("eci", "body")
+
+
+FIELD_CASES = [
+    ("NaN attitude", dict(q=np.array([np.nan, 0, 0, 1.0])), "state.attitude has NaN"),
+    ("zero attitude", dict(q=np.zeros(4)), "zero quaternion"),
+    ("attitude of norm 2", dict(q=np.array([0, 0, 0, 2.0])), "norm 2"),
+    ("infinite rate", dict(omega=np.array([np.inf, 0, 0])), "state.body_rate has NaN or Inf"),
+    ("rate of 100 rad/s", dict(omega=np.array([0, 100.0, 0])), "body_rate reaches 100"),
+    ("two wheel speeds for three wheels", dict(wheel_speeds=np.zeros(2)), "wheel_speeds has 2 entries"),
+    ("wheel speed of 1e30", dict(wheel_speeds=np.array([1e30, 0, 0])), "wheel_speeds reach"),
+    ("NaN wheel speed", dict(wheel_speeds=np.array([np.nan, 0, 0])), "wheel_speeds has NaN"),
+    ("field of 1 T", dict(field_body=np.array([1.0, 0, 0])), "magnetic_field_body is 1 T"),
+    ("NaN field", dict(field_body=np.array([np.nan, 0, 0])), "magnetic_field_body has NaN"),
+    ("another inertial frame", dict(frame_id="map"), "state frames 'map'"),
+    ("another body frame", dict(body_frame_id="base_link"), "'base_link'"),
+    ("negative stamp", dict(t=-1.0), "stamp -1.0"),
+    ("NaN stamp", dict(t=math.nan), "stamp nan"),
+]
+
+
+@pytest.mark.parametrize("case, change, words", FIELD_CASES, ids=[c[0] for c in FIELD_CASES])
+def test_a_state_with_a_bad_field_changes_nothing(loop, case, change, words):
+    core, sim = loop
+    before = core.state
+    out = core.accept_state(replace(base(sim), **change), wall=sim.t, clock=sim.t, source=SIM_A)
+    assert out.refused.code == ErrorCode.INVALID_STATE and words in out.refused.message, out.refused.message
+    assert core.state is before
+
+
+TIME_CASES = [
+    ("stamp of 1e6 s", dict(t=1e6), ErrorCode.STATE_TIME_JUMP, "from the node's clock"),
+    ("stamp backward", dict(t=0.5), ErrorCode.STATE_TIME_JUMP, "after 1"),
+    ("stamp repeated", dict(t=1.0), ErrorCode.STATE_TIME_JUMP, "after 1"),
+    ("stamp 100 s ahead", dict(t=101.0), ErrorCode.STATE_TIME_JUMP, "from the node's clock"),
+]
+
+
+@pytest.mark.parametrize("case, change, code, words", TIME_CASES, ids=[c[0] for c in TIME_CASES])
+def test_a_state_out_of_time_changes_nothing_and_the_loop_goes_on(loop, case, change, code, words):
+    core, sim = loop
+    out = core.accept_state(replace(base(sim), **change), wall=sim.t, clock=sim.t, source=SIM_A)
+    assert out.refused.code == code and words in out.refused.message, out.refused.message
+    assert core.state.t == pytest.approx(1.0)
+    assert core.accept_state(base(sim), wall=sim.t, clock=sim.t, source=SIM_A).refused is None   # the next real one
+    assert core.state.t == pytest.approx(sim.t)
+
+
+def test_without_a_clock_the_previous_state_bounds_a_forward_jump(loop):
+    core, sim = loop
+    out = core.accept_state(replace(base(sim), t=30.0), wall=sim.t, source=SIM_A)
+    assert out.refused.code == ErrorCode.STATE_TIME_JUMP and "at most 5 s" in out.refused.message
+
+
+def test_a_second_publisher_is_ignored_while_the_first_is_alive_then_may_take_over(loop):
+    core, sim = loop
+    out = core.accept_state(base(sim), wall=sim.t, clock=sim.t, source=SIM_B)
+    assert out.refused.code == ErrorCode.INVALID_STATE and "second publisher" in out.refused.message
+    sim.advance(3.0)                        # the first publisher fell silent for longer than resync_timeout
+    assert core.accept_state(base(sim), wall=sim.t, clock=sim.t, source=SIM_B).refused is None
+    assert core.gate.source == SIM_B
+
+
+def test_a_hand_published_far_stamp_before_the_clock_runs_stalls_nothing_for_long():
+    core = Controller(context(), ControllerConfig(), body_frame_id="body")
+    sim = Simulation(SWIFT.spacecraft, SWIFT.orbit)
+    assert core.accept_state(replace(base(sim), t=1e6), wall=0.0, source=SIM_B).refused is None  # the first one
+    refused_until = None
+    for k in range(60):                      # the simulator's states, 20 Hz of wall time
+        wall = 0.05 * (k + 1)
+        out = core.accept_state(base(sim), wall=wall, source=SIM_A)
+        if out.refused is None:
+            refused_until = wall
+            assert "timeline restarted" in out.note
+            break
+        sim.advance(0.05)
+    assert refused_until is not None and refused_until <= core.gate.config.resync_timeout + 0.1
+
+
+def test_a_new_timeline_aborts_the_running_maneuver(loop):
+    core, sim = loop
+    plan, payload = issue(plan_eigenaxis_smooth(ManeuverProblem(SWIFT.spacecraft, rot.IDENTITY,
+                                                                rot.from_axis_angle([0, 0, 1], 0.5))), core.context)
+    assert core.start(core.resolve("", plan, payload)[0]) is None
+    restarted = Simulation(SWIFT.spacecraft, SWIFT.orbit)          # a restarted simulator: t = 0 again
+    out = core.accept_state(base(restarted), wall=sim.t + 5.0, clock=0.0, source=SIM_B)
+    assert out.refused is None and "timeline restarted" in out.note
+    assert out.ended.error_code == ErrorCode.ABORTED and core.maneuver is None and core.mode == ControlMode.SAFE
+
+
+@pytest.mark.parametrize("rate, mode", [(0.02, ControlMode.SAFE), (0.001, ControlMode.IDLE)])
+def test_a_controller_that_starts_on_a_spinning_spacecraft_damps_it(rate, mode):
+    core = Controller(context(), ControllerConfig(safe_rate_threshold=0.005), body_frame_id="body")
+    sim = Simulation(SWIFT.spacecraft, SWIFT.orbit, omega0=[rate, -rate, 0.0])
+    out = core.accept_state(base(sim))
+    assert core.mode == mode and (("safe mode" in out.note) if mode == ControlMode.SAFE else out.note is None)
+    w0 = np.linalg.norm(sim.x[4:7])
+    for _ in range(400):
+        sim.advance(0.05)
+        core.accept_state(base(sim), wall=sim.t)
+        if core.due():
+            assert sim.set_command(core.step().command) is None
+    assert (np.linalg.norm(sim.x[4:7]) < 0.3 * w0) == (mode == ControlMode.SAFE)
+
+
+@pytest.mark.parametrize("mode, code", [(255, ErrorCode.INVALID_MODE), (4, ErrorCode.INVALID_MODE),
+                                        (int(ControlMode.PLAN_TRACKING), ErrorCode.INVALID_MODE)])
+def test_bad_mode_requests_are_refused(loop, mode, code):
+    core, _ = loop
+    assert core.set_mode(mode)[0] == code and core.mode == ControlMode.IDLE
