@@ -23,6 +23,7 @@ from collections.abc import Callable
 from pathlib import Path
 
 import rclpy
+import yaml
 from rcl_interfaces.msg import ParameterDescriptor
 from rclpy.executors import Executor, ExternalShutdownException, SingleThreadedExecutor
 
@@ -108,10 +109,22 @@ def _check_params_files(args) -> None:
     directory), checked before rcl reads them."""
     args = list(sys.argv if args is None else args)
     for flag, path in zip(args, args[1:]):
-        if flag == "--params-file" and not Path(path).is_file():
+        if flag != "--params-file":
+            continue
+        if not Path(path).is_file():
             raise ConfigError(ErrorCode.INVALID_CONFIG,
                               f"--params-file '{clip(path, 200)}': no such file (relative paths are taken from the "
                               f"current directory, {Path.cwd()})")
+        try:
+            doc = yaml.safe_load(Path(path).read_text(encoding="utf-8"))
+        except (OSError, UnicodeDecodeError, yaml.YAMLError) as exc:
+            raise ConfigError(ErrorCode.INVALID_CONFIG, f"--params-file '{clip(path, 200)}' is not readable YAML: "
+                                                        f"{clip(str(exc).splitlines()[0] if str(exc) else exc, 200)}"
+                              ) from None
+        if not isinstance(doc, dict) or not all(isinstance(v, dict) and "ros__parameters" in v for v in doc.values()):
+            raise ConfigError(ErrorCode.INVALID_CONFIG,
+                              f"--params-file '{clip(path, 200)}' is not a ROS 2 parameter file (expected "
+                              "'<node or /**>: ros__parameters: {...}' sections)")
 
 
 def run_node(make_node: Callable, args=None, make_executor: Callable[[], Executor] = SingleThreadedExecutor,

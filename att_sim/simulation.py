@@ -3,18 +3,47 @@
 :class:`Simulation` holds the truth state of :mod:`att_sim.dynamics`, the latest accepted actuator
 command and the orbit/field environment of :mod:`att_sim.environment`. The simulator node is a thin
 adapter around it; tests drive it directly.
+
+Every command and reset is checked field by field first (:class:`Checks`); a refused one changes
+nothing and comes back as a :class:`Refusal` (an :class:`~att_msgs_py.errors.ErrorCode` and a
+sentence naming the field). A command within ``command_limit_factor`` × an actuator limit is
+clamped to the limit (saturation); beyond it, it is a fault and refused.
 """
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from typing import NamedTuple
 
 import numpy as np
 
+from att_msgs_py import validation
+from att_msgs_py.errors import ErrorCode, RequestError, clip
 from att_msgs_py.types import CONTROL_MODES, Command, ControlMode, State
 from att_sim import dynamics as dyn
 from att_sim import environment as env
 from att_sim import rotations as rot
+
+MAX_ORBIT_PHASE = 1e6          # rad: |orbit_phase| of a reset (beyond it the phase drowns in rounding)
+
+
+class Refusal(NamedTuple):
+    """Why a command or a reset was refused."""
+
+    code: ErrorCode
+    message: str
+
+
+@dataclass(frozen=True)
+class Checks:
+    """What a command or reset must satisfy. The simulator node sets every field from its
+    parameters; the defaults leave command stamps unchecked for cores driven directly (tests)."""
+
+    command_limit_factor: float = 2.0   # a command beyond factor × its limit is refused (COMMAND_LIMIT)
+    max_reset_rate: float = 1.0         # rad/s: largest ‖body_rate‖ of a reset
+    body_frame_id: str = "body"         # a command's frame_id is "" or this
+    stamp_ahead: float = math.inf       # s: a command stamped after t + stamp_ahead is refused (node: one step)
+    stamp_age: float = math.inf         # s: one stamped before t − stamp_age is refused (node: command_timeout)
 
 
 @dataclass
@@ -27,10 +56,30 @@ class Applied:
     body_torque: np.ndarray = field(default_factory=lambda: np.zeros(3))   # total torque on the body
 
 
+def _numbers(value, name: str, code: ErrorCode, shape: tuple) -> np.ndarray:
+    """``value`` as a finite float array of ``shape`` (RequestError otherwise)."""
+    try:
+        return validation.finite_array(value, name, code, shape)
+    except RequestError:
+        raise
+    except (TypeError, ValueError):
+        raise RequestError(code, f"{name} is not made of numbers") from None
+
+
+def _number(value, name: str, code: ErrorCode, low: float = -math.inf, high: float = math.inf) -> float:
+    """``value`` as a finite float in [low, high] (RequestError otherwise)."""
+    try:
+        return validation.number(value, name, code, low, high)
+    except RequestError:
+        raise
+    except (TypeError, ValueError):
+        raise RequestError(code, f"{name} is not a number") from None
+
+
 class Simulation:
     def __init__(self, sc: dyn.Spacecraft, orbit: env.OrbitParams, q0=rot.IDENTITY, omega0=(0, 0, 0),
-                 wheel_speed0=None, gravity_gradient: bool = False):
-        self.sc, self.orbit, self.gravity_gradient = sc, orbit, gravity_gradient
+                 wheel_speed0=None, gravity_gradient: bool = False, checks: Checks = Checks()):
+        self.sc, self.orbit, self.gravity_gradient, self.checks = sc, orbit, gravity_gradient, checks
         self.t = 0.0
         self.arg0 = orbit.arg0
         self.x = dyn.initial_state(sc, q0, omega0, wheel_speed0)
@@ -41,37 +90,88 @@ class Simulation:
         self.halted, self.halt_reason = False, ""
         self.applied = Applied(np.zeros(sc.n_wheels))
 
-    def set_command(self, command: Command) -> str | None:
-        """Accept a command (None) or say why it is rejected; a rejected command changes nothing."""
-        if command.mode not in CONTROL_MODES:
-            return f"mode {command.mode} is not one of {CONTROL_MODES}"
-        wheel_torque = np.asarray(command.wheel_torques, float)
-        if wheel_torque.size not in (0, self.sc.n_wheels):
-            return f"wheel_torques has {wheel_torque.size} entries, the spacecraft has {self.sc.n_wheels} wheels"
-        for name, v in (("wheel_torques", wheel_torque), ("dipole", command.dipole),
-                        ("body_torque", command.body_torque)):
-            if not np.all(np.isfinite(v)):
-                return f"{name} contains NaN or Inf"
+    def set_command(self, command: Command) -> Refusal | None:
+        """Accept a command (None) or say why it is refused; a refused command changes nothing."""
+        try:
+            wheel_torque, dipole, body_torque = self.check_command(command)
+        except RequestError as err:
+            return Refusal(err.code, err.message)
         idle = command.mode == ControlMode.IDLE
         self.wheel_cmd = np.zeros(self.sc.n_wheels) if idle or wheel_torque.size == 0 else wheel_torque
-        self.dipole_cmd = np.zeros(3) if idle else np.asarray(command.dipole, float)
-        self.body_cmd = np.zeros(3) if idle else np.asarray(command.body_torque, float)
+        self.dipole_cmd = np.zeros(3) if idle else dipole
+        self.body_cmd = np.zeros(3) if idle else body_torque
         return None
 
-    def reset(self, q, omega, wheel_speed, orbit_phase: float) -> str | None:
-        q, omega = np.asarray(q, float), np.asarray(omega, float)
-        wheel_speed = np.zeros(self.sc.n_wheels) if len(wheel_speed) == 0 else np.asarray(wheel_speed, float)
-        if not (np.all(np.isfinite(q)) and np.all(np.isfinite(omega)) and np.all(np.isfinite(wheel_speed))
-                and math.isfinite(orbit_phase)):
-            return "reset values contain NaN or Inf"
-        if abs(np.linalg.norm(q) - 1.0) > 1e-3:
-            return f"attitude norm {np.linalg.norm(q):.6g} is not 1 (tolerance 1e-3)"
-        if wheel_speed.size != self.sc.n_wheels:
-            return f"wheel_speeds has {wheel_speed.size} entries, the spacecraft has {self.sc.n_wheels} wheels"
-        self.x = dyn.initial_state(self.sc, q, omega, wheel_speed)
-        self.arg0 = orbit_phase - self.orbit.mean_motion * self.t
+    def check_command(self, command: Command) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The command's wheel torques, dipole and body torque, checked (RequestError otherwise):
+        mode, sizes, finiteness, magnitude against the limits, stamp, frame and plan id."""
+        bad, c = ErrorCode.INVALID_COMMAND, self.checks
+        if isinstance(command.mode, bool) or not isinstance(command.mode, (int, np.integer)) \
+                or command.mode not in CONTROL_MODES:
+            raise RequestError(bad, f"mode {clip(repr(command.mode), 40)} is not one of {CONTROL_MODES}")
+        n = self.sc.n_wheels
+        wheel_torque = _numbers(command.wheel_torques, "wheel_torques", bad, (-1,))
+        if wheel_torque.size not in (0, n):
+            raise RequestError(bad, f"wheel_torques has {wheel_torque.size} entries, the spacecraft has {n} wheels "
+                                    f"(or give none)")
+        dipole = _numbers(command.dipole, "dipole", bad, (3,))
+        body_torque = _numbers(command.body_torque, "body_torque", bad, (3,))
+        for name, value, limit, limit_name in (
+                ("wheel_torques", wheel_torque, self.sc.wheel_torque_max, "wheel_torque_max"),
+                ("dipole", dipole, self.sc.dipole_max, "dipole_max"),
+                ("body_torque", body_torque, self.sc.body_torque_max, "torque_max")):
+            peak = float(np.max(np.abs(value))) if value.size else 0.0
+            if peak > c.command_limit_factor * limit:
+                ratio = f"{peak / limit:.3g} x" if limit > 0 else "above"
+                raise RequestError(ErrorCode.COMMAND_LIMIT,
+                                   f"{name} reaches {peak:.6g}, {ratio} its limit {limit_name} = {limit:g}; more "
+                                   f"than {c.command_limit_factor:g} x the limit is refused")
+        t = _number(command.t, "header.stamp", bad)
+        if t > self.t + c.stamp_ahead + 1e-9:
+            raise RequestError(bad, f"header.stamp t = {t:.6g} s is ahead of the simulation (t = {self.t:.6g} s, at "
+                                    f"most {c.stamp_ahead:g} s ahead)")
+        if t < self.t - c.stamp_age - 1e-9:
+            raise RequestError(bad, f"header.stamp t = {t:.6g} s is older than the simulation's t = {self.t:.6g} s "
+                                    f"by more than command_timeout = {c.stamp_age:g} s")
+        frame = validation.text(command.frame_id, "header.frame_id", bad)
+        if frame not in ("", c.body_frame_id):
+            raise RequestError(bad, f"header.frame_id '{frame}' is not the body frame '{c.body_frame_id}' (or empty)")
+        validation.text(command.plan_id, "plan_id")
+        return wheel_torque, dipole, body_torque
+
+    def reset(self, q, omega, wheel_speed, orbit_phase: float) -> Refusal | None:
+        """Reset attitude, rate, wheel speeds (empty: zeros) and orbit phase, or say why not (a
+        refused reset changes nothing); sim time keeps running."""
+        try:
+            x, arg0 = self.check_reset(q, omega, wheel_speed, orbit_phase)
+        except RequestError as err:
+            return Refusal(err.code, err.message)
+        self.x, self.arg0 = x, arg0
         self.halted, self.halt_reason = False, ""
         return None
+
+    def check_reset(self, q, omega, wheel_speed, orbit_phase: float) -> tuple[np.ndarray, float]:
+        """The state vector and orbit anchor ``arg0`` a reset asks for (RequestError otherwise)."""
+        bad, sc = ErrorCode.INVALID_RESET, self.sc
+        with np.errstate(over="ignore"):                 # a 1e308 attitude has norm inf: refused below
+            q = validation.unit_quaternion(_numbers(q, "attitude", bad, (4,)), "attitude", bad)
+        omega = _numbers(omega, "body_rate", bad, (3,))
+        rate = float(np.linalg.norm(omega))
+        if rate > self.checks.max_reset_rate:
+            raise RequestError(bad, f"body_rate has norm {rate:.6g} rad/s, above max_reset_rate = "
+                                    f"{self.checks.max_reset_rate:g} rad/s")
+        wheel_speed = _numbers(wheel_speed, "wheel_speeds", bad, (-1,))
+        if wheel_speed.size == 0:
+            wheel_speed = np.zeros(sc.n_wheels)
+        if wheel_speed.size != sc.n_wheels:
+            raise RequestError(bad, f"wheel_speeds has {wheel_speed.size} entries, the spacecraft has {sc.n_wheels} "
+                                    f"wheels (or give none)")
+        if wheel_speed.size and np.max(np.abs(wheel_speed)) > sc.wheel_speed_max:
+            i = int(np.argmax(np.abs(wheel_speed)))
+            raise RequestError(bad, f"wheel_speeds[{i}] = {wheel_speed[i]:.6g} rad/s is beyond wheel_speed_max = "
+                                    f"{sc.wheel_speed_max:g} rad/s")
+        phase = _number(orbit_phase, "orbit_phase", bad, -MAX_ORBIT_PHASE, MAX_ORBIT_PHASE)
+        return dyn.initial_state(sc, q, omega, wheel_speed), phase - self.orbit.mean_motion * self.t
 
     def position(self) -> np.ndarray:
         return env.position(self.orbit, self.t, self.arg0)

@@ -7,14 +7,21 @@ no lock or cross-thread wake-up sits in the control loop.
 Subscribes ``/actuator/command`` (ActuatorCommand), publishes ``/spacecraft/state``
 (SpacecraftState) at ``publish_rate`` and ``/clock`` at ``clock_rate`` (Hz of sim time), serves
 ``/simulator/reset``. Runs at ``real_time_factor`` × wall time (0: as fast as possible).
-Parameters come from the scenario file (``scenario`` parameter), overridable by ROS parameters.
+Parameters come from the scenario file (``scenario`` parameter), overridable by ROS parameters;
+each is type- and range-checked, and a bad one stops the node with one line on stderr (exit 2).
 
-Safety: commands with NaN/Inf or of the wrong size are rejected and never integrated; when no
-valid command arrived for ``command_timeout`` s of sim time the actuator inputs are zeroed and the
-state says so; a non-finite state stops the propagation (reported, the node stays up).
+Safety: every command and reset is checked by :class:`~att_sim.simulation.Simulation` (sizes,
+NaN/Inf, magnitude against ``command_limit_factor`` × the limits, stamp, frame, text); a refused one
+is never integrated and is logged at most once a second with the running count. When no valid
+command arrived for ``command_timeout`` s of sim time the actuator inputs are zeroed and the state
+says so. In lockstep, a state that no command answers within ``lockstep_timeout`` s of wall time
+ends the waiting: the simulator free-runs at its real-time factor with zero inputs
+(``command_timeout`` set) until a command answers again. A non-finite state stops the propagation
+(reported, the node stays up).
 """
 from __future__ import annotations
 
+import math
 import time
 
 import numpy as np
@@ -24,42 +31,30 @@ from rosgraph_msgs.msg import Clock
 
 from att_msgs.msg import ActuatorCommand, SpacecraftState
 from att_msgs.srv import ResetSimulator
-from att_msgs_py import convert, qos, topics
-from att_msgs_py.errors import ErrorCode
+from att_msgs_py import convert, qos, topics, validation
+from att_msgs_py.errors import ConfigError, ErrorCode, RequestError, clip
 from att_msgs_py.node_runner import parameter_reader, run_node, spin_until_shutdown
 from att_sim import scenario as scen
-from att_sim.simulation import Simulation
+from att_sim.simulation import Checks, Refusal, Simulation
 
 
 class SimulatorNode(Node):
     def __init__(self):
         super().__init__("simulator")
-        name = self.declare_parameter("scenario", "swift_demo").value
-        self.scenario = scen.load(name)
-        param = parameter_reader(self, self.scenario.node_params.get("simulator", {}))
-        self.step = float(param("step", 0.05))
-        self.publish_period = 1.0 / float(param("publish_rate", 10.0))
-        self.clock_period = 1.0 / float(param("clock_rate", 50.0))
-        self.real_time_factor = float(param("real_time_factor", 1.0))
-        self.command_timeout = float(param("command_timeout", 1.0))
-        self.end_time = float(param("end_time", 0.0))      # s of sim time; 0: run until stopped
-        # Hold sim time at zero until this many subscribers (recorder, controller) see the state,
-        # so that no run starts before it is recorded and controlled; at most start_timeout s.
-        self.wait_for_subscribers = int(param("wait_for_subscribers", 0))
-        self.start_timeout = float(param("start_timeout", 60.0))
-        # Lockstep: after each published state, wait (up to lockstep_timeout s of wall time) for
-        # the command that answers it, so the loop stays closed at any speed and under CPU load.
-        self.lockstep = bool(param("lockstep", True))
-        self.lockstep_timeout = float(param("lockstep_timeout", 0.5))
+        self.scenario = scen.load_checked(parameter_reader(self, {})("scenario", "swift_demo"))
+        param = self.read_parameters()
         self.answered = False
         self.awaited_stamp = 0.0
-        self.sim = Simulation(
-            self.scenario.spacecraft, self.scenario.orbit,
-            q0=param("initial_attitude", [0.0, 0.0, 0.0, 1.0]),
-            omega0=param("initial_rate", [0.0, 0.0, 0.0]),
-            gravity_gradient=bool(param("gravity_gradient", False)))
+        self.free_running = False      # lockstep suspended: no command answered a state in time
+        self.pace = (0.0, 0.0)         # (wall, sim) time the real-time pacing counts from
         self.last_command_time = -np.inf
-        self.rejected_commands = 0
+        self.refused = {"command": 0, "reset": 0}
+        self.sim = Simulation(self.scenario.spacecraft, self.scenario.orbit, q0=param["initial_attitude"],
+                              omega0=param["initial_rate"], gravity_gradient=param["gravity_gradient"],
+                              checks=Checks(command_limit_factor=param["command_limit_factor"],
+                                            max_reset_rate=param["max_reset_rate"],
+                                            body_frame_id=self.scenario.body_frame_id,
+                                            stamp_ahead=self.step, stamp_age=self.command_timeout))
 
         self.state_pub = self.create_publisher(SpacecraftState, topics.STATE, qos.STREAM_QOS)
         self.clock_pub = self.create_publisher(Clock, topics.CLOCK, qos.CLOCK_QOS)
@@ -69,27 +64,105 @@ class SimulatorNode(Node):
             f"scenario '{self.scenario.name}', step {self.step} s, RTF "
             f"{self.real_time_factor or 'max'}, {self.scenario.spacecraft.n_wheels} wheels")
 
+    def read_parameters(self) -> dict:
+        """Read and check every parameter (ConfigError naming the first bad one); the timing ones
+        become attributes, the rest (initial state, checks) are returned."""
+        section = self.scenario.node_params.get("simulator", {})
+        read = parameter_reader(self, section, source=str(self.scenario.path))
+        used = set()
+
+        def param(name, default, *args, hint="", **kwargs):
+            used.add(name)
+            try:
+                return read(name, default, *args, **kwargs)
+            except ConfigError as err:
+                raise ConfigError(err.code, err.message + hint) from None
+
+        inf = math.inf
+        self.step = param("step", 0.05, 0.0, 1.0, low_open=True)
+        per_step = dict(hint=" (at most 1/step: one per integration step)", low_open=True)
+        top = (1 + 1e-9) / self.step
+        self.publish_period = 1.0 / param("publish_rate", min(10.0, 1.0 / self.step), 0.0, top, **per_step)
+        self.clock_period = 1.0 / param("clock_rate", min(50.0, 1.0 / self.step), 0.0, top, **per_step)
+        self.real_time_factor = param("real_time_factor", 1.0, 0.0, inf)
+        self.command_timeout = param("command_timeout", 1.0, 0.0, inf, low_open=True)
+        self.end_time = param("end_time", 0.0, 0.0, inf)      # s of sim time; 0: run until stopped
+        # Hold sim time at zero until this many subscribers (recorder, controller) see the state,
+        # so that no run starts before it is recorded and controlled; at most start_timeout s.
+        self.wait_for_subscribers = param("wait_for_subscribers", 0, 0, 1000)
+        self.start_timeout = param("start_timeout", 60.0, 0.0, inf, low_open=True)
+        # Lockstep: after each published state, wait (up to lockstep_timeout s of wall time) for
+        # the command that answers it, so the loop stays closed at any speed and under CPU load.
+        self.lockstep = param("lockstep", True)
+        self.lockstep_timeout = param("lockstep_timeout", 0.5, 0.0, inf, low_open=True)
+        values = {
+            "command_limit_factor": param("command_limit_factor", 2.0, 1.0, inf),
+            "max_reset_rate": param("max_reset_rate", 1.0, 0.0, inf, low_open=True),
+            "gravity_gradient": param("gravity_gradient", False),
+            "initial_attitude": param("initial_attitude", [0.0, 0.0, 0.0, 1.0], -inf, inf, length=4),
+            "initial_rate": param("initial_rate", [0.0, 0.0, 0.0], -inf, inf, length=3)}
+        try:
+            values["initial_attitude"] = validation.unit_quaternion(
+                values["initial_attitude"], "parameter 'initial_attitude'", ErrorCode.INVALID_PARAMETER)
+        except RequestError as err:
+            raise ConfigError(err.code, err.message) from None
+        rate = float(np.linalg.norm(values["initial_rate"]))
+        if rate > values["max_reset_rate"]:
+            raise ConfigError(ErrorCode.INVALID_PARAMETER, f"parameter 'initial_rate' has norm {rate:g} rad/s, above "
+                                                           f"max_reset_rate = {values['max_reset_rate']:g} rad/s")
+        self.refuse_unknown(section, used)
+        return values
+
+    def refuse_unknown(self, section: dict, used: set) -> None:
+        """A simulator parameter in the scenario file or on the command line that no code reads
+        (a typo) is an error, not silently ignored; the shared ``/**`` ones are allowed."""
+        overrides = set(getattr(self, "_parameter_overrides", {}))     # -p and --params-file values
+        shared = ("spacecraft.", "orbit.", "qos_overrides.")
+        for where, names in ((str(self.scenario.path), set(section)), ("the command line or a --params-file",
+                                                                        overrides)):
+            unknown = sorted(n for n in names - used - {"scenario", "use_sim_time", "frame_id", "body_frame_id"}
+                             if not n.startswith(shared))
+            if unknown:
+                raise ConfigError(ErrorCode.INVALID_PARAMETER,
+                                  f"unknown simulator parameter(s) {clip(', '.join(unknown), 120)} (from {where}); "
+                                  f"known: {', '.join(sorted(used))}")
+
     # -- callbacks: translate messages to Simulation calls -------------------------------------
     def on_command(self, msg: ActuatorCommand):
         command = convert.command_from_msg(msg)
-        error = self.sim.set_command(command)
-        if error is None:
-            self.last_command_time = self.sim.t
-            if command.t >= self.awaited_stamp - 1e-9:
-                self.answered = True
-        else:
-            self.rejected_commands += 1
-            self.get_logger().warning(f"command rejected ({self.rejected_commands} so far): {error}",
-                                      throttle_duration_sec=1.0)
+        refusal = self.sim.set_command(command)
+        if refusal is not None:
+            self.report("command", refusal)
+            return
+        self.last_command_time = self.sim.t
+        if command.t >= self.awaited_stamp - 1e-9:
+            self.answered = True
+        if self.free_running:
+            self.free_running = False
+            self.get_logger().info(f"a command answers the state again at t = {self.sim.t:.3f} s: lockstep resumed",
+                                   throttle_duration_sec=1.0)
 
     def on_reset(self, request: ResetSimulator.Request, response: ResetSimulator.Response):
         q = convert.from_quaternion(request.attitude)
         w = convert.from_vector3(request.body_rate)
-        error = self.sim.reset(q, w, np.asarray(request.wheel_speeds, float), request.orbit_phase)
-        response.success = error is None
-        response.error_code = 0 if error is None else int(ErrorCode.INVALID_RESET)
-        response.message = "state reset" if error is None else error
+        refusal = self.sim.reset(q, w, np.asarray(request.wheel_speeds, float), request.orbit_phase)
+        if refusal is not None:
+            self.report("reset", refusal)
+        response.success = refusal is None
+        response.error_code = 0 if refusal is None else int(refusal.code)
+        response.message = "state reset" if refusal is None else refusal.message
         return response
+
+    def report(self, what: str, refusal: Refusal) -> None:
+        """Log a refused command or reset: at most one line a second for each (a flood of commands
+        cannot hide a refused reset), with the running count."""
+        self.refused[what] += 1
+        line = clip(f"{'actuator command' if what == 'command' else 'reset'} rejected [{int(refusal.code)} "
+                    f"{refusal.code.name}] ({self.refused[what]} so far): {refusal.message}")
+        if what == "command":            # two call sites: rclpy throttles each call site separately
+            self.get_logger().warning(line, throttle_duration_sec=1.0)
+        else:
+            self.get_logger().warning(line, throttle_duration_sec=1.0)
 
     # -- loop ----------------------------------------------------------------------------------
     def run(self, executor) -> None:
@@ -107,7 +180,8 @@ class SimulatorNode(Node):
                                           f"{self.wait_for_subscribers} expected state subscribers")
                 break
             executor.spin_once(timeout_sec=0.05)
-        wall0, sim0, k = time.monotonic(), self.sim.t, 0
+        k = 0
+        self.pace = (time.monotonic(), self.sim.t)
         self.publish(k, state_every, clock_every)
         while rclpy.ok():
             if self.end_time > 0 and self.sim.t >= self.end_time - 1e-9:
@@ -117,7 +191,8 @@ class SimulatorNode(Node):
             if self.sim.halted:
                 executor.spin_once(timeout_sec=0.1)
                 continue
-            self.sim.command_timeout = self.sim.t - self.last_command_time > self.command_timeout
+            self.sim.command_timeout = (self.free_running
+                                        or self.sim.t - self.last_command_time > self.command_timeout)
             self.sim.advance(self.step)
             if self.sim.halted:
                 self.get_logger().error(f"propagation stopped: {self.sim.halt_reason}")
@@ -126,6 +201,7 @@ class SimulatorNode(Node):
             self.publish(k, state_every, clock_every)
             executor.spin_once(timeout_sec=0.0)
             if self.real_time_factor > 0:
+                wall0, sim0 = self.pace
                 self.spin_until(lambda: False, wall0 + (self.sim.t - sim0) / self.real_time_factor)
 
     def spin_until(self, done, deadline: float) -> None:
@@ -143,8 +219,20 @@ class SimulatorNode(Node):
         if k % state_every == 0:
             self.answered, self.awaited_stamp = False, t
             self.state_pub.publish(self.state_message())
-            if self.lockstep:
-                self.spin_until(lambda: self.answered, time.monotonic() + self.lockstep_timeout)
+            if self.lockstep and not self.free_running:
+                self.wait_for_answer()
+
+    def wait_for_answer(self) -> None:
+        """Lockstep: run callbacks until a command answers the state just published; after
+        ``lockstep_timeout`` s stop waiting and free-run at the real-time factor, paced from now."""
+        self.spin_until(lambda: self.answered, time.monotonic() + self.lockstep_timeout)
+        if not self.answered:
+            self.free_running = True
+            self.pace = (time.monotonic(), self.sim.t)
+            self.get_logger().warning(
+                f"no command answered the state at t = {self.awaited_stamp:.3f} s within {self.lockstep_timeout:g} s: "
+                f"free-running at RTF {self.real_time_factor or 'max'} with zero actuator inputs until one does",
+                throttle_duration_sec=1.0)
 
     def state_message(self) -> SpacecraftState:
         return convert.state_msg(self.sim.state(self.scenario.frame_id, self.scenario.body_frame_id))

@@ -268,8 +268,11 @@ class Controller:
 
     def stale_command(self) -> tuple[Command, ControllerStatus]:
         """What the watchdog sends when no state arrives: zero wheel torques in safe mode."""
-        return (Command(mode=ControlMode.SAFE, wheel_torques=np.zeros(self.spacecraft.n_wheels)),
-                ControllerStatus(mode=self.mode, state_stale=True, message="no state (wall clock)"))
+        t = self.state.t if self.state is not None else 0.0
+        return (Command(mode=ControlMode.SAFE, wheel_torques=np.zeros(self.spacecraft.n_wheels), t=t,
+                        frame_id=self.body_frame_id),
+                ControllerStatus(mode=self.mode, t=t, state_stale=True, message="no state (wall clock)",
+                                 frame_id=self.body_frame_id))
 
     def _wheel_command(self, ref: tracking.Reference) -> np.ndarray:
         """Wheel torques of the tracking law about a body-torque reference."""

@@ -2,6 +2,7 @@
 import numpy as np
 import pytest
 
+from att_msgs_py.errors import ErrorCode
 from att_msgs_py.types import Command, ControlMode
 from att_sim import rotations as rot
 from att_sim import scenario
@@ -27,15 +28,15 @@ def sim():
 ])
 def test_bad_commands_are_rejected_and_never_integrated(sim, wheel, dipole, body, words):
     assert sim.set_command(command(ControlMode.PLAN_TRACKING, [0.01, 0, 0])) is None
-    error = sim.set_command(command(ControlMode.PLAN_TRACKING, wheel, dipole, body))
-    assert words in error
+    refusal = sim.set_command(command(ControlMode.PLAN_TRACKING, wheel, dipole, body))
+    assert refusal.code == ErrorCode.INVALID_COMMAND and words in refusal.message
     assert sim.wheel_cmd.tolist() == [0.01, 0, 0]          # the previous good command stays
     sim.advance(0.1)
     assert np.all(np.isfinite(sim.x))
 
 
 def test_unknown_mode_is_rejected(sim):
-    assert "mode 9" in sim.set_command(command(9, []))
+    assert "mode 9" in sim.set_command(command(9, [])).message
 
 
 def test_watchdog_zeroes_inputs(sim):
@@ -46,9 +47,12 @@ def test_watchdog_zeroes_inputs(sim):
 
 
 def test_wheel_torque_is_limited(sim):
-    sim.set_command(command(ControlMode.PLAN_TRACKING, [5.0, -5.0, 0.0]))
+    """Within command_limit_factor (2) x the limit a command saturates; beyond it, it is refused."""
+    limit = sim.sc.wheel_torque_max
+    assert sim.set_command(command(ControlMode.PLAN_TRACKING, [1.9 * limit, -1.9 * limit, 0.0])) is None
     sim.advance(0.1)
-    assert np.allclose(np.abs(sim.applied.wheel_torque[:2]), sim.sc.wheel_torque_max)
+    assert np.allclose(np.abs(sim.applied.wheel_torque[:2]), limit)
+    assert sim.set_command(command(ControlMode.PLAN_TRACKING, [5.0, -5.0, 0.0])).code == ErrorCode.COMMAND_LIMIT
 
 
 def test_non_finite_state_halts_propagation(sim):
@@ -61,9 +65,10 @@ def test_non_finite_state_halts_propagation(sim):
 
 
 def test_reset_validates(sim):
-    assert "norm" in sim.reset([0, 0, 0, 2], [0, 0, 0], [], 0.0)
-    assert "NaN" in sim.reset(rot.IDENTITY, [np.nan, 0, 0], [], 0.0)
-    assert "wheels" in sim.reset(rot.IDENTITY, [0, 0, 0], [1.0], 0.0)
+    assert "norm" in sim.reset([0, 0, 0, 2], [0, 0, 0], [], 0.0).message
+    assert "NaN" in sim.reset(rot.IDENTITY, [np.nan, 0, 0], [], 0.0).message
+    assert "wheels" in sim.reset(rot.IDENTITY, [0, 0, 0], [1.0], 0.0).message
+    assert sim.reset(rot.IDENTITY, [0, 0, 0], [1e30, 0, 0], 0.0).code == ErrorCode.INVALID_RESET
 
 
 def test_idle_mode_applies_nothing(sim):

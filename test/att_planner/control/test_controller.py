@@ -8,12 +8,12 @@ import pytest
 from att_msgs_py.errors import ErrorCode
 from att_msgs_py.types import ControlKind, ControlMode, Plan, Status
 from att_planner.control.controller import Controller, ControllerConfig
-from helpers.signed_plans import context, issue
 from att_planner.methods.eigenaxis import plan_eigenaxis_smooth
 from att_planner.problem import ManeuverProblem
 from att_sim import rotations as rot
 from att_sim import scenario
 from att_sim.simulation import Simulation
+from helpers.signed_plans import context, issue
 
 GOAL = rot.from_axis_angle([0.3, -0.5, 1.0], 1.2)
 CONFIG = ControllerConfig(control_period=0.1, settle_time=10.0, tracking_kp=1.0, tracking_kd=16.0)

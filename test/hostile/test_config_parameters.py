@@ -1,0 +1,302 @@
+"""Hostile configuration: scenario files that are not scenarios, and node parameters of the wrong
+type or out of range.
+
+A bad scenario file is a :class:`ConfigError` (INVALID_CONFIG, a ValueError) naming the file and
+the field; an unknown scenario name stays a KeyError (the planner maps it to UNKNOWN_SPACECRAFT).
+A node started with a bad parameter, an unknown or broken scenario or a missing or broken
+``--params-file`` prints one line ``<prog>: [code NAME] message`` naming it and exits 2, without a
+traceback. Good values (an integer for a float, relative paths from the current directory) start.
+"""
+from __future__ import annotations
+
+import copy
+import re
+import signal
+import subprocess
+import sys
+import time
+from concurrent.futures import ThreadPoolExecutor
+from pathlib import Path
+
+import pytest
+import rclpy
+import yaml
+
+from att_msgs.msg import SpacecraftState
+from att_msgs_py import convert, qos, topics
+from att_msgs_py.errors import ConfigError, ErrorCode, RequestError
+from att_planner.service.requests import load_spacecraft
+from att_planner.tools.launch import NODE_MODULES, isolated_env
+from att_sim import scenario
+
+BASE = {
+    "/**": {"ros__parameters": {
+        "frame_id": "eci", "body_frame_id": "body",
+        "spacecraft": {"inertia": [10.0, 12.0, 14.0], "torque_max": 0.1,
+                       "wheel_axes": [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0], "wheel_inertia": 0.01,
+                       "wheel_torque_max": 0.1, "wheel_speed_max": 600.0, "dipole_max": 5.0},
+        "orbit": {"altitude": 500000.0, "inclination_deg": 97.0}}},
+    "simulator": {"ros__parameters": {"step": 0.1, "publish_rate": 10.0}},
+}
+
+
+def edited(**changes):
+    """BASE as YAML with ``changes``: key paths ``a__b`` (under the shared parameters, or a node
+    section named ``simulator``) set to a value, or deleted with ``...``."""
+    doc = copy.deepcopy(BASE)
+    for path, value in changes.items():
+        keys = path.split("__")
+        node = doc if keys[0] == "simulator" else doc["/**"]["ros__parameters"]
+        for key in keys[:-1]:
+            node = node[key]
+        if value is ...:
+            del node[keys[-1]]
+        else:
+            node[keys[-1]] = value
+    return yaml.safe_dump(doc)
+
+
+GAINS = (Path(scenario.__file__).resolve().parents[1] / "config" / "controller_gains.yaml").read_text()
+BAD_SCENARIOS = {
+    "a list": ("- 1\n- 2\n", "a mapping"),
+    "a scalar": ("just some text\n", "a mapping"),
+    "empty": ("", "an empty file"),
+    "broken YAML": ("/**: {ros__parameters: [\n", "not valid YAML"),
+    "tab indentation": ("/**:\n\tros__parameters: {}\n", "not valid YAML"),
+    "a gains file (no /**)": (GAINS, "not a scenario file"),
+    "/** without ros__parameters": ("/**:\n  spacecraft: {inertia: [1, 1, 1]}\n", "ros__parameters"),
+    "no spacecraft": (edited(spacecraft=...), "spacecraft"),
+    "spacecraft a list": (edited(spacecraft=[1, 2]), "mapping"),
+    "inertia missing": (edited(spacecraft__inertia=...), "spacecraft.inertia is missing"),
+    "inertia of 4 numbers": (edited(spacecraft__inertia=[1.0, 2.0, 3.0, 4.0]), "spacecraft.inertia"),
+    "inertia text": (edited(spacecraft__inertia="heavy"), "spacecraft.inertia"),
+    "inertia with a text entry": (edited(spacecraft__inertia=[1.0, "x", 1.0]), "spacecraft.inertia"),
+    "inertia NaN": (edited(spacecraft__inertia=[float("nan"), 1.0, 1.0]), "finite"),
+    "inertia a scalar": (edited(spacecraft__inertia=5.0), "spacecraft.inertia"),
+    "inertia nested lists": (edited(spacecraft__inertia=[[1, 0, 0], [0, 1, 0], [0, 0, 1]]), "spacecraft.inertia"),
+    "torque_max text": (edited(spacecraft__torque_max="fast"), "spacecraft.torque_max"),
+    "torque_max zero": (edited(spacecraft__torque_max=0.0), "spacecraft.torque_max"),
+    "torque_max negative": (edited(spacecraft__torque_max=-0.1), "positive"),
+    "dipole_max NaN": (edited(spacecraft__dipole_max=float("nan")), "spacecraft.dipole_max"),
+    "wheel_speed_max a bool": (edited(spacecraft__wheel_speed_max=True), "spacecraft.wheel_speed_max"),
+    "wheel_torque_max a list": (edited(spacecraft__wheel_torque_max=[0.1]), "spacecraft.wheel_torque_max"),
+    "unknown spacecraft key (typo)": (edited(spacecraft__intertia=[1.0, 1.0, 1.0]), "unknown key(s) intertia"),
+    "wheel_axes of 4 numbers": (edited(spacecraft__wheel_axes=[1.0, 0.0, 0.0, 1.0]), "3 numbers per wheel"),
+    "wheel axis not unit": (edited(spacecraft__wheel_axes=[2.0, 0.0, 0.0]), "wheel_axes[0]"),
+    "wheels without inertia": (edited(spacecraft__wheel_inertia=0.0), "wheel_inertia"),
+    "wheel_inertia negative": (edited(spacecraft__wheel_inertia=-1.0), "wheel_inertia"),
+    "unknown orbit key": (edited(orbit__eccentricity=0.1), "orbit"),
+    "orbit altitude text": (edited(orbit__altitude="high"), "orbit.altitude"),
+    "orbit altitude negative": (edited(orbit__altitude=-1.0), "orbit.altitude"),
+    "orbit a list": (edited(orbit=[1, 2]), "orbit"),
+    "frame_id empty": (edited(frame_id=""), "frame_id"),
+    "body_frame_id with a newline": (edited(body_frame_id="body\nx"), "body_frame_id"),
+    "node section not a mapping": (edited(simulator=5), "section 'simulator'"),
+    "node section without ros__parameters": (edited(simulator={"step": 0.1}), "section 'simulator'"),
+    "a file over 1 MB": ("# " + "x" * 1_100_000 + "\n" + yaml.safe_dump(BASE), "bytes"),
+    "not UTF-8": (b"\xff\xfe/**: \x00\x81", "cannot be read"),
+}
+
+
+@pytest.mark.parametrize("content, words", BAD_SCENARIOS.values(), ids=BAD_SCENARIOS.keys())
+def test_a_file_that_is_not_a_valid_scenario_is_a_config_error_naming_file_and_field(tmp_path, content, words):
+    path = tmp_path / "hostile_scenario.yaml"
+    path.write_bytes(content if isinstance(content, bytes) else content.encode())
+    with pytest.raises(ConfigError) as err:
+        scenario.load(str(path))
+    assert isinstance(err.value, ValueError) and err.value.code == ErrorCode.INVALID_CONFIG
+    assert "hostile_scenario.yaml" in err.value.message and words in err.value.message, err.value.message
+    assert len(err.value.message) <= 400
+
+
+def test_the_base_scenario_of_these_cases_is_valid(tmp_path):
+    path = tmp_path / "good.yaml"
+    path.write_text(yaml.safe_dump(BASE))
+    s = scenario.load(str(path))
+    assert s.spacecraft.n_wheels == 3 and s.node_params["simulator"]["step"] == 0.1
+
+
+def test_unknown_names_stay_key_errors_and_the_planner_maps_both(tmp_path, monkeypatch):
+    with pytest.raises(KeyError):
+        scenario.load("no_such_scenario")
+    with pytest.raises(ConfigError) as err:
+        scenario.load_checked("no_such_scenario")
+    assert err.value.code == ErrorCode.INVALID_CONFIG and "no_such_scenario" in err.value.message
+    monkeypatch.setenv("ATT_CONFIG_PATH", str(tmp_path))
+    (tmp_path / "typo_craft.yaml").write_text(edited(spacecraft__intertia=[1.0, 1.0, 1.0]))
+    for name, code in (("typo_craft", ErrorCode.INVALID_SPACECRAFT), ("missing_craft", ErrorCode.UNKNOWN_SPACECRAFT)):
+        with pytest.raises(RequestError) as err:
+            load_spacecraft(name)
+        assert err.value.code == code and name in err.value.message
+
+
+# -- nodes started with hostile parameters -------------------------------------------------------
+
+SIM = "simulator"
+P, C = "INVALID_PARAMETER", "INVALID_CONFIG"
+NODE_CASES = {
+    # type
+    "real_time_factor text": (SIM, ["-p", "real_time_factor:=fast"], P, ["'real_time_factor'", "a number"]),
+    "step text": (SIM, ["-p", "step:=abc"], P, ["'step'", "a number"]),
+    "wait_for_subscribers float": (SIM, ["-p", "wait_for_subscribers:=1.5"], P, ["'wait_for_subscribers'", "integer"]),
+    "wait_for_subscribers text": (SIM, ["-p", "wait_for_subscribers:=many"], P, ["'wait_for_subscribers'"]),
+    "lockstep integer": (SIM, ["-p", "lockstep:=1"], P, ["'lockstep'", "true or false"]),
+    "lockstep text": (SIM, ["-p", "lockstep:=maybe"], P, ["'lockstep'", "true or false"]),
+    "gravity_gradient integer": (SIM, ["-p", "gravity_gradient:=2"], P, ["'gravity_gradient'"]),
+    "initial_attitude text list": (SIM, ["-p", "initial_attitude:=[a,b,c,d]"], P, ["'initial_attitude'", "list"]),
+    "initial_attitude a number": (SIM, ["-p", "initial_attitude:=1.0"], P, ["'initial_attitude'", "list"]),
+    "scenario integer": (SIM, ["-p", "scenario:=5"], P, ["'scenario'", "a string"]),
+    # range
+    "real_time_factor negative": (SIM, ["-p", "real_time_factor:=-1.0"], P, ["'real_time_factor'", "[0, inf]"]),
+    "real_time_factor inf": (SIM, ["-p", "real_time_factor:=.inf"], P, ["'real_time_factor'"]),
+    "real_time_factor NaN": (SIM, ["-p", "real_time_factor:=.nan"], P, ["'real_time_factor'"]),
+    "step zero": (SIM, ["-p", "step:=0.0"], P, ["'step'", "(0, 1]"]),
+    "step 2 s": (SIM, ["-p", "step:=2.0"], P, ["'step'", "(0, 1]"]),
+    "publish_rate zero": (SIM, ["-p", "publish_rate:=0.0"], P, ["'publish_rate'"]),
+    "publish_rate above 1/step": (SIM, ["-p", "publish_rate:=1000.0"], P, ["'publish_rate'", "1/step"]),
+    "clock_rate negative": (SIM, ["-p", "clock_rate:=-5.0"], P, ["'clock_rate'"]),
+    "command_timeout zero": (SIM, ["-p", "command_timeout:=0.0"], P, ["'command_timeout'"]),
+    "end_time negative": (SIM, ["-p", "end_time:=-1.0"], P, ["'end_time'"]),
+    "wait_for_subscribers negative": (SIM, ["-p", "wait_for_subscribers:=-1"], P, ["'wait_for_subscribers'"]),
+    "start_timeout zero": (SIM, ["-p", "start_timeout:=0.0"], P, ["'start_timeout'"]),
+    "lockstep_timeout zero": (SIM, ["-p", "lockstep_timeout:=0.0"], P, ["'lockstep_timeout'"]),
+    "initial_attitude norm 2": (SIM, ["-p", "initial_attitude:=[0.0,0.0,0.0,2.0]"], P, ["'initial_attitude'", "norm"]),
+    "initial_attitude 3 numbers": (SIM, ["-p", "initial_attitude:=[0.0,0.0,1.0]"], P, ["'initial_attitude'", "4"]),
+    "initial_rate 2 numbers": (SIM, ["-p", "initial_rate:=[0.0,0.0]"], P, ["'initial_rate'", "3"]),
+    "initial_rate NaN": (SIM, ["-p", "initial_rate:=[.nan,0.0,0.0]"], P, ["'initial_rate'"]),
+    "initial_rate above max_reset_rate": (SIM, ["-p", "initial_rate:=[5.0,0.0,0.0]"], P,
+                                          ["'initial_rate'", "max_reset_rate"]),
+    "command_limit_factor below 1": (SIM, ["-p", "command_limit_factor:=0.5"], P, ["'command_limit_factor'"]),
+    "max_reset_rate zero": (SIM, ["-p", "max_reset_rate:=0.0"], P, ["'max_reset_rate'"]),
+    "unknown parameter (typo)": (SIM, ["-p", "real_time_facter:=3.0"], P, ["real_time_facter"]),
+    # scenario and files
+    "unknown scenario": (SIM, ["-p", "scenario:=no_such_scenario"], C, ["'scenario'", "no_such_scenario", "known:"]),
+    "scenario that is a gains file": (SIM, ["-p", "scenario:=controller_gains"], C, ["controller_gains.yaml",
+                                                                                    "not a scenario"]),
+    "scenario file a list": (SIM, ["-p", "scenario:={tmp}/list.yaml"], C, ["list.yaml", "a mapping"]),
+    "scenario file broken": (SIM, ["-p", "scenario:={tmp}/broken.yaml"], C, ["broken.yaml", "not valid YAML"]),
+    "scenario with a bad simulator value": (SIM, ["-p", "scenario:={tmp}/bad_step.yaml"], P,
+                                            ["'step'", "bad_step.yaml", "(0, 1]"]),
+    "scenario with an unknown simulator key": (SIM, ["-p", "scenario:={tmp}/sim_typo.yaml"], P,
+                                               ["lockstep_timout", "sim_typo.yaml"]),
+    "missing --params-file": (SIM, ["--params-file", "no_such_params.yaml"], C,
+                              ["no_such_params.yaml", "no such file", "current directory"]),
+    "--params-file a directory": (SIM, ["--params-file", "{tmp}"], C, ["no such file"]),
+    "--params-file not YAML": (SIM, ["--params-file", "{tmp}/broken.yaml"], C, ["broken.yaml"]),
+    "--params-file a list": (SIM, ["--params-file", "{tmp}/list.yaml"], C, ["list.yaml"]),
+    "--params-file with a wrong type": (SIM, ["--params-file", "{tmp}/rtf_text.yaml"], P,
+                                        ["'real_time_factor'", "a number"]),
+    "--params-file with a typo": (SIM, ["--params-file", "{tmp}/typo.yaml"], P, ["real_time_facter"]),
+    # the other nodes take the same scenario parameter
+    "controller: unknown scenario": ("controller", ["-p", "scenario:=no_such_scenario"], C, ["no_such_scenario"]),
+    "controller: not a scenario": ("controller", ["-p", "scenario:=controller_gains"], C, ["not a scenario"]),
+    "planner: unknown scenario": ("planner", ["-p", "scenario:=no_such_scenario"], C, ["no_such_scenario"]),
+    "planner: not a scenario": ("planner", ["-p", "scenario:=controller_gains"], C, ["not a scenario"]),
+}
+RCL_PARSE_ERROR = re.compile(r"^\[ERROR\] \[[\d.]+\] \[rcl\]: Failed to parse global arguments$")
+REFUSAL = re.compile(r"^(\w+)\.py: \[(\d+) (\w+)\] (.+)$")
+
+
+def write_files(tmp: Path) -> None:
+    swift = (Path(scenario.__file__).resolve().parents[1] / "config" / "swift_demo.yaml").read_text()
+    (tmp / "list.yaml").write_text("- 1\n- 2\n")
+    (tmp / "broken.yaml").write_text("{{{ not yaml\n")
+    (tmp / "bad_step.yaml").write_text(swift.replace("step: 0.05 ", "step: 5.0 "))
+    (tmp / "sim_typo.yaml").write_text(swift.replace("lockstep_timeout:", "lockstep_timout:"))
+    (tmp / "rtf_text.yaml").write_text("simulator:\n  ros__parameters:\n    real_time_factor: fast\n")
+    (tmp / "typo.yaml").write_text("simulator:\n  ros__parameters:\n    real_time_facter: 2.0\n")
+    (tmp / "rtf3.yaml").write_text("simulator:\n  ros__parameters:\n    real_time_factor: 3\n")
+    (tmp / "mine.yaml").write_text(swift.replace("real_time_factor: 8.0", "real_time_factor: 5.0"))
+
+
+def start(node: str, args: list, cwd: Path | None = None, output=subprocess.PIPE) -> subprocess.Popen:
+    return subprocess.Popen([sys.executable, "-m", NODE_MODULES[node], "--ros-args", *args], env=isolated_env(),
+                            cwd=cwd, stdout=output, stderr=subprocess.STDOUT if output is not subprocess.PIPE
+                            else subprocess.PIPE, text=True)
+
+
+def run_case(node: str, args: list) -> tuple[int | None, str]:
+    """Exit code (None: still running after 30 s, then killed) and stderr + stdout."""
+    proc = start(node, args)
+    try:
+        out, err = proc.communicate(timeout=30)
+    except subprocess.TimeoutExpired:
+        proc.kill()
+        out, err = proc.communicate()
+        return None, err + out
+    return proc.returncode, err + out
+
+
+@pytest.fixture(scope="module")
+def node_results(tmp_path_factory):
+    """Every case of NODE_CASES, run three at a time."""
+    tmp = tmp_path_factory.mktemp("hostile_config")
+    write_files(tmp)
+    with ThreadPoolExecutor(max_workers=3) as pool:
+        futures = {name: pool.submit(run_case, node, [a.replace("{tmp}", str(tmp)) for a in args])
+                   for name, (node, args, _, _) in NODE_CASES.items()}
+        return {name: f.result() for name, f in futures.items()}
+
+
+@pytest.mark.ros
+@pytest.mark.parametrize("name", NODE_CASES)
+def test_a_node_with_a_hostile_parameter_prints_one_line_and_exits_2(node_results, name):
+    node, _, code_name, words = NODE_CASES[name]
+    exit_code, output = node_results[name]
+    assert exit_code == 2, f"exit {exit_code}:\n{output}"
+    assert "Traceback" not in output, output
+    lines = [ln for ln in output.splitlines() if ln.strip() and not RCL_PARSE_ERROR.match(ln)]
+    assert len(lines) == 1, output
+    match = REFUSAL.match(lines[0])
+    assert match and match.group(1) == NODE_MODULES[node].rsplit(".", 1)[1], lines[0]
+    assert match.group(3) == code_name and int(match.group(2)) == ErrorCode[code_name], lines[0]
+    assert all(w in match.group(4) for w in words), lines[0]
+    assert len(lines[0]) <= 450
+
+
+def test_there_are_enough_distinct_hostile_configurations():
+    assert len(BAD_SCENARIOS) + len(NODE_CASES) >= 70
+
+
+@pytest.mark.ros
+def test_good_values_start_the_simulator(tmp_path):
+    """An integer for a float, and --params-file and scenario paths relative to the current
+    directory, start the node (which then stops cleanly on SIGINT)."""
+    write_files(tmp_path)
+    cases = [(["-p", "real_time_factor:=0"], "RTF max"),
+             (["--params-file", "rtf3.yaml"], "RTF 3.0"),
+             (["-p", "scenario:=./mine.yaml"], "scenario 'mine', step 0.05 s, RTF 5.0"),
+             (["-p", "initial_attitude:=[0,0,0,1]", "-p", "command_limit_factor:=1"], "scenario 'swift_demo'")]
+    logs = [tmp_path / f"good_{i}.log" for i in range(len(cases))]
+    procs = [start(SIM, args, cwd=tmp_path, output=open(log, "w")) for (args, _), log in zip(cases, logs)]
+    try:
+        for proc, log, (_, words) in zip(procs, logs, cases):
+            end = time.monotonic() + 40
+            while words not in log.read_text() and time.monotonic() < end and proc.poll() is None:
+                time.sleep(0.2)
+            assert words in log.read_text(), f"exit {proc.poll()}: {log.read_text()}"
+    finally:
+        for proc in procs:
+            proc.send_signal(signal.SIGINT)
+        codes = [proc.wait(20) for proc in procs]
+    assert codes == [0] * len(cases)
+
+
+@pytest.mark.ros
+def test_a_simulator_started_by_hand_waits_for_its_subscribers(ros_suite):
+    """``-p wait_for_subscribers:=2``: sim time stays at 0 while one subscriber listens; with the
+    second the run starts, and the first state either sees is the one at t = 0."""
+    with ros_suite("swift_demo", nodes=("simulator",), params={"simulator": {"wait_for_subscribers": 2}},
+                   name="wait_subs") as s:
+        first, second = [], []
+        s.client.create_subscription(SpacecraftState, topics.STATE, first.append, qos.STREAM_QOS)
+        end = time.monotonic() + 3.0
+        while time.monotonic() < end:
+            rclpy.spin_once(s.client, timeout_sec=0.05)
+        assert not first, "the simulator started with one of two subscribers"
+        s.client.create_subscription(SpacecraftState, topics.STATE, second.append, qos.STREAM_QOS)
+        end = time.monotonic() + 10.0
+        while time.monotonic() < end and not (first and second):
+            rclpy.spin_once(s.client, timeout_sec=0.05)
+        assert first and second, "no state after the second subscriber came"
+        assert convert.from_time(first[0].header.stamp) == 0.0 and convert.from_time(second[0].header.stamp) == 0.0
