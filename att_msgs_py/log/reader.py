@@ -1,7 +1,8 @@
 """The one reader of the suite's MCAP logs, for tools and tests.
 
 :func:`read_log` returns per-topic arrays with timestamps; it also reads a file whose end is
-missing (killed writer) up to its last complete chunk.
+missing (killed writer) up to its last whole record (``att-log repair`` makes such a file whole for
+every reader).
 """
 from __future__ import annotations
 
@@ -10,13 +11,11 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
-from mcap.exceptions import McapError
 from mcap.reader import make_reader
-from mcap.records import Channel, Message, Schema
-from mcap.stream_reader import StreamReader
 from mcap_ros2.decoder import DecoderFactory
 
 from att_msgs_py import topics as suite_topics
+from att_msgs_py.log.repair import DAMAGE, salvaged_messages
 
 
 @dataclass
@@ -78,29 +77,20 @@ def _stack(values: list):
 
 
 def iter_records(path: str | Path):
-    """(schema, channel, message) of every message; tolerant of a missing end (killed writer)."""
+    """(schema, channel, message) of every message, in log-time order for a complete, indexed file;
+    a file whose writer was killed is read in file order up to its last whole record
+    (:func:`~att_msgs_py.log.repair.salvaged_messages`)."""
     with open(path, "rb") as fh:
         try:
             reader = make_reader(fh)
             summary = reader.get_summary()
-            if summary is not None and summary.chunk_indexes:
-                yield from reader.iter_messages(log_time_order=True)
-                return
-        except McapError:
-            pass
-    schemas, channels = {}, {}
-    with open(path, "rb") as fh:
-        try:
-            for record in StreamReader(fh, emit_chunks=False).records:
-                if isinstance(record, Schema):
-                    schemas[record.id] = record
-                elif isinstance(record, Channel):
-                    channels[record.id] = record
-                elif isinstance(record, Message):
-                    ch = channels[record.channel_id]
-                    yield schemas.get(ch.schema_id), ch, record
-        except (McapError, EOFError, ValueError, KeyError) as exc:  # truncated tail: stop there
-            del exc
+            indexed = summary is not None and bool(summary.chunk_indexes)
+        except DAMAGE:
+            indexed = False
+        if indexed:
+            yield from reader.iter_messages(log_time_order=True)
+            return
+    yield from salvaged_messages(path)
 
 
 def read_log(path: str | Path, topics: list[str] | None = None,

@@ -2,7 +2,9 @@
 
 Subscribes in raw (serialized CDR) form to :func:`att_msgs_py.qos.recorded_topics`, so messages
 are stored byte-for-byte as published. The file is flushed at least every ``flush_period`` s (a
-killed recorder loses at most that) and finalised (summary and index) on SIGINT/SIGTERM.
+killed recorder loses at most that) and finalised (summary and index) on SIGINT/SIGTERM. A file
+left at ``output`` by a recorder that did not finish is first repaired to ``OUT.repaired.mcap``
+(``att-log repair``), so starting again on the same path loses nothing.
 
 Usage: ``att-recorder --ros-args -p output:=runs/demo.mcap``
 """
@@ -10,10 +12,12 @@ from __future__ import annotations
 
 import time
 from datetime import UTC, datetime
+from pathlib import Path
 
 from rclpy.node import Node
 
 from att_msgs_py import qos, topics
+from att_msgs_py.log.repair import LogFileError, Scan, repair, scan_records
 from att_msgs_py.log.writer import LogWriter
 from att_msgs_py.node_runner import run_node
 
@@ -24,6 +28,8 @@ class RecorderNode(Node):
         stamp = datetime.now(UTC).strftime("%Y%m%d_%H%M%S")
         output = self.declare_parameter("output", f"runs/run_{stamp}.mcap").value
         flush_period = float(self.declare_parameter("flush_period", 0.5).value)
+        if Path(output).is_file():
+            self.keep_leftover(Path(output))
         self.log = LogWriter(output, flush_period=flush_period)
         for topic, (type_name, profile) in qos.recorded_topics().items():
             self.log.add_topic(topic, type_name, profile)
@@ -32,6 +38,22 @@ class RecorderNode(Node):
         # flush even when nothing arrives, so the file on disk is never more than a period behind
         self.create_timer(flush_period, self.log.flush)
         self.get_logger().info(f"recording {len(self.log.counts)} topics to {output}")
+
+    def keep_leftover(self, path: Path) -> None:
+        """Repair an unfinished log at ``path`` aside before it is recorded over."""
+        scan = Scan(path, 0)
+        try:
+            for _ in scan_records(path, scan):
+                pass
+        except LogFileError as err:
+            self.get_logger().warning(f"recording over {path}: {err}")
+            return
+        if scan.complete:
+            self.get_logger().warning(f"recording over the complete log {path} ({scan.messages} messages)")
+            return
+        done = repair(path)
+        self.get_logger().warning(f"{path} was left unfinished ({scan.problem}): repaired into {done.output} "
+                                  f"({done.result.messages} messages) before recording over it")
 
     def on_message(self, topic: str, data: bytes):
         self.log.write(topic, data, time.time_ns())

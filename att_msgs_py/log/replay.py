@@ -1,11 +1,16 @@
-"""``att-replay LOG.mcap [--rate X] [--topics ...] [--clock]``: play a recorded log back onto ROS topics.
+"""``att-replay LOG.mcap [--rate X] [--topics ...] [--clock] [--live]``: play a recorded log back under /replay.
 
 Like ``ros2 bag play`` (not available from PyPI): every recorded message is republished as its
-raw CDR bytes (rclpy ``Publisher.publish`` takes serialized bytes) on its topic, with its
-original type (``topics.message_class`` of the channel's schema name) and the recorded QoS
+raw CDR bytes (rclpy ``Publisher.publish`` takes serialized bytes), with its original type
+(``topics.message_class`` of the channel's schema name) and the recorded QoS
 (reliability and durability; the history depth is raised to at least 1000 so that a burst at
 ``--rate 0`` is not overwritten before reliable delivery). Messages keep their recorded order and
 spacing (log time) divided by ``--rate``; ``--rate 0`` publishes as fast as possible.
+
+Topics are published under the ``/replay`` namespace by default (``/spacecraft/state`` ->
+``/replay/spacecraft/state``, ``/clock`` -> ``/replay/clock``), so a replay onto a domain where
+the suite runs never feeds its nodes; ``--namespace NS`` picks another, and only ``--live``
+publishes on the recorded names (with a warning: the nodes then act on the replayed messages).
 
 ``/clock`` is replayed only with ``--clock`` (or when named in ``--topics``): the recorded sim-time
 ``/clock`` messages when the log has them, otherwise a clock built from each message's log time,
@@ -16,6 +21,7 @@ have acknowledged everything.
 from __future__ import annotations
 
 import argparse
+import os
 import re
 import sys
 import time
@@ -28,6 +34,16 @@ from att_msgs_py.log.reader import iter_records
 CLOCK = suite_topics.CLOCK
 CLOCK_TYPE = suite_topics.RECORDED[CLOCK]
 MIN_DEPTH = 1000
+NAMESPACE = "/replay"
+NAMESPACE_PATTERN = re.compile(r"(/[A-Za-z][A-Za-z0-9_]*)+")
+
+
+def replayed_name(topic: str, namespace: str = NAMESPACE) -> str:
+    """Where ``topic`` is republished: under ``namespace`` ("" for the recorded name itself)."""
+    if namespace and not NAMESPACE_PATTERN.fullmatch(namespace):
+        raise ValueError(f"--namespace must look like /replay (a '/' before each name of letters, digits "
+                         f"and '_', starting with a letter), got '{namespace[:80]}'")
+    return f"{namespace}/{topic.lstrip('/')}" if namespace else topic
 
 
 @dataclass
@@ -94,13 +110,16 @@ def schedule(records: list[Record], clock: bool, clock_recorded: bool) -> list[R
 
 
 def play(path: str | Path, *, rate: float = 1.0, topics: list[str] | None = None, clock: bool = False,
-         wait: float = 5.0, linger: float = 5.0, node_name: str = "att_replay", log=print) -> dict[str, int]:
-    """Republish the log; returns messages published per topic. Needs ``rclpy`` initialised."""
+         wait: float = 5.0, linger: float = 5.0, namespace: str = NAMESPACE, node_name: str = "att_replay",
+         log=print) -> dict[str, int]:
+    """Republish the log under ``namespace`` ("": the recorded names); returns messages published
+    per published topic name. Needs ``rclpy`` initialised."""
     from rclpy.duration import Duration
     from rclpy.node import Node
 
-    if rate < 0:
+    if not rate >= 0:
         raise ValueError(f"--rate must be >= 0 (0: as fast as possible), got {rate}")
+    replayed_name(CLOCK, namespace)        # the namespace is checked before anything is read
     all_records, channels = read_records(path)
     selected = set(topics) if topics else {t for t in channels if t != CLOCK}
     if clock:
@@ -116,15 +135,17 @@ def play(path: str | Path, *, rate: float = 1.0, topics: list[str] | None = None
         types[CLOCK] = (CLOCK_TYPE, "")
     node = Node(node_name)
     try:
-        pubs = {t: node.create_publisher(suite_topics.message_class(type_name), t, qos_from_metadata(t, meta))
+        pubs = {t: node.create_publisher(suite_topics.message_class(type_name), replayed_name(t, namespace),
+                                         qos_from_metadata(t, meta))
                 for t, (type_name, meta) in types.items()}
         deadline = time.monotonic() + wait
         while time.monotonic() < deadline and any(p.get_subscription_count() == 0 for p in pubs.values()):
             time.sleep(0.05)
         counts = dict.fromkeys(pubs, 0)
         listened = sum(p.get_subscription_count() > 0 for p in pubs.values())
-        log(f"replaying {len(records)} messages on {len(pubs)} topics ({listened} with subscribers), "
-            f"{'as fast as possible' if rate == 0 else f'rate {rate:g}'}")
+        log(f"replaying {len(records)} messages on {len(pubs)} topics "
+            f"{f'under {namespace}' if namespace else 'on their recorded (live) names'} ({listened} with "
+            f"subscribers), {'as fast as possible' if rate == 0 else f'rate {rate:g}'}")
         t_start, wall_start = (records[0].log_time_ns if records else 0), time.monotonic()
         for r in records:
             if rate > 0:
@@ -136,7 +157,7 @@ def play(path: str | Path, *, rate: float = 1.0, topics: list[str] | None = None
         acked_by = time.monotonic() + linger
         for pub in pubs.values():      # reliable subscribers: wait until they have everything
             pub.wait_for_all_acked(Duration(nanoseconds=int(max(0.0, acked_by - time.monotonic()) * 1e9)))
-        return counts
+        return {p.topic_name: n for p, n in zip(pubs.values(), counts.values())}
     finally:
         node.destroy_node()
 
@@ -151,16 +172,30 @@ def main(argv=None) -> int:
     parser.add_argument("--linger", type=float, default=5.0,
                         help="at most this many s waited after the last message for reliable subscribers "
                              "to acknowledge")
+    where = parser.add_mutually_exclusive_group()
+    where.add_argument("--namespace", default=NAMESPACE,
+                       help=f"publish under this namespace (default {NAMESPACE}: live nodes never see the replay)")
+    where.add_argument("--live", action="store_true",
+                       help="publish on the recorded topic names: nodes on this domain act on the replay")
     args, ros_args = parser.parse_known_args(argv)
     if not Path(args.log).is_file():
         parser.error(f"log file '{args.log}' does not exist")
+    namespace = "" if args.live else args.namespace
+    try:
+        replayed_name(CLOCK, namespace)
+    except ValueError as err:
+        parser.error(str(err))
+    if args.live:
+        print(f"att-replay: WARNING: --live publishes on the recorded topic names: every node on ROS_DOMAIN_ID "
+              f"{os.environ.get('ROS_DOMAIN_ID', '0 (unset)')} acts on the replayed messages as if they were live",
+              file=sys.stderr, flush=True)
     import rclpy
     from rclpy.executors import ExternalShutdownException
 
     rclpy.init(args=ros_args)
     try:
         counts = play(args.log, rate=args.rate, topics=args.topics, clock=args.clock, wait=args.wait,
-                      linger=args.linger)
+                      linger=args.linger, namespace=namespace)
     except ValueError as err:
         print(f"att-replay: {err}", file=sys.stderr)
         return 2

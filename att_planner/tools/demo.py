@@ -1,15 +1,17 @@
 """``att-demo`` (``make demo``): the suite end to end.
 
-Starts recorder, simulator, controller and planner as separate processes on an isolated ROS
-domain, asks the planner for the scenario's keep-out maneuver, executes it on the simulator
-through the controller, stops everything cleanly and prints a summary measured from the recorded
-MCAP, writes the ``att-review`` figures and HTML page next to it (``review/``). The last line
-printed is ``MCAP: <path>``.
+Starts recorder, simulator, controller and planner as separate processes on the ``ROS_DOMAIN_ID``
+you set (a random one when it is unset; localhost-only discovery unless
+``ROS_AUTOMATIC_DISCOVERY_RANGE`` is set) and says which, asks the planner for the scenario's
+keep-out maneuver, executes it on the simulator through the controller, stops everything cleanly
+and prints a summary measured from the recorded MCAP, writes the ``att-review`` figures and HTML
+page next to it (``review/``). The last line printed is ``MCAP: <path>``.
 """
 from __future__ import annotations
 
 import argparse
 import math
+import os
 import sys
 import time
 from datetime import UTC, datetime
@@ -47,6 +49,17 @@ def summarize(mcap_path: Path, maneuver: dict) -> dict:
             "final_rate": float(np.linalg.norm(state["body_rate"][-1])),
             "min_cone_margin_deg": float(np.degrees(m.min())),
             "min_margin_per_cone_deg": {c.name: float(np.degrees(v)) for c, v in zip(maneuver["cones"], m.min(axis=0))}}
+
+
+def domain_line(env: dict, base: dict | None = None) -> str:
+    """Which domain and discovery range the run uses, and whether they were inherited or chosen."""
+    base = os.environ if base is None else base
+    inherited = bool(base.get("ROS_DOMAIN_ID", "").strip())
+    range_set = bool(base.get("ROS_AUTOMATIC_DISCOVERY_RANGE", "").strip())
+    how = ("inherited from your environment" if inherited
+           else "chosen at random: ROS_DOMAIN_ID is unset (export ROS_DOMAIN_ID=<0..232> to pick one)")
+    return (f"ROS_DOMAIN_ID {env['ROS_DOMAIN_ID']} ({how}), discovery {env['ROS_AUTOMATIC_DISCOVERY_RANGE']} "
+            f"({'inherited' if range_set else 'default: this host only'})")
 
 
 def request_and_execute(client, scenario: scen.Scenario, maneuver: dict):
@@ -90,9 +103,14 @@ def main(argv=None) -> int:
     maneuver = maneuver_from_scenario(scenario)
     run_dir = Path(args.out) / f"{scenario.name}_{datetime.now(UTC).strftime('%Y%m%d_%H%M%S')}"
     mcap_path = run_dir / "run.mcap"
-    env = isolated_env()
+    try:
+        env = isolated_env(inherit=True)
+    except ValueError as err:
+        print(f"att-demo: {err}", file=sys.stderr)
+        return 2
+    print(f"[demo] {domain_line(env)}")
     join_env(env)
-    print(f"[demo] scenario {scenario.name}, ROS_DOMAIN_ID {env['ROS_DOMAIN_ID']} (localhost only), logs in {run_dir}")
+    print(f"[demo] scenario {scenario.name}, logs in {run_dir}")
     suite = start_suite(scenario.name, mcap_path, run_dir, env=env)
 
     ok, plan = False, None

@@ -2,13 +2,15 @@
 
 Used by ``att-demo`` and the integration tests. :func:`isolated_env` gives a process environment
 on a random ``ROS_DOMAIN_ID`` with localhost-only discovery, so runs never see each other or the
-network. :meth:`Suite.stop` stops the nodes with SIGINT (recorder last, so it sees everything),
-waits, and kills what does not exit.
+network (``inherit=True``, for ``att-demo``: a domain and discovery range the user set are kept).
+:meth:`Suite.stop` stops the nodes with SIGINT (recorder last, so it sees everything), waits, and
+kills what does not exit.
 """
 from __future__ import annotations
 
 import os
 import random
+import re
 import signal
 import subprocess
 import sys
@@ -24,10 +26,28 @@ NODE_MODULES = {
 }
 
 
-def isolated_env(domain_id: int | None = None, base: dict | None = None) -> dict:
+MAX_DOMAIN_ID = 232            # the largest ROS_DOMAIN_ID that maps to valid DDS ports on Linux
+DISCOVERY_RANGES = ("OFF", "LOCALHOST", "SUBNET", "SYSTEM_DEFAULT")
+
+
+def isolated_env(domain_id: int | None = None, base: dict | None = None, *, inherit: bool = False) -> dict:
+    """``base`` (default: this process's environment) on ``domain_id`` (default: random 1..200) with
+    localhost-only discovery. ``inherit``: a ``ROS_DOMAIN_ID`` / ``ROS_AUTOMATIC_DISCOVERY_RANGE``
+    set (non-empty) in ``base`` is kept instead (ValueError when it is not a valid value)."""
     env = dict(os.environ if base is None else base)
-    env["ROS_DOMAIN_ID"] = str(domain_id if domain_id is not None else random.randint(1, 200))
-    env["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
+    user_domain = env.get("ROS_DOMAIN_ID", "").strip() if inherit and domain_id is None else ""
+    if user_domain:
+        if not re.fullmatch(r"[0-9]{1,3}", user_domain) or int(user_domain) > MAX_DOMAIN_ID:
+            raise ValueError(f"ROS_DOMAIN_ID is '{user_domain[:40]}': expected an integer 0..{MAX_DOMAIN_ID} "
+                             "(or unset it for a random free domain)")
+        env["ROS_DOMAIN_ID"] = str(int(user_domain))
+    else:
+        env["ROS_DOMAIN_ID"] = str(domain_id if domain_id is not None else random.randint(1, 200))
+    user_range = env.get("ROS_AUTOMATIC_DISCOVERY_RANGE", "").strip() if inherit else ""
+    if user_range and user_range not in DISCOVERY_RANGES:
+        raise ValueError(f"ROS_AUTOMATIC_DISCOVERY_RANGE is '{user_range[:40]}': expected one of "
+                         f"{', '.join(DISCOVERY_RANGES)}")
+    env["ROS_AUTOMATIC_DISCOVERY_RANGE"] = user_range or "LOCALHOST"
     env.setdefault("RCUTILS_COLORIZED_OUTPUT", "0")
     env["PYTHONUNBUFFERED"] = "1"
     return env

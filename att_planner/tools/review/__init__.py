@@ -14,6 +14,11 @@ executed plan, else the last magnetorquer-PD run, else the whole log), and write
 * ``overview.png`` — a screenshot-sized digest (sky, margins, torque, wheel speeds);
 * ``summary.txt``, ``summary.json`` and ``index.html`` (summary table, figures embedded).
 
+For a maneuver, "executed" is the whole reviewed segment: the maneuver (the plan, t = 0 to its
+duration) and the settle and hold on its final attitude after it; the peak body torque is given
+against the planning limit ``torque_max`` and the actuator (wheel) limit, and only the latter is
+flagged when exceeded (:func:`.summary.notes`).
+
 Limits come from the scenario named by the plan (``att_sim.scenario.load(plan.spacecraft)``) or
 ``--scenario``. Modules: :mod:`.run` (the reviewed segment), :mod:`.summary` (the pure
 :func:`summarize` of a read log), :mod:`.figures` (matplotlib, Agg, in the ``plot_*`` functions).
@@ -32,7 +37,7 @@ from att_msgs_py.log import read_log
 from att_msgs_py.topics import COMMAND, PLANS, STATE
 from att_planner.tools.review.figures import figure_overview, figure_sky, figure_time_histories
 from att_planner.tools.review.run import extract_run, settling_time
-from att_planner.tools.review.summary import format_summary, spacecraft_for, summarize, summary_of
+from att_planner.tools.review.summary import format_summary, notes, spacecraft_for, summarize, summary_of
 
 __all__ = ["Review", "extract_run", "format_summary", "main", "review", "settling_time", "summarize"]
 
@@ -46,7 +51,7 @@ class Review:
     html: Path
 
 
-def _html(log_path: Path, text: str, figures: dict) -> str:
+def _html(log_path: Path, text: str, remarks: list[str], figures: dict) -> str:
     imgs = "\n".join(
         f'<h2>{html.escape(name)}</h2>\n<img alt="{html.escape(name)}" style="max-width:100%" '
         f'src="data:image/png;base64,{base64.b64encode(Path(p).read_bytes()).decode()}">'
@@ -54,7 +59,8 @@ def _html(log_path: Path, text: str, figures: dict) -> str:
     return ("<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\">"
             f"<title>Review of {html.escape(log_path.name)}</title>"
             "<style>body{font-family:sans-serif;margin:2em}pre{background:#f4f4f4;padding:1em}</style></head><body>\n"
-            f"<h1>Review of {html.escape(str(log_path))}</h1>\n<pre>{html.escape(text)}</pre>\n{imgs}\n"
+            f"<h1>Review of {html.escape(str(log_path))}</h1>\n<pre>{html.escape(text)}</pre>\n"
+            + "".join(f'<p class="note">{html.escape(r)}</p>\n' for r in remarks) + f"{imgs}\n"
             "</body></html>\n")
 
 
@@ -75,7 +81,7 @@ def review(log_path: str | Path, out_dir: str | Path | None = None, *, plan_id: 
     (out / "summary.txt").write_text(text + "\n")
     (out / "summary.json").write_text(json.dumps(summary, indent=2) + "\n")
     page = out / "index.html"
-    page.write_text(_html(log_path, text, figures))
+    page.write_text(_html(log_path, format_summary(summary, with_notes=False), notes(summary), figures))
     return Review(out, summary, text, figures, page)
 
 

@@ -10,7 +10,7 @@ from att_msgs_py.types import ControlKind, Interpolation, Plan
 from att_planner.cones import boresight, margins
 from att_planner.control import tracking
 from att_planner.tools.review.run import MODE_NAMES, Run, reference_error
-from att_planner.tools.review.summary import finite_limit
+from att_planner.tools.review.summary import body_torque_limits, finite_limit
 from att_sim import rotations as rot
 from att_sim.dynamics import Spacecraft
 
@@ -114,10 +114,10 @@ def plot_sky(ax, run: Run) -> None:
                  else "Body x axis on the sky (no plan in the log)", fontsize=10)
 
 
-def _limits(ax, limit, label=None):
+def _limits(ax, limit, label=None, color="r", ls="--"):
     if limit is not None:
         for sign in (1, -1):
-            ax.axhline(sign * limit, color="r", ls="--", lw=0.8, label=label if sign == 1 else None)
+            ax.axhline(sign * limit, color=color, ls=ls, lw=0.8, label=label if sign == 1 else None)
 
 
 def _maneuver_end(ax, run):
@@ -159,7 +159,10 @@ def plot_body_torque(ax, run: Run, sc: Spacecraft | None) -> None:
                 ax.step(run.plan.t, run.plan.torque[:, i], where="post", ls="--", lw=0.8)
             else:
                 ax.plot(run.plan.t, run.plan.torque[:, i], ls="--", lw=0.8)
-    _limits(ax, finite_limit(sc.body_torque_max) if sc else None, "limit")
+    planning, actuator = body_torque_limits(sc)
+    if planning != actuator:
+        _limits(ax, planning, "planning limit", color="tab:orange", ls=":")
+    _limits(ax, actuator, "actuator limit")
     ax.set_ylabel("body torque [N m]\n(-- planned)")
     ax.legend(loc="upper right", fontsize=7, ncol=2)
 
@@ -233,7 +236,8 @@ def _figure(*args, **kwargs):
 
 
 def _time_label(run: Run) -> str:
-    return f"t [s] from sim time {run.t0:.1f} s" + (" (dotted: plan end)" if run.kind == "maneuver" else "")
+    return f"t [s] from sim time {run.t0:.1f} s" + (" (dotted: plan end, then settle/hold)" if run.kind == "maneuver"
+                                                    else "")
 
 
 def figure_time_histories(run: Run, sc: Spacecraft | None, path: Path) -> Path:

@@ -37,6 +37,7 @@ class Run:
     cmd_dipole: np.ndarray         # (m, 3)
     goal: np.ndarray | None        # (4,) goal attitude (plan end; identity for magnetorquer runs)
     plan: Plan | None = None       # the executed (or last recorded) plan
+    goal_end: float | None = None  # maneuvers: t of the last command carrying the plan id (the execute goal's end)
 
 
 def plans_of(log: dict[str, TopicLog]) -> list[Plan]:
@@ -50,7 +51,10 @@ def plans_of(log: dict[str, TopicLog]) -> list[Plan]:
 
 
 def _segment(cmd_t, cmd_mode, cmd_plan, plan_id):
-    """[start, end) command indices of the execution of ``plan_id`` and the hold after it."""
+    """[start, end) command indices of the execution of ``plan_id`` and the hold after it: from the
+    execute goal's first command (the first carrying the plan id) through the plan, the settle time
+    (still carrying it) and the hold of the final attitude after the goal ended (plan tracking, no
+    plan id), up to the next change of mode or plan."""
     idx = np.flatnonzero(cmd_plan == plan_id)
     start, last = idx[0], idx[-1]
     after = np.flatnonzero((np.arange(len(cmd_t)) > last)
@@ -79,11 +83,11 @@ def extract_run(log: dict[str, TopicLog], plan_id: str | None = None) -> Run:
         raise ValueError(f"plan_id '{plan_id}' was not executed in this log "
                          f"(executed: {', '.join(executed) or 'none'})")
     plan_id = plan_id or next((p for p in reversed(executed) if p in by_id), None)
-    plan, goal = None, None
+    plan, goal, goal_end = None, None, None
     if plan_id is not None:
         kind, plan = "maneuver", by_id[plan_id]
         i0, i1 = _segment(cmd_t, cmd_mode, cmd_plan, plan_id)
-        goal = plan.q[-1]
+        goal, goal_end = plan.q[-1], float(cmd_t[np.flatnonzero(cmd_plan == plan_id)[-1]] - cmd_t[i0])
     elif np.any(cmd_mode == ControlMode.MAGNETORQUER_PD):
         kind, goal = "magnetorquer", rot.IDENTITY.copy()
         on = np.flatnonzero(cmd_mode == ControlMode.MAGNETORQUER_PD)
@@ -108,7 +112,7 @@ def extract_run(log: dict[str, TopicLog], plan_id: str | None = None) -> Run:
         body_torque=np.asarray(state["applied_torque"], float)[keep],
         command_timeout=np.asarray(state["command_timeout"], bool)[keep],
         cmd_t=cmd_t[ckeep] - t0, cmd_mode=cmd_mode[ckeep], cmd_wheel_torques=cmd_wheels[ckeep],
-        cmd_dipole=cmd_dipole[ckeep], goal=goal, plan=plan)
+        cmd_dipole=cmd_dipole[ckeep], goal=goal, plan=plan, goal_end=goal_end)
 
 
 def settling_time(t: np.ndarray, q: np.ndarray, threshold: float = SETTLING_THRESHOLD) -> float | None:

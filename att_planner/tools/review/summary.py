@@ -26,15 +26,39 @@ def finite_limit(value: float | None) -> float | None:
 def summarize(log: dict[str, TopicLog], spacecraft: Spacecraft | None = None, plan_id: str | None = None) -> dict:
     """Summary of the reviewed segment of a read log (see :func:`~.run.extract_run`).
 
-    Keys: kind, plan (id, method, status, spacecraft), maneuver_time_s (planned duration),
-    executed_time_s (segment length), final_attitude_error_deg (to ``goal``: the plan's final
-    attitude, identity for magnetorquer runs) and final_rate_rad_s at the end of the segment,
-    min_margin_deg and closest_approach_s per cone, peak body torque / wheel torque /
-    wheel speed / dipole with their limits and ratios (limits None without ``spacecraft``),
-    settling_time_s (magnetorquer runs: Bruni & Celani's ν = 0.05 criterion on q_v), command_timeouts.
+    Keys: kind, plan (id, method, status, spacecraft); for maneuvers ``executed_time_s`` is the
+    whole reviewed segment, from the execute goal's first command to the next change of mode or
+    plan: ``maneuver_time_s`` (the plan's duration, t = 0 to its end) then ``after_plan_s`` of
+    settle and hold on its final attitude (``goal_end_s``: when the goal itself ended);
+    error_at_plan_end_deg and final_attitude_error_deg (to ``goal``: the plan's final attitude,
+    identity for magnetorquer runs) with final_rate_rad_s at the end of the segment, min_margin_deg
+    and closest_approach_s per cone, peak body torque / wheel torque / wheel speed / dipole with
+    when they occur, their actuator ``_limit``, ``_ratio`` and ``_above_limit`` (limits None
+    without ``spacecraft``) and for the body torque also the planning limit (``torque_max``) and
+    ratio, settling_time_s (magnetorquer runs: Bruni & Celani's ν = 0.05 criterion on q_v),
+    command_timeouts.
     """
     run = extract_run(log, plan_id)
     return summary_of(run, spacecraft)
+
+
+def body_torque_limits(sc: Spacecraft | None) -> tuple[float | None, float | None]:
+    """(planning, actuator) limits of the body torque per body axis: the plans' ``torque_max``, and
+    the most the actuators put on one body axis: ``wheel_torque_max`` × max_k Σ_i |G_ki| with
+    wheels (0.12 N m for swift_demo's three body-aligned wheels), else the direct torque input's
+    limit ``torque_max``."""
+    if sc is None:
+        return None, None
+    planning = finite_limit(sc.body_torque_max)
+    if sc.n_wheels == 0:
+        return planning, planning
+    return planning, finite_limit(sc.wheel_torque_max * float(np.abs(sc.wheel_axes).sum(axis=1).max()))
+
+
+def _phase(run: Run, t: float) -> str:
+    if run.kind != "maneuver":
+        return run.kind
+    return "maneuver" if t <= run.plan.duration + 1e-9 else "settle/hold"
 
 
 def summary_of(run: Run, spacecraft: Spacecraft | None = None) -> dict:
@@ -42,13 +66,18 @@ def summary_of(run: Run, spacecraft: Spacecraft | None = None) -> dict:
     out = {"kind": run.kind, "start_sim_time_s": run.t0, "executed_time_s": float(run.t[-1] - run.t[0]),
            "state_samples": int(len(run.t)), "command_timeouts": int(np.sum(run.command_timeout)),
            "wheels": int(run.wheel_speeds.shape[1]),
-           "plan": None, "maneuver_time_s": None}
+           "plan": None, "maneuver_time_s": None, "after_plan_s": None, "goal_end_s": None,
+           "error_at_plan_end_deg": None}
     if run.plan is not None:
         p = run.plan
         out["plan"] = {k: str(getattr(p, k)) for k in ("plan_id", "method", "status", "spacecraft", "control_kind")}
         out["plan"]["verified_min_margin_deg"] = math.degrees(p.verification.min_cone_margin)
         if run.kind == "maneuver":
             out["maneuver_time_s"] = p.duration
+            out["after_plan_s"] = max(0.0, out["executed_time_s"] - p.duration)
+            out["goal_end_s"] = run.goal_end
+            k = int(np.argmin(np.abs(run.t - p.duration)))
+            out["error_at_plan_end_deg"] = float(np.degrees(rot.angle_between(run.q[k], run.goal)))
     out["goal"] = None if run.goal is None else {"maneuver": "the plan's final attitude", "magnetorquer": "identity",
                                                    "log": "the last plan's final attitude"}[run.kind]
     if run.goal is not None:
@@ -66,12 +95,19 @@ def summary_of(run: Run, spacecraft: Spacecraft | None = None) -> dict:
             out["closest_approach_s"][c.name or f"cone{j}"] = float(run.t[k])
     out["min_cone_margin_deg"] = min(out["min_margin_deg"].values()) if cones else None
 
-    def peak(name, values, limit):
+    def peak(name, values, limit, t=None):
         v = peak_magnitude(values)
         lim = finite_limit(limit)
         out[f"peak_{name}"], out[f"{name}_limit"], out[f"{name}_ratio"] = v, lim, _ratio(v, lim)
+        out[f"{name}_above_limit"] = lim is not None and v > lim * (1 + 1e-9)
+        if t is not None and np.size(values):
+            out[f"peak_{name}_t_s"] = float(t[int(np.argmax(np.abs(values).max(axis=1)))])
 
-    peak("body_torque_Nm", run.body_torque, sc.body_torque_max if sc else None)
+    planning, actuator = body_torque_limits(sc)
+    peak("body_torque_Nm", run.body_torque, actuator, run.t)
+    out["peak_body_torque_phase"] = _phase(run, out.get("peak_body_torque_Nm_t_s", 0.0))
+    out["body_torque_Nm_planning_limit"] = planning
+    out["body_torque_Nm_planning_ratio"] = _ratio(out["peak_body_torque_Nm"], planning)
     peak("wheel_torque_Nm", np.concatenate([run.wheel_torques.ravel(), run.cmd_wheel_torques.ravel()]),
          sc.wheel_torque_max if sc else None)
     peak("wheel_speed_rad_s", run.wheel_speeds, sc.wheel_speed_max if sc else None)
@@ -91,15 +127,53 @@ def spacecraft_for(run: Run, scenario: str | None = None) -> Spacecraft | None:
         return None
 
 
-def format_summary(s: dict) -> str:
-    """The summary as aligned text lines."""
+def notes(s: dict) -> list[str]:
+    """Plain sentences on what the figures cover: the executed segment, the two torque limits."""
+    out = []
+    if s["maneuver_time_s"] is not None:
+        goal = f" (the execute goal, which includes the settle time, ended at t = {s['goal_end_s']:.2f} s)" \
+            if s["goal_end_s"] is not None else ""
+        out.append(f"\"executed\" is the whole reviewed segment, from the execute goal's first command to the next "
+                   f"change of mode or plan: the maneuver (the plan, t = 0 to {s['maneuver_time_s']:.2f} s) and then "
+                   f"{s['after_plan_s']:.2f} s of settle and hold on its final attitude{goal}; final figures are "
+                   "taken at the end of the segment.")
+    planning, actuator = s["body_torque_Nm_planning_limit"], s["body_torque_Nm_limit"]
+    if planning is not None and actuator is not None and actuator > planning * (1 + 1e-9):
+        out.append(f"Plans use at most the planning limit torque_max = {planning:.4g} N m per body axis, while the "
+                   f"wheels can deliver {actuator:.4g} N m ({100 * (actuator / planning - 1):.0f}% headroom, left for "
+                   "the tracking feedback), so a peak body torque above the planning limit but within the "
+                   "actuator limit is by design, and only a peak above the actuator limit is flagged.")
+    return out
+
+
+def _above(s: dict, name: str, what: str) -> str:
+    return f" ABOVE {what}" if s[f"{name}_above_limit"] else ""
+
+
+def _body_torque(s: dict) -> str:
+    """Peak body torque, when and in which phase, against the planning and the actuator limit."""
+    text = (f"{s['peak_body_torque_Nm']:.4g} N m at t = {s.get('peak_body_torque_Nm_t_s', 0.0):.1f} s "
+            f"({s['peak_body_torque_phase']})")
+    actuator, planning = s["body_torque_Nm_limit"], s["body_torque_Nm_planning_limit"]
+    if actuator is None:
+        return text + " (no limit known)"
+    against = [] if planning is None else [f"{s['body_torque_Nm_planning_ratio']:.3f} x the planning limit "
+                                           f"{planning:.4g} N m (torque_max)"]
+    against.append(f"{s['body_torque_Nm_ratio']:.3f} x the actuator limit {actuator:.4g} N m")
+    return text + ": " + ", ".join(against) + _above(s, "body_torque_Nm", "THE ACTUATOR LIMIT")
+
+
+def format_summary(s: dict, with_notes: bool = True) -> str:
+    """The summary as aligned text lines (then the :func:`notes`, unless ``with_notes`` is False)."""
     def deg(v, digits=3):
         return "n/a" if v is None else f"{v:.{digits}f} deg"
 
     def ratio(name, unit):
         lim = s[f"{name}_limit"]
         text = f"{s[f'peak_{name}']:.4g} {unit}"
-        return text + (f" / limit {lim:.4g} = {s[f'{name}_ratio']:.3f}" if lim is not None else " (no limit known)")
+        if lim is None:
+            return text + " (no limit known)"
+        return text + f" / limit {lim:.4g} = {s[f'{name}_ratio']:.3f}" + _above(s, name, "THE LIMIT")
 
     lines = [f"kind                  {s['kind']} (segment from sim time {s['start_sim_time_s']:.2f} s, "
              f"{s['state_samples']} states)"]
@@ -107,16 +181,16 @@ def format_summary(s: dict) -> str:
         p = s["plan"]
         lines.append(f"plan                  {p['plan_id']} {p['method']} ({p['status']}, {p['spacecraft']})")
     if s["maneuver_time_s"] is not None:
-        lines.append(f"maneuver time         {s['maneuver_time_s']:.2f} s planned, "
-                     f"{s['executed_time_s']:.2f} s executed "
-                     "(with hold)")
+        lines.append(f"executed              {s['executed_time_s']:.2f} s = {s['maneuver_time_s']:.2f} s maneuver "
+                     f"(the plan) + {s['after_plan_s']:.2f} s settle/hold on its final attitude")
+        lines.append(f"error at plan end     {deg(s['error_at_plan_end_deg'], 4)} (t = {s['maneuver_time_s']:.2f} s)")
     else:
         lines.append(f"segment length        {s['executed_time_s']:.2f} s")
-    lines.append(f"final attitude error  {deg(s['final_attitude_error_deg'], 4)} (to {s['goal'] or 'no goal known'}), "
-                 f"final rate {s['final_rate_rad_s']:.2e} rad/s")
+    lines.append(f"final attitude error  {deg(s['final_attitude_error_deg'], 4)} (to {s['goal'] or 'no goal known'}, "
+                 f"end of the segment), final rate {s['final_rate_rad_s']:.2e} rad/s")
     for name, v in s["min_margin_deg"].items():
         lines.append(f"min margin {name:<10} {deg(v, 2)} at t = {s['closest_approach_s'][name]:.1f} s")
-    lines.append(f"peak body torque      {ratio('body_torque_Nm', 'N m')}")
+    lines.append(f"peak body torque      {_body_torque(s)}")
     if s["wheels"]:
         lines.append(f"peak wheel torque     {ratio('wheel_torque_Nm', 'N m')}")
         lines.append(f"peak wheel speed      {ratio('wheel_speed_rad_s', 'rad/s')}")
@@ -129,4 +203,6 @@ def format_summary(s: dict) -> str:
         lines.append(f"settling time         {settled} (|q_i| <= {SETTLING_THRESHOLD})")
     if s["command_timeouts"]:
         lines.append(f"command timeouts      {s['command_timeouts']} state samples with inputs zeroed")
+    if with_notes:
+        lines += [f"note: {n}" for n in notes(s)]
     return "\n".join(lines)

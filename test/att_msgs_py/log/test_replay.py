@@ -1,5 +1,6 @@
-"""``att-replay``: the regression log played back onto an isolated domain, and the clock it
-builds when a log has none."""
+"""``att-replay``: the regression log played back onto an isolated domain under ``/replay`` (a
+subscriber on the live names hears nothing), on the live names only with ``--live``, and the clock
+it builds when a log has none."""
 from __future__ import annotations
 
 import random
@@ -7,6 +8,7 @@ import subprocess
 import sys
 import threading
 import time
+from contextlib import contextmanager
 
 import numpy as np
 import pytest
@@ -22,26 +24,28 @@ def log():
     return read_log(FIXTURE)
 
 
-def test_replay_republishes_the_fixture_with_its_types(log):
-    """att-replay as a process on its own domain; a subscriber here receives every message."""
+@contextmanager
+def listening(prefixes: tuple[str, ...]):
+    """A node on a fresh domain subscribed to every recorded topic under each of ``prefixes``
+    ("" is the live name); yields (domain, {prefix: {topic: [messages]}})."""
     import rclpy
     from rclpy.executors import SingleThreadedExecutor
     from rclpy.node import Node
     from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
 
     from att_msgs_py.topics import message_class
-    from att_planner.tools.launch import isolated_env
 
     domain = random.randint(1, 200)
     context = rclpy.Context()
     rclpy.init(context=context, domain_id=domain)
     node = Node("replay_test", context=context)
-    received = {t: [] for t in TOPIC_TYPES}
-    for topic, type_name in TOPIC_TYPES.items():
-        qos = QoSProfile(history=HistoryPolicy.KEEP_ALL, reliability=ReliabilityPolicy.RELIABLE,
-                         durability=DurabilityPolicy.TRANSIENT_LOCAL if topic == "/planner/plans"
-                         else DurabilityPolicy.VOLATILE)
-        node.create_subscription(message_class(type_name), topic, received[topic].append, qos)
+    received = {p: {t: [] for t in TOPIC_TYPES} for p in prefixes}
+    for prefix in prefixes:
+        for topic, type_name in TOPIC_TYPES.items():
+            qos = QoSProfile(history=HistoryPolicy.KEEP_ALL, reliability=ReliabilityPolicy.RELIABLE,
+                             durability=DurabilityPolicy.TRANSIENT_LOCAL if topic == "/planner/plans"
+                             else DurabilityPolicy.VOLATILE)
+            node.create_subscription(message_class(type_name), prefix + topic, received[prefix][topic].append, qos)
     executor = SingleThreadedExecutor(context=context)
     executor.add_node(node)
     stop = threading.Event()
@@ -52,30 +56,89 @@ def test_replay_republishes_the_fixture_with_its_types(log):
 
     spinner = threading.Thread(target=spin)
     spinner.start()
-    proc = subprocess.Popen([sys.executable, "-m", "att_msgs_py.log.replay", str(FIXTURE), "--rate", "0", "--clock",
-                             "--wait", "30"],
-                            env=isolated_env(domain), stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
     try:
-        out, _ = proc.communicate(timeout=40)
-        expected = {t: len(v) for t, v in log.items()}
-        deadline = time.monotonic() + 10
-        while {t: len(v) for t, v in received.items()} != expected and time.monotonic() < deadline:
-            time.sleep(0.1)
+        yield domain, received
     finally:
-        if proc.poll() is None:
-            proc.kill()
-            proc.wait()
         stop.set()
         spinner.join()
         node.destroy_node()
         context.try_shutdown()
-    assert proc.returncode == 0, out
-    assert {t: len(v) for t, v in received.items()} == expected, out
+
+
+def replay(domain: int, *args: str) -> tuple[int, str]:
+    from att_planner.tools.launch import isolated_env
+
+    proc = subprocess.Popen([sys.executable, "-m", "att_msgs_py.log.replay", str(FIXTURE), "--rate", "0", *args],
+                            env=isolated_env(domain), stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    try:
+        out, _ = proc.communicate(timeout=40)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()
+    return proc.returncode, out
+
+
+def counts(received: dict) -> dict:
+    return {t: len(v) for t, v in received.items()}
+
+
+def wait_for(received: dict, expected: dict, timeout: float = 10.0) -> None:
+    deadline = time.monotonic() + timeout
+    while counts(received) != expected and time.monotonic() < deadline:
+        time.sleep(0.1)
+
+
+def test_replay_republishes_the_fixture_under_replay_and_nothing_on_the_live_names(log):
+    """att-replay as a process on its own domain: a subscriber on /replay/<topic> receives every
+    message with its type, in order; one on the live names (where a controller listens) nothing."""
+    from att_msgs_py.topics import message_class
+
+    with listening(("/replay", "")) as (domain, received):
+        code, out = replay(domain, "--clock", "--wait", "30")
+        expected = {t: len(v) for t, v in log.items()}
+        wait_for(received["/replay"], expected)
+        time.sleep(0.5)                          # anything sent to the live names would be in by now
+    assert code == 0, out
+    assert "under /replay" in out and "/replay/spacecraft/state: " in out, out
+    assert counts(received["/replay"]) == expected, out
+    assert counts(received[""]) == dict.fromkeys(TOPIC_TYPES, 0), "the replay reached the live topics"
+    replayed = received["/replay"]
     for topic, type_name in TOPIC_TYPES.items():
-        assert all(isinstance(m, message_class(type_name)) for m in received[topic])
-    stamps = [m.header.stamp.sec + 1e-9 * m.header.stamp.nanosec for m in received["/spacecraft/state"]]
+        assert all(isinstance(m, message_class(type_name)) for m in replayed[topic])
+    stamps = [m.header.stamp.sec + 1e-9 * m.header.stamp.nanosec for m in replayed["/spacecraft/state"]]
     assert np.allclose(stamps, log["/spacecraft/state"]["header.stamp"])       # in order, unchanged
-    assert received["/planner/plans"][0].plan_id == log["/planner/plans"]["plan_id"][0]
+    assert replayed["/planner/plans"][0].plan_id == log["/planner/plans"]["plan_id"][0]
+
+
+def test_replay_live_publishes_on_the_recorded_names_with_a_warning(log):
+    with listening(("/replay", "")) as (domain, received):
+        code, out = replay(domain, "--live", "--topics", "/planner/plans", "/actuator/command", "--wait", "30")
+        expected = dict.fromkeys(TOPIC_TYPES, 0)
+        expected.update({t: len(log[t]) for t in ("/planner/plans", "/actuator/command")})
+        wait_for(received[""], expected)
+    assert code == 0, out
+    assert "WARNING: --live publishes on the recorded topic names" in out and f"ROS_DOMAIN_ID {domain}" in out, out
+    assert counts(received[""]) == expected, out
+    assert counts(received["/replay"]) == dict.fromkeys(TOPIC_TYPES, 0)
+
+
+@pytest.mark.parametrize("namespace", ["replay", "/", "/re play", "/replay/", "/1x", "/a\x07"])
+def test_replay_refuses_a_malformed_namespace(namespace):
+    from att_msgs_py.log.replay import main
+
+    with pytest.raises(SystemExit) as exit_info:
+        main([str(FIXTURE), "--namespace", namespace])
+    assert exit_info.value.code == 2
+
+
+def test_replayed_names():
+    from att_msgs_py.log.replay import replayed_name
+
+    assert replayed_name("/spacecraft/state") == "/replay/spacecraft/state"
+    assert replayed_name("/clock") == "/replay/clock"
+    assert replayed_name("/clock", "/bench/run1") == "/bench/run1/clock"
+    assert replayed_name("/spacecraft/state", "") == "/spacecraft/state"
 
 
 def test_replay_builds_a_clock_from_log_times_when_the_log_has_none():

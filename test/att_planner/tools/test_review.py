@@ -1,5 +1,6 @@
 """``att-review``: the regression log reviewed (summary against independent figures, figures,
-HTML page) and a synthetic magnetorquer run's settling time."""
+HTML page), what "executed" covers, the body torque against the planning and the actuator limit,
+and a synthetic magnetorquer run's settling time."""
 from __future__ import annotations
 
 import json
@@ -11,16 +12,26 @@ import pytest
 from att_msgs_py.log import TopicLog, read_log
 from att_msgs_py.types import Cone
 from att_planner.cones import margins
-from att_planner.tools.review import extract_run, settling_time, summarize
+from att_planner.tools.review import extract_run, format_summary, settling_time, summarize
 from att_planner.tools.review import main as review_main
+from att_planner.tools.review.summary import body_torque_limits
 from att_sim import rotations as rot
 from att_sim import scenario as scen
+from att_sim.dynamics import Spacecraft
 from helpers.regression_log import FIXTURE, GOAL, TOPIC_TYPES
+
+FIXTURE_SETTLE_TIME = 5.0          # the controller's settle_time when the fixture was recorded (make_fixture.py)
 
 
 @pytest.fixture(scope="module")
 def log():
     return read_log(FIXTURE)
+
+
+def segment_states(log, run):
+    """The state samples of the reviewed segment, selected independently of extract_run."""
+    t = log["/spacecraft/state"]["header.stamp"]
+    return (t >= run.t0) & (t < run.t0 + run.t[-1] + 1e-9)
 
 
 def test_summary_of_the_fixture_matches_independent_figures(log):
@@ -29,7 +40,9 @@ def test_summary_of_the_fixture_matches_independent_figures(log):
     state, plans = log["/spacecraft/state"], log["/planner/plans"]
     assert s["kind"] == "maneuver" and s["plan"]["plan_id"] == plans["plan_id"][0]
     assert s["maneuver_time_s"] == pytest.approx(plans["duration"][0])
-    assert s["maneuver_time_s"] < s["executed_time_s"] < s["maneuver_time_s"] + 10
+    # no change of mode or plan after the maneuver: the segment runs to the log's last state
+    assert s["executed_time_s"] == pytest.approx(state["header.stamp"][-1] - s["start_sim_time_s"], abs=0.11)
+    assert s["executed_time_s"] > s["maneuver_time_s"] + FIXTURE_SETTLE_TIME - 0.2
     assert s["final_attitude_error_deg"] == pytest.approx(math.degrees(rot.angle_between(state["attitude"][-1], GOAL)))
     assert s["final_attitude_error_deg"] < 0.1
     cones = [Cone(c["direction"], c["half_angle"], c["name"]) for c in plans["cones"][0]]
@@ -37,10 +50,82 @@ def test_summary_of_the_fixture_matches_independent_figures(log):
     assert s["min_margin_deg"] == pytest.approx(dict(zip(["sun", "earth", "moon"], m)), abs=1e-9)
     assert 10 < s["min_margin_deg"]["moon"] < 20 and s["min_cone_margin_deg"] == pytest.approx(m.min())
     assert s["closest_approach_s"]["moon"] > 0.8 * s["maneuver_time_s"]     # the path ends nearest the Moon
-    assert s["body_torque_Nm_limit"] == sc.body_torque_max and s["wheel_speed_rad_s_limit"] == sc.wheel_speed_max
-    assert 0.5 < s["body_torque_Nm_ratio"] < 1.1 and 0.1 < s["wheel_speed_rad_s_ratio"] < 1.0
+    assert s["wheel_speed_rad_s_limit"] == sc.wheel_speed_max and 0.1 < s["wheel_speed_rad_s_ratio"] < 1.0
     assert s["peak_dipole_Am2"] == 0.0 and s["settling_time_s"] is None
     assert summarize(log)["body_torque_Nm_limit"] is None       # no spacecraft given: no limits invented
+
+
+def test_executed_is_the_maneuver_then_the_settle_and_hold(log):
+    """executed = the plan's duration + the time after it; the goal ends a settle time after the
+    plan; the error at the plan's end is the recorded state's at t = duration."""
+    s = summarize(log, scen.load("swift_demo").spacecraft)
+    run = extract_run(log)
+    duration = log["/planner/plans"]["duration"][0]
+    assert s["maneuver_time_s"] == pytest.approx(duration)
+    assert s["executed_time_s"] == pytest.approx(s["maneuver_time_s"] + s["after_plan_s"])
+    assert s["after_plan_s"] >= FIXTURE_SETTLE_TIME - 0.2
+    assert s["goal_end_s"] == pytest.approx(duration + FIXTURE_SETTLE_TIME, abs=0.2)
+    state = log["/spacecraft/state"]
+    k = np.argmin(np.abs(state["header.stamp"] - (run.t0 + duration)))
+    assert s["error_at_plan_end_deg"] == pytest.approx(math.degrees(rot.angle_between(state["attitude"][k], GOAL)),
+                                                       abs=1e-9)
+    text = format_summary(s)
+    assert f"executed              {s['executed_time_s']:.2f} s = {duration:.2f} s maneuver (the plan) + " in text
+    assert "the execute goal's first command to the next change of mode or plan" in text
+    assert f"ended at t = {s['goal_end_s']:.2f} s" in text
+
+
+def test_peak_body_torque_against_the_planning_and_the_actuator_limit(log):
+    """swift_demo plans with torque_max = 0.1 N m; its body-aligned wheels deliver 0.12 N m."""
+    sc = scen.load("swift_demo").spacecraft
+    s = summarize(log, sc)
+    run = extract_run(log)
+    applied = log["/spacecraft/state"]["applied_torque"][segment_states(log, run)]
+    peak = np.abs(applied).max()
+    assert s["peak_body_torque_Nm"] == pytest.approx(peak, rel=1e-12)
+    assert s["body_torque_Nm_planning_limit"] == sc.body_torque_max == 0.1
+    assert s["body_torque_Nm_limit"] == pytest.approx(sc.wheel_torque_max) and sc.wheel_torque_max == 0.12
+    assert s["body_torque_Nm_planning_ratio"] == pytest.approx(peak / 0.1)
+    assert s["body_torque_Nm_ratio"] == pytest.approx(peak / 0.12)
+    assert s["body_torque_Nm_above_limit"] is False
+    i = np.argmax(np.abs(applied).max(axis=1))
+    assert s["peak_body_torque_Nm_t_s"] == pytest.approx(run.t[i])
+    assert s["peak_body_torque_phase"] == ("maneuver" if run.t[i] <= s["maneuver_time_s"] else "settle/hold")
+    text = format_summary(s)
+    assert f"{peak / 0.1:.3f} x the planning limit 0.1 N m (torque_max), {peak / 0.12:.3f} x the actuator limit" in text
+    assert "20% headroom" in text and "ABOVE" not in text
+
+
+@pytest.mark.parametrize("peak, above", [(0.1027, False), (0.1199, False), (0.1201, True), (0.5, True)])
+def test_only_a_peak_above_the_actuator_limit_is_flagged(log, peak, above):
+    """The README run's 1.027 x torque_max is within the wheels' limit; past 0.12 N m it is flagged."""
+    run = extract_run(log)
+    inside = segment_states(log, run)
+    state = log["/spacecraft/state"]
+    torque = np.array(state["applied_torque"], float)
+    k = np.flatnonzero(inside)[len(run.t) // 3]
+    torque[k] = [0.0, -peak, 0.0]
+    scaled = dict(log)
+    scaled["/spacecraft/state"] = TopicLog(state.topic, state.type_name, state.log_time,
+                                           {**state.fields, "applied_torque": torque}, state.messages)
+    s = summarize(scaled, scen.load("swift_demo").spacecraft)
+    assert s["peak_body_torque_Nm"] == pytest.approx(peak)
+    assert s["body_torque_Nm_planning_ratio"] == pytest.approx(peak / 0.1) and s["body_torque_Nm_planning_ratio"] > 1
+    assert s["body_torque_Nm_above_limit"] is above
+    assert ("ABOVE THE ACTUATOR LIMIT" in format_summary(s)) is above
+
+
+def test_actuator_limit_of_the_body_torque_follows_the_wheel_axes():
+    inertia = np.eye(3) * 10.0
+    pyramid = np.array([[1, -1, 0, 0], [0, 0, 1, -1], [1, 1, 1, 1]]) / math.sqrt(2)
+    four = Spacecraft(inertia, wheel_axes=pyramid, wheel_torque_max=0.2, body_torque_max=0.15)
+    assert body_torque_limits(four) == pytest.approx((0.15, 0.2 * 4 / math.sqrt(2)))   # z: all four wheels
+    skewed = Spacecraft(inertia, wheel_axes=np.array([[1, 0], [0, 0.6], [0, 0.8]]), wheel_torque_max=0.1,
+                        body_torque_max=0.05)
+    assert body_torque_limits(skewed) == pytest.approx((0.05, 0.1))
+    assert body_torque_limits(Spacecraft(inertia, wheel_axes=np.zeros((3, 0)), body_torque_max=0.001)) == (0.001, 0.001)
+    assert body_torque_limits(Spacecraft(inertia)) == (None, None)     # unlimited wheels: no limit shown
+    assert body_torque_limits(None) == (None, None)
 
 
 def test_settling_time_of_a_magnetorquer_run():
@@ -74,6 +159,8 @@ def test_review_cli_writes_figures_html_and_summary(tmp_path, capsys):
         assert png[:8] == b"\x89PNG\r\n\x1a\n" and len(png) > 20_000
     page = (tmp_path / "index.html").read_text()
     assert page.count("data:image/png;base64,") == 3 and "final attitude error" in page
+    assert page.count('<p class="note">') == 2 and "&quot;executed&quot; is the whole reviewed segment" in page
+    assert "planning limit torque_max = 0.1 N m" in page and "note:" not in page
     summary = json.loads((tmp_path / "summary.json").read_text())
     assert summary["kind"] == "maneuver" and summary["plan"]["method"] == "eigenaxis_smooth"
     assert summary["final_attitude_error_deg"] < 0.1 and set(summary["min_margin_deg"]) == {"sun", "earth", "moon"}

@@ -1,0 +1,279 @@
+"""Crash-safe logs: read an MCAP file record by record up to the first missing or damaged byte,
+and rewrite what was fully on disk into a valid, indexed MCAP (``att-log repair``).
+
+A recorder killed with SIGKILL leaves its file without data end, summary, footer and closing magic,
+perhaps with its last chunk cut short; ``rosbags`` and ``mcap``'s seeking reader refuse such a file.
+:func:`scan_records` reads it with ``mcap``'s :class:`~mcap.stream_reader.StreamReader` (every read
+bounded by what is left of the file, so a damaged length field cannot allocate more) and stops
+at the first record that is cut or fails its CRC; :func:`repair` writes every record read before
+that point (header, schemas, channels with their metadata, messages byte for byte with their log
+time, publish time and sequence, attachments, metadata) through ``mcap``'s Writer, which adds the
+index and the summary. A chunk the kill cut short is dropped: the recorder flushes a chunk at least
+every 0.5 s, so that is all that is lost.
+"""
+from __future__ import annotations
+
+import os
+import struct
+from collections.abc import Iterator
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import zstandard
+from mcap.exceptions import McapError
+from mcap.records import (
+    Attachment,
+    Channel,
+    Chunk,
+    ChunkIndex,
+    Footer,
+    Header,
+    Message,
+    Metadata,
+    Schema,
+    Statistics,
+)
+from mcap.stream_reader import StreamReader, breakup_chunk
+from mcap.writer import CompressionType, Writer
+
+MAGIC = b"\x89MCAP0\r\n"
+CHUNK_SIZE = 256 * 1024
+MAX_CHUNK_BYTES = 1 << 30          # an uncompressed chunk claiming more is damaged
+# what a cut or damaged record raises inside mcap's readers and decompressors
+DAMAGE = (McapError, ValueError, EOFError, struct.error, zstandard.ZstdError, RuntimeError, MemoryError,
+          KeyError, IndexError)
+KEPT = (Header, Schema, Channel, Message, Attachment, Metadata)
+
+
+class LogFileError(ValueError):
+    """A file that is not an MCAP log, or holds nothing that can be recovered."""
+
+
+@dataclass
+class Scan:
+    """What :func:`scan_records` found in a file (filled while it is read)."""
+
+    path: Path
+    size: int
+    profile: str = ""
+    library: str = ""
+    header: bool = False
+    schemas: dict[int, Schema] = field(default_factory=dict)
+    channels: dict[int, Channel] = field(default_factory=dict)
+    counts: dict[int, int] = field(default_factory=dict)     # channel id -> messages
+    messages: int = 0
+    start_ns: int | None = None                              # log time range of the messages read
+    end_ns: int | None = None
+    chunks: int = 0
+    chunk_indexes: int = 0
+    statistics: Statistics | None = None
+    good_bytes: int = 0          # end of the last record read whole (CRC checked)
+    complete: bool = False       # data end, summary, footer and closing magic all read
+    problem: str = ""            # why reading stopped before the end ("" when complete)
+
+    @property
+    def indexed(self) -> bool:
+        """Complete with a summary: statistics, and a chunk index per chunk."""
+        return self.complete and self.statistics is not None and self.chunk_indexes == self.chunks
+
+    @property
+    def dropped_bytes(self) -> int:
+        return self.size - self.good_bytes
+
+
+class _Bounded:
+    """A read-only view of a file whose reads never ask for more than what is left."""
+
+    def __init__(self, fh, size: int):
+        self._fh, self._size, self.pos = fh, size, 0
+
+    def read(self, n: int = -1) -> bytes:
+        n = self._size - self.pos if n is None or n < 0 else min(n, self._size - self.pos)
+        data = self._fh.read(n)
+        self.pos += len(data)
+        return data
+
+
+def check_magic(path: str | Path) -> int:
+    """Size of the file; :class:`LogFileError` if it is missing, empty or not an MCAP file."""
+    path = Path(path)
+    if not path.is_file():
+        raise LogFileError(f"{path}: {'not a regular file' if path.exists() else 'no such file'}")
+    size = path.stat().st_size
+    with open(path, "rb") as fh:
+        start = fh.read(len(MAGIC))
+    if size == 0:
+        raise LogFileError(f"{path}: the file is empty (its writer stopped before writing anything)")
+    if start != MAGIC[:len(start)]:
+        raise LogFileError(f"{path}: not an MCAP file (it does not start with the MCAP magic bytes)")
+    if len(start) < len(MAGIC):
+        raise LogFileError(f"{path}: only {size} bytes, cut inside the MCAP magic: nothing to recover")
+    return size
+
+
+def _chunk_records(chunk: Chunk) -> list:
+    """The records of a chunk, its CRC checked; DAMAGE for a chunk that does not decode."""
+    if chunk.uncompressed_size > MAX_CHUNK_BYTES:
+        raise ValueError(f"chunk claims {chunk.uncompressed_size} uncompressed bytes")
+    if chunk.compression == "zstd":
+        content = zstandard.frame_content_size(chunk.data)
+        if content not in (-1, chunk.uncompressed_size):
+            raise ValueError(f"zstd frame of {content} bytes in a chunk of {chunk.uncompressed_size}")
+    return breakup_chunk(chunk, validate_crc=True)
+
+
+def _problem(exc: Exception, start: int, end: int, size: int, footer: bool) -> str:
+    if footer:
+        return f"the closing magic after the footer is missing or wrong ({exc})"
+    if start >= size:
+        return "no data end, summary or footer after the last complete record (the writer did not finish)"
+    if end >= size:
+        return f"the last record (at byte {start}) is cut short: its writer was stopped while writing it"
+    return f"damaged record at byte {start}: {exc}"
+
+
+def _check_channels(scan: Scan, records: list) -> None:
+    """KeyError for a message on a channel no earlier record defines (the whole chunk is refused)."""
+    known = set(scan.channels)
+    for r in records:
+        if isinstance(r, Channel):
+            known.add(r.id)
+        elif isinstance(r, Message) and r.channel_id not in known:
+            raise KeyError(f"message on channel {r.channel_id}, which no channel record defines")
+
+
+def _take(scan: Scan, record) -> bool:
+    """Account for one record; True when it is to be passed on."""
+    if isinstance(record, Header):
+        scan.header, scan.profile, scan.library = True, record.profile, record.library
+    elif isinstance(record, Schema):
+        if record.id in scan.schemas:
+            return False
+        scan.schemas[record.id] = record
+    elif isinstance(record, Channel):
+        if record.id in scan.channels:
+            return False
+        scan.channels[record.id] = record
+        scan.counts[record.id] = 0
+    elif isinstance(record, Message):
+        scan.counts[record.channel_id] += 1
+        scan.messages += 1
+        scan.start_ns = record.log_time if scan.start_ns is None else min(scan.start_ns, record.log_time)
+        scan.end_ns = record.log_time if scan.end_ns is None else max(scan.end_ns, record.log_time)
+    elif isinstance(record, ChunkIndex):
+        scan.chunk_indexes += 1
+    elif isinstance(record, Statistics):
+        scan.statistics = record
+    return isinstance(record, KEPT)
+
+
+def scan_records(path: str | Path, scan: Scan | None = None) -> Iterator:
+    """Header, schemas and channels (once per id), messages, attachments and metadata of an MCAP
+    file in file order, up to the first record that is cut or damaged; ``scan`` (a :class:`Scan`)
+    is filled as the file is read. :class:`LogFileError` if the file is not MCAP at all."""
+    path = Path(path)
+    size = check_magic(path)
+    scan = scan if scan is not None else Scan(path, size)
+    scan.path, scan.size, scan.good_bytes = path, size, len(MAGIC)
+    with open(path, "rb") as fh:
+        view = _Bounded(fh, size)
+        records = StreamReader(view, emit_chunks=True, record_size_limit=None).records
+        footer, start = False, len(MAGIC)
+        while True:
+            try:
+                record = next(records)
+                if not scan.header and not isinstance(record, Header):
+                    raise ValueError(f"the first record is a {type(record).__name__}, not a header")
+                inner = _chunk_records(record) if isinstance(record, Chunk) else [record]
+                _check_channels(scan, inner)
+            except StopIteration:
+                scan.complete, scan.good_bytes = footer, view.pos
+                return
+            except DAMAGE as exc:
+                scan.problem = _problem(exc, start, view.pos, size, footer)
+                return
+            passed = [r for r in inner if _take(scan, r)]
+            scan.chunks += isinstance(record, Chunk)
+            footer = footer or isinstance(record, Footer)
+            start = scan.good_bytes = view.pos
+            yield from passed
+
+
+def salvaged_messages(path: str | Path) -> Iterator[tuple[Schema | None, Channel, Message]]:
+    """(schema, channel, message) of every message :func:`scan_records` reads, in file order."""
+    scan = Scan(Path(path), 0)
+    for record in scan_records(path, scan):
+        if isinstance(record, Message):
+            channel = scan.channels[record.channel_id]
+            yield scan.schemas.get(channel.schema_id), channel, record
+
+
+@dataclass
+class Repair:
+    """A repair: what the input held (``source``), where it went and what the output holds."""
+
+    source: Scan
+    output: Path
+    result: Scan
+
+
+def default_output(path: str | Path) -> Path:
+    """``IN.repaired.mcap`` next to ``IN.mcap``."""
+    path = Path(path)
+    stem = path.name[:-len(".mcap")] if path.name.endswith(".mcap") else path.name
+    return path.with_name(f"{stem}.repaired.mcap")
+
+
+def _copy(src: Path, stream) -> Scan:
+    """Write every record :func:`scan_records` reads from ``src`` to ``stream`` as a new MCAP."""
+    scan = Scan(src, 0)
+    writer, schemas, channels = None, {}, {}
+    for r in scan_records(src, scan):
+        if isinstance(r, Header):
+            writer = Writer(stream, chunk_size=CHUNK_SIZE, compression=CompressionType.ZSTD)
+            writer.start(profile=r.profile, library=r.library)
+        elif isinstance(r, Schema):
+            schemas[r.id] = writer.register_schema(name=r.name, encoding=r.encoding, data=r.data)
+        elif isinstance(r, Channel):
+            channels[r.id] = writer.register_channel(topic=r.topic, message_encoding=r.message_encoding,
+                                                     schema_id=schemas.get(r.schema_id, 0), metadata=r.metadata)
+        elif isinstance(r, Message):
+            writer.add_message(channels[r.channel_id], log_time=r.log_time, data=r.data,
+                               publish_time=r.publish_time, sequence=r.sequence)
+        elif isinstance(r, Attachment):
+            writer.add_attachment(create_time=r.create_time, log_time=r.log_time, name=r.name,
+                                  media_type=r.media_type, data=r.data)
+        elif isinstance(r, Metadata):
+            writer.add_metadata(r.name, r.metadata)
+    if writer is None:
+        raise LogFileError(f"{src}: {scan.problem or 'no header record'}; nothing to recover")
+    writer.finish()
+    return scan
+
+
+def repair(path: str | Path, output: str | Path | None = None, *, in_place: bool = False) -> Repair:
+    """Rewrite ``path`` into a complete, indexed MCAP at ``output`` (default ``IN.repaired.mcap``;
+    ``in_place``: the input itself), written to a temporary file in the same directory and renamed
+    over the target only once it has been read back whole. A complete input is copied without loss."""
+    src = Path(path)
+    check_magic(src)
+    dst = src if in_place else Path(output) if output is not None else default_output(src)
+    if not in_place and dst.resolve() == src.resolve():
+        raise LogFileError(f"{dst}: the output would overwrite the input; use --in-place for that")
+    tmp = dst.with_name(f".{dst.name}.{os.getpid()}.tmp")
+    try:
+        with open(tmp, "wb") as stream:
+            source = _copy(src, stream)
+            stream.flush()
+            os.fsync(stream.fileno())
+        result = Scan(tmp, 0)
+        for _ in scan_records(tmp, result):
+            pass
+        if not result.indexed or result.messages != source.messages:
+            raise RuntimeError(f"the rewritten file did not read back whole ({result.messages} of "
+                               f"{source.messages} messages; {result.problem or 'no index'})")
+        os.replace(tmp, dst)
+    finally:
+        tmp.unlink(missing_ok=True)
+    result.path = dst
+    return Repair(source, dst, result)

@@ -1,0 +1,272 @@
+"""``att-log repair`` / ``info`` without ROS: a log whose writer stopped mid-file (cut at every
+kind of offset, or damaged) is rewritten into a valid, indexed MCAP holding exactly the messages
+of its whole chunks, byte for byte; a complete log is copied without loss; what is not MCAP is
+refused in one line with exit 2."""
+from __future__ import annotations
+
+import shutil
+from pathlib import Path
+
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+from mcap.exceptions import McapError
+from mcap.reader import make_reader
+from mcap_ros2.decoder import DecoderFactory
+
+from att_msgs_py.log import LogWriter, iter_records
+from att_msgs_py.log.cli import main as att_log
+from att_msgs_py.log.repair import LogFileError, Scan, default_output, repair, scan_records
+from att_msgs_py.qos import recorded_topics
+from helpers.regression_log import FIXTURE
+
+PER_CHUNK = 25                 # messages between flushes: one chunk each
+TOPICS = ("/spacecraft/state", "/actuator/command", "/clock", "/controller/status")   # types unchanged since
+
+
+def fixture_messages(n: int = 400) -> list:
+    """The first ``n`` fixture messages of :data:`TOPICS` as (topic, data, log_time, publish_time)."""
+    out = []
+    for _, channel, m in iter_records(FIXTURE):
+        if channel.topic in TOPICS:
+            out.append((channel.topic, bytes(m.data), m.log_time, m.log_time + 7))
+        if len(out) == n:
+            break
+    return out
+
+
+def write_log(path: Path, messages: list, finish: bool = True) -> Path:
+    """A suite log with a chunk every PER_CHUNK messages; ``finish=False``: the bytes on disk of a
+    writer killed after its last flush (no data end, summary or footer)."""
+    writer = LogWriter(path, flush_period=1e9)
+    for topic, (type_name, qos) in recorded_topics().items():
+        writer.add_topic(topic, type_name, qos)
+    for i, (topic, data, log_time, publish_time) in enumerate(messages):
+        writer.write(topic, data, log_time, publish_time)
+        if (i + 1) % PER_CHUNK == 0:
+            writer.flush()
+    writer.flush()
+    if finish:
+        writer.close()
+        return path
+    killed = path.with_name("killed_" + path.name)
+    shutil.copyfile(path, killed)
+    writer.close()
+    return killed
+
+
+def records_of(path: Path) -> list:
+    """Every message as mcap's own (seeking, indexed) reader sees it."""
+    with open(path, "rb") as fh:
+        reader = make_reader(fh)
+        summary = reader.get_summary()
+        assert summary is not None and summary.statistics is not None
+        assert len(summary.chunk_indexes) == summary.statistics.chunk_count
+        return [(c.topic, bytes(m.data), m.log_time, m.publish_time, m.sequence)
+                for _, c, m in reader.iter_messages(log_time_order=False)]
+
+
+@pytest.fixture(scope="module")
+def finished(tmp_path_factory):
+    path = write_log(tmp_path_factory.mktemp("finished") / "run.mcap", fixture_messages())
+    return path, records_of(path)
+
+
+def chunk_ends(path: Path) -> list[int]:
+    with open(path, "rb") as fh:
+        summary = make_reader(fh).get_summary()
+    return sorted(c.chunk_start_offset + c.chunk_length for c in summary.chunk_indexes)
+
+
+def test_a_file_cut_at_any_offset_is_repaired_to_exactly_its_whole_chunks(finished, tmp_path):
+    """Cut the finished file at offsets across it (in every record kind, at and around each chunk
+    end): the repair holds exactly the messages of the chunks that end before the cut, in order,
+    byte for byte with log time, publish time and sequence, and every reader opens it."""
+    path, original = finished
+    data = path.read_bytes()
+    ends = chunk_ends(path)
+    assert len(ends) == len(original) // PER_CHUNK
+    offsets = sorted({*range(8, len(data), max(1, len(data) // 60)), *(e + d for e in ends for d in (-1, 0, 1)),
+                      len(data) - 1, len(data) - 9})
+    header_end = 8 + 9 + len(b"ros2") + len(b"att_suite") + 8
+    for cut in offsets:
+        cut_path = tmp_path / f"cut_{cut}.mcap"
+        cut_path.write_bytes(data[:cut])
+        if cut < header_end:
+            with pytest.raises(LogFileError, match="nothing to recover"):
+                repair(cut_path)
+            continue
+        done = repair(cut_path)
+        whole = sum(e <= cut for e in ends) * PER_CHUNK
+        if cut >= ends[-1]:
+            whole = len(original)          # everything after the last chunk is index and summary
+        got = records_of(done.output)
+        assert got == original[:whole], f"cut at byte {cut}"
+        assert done.source.messages == whole and done.result.indexed and not done.source.complete
+        assert done.source.problem and done.source.good_bytes <= cut
+        done.output.unlink()
+        cut_path.unlink()
+
+
+@settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(cut=st.floats(0.05, 1.0), flips=st.lists(st.tuples(st.floats(0.0, 1.0), st.integers(1, 255)), max_size=3))
+def test_a_cut_and_damaged_file_repairs_to_a_prefix_of_its_messages(finished, tmp_path, cut, flips):
+    """Bytes flipped anywhere and the end cut: whatever is recovered is a prefix of the original
+    messages (a damaged chunk fails its CRC and ends the recovery), and the output is valid."""
+    path, original = finished
+    data = bytearray(path.read_bytes()[:max(40, int(cut * path.stat().st_size))])
+    for where, xor in flips:
+        data[8 + int(where * (len(data) - 9))] ^= xor
+    damaged = tmp_path / "damaged.mcap"
+    damaged.write_bytes(bytes(data))
+    try:
+        done = repair(damaged, tmp_path / "out.mcap")
+    except LogFileError as err:
+        assert "nothing to recover" in str(err)       # the header itself was hit
+        return
+    got = records_of(done.output)
+    assert got == original[:len(got)]
+
+
+def test_a_killed_writers_file_is_refused_by_rosbags_and_mcap_and_opens_once_repaired(tmp_path):
+    from rosbags.highlevel import AnyReader, AnyReaderError
+    from rosbags.typesys import Stores, get_typestore
+
+    messages = fixture_messages(230)
+    killed = write_log(tmp_path / "run.mcap", messages, finish=False)
+    for decoded in (False, True):
+        with open(killed, "rb") as fh, pytest.raises(McapError):
+            reader = make_reader(fh, decoder_factories=[DecoderFactory()])
+            list(reader.iter_decoded_messages() if decoded else reader.iter_messages())
+    with pytest.raises(AnyReaderError, match="magic"):
+        with AnyReader([killed], default_typestore=get_typestore(Stores.EMPTY)) as reader:
+            list(reader.messages())
+    assert att_log(["repair", str(killed)]) == 0
+    repaired = default_output(killed)
+    assert repaired == tmp_path / "killed_run.repaired.mcap"
+    with AnyReader([repaired], default_typestore=get_typestore(Stores.EMPTY)) as reader:
+        decoded = [(c.topic, reader.deserialize(raw, c.msgtype), t) for c, t, raw in reader.messages()]
+    assert sorted((topic, t) for topic, _, t in decoded) == sorted((m[0], m[2]) for m in messages)
+    with open(repaired, "rb") as fh:
+        mcap_decoded = list(make_reader(fh, decoder_factories=[DecoderFactory()]).iter_decoded_messages())
+    assert len(mcap_decoded) == len(messages)
+    state = [m for (_, c, _, m) in mcap_decoded if c.topic == "/spacecraft/state"]
+    assert state and all(abs(m.attitude.x ** 2 + m.attitude.y ** 2 + m.attitude.z ** 2 + m.attitude.w ** 2 - 1) < 1e-9
+                         for m in state)
+
+
+def test_a_complete_file_is_copied_without_loss_and_reported_complete(finished, tmp_path, capsys):
+    path, original = finished
+    out = tmp_path / "copy.mcap"
+    assert att_log(["repair", str(path), "-o", str(out)]) == 0
+    assert "was complete and indexed: copied 400 messages on 5 topics" in capsys.readouterr().out
+    assert records_of(out) == original
+    source, copy = Scan(path, 0), Scan(out, 0)
+    list(scan_records(path, source))
+    list(scan_records(out, copy))
+    assert (copy.profile, copy.library) == (source.profile, source.library) == ("ros2", "att_suite")
+    assert [(c.topic, c.message_encoding, c.metadata) for c in copy.channels.values()] == \
+        [(c.topic, c.message_encoding, c.metadata) for c in source.channels.values()]
+    assert all("reliability:" in c.metadata["offered_qos_profiles"] for c in copy.channels.values())
+    assert [(s.name, s.encoding, s.data) for s in copy.schemas.values()] == \
+        [(s.name, s.encoding, s.data) for s in source.schemas.values()]
+
+
+def test_info_tells_a_complete_file_from_one_to_repair(finished, tmp_path, capsys):
+    path, original = finished
+    assert att_log(["info", str(path)]) == 0
+    out = capsys.readouterr().out
+    assert "complete and indexed (16 chunks" in out
+    counts = {t: sum(r[0] == t for r in original) for t in TOPICS}
+    for topic, n in counts.items():
+        assert any(line.split()[0] == topic and line.split()[-1] == str(n) for line in out.splitlines()), out
+    cut = tmp_path / "cut.mcap"
+    cut.write_bytes(path.read_bytes()[:chunk_ends(path)[3] + 100])
+    assert att_log(["info", str(cut)]) == 1
+    out = capsys.readouterr().out
+    assert "INCOMPLETE" in out and f"messages  {4 * PER_CHUNK} on 5 channels" in out and "att-log repair" in out
+
+
+def test_repair_never_overwrites_its_input_unless_in_place(finished, tmp_path, capsys):
+    path, original = finished
+    cut = tmp_path / "run.mcap"
+    cut.write_bytes(path.read_bytes()[:chunk_ends(path)[5] + 3])
+    before = cut.read_bytes()
+    assert att_log(["repair", str(cut), "-o", str(cut)]) == 2
+    assert "would overwrite the input; use --in-place" in capsys.readouterr().err
+    assert cut.read_bytes() == before
+    assert att_log(["repair", str(cut), "--in-place"]) == 0
+    assert records_of(cut) == original[:6 * PER_CHUNK]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["run.mcap"]          # no temporary file left
+    with pytest.raises(SystemExit) as exit_info:
+        att_log(["repair", str(cut), "--in-place", "-o", str(tmp_path / "x.mcap")])
+    assert exit_info.value.code == 2
+
+
+NOT_MCAP = {
+    "empty": b"",
+    "text": b"hello, this is not a log\n",
+    "png": b"\x89PNG\r\n\x1a\n" + bytes(100),
+    "zip": b"PK\x03\x04" + bytes(100),
+    "random": bytes(range(256)) * 4,
+    "half magic": b"\x89MCA",
+    "magic only": b"\x89MCAP0\r\n",
+    "magic and cut header": b"\x89MCAP0\r\n\x01\x30\x00\x00",
+    "no header first": b"\x89MCAP0\r\n" + b"\x0f" + (4).to_bytes(8, "little") + bytes(4),
+}
+
+
+@pytest.mark.parametrize("name", [*NOT_MCAP, "missing", "directory"])
+def test_what_is_not_an_mcap_log_is_refused_in_one_line(tmp_path, capsys, name):
+    path = tmp_path / "in.mcap"
+    if name == "directory":
+        path.mkdir()
+    elif name != "missing":
+        path.write_bytes(NOT_MCAP[name])
+    for command in (["repair", str(path)], ["info", str(path)]):
+        assert att_log(command) == 2, (name, command)
+        err = capsys.readouterr().err
+        assert err.count("\n") == 1 and err.startswith(f"att-log: {path}: "), err
+        assert "Traceback" not in err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ([] if name == "missing" else ["in.mcap"])
+
+
+def test_a_chunk_with_a_message_on_an_undefined_channel_ends_the_recovery(tmp_path):
+    from mcap.writer import Writer
+
+    path = tmp_path / "orphan.mcap"
+    with open(path, "wb") as fh:
+        writer = Writer(fh)
+        writer.start(profile="ros2", library="test")
+        schema = writer.register_schema("std_msgs/msg/Empty", "ros2msg", b"")
+        channel = writer.register_channel("/a", "cdr", schema)
+        for i, channel_id in enumerate([channel] * 3 + [99] + [channel] * 3):
+            writer.add_message(channel_id, log_time=i, data=bytes([i]), publish_time=i, sequence=i)
+            if i in (2, 3):
+                writer.flush()             # chunks: [0, 1, 2], [3 on channel 99], [4, 5, 6]
+        writer.finish()
+    done = repair(path)
+    assert "channel 99" in done.source.problem and not done.source.complete
+    assert [r[1] for r in records_of(done.output)] == [b"\x00", b"\x01", b"\x02"]
+
+
+def test_an_unchunked_log_cut_anywhere_keeps_a_growing_prefix(tmp_path):
+    """Messages outside chunks (another writer's layout): each cut keeps the whole records before it."""
+    from mcap.writer import Writer
+
+    path = tmp_path / "flat.mcap"
+    with open(path, "wb") as fh:
+        writer = Writer(fh, use_chunking=False)
+        writer.start(profile="ros2", library="test")
+        channel = writer.register_channel("/a", "cdr", writer.register_schema("std_msgs/msg/Empty", "ros2msg", b""))
+        for i in range(40):
+            writer.add_message(channel, log_time=1000 + i, data=bytes(range(i)), publish_time=2000 + i, sequence=i)
+        writer.finish()
+    original = records_of(path)
+    data, last = path.read_bytes(), -1
+    for cut in range(60, len(data), 37):
+        (tmp_path / "cut.mcap").write_bytes(data[:cut])
+        got = records_of(repair(tmp_path / "cut.mcap", tmp_path / "out.mcap").output)
+        assert got == original[:len(got)] and len(got) >= last
+        last = len(got)
+    assert last == len(original)
