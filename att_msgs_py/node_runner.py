@@ -64,44 +64,66 @@ def _coerce(name: str, value, default, where: str):
     return value
 
 
-def parameter_reader(node, scenario_values: dict, source: str = "") -> Callable:
+SHARED_PARAMETERS = ("scenario", "use_sim_time", "frame_id", "body_frame_id")
+SHARED_PREFIXES = ("spacecraft.", "orbit.", "qos_overrides.")
+
+
+class ParameterReader:
     """``read(name, default, low=, high=, low_open=, length=, choices=)`` for a node: declares ROS
     parameter ``name`` with the value of its scenario-file section (``scenario_values``) or else
     ``default``, so ``-p`` and ``--params-file`` overrides win over both, and returns the value
     checked against the type of ``default`` (an integer is accepted for a float), the range
     [``low``, ``high``] (``(low, high]`` with ``low_open``; NaN and Inf never pass for a bounded
     number), the list ``length`` and the ``choices``. Anything else raises :class:`ConfigError`
-    with one line naming the parameter, where it came from and what is expected."""
-    def read(name: str, default, low: float | None = None, high: float | None = None, *, low_open: bool = False,
-             length: int | None = None, choices=None):
-        in_file = name in scenario_values
-        where = f" (from {source})" if in_file and source else ""
-        initial = _coerce(name, scenario_values[name], default, where) if in_file else default
-        descriptor = ParameterDescriptor(dynamic_typing=True)
-        value = node.declare_parameter(name, initial, descriptor).value
+    with one line naming the parameter, where it came from and what is expected.
+    :meth:`refuse_unknown` then refuses every parameter given that no ``read`` asked for (a typo)."""
+
+    def __init__(self, node, scenario_values: dict, source: str = ""):
+        self.node, self.values, self.source = node, scenario_values, source
+        self.used: set[str] = set()
+
+    def __call__(self, name: str, default, low: float | None = None, high: float | None = None, *,
+                 low_open: bool = False, length: int | None = None, choices=None):
+        self.used.add(name)
+        in_file = name in self.values
+        where = f" (from {self.source})" if in_file and self.source else ""
+        initial = _coerce(name, self.values[name], default, where) if in_file else default
+        value = self.node.declare_parameter(name, initial, ParameterDescriptor(dynamic_typing=True)).value
         if value != initial or type(value) is not type(initial):
             where = " (from the command line or a --params-file)"
         value = _coerce(name, value, default, where)
         label = f"parameter '{name}'{where}"
-        if low is not None or high is not None:
-            for v in (value if isinstance(value, list) else [value]):
-                try:
+        try:
+            if low is not None or high is not None:
+                for v in (value if isinstance(value, list) else [value]):
                     number(v, label, ErrorCode.INVALID_PARAMETER, -math.inf if low is None else low,
                            math.inf if high is None else high, low_open=low_open)
-                except RequestError as err:
-                    raise ConfigError(err.code, err.message) from None
+            if isinstance(value, str):
+                text(value, label, ErrorCode.INVALID_PARAMETER, max_length=4096)
+        except RequestError as err:
+            raise ConfigError(ErrorCode.INVALID_PARAMETER, err.message) from None
         if length is not None and len(value) != length:
             raise ConfigError(ErrorCode.INVALID_PARAMETER, f"{label}: expected {length} numbers, got {len(value)}")
         if choices is not None and value not in choices:
             raise ConfigError(ErrorCode.INVALID_PARAMETER,
                               f"{label}: expected one of {', '.join(map(str, choices))}, got {clip(repr(value), 80)}")
-        if isinstance(value, str):
-            try:
-                text(value, label, ErrorCode.INVALID_PARAMETER, max_length=4096)
-            except RequestError as err:
-                raise ConfigError(ErrorCode.INVALID_PARAMETER, err.message) from None
         return value
-    return read
+
+    def refuse_unknown(self) -> None:
+        """A parameter of this node in the scenario file or on the command line that nothing
+        read (a typo) is an error, not silently ignored; the shared ``/**`` ones are allowed."""
+        overrides = set(getattr(self.node, "_parameter_overrides", {}))     # -p and --params-file values
+        for where, names in ((self.source or "the scenario file", set(self.values)),
+                             ("the command line or a --params-file", overrides)):
+            unknown = sorted(n for n in names - self.used - set(SHARED_PARAMETERS) if not n.startswith(SHARED_PREFIXES))
+            if unknown:
+                raise ConfigError(ErrorCode.INVALID_PARAMETER,
+                                  f"unknown {self.node.get_name()} parameter(s) {clip(', '.join(unknown), 120)} "
+                                  f"(from {where}); known: {', '.join(sorted(self.used))}")
+
+
+def parameter_reader(node, scenario_values: dict, source: str = "") -> ParameterReader:
+    return ParameterReader(node, scenario_values, source)
 
 
 def _check_params_files(args) -> None:

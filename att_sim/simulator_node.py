@@ -69,10 +69,8 @@ class SimulatorNode(Node):
         become attributes, the rest (initial state, checks) are returned."""
         section = self.scenario.node_params.get("simulator", {})
         read = parameter_reader(self, section, source=str(self.scenario.path))
-        used = set()
 
         def param(name, default, *args, hint="", **kwargs):
-            used.add(name)
             try:
                 return read(name, default, *args, **kwargs)
             except ConfigError as err:
@@ -110,22 +108,8 @@ class SimulatorNode(Node):
         if rate > values["max_reset_rate"]:
             raise ConfigError(ErrorCode.INVALID_PARAMETER, f"parameter 'initial_rate' has norm {rate:g} rad/s, above "
                                                            f"max_reset_rate = {values['max_reset_rate']:g} rad/s")
-        self.refuse_unknown(section, used)
+        read.refuse_unknown()
         return values
-
-    def refuse_unknown(self, section: dict, used: set) -> None:
-        """A simulator parameter in the scenario file or on the command line that no code reads
-        (a typo) is an error, not silently ignored; the shared ``/**`` ones are allowed."""
-        overrides = set(getattr(self, "_parameter_overrides", {}))     # -p and --params-file values
-        shared = ("spacecraft.", "orbit.", "qos_overrides.")
-        for where, names in ((str(self.scenario.path), set(section)), ("the command line or a --params-file",
-                                                                        overrides)):
-            unknown = sorted(n for n in names - used - {"scenario", "use_sim_time", "frame_id", "body_frame_id"}
-                             if not n.startswith(shared))
-            if unknown:
-                raise ConfigError(ErrorCode.INVALID_PARAMETER,
-                                  f"unknown simulator parameter(s) {clip(', '.join(unknown), 120)} (from {where}); "
-                                  f"known: {', '.join(sorted(used))}")
 
     # -- callbacks: translate messages to Simulation calls -------------------------------------
     def on_command(self, msg: ActuatorCommand):

@@ -56,6 +56,7 @@ class ControllerNode(Node):
                                       choices=[int(m) for m in ControlMode if m != ControlMode.PLAN_TRACKING]),
                                 self._scenario.body_frame_id, self._gate_config(param))
         self._wall_timeout = param("wall_timeout", 2.0, 0.0, 3600.0, low_open=True)
+        param.refuse_unknown()
         self._state_wall = time.monotonic()   # no "no state" warning before wall_timeout has passed
         self._stale = False
         self._refused = Counter()             # refused inputs per kind, for the throttled log lines
