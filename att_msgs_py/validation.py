@@ -23,18 +23,19 @@ MAX_PLAN_DURATION = 86_400.0   # s
 
 
 def text(value, name: str, code: ErrorCode = ErrorCode.INVALID_TEXT, max_length: int = MAX_NAME_LENGTH) -> str:
-    """A string without control characters (NUL, newline, escape, ...) and at most ``max_length``
+    """A string without control or format characters (NUL, newline, escape, bidi overrides, ...)
+    and at most ``max_length``
     characters. (A NUL cannot reach a node: rclpy's C strings end at the first NUL, so senders
     check with this too, see :mod:`att_msgs_py.convert`.)"""
     if not isinstance(value, str):
         raise RequestError(code, f"{name} must be a string, got {type(value).__name__}")
     if len(value) > max_length:
         raise RequestError(ErrorCode.SIZE_LIMIT, f"{name} has {len(value)} characters; at most {max_length}")
-    bad = next((ch for ch in value if unicodedata.category(ch) in ("Cc", "Cs", "Cn")), None)
+    bad = next((ch for ch in value if unicodedata.category(ch) in ("Cc", "Cf", "Cs", "Cn")), None)
     if bad is not None:
         raise RequestError(ErrorCode.INVALID_TEXT,
-                           f"{name} contains the control or unassigned character U+{ord(bad):04X} at position "
-                           f"{value.index(bad)}")
+                           f"{name} contains the control, format or unassigned character U+{ord(bad):04X} at "
+                           f"position {value.index(bad)}")
     return value
 
 
@@ -64,7 +65,8 @@ def unit_quaternion(q, name: str, code: ErrorCode = ErrorCode.INVALID_ATTITUDE) 
     q = np.asarray(q, float)
     if q.shape != (4,) or not np.all(np.isfinite(q)):
         raise RequestError(code, f"{name} has NaN or Inf components")
-    n = np.linalg.norm(q)
+    with np.errstate(over="ignore"):
+        n = np.linalg.norm(q)
     if n == 0.0:
         raise RequestError(code, f"{name} is the zero quaternion")
     if abs(n - 1.0) > UNIT_TOLERANCE:
@@ -77,7 +79,8 @@ def unit_vector(v, name: str, code: ErrorCode) -> np.ndarray:
     v = np.asarray(v, float)
     if v.shape != (3,) or not np.all(np.isfinite(v)):
         raise RequestError(code, f"{name} has NaN or Inf components")
-    n = np.linalg.norm(v)
+    with np.errstate(over="ignore"):
+        n = np.linalg.norm(v)
     if n == 0.0:
         raise RequestError(code, f"{name} is the zero vector")
     if abs(n - 1.0) > UNIT_TOLERANCE:
@@ -88,7 +91,8 @@ def unit_vector(v, name: str, code: ErrorCode) -> np.ndarray:
 def unit_quaternions(q, name: str, code: ErrorCode) -> np.ndarray:
     """(K, 4) quaternions, each within :data:`UNIT_TOLERANCE` of unit norm, normalised."""
     q = finite_array(q, name, code, (-1, 4))
-    n = np.linalg.norm(q, axis=1)
+    with np.errstate(over="ignore"):
+        n = np.linalg.norm(q, axis=1)
     bad = np.flatnonzero(np.abs(n - 1.0) > UNIT_TOLERANCE)
     if bad.size:
         raise RequestError(code, f"{name}[{bad[0]}] has norm {n[bad[0]]:.6g}; unit quaternions are required "

@@ -125,7 +125,8 @@ REGISTRY = [
            {"ride_margin_deg": Option(0.0, 10.0)}, cheap=True),
     Method("eigenaxis_smooth", "att_planner.methods.eigenaxis", "plan_eigenaxis_smooth",
            "eigenaxis slew with a quintic angle profile (C1 rate, zero torque at both ends); ignores cones",
-           {"samples": Option(61, 100_000, True, doc="knots of the linear torque profile")}, cheap=True),
+           # at most 5000 knots: a plan verified, signed and sent within its budget (+ 1 s)
+           {"samples": Option(61, 5000, True, doc="knots of the linear torque profile")}, cheap=True),
     Method("eigenaxis", "att_planner.methods.eigenaxis", "plan_eigenaxis",
            "eigenaxis bang-bang slew with the largest torque the per-axis limits allow; ignores cones", cheap=True),
     _slepian("mssa", "Slepian basis, minimum sum of squared coefficients (Celani & Lucarelli); cone-aware"),

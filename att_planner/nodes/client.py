@@ -6,9 +6,19 @@ Used by ``att-demo``, the integration tests and user scripts::
     client.wait_for_servers(timeout=20)
     response = client.plan(maneuver_request(q0, qf, sensor, cones))
     result = client.execute(response.plan.plan_id)
+
+Robust to hostile input and to the other side failing: :func:`maneuver_request` refuses a string
+with a NUL or another control character, and every call refuses a NUL before sending (ValueError
+naming the field; rclpy would silently cut the string at the NUL); a service call survives a
+restart of its server (the request is sent again once a new server has appeared, see
+:meth:`SuiteClient._call`); an executing goal whose controller falls silent (no feedback for
+``stall_timeout`` s of wall time) is cancelled and reported as ABORTED instead of waiting for the
+overall timeout.
 """
 from __future__ import annotations
 
+import math
+import sys
 import time
 from contextlib import contextmanager
 
@@ -19,13 +29,47 @@ from rclpy.node import Node
 from att_msgs.action import ExecuteManeuver
 from att_msgs.srv import PlanManeuver, PlanSchedule, SetControllerMode
 from att_msgs_py import convert, qos, topics
-from att_msgs_py.errors import ErrorCode
+from att_msgs_py.errors import ErrorCode, RequestError
 from att_msgs_py.types import Cone
+from att_msgs_py.validation import text
+
+POLL = 0.05                 # s between checks of a pending call or goal
+RESEND_SETTLE = 0.5         # s a new server is given to discover this client before a request is sent again
+STALL_TIMEOUT = 15.0        # s of wall time without feedback after which an executing goal is given up
+GOAL_ANSWER_TIMEOUT = 30.0  # s for the controller to accept or reject a goal
+_NO_STRINGS = ("geometry_msgs/", "builtin_interfaces/", "float", "double", "int", "uint", "bool", "octet", "byte")
+
+
+def check_strings(msg, name: str = "", nul_only: bool = False) -> None:
+    """Every string of ``msg`` (nested messages and sequences too) is free of NUL and other control
+    characters (only of NUL with ``nul_only``), or ValueError naming the field (``header.frame_id``,
+    ``cones[2].name``)."""
+    def check(value: str, label: str) -> None:
+        if not nul_only:
+            text(value, label, max_length=sys.maxsize)
+        elif "\0" in value:
+            raise RequestError(ErrorCode.INVALID_TEXT, f"{label} contains a NUL character at position "
+                                                       f"{value.index(chr(0))} (it would be cut there unseen)")
+
+    for field, kind in msg.get_fields_and_field_types().items():
+        label = f"{name}.{field}" if name else field
+        value = getattr(msg, field)
+        if isinstance(value, str):
+            check(value, label)
+        elif hasattr(value, "get_fields_and_field_types"):
+            check_strings(value, label, nul_only)
+        elif kind.startswith("sequence<") and not kind[len("sequence<"):].startswith(_NO_STRINGS):
+            for i, item in enumerate(value):
+                if isinstance(item, str):
+                    check(item, f"{label}[{i}]")
+                else:
+                    check_strings(item, f"{label}[{i}]", nul_only)
 
 
 def maneuver_request(q_initial, q_final, sensor_axis, cones: list[Cone], *, method: str = "",
                      time_budget: float = 0.0, spacecraft: str = "", frame_id: str = "eci",
                      options: dict | None = None) -> PlanManeuver.Request:
+    """A PlanManeuver request; ValueError when a string holds a NUL or another control character."""
     req = PlanManeuver.Request()
     req.header.frame_id = frame_id
     req.initial_attitude = convert.quaternion(q_initial)
@@ -35,6 +79,7 @@ def maneuver_request(q_initial, q_final, sensor_axis, cones: list[Cone], *, meth
     req.method, req.time_budget, req.spacecraft = method, float(time_budget), spacecraft
     req.option_names = list((options or {}).keys())
     req.option_values = [float(v) for v in (options or {}).values()]
+    check_strings(req)
     return req
 
 
@@ -55,12 +100,58 @@ class SuiteClient(Node):
         if not self.execute_client.wait_for_server(timeout_sec=max(0.1, deadline - time.monotonic())):
             raise TimeoutError(f"action {topics.EXECUTE_MANEUVER} not available after {timeout} s")
 
+    def _servers(self, client) -> frozenset:
+        """The servers of ``client``'s service as this node's graph lists them: the GIDs of their
+        reply writers (empty for a middleware without DDS topic names, or while the graph lags)."""
+        try:
+            return frozenset(bytes(i.endpoint_gid)
+                             for i in self.get_publishers_info_by_topic(f"rr{client.srv_name}Reply", no_mangle=True))
+        except Exception:  # a middleware that does not list them: only readiness changes are seen
+            return frozenset()
+
     def _call(self, client, request, timeout: float):
-        future = client.call_async(request)
-        rclpy.spin_until_future_complete(self, future, timeout_sec=timeout)
-        if not future.done():
-            raise TimeoutError(f"no answer from {client.srv_name} within {timeout} s")
-        return future.result()
+        """Send ``request`` once the service is ready and wait for the first answer.
+
+        The graph still lists a killed server until its lease expires, so a request can go to a
+        dead server. Whenever a server appears that was not listed when the request was sent (a
+        restart), or the service comes back after being gone, the request is sent again
+        :data:`RESEND_SETTLE` s later (time for the new server to discover this client, so that
+        its reply is not lost); a server that has only just appeared gets that time before the
+        first send too. The first answer wins. A string with a NUL is refused (ValueError): rclpy
+        would send it cut at the NUL; other control characters are for the server to refuse."""
+        check_strings(request, nul_only=True)
+        deadline = time.monotonic() + timeout
+        if not client.service_is_ready():
+            if not client.wait_for_service(timeout_sec=max(0.0, timeout)):
+                raise TimeoutError(f"no answer from {client.srv_name} within {timeout} s (no server)")
+            self._spin_for(RESEND_SETTLE)
+        futures, known, was_ready, appeared = [client.call_async(request)], self._servers(client), True, None
+        try:
+            while True:
+                rclpy.spin_until_future_complete(self, futures[-1], timeout_sec=POLL)
+                answered = next((f for f in futures if f.done()), None)
+                if answered is not None:
+                    return answered.result()
+                now = time.monotonic()
+                if now > deadline:
+                    raise TimeoutError(f"no answer from {client.srv_name} within {timeout} s")
+                servers, ready = self._servers(client), client.service_is_ready()
+                if ready and ((known and servers - known) or not was_ready):
+                    appeared = appeared or now
+                known, was_ready = known | servers, ready
+                if appeared is not None and ready and now - appeared >= RESEND_SETTLE:
+                    self.get_logger().info(f"{client.srv_name}: a new server appeared; sending the request again")
+                    futures.append(client.call_async(request))
+                    appeared = None
+        finally:
+            for future in futures:
+                if not future.done():
+                    client.remove_pending_request(future)
+
+    def _spin_for(self, seconds: float) -> None:
+        end = time.monotonic() + seconds
+        while time.monotonic() < end:
+            rclpy.spin_once(self, timeout_sec=min(POLL, max(0.0, end - time.monotonic())))
 
     def plan(self, request: PlanManeuver.Request, timeout: float = 120.0) -> PlanManeuver.Response:
         return self._call(self.plan_client, request, timeout)
@@ -72,28 +163,62 @@ class SuiteClient(Node):
         return self._call(self.mode_client, SetControllerMode.Request(mode=mode), timeout)
 
     def execute(self, plan_id: str = "", plan=None, timeout: float = 600.0, on_feedback=None,
-                retries: int = 10) -> ExecuteManeuver.Result:
+                retries: int = 10, stall_timeout: float = STALL_TIMEOUT) -> ExecuteManeuver.Result:
         """Run a plan on the controller and wait for the result. A plan just published may not have
-        reached the controller yet: UNKNOWN_PLAN is retried ``retries`` times, 0.5 s apart."""
+        reached the controller yet: UNKNOWN_PLAN is retried ``retries`` times, 0.5 s apart. A
+        controller that falls silent (no feedback for ``stall_timeout`` s of wall time) gives an
+        ABORTED result (:meth:`_await_result`)."""
         goal = ExecuteManeuver.Goal(plan_id=plan_id, use_inline_plan=plan is not None)
         if plan is not None:
             goal.plan = plan
+        check_strings(goal, "goal", nul_only=True)
         for _ in range(retries + 1):
-            send = self.execute_client.send_goal_async(goal, feedback_callback=on_feedback)
-            rclpy.spin_until_future_complete(self, send, timeout_sec=30.0)
+            heard = [time.monotonic(), None]            # wall time of the last sign of life, last feedback
+
+            def feedback(msg, heard=heard):
+                heard[0], heard[1] = time.monotonic(), msg.feedback
+                if on_feedback is not None:
+                    on_feedback(msg)
+
+            send = self.execute_client.send_goal_async(goal, feedback_callback=feedback)
+            rclpy.spin_until_future_complete(self, send, timeout_sec=GOAL_ANSWER_TIMEOUT)
+            if not send.done():
+                raise TimeoutError(f"the controller did not answer the goal within {GOAL_ANSWER_TIMEOUT:g} s")
             handle = send.result()
             if handle is None or not handle.accepted:
                 raise RuntimeError("the controller rejected the goal (another maneuver is executing)")
-            done = handle.get_result_async()
-            rclpy.spin_until_future_complete(self, done, timeout_sec=timeout)
-            if not done.done():
-                raise TimeoutError(f"maneuver not finished within {timeout} s")
-            result = done.result().result
+            heard[0] = time.monotonic()
+            result = self._await_result(handle, heard, timeout, stall_timeout)
             if result.error_code != ErrorCode.UNKNOWN_PLAN:
                 return result
             time.sleep(0.5)
         return result
 
+    def _await_result(self, handle, heard: list, timeout: float, stall_timeout: float) -> ExecuteManeuver.Result:
+        """The goal's result; ABORTED when nothing was heard from the controller for
+        ``stall_timeout`` s (the goal is then cancelled, in case the controller still lives);
+        TimeoutError after ``timeout`` s."""
+        done = handle.get_result_async()
+        deadline = time.monotonic() + timeout
+        while not done.done():
+            rclpy.spin_until_future_complete(self, done, timeout_sec=POLL)
+            now = time.monotonic()
+            if done.done():
+                break
+            if now - heard[0] > stall_timeout:
+                handle.cancel_goal_async()
+                rclpy.spin_once(self, timeout_sec=POLL)
+                last = heard[1]
+                return ExecuteManeuver.Result(
+                    success=False, error_code=int(ErrorCode.ABORTED),
+                    message=f"the controller fell silent: no feedback for {stall_timeout:g} s of wall time "
+                            f"(server {'still listed' if self.execute_client.server_is_ready() else 'gone'}); "
+                            "the maneuver's outcome is unknown",
+                    duration=float(last.elapsed) if last is not None else 0.0,
+                    final_attitude_error=math.nan, final_rate=math.nan)
+            if now > deadline:
+                raise TimeoutError(f"maneuver not finished within {timeout} s")
+        return done.result().result
 
 
 @contextmanager

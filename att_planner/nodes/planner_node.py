@@ -6,6 +6,11 @@ Callbacks only translate: message -> :class:`ManeuverRequest` -> :func:`validate
 concurrently (reentrant callback group on a multi-threaded executor), so a long solve never
 blocks a quick request; each request builds its own problem, nothing is shared between requests
 but the read-only method registry.
+
+Every plan it issues is signed with the Ed25519 private key ``signing_key``
+(:mod:`att_msgs_py.signing`) after its last field is set, and names the spacecraft configuration
+it was made for (``spacecraft_digest``); the response and the published plan are the same message.
+Refusals and log lines are clipped (:func:`att_msgs_py.errors.clip`).
 """
 from __future__ import annotations
 
@@ -18,14 +23,14 @@ from rclpy.node import Node
 
 from att_msgs.msg import ManeuverPlan
 from att_msgs.srv import PlanManeuver, PlanSchedule
-from att_msgs_py import convert, qos, topics
-from att_msgs_py.errors import ErrorCode, RequestError
+from att_msgs_py import convert, qos, signing, topics
+from att_msgs_py.errors import ConfigError, ErrorCode, RequestError, clip
 from att_msgs_py.node_runner import parameter_reader, run_node
 from att_msgs_py.types import Plan
 from att_planner import methods
 from att_planner.methods.schedule import plan_schedule
-from att_planner.service.planning import PlanOutcome, plan_maneuver, plan_schedule_request, run_method
-from att_planner.service.requests import ManeuverRequest, validate_maneuver, validate_schedule
+from att_planner.service.planning import PlanOutcome, plan_maneuver, plan_schedule_request, prepare, run_method
+from att_planner.service.requests import MAX_TIME_BUDGET, ManeuverRequest, validate_maneuver, validate_schedule
 from att_planner.service.worker import call_isolated, run_isolated, set_max_parallel, warm_up
 from att_planner.verification import TOLERANCES, Tolerances
 from att_sim import scenario as scen
@@ -34,28 +39,52 @@ from att_sim import scenario as scen
 class PlannerNode(Node):
     def __init__(self):
         super().__init__("planner")
-        self._scenario_name = self.declare_parameter("scenario", "swift_demo").value
-        scenario = scen.load(self._scenario_name)
-        param = parameter_reader(self, scenario.node_params.get("planner", {}))
+        scenario = scen.load_checked(parameter_reader(self, {})("scenario", "swift_demo"))
+        self._scenario_name = scenario.name
+        param = parameter_reader(self, scenario.node_params.get("planner", {}), str(scenario.path))
         self._frame_id = scenario.frame_id
         self._default_method = param("default_method", "") or methods.REGISTRY[0].name
-        self._default_budget = float(param("time_budget", 20.0))
+        if self._default_method not in methods.METHODS:
+            raise ConfigError(ErrorCode.INVALID_PARAMETER, f"parameter 'default_method': expected '' (the best) or one "
+                                                           f"of {', '.join(methods.METHODS)}, got "
+                                                           f"'{clip(self._default_method, 80)}'")
+        self._default_budget = param("time_budget", 20.0, 0.0, MAX_TIME_BUDGET, low_open=True)
         self._tolerances = Tolerances(
-            attitude=math.radians(float(param("accept_attitude_error_deg", math.degrees(TOLERANCES.attitude)))),
-            rate=float(param("accept_final_rate", TOLERANCES.rate)),
-            cone_penetration=math.radians(float(param("accept_cone_penetration_deg",
-                                                      math.degrees(TOLERANCES.cone_penetration)))))
-        self._cone_padding = math.radians(float(param("cone_padding_deg", 1.0)))
-        self._schedule_rate_max = float(param("schedule_rate_max", float("inf")))
-        set_max_parallel(int(param("max_parallel_solves", 2)))
+            attitude=math.radians(param("accept_attitude_error_deg", math.degrees(TOLERANCES.attitude), 0.0, 180.0,
+                                        low_open=True)),
+            rate=param("accept_final_rate", TOLERANCES.rate, 0.0, 10.0, low_open=True),
+            cone_penetration=math.radians(param("accept_cone_penetration_deg",
+                                                math.degrees(TOLERANCES.cone_penetration), 0.0, 10.0)))
+        self._cone_padding = math.radians(param("cone_padding_deg", 1.0, 0.0, 10.0))
+        self._schedule_rate_max = param("schedule_rate_max", math.inf)
+        if not self._schedule_rate_max > 0:        # .inf: no bound; NaN, 0 and negatives are refused
+            raise ConfigError(ErrorCode.INVALID_PARAMETER, "parameter 'schedule_rate_max': expected a body-rate bound "
+                                                           f"> 0 rad/s (.inf: none), got {self._schedule_rate_max!r}")
+        key_path = param("signing_key", str(signing.default_key_dir() / signing.PRIVATE_NAME))
+        self._signing_key = self._load_signing_key(key_path)
+        set_max_parallel(param("max_parallel_solves", 2, 1, 64))
         warm_up()
+        prepare(scenario.spacecraft)
         group = ReentrantCallbackGroup()
         self._plan_pub = self.create_publisher(ManeuverPlan, topics.PLANS, qos.LATCHED_QOS)
         self.create_service(PlanManeuver, topics.PLAN_MANEUVER, self.on_plan_maneuver, qos_profile=qos.SERVICE_QOS,
                             callback_group=group)
         self.create_service(PlanSchedule, topics.PLAN_SCHEDULE, self.on_plan_schedule, qos_profile=qos.SERVICE_QOS,
                             callback_group=group)
-        self.get_logger().info(f"methods: {', '.join(methods.METHODS)} (default {self._default_method})")
+        self.get_logger().info(f"methods: {', '.join(methods.METHODS)} (default {self._default_method}); plans "
+                               f"signed with key {signing.key_id(self._signing_key.public_key())}")
+
+    @staticmethod
+    def _load_signing_key(path: str):
+        try:
+            return signing.load_private_key(path)
+        except FileNotFoundError:
+            raise ConfigError(ErrorCode.INVALID_CONFIG, f"parameter 'signing_key': no plan-signing key at "
+                                                        f"'{clip(path, 200)}': run att-keygen") from None
+        except (OSError, ValueError, TypeError) as exc:
+            raise ConfigError(ErrorCode.INVALID_CONFIG, f"parameter 'signing_key': '{clip(path, 200)}' is not a "
+                                                        f"readable Ed25519 private key ({clip(exc, 120)}): run "
+                                                        "att-keygen") from None
 
     def on_plan_maneuver(self, request: PlanManeuver.Request, response: PlanManeuver.Response):
         try:
@@ -78,8 +107,8 @@ class PlannerNode(Node):
             outcome = plan_maneuver(valid, self._tolerances, self._cone_padding, runner)
         except Exception as exc:  # a fault of the service itself is answered, never left hanging
             outcome = self.internal_error(exc)
-        self.answer(response, outcome, valid.spacecraft, valid.method.name,
-                    sensor_axis=valid.problem.sensor_axis, cones=valid.problem.cones)
+        self.answer(response, outcome, valid.spacecraft, valid.method.name, sensor_axis=valid.problem.sensor_axis,
+                    cones=valid.problem.cones, spacecraft_digest=valid.problem.spacecraft.digest)
         return response
 
     def on_plan_schedule(self, request: PlanSchedule.Request, response: PlanSchedule.Response):
@@ -105,36 +134,40 @@ class PlannerNode(Node):
         if outcome.code == ErrorCode.OK:
             response.order = outcome.plan.order
             response.passage_times = [float(p.time) for p in outcome.plan.passages]
-        self.answer(response, outcome, valid.spacecraft, f"schedule of {len(valid.problem.targets)} targets")
+        self.answer(response, outcome, valid.spacecraft, f"schedule of {len(valid.problem.targets)} targets",
+                    spacecraft_digest=valid.problem.spacecraft.digest)
         return response
 
     def internal_error(self, exc: Exception) -> PlanOutcome:
-        self.get_logger().error(f"planning failed unexpectedly: {type(exc).__name__}: {exc}")
-        return PlanOutcome(ErrorCode.SOLVER_FAILED, f"internal error while planning: {type(exc).__name__}: {exc}",
+        self.get_logger().error(clip(f"planning failed unexpectedly: {type(exc).__name__}: {exc}"))
+        return PlanOutcome(ErrorCode.SOLVER_FAILED, clip(f"internal error while planning: {type(exc).__name__}: {exc}"),
                            None)
 
     def refuse(self, response, err: RequestError, what: str):
-        self.get_logger().warning(f"{what} rejected [{int(err.code)} {err.code.name}]: {err.message}")
-        response.success, response.error_code, response.message = False, int(err.code), err.message
+        self.get_logger().warning(clip(f"{what} rejected [{int(err.code)} {err.code.name}]: {err.message}"))
+        response.success, response.error_code, response.message = False, int(err.code), clip(err.message)
         return response
 
     def answer(self, response, outcome: PlanOutcome, spacecraft: str, what: str, **context):
-        """Fill the response from ``outcome``; an accepted plan gets an id and is published."""
+        """Fill the response from ``outcome``; a plan gets an id, the spacecraft digest, a stamp and
+        its signature (in that order, the signature last); an accepted one is published."""
         response.success = outcome.code == ErrorCode.OK
-        response.error_code, response.message = int(outcome.code), outcome.message
+        response.error_code, response.message = int(outcome.code), clip(outcome.message)
         plan: Plan | None = outcome.plan
         if plan is not None and len(plan.t) >= 2:
             plan.plan_id, plan.frame_id, plan.spacecraft = uuid.uuid4().hex[:12], self._frame_id, spacecraft
             for key, value in context.items():
                 setattr(plan, key, value)
+            plan.message = clip(plan.message)
             plan.verification = outcome.verification      # a refused plan goes out unverified
             response.plan = convert.plan_msg(plan)
             response.plan.header.stamp = self.get_clock().now().to_msg()
+            signing.sign(response.plan, self._signing_key)
         if response.success:
-            self.get_logger().info(f"{what}: {outcome.message}")
+            self.get_logger().info(clip(f"{what}: {outcome.message}"))
             self._plan_pub.publish(response.plan)
         else:
-            self.get_logger().warning(f"{what} failed (code {response.error_code}): {outcome.message}")
+            self.get_logger().warning(clip(f"{what} failed (code {response.error_code}): {outcome.message}"))
 
 
 def main(args=None):

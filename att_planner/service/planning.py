@@ -6,6 +6,13 @@ tolerances. A method that fails, raises or runs out of budget without a plan tha
 replaced by the smooth eigenaxis slew when that one verifies (status FALLBACK); otherwise the
 answer is an error. No unverified plan ever leaves. :func:`plan_schedule_request` does the same
 for a schedule (no fallback exists there).
+
+Bounded: a plan of more than :data:`MAX_PLAN_SAMPLES` samples is refused (SIZE_LIMIT) before it is
+verified or sent. Every answer comes within the request's budget plus :data:`ANSWER_GRACE`: the
+method gets the budget minus a reserve (:func:`verify_reserve`), a child solver is killed soon
+after, and a plan is verified only when its verification (and the fallback's, should it be
+rejected) still fits, as estimated from the measured cost of an integration step
+(:func:`verify_cost`); a plan that does not fit is replaced by the fallback like a failed one.
 """
 from __future__ import annotations
 
@@ -17,21 +24,56 @@ import numpy as np
 
 from att_msgs_py.errors import ErrorCode
 from att_msgs_py.types import Cone, Plan, Status, Verification
+from att_msgs_py.validation import MAX_PLAN_SAMPLES
+from att_planner import methods
 from att_planner.cones import direction_margins, endpoint_directions
 from att_planner.methods import Method
 from att_planner.methods.eigenaxis import METHOD as FALLBACK_METHOD
 from att_planner.methods.eigenaxis import plan_eigenaxis_smooth
 from att_planner.problem import ManeuverProblem
 from att_planner.service.requests import ValidRequest, ValidSchedule
-from att_planner.verification import TOLERANCES, Tolerances, rejection, verify
+from att_planner.service.sky import lattice
+from att_planner.verification import TOLERANCES, VERIFY_STEPS, Tolerances, rejection, verify
 
 VERIFY_RESERVE = 0.2        # fraction of the time budget kept for verification and fallback
+VERIFY_RESERVE_MIN = 0.25   # s (at most half the budget)
 VERIFY_RESERVE_MAX = 3.0    # s
+ANSWER_GRACE = 1.0          # s an answer may come after the request's time budget
+ANSWER_MARGIN = 0.3         # s of that kept for building, signing and sending the answer
+FALLBACK_SAMPLES = 401      # knots of the eigenaxis fallback (its default)
+_step_seconds = 2e-4        # running estimate of the wall time of one verification step (s)
 
 
 def verify_reserve(time_budget: float) -> float:
     """Seconds of a request's budget kept back from the solver for verification and fallback."""
-    return min(VERIFY_RESERVE * time_budget, VERIFY_RESERVE_MAX)
+    return min(max(VERIFY_RESERVE * time_budget, min(VERIFY_RESERVE_MIN, 0.5 * time_budget)), VERIFY_RESERVE_MAX)
+
+
+def verify_cost(samples: int) -> float:
+    """Estimated wall time (s) of verifying a plan of ``samples`` knots: the integration takes
+    :data:`VERIFY_STEPS` steps plus about one per knot."""
+    return (VERIFY_STEPS + samples) * _step_seconds
+
+
+def timed_verify(problem: ManeuverProblem, plan: Plan) -> Verification:
+    """:func:`verify`, keeping the cost estimate of :func:`verify_cost` up to date (it follows a
+    slower machine at once, a faster one gradually)."""
+    global _step_seconds
+    start = time.perf_counter()
+    ver = verify(problem, plan)
+    per_step = (time.perf_counter() - start) / (VERIFY_STEPS + len(plan.t))
+    _step_seconds = max(per_step, 0.8 * _step_seconds + 0.2 * per_step)
+    return ver
+
+
+def prepare(spacecraft) -> None:
+    """What the first request would otherwise pay for, done at start: the sky lattice, the imports
+    of the methods' option checks, and a first measure of the verification cost."""
+    lattice()
+    for method in methods.REGISTRY:
+        method.validate({})
+    problem = ManeuverProblem(spacecraft, np.array([0.0, 0.0, 0.0, 1.0]), np.array([0.0, 0.0, 0.5 ** 0.5, 0.5 ** 0.5]))
+    timed_verify(problem, plan_eigenaxis_smooth(problem, samples=FALLBACK_SAMPLES))
 
 
 @dataclass
@@ -73,15 +115,36 @@ def run_method(method: Method, problem: ManeuverProblem, options: dict, wait: fl
     return plan
 
 
+def too_many_samples(plan: Plan) -> str:
+    """Why ``plan`` is too large to verify and send (more than :data:`MAX_PLAN_SAMPLES` samples), or ''."""
+    if len(plan.t) <= MAX_PLAN_SAMPLES:
+        return ""
+    return (f"{plan.method or 'the method'} returned a plan of {len(plan.t)} samples; at most {MAX_PLAN_SAMPLES} "
+            "are sent")
+
+
+def _no_time_to_verify(valid: ValidRequest, plan: Plan, fallback: bool) -> str:
+    """Why ``plan`` cannot be verified before the answer is due (its verification, and the
+    fallback's when there is one, would not fit), or ''."""
+    if valid.problem.deadline is None:
+        return ""
+    due = valid.problem.deadline + ANSWER_GRACE - ANSWER_MARGIN
+    need = verify_cost(len(plan.t)) + (verify_cost(FALLBACK_SAMPLES) if fallback else 0.0)
+    if time.monotonic() + need <= due:
+        return ""
+    return (f"{valid.method.name} returned its plan of {len(plan.t)} samples too late to verify it within the time "
+            f"budget of {valid.time_budget:g} s (+{ANSWER_GRACE:g} s)")
+
+
 def plan_maneuver(valid: ValidRequest, tol: Tolerances = TOLERANCES, cone_padding: float = 0.0,
                   runner: Callable = run_method) -> PlanOutcome:
     """Plan with cones widened by ``cone_padding`` rad, verify against the requested cones, fall
     back to the eigenaxis slew when that is safe.
 
     The method gets the request's deadline minus a reserve for verification and fallback
-    (:data:`VERIFY_RESERVE` of the budget, at most :data:`VERIFY_RESERVE_MAX` s). ``runner``
-    executes it (:func:`run_method` in-process, or :func:`att_planner.service.worker.run_isolated`
-    in a child process that is killed if it overruns); ``None`` from the runner means it overran.
+    (:func:`verify_reserve`). ``runner`` executes it (:func:`run_method` in-process, or
+    :func:`att_planner.service.worker.run_isolated` in a child process that is killed if it
+    overruns); ``None`` from the runner means it overran.
     """
     problem = valid.problem
     method_deadline = problem.deadline - verify_reserve(valid.time_budget) if problem.deadline is not None else None
@@ -91,17 +154,23 @@ def plan_maneuver(valid: ValidRequest, tol: Tolerances = TOLERANCES, cone_paddin
         plan = Plan(method=valid.method.name, status=Status.BUDGET_EXPIRED,
                     message=f"time budget of {valid.time_budget:g} s expired before {valid.method.name} "
                             "returned a plan")
+    oversize = too_many_samples(plan)
+    if oversize:
+        return PlanOutcome(ErrorCode.SIZE_LIMIT, oversize, None)
+    can_fall_back = problem.sensor_target is None and valid.method.name != FALLBACK_METHOD
     reason = plan.message or plan.status
-    if plan.success:
-        plan.verification = verify(problem, plan)
+    late = _no_time_to_verify(valid, plan, can_fall_back) if plan.success else ""
+    if late:
+        reason, plan.status = late, Status.BUDGET_EXPIRED
+    elif plan.success:
+        plan.verification = timed_verify(problem, plan)
         reason = rejection(plan.verification, tol)
         if reason is None:
             return PlanOutcome(ErrorCode.OK, plan.message or plan.status, plan)
         reason = f"{valid.method.name} plan rejected by verification: {reason}"
-    # fallback: the smooth eigenaxis slew, if it is safe
-    if problem.sensor_target is None and valid.method.name != FALLBACK_METHOD:
-        fallback = plan_eigenaxis_smooth(problem)
-        fallback.verification = verify(problem, fallback)
+    if can_fall_back:           # the smooth eigenaxis slew, if it is safe
+        fallback = plan_eigenaxis_smooth(problem, samples=FALLBACK_SAMPLES)
+        fallback.verification = timed_verify(problem, fallback)
         if fallback.status != Status.FAILED and rejection(fallback.verification, tol) is None:
             fallback.status = Status.FALLBACK
             fallback.message = f"{reason}; returning the eigenaxis fallback ({fallback.message})"
@@ -121,6 +190,9 @@ def plan_schedule_request(valid: ValidSchedule, tol: Tolerances = TOLERANCES, *,
     if plan is None or isinstance(plan, str):
         return PlanOutcome(ErrorCode.SOLVER_FAILED,
                            plan or f"time budget of {valid.time_budget:g} s expired without a schedule", None)
+    oversize = too_many_samples(plan)
+    if oversize:
+        return PlanOutcome(ErrorCode.SIZE_LIMIT, oversize, None)
     if not plan.success or plan.verification is None:
         code = ErrorCode.VERIFICATION_FAILED if plan.verification else ErrorCode.SOLVER_FAILED
         return PlanOutcome(code, f"no verified schedule: {plan.message}", None)

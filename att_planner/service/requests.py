@@ -4,7 +4,11 @@
 or ``PlanSchedule`` request into a :class:`~att_planner.problem.ManeuverProblem`, or raise
 :class:`RequestError` with a code and a sentence naming the field and the reason. Documented
 tolerances and caps are the constants below (README, "Errors and limits"); method options are
-checked by the registry (:mod:`att_planner.methods`).
+checked by the registry (:mod:`att_planner.methods`). Field checks are the shared ones of
+:mod:`att_msgs_py.validation` (``unit_quaternion`` and ``unit_vector`` are re-exported here): every
+string is free of control characters (INVALID_TEXT) and at most ``MAX_NAME_LENGTH`` characters
+(SIZE_LIMIT). Cones that close the sky between the start and goal sensor directions are refused
+as INFEASIBLE before any solving (:mod:`att_planner.service.sky`).
 """
 from __future__ import annotations
 
@@ -16,19 +20,21 @@ import numpy as np
 
 from att_msgs_py.errors import ErrorCode, RequestError
 from att_msgs_py.types import Cone
+from att_msgs_py.validation import MAX_NAME_LENGTH, text, unit_quaternion, unit_vector
 from att_planner import methods
 from att_planner.cones import endpoint_in_cone
 from att_planner.methods import Method
 from att_planner.problem import ManeuverProblem
+from att_planner.service.sky import closed_sky
+from att_sim import rotations as rot
 from att_sim import scenario as scen
 from att_sim.dynamics import Spacecraft
 
-UNIT_TOLERANCE = 1e-3          # |‖q‖ − 1| (and unit vectors) accepted and normalised below this
 MAX_CONES = 16
 MAX_OPTIONS = 16
 MAX_TIME_BUDGET = 600.0        # s
-MAX_NAME_LENGTH = 128
 MAX_TARGETS = 20               # schedule targets (the order search is exponential in their number)
+SAME_TARGET = 1e-6             # rad: schedule targets closer than this are one attitude (q and -q too)
 
 
 @dataclass
@@ -58,31 +64,6 @@ class ValidRequest:
     time_budget: float
 
 
-def unit_quaternion(q, name: str) -> np.ndarray:
-    q = np.asarray(q, float)
-    if q.shape != (4,) or not np.all(np.isfinite(q)):
-        raise RequestError(ErrorCode.INVALID_ATTITUDE, f"{name} has NaN or Inf components")
-    n = np.linalg.norm(q)
-    if n == 0.0:
-        raise RequestError(ErrorCode.INVALID_ATTITUDE, f"{name} is the zero quaternion")
-    if abs(n - 1.0) > UNIT_TOLERANCE:
-        raise RequestError(ErrorCode.INVALID_ATTITUDE,
-                           f"{name} has norm {n:.6g}; a unit quaternion is required (tolerance {UNIT_TOLERANCE})")
-    return q / n
-
-
-def unit_vector(v, name: str, code: ErrorCode) -> np.ndarray:
-    v = np.asarray(v, float)
-    if v.shape != (3,) or not np.all(np.isfinite(v)):
-        raise RequestError(code, f"{name} has NaN or Inf components")
-    n = np.linalg.norm(v)
-    if n == 0.0:
-        raise RequestError(code, f"{name} is the zero vector")
-    if abs(n - 1.0) > UNIT_TOLERANCE:
-        raise RequestError(code, f"{name} has norm {n:.6g}; a unit vector is required (tolerance {UNIT_TOLERANCE})")
-    return v / n
-
-
 def check_spacecraft(sc: Spacecraft, name: str) -> None:
     J = sc.inertia
     if not np.all(np.isfinite(J)) or not np.allclose(J, J.T, rtol=1e-9, atol=1e-12):
@@ -102,53 +83,85 @@ def check_spacecraft(sc: Spacecraft, name: str) -> None:
 
 
 def check_options(method: Method, names, values) -> dict:
-    """The request's option lists as the method's validated options (:meth:`Method.validate`)."""
+    """The request's option lists as the method's validated options (:meth:`Method.validate`):
+    names are text, each given once; values finite and in range (the registry)."""
     if len(names) != len(values):
         raise RequestError(ErrorCode.INVALID_OPTION,
                            f"option_names has {len(names)} entries but option_values has {len(values)}")
     if len(names) > MAX_OPTIONS:
         raise RequestError(ErrorCode.SIZE_LIMIT, f"{len(names)} options given; at most {MAX_OPTIONS} are accepted")
-    return method.validate(dict(zip(names, values)))
+    seen = {}
+    for i, name in enumerate(names):
+        text(name, f"option_names[{i}]")
+        if not name:
+            raise RequestError(ErrorCode.INVALID_OPTION, f"option_names[{i}] is empty")
+        if name in seen:
+            raise RequestError(ErrorCode.INVALID_OPTION,
+                               f"option_names[{i}] repeats option '{name}' (first at option_names[{seen[name]}]); "
+                               "each option may be given once")
+        seen[name] = i
+    return method.validate(dict(zip(names, [float(v) for v in values])))
 
 
 def check_frame(request_frame: str, frame_id: str) -> None:
     """The request's header frame is empty (meaning ours) or the planner's inertial frame."""
+    text(request_frame, "header.frame_id")
     if request_frame not in ("", frame_id):
         raise RequestError(ErrorCode.INVALID_FRAME,
-                           f"header.frame_id '{request_frame[:MAX_NAME_LENGTH]}' is not the planner's inertial "
-                           f"frame '{frame_id}'")
+                           f"header.frame_id '{request_frame}' is not the planner's inertial frame '{frame_id}'")
+
+
+def check_cones(raw: list) -> list[Cone]:
+    """At most :data:`MAX_CONES` cones, each with a unit direction, a half-angle in (0, pi/2) and a
+    text name."""
+    if len(raw) > MAX_CONES:
+        raise RequestError(ErrorCode.SIZE_LIMIT, f"{len(raw)} cones given; at most {MAX_CONES} are accepted")
+    cones = []
+    for i, (direction, half_angle, name) in enumerate(raw):
+        text(name, f"cones[{i}].name")
+        label = f"cones[{i}] ('{name}')"
+        d = unit_vector(direction, f"{label}.direction", ErrorCode.INVALID_CONE)
+        if not (math.isfinite(half_angle) and 0.0 < half_angle < math.pi / 2):
+            raise RequestError(ErrorCode.INVALID_CONE,
+                               f"{label}.half_angle = {half_angle} rad is outside (0, pi/2)")
+        cones.append(Cone(d, float(half_angle), name or f"cone{i}"))
+    return cones
+
+
+def check_reachable(q0, qf, r, cones: list[Cone], sensor_target) -> None:
+    """Neither end inside a cone (SENSOR_IN_CONE), and the cones do not close the sky between
+    them (INFEASIBLE)."""
+    hit = endpoint_in_cone(q0, qf, r, cones, sensor_target)
+    if hit is not None:
+        label, cone, depth = hit
+        raise RequestError(ErrorCode.SENSOR_IN_CONE,
+                           f"the {label} is inside cone '{cone.name}' by {np.degrees(depth):.3f} deg")
+    if closed_sky(q0, qf, r, cones, sensor_target):
+        goal = "goal" if sensor_target is None else "sensor_target"
+        raise RequestError(ErrorCode.INFEASIBLE,
+                           f"cones: the {len(cones)} keep-out cones close the sky between the start and {goal} "
+                           "sensor directions; no sensor path avoids them")
 
 
 def validate_maneuver(req: ManeuverRequest, *, frame_id: str, default_spacecraft: str, default_method: str,
                       default_budget: float) -> ValidRequest:
     """Check every field of a maneuver request; return the problem or raise RequestError."""
     check_frame(req.frame_id, frame_id)
+    text(req.method, "method")
+    text(req.spacecraft, "spacecraft")
     q0 = unit_quaternion(req.q_initial, "initial_attitude")
     qf = unit_quaternion(req.q_final, "final_attitude")
     r = unit_vector(req.sensor_axis, "sensor_axis", ErrorCode.INVALID_SENSOR_AXIS)
-    if len(req.cones) > MAX_CONES:
-        raise RequestError(ErrorCode.SIZE_LIMIT, f"{len(req.cones)} cones given; at most {MAX_CONES} are accepted")
-    cones = []
-    for i, (direction, half_angle, name) in enumerate(req.cones):
-        label = f"cones[{i}] ('{name[:MAX_NAME_LENGTH]}')"
-        d = unit_vector(direction, f"{label}.direction", ErrorCode.INVALID_CONE)
-        if not (math.isfinite(half_angle) and 0.0 < half_angle < math.pi / 2):
-            raise RequestError(ErrorCode.INVALID_CONE,
-                               f"{label}.half_angle = {half_angle} rad is outside (0, pi/2)")
-        cones.append(Cone(d, float(half_angle), name or f"cone{i}"))
+    cones = check_cones(list(req.cones))
     sensor_target = None
     if req.semi_free:
         sensor_target = unit_vector(req.sensor_target, "sensor_target", ErrorCode.INVALID_SENSOR_AXIS)
-    hit = endpoint_in_cone(q0, qf, r, cones, sensor_target)
-    if hit is not None:
-        label, cone, depth = hit
-        raise RequestError(ErrorCode.SENSOR_IN_CONE,
-                           f"the {label} is inside cone '{cone.name}' by {np.degrees(depth):.3f} deg")
     name = req.spacecraft or default_spacecraft
     sc = load_spacecraft(name)
     method = methods.get(req.method or default_method)
-    options, limits = method.split(check_options(method, list(req.option_names), [float(v) for v in req.option_values]))
+    options, limits = method.split(check_options(method, list(req.option_names), list(req.option_values)))
     budget = check_budget(float(req.time_budget), default_budget)
+    check_reachable(q0, qf, r, cones, sensor_target)
     problem = ManeuverProblem(sc, q0, qf, r, cones, deadline=time.monotonic() + budget, sensor_target=sensor_target,
                               **limits)
     return ValidRequest(problem, method, options, name, budget)
@@ -164,13 +177,18 @@ class ValidSchedule:
 def load_spacecraft(name: str) -> Spacecraft:
     if len(name) > MAX_NAME_LENGTH or not all(ch.isalnum() or ch in "_-" for ch in name):
         raise RequestError(ErrorCode.UNKNOWN_SPACECRAFT,
-                           "spacecraft must be a configuration name (letters, digits, '_' and '-')")
+                           f"spacecraft '{name[:MAX_NAME_LENGTH]}' must be a configuration name (letters, digits, "
+                           "'_' and '-')")
+    try:
+        scen.find(name)
+    except KeyError as exc:
+        raise RequestError(ErrorCode.UNKNOWN_SPACECRAFT, f"spacecraft: {exc.args[0]}") from None
     try:
         sc = scen.load(name).spacecraft
-    except KeyError as exc:
-        raise RequestError(ErrorCode.UNKNOWN_SPACECRAFT, str(exc.args[0])) from None
-    except (ValueError, TypeError) as exc:
-        raise RequestError(ErrorCode.INVALID_SPACECRAFT, f"spacecraft '{name}': {exc}") from None
+    except Exception as exc:  # any configuration that does not load is refused, the node keeps serving
+        why = exc.message if isinstance(exc, RequestError) else f"{type(exc).__name__}: {exc}"
+        raise RequestError(ErrorCode.INVALID_SPACECRAFT, f"spacecraft '{name}': its configuration does not load ({why})"
+                           ) from None
     check_spacecraft(sc, name)
     return sc
 
@@ -182,12 +200,9 @@ def check_budget(budget: float, default: float) -> float:
     return budget or default
 
 
-def validate_schedule(names: list, targets: list, q_start, q_end, spacecraft: str, time_budget: float, *,
-                      frame_id: str, request_frame: str, default_spacecraft: str, default_budget: float,
-                      rate_max: float = math.inf) -> ValidSchedule:
-    """Check a PlanSchedule request: names match targets, unit quaternions, a wheeled spacecraft.
-    ``q_end`` None: end where the schedule started. ``rate_max``: the planner's body-rate bound."""
-    check_frame(request_frame, frame_id)
+def check_targets(names: list, targets: list) -> dict:
+    """Schedule targets: as many text names as quaternions, names distinct and non-empty, unit
+    quaternions, no attitude twice (within :data:`SAME_TARGET`; q and -q are one attitude)."""
     if len(targets) > MAX_TARGETS or len(names) > MAX_TARGETS:
         raise RequestError(ErrorCode.SIZE_LIMIT,
                            f"{max(len(targets), len(names))} targets given; at most {MAX_TARGETS}")
@@ -195,9 +210,30 @@ def validate_schedule(names: list, targets: list, q_start, q_end, spacecraft: st
         raise RequestError(ErrorCode.INVALID_ATTITUDE, "targets is empty")
     if len(names) != len(targets):
         raise RequestError(ErrorCode.INVALID_ATTITUDE, f"{len(names)} target_names for {len(targets)} targets")
-    if len(set(names)) != len(names) or any(not n or len(n) > MAX_NAME_LENGTH for n in names):
-        raise RequestError(ErrorCode.INVALID_ATTITUDE, "target_names must be distinct, non-empty and short")
-    checked = {n: unit_quaternion(q, f"targets[{i}] ('{n}')") for i, (n, q) in enumerate(zip(names, targets))}
+    for i, n in enumerate(names):
+        text(n, f"target_names[{i}]")
+        if not n or n in names[:i]:
+            raise RequestError(ErrorCode.INVALID_ATTITUDE,
+                               f"target_names[{i}] is {'empty' if not n else f'a repeat of {n!r}'}; names must be "
+                               "distinct and non-empty")
+    qs = [unit_quaternion(q, f"targets[{i}] ('{n}')") for i, (n, q) in enumerate(zip(names, targets))]
+    for j in range(len(qs)):
+        for i in range(j):
+            if rot.angle_between(qs[i], qs[j]) < SAME_TARGET:
+                raise RequestError(ErrorCode.INVALID_ATTITUDE,
+                                   f"targets[{i}] ('{names[i]}') and targets[{j}] ('{names[j]}') are the same "
+                                   "attitude (q and -q are one attitude); each target must be distinct")
+    return dict(zip(names, qs))
+
+
+def validate_schedule(names: list, targets: list, q_start, q_end, spacecraft: str, time_budget: float, *,
+                      frame_id: str, request_frame: str, default_spacecraft: str, default_budget: float,
+                      rate_max: float = math.inf) -> ValidSchedule:
+    """Check a PlanSchedule request: names match targets, unit quaternions, a wheeled spacecraft.
+    ``q_end`` None: end where the schedule started. ``rate_max``: the planner's body-rate bound."""
+    check_frame(request_frame, frame_id)
+    text(spacecraft, "spacecraft")
+    checked = check_targets(list(names), list(targets))
     q0 = unit_quaternion(q_start, "start_attitude")
     q1 = q0 if q_end is None else unit_quaternion(q_end, "end_attitude")
     name = spacecraft or default_spacecraft

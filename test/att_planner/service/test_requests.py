@@ -85,6 +85,7 @@ def test_bad_spacecraft_configs_are_rejected(tmp_path, monkeypatch):
         "neg_wheel": ("inertia: [1, 1, 1]\n      torque_max: 1.0\n      wheel_torque_max: -1", "wheel_torque_max"),
     }
     for name, (body, words) in cases.items():
+        body += "\n      wheel_inertia: 0.01"       # the scenario loader's own checks pass
         (tmp_path / f"{name}.yaml").write_text(f"/**:\n  ros__parameters:\n    spacecraft:\n      {body}\n")
         with pytest.raises(RequestError) as err:
             validate(request(spacecraft=name))
