@@ -109,6 +109,7 @@ class CachedPlan:
 
 
 MAX_REMEMBERED_IDS = 100_000                   # plan ids whose content is remembered (32 bytes each)
+MAX_REMEMBERED_REFUSALS = 1000                 # refused plan ids whose reason an execute goal is told
 
 
 class Controller:
@@ -121,6 +122,7 @@ class Controller:
         self.hold_q: np.ndarray | None = None          # final attitude held after a maneuver
         self.plans: OrderedDict[str, CachedPlan] = OrderedDict()
         self.seen: OrderedDict[str, bytes] = OrderedDict()   # plan id -> SHA-256 of its signed bytes
+        self.refused: OrderedDict[str, RequestError] = OrderedDict()   # published plans refused, why
 
     @property
     def spacecraft(self) -> Spacecraft:
@@ -182,8 +184,15 @@ class Controller:
         """Cache a published plan once it passes :meth:`admit_plan`; the oldest plans go beyond
         ``max_cached_plans`` or ``max_cache_bytes``, never the one being flown."""
         refused = self.admit_plan(plan, payload)
-        if refused is not None or plan.plan_id in self.plans:
+        if refused is not None:
+            key = plan.plan_id[:validation.MAX_NAME_LENGTH]
+            self.refused[key] = refused
+            self.refused.move_to_end(key)
+            while len(self.refused) > MAX_REMEMBERED_REFUSALS:
+                self.refused.popitem(last=False)
             return refused
+        if plan.plan_id in self.plans:
+            return None
         self.plans[plan.plan_id] = CachedPlan(plan, len(payload))
         flying = self.maneuver.plan.plan_id if self.maneuver is not None else None
         for plan_id in list(self.plans):
@@ -218,9 +227,12 @@ class Controller:
         except RequestError as err:
             return None, err
         cached = self.plans.get(plan_id)
+        if cached is None and plan_id in self.refused:
+            why = self.refused[plan_id]
+            return None, RequestError(why.code, f"plan '{plan_id}' was refused when it arrived: {why.message}")
         if cached is None:
             return None, RequestError(ErrorCode.UNKNOWN_PLAN,
-                                      f"plan_id '{plan_id[:128]}' is not a plan this controller received")
+                                      f"plan_id '{plan_id}' is not a plan this controller received")
         return cached.plan, None
 
     def start(self, plan: Plan) -> RequestError | None:
