@@ -12,6 +12,11 @@ Nothing received is trusted (the core's checks, :mod:`att_planner.control.plan_c
 per kind, clipped, with a running count) and changes nothing. Plans must verify against the
 Ed25519 public key ``plan_public_key`` (:mod:`att_msgs_py.signing`).
 
+Sim time comes from the states' stamps. ``/clock`` is read by the node itself, not through
+rclpy's ``use_sim_time`` (whose time source raises on a negative stamp, so one hostile message
+would kill the node): only clock messages from the participant that publishes the accepted states
+count, and they only serve the state gate's skew check.
+
 Watchdog: when no state came for ``wall_timeout`` s of wall time the controller commands zero
 and reports ``state_stale`` until states flow again.
 """
@@ -24,8 +29,8 @@ from collections import Counter
 from rclpy.action import ActionServer, CancelResponse, GoalResponse
 from rclpy.clock import Clock, ClockType
 from rclpy.node import Node
-from rclpy.parameter import Parameter
 from rclpy.task import Future
+from rosgraph_msgs.msg import Clock as ClockMsg
 
 from att_msgs.action import ExecuteManeuver
 from att_msgs.msg import ActuatorCommand, ControllerStatus, ManeuverPlan, SpacecraftState
@@ -46,9 +51,14 @@ def publisher_of(info) -> bytes | None:
     return bytes(gid["data"]) if isinstance(gid, dict) and gid.get("data") is not None else None
 
 
+def participant_of(gid: bytes | None) -> bytes | None:
+    """The DDS participant of a publisher GID (its 12-byte GUID prefix): one per node process."""
+    return None if gid is None else gid[:12]
+
+
 class ControllerNode(Node):
     def __init__(self):
-        super().__init__("controller", parameter_overrides=[Parameter("use_sim_time", value=True)])
+        super().__init__("controller")
         self._scenario = scen.load_checked(parameter_reader(self, {})("scenario", "swift_demo"))
         param = parameter_reader(self, self._scenario.node_params.get("controller", {}), str(self._scenario.path))
         self._core = Controller(self._plan_context(param), self._config(param),
@@ -60,6 +70,7 @@ class ControllerNode(Node):
         self._state_wall = time.monotonic()   # no "no state" warning before wall_timeout has passed
         self._stale = False
         self._refused = Counter()             # refused inputs per kind, for the throttled log lines
+        self._sim_clock: tuple[bytes, float] | None = None   # (participant, s): its latest /clock
         self._goal = None                     # the goal handle of the running maneuver
         self._done: Future | None = None
 
@@ -67,6 +78,7 @@ class ControllerNode(Node):
         self._status_pub = self.create_publisher(ControllerStatus, topics.CONTROLLER_STATUS, qos.STREAM_QOS)
         self.create_subscription(SpacecraftState, topics.STATE, self.on_state, qos.STREAM_QOS)
         self.create_subscription(ManeuverPlan, topics.PLANS, self.on_plan, qos.LATCHED_QOS)
+        self.create_subscription(ClockMsg, topics.CLOCK, self.on_clock, qos.CLOCK_QOS)
         self.create_service(SetControllerMode, topics.SET_CONTROLLER_MODE, self.on_set_mode)
         self.create_timer(0.5, self.on_wall_watchdog, clock=Clock(clock_type=ClockType.STEADY_TIME))
         self._action = ActionServer(self, ExecuteManeuver, topics.EXECUTE_MANEUVER, execute_callback=self.execute,
@@ -121,10 +133,17 @@ class ControllerNode(Node):
                                        f"{err.code.name}]: {err.message}"), throttle_duration_sec=1.0)
 
     # -- inputs ---------------------------------------------------------------------------------
-    def on_state(self, msg: SpacecraftState, info=None):
-        clock = self.get_clock().now().nanoseconds * 1e-9
-        outcome = self._core.accept_state(convert.state_from_msg(msg), time.monotonic(), clock or None,
-                                          publisher_of(info))
+    # (``info`` has no default: rclpy passes the message info only to two-argument callbacks)
+    def on_clock(self, msg: ClockMsg, info: dict):
+        sender = participant_of(publisher_of(info))
+        if sender is not None and sender == participant_of(self._core.gate.source):
+            if msg.clock.sec >= 0 and msg.clock.nanosec < 1_000_000_000:
+                self._sim_clock = (sender, convert.from_time(msg.clock))
+
+    def on_state(self, msg: SpacecraftState, info: dict):
+        source = publisher_of(info)
+        clock = self._sim_clock[1] if self._sim_clock and self._sim_clock[0] == participant_of(source) else None
+        outcome = self._core.accept_state(convert.state_from_msg(msg), time.monotonic(), clock, source)
         if outcome.refused is not None:
             self._report_refusal("state", outcome.refused)
             return

@@ -1,0 +1,199 @@
+"""Random valid messages with extreme field values on every subscribed topic while a maneuver runs.
+
+The whole suite runs (recorder, simulator, controller, planner); a maneuver is executing; for each
+message type hypothesis publishes random, well-formed CDR messages (NaN, ±Inf, ±1e308, denormals,
+huge and empty arrays, control characters, any stamp) on the topics the nodes subscribe to. Then:
+no node died, no loop stalled for more than a second (the state and controller-status streams
+kept flowing), and the maneuver ended with an answer: completed, or aborted with a code.
+"""
+from __future__ import annotations
+
+import math
+import threading
+import time
+
+import pytest
+import rclpy
+from builtin_interfaces.msg import Time
+from geometry_msgs.msg import Quaternion, Vector3
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+from rclpy.executors import SingleThreadedExecutor
+from rclpy.node import Node
+from rosgraph_msgs.msg import Clock
+
+from att_msgs.action import ExecuteManeuver
+from att_msgs.msg import ActuatorCommand, ControllerStatus, KeepOutCone, ManeuverPlan, SpacecraftState
+from att_msgs_py import qos, topics
+from att_msgs_py.errors import ErrorCode
+from att_planner.nodes.client import maneuver_request
+from att_sim import rotations as rot
+
+pytestmark = pytest.mark.ros
+
+EXTREME = st.one_of(st.floats(allow_nan=True, allow_infinity=True),
+                    st.sampled_from([0.0, -0.0, 1e308, -1e308, 5e-324, 1e-300, 1e30, -1e30, 1.0, 0.1]))
+TEXT = st.text(alphabet=st.characters(blacklist_categories=("Cs",), blacklist_characters="\x00"), max_size=40)
+EXAMPLES = settings(max_examples=25, deadline=None, suppress_health_check=list(HealthCheck))
+
+
+def stamps():
+    return st.builds(Time, sec=st.integers(-2**31, 2**31 - 1), nanosec=st.integers(0, 2**32 - 1))
+
+
+def vectors():
+    return st.builds(Vector3, x=EXTREME, y=EXTREME, z=EXTREME)
+
+
+def quaternions():
+    return st.builds(Quaternion, x=EXTREME, y=EXTREME, z=EXTREME, w=EXTREME)
+
+
+@st.composite
+def states(draw):
+    msg = SpacecraftState(body_frame_id=draw(st.sampled_from(["body", "", "x\x01"])),
+                          attitude=draw(quaternions()), body_rate=draw(vectors()),
+                          wheel_speeds=draw(st.lists(EXTREME, max_size=6)),
+                          wheel_torques=draw(st.lists(EXTREME, max_size=6)),
+                          magnetic_field_body=draw(vectors()), dipole=draw(vectors()), applied_torque=draw(vectors()),
+                          position=draw(vectors()), command_timeout=draw(st.booleans()))
+    msg.header.stamp = draw(stamps())
+    msg.header.frame_id = draw(st.sampled_from(["eci", "", "map"]) | TEXT)
+    return msg
+
+
+@st.composite
+def plans(draw):
+    k = draw(st.integers(0, 30))
+    kinds = st.sampled_from(["body_torque", "wheel_torque"]) | TEXT
+    msg = ManeuverPlan(plan_id=draw(TEXT), method=draw(TEXT),
+                       status=draw(st.sampled_from(["optimal", "failed"]) | TEXT),
+                       message=draw(TEXT), spacecraft=draw(st.sampled_from(["swift_demo", ""]) | TEXT),
+                       duration=draw(EXTREME), control_kind=draw(kinds),
+                       interpolation=draw(st.sampled_from(["zoh", "linear"]) | TEXT),
+                       times=draw(st.lists(EXTREME, min_size=k, max_size=k + 2)),
+                       attitudes=draw(st.lists(quaternions(), min_size=max(0, k - 2), max_size=k)),
+                       rates=draw(st.lists(vectors(), min_size=k, max_size=k)),
+                       torques=draw(st.lists(vectors(), min_size=k, max_size=k)), sensor_axis=draw(vectors()),
+                       cones=draw(st.lists(st.builds(KeepOutCone, name=TEXT, direction=vectors(), half_angle=EXTREME),
+                                           max_size=20)),
+                       solve_seconds=draw(EXTREME), spacecraft_digest=draw(TEXT), key_id=draw(TEXT),
+                       signature=draw(st.binary(max_size=80)))
+    msg.header.stamp = draw(stamps())
+    msg.header.frame_id = draw(st.sampled_from(["eci", ""]) | TEXT)
+    return msg
+
+
+@st.composite
+def commands(draw):
+    msg = ActuatorCommand(mode=draw(st.integers(0, 255)), wheel_torques=draw(st.lists(EXTREME, max_size=6)),
+                          dipole=draw(vectors()), body_torque=draw(vectors()), plan_id=draw(TEXT))
+    msg.header.stamp = draw(stamps())
+    msg.header.frame_id = draw(st.sampled_from(["body", ""]) | TEXT)
+    return msg
+
+
+@st.composite
+def statuses(draw):
+    msg = ControllerStatus(mode=draw(st.integers(0, 255)), plan_id=draw(TEXT), plan_progress=draw(EXTREME),
+                           state_stale=draw(st.booleans()), message=draw(TEXT))
+    msg.header.stamp = draw(stamps())
+    return msg
+
+
+class Monitor(Node):
+    """Wall-clock arrival times of the state and controller-status streams."""
+
+    def __init__(self):
+        super().__init__("fuzz_monitor")
+        self.arrivals = {topics.STATE: [], topics.CONTROLLER_STATUS: []}
+        self.create_subscription(SpacecraftState, topics.STATE, lambda _: self.arrived(topics.STATE), qos.STREAM_QOS)
+        self.create_subscription(ControllerStatus, topics.CONTROLLER_STATUS,
+                                 lambda _: self.arrived(topics.CONTROLLER_STATUS), qos.STREAM_QOS)
+
+    def arrived(self, topic):
+        self.arrivals[topic].append(time.monotonic())
+
+    def largest_gap(self, topic, start, end) -> float:
+        t = [start] + [a for a in self.arrivals[topic] if start <= a <= end] + [end]
+        return max(b - a for a, b in zip(t, t[1:]))
+
+
+@pytest.fixture(scope="module")
+def fuzzed(ros_suite):
+    with ros_suite("swift_demo", params={"simulator": {"real_time_factor": 4.0}}, name="fuzz_test") as s:
+        monitor = Monitor()
+        executor = SingleThreadedExecutor()
+        executor.add_node(monitor)
+        spinner = threading.Thread(target=executor.spin, daemon=True)
+        spinner.start()
+        client = s.client
+        response = client.plan(maneuver_request(rot.IDENTITY, rot.from_axis_angle([0, 0, 1], 1.2), [1, 0, 0], [],
+                                                method="eigenaxis_smooth"))
+        assert response.success, response.message
+        send = client.execute_client.send_goal_async(ExecuteManeuver.Goal(plan_id=response.plan.plan_id))
+        rclpy.spin_until_future_complete(client, send, timeout_sec=20)
+        assert send.result().accepted
+        publishers = {t: client.create_publisher(cls, t, qos.LATCHED_QOS if t == topics.PLANS else qos.STREAM_QOS)
+                      for t, cls in ((topics.STATE, SpacecraftState), (topics.PLANS, ManeuverPlan),
+                                     (topics.COMMAND, ActuatorCommand), (topics.CLOCK, Clock),
+                                     (topics.CONTROLLER_STATUS, ControllerStatus))}
+        state = {"suite": s, "monitor": monitor, "goal": send.result(), "pubs": publishers,
+                 "start": time.monotonic(), "published": 0}
+        yield state
+        executor.shutdown()
+        monitor.destroy_node()
+
+
+def publish(fuzzed, topic, msg):
+    for _ in range(3):
+        fuzzed["pubs"][topic].publish(msg)
+    fuzzed["published"] += 3
+    time.sleep(0.005)
+
+
+@EXAMPLES
+@given(msg=states())
+def test_random_states(fuzzed, msg):
+    publish(fuzzed, topics.STATE, msg)
+
+
+@EXAMPLES
+@given(msg=plans())
+def test_random_plans(fuzzed, msg):
+    publish(fuzzed, topics.PLANS, msg)
+
+
+@EXAMPLES
+@given(msg=commands())
+def test_random_commands(fuzzed, msg):
+    publish(fuzzed, topics.COMMAND, msg)
+
+
+@EXAMPLES
+@given(stamp=stamps())
+def test_random_clocks(fuzzed, stamp):
+    publish(fuzzed, topics.CLOCK, Clock(clock=stamp))
+
+
+@EXAMPLES
+@given(msg=statuses())
+def test_random_controller_statuses(fuzzed, msg):
+    publish(fuzzed, topics.CONTROLLER_STATUS, msg)
+
+
+def test_nothing_died_nothing_stalled_and_the_maneuver_got_an_answer(fuzzed):
+    s, monitor, client = fuzzed["suite"], fuzzed["monitor"], fuzzed["suite"].client
+    end = time.monotonic()
+    assert fuzzed["published"] >= 5 * 3 * 10
+    assert all(s.suite.alive().values()), s.suite.alive()
+    for topic in (topics.STATE, topics.CONTROLLER_STATUS):
+        gap = monitor.largest_gap(topic, fuzzed["start"] + 0.5, end)
+        assert gap < 1.0, f"{topic} stalled for {gap:.2f} s while fuzzing"
+    done = fuzzed["goal"].get_result_async()
+    rclpy.spin_until_future_complete(client, done, timeout_sec=120)
+    assert done.done(), "the maneuver was never answered"
+    result = done.result().result
+    assert result.success or result.error_code in (ErrorCode.ABORTED, ErrorCode.STATE_TIME_JUMP), result.message
+    if result.success:
+        assert result.final_attitude_error < math.radians(1.0)
