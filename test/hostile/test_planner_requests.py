@@ -301,7 +301,7 @@ def test_the_node_refuses_a_closed_sky_and_nan_attitudes(planner):
 
 
 def test_the_client_refuses_a_nul_before_sending():
-    with pytest.raises(ValueError, match="header.frame_id contains the control or unassigned character U"):
+    with pytest.raises(ValueError, match="header.frame_id contains the control, format or unassigned character U"):
         good_request(frame_id="eci\0junk")
     with pytest.raises(ValueError, match=r"cones\[0\].name"):
         maneuver_request(rot.IDENTITY, GOAL, X, [Cone([0, 0, 1], 0.3, "sun\0")])
