@@ -39,6 +39,7 @@ class ErrorCode(IntEnum):
     PLAN_CONTEXT = 309            # the plan starts far from the current attitude or rate
     INVALID_STATE = 310           # a state message with a bad field (discarded, reported)
     STATE_TIME_JUMP = 311         # a state stamp backward or far forward (discarded, reported)
+    MODE_NOT_AUTHENTIC = 312      # a mode request unsigned, wrongly signed or replayed (require_signed_modes)
     # simulator
     INVALID_RESET = 400
     INVALID_COMMAND = 401         # actuator command with a bad field or stamp (refused, reported)

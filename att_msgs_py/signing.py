@@ -118,22 +118,24 @@ def payload(msg) -> bytes:
 
 
 def sign(msg, private_key: Ed25519PrivateKey) -> None:
-    """Set ``msg.key_id`` and ``msg.signature`` (call after every other field is final)."""
+    """Set ``msg.key_id`` and ``msg.signature`` (call after every other field is final); any
+    message with those two fields (a ``ManeuverPlan``, a ``SetControllerMode`` request)."""
     msg.key_id = key_id(private_key.public_key())
     msg.signature = private_key.sign(payload(msg))
 
 
-def check(data: bytes, signature: bytes, signer: str, public_key: Ed25519PublicKey) -> str | None:
+def check(data: bytes, signature: bytes, signer: str, public_key: Ed25519PublicKey,
+          what: str = "the plan") -> str | None:
     """Why ``signature`` (made by key ``signer``) does not authenticate ``data``; None when it does."""
     if not signature:
-        return "the plan is not signed"
+        return f"{what} is not signed"
     expected = key_id(public_key)
     if signer != expected:
-        return f"the plan is signed with key '{signer[:32]}', not with the configured key '{expected}'"
+        return f"{what} is signed with key '{signer[:32]}', not with the configured key '{expected}'"
     if len(signature) != SIGNATURE_LENGTH:
         return f"the signature has {len(signature)} bytes, an Ed25519 signature has {SIGNATURE_LENGTH}"
     try:
         public_key.verify(bytes(signature), data)
     except InvalidSignature:
-        return "the signature does not verify (the plan was altered or signed by another key)"
+        return f"the signature does not verify ({what} was altered or signed by another key)"
     return None

@@ -28,7 +28,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from att_msgs_py import validation
+from att_msgs_py import signing, validation
 from att_msgs_py.errors import ErrorCode, RequestError
 from att_msgs_py.types import (
     CONTROL_MODES,
@@ -123,6 +123,8 @@ class Controller:
         self.plans: OrderedDict[str, CachedPlan] = OrderedDict()
         self.seen: OrderedDict[str, bytes] = OrderedDict()   # plan id -> SHA-256 of its signed bytes
         self.refused: OrderedDict[str, RequestError] = OrderedDict()   # published plans refused, why
+        self.mode_key = None                           # Ed25519 public key mode requests must verify against
+        self.mode_sequence = 0                         # sequence of the last authenticated mode request
 
     @property
     def spacecraft(self) -> Spacecraft:
@@ -200,6 +202,19 @@ class Controller:
                 break
             if plan_id != flying:
                 del self.plans[plan_id]
+        return None
+
+    def authorize_mode(self, payload: bytes, signature: bytes, signer: str, sequence: int) -> RequestError | None:
+        """Why a mode request (signed bytes ``payload``) is not authentic, when :attr:`mode_key` is
+        set; its ``sequence`` must be above the last accepted one (no replay)."""
+        if self.mode_key is None:
+            return None
+        why = signing.check(payload, signature, signer, self.mode_key, "the mode request")
+        if why is None and sequence <= self.mode_sequence:
+            why = f"sequence {sequence} is not above the last accepted {self.mode_sequence} (a replayed request)"
+        if why is not None:
+            return RequestError(ErrorCode.MODE_NOT_AUTHENTIC, why)
+        self.mode_sequence = sequence
         return None
 
     def set_mode(self, mode: int) -> tuple[ErrorCode, str, ManeuverResult | None]:

@@ -28,7 +28,7 @@ from rclpy.node import Node
 
 from att_msgs.action import ExecuteManeuver
 from att_msgs.srv import PlanManeuver, PlanSchedule, SetControllerMode
-from att_msgs_py import convert, qos, topics
+from att_msgs_py import convert, qos, signing, topics
 from att_msgs_py.errors import ErrorCode, RequestError
 from att_msgs_py.types import Cone
 from att_msgs_py.validation import text
@@ -81,6 +81,9 @@ def maneuver_request(q_initial, q_final, sensor_axis, cones: list[Cone], *, meth
     req.option_values = [float(v) for v in (options or {}).values()]
     check_strings(req)
     return req
+
+
+DEFAULT_KEY = object()      # set_mode: sign with the default key file when it exists
 
 
 class SuiteClient(Node):
@@ -159,8 +162,17 @@ class SuiteClient(Node):
     def schedule(self, request: PlanSchedule.Request, timeout: float = 300.0) -> PlanSchedule.Response:
         return self._call(self.schedule_client, request, timeout)
 
-    def set_mode(self, mode: int, timeout: float = 10.0) -> SetControllerMode.Response:
-        return self._call(self.mode_client, SetControllerMode.Request(mode=mode), timeout)
+    def set_mode(self, mode: int, timeout: float = 10.0, key=DEFAULT_KEY) -> SetControllerMode.Response:
+        """Change the controller's mode; the request is signed with ``key`` (an Ed25519 private key;
+        by default the key file of :func:`att_msgs_py.signing.default_key_dir` when there is one,
+        ``None``: unsigned), which a controller with ``require_signed_modes`` needs."""
+        if key is DEFAULT_KEY:
+            path = signing.default_key_dir() / signing.PRIVATE_NAME
+            key = signing.load_private_key(path) if path.is_file() else None
+        request = SetControllerMode.Request(mode=mode, sequence=time.time_ns())
+        if key is not None:
+            signing.sign(request, key)
+        return self._call(self.mode_client, request, timeout)
 
     def execute(self, plan_id: str = "", plan=None, timeout: float = 600.0, on_feedback=None,
                 retries: int = 10, stall_timeout: float = STALL_TIMEOUT) -> ExecuteManeuver.Result:

@@ -10,7 +10,8 @@ time (the simulator's lockstep waits for it); serves ``/controller/set_mode`` an
 Nothing received is trusted (the core's checks, :mod:`att_planner.control.plan_checks` and
 :mod:`att_planner.control.state_gate`): a refused state or plan is logged (at most once a second
 per kind, clipped, with a running count) and changes nothing. Plans must verify against the
-Ed25519 public key ``plan_public_key`` (:mod:`att_msgs_py.signing`).
+Ed25519 public key ``plan_public_key`` (:mod:`att_msgs_py.signing`); with ``require_signed_modes``
+mode requests must verify against ``mode_public_key`` and carry an increasing sequence number.
 
 Sim time comes from the states' stamps. ``/clock`` is read by the node itself, not through
 rclpy's ``use_sim_time`` (whose time source raises on a negative stamp, so one hostile message
@@ -66,6 +67,8 @@ class ControllerNode(Node):
                                       choices=[int(m) for m in ControlMode if m != ControlMode.PLAN_TRACKING]),
                                 self._scenario.body_frame_id, self._gate_config(param))
         self._wall_timeout = param("wall_timeout", 2.0, 0.0, 3600.0, low_open=True)
+        if param("require_signed_modes", False):
+            self._core.mode_key = self._public_key(param, "mode_public_key")
         param.refuse_unknown()
         self._state_wall = time.monotonic()   # no "no state" warning before wall_timeout has passed
         self._stale = False
@@ -105,14 +108,18 @@ class ControllerNode(Node):
             max_cache_bytes=int(param("max_cache_mb", d.max_cache_bytes / 2**20, 0.0, 4096.0, low_open=True) * 2**20),
             safe_rate_threshold=param("safe_rate_threshold", d.safe_rate_threshold, 0.0, 10.0, low_open=True))
 
-    def _plan_context(self, param) -> PlanContext:
-        path = param("plan_public_key", str(signing.default_key_dir() / signing.PUBLIC_NAME))
+    @staticmethod
+    def _public_key(param, name: str):
+        path = param(name, str(signing.default_key_dir() / signing.PUBLIC_NAME))
         try:
-            key = signing.load_public_key(path)
+            return signing.load_public_key(path)
         except (OSError, ValueError) as exc:
-            raise ConfigError(ErrorCode.INVALID_CONFIG, f"parameter 'plan_public_key': no Ed25519 public key at "
+            raise ConfigError(ErrorCode.INVALID_CONFIG, f"parameter '{name}': no Ed25519 public key at "
                                                         f"'{clip(path, 200)}' ({clip(exc, 120)}): run att-keygen, or "
                                                         "copy the planner's plan_signing.pub") from None
+
+    def _plan_context(self, param) -> PlanContext:
+        key = self._public_key(param, "plan_public_key")
         return PlanContext(
             self._scenario.spacecraft, self._scenario.name, self._scenario.frame_id, key,
             max_start_attitude_error=math.radians(param("max_start_attitude_error_deg", 5.0, 0.0, 180.0,
@@ -170,6 +177,12 @@ class ControllerNode(Node):
             self._report_refusal("published plan", refused)
 
     def on_set_mode(self, request, response):
+        refused = self._core.authorize_mode(signing.payload(request), bytes(request.signature), request.key_id,
+                                            int(request.sequence))
+        if refused is not None:
+            self._report_refusal("mode request", refused)
+            response.success, response.error_code, response.message = False, int(refused.code), refused.message
+            return response
         code, message, ended = self._core.set_mode(int(request.mode))
         if ended is not None:
             self.finish(ended)

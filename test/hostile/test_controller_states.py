@@ -7,7 +7,10 @@ from dataclasses import replace
 
 import numpy as np
 import pytest
+from cryptography.hazmat.primitives.asymmetric.ed25519 import Ed25519PrivateKey
 
+from att_msgs.srv import SetControllerMode
+from att_msgs_py import signing
 from att_msgs_py.errors import ErrorCode
 from att_msgs_py.types import ControlMode
 from att_planner.control.controller import Controller, ControllerConfig
@@ -16,7 +19,7 @@ from att_planner.problem import ManeuverProblem
 from att_sim import rotations as rot
 from att_sim import scenario
 from att_sim.simulation import Simulation
-from helpers.signed_plans import context, issue
+from helpers.signed_plans import KEY, context, issue
 
 SWIFT = scenario.load("swift_demo")
 SIM_A, SIM_B = b"simulator-gid", b"intruder-gid"
@@ -144,3 +147,37 @@ def test_a_controller_that_starts_on_a_spinning_spacecraft_damps_it(rate, mode):
 def test_bad_mode_requests_are_refused(loop, mode, code):
     core, _ = loop
     assert core.set_mode(mode)[0] == code and core.mode == ControlMode.IDLE
+
+
+def mode_request(mode, sequence, key=KEY, tamper=None):
+    request = SetControllerMode.Request(mode=mode, sequence=sequence)
+    if key is not None:
+        signing.sign(request, key)
+    if tamper:
+        tamper(request)
+    return signing.payload(request), bytes(request.signature), request.key_id, int(request.sequence)
+
+
+@pytest.mark.parametrize("case, request_, words", [
+    ("unsigned", lambda: mode_request(1, 10, key=None), "not signed"),
+    ("another key", lambda: mode_request(1, 10, key=Ed25519PrivateKey.generate()), "not with the configured"),
+    ("mode changed after signing", lambda: mode_request(1, 10, tamper=lambda r: setattr(r, "mode", 3)),
+     "does not verify"),
+    ("sequence changed after signing", lambda: mode_request(1, 10, tamper=lambda r: setattr(r, "sequence", 11)),
+     "does not verify"),
+    ("replayed", lambda: mode_request(1, 5), "not above the last accepted 5"),
+    ("older", lambda: mode_request(1, 4), "not above the last accepted 5"),
+])
+def test_signed_mode_requests_when_required(loop, case, request_, words):
+    core, _ = loop
+    core.mode_key = KEY.public_key()
+    assert core.authorize_mode(*mode_request(3, 5)) is None and core.mode_sequence == 5
+    refused = core.authorize_mode(*request_())
+    assert refused.code == ErrorCode.MODE_NOT_AUTHENTIC and words in refused.message, refused.message
+    assert core.mode_sequence == 5
+    assert core.authorize_mode(*mode_request(1, 6)) is None
+
+
+def test_mode_requests_need_no_signature_unless_required(loop):
+    core, _ = loop
+    assert core.mode_key is None and core.authorize_mode(*mode_request(1, 0, key=None)) is None
