@@ -34,6 +34,7 @@ from att_msgs_py.log.reader import iter_records
 CLOCK = suite_topics.CLOCK
 CLOCK_TYPE = suite_topics.RECORDED[CLOCK]
 MIN_DEPTH = 1000
+DISCOVERY_SETTLE = 0.5      # s between seeing a subscriber and publishing to it (discovery is two-sided)
 NAMESPACE = "/replay"
 NAMESPACE_PATTERN = re.compile(r"(/[A-Za-z][A-Za-z0-9_]*)+")
 
@@ -141,6 +142,8 @@ def play(path: str | Path, *, rate: float = 1.0, topics: list[str] | None = None
         deadline = time.monotonic() + wait
         while time.monotonic() < deadline and any(p.get_subscription_count() == 0 for p in pubs.values()):
             time.sleep(0.05)
+        if any(p.get_subscription_count() for p in pubs.values()):
+            time.sleep(DISCOVERY_SETTLE)   # they must have discovered us too, or the first messages are lost
         counts = dict.fromkeys(pubs, 0)
         listened = sum(p.get_subscription_count() > 0 for p in pubs.values())
         log(f"replaying {len(records)} messages on {len(pubs)} topics "

@@ -344,7 +344,7 @@ class Controller:
         s, plan = self.state, self.maneuver.plan
         result = ManeuverResult(
             success=success, error_code=int(code), message=message,
-            duration=float(s.t - self.maneuver.t0),
+            duration=max(0.0, float(s.t - self.maneuver.t0)),   # 0 when a new timeline began
             final_attitude_error=float(rot.angle_between(s.q, plan.q[-1])),
             final_rate=float(np.linalg.norm(s.omega)))
         self.hold_q = plan.q[-1] if success else None

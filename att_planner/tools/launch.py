@@ -67,7 +67,8 @@ class Suite:
 
     def start(self, name: str, params: dict | None = None, params_files: tuple = ()) -> subprocess.Popen:
         """Start node ``name`` with ``-p key:=value`` parameters and ``--params-file`` files
-        (files override the scenario defaults, ``params`` override both)."""
+        (both override the scenario defaults; between them rcl's rule applies, see README "Starting
+        nodes by hand")."""
         args = [sys.executable, "-m", NODE_MODULES[name], "--ros-args"]
         for path in params_files:
             args += ["--params-file", str(path)]
