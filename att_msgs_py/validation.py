@@ -60,32 +60,28 @@ def number(value, name: str, code: ErrorCode, low: float = -math.inf, high: floa
     return v
 
 
-def unit_quaternion(q, name: str, code: ErrorCode = ErrorCode.INVALID_ATTITUDE) -> np.ndarray:
-    """A quaternion within :data:`UNIT_TOLERANCE` of unit norm, normalised."""
-    q = np.asarray(q, float)
-    if q.shape != (4,) or not np.all(np.isfinite(q)):
-        raise RequestError(code, f"{name} has NaN or Inf components")
-    with np.errstate(over="ignore"):
-        n = np.linalg.norm(q)
-    if n == 0.0:
-        raise RequestError(code, f"{name} is the zero quaternion")
-    if abs(n - 1.0) > UNIT_TOLERANCE:
-        raise RequestError(code, f"{name} has norm {n:.6g}; a unit quaternion is required (tolerance {UNIT_TOLERANCE})")
-    return q / n
-
-
-def unit_vector(v, name: str, code: ErrorCode) -> np.ndarray:
-    """A 3-vector within :data:`UNIT_TOLERANCE` of unit norm, normalised."""
+def _unit(v, size: int, name: str, code: ErrorCode, what: str) -> np.ndarray:
+    """A ``size``-vector within :data:`UNIT_TOLERANCE` of unit norm, normalised."""
     v = np.asarray(v, float)
-    if v.shape != (3,) or not np.all(np.isfinite(v)):
+    if v.shape != (size,) or not np.all(np.isfinite(v)):
         raise RequestError(code, f"{name} has NaN or Inf components")
     with np.errstate(over="ignore"):
         n = np.linalg.norm(v)
     if n == 0.0:
-        raise RequestError(code, f"{name} is the zero vector")
+        raise RequestError(code, f"{name} is the zero {what}")
     if abs(n - 1.0) > UNIT_TOLERANCE:
-        raise RequestError(code, f"{name} has norm {n:.6g}; a unit vector is required (tolerance {UNIT_TOLERANCE})")
+        raise RequestError(code, f"{name} has norm {n:.6g}; a unit {what} is required (tolerance {UNIT_TOLERANCE})")
     return v / n
+
+
+def unit_quaternion(q, name: str, code: ErrorCode = ErrorCode.INVALID_ATTITUDE) -> np.ndarray:
+    """A quaternion within :data:`UNIT_TOLERANCE` of unit norm, normalised."""
+    return _unit(q, 4, name, code, "quaternion")
+
+
+def unit_vector(v, name: str, code: ErrorCode) -> np.ndarray:
+    """A 3-vector within :data:`UNIT_TOLERANCE` of unit norm, normalised."""
+    return _unit(v, 3, name, code, "vector")
 
 
 def unit_quaternions(q, name: str, code: ErrorCode) -> np.ndarray:
