@@ -10,7 +10,7 @@ import pytest
 import rclpy
 
 from att_msgs.action import ExecuteManeuver
-from att_msgs.msg import SpacecraftState
+from att_msgs.msg import ControllerStatus, SpacecraftState
 from att_msgs_py import convert, qos, signing, topics
 from att_planner.methods.eigenaxis import plan_eigenaxis_smooth
 from att_planner.problem import ManeuverProblem
@@ -39,18 +39,37 @@ def collect(client, seconds, states):
     return [convert.state_from_msg(m) for m in states]
 
 
+def wait_for(client, seconds, condition):
+    """Spin until ``condition()`` holds (True) or ``seconds`` of wall time pass (False)."""
+    end = time.monotonic() + seconds
+    while time.monotonic() < end:
+        if condition():
+            return True
+        rclpy.spin_once(client, timeout_sec=0.05)
+    return condition()
+
+
+def rate_of(msg) -> float:
+    return float(np.linalg.norm(convert.state_from_msg(msg).omega))
+
+
 def test_killed_controller_then_restarted_controller_damps_the_coasting_spacecraft(ros_suite):
     with ros_suite("swift_demo", nodes=("simulator", "controller"), name="restart_test",
                    params={"simulator": {"real_time_factor": RTF}}) as s:
         client, suite = s.client, s.suite
         assert client.execute_client.wait_for_server(timeout_sec=30)
-        received = []
+        received, statuses = [], []
         client.create_subscription(SpacecraftState, topics.STATE, received.append, qos.STREAM_QOS)
+        client.create_subscription(ControllerStatus, topics.CONTROLLER_STATUS, statuses.append, qos.STREAM_QOS)
+        # A goal sent before the controller has a state is answered NO_STATE: wait until it steps.
+        assert wait_for(client, 30, lambda: any(not m.state_stale for m in statuses)), "controller never stepped"
         send = client.execute_client.send_goal_async(
             ExecuteManeuver.Goal(use_inline_plan=True, plan=signed_plan_msg(rot.from_axis_angle([0, 0, 1], 1.5))))
         rclpy.spin_until_future_complete(client, send, timeout_sec=20)
         assert send.result().accepted
-        collect(client, 8.0, received)                   # mid-slew: the spacecraft turns
+        result = send.result().get_result_async()
+        turning = wait_for(client, 30, lambda: bool(received) and rate_of(received[-1]) > 0.01)
+        assert turning and not result.done(), "the maneuver did not start"       # mid-slew: the spacecraft turns
         suite.procs["controller"].send_signal(signal.SIGKILL)
         suite.procs["controller"].wait(10)
         received.clear()
