@@ -23,6 +23,13 @@ class ErrorCode(IntEnum):
     SIZE_LIMIT = 132              # arrays, samples, cone lists or strings above the documented caps
     INVALID_TEXT = 133            # a string with control characters (or not UTF-8)
     INVALID_TIME_BUDGET = 140
+    # planner: the real sky (epoch, orbit, moving zones)
+    INVALID_EPOCH = 150           # an epoch that does not parse, or outside the ephemeris span (1900-2050)
+    INVALID_ORBIT = 151           # a TLE that fails to parse or its checksum, bad Keplerian elements
+    ORBIT_TOO_LOW = 152           # the orbit decays or is below 150 km during the maneuver
+    INVALID_ZONE = 153            # an unknown body, a bad sensor axis, half-angle or direction of a zone
+    ZONE_AT_END = 154             # the start or goal violates a zone (keep-out entered / keep-in left)
+    CONTRADICTORY_ZONES = 155     # zones no direction can satisfy together (e.g. keep-in inside keep-out)
     # planner: solving
     SOLVER_FAILED = 200           # the method failed and no fallback plan was possible
     VERIFICATION_FAILED = 201     # the plan did not survive integration through the dynamics
