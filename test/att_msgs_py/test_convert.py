@@ -55,5 +55,6 @@ def test_message_definition_has_every_dependency_once():
     text = message_definition("att_msgs/msg/ManeuverPlan")
     deps = [line[5:] for line in text.splitlines() if line.startswith("MSG: ")]
     assert set(deps) == {"std_msgs/msg/Header", "builtin_interfaces/msg/Time", "geometry_msgs/msg/Quaternion",
-                         "geometry_msgs/msg/Vector3", "att_msgs/msg/KeepOutCone", "att_msgs/msg/PlanVerification"}
+                         "geometry_msgs/msg/Vector3", "att_msgs/msg/KeepOutCone", "att_msgs/msg/PlanVerification",
+                         "att_msgs/msg/Zone"}
     assert len(deps) == len(set(deps)) and text.count(SEPARATOR) == len(deps)
