@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from datetime import datetime
 from enum import IntEnum, StrEnum
 
 import numpy as np
@@ -68,6 +69,41 @@ class Cone:
         object.__setattr__(self, "direction", d / np.linalg.norm(d))
 
 
+ZONE_BODIES = ("inertial", "sun", "moon", "earth_limb")
+
+
+@dataclass(frozen=True)
+class Zone:
+    """A zone of a body-fixed sensor (issue 13): the boresight ``R(q) sensor_axis`` stays out of
+    (``keep_in`` False) or inside (True) a cone about a target seen from the spacecraft.
+
+    ``body`` (:data:`ZONE_BODIES`): ``inertial`` (the fixed unit ``direction``, today's cones),
+    ``sun`` or ``moon`` (the direction from the spacecraft), ``earth_limb`` (axis −r̂, the nadir,
+    and half-angle asin(R_E/|r|) + ``half_angle``: there ``half_angle`` is the margin beyond the
+    limb). ``half_angle`` in rad. Vectors are normalised when they have a finite, non-zero norm
+    (:func:`att_planner.cones.zone_issue` refuses the others; a vector unit to 1e-15 is kept bit for
+    bit, so cones convert exactly); ``direction`` is None for the bodies.
+    """
+
+    name: str
+    body: str
+    sensor_axis: np.ndarray
+    half_angle: float
+    keep_in: bool = False
+    direction: np.ndarray | None = None
+
+    def __post_init__(self):
+        for name in ("sensor_axis", "direction"):
+            value = getattr(self, name)
+            if value is None:
+                continue
+            v = np.array(value, dtype=float).reshape(-1)
+            n = np.linalg.norm(v) if v.size == 3 and np.isfinite(v).all() else 0.0
+            object.__setattr__(self, name, v / n if n > 0 and abs(n - 1.0) > 1e-15 else v)
+        object.__setattr__(self, "half_angle", float(self.half_angle))
+        object.__setattr__(self, "keep_in", bool(self.keep_in))
+
+
 @dataclass
 class Verification:
     """A plan integrated through the truth dynamics (``att_msgs/PlanVerification``).
@@ -77,8 +113,8 @@ class Verification:
 
     final_attitude_error: float        # rad, to the goal attitude (semi-free: boresight to target)
     final_rate: float                  # rad/s, ‖ω(t_f)‖
-    min_cone_margin: float             # rad over the dense grid (+inf without cones)
-    cone_margins: list                 # rad, minimum per cone (request order)
+    min_cone_margin: float             # rad over the dense grid and every zone (+inf without zones)
+    cone_margins: list                 # rad, minimum per zone: the cones, then the zones (request order)
     torque_ratio: float                # max |control| / its limit over the applied samples
     wheel_speed_ratio: float           # max |Ω_i| / limit over the dense grid (0 without wheels)
     rate_max: float                    # rad/s, largest ‖ω‖ over the dense grid
@@ -88,6 +124,8 @@ class Verification:
     wheel_momentum_ratio: float = 0.0  # max |h_w,i| / the problem's momentum bound (0 without one)
     passage_attitude_errors: list = field(default_factory=list)   # rad, per passage
     passage_rates_z: list = field(default_factory=list)           # rad/s, |ω_z| per passage
+    zone_names: list = field(default_factory=list)                # name per entry of cone_margins
+    zone_keep_in: list = field(default_factory=list)              # keep-in flag per entry of cone_margins
 
 
 @dataclass(frozen=True)
@@ -115,7 +153,8 @@ class Plan:
     function evaluations, 0 where they do not apply), ``wall_time`` (s) and free-form ``stats``.
     Context, filled by the planner service: ``plan_id``, ``spacecraft``, ``frame_id``,
     ``sensor_axis``, ``cones``, ``verification`` and, for a schedule, the ``passages``; then
-    ``spacecraft_digest``, ``key_id`` and the Ed25519 ``signature`` (:mod:`att_msgs_py.signing`). A method
+    ``spacecraft_digest``, ``key_id`` and the Ed25519 ``signature`` (:mod:`att_msgs_py.signing`);
+    ``zones`` (:class:`Zone`, besides the cones) and the ``epoch`` of t = 0 (issue 13). A method
     that finds nothing returns a plan without samples and status FAILED (or BUDGET_EXPIRED).
     ``nit``, ``nfev``, ``stats`` and ``passages`` are not on the wire.
     """
@@ -143,6 +182,8 @@ class Plan:
     spacecraft_digest: str = ""
     key_id: str = ""
     signature: bytes = b""
+    zones: list = field(default_factory=list)          # Zone, the request's (besides the cones)
+    epoch: datetime | None = None                      # UTC instant of t = 0 (None: no epoch)
 
     @property
     def duration(self) -> float:

@@ -4,12 +4,17 @@ The sensor boresight ``r`` (body) points along ``R(q) r`` in inertial axes. Cone
 axis ``w_i`` and half-angle ``θ_i`` (:class:`att_msgs_py.types.Cone`) is respected when
 ``rᵀ Rᵀ w_i ≤ cos θ_i``. The *margin* is the angle between boresight and cone axis minus the
 half-angle (rad): ≥ 0 means outside the cone.
+
+The checks of a request's zones (issue 13; :mod:`att_planner.zones`) are here too:
+:func:`zone_issue` gives the code and sentence of the first bad zone, contradiction or violated end.
 """
 from __future__ import annotations
 
 import numpy as np
 
-from att_msgs_py.types import Cone
+from att_msgs_py.errors import ErrorCode, RequestError
+from att_msgs_py.types import ZONE_BODIES, Cone, Zone
+from att_planner.zones import ZoneSky
 from att_sim import rotations as rot
 
 
@@ -63,11 +68,121 @@ def endpoint_in_cone(q_initial, q_final, sensor_axis, cones: list[Cone],
 
 
 def blocked_endpoint(problem) -> str:
-    """Why a problem (``ManeuverProblem``) has no plan because an end lies inside a cone, or ''."""
+    """Why a problem (``ManeuverProblem``) has no plan because an end lies inside a cone, or
+    violates a zone at t = 0 (:func:`zone_at_end`), or ''."""
     hit = endpoint_in_cone(problem.q_initial, problem.q_final, problem.sensor_axis, problem.cones,
                            problem.sensor_target)
     if hit is None:
-        return ""
+        why = zone_at_end(problem) if problem.zones else ""
+        return f"infeasible request: {why}" if why else ""
     label, cone, depth = hit
     return (f"infeasible request: the {label} is inside keep-out cone {cone.name or '(unnamed)'} "
             f"({np.degrees(depth):.2f} deg inside its {np.degrees(cone.half_angle):.1f} deg half-angle)")
+
+
+# ---------------------------------------------------------------------- zones (issue 13)
+EARTH_LIMB_MARGIN_MAX = np.pi / 2      # rad: the largest margin beyond the Earth's limb
+
+
+def invalid_zone(index: int, zone: Zone) -> str:
+    """Why ``zone`` (``zones[index]``) cannot be used, or '': an unknown body, a sensor axis or an
+    inertial direction not finite and non-zero, a half-angle outside (0, π) (for ``earth_limb``
+    a margin outside [0, π/2)), a direction given for a body."""
+    field = f"zones[{index}]"
+    if zone.body not in ZONE_BODIES:
+        return f"{field}.body = '{str(zone.body)[:32]}' is not one of {', '.join(ZONE_BODIES)}"
+    for name, v in (("sensor_axis", zone.sensor_axis), ("direction", zone.direction)):
+        if v is None and name == "direction" and zone.body != "inertial":
+            continue
+        v = np.asarray(v if v is not None else [], float)
+        if v.shape != (3,) or not np.isfinite(v).all() or not np.linalg.norm(v) > 0:
+            return f"{field}.{name} must be a finite, non-zero 3-vector"
+        if name == "direction" and zone.body != "inertial" and np.any(v):
+            return f"{field}.direction is only for body inertial (body {zone.body} moves)"
+    h = zone.half_angle
+    if zone.body == "earth_limb":
+        if not (np.isfinite(h) and 0.0 <= h < EARTH_LIMB_MARGIN_MAX):
+            return f"{field}.half_angle = {h!r} rad (the margin beyond the Earth's limb) is outside [0, pi/2)"
+    elif not (np.isfinite(h) and 0.0 < h < np.pi):
+        return f"{field}.half_angle = {h!r} rad is outside (0, pi)"
+    return ""
+
+
+def _angle(a: np.ndarray, b: np.ndarray) -> float:
+    return float(np.arccos(np.clip(a @ b / (np.linalg.norm(a) * np.linalg.norm(b)), -1.0, 1.0)))
+
+
+def contradictory_zones(zone_sky: ZoneSky) -> str:
+    """Why no boresight satisfies the zones of one sensor at t = 0, or '': a keep-in cone entirely
+    inside a keep-out cone (γ + θ_in ≤ θ_out), or two keep-in cones that do not meet (γ > θ_1 + θ_2).
+    Only pairs are checked: a keep-in cone covered by several keep-out cones together is not."""
+    axes, half = zone_sky.true_axes(0.0), zone_sky.true_half_angles(0.0)
+    names, keep_in, s = zone_sky.names, zone_sky.keep_in, zone_sky.sensor_axes
+    for i in np.flatnonzero(keep_in):
+        for j in range(len(names)):
+            if j == i or not np.array_equal(s[i], s[j]):
+                continue
+            gamma = _angle(axes[i], axes[j])
+            if not keep_in[j] and gamma + half[i] <= half[j]:
+                return (f"keep-in zone {names[i]} lies entirely inside keep-out zone {names[j]} at t = 0 "
+                        f"({np.degrees(gamma):.2f} deg apart, half-angles {np.degrees(half[i]):.2f} and "
+                        f"{np.degrees(half[j]):.2f} deg)")
+            if keep_in[j] and j > i and gamma > half[i] + half[j]:
+                return (f"keep-in zones {names[i]} and {names[j]} of one sensor do not meet at t = 0 "
+                        f"({np.degrees(gamma):.2f} deg apart > {np.degrees(half[i] + half[j]):.2f} deg)")
+    return ""
+
+
+def zone_at_end(problem, zone_sky: ZoneSky | None = None) -> str:
+    """Why the start or the goal violates a zone at t = 0, or '': the start at t = 0; the goal
+    against the zones at t = 0 too (the arrival time is not known before planning: the
+    verification checks the zones at the true arrival time). For a semi-free goal only the zones of
+    ``problem.sensor_axis`` are checked, on ``sensor_target`` (the roll about it is free)."""
+    zs = zone_sky if zone_sky is not None else problem.zone_sky()
+    if not zs.zones:
+        return ""
+    ends = [("start attitude", zs.margins(0.0, problem.q_initial, true=True)[0])]
+    if problem.sensor_target is None:
+        ends.append(("goal attitude", zs.margins(0.0, problem.q_final, true=True)[0]))
+    else:
+        target = np.asarray(problem.sensor_target, float)
+        own = np.all(zs.sensor_axes == np.asarray(problem.sensor_axis, float), axis=1)
+        angle = np.arccos(np.clip(zs.true_axes(0.0) @ target / np.linalg.norm(target), -1.0, 1.0))
+        m = np.where(zs.keep_in, zs.true_half_angles(0.0) - angle, angle - zs.true_half_angles(0.0))
+        ends.append(("sensor_target direction", np.where(own, m, np.inf)))
+    for label, m in ends:
+        if m.size and m.min() < 0:
+            k = int(np.argmin(m))
+            kind = "outside keep-in" if zs.keep_in[k] else "inside keep-out"
+            return (f"the {label} is {kind} zone {zs.names[k]} at t = 0 ({np.degrees(-m[k]):.2f} deg beyond "
+                    f"its {np.degrees(zs.true_half_angles(0.0)[k]):.2f} deg half-angle)")
+    return ""
+
+
+def zone_issue(problem) -> tuple[ErrorCode, str] | None:
+    """The first reason the zones of ``problem`` make it unplannable, as ``(code, sentence)``, else
+    None: INVALID_ZONE (:func:`invalid_zone`, or a moving zone without a sky),
+    CONTRADICTORY_ZONES (:func:`contradictory_zones`), ZONE_AT_END (:func:`zone_at_end`). The
+    cones (zones of ``sensor_axis``) take part; their own checks stay SENSOR_IN_CONE's."""
+    for i, zone in enumerate(problem.zones):
+        why = invalid_zone(i, zone)
+        if why:
+            return ErrorCode.INVALID_ZONE, why
+    try:
+        zs = problem.zone_sky()
+    except ValueError as exc:
+        return ErrorCode.INVALID_ZONE, str(exc)
+    why = contradictory_zones(zs)
+    if why:
+        return ErrorCode.CONTRADICTORY_ZONES, why
+    why = zone_at_end(problem, zs)
+    if why:
+        return ErrorCode.ZONE_AT_END, why
+    return None
+
+
+def check_zones(problem) -> None:
+    """:func:`zone_issue` as a ``RequestError`` (the planner service's check), or nothing."""
+    issue = zone_issue(problem)
+    if issue is not None:
+        raise RequestError(*issue)

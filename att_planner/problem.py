@@ -12,11 +12,17 @@ from __future__ import annotations
 import math
 import time
 from dataclasses import dataclass, field
+from datetime import datetime
 
 import numpy as np
 
-from att_msgs_py.types import Cone
+from att_msgs_py.types import Cone, Zone
+from att_planner.zones import ZoneSky, zones_from_cones
+from att_sim import rotations as rot
 from att_sim.dynamics import Spacecraft
+
+MIN_WINDOW = 600.0        # s: the shortest default zone window
+WINDOW_FACTOR = 4.0       # the default window: this many times the eigenaxis slew time, at least MIN_WINDOW
 
 
 @dataclass
@@ -35,6 +41,11 @@ class ManeuverProblem:
     * ``rate_max`` (rad/s per body axis) and ``wheel_momentum_max`` (N m s per wheel, the momentum
       the wheels store producing a body-torque plan with zero total momentum): bounds a plan must
       keep, checked by the verification; infinite when not imposed.
+    * ``cones``: inertial keep-out cones of ``sensor_axis`` (as before issue 13); ``zones``: further
+      zones, each with its own sensor axis, moving or not (:class:`att_msgs_py.types.Zone`);
+      ``epoch``: the UTC instant of t = 0; ``sky``: the sky seen from the spacecraft
+      (:class:`att_sim.ephemeris.Sky`, needed by sun, moon and earth_limb zones).
+      :meth:`zone_sky` joins them: what every method and the verification use.
     """
 
     spacecraft: Spacecraft
@@ -47,6 +58,49 @@ class ManeuverProblem:
     targets: dict = field(default_factory=dict)
     rate_max: float = math.inf
     wheel_momentum_max: float = math.inf
+    zones: list[Zone] = field(default_factory=list)
+    epoch: datetime | None = None
+    sky: object | None = None
+    _zone_skies: dict = field(default_factory=dict, init=False, repr=False, compare=False)
 
     def time_left(self) -> float:
         return np.inf if self.deadline is None else self.deadline - time.monotonic()
+
+    def zone_sky(self, window: float | None = None) -> ZoneSky:
+        """The cones (first, as inertial keep-out zones of ``sensor_axis``) and the zones over
+        ``[0, window]`` s, built once per window and field values (cached).
+
+        Default window: :data:`WINDOW_FACTOR` × :meth:`slew_time_bound`, at least :data:`MIN_WINDOW`:
+        room for detours around the zones. A plan longer than the window cannot be judged against
+        the fitted zones (the ZoneSky refuses those times); a method asks for a longer window then.
+        """
+        if window is None:
+            window = max(MIN_WINDOW, WINDOW_FACTOR * self.slew_time_bound())
+        key = (float(window), tuple(map(id, self.cones)), tuple(map(id, self.zones)), id(self.sky),
+               np.asarray(self.sensor_axis, float).tobytes())
+        if key not in self._zone_skies:
+            self._zone_skies.clear()
+            zones = zones_from_cones(self.cones, self.sensor_axis) + list(self.zones)
+            self._zone_skies[key] = ZoneSky(zones, self.sky, float(window))
+        return self._zone_skies[key]
+
+    def slew_time_bound(self) -> float:
+        """Duration (s) of the rest-to-rest eigenaxis slew to ``q_final`` (or by π for a semi-free
+        goal) with the largest acceleration the per-axis torque bound allows, coasting at the
+        problem's rate and momentum bounds: the scale of every method's t_f (0 without a torque bound)."""
+        sc = self.spacecraft
+        if not (np.isfinite(sc.body_torque_max) and sc.body_torque_max > 0):
+            return 0.0
+        q_rel = rot.multiply(rot.conjugate(rot.normalize(np.asarray(self.q_initial, float))),
+                             rot.normalize(np.asarray(self.q_final, float)))
+        e, phi = rot.to_axis_angle(q_rel)
+        if self.sensor_target is not None or phi < 1e-12:
+            e, phi = np.ones(3) / np.sqrt(3.0), math.pi
+        J = sc.inertia
+        alpha = sc.body_torque_max / np.max(np.abs(J @ e) + phi * np.abs(np.cross(e, J @ e)))
+        w = math.sqrt(alpha * phi)                       # peak rate of the bang-bang slew
+        if np.isfinite(self.rate_max):
+            w = min(w, self.rate_max / np.abs(e).max())
+        if np.isfinite(self.wheel_momentum_max) and sc.n_wheels:
+            w = min(w, self.wheel_momentum_max / np.abs(sc.wheel_axes_pinv @ J @ e).max())
+        return float(phi / w + w / alpha)                # accelerate, coast, brake

@@ -6,8 +6,10 @@ plans by them; nothing is taken from a planner's own model. The integration is
 :func:`att_sim.dynamics.simulate_profile` (RK4 with inputs switched exactly at the knots for
 zero-order hold, :data:`VERIFY_STEPS` steps over the plan at least), from the problem's initial
 attitude at rest with the wheels stopped. Checked: the final attitude (semi-free: the boresight
-on its target) and rate, every passage of a schedule (attitude, rate about body z), every cone at
-every dense sample, and the control, wheel-speed, body-rate and wheel-momentum limits.
+on its target) and rate, every passage of a schedule (attitude, rate about body z), every zone
+(the cones, then the zones: :meth:`ManeuverProblem.zone_sky`) at every dense sample at its TRUE
+position at that sample's time (straight from the sky, not the planners' fit, at any time), and the
+control, wheel-speed, body-rate and wheel-momentum limits.
 """
 from __future__ import annotations
 
@@ -17,7 +19,6 @@ from dataclasses import dataclass
 import numpy as np
 
 from att_msgs_py.types import ControlKind, Interpolation, Plan, Verification
-from att_planner.cones import margins
 from att_planner.problem import ManeuverProblem
 from att_sim import dynamics as dyn
 from att_sim import rotations as rot
@@ -54,7 +55,8 @@ def measure(problem: ManeuverProblem, plan: Plan, traj: dyn.Trajectory) -> Verif
     controls = np.asarray(plan.torque, float).reshape(len(plan.t), -1)
     applied = controls[:-1] if plan.interpolation == Interpolation.ZOH and len(controls) > 1 else controls
     limit = sc.wheel_torque_max if wheels else sc.body_torque_max
-    m = margins(traj.q, problem.sensor_axis, problem.cones)
+    zone_sky = problem.zone_sky()
+    m = zone_sky.margins(traj.t, traj.q, true=True)
     if problem.sensor_target is None:
         final_error = float(rot.angle_between(traj.q[-1], problem.q_final))
     else:
@@ -80,6 +82,8 @@ def measure(problem: ManeuverProblem, plan: Plan, traj: dyn.Trajectory) -> Verif
         wheel_momentum_ratio=_ratio(peak_magnitude(_wheel_momentum(sc, traj, wheels)), problem.wheel_momentum_max),
         passage_attitude_errors=passage_errors,
         passage_rates_z=passage_rates,
+        zone_names=list(zone_sky.names),
+        zone_keep_in=[bool(k) for k in zone_sky.keep_in],
     )
 
 
@@ -96,7 +100,7 @@ def rejection(ver: Verification, tol: Tolerances = TOLERANCES) -> str | None:
     if ver.final_rate > tol.rate:
         return f"final rate {ver.final_rate:.3g} rad/s > {tol.rate:.3g} rad/s"
     if ver.min_cone_margin < -tol.cone_penetration:
-        return f"enters a keep-out cone by {math.degrees(-ver.min_cone_margin):.3f} deg"
+        return _zone_violation(ver)
     for name in ("torque_ratio", "wheel_speed_ratio", "body_rate_ratio", "wheel_momentum_ratio"):
         if getattr(ver, name) > tol.limit_ratio:
             return f"{name.replace('_ratio', '').replace('_', ' ')} {getattr(ver, name):.6f} x the limit"
@@ -105,6 +109,17 @@ def rejection(ver: Verification, tol: Tolerances = TOLERANCES) -> str | None:
             return (f"passage {k} missed: attitude error {math.degrees(err):.3f} deg, "
                     f"|w_z| {rate:.3g} rad/s")
     return None
+
+
+def _zone_violation(ver: Verification) -> str:
+    """Which zone the plan violates and by how much (the deepest one)."""
+    depth = math.degrees(-ver.min_cone_margin)
+    if not ver.zone_names or len(ver.zone_names) != len(ver.cone_margins):
+        return f"enters a keep-out cone by {depth:.3f} deg"
+    k = min(range(len(ver.cone_margins)), key=ver.cone_margins.__getitem__)
+    if k < len(ver.zone_keep_in) and ver.zone_keep_in[k]:
+        return f"leaves keep-in zone {ver.zone_names[k]} by {depth:.3f} deg"
+    return f"enters keep-out zone {ver.zone_names[k]} by {depth:.3f} deg"
 
 
 def peak_magnitude(values: np.ndarray) -> float:
