@@ -49,6 +49,8 @@ def _unit(v) -> np.ndarray:
 def shadow_function(r_sat, r_sun) -> np.ndarray:
     """Fraction of the solar disc visible from ``r_sat`` (m, geocentric) with the Sun at ``r_sun``:
     conical Earth shadow with penumbra (Montenbruck & Gill 2000 §3.4.2); vectorised over ``...``."""
+    if np.ndim(r_sat) == 1 and np.ndim(r_sun) == 1:
+        return _shadow_scalar(*(float(x) for x in r_sat), *(float(x) for x in r_sun))
     r, s = np.broadcast_arrays(np.asarray(r_sat, float), np.asarray(r_sun, float) - np.asarray(r_sat, float))
     rn, sn = np.linalg.norm(r, axis=-1), np.linalg.norm(s, axis=-1)
     a = np.arcsin(np.minimum(SUN_RADIUS / sn, 1.0))
@@ -62,6 +64,22 @@ def shadow_function(r_sat, r_sun) -> np.ndarray:
     inner = np.where(a < b, 0.0, 1.0 - (b * b) / (a * a))
     nu = np.where(c >= a + b, 1.0, np.where(c <= np.abs(a - b), inner, partial))
     return np.clip(nu, 0.0, 1.0)
+
+
+def _shadow_scalar(rx, ry, rz, sx, sy, sz) -> float:
+    """:func:`shadow_function` of one position with math on floats (the per-stage call)."""
+    sx, sy, sz = sx - rx, sy - ry, sz - rz
+    rn, sn = math.sqrt(rx * rx + ry * ry + rz * rz), math.sqrt(sx * sx + sy * sy + sz * sz)
+    a, b = math.asin(min(SUN_RADIUS / sn, 1.0)), math.asin(min(EARTH_RADIUS / rn, 1.0))
+    c = math.acos(max(-1.0, min(1.0, -(rx * sx + ry * sy + rz * sz) / (rn * sn))))
+    if c >= a + b:
+        return 1.0
+    if c <= abs(a - b):
+        return 0.0 if a < b else 1.0 - (b * b) / (a * a)
+    x = (c * c + a * a - b * b) / (2.0 * c)
+    y = math.sqrt(max(a * a - x * x, 0.0))
+    area = a * a * math.acos(max(-1.0, min(1.0, x / a))) + b * b * math.acos(max(-1.0, min(1.0, (c - x) / b))) - c * y
+    return min(1.0, max(0.0, 1.0 - area / (math.pi * a * a)))
 
 
 class Sky:
@@ -90,15 +108,15 @@ class Sky:
 
         def sample(t):
             at = vector.at(skyfield_times(self.epoch, t))
-            return np.moveaxis(at.position.m, 0, -1), np.moveaxis(at.velocity.m_per_s, 0, -1)
+            return np.moveaxis(at.position.m, 0, -1)
         return sample
 
     def direct_sun(self, t) -> np.ndarray:
         """Geocentric Sun straight from skyfield (slow; for verification)."""
-        return self._direct(self._sun)(t)[0]
+        return self._direct(self._sun)(t)
 
     def direct_moon(self, t) -> np.ndarray:
-        return self._direct(self._moon)(t)[0]
+        return self._direct(self._moon)(t)
 
     def _orbit_time(self, t):
         if self.orbit_offset == 0.0:

@@ -30,7 +30,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import fields
-from datetime import datetime
+from datetime import UTC, datetime, timedelta
 
 import numpy as np
 
@@ -39,7 +39,7 @@ from att_sim.epoch import parse_epoch, skyfield_times, timescale
 
 J2 = 1.08262668e-3          # EGM-96 / Vallado 2013 Table D-1, with R_E = 6378.137 km
 TLE_STEP = 60.0             # s, node spacing of the TLE table
-TLE_CHUNK = 720             # intervals per chunk (12 h)
+TLE_CHUNK = 180             # intervals per chunk (3 h)
 ALTITUDE_STEP = 30.0        # s, largest sample spacing of check_altitude
 
 
@@ -58,6 +58,10 @@ class Orbit:
 
     def velocity(self, t) -> np.ndarray:
         return self.state(t)[1]
+
+    def unchecked_position(self, t) -> np.ndarray:
+        """Position, NaN where the propagator fails instead of an error (for :func:`check_altitude`)."""
+        return self.position(t)
 
 
 class CircularOrbit(Orbit):
@@ -79,13 +83,12 @@ class CircularOrbit(Orbit):
 
 
 def _rotation(raan, i, argp):
-    """Columns P̂, Q̂, Ŵ of ``R_z(Ω) R_x(i) R_z(ω)`` (perifocal to inertial), shape ``(..., 3, 3)``."""
+    """Inertial P̂, Q̂ (perifocal x, y axes) of ``R_z(Ω) R_x(i) R_z(ω)``, each ``(..., 3)``."""
     co, so, ci, si, cw, sw = np.cos(raan), np.sin(raan), np.cos(i), np.sin(i), np.cos(argp), np.sin(argp)
     si, ci = np.broadcast_to(si, co.shape), np.broadcast_to(ci, co.shape)
     p = np.stack([co * cw - so * sw * ci, so * cw + co * sw * ci, sw * si], -1)
     q = np.stack([-co * sw - so * cw * ci, -so * sw + co * cw * ci, cw * si], -1)
-    w = np.stack([so * si, -co * si, ci], -1)
-    return p, q, w
+    return p, q
 
 
 def solve_kepler(mean_anomaly, e: float, tol: float = 1e-15) -> np.ndarray:
@@ -126,47 +129,93 @@ class KeplerOrbit(Orbit):
         self.period = 2.0 * math.pi / self.mean_motion          # anomalistic period
 
     def state(self, t):
+        if isinstance(t, (float, int)) and not isinstance(t, bool):
+            return self._state_scalar(float(t))
         t = np.asarray(t, float)
         a, e = self.a, self.e
         big = solve_kepler(self.m0 + self.mean_motion * t, e)
         ce, se = np.cos(big), np.sin(big)
         b = a * math.sqrt(1.0 - e * e)
         e_dot = self.mean_motion / (1.0 - e * ce)
-        p, q, w = _rotation(self.raan0 + self.raan_rate * t, np.float64(self.i), self.argp0 + self.argp_rate * t)
-        x, y = (a * (ce - e))[..., None], (b * se)[..., None]
-        r = x * p + y * q
-        v = (-a * se * e_dot)[..., None] * p + (b * ce * e_dot)[..., None] * q
-        v = v + self.argp_rate * np.cross(w, r) + self.raan_rate * np.cross([0.0, 0.0, 1.0], r)
+        p, q = _rotation(self.raan0 + self.raan_rate * t, np.float64(self.i), self.argp0 + self.argp_rate * t)
+        x, y = a * (ce - e), b * se
+        vx, vy = -a * se * e_dot - self.argp_rate * y, b * ce * e_dot + self.argp_rate * x    # ω̇ Ŵ × r
+        r = x[..., None] * p + y[..., None] * q
+        v = vx[..., None] * p + vy[..., None] * q
+        v[..., 0] -= self.raan_rate * r[..., 1]                                              # Ω̇ ẑ × r
+        v[..., 1] += self.raan_rate * r[..., 0]
         return r, v
 
+    def _state_scalar(self, t: float):
+        """:meth:`state` at one time with math on floats (the per-stage call)."""
+        a, e = self.a, self.e
+        m = math.remainder(self.m0 + self.mean_motion * t, 2.0 * math.pi)
+        big = m + e * math.sin(m)
+        for _ in range(30):
+            step = (big - e * math.sin(big) - m) / (1.0 - e * math.cos(big))
+            big -= step
+            if abs(step) <= 1e-15:
+                break
+        ce, se = math.cos(big), math.sin(big)
+        b = a * math.sqrt(1.0 - e * e)
+        e_dot = self.mean_motion / (1.0 - e * ce)
+        x, y = a * (ce - e), b * se
+        vx, vy = -a * se * e_dot - self.argp_rate * y, b * ce * e_dot + self.argp_rate * x
+        raan, argp = self.raan0 + self.raan_rate * t, self.argp0 + self.argp_rate * t
+        co, so, cw, sw = math.cos(raan), math.sin(raan), math.cos(argp), math.sin(argp)
+        ci, si = math.cos(self.i), math.sin(self.i)
+        p = (co * cw - so * sw * ci, so * cw + co * sw * ci, sw * si)
+        q = (-co * sw - so * cw * ci, -so * sw + co * cw * ci, cw * si)
+        r = [x * p[k] + y * q[k] for k in range(3)]
+        v = [vx * p[k] + vy * q[k] for k in range(3)]
+        v[0] -= self.raan_rate * r[1]
+        v[1] += self.raan_rate * r[0]
+        return np.array(r), np.array(v)
 
-def hermite(y0, y1, d0, d1, s, h):
-    """Cubic Hermite on one interval: value and derivative at ``s ∈ [0, 1]`` of step ``h``."""
-    s2, s3 = s * s, s * s * s
-    h00, h10, h01, h11 = 2 * s3 - 3 * s2 + 1, s3 - 2 * s2 + s, 3 * s2 - 2 * s3, s3 - s2
-    g00, g10, g01, g11 = 6 * (s2 - s), 3 * s2 - 4 * s + 1, 6 * (s - s2), 3 * s2 - 2 * s
-    return (h00 * y0 + h10 * h * d0 + h01 * y1 + h11 * h * d1,
-            (g00 * y0 + g01 * y1) / h + g10 * d0 + g11 * d1)
+
+# 8th-order central differences on 9 nodes (Fornberg 1988, Math. Comp. 51, Table 1)
+_D1 = np.array([1 / 280, -4 / 105, 1 / 5, -4 / 5, 0.0, 4 / 5, -1 / 5, 4 / 105, -1 / 280])
+_D2 = np.array([-1 / 560, 8 / 315, -1 / 5, 8 / 5, -205 / 72, 8 / 5, -1 / 5, 8 / 315, -1 / 560])
+_HALF = 4
+
+
+def quintic_hermite(y, d1, d2, h: float) -> np.ndarray:
+    """Coefficients ``c_k`` (``(n − 1, 6, 3)``) of ``y(s) = Σ c_k s^k`` on each interval of the nodes
+    ``y`` (``(n, 3)``) with first and second derivatives ``d1``, ``d2`` (step ``h``, ``s ∈ [0, 1]``)."""
+    c0, c1, c2 = y[:-1], h * d1[:-1], 0.5 * h * h * d2[:-1]
+    big_d = y[1:] - c0 - c1 - c2
+    slope = h * d1[1:] - c1 - 2.0 * c2
+    curv = h * h * d2[1:] - 2.0 * c2
+    c3 = 10.0 * big_d - 4.0 * slope + 0.5 * curv
+    c4 = -15.0 * big_d + 7.0 * slope - curv
+    c5 = 6.0 * big_d - 3.0 * slope + 0.5 * curv
+    return np.ascontiguousarray(np.stack([c0, c1, c2, c3, c4, c5], 1))
 
 
 class HermiteTable:
-    """Lazily built table of a smooth vector function and its derivative, cubic-Hermite interpolated.
+    """Lazily built table of a smooth vector function y(t), quintic-Hermite interpolated.
 
-    ``sample(times) -> (y, dy)`` (arrays ``(N, 3)``) is called for one chunk of ``chunk + 1`` nodes
-    spaced ``step`` at a time, when a requested ``t`` first falls in it. ``__call__(t)`` gives the
-    interpolated value and derivative.
+    ``sample(times) -> (N, 3)`` is called for one chunk of nodes spaced ``step`` (plus four on each
+    side) when a requested ``t`` first falls in it. The node derivatives ẏ, ÿ are 8th-order central
+    differences of the samples (error ≈ (ωh)⁸|y|ω/630 for a motion of rate ω), so the interpolant is
+    consistent with y itself; on each interval y is the quintic matching y, ẏ, ÿ at both ends
+    (error ≤ h⁶|y⁽⁶⁾|/46080). ``__call__(t)`` returns ``(y, ẏ)``, ẏ the interpolant's derivative.
     """
 
     def __init__(self, sample, step: float, chunk: int):
         self._sample, self.step, self.chunk = sample, float(step), int(chunk)
-        self._chunks: dict[int, tuple[np.ndarray, np.ndarray]] = {}
+        self._chunks: dict[int, np.ndarray] = {}
 
-    def _get(self, c: int):
+    def _get(self, c: int) -> np.ndarray:
         got = self._chunks.get(c)
         if got is None:
-            times = (c * self.chunk + np.arange(self.chunk + 1)) * self.step
-            y, dy = self._sample(times)
-            got = self._chunks[c] = (np.ascontiguousarray(y, float), np.ascontiguousarray(dy, float))
+            times = (c * self.chunk + np.arange(-_HALF, self.chunk + 1 + _HALF)) * self.step
+            y = np.asarray(self._sample(times), float)
+            n = self.chunk + 1
+            windows = np.stack([y[k:k + n] for k in range(2 * _HALF + 1)])       # (9, n, 3)
+            d1 = np.tensordot(_D1, windows, 1) / self.step
+            d2 = np.tensordot(_D2, windows, 1) / self.step**2
+            got = self._chunks[c] = quintic_hermite(y[_HALF:_HALF + n], d1, d2, self.step)
         return got
 
     def __call__(self, t):
@@ -178,14 +227,16 @@ class HermiteTable:
             raise ValueError("time t must be finite")
         k = np.floor(flat / self.step).astype(np.int64)
         c, j = np.divmod(k, self.chunk)
+        s = flat / self.step - k
+        powers = s[:, None] ** np.arange(6)
+        slopes = np.arange(1, 6) * powers[:, :5] / self.step
         y = np.empty((flat.size, 3))
         dy = np.empty((flat.size, 3))
-        s = (flat / self.step - k)[:, None]
         for ci in np.unique(c):
             m = c == ci
-            ys, ds = self._get(int(ci))
-            jm = j[m]
-            y[m], dy[m] = hermite(ys[jm], ys[jm + 1], ds[jm], ds[jm + 1], s[m], self.step)
+            coef = self._get(int(ci))[j[m]]
+            y[m] = np.einsum("nk,nkd->nd", powers[m], coef)
+            dy[m] = np.einsum("nk,nkd->nd", slopes[m], coef[:, 1:])
         return y.reshape(t.shape + (3,)), dy.reshape(t.shape + (3,))
 
     def _scalar(self, t: float):
@@ -194,8 +245,13 @@ class HermiteTable:
         x = t / self.step
         k = math.floor(x)
         c, j = divmod(k, self.chunk)
-        ys, ds = self._get(c)
-        return hermite(ys[j], ys[j + 1], ds[j], ds[j + 1], x - k, self.step)
+        coef = self._get(c)[j]
+        s = x - k
+        s2 = s * s
+        s3, s4 = s2 * s, s2 * s2
+        g = 1.0 / self.step
+        return (np.dot((1.0, s, s2, s3, s4, s4 * s), coef),
+                np.dot((g, 2.0 * s * g, 3.0 * s2 * g, 4.0 * s3 * g, 5.0 * s4 * g), coef[1:]))
 
 
 # ---------------------------------------------------------------- TLE
@@ -282,28 +338,38 @@ class TLEOrbit(Orbit):
             raise ValueError(f"TLE elements are rejected by SGP4 (error {self.satrec.error})")
         self.satellite = EarthSatellite.from_satrec(self.satrec, timescale())
         self.period = 2.0 * math.pi / (self.satrec.no_kozai / 60.0)
-        self._table = HermiteTable(self.direct_state, TLE_STEP, TLE_CHUNK)
+        self.failure: tuple[float, str] | None = None       # earliest tabulated SGP4 failure (t, message)
+        self._table = HermiteTable(self._sample, TLE_STEP, TLE_CHUNK)
 
     @property
     def tle_epoch(self) -> datetime:
-        return self.satellite.epoch.utc_datetime()
+        """The element set's epoch (UTC, to the microsecond; skyfield's ``utc_datetime`` loses ~40 µs)."""
+        year = self.satrec.epochyr + (2000 if self.satrec.epochyr < 57 else 1900)
+        return datetime(year, 1, 1, tzinfo=UTC) + timedelta(days=self.satrec.epochdays - 1.0)
 
     def direct_state(self, t):
         """r, v (m, m/s, GCRS) straight from skyfield (slow: ~0.1 ms a call); NaN where SGP4 fails."""
         at = self.satellite.at(skyfield_times(self.epoch, t))
-        r, v = np.moveaxis(at.position.m, 0, -1), np.moveaxis(at.velocity.m_per_s, 0, -1)
-        return r, v
+        return np.moveaxis(at.position.m, 0, -1), np.moveaxis(at.velocity.m_per_s, 0, -1)
 
-    def sgp4_message(self, t) -> str | None:
-        """SGP4's error message at time ``t`` (scalar), or None if it propagates."""
-        return self.satellite.at(skyfield_times(self.epoch, float(t))).message
+    def _sample(self, times):
+        at = self.satellite.at(skyfield_times(self.epoch, times))
+        for ti, message in zip(times, at.message):
+            if message and (self.failure is None or ti < self.failure[0]):
+                self.failure = (float(ti), message)
+                break
+        return np.moveaxis(at.position.m, 0, -1)
+
+    def unchecked_position(self, t) -> np.ndarray:
+        return self._table(t)[0]
 
     def state(self, t):
         r, v = self._table(t)
         if np.isnan(r[..., 0]).any():
             bad = np.asarray(t, float).reshape(-1)[np.isnan(r[..., 0]).reshape(-1)][0]
-            raise ValueError(f"orbit: SGP4 fails near t = {bad:.0f} s past {self.epoch.isoformat()}: "
-                             f"{self.sgp4_message(bad) or 'decayed'}")
+            when, why = self.failure or (bad, "no position")
+            raise ValueError(f"orbit: SGP4 cannot propagate the TLE from t = {when:.0f} s past "
+                             f"{self.epoch.isoformat()} ({why}), needed at t = {bad:.0f} s")
         return r, v
 
 
@@ -356,19 +422,16 @@ def orbit_from_mapping(mapping: dict, epoch=None) -> Orbit:
                        math.radians(v["mean_anomaly_deg"]))
 
 
-def altitude(orbit: Orbit, t) -> np.ndarray:
-    """Spherical altitude ``|r| − R_E`` (m), a lower bound of the geodetic one."""
-    return np.linalg.norm(orbit.position(t), axis=-1) - env.EARTH_RADIUS
-
-
 def check_altitude(orbit: Orbit, t0: float, t1: float, minimum: float = 150e3) -> None:
     """``ValueError`` if ``|r| − R_E`` drops below ``minimum`` anywhere in ``[t0, t1]`` (sampled every
-    ≤ 30 s, ends included) or if SGP4 fails (a decayed TLE)."""
+    ≤ 30 s, ends included) or if SGP4 fails there (a decayed TLE)."""
     if not (math.isfinite(t0) and math.isfinite(t1)) or t1 < t0:
         raise ValueError(f"altitude check needs finite t0 <= t1, got [{t0!r}, {t1!r}]")
     t = np.linspace(t0, t1, max(2, math.ceil((t1 - t0) / ALTITUDE_STEP) + 1))
-    h = altitude(orbit, t)
-    k = int(np.argmin(h))
-    if h[k] < minimum:
-        raise ValueError(f"orbit altitude |r| - R_E is {h[k] / 1e3:.1f} km at t = {t[k]:.0f} s, below the "
-                         f"minimum {minimum / 1e3:.0f} km")
+    h = np.linalg.norm(orbit.unchecked_position(t), axis=-1) - env.EARTH_RADIUS
+    low = np.flatnonzero(h < minimum)
+    if low.size:
+        raise ValueError(f"orbit altitude |r| - R_E drops below the minimum {minimum / 1e3:.0f} km at t = "
+                         f"{t[low[0]]:.0f} s ({h[low[0]] / 1e3:.1f} km)")
+    if np.isnan(h).any():
+        orbit.position(t)          # raises the propagator's own sentence
