@@ -11,6 +11,9 @@ cycle), and the bands join with small steps. ``altitude`` is the caller's: the s
 """
 from __future__ import annotations
 
+import bisect
+import math
+
 import numpy as np
 
 # Vallado (2013) Table 8-4: base altitude (km), nominal density (kg/m³), scale height (km)
@@ -27,10 +30,16 @@ VALLADO_TABLE_8_4 = np.array([
 _BASE = VALLADO_TABLE_8_4[:, 0] * 1e3          # m
 _RHO0 = VALLADO_TABLE_8_4[:, 1]                # kg/m³
 _SCALE = VALLADO_TABLE_8_4[:, 2] * 1e3         # m
+_BANDS = (_BASE.tolist(), _RHO0.tolist(), _SCALE.tolist())
 
 
 def density(altitude_m) -> np.ndarray | float:
     """Mass density (kg/m³) at geometric altitude(s) ``altitude_m`` (m, ≥ 0), same shape."""
+    if isinstance(altitude_m, float | int) and not isinstance(altitude_m, bool):
+        h = float(altitude_m)                  # one altitude: the simulator's per-stage path
+        if h >= 0.0:
+            i = bisect.bisect_right(_BANDS[0], h) - 1
+            return _BANDS[1][i] * math.exp(-(h - _BANDS[0][i]) / _BANDS[2][i])
     h = np.asarray(altitude_m, float)
     if not np.all(h >= 0.0):                   # NaN fails too
         raise ValueError(f"altitude must be at least 0 m (Vallado Table 8-4 starts at sea level), "

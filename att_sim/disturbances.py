@@ -27,10 +27,10 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
-from functools import lru_cache
 
 import numpy as np
 
+from att_sim import rotations as rot
 from att_sim.environment import EARTH_MU, to_body
 
 SOLAR_PRESSURE_1AU = 4.56e-6          # N/m², solar flux 1367 W/m² over c (Wertz §17.2)
@@ -120,70 +120,104 @@ def facets_from_params(params, field: str = "environment.facets") -> list[Facet]
     return out
 
 
-@lru_cache(maxsize=32)
-def _arrays(facets: tuple[Facet, ...]):
-    """``(A (F,), n̂ (F, 3), c (F, 3), ρ (F,), δ (F,))`` of a facet set."""
-    return (np.array([f.area for f in facets]), np.array([f.normal_B for f in facets]).reshape(-1, 3),
-            np.array([f.center_B for f in facets]).reshape(-1, 3), np.array([f.specular for f in facets]),
-            np.array([f.diffuse for f in facets]))
+def _body(q, v_N) -> tuple:
+    """``C(q) v`` as three components: floats for one attitude and one vector (the simulator's
+    per-stage path), arrays for stacks. Same matrix as :func:`att_sim.rotations.dcm`, transposed."""
+    q, v = np.asarray(q, float), np.asarray(v_N, float)
+    if q.shape != (4,) or v.shape != (3,):
+        b = to_body(q, v)
+        return b[..., 0], b[..., 1], b[..., 2]
+    x, y, z, w = q.tolist()
+    a, b, c = v.tolist()
+    return ((1 - 2 * (y * y + z * z)) * a + 2 * (x * y + z * w) * b + 2 * (x * z - y * w) * c,
+            2 * (x * y - z * w) * a + (1 - 2 * (x * x + z * z)) * b + 2 * (y * z + x * w) * c,
+            2 * (x * z + y * w) * a + 2 * (y * z - x * w) * b + (1 - 2 * (x * x + y * y)) * c)
 
 
-def _unit(v, name: str) -> tuple[np.ndarray, np.ndarray]:
-    norm = np.linalg.norm(v, axis=-1, keepdims=True)
-    if not np.all(np.isfinite(norm)):
-        raise ValueError(f"{name} must be finite")
-    return v / np.where(norm > 0.0, norm, 1.0), norm[..., 0]
+def _vector_out(tx, ty, tz, like) -> np.ndarray:
+    if isinstance(like, float):
+        return np.array([tx, ty, tz])
+    return np.stack(np.broadcast_arrays(tx, ty, tz, like)[:3], -1)
+
+
+def _plain(value):
+    """A 0-d input as a float (the per-stage path), anything else as an array."""
+    a = np.asarray(value, float)
+    return float(a) if a.ndim == 0 else a
+
+
+def _all(condition) -> bool:
+    """``np.all`` without its cost on a plain bool (the per-stage path)."""
+    return condition if isinstance(condition, bool) else bool(np.all(condition))
 
 
 def srp_torque(facets, q, sun_direction_N, sun_distance_m, shadow) -> np.ndarray:
     """Solar-radiation-pressure torque (N m, body): flat facets, ``sun_direction_N`` from the
     spacecraft to the Sun (normalised here), ``sun_distance_m`` (m), ``shadow`` in [0, 1]."""
-    d, nu = np.asarray(sun_distance_m, float), np.asarray(shadow, float)
-    if not np.all(d > 0.0):
+    d, nu = _plain(sun_distance_m), _plain(shadow)
+    if not _all(d > 0.0):
         raise ValueError(f"sun_distance_m must be > 0 m, got {sun_distance_m}")
-    if not np.all((nu >= 0.0) & (nu <= 1.0)):
+    if not _all((nu >= 0.0) & (nu <= 1.0)):
         raise ValueError(f"shadow must be a visible fraction of the solar disc in [0, 1], got {shadow}")
-    a, n, c, rho, delta = _arrays(tuple(facets))
-    s, s_norm = _unit(to_body(q, sun_direction_N), "sun_direction_N")
-    if not np.all(s_norm > 0.0):
+    sx, sy, sz = _body(q, sun_direction_N)
+    norm = (sx * sx + sy * sy + sz * sz) ** 0.5
+    if not _all((norm > 0.0) & (norm < math.inf)):
         raise ValueError("sun_direction_N must be a nonzero vector")
+    sx, sy, sz = sx / norm, sy / norm, sz / norm
     p = SOLAR_PRESSURE_1AU * (ASTRONOMICAL_UNIT / d) ** 2 * nu
-    cos = np.maximum(np.einsum("...i,fi->...f", s, n), 0.0)             # unlit facets: 0
-    scale = -np.asarray(p)[..., None] * a * cos                            # (..., F)
-    force = scale[..., None] * (2.0 * (delta / 3.0 + rho * cos)[..., None] * n
-                                + (1.0 - rho)[:, None] * s[..., None, :])
-    return np.sum(np.cross(c, force), axis=-2)
+    tx = ty = tz = 0.0
+    for f in facets:
+        (nx, ny, nz), (cx, cy, cz) = f.normal_B, f.center_B
+        cos = nx * sx + ny * sy + nz * sz
+        cos = cos * (cos > 0.0)                                   # unlit: 0
+        k = -p * f.area * cos
+        kn, ks = k * 2.0 * (f.diffuse / 3.0 + f.specular * cos), k * (1.0 - f.specular)
+        fx, fy, fz = kn * nx + ks * sx, kn * ny + ks * sy, kn * nz + ks * sz
+        tx, ty, tz = tx + cy * fz - cz * fy, ty + cz * fx - cx * fz, tz + cx * fy - cy * fx
+    return _vector_out(tx, ty, tz, sx * p)
 
 
 def drag_torque(facets, q, v_rel_N, density, cd: float = DRAG_COEFFICIENT) -> np.ndarray:
     """Aerodynamic torque (N m, body): flat facets facing the flow, velocity ``v_rel_N`` (m/s,
     inertial axes) relative to the atmosphere, air ``density`` (kg/m³)."""
-    rho_air = np.asarray(density, float)
-    if not np.all(rho_air >= 0.0):
+    rho_air = _plain(density)
+    if not _all(rho_air >= 0.0):
         raise ValueError(f"density must be at least 0 kg/m³, got {density}")
     if not (math.isfinite(cd) and cd > 0.0):
         raise ValueError(f"cd must be a finite drag coefficient > 0, got {cd}")
-    a, n, c, _, _ = _arrays(tuple(facets))
-    v_hat, speed = _unit(to_body(q, v_rel_N), "v_rel_N")
-    cos = np.maximum(np.einsum("...i,fi->...f", v_hat, n), 0.0)
-    scale = -0.5 * cd * (rho_air * speed**2)[..., None] * a * cos          # (..., F)
-    return np.sum(np.cross(c, scale[..., None] * v_hat[..., None, :]), axis=-2)
+    vx, vy, vz = _body(q, v_rel_N)
+    if not _all(abs(vx) + abs(vy) + abs(vz) < math.inf):          # NaN fails too
+        raise ValueError("v_rel_N must be finite")
+    k_air = -0.5 * cd * rho_air                     # F = −½ρC_d A (n̂·v̂)|v|² v̂ = −½ρC_d A (n̂·v) v
+    tx = ty = tz = 0.0
+    for f in facets:
+        (nx, ny, nz), (cx, cy, cz) = f.normal_B, f.center_B
+        nv = nx * vx + ny * vy + nz * vz
+        k = k_air * f.area * nv * (nv > 0.0)                      # leeward: 0
+        fx, fy, fz = k * vx, k * vy, k * vz
+        tx, ty, tz = tx + cy * fz - cz * fy, ty + cz * fx - cx * fz, tz + cx * fy - cy * fx
+    return _vector_out(tx, ty, tz, vx * rho_air)
 
 
 def relative_velocity(r_N, v_N) -> np.ndarray:
     """``v − ω_E × r``: velocity relative to the co-rotating atmosphere (ω_E along GCRS z)."""
     r, v = np.asarray(r_N, float), np.asarray(v_N, float)
     w = EARTH_ANGULAR_VELOCITY
+    if r.shape == v.shape == (3,):
+        (x, y, _), (a, b, c) = r.tolist(), v.tolist()
+        return np.array([a + w * y, b - w * x, c])
     return v - np.stack(np.broadcast_arrays(-w * r[..., 1], w * r[..., 0], 0.0 * r[..., 2]), -1)
 
 
 def residual_dipole_torque(m_B, B_B) -> np.ndarray:
     """``m × B`` (N m): residual dipole ``m_B`` (A m²) in the field ``B_B`` (T), body axes."""
-    return np.cross(np.asarray(m_B, float), np.asarray(B_B, float))
+    return rot.cross(np.asarray(m_B, float), np.asarray(B_B, float))
 
 
 def gravity_gradient_torque(r_N, q, inertia) -> np.ndarray:
     """``(3μ/|r|⁵) r_b × (J r_b)``, ``r_b = C(q) r_N`` (N m, body), at any position ``r_N`` (m)."""
-    r_b = to_body(q, r_N)
-    j_r = np.einsum("ij,...j->...i", np.asarray(inertia, float), r_b)
-    return 3.0 * EARTH_MU / np.sum(r_b * r_b, -1, keepdims=True) ** 2.5 * np.cross(r_b, j_r)
+    x, y, z = _body(q, r_N)
+    (j00, j01, j02), (j10, j11, j12), (j20, j21, j22) = np.asarray(inertia, float).tolist()
+    jx, jy, jz = j00 * x + j01 * y + j02 * z, j10 * x + j11 * y + j12 * z, j20 * x + j21 * y + j22 * z
+    k = 3.0 * EARTH_MU / (x * x + y * y + z * z) ** 2.5
+    return _vector_out(k * (y * jz - z * jy), k * (z * jx - x * jz), k * (x * jy - y * jx), x)

@@ -58,7 +58,7 @@ def test_srp_and_drag_on_a_symmetric_box_are_zero_and_broadcast():
     q = rot.normalize(np.random.default_rng(4).normal(size=(20, 4)))
     d = np.random.default_rng(5).normal(size=(20, 3))
     np.testing.assert_allclose(dist.srp_torque(box, q, d, AU, 1.0), 0.0, atol=1e-20)
-    np.testing.assert_allclose(dist.drag_torque(box, q, 7500.0 * d, 1e-12), 0.0, atol=1e-18)
+    np.testing.assert_allclose(dist.drag_torque(box, q, 7500.0 * d, 1e-12), 0.0, atol=1e-15)   # forces ~1e-4 N
     assert dist.srp_torque(box, q, d, AU, np.ones(20)).shape == (20, 3)
     # an offset box is not: the centre of pressure moves by 0.1 m along z
     shifted = [dist.Facet(f.area, f.normal_B, tuple(np.add(f.center_B, [0, 0, 0.1])), 0.3, 0.2) for f in box]
@@ -77,6 +77,26 @@ def test_drag_on_a_facet_facing_the_flow_by_hand():
                                np.cross([0, 1.0, 0], -0.5e-12 * 2.0 * 1.5 * math.cos(0.4) * 7500.0 * v), rtol=1e-13)
     assert np.all(dist.drag_torque([facet], rot.IDENTITY, [-7500.0, 0.0, 0.0], 1e-12) == 0.0)   # leeward
     assert np.all(dist.drag_torque([facet], rot.IDENTITY, [0.0, 0.0, 0.0], 1e-12) == 0.0)       # at rest
+
+
+def test_one_attitude_and_a_stack_give_the_same_torques():
+    facets = [dist.Facet(1.0 + k, tuple(n / np.linalg.norm(n)), tuple(c), 0.2, 0.3)
+              for k, (n, c) in enumerate(np.random.default_rng(7).normal(size=(5, 2, 3)))]
+    q = rot.normalize(np.random.default_rng(8).normal(size=(6, 4)))
+    u = np.random.default_rng(9).normal(size=(6, 3))
+    r = 7e6 * u / np.linalg.norm(u, axis=1, keepdims=True)
+    inertia = np.array([[3000.0, 10.0, -5.0], [10.0, 4500.0, 2.0], [-5.0, 2.0, 6000.0]])
+    stacks = (dist.srp_torque(facets, q, u, AU, 0.7), dist.drag_torque(facets, q, 7500.0 * u, 1e-12),
+              dist.gravity_gradient_torque(r, q, inertia), dist.residual_dipole_torque(u, 2e-5 * u[::-1]),
+              dist.relative_velocity(r, 7500.0 * u))
+    for k in range(6):
+        ones = (dist.srp_torque(facets, q[k], u[k], AU, 0.7), dist.drag_torque(facets, q[k], 7500.0 * u[k], 1e-12),
+                dist.gravity_gradient_torque(r[k], q[k], inertia), dist.residual_dipole_torque(u[k], 2e-5 * u[5 - k]),
+                dist.relative_velocity(r[k], 7500.0 * u[k]))
+        for one, stack in zip(ones, stacks):
+            np.testing.assert_allclose(one, stack[k], rtol=1e-12, atol=1e-20)
+    assert np.any(stacks[0] != 0.0) and np.any(stacks[1] != 0.0)
+    np.testing.assert_allclose(atm.density(np.array(480e3)), atm.density(480e3), rtol=1e-15)
 
 
 def test_relative_velocity_removes_the_corotating_atmosphere():
@@ -157,6 +177,10 @@ def test_bad_torque_inputs_are_refused():
         dist.srp_torque(box, rot.IDENTITY, [0.0, 0, 0], AU, 1.0)
     with pytest.raises(ValueError, match="density must be at least 0"):
         dist.drag_torque(box, rot.IDENTITY, [7500.0, 0, 0], -1.0)
+    with pytest.raises(ValueError, match="v_rel_N must be finite"):
+        dist.drag_torque(box, rot.IDENTITY, [math.nan, 0, 0], 1e-12)
+    with pytest.raises(ValueError, match="shadow must be"):
+        dist.srp_torque(box, rot.IDENTITY, [1.0, 0, 0], AU, math.nan)
     with pytest.raises(ValueError, match="cd must be a finite drag coefficient > 0"):
         dist.drag_torque(box, rot.IDENTITY, [7500.0, 0, 0], 1e-12, cd=0.0)
     assert np.all(dist.srp_torque([], rot.IDENTITY, [1.0, 0, 0], AU, 1.0) == 0.0)          # no facets: no torque
