@@ -4,8 +4,9 @@
   Report 42-178, 2009) through skyfield, opened offline from the ``de421.bsp`` packaged by
   ``skyfield-data``. Light time and aberration are ignored (≤ 20.5″ ≈ 1e-4 rad for the Sun, 0.7″ for
   the Moon); axes ICRF, i.e. GCRS's. Positions are tabulated every 600 s (1-day chunks, built as t
-  reaches them) and cubic-Hermite interpolated with DE421's velocities: ≤ 1 m (≤ 1e-11 rad in
-  direction) against direct evaluation, measured in test/att_sim/test_ephemeris.py.
+  reaches them) and interpolated by :class:`att_sim.orbit.HermiteTable` (quintic Hermite on 8th-order
+  differences): against direct evaluation ≤ 1e-4 m, i.e. rounding (≤ 1e-13 rad in direction; the
+  bound required is 1e-7 rad), measured in test/att_sim/test_ephemeris.py.
 * Directions from the spacecraft ``r`` (not the Earth's centre): ``ŝ = (r_sun − r)/|r_sun − r|``; the
   lunar parallax in LEO is up to ~1°.
 * Earth: nadir ``−r̂``, angular radius ``asin(R_E/|r|)`` (sphere of the WGS-84 equatorial radius).
@@ -27,7 +28,7 @@ from att_sim.environment import EARTH_RADIUS
 from att_sim.epoch import parse_epoch, skyfield_times, timescale
 from att_sim.orbit import HermiteTable, Orbit
 
-SUN_RADIUS = 696.0e6        # m (Montenbruck & Gill 2000, Table 3.? / §3.4.2)
+SUN_RADIUS = 696.0e6        # m (Montenbruck & Gill 2000 §3.4.2)
 BODY_STEP = 600.0           # s, node spacing of the Sun/Moon tables
 BODY_CHUNK = 144            # intervals per chunk (1 day)
 

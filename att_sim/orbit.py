@@ -18,10 +18,12 @@ seconds past its ``epoch`` (sim time zero), scalar or array (leading shape kept,
   AIAA 2006-6753) through ``sgp4`` and skyfield's ``EarthSatellite``, which rotates TEME into GCRS
   (IAU 2000B-class precession–nutation and the equation of the equinoxes; polar motion ignored). The
   TLE is checked column by column and by its checksum (mod-10 sum of the digits, '-' = 1, of columns
-  1–68; ``Satrec.twoline2rv`` checks neither). skyfield costs ~0.1 ms a call, so r and v are tabulated
-  every 60 s in chunks built as ``t`` reaches them and interpolated by cubic Hermite (r and v at the
-  nodes): position error ≤ 1 mm, velocity ≤ 0.1 mm/s, measured in LEO against direct evaluation
-  (test/att_sim/test_orbit.py; the error bound h⁴|r⁗|/384 ≈ 0.3 mm at 60 s, 580 km).
+  1–68; ``Satrec.twoline2rv`` checks neither). skyfield costs ~0.1 ms a call, so positions are tabulated
+  every 60 s in 3-h chunks built as ``t`` reaches them and interpolated by :class:`HermiteTable`
+  (quintic Hermite on 8th-order central differences): position within 1e-5 m of direct evaluation in
+  LEO (7e-4 m at the perigee of a 0.7-eccentric orbit), ``v`` the interpolant's derivative, within
+  2e-4 m/s of dr/dt. SGP4's own velocity is not dr/dt (5 cm/s off in LEO, up to ~3 m/s in eccentric
+  orbits), so it is not used. Where SGP4 fails (decay) ``state`` raises ``ValueError``.
 
 :func:`check_altitude` uses the spherical altitude ``|r| − R_E`` (R_E the WGS-84 equatorial radius),
 a lower bound of the geodetic altitude, sampled every ≤ 30 s.
