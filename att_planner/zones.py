@@ -79,7 +79,7 @@ class ZoneSky:
         for i, z in enumerate(self.zones):
             if z.body not in ZONE_BODIES:
                 raise ValueError(f"zones[{i}].body = '{z.body}' is not one of {', '.join(ZONE_BODIES)}")
-        self.names = [z.name or f"zone {i}" for i, z in enumerate(self.zones)]
+        self.names = [z.name or str(i) for i, z in enumerate(self.zones)]
         self.keep_in = np.array([z.keep_in for z in self.zones], bool)
         self.sensor_axes = np.array([z.sensor_axis for z in self.zones], float).reshape(-1, 3)
         self._moving = np.array([i for i, z in enumerate(self.zones) if z.body != "inertial"], int)

@@ -57,10 +57,22 @@ def leg_profile(problem: ManeuverProblem, legs: list[AxisLeg], pieces_per_half: 
     (for cone checks). With a gyroscopic term each half is split into ``pieces_per_half`` pieces
     holding the mean torque of the piece (default 32; 1 when the axis is principal).
     """
+    return _profile(problem, legs, pieces_per_half)[:6]
+
+
+def leg_path(problem: ManeuverProblem, legs: list[AxisLeg]) -> tuple[np.ndarray, np.ndarray]:
+    """``(t_dense, q_dense)``: the dense attitude path of :func:`leg_profile` (200 samples per leg,
+    even in angle) with the physical time of each sample, for zones that move: on a leg the angle
+    is ``½ α τ²`` up to half-way, then ``φ − ½ α (T − τ)²``."""
+    out = _profile(problem, legs, 1)
+    return out[6], out[5]
+
+
+def _profile(problem: ManeuverProblem, legs: list[AxisLeg], pieces_per_half: int | None):
     sc = problem.spacecraft
     J = sc.inertia
     q = rot.normalize(np.asarray(problem.q_initial, float))
-    ts, us, qs, ws, durations, dense = [0.0], [], [q], [np.zeros(3)], [], [q[None]]
+    ts, us, qs, ws, durations, dense, dense_t = [0.0], [], [q], [np.zeros(3)], [], [q[None]], [np.zeros(1)]
     t0 = 0.0
     for leg in legs:
         if leg.angle <= 1e-12:
@@ -84,7 +96,10 @@ def leg_profile(problem: ManeuverProblem, legs: list[AxisLeg], pieces_per_half: 
         ts += list(t0 + local[1:]) + [t0 + T]
         qs += list(q_knots[1:])
         ws += list(rate[1:, None] * e)
-        dense.append(rot.multiply(_axis_rotation(leg.axis, leg.angle * np.linspace(0.0, 1.0, 200)), q))
+        swept = leg.angle * np.linspace(0.0, 1.0, 200)
+        dense.append(rot.multiply(_axis_rotation(leg.axis, swept), q))
+        dense_t.append(t0 + np.where(swept <= leg.angle / 2, np.sqrt(2 * swept / alpha),
+                                     T - np.sqrt(2 * np.maximum(leg.angle - swept, 0.0) / alpha)))
         q = rot.multiply(_axis_rotation(leg.axis, leg.angle), q)
         qs.append(q)
         ws.append(np.zeros(3))
@@ -92,7 +107,8 @@ def leg_profile(problem: ManeuverProblem, legs: list[AxisLeg], pieces_per_half: 
         t0 += T
     us.append(np.zeros(3))
     torque = np.clip(np.array(us), -sc.body_torque_max, sc.body_torque_max)
-    return (np.array(ts), torque, np.array(qs), np.array(ws), durations, np.concatenate(dense))
+    return (np.array(ts), torque, np.array(qs), np.array(ws), durations, np.concatenate(dense),
+            np.concatenate(dense_t))
 
 
 def _semi_free_goal(problem: ManeuverProblem) -> np.ndarray:

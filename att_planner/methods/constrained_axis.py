@@ -1,12 +1,20 @@
 """The constrained rotation axis: λ-rotations (:mod:`.axis_rotations`) that take the sensor round
-the keep-out cones.
+the keep-out zones, moving or not (issue 13).
 
-When the eigenaxis sweeps the sensor through a keep-out cone, the sensor goes around it on the
-shortest path around a spherical cap: a great circle tangent to a circle just outside the cone, a
-λ-rotation **about the cone axis** so the sensor rides that circle, the tangent great circle to the
+When the eigenaxis sweeps a sensor through a keep-out zone, that sensor goes around it on the
+shortest path around a spherical cap: a great circle tangent to a circle just outside the zone, a
+λ-rotation **about the zone axis** so the sensor rides that circle, the tangent great circle to the
 target direction, then a roll about the sensor to the final attitude (or, when shorter and clear,
 an eigenaxis rotation instead of the last two legs). Every leg is a rest-to-rest λ-rotation; both
-ways around each cone are tried and the fastest sequence that clears every cone is kept.
+ways around each keep-out zone are tried and the fastest sequence that clears every zone is kept.
+
+Zones that move: every candidate is judged with the margins of each dense sample at its physical
+time (:func:`.axis_rotations.leg_path`, :meth:`att_planner.zones.ZoneSky.margins`), never a
+snapshot. The ride is built about the zone as it is at ``t*``, the middle of the ride, on a circle
+widened by how far the zone's axis and half-angle move during the ride; ``t*`` and that widening
+are found by a few fixed-point iterations (:data:`RIDE_ITERATIONS`) of the construction. Keep-in
+zones are checked, not steered into. A sequence longer than the zones' window
+(:meth:`ManeuverProblem.zone_sky`) is refused, never judged on extrapolated zones.
 """
 from __future__ import annotations
 
@@ -15,19 +23,21 @@ import time
 import numpy as np
 
 from att_msgs_py.types import Plan, Status
-from att_planner.cones import min_margin
 from att_planner.methods.axis_rotations import (
     AxisLeg,
     eigenaxis_leg,
     goal_attitude,
+    leg_path,
     leg_profile,
     legs_plan,
     no_torque_limit,
 )
 from att_planner.problem import ManeuverProblem
+from att_planner.zones import ZoneSky
 from att_sim import rotations as rot
 
 METHOD = "constrained_axis"
+RIDE_ITERATIONS = 4        # fixed-point iterations on the ride time t* and the widening
 
 
 def _polar(b, w, u, v):
@@ -46,23 +56,35 @@ def _great_circle_leg(b_from, b_to, label):
     return AxisLeg(axis / n, float(np.arctan2(n, b_from @ b_to)), label)
 
 
-def cone_riding_legs(problem: ManeuverProblem, cone_index: int, side: int, ride_margin: float,
-                     finish: str) -> list[AxisLeg] | None:
-    """Legs taking the sensor around cone ``cone_index`` on ``side`` (+1: increasing azimuth about
-    its axis, −1: decreasing) along a circle ``ride_margin`` outside it.
+def cone_riding_legs(problem: ManeuverProblem, zone_index: int, side: int, ride_margin: float, finish: str,
+                     axis: np.ndarray | None = None, half_angle: float | None = None) -> list[AxisLeg] | None:
+    """Legs taking zone ``zone_index``'s sensor (of :meth:`ManeuverProblem.zone_sky`: the cones
+    first) around the zone's cone of ``axis`` and ``half_angle`` (default: the zone at t = 0) on
+    ``side`` (+1: increasing azimuth about its axis, −1: decreasing) along a circle ``ride_margin``
+    outside it.
 
     ``finish='roll'``: tangent arc to the target direction, then a roll about the sensor;
     ``finish='eigenaxis'``: an eigenaxis rotation from the end of the ride to the goal attitude.
     None when a boresight end lies inside the riding circle.
     """
-    cone = problem.cones[cone_index]
-    w = cone.direction
+    if zone_index < len(problem.cones):          # a cone: no need to build the zones
+        cone = problem.cones[zone_index]
+        sensor, name = np.asarray(problem.sensor_axis, float), cone.name or str(zone_index)
+        w0, theta0 = cone.direction, cone.half_angle
+    else:
+        zs = problem.zone_sky()
+        sensor, name = zs.sensor_axes[zone_index], zs.names[zone_index]
+        w0, theta0 = zs.true_axes(0.0)[zone_index], float(zs.true_half_angles(0.0)[zone_index])
+    w = np.asarray(w0 if axis is None else axis, float)
+    w = w / np.linalg.norm(w)
+    theta = theta0 if half_angle is None else half_angle
     u, v = rot.orthonormal_basis(w)              # azimuth ψ measured from u towards v
-    r = np.asarray(problem.sensor_axis, float) / np.linalg.norm(problem.sensor_axis)
+    r = sensor / np.linalg.norm(sensor)
+    own_sensor = np.array_equal(sensor, np.asarray(problem.sensor_axis, float))
     q0 = rot.normalize(np.asarray(problem.q_initial, float))
     q_goal = goal_attitude(problem)
     b0, bf = rot.dcm(q0) @ r, rot.dcm(q_goal) @ r
-    rho = cone.half_angle + ride_margin
+    rho = theta + ride_margin
     beta0, psi0 = _polar(b0, w, u, v)
     betaf, psif = _polar(bf, w, u, v)
     if min(beta0, betaf) <= rho or rho >= np.pi / 2:
@@ -73,8 +95,8 @@ def cone_riding_legs(problem: ManeuverProblem, cone_index: int, side: int, ride_
     psi1 = psi0 + side * A0
     ride = np.mod(side * ((psif - side * Af) - psi1), 2 * np.pi)
     p1 = _point(rho, psi1, w, u, v)
-    legs = [_great_circle_leg(b0, p1, f"tangent to {cone.name or cone_index}"),
-            AxisLeg(side * w, float(ride), f"ride {cone.name or cone_index} boundary")]
+    legs = [_great_circle_leg(b0, p1, f"tangent to {name}"),
+            AxisLeg(side * w, float(ride), f"ride {name} boundary")]
     q = q0
     for leg in legs:
         q = rot.multiply(rot.from_axis_angle(leg.axis, leg.angle), q)
@@ -83,7 +105,7 @@ def cone_riding_legs(problem: ManeuverProblem, cone_index: int, side: int, ride_
     b2 = rot.dcm(q) @ r
     legs.append(_great_circle_leg(b2, bf, "tangent to target"))
     q = rot.multiply(rot.from_axis_angle(legs[-1].axis, legs[-1].angle), q)
-    if problem.sensor_target is None:
+    if problem.sensor_target is None or not own_sensor:
         roll_q = rot.multiply(q_goal, rot.conjugate(q))            # rotation about bf (inertial)
         if roll_q[3] < 0:
             roll_q = -roll_q
@@ -93,42 +115,77 @@ def cone_riding_legs(problem: ManeuverProblem, cone_index: int, side: int, ride_
 
 
 def _legs_time(problem: ManeuverProblem, legs: list[AxisLeg]) -> tuple[float, float]:
-    """(duration, min cone margin along the path) of a leg sequence, without simulation."""
-    t, _, _, _, _, q_dense = leg_profile(problem, legs, pieces_per_half=1)
-    return float(t[-1]), min_margin(q_dense, problem.sensor_axis, problem.cones)
+    """(duration, min zone margin along the path at the physical times; −inf beyond the zones'
+    window) of a leg sequence, without simulation."""
+    t, q = leg_path(problem, legs)
+    zs = problem.zone_sky()
+    if zs.moving and t[-1] > zs.window:
+        return float(t[-1]), -np.inf
+    m = zs.margins(t, q)
+    return float(t[-1]), float(m.min()) if m.size else np.inf
+
+
+def _moving_ride(problem: ManeuverProblem, zs: ZoneSky, z: int, side: int, ride_margin: float,
+                 finish: str) -> tuple[list[AxisLeg] | None, float, float]:
+    """``(legs, t*, widening)``: the riding legs about zone ``z`` as it is at the middle ``t*`` of the
+    ride, on a circle widened by the zone's motion during the ride (how far its axis turns from
+    ``a(t*)`` plus the growth of its half-angle), found by fixed-point iteration
+    (:data:`RIDE_ITERATIONS`)."""
+    t_star, widen, legs = 0.0, 0.0, None
+    for _ in range(RIDE_ITERATIONS if zs.moving else 1):
+        t_c = min(t_star, zs.window)
+        legs = cone_riding_legs(problem, z, side, ride_margin + widen, finish,
+                                zs.axes(t_c)[z], float(zs.half_angles(t_c)[z]))
+        if legs is None:
+            return None, t_star, widen
+        d = leg_profile(problem, legs, pieces_per_half=1)[4]
+        if len(d) < 2 or not zs.moving:
+            break
+        t_star = min(d[0] + d[1] / 2, zs.window)
+        ts = np.linspace(d[0], min(d[0] + d[1], zs.window), 32)
+        a, th = zs.axes(ts)[:, z], zs.half_angles(ts)[:, z]
+        a_star, th_star = zs.axes(t_star)[z], zs.half_angles(t_star)[z]
+        drift = np.arccos(np.clip(a @ a_star / np.linalg.norm(a, axis=1) / np.linalg.norm(a_star), -1, 1))
+        widen = float(np.max(drift + th - th_star))
+    return legs, t_star, widen
 
 
 def plan_constrained_axis(problem: ManeuverProblem, *, ride_margin_deg: float = 0.5) -> Plan:
-    """Eigenaxis slew if it clears the cones, else the fastest cone-riding λ-rotation sequence.
+    """Eigenaxis slew if it clears the zones, else the fastest zone-riding λ-rotation sequence.
 
-    ``ride_margin_deg``: how far outside the cone boundary the sensor rides (deg, ≥ 0).
+    ``ride_margin_deg``: how far outside the zone boundary the sensor rides (deg, ≥ 0).
     """
     start = time.monotonic()
     why = no_torque_limit(problem)
     if why:
         return Plan(method=METHOD, status=Status.FAILED, message=why)
+    zs = problem.zone_sky()
     eig = [eigenaxis_leg(problem.q_initial, goal_attitude(problem))]
     tf, margin = _legs_time(problem, eig)
     if margin >= 0:
-        return legs_plan(problem, METHOD, eig, start, "eigenaxis path clears every cone",
-                       {"candidates": [{"route": "eigenaxis", "tf": tf, "min_margin": margin}]})
+        return legs_plan(problem, METHOD, eig, start, "eigenaxis path clears every zone",
+                         {"candidates": [{"route": "eigenaxis", "tf": tf, "min_margin": margin}]})
     candidates = []
-    for c in range(len(problem.cones)):
+    for z in np.flatnonzero(~zs.keep_in):
         for side in (+1, -1):
             for finish in ("roll", "eigenaxis"):
-                legs = cone_riding_legs(problem, c, side, np.deg2rad(ride_margin_deg), finish)
+                legs, t_star, widen = _moving_ride(problem, zs, int(z), side, np.deg2rad(ride_margin_deg), finish)
                 if legs is None:
                     continue
                 tf_c, m_c = _legs_time(problem, legs)
-                name = problem.cones[c].name or str(c)
-                candidates.append({"route": f"ride {name} {'+' if side > 0 else '-'} then {finish}",
-                                   "tf": tf_c, "min_margin": m_c, "legs": legs})
+                candidates.append({"route": f"ride {zs.names[z]} {'+' if side > 0 else '-'} then {finish}",
+                                   "tf": tf_c, "min_margin": m_c, "ride_time": t_star, "widening": widen,
+                                   "legs": legs})
     clear = [c for c in candidates if c["min_margin"] >= 0]
-    stats = {"candidates": [{k: c[k] for k in ("route", "tf", "min_margin")} for c in candidates]}
+    stats = {"candidates": [{k: c[k] for k in ("route", "tf", "min_margin", "ride_time", "widening")}
+                            for c in candidates],
+             "zone_window": zs.window}
     if not clear:
-        msg = "no cone-riding λ-rotation sequence clears every cone"
+        msg = "no zone-riding λ-rotation sequence clears every zone"
+        if any(c["tf"] > zs.window for c in candidates) and zs.moving:
+            msg += f" (sequences longer than the zones' window of {zs.window:.0f} s are refused)"
         best = max(candidates, key=lambda c: c["min_margin"]) if candidates else None
-        if best is None:
+        if best is None or not np.isfinite(best["min_margin"]):
             return Plan(method=METHOD, status=Status.FAILED, message=msg, stats=stats)
         plan = legs_plan(problem, METHOD, best["legs"], start, msg, stats)
         plan.status = Status.FAILED

@@ -1,6 +1,8 @@
 """Eigenaxis slews: the smooth quintic slew (always available, the planner's safe fallback) and
-the bang-bang λ-rotation about the eigenaxis. Both ignore cones; the smooth slew reports a path
-that enters one, the bang-bang plan is verified (:mod:`.axis_rotations`).
+the bang-bang λ-rotation about the eigenaxis. Both ignore the cones and zones (they do not steer
+round them, moving or not); the smooth slew reports a path that enters one (every zone at its true
+position at each sample's time, :meth:`att_planner.zones.ZoneSky.margins`), the bang-bang plan is
+verified (:mod:`.axis_rotations`), which checks every zone the same way.
 
 Smooth: rotation by φ about the fixed body axis e of ``q_i* ⊗ q_f`` with the quintic (minimum-jerk)
 angle profile θ(t) = φ p(t/T), p(s) = 10s³ − 15s⁴ + 6s⁵: the rate is C¹, zero with zero
@@ -20,7 +22,6 @@ import time
 import numpy as np
 
 from att_msgs_py.types import Interpolation, Plan, Status
-from att_planner.cones import min_margin
 from att_planner.methods.axis_rotations import eigenaxis_leg, goal_attitude, legs_plan, no_torque_limit
 from att_planner.problem import ManeuverProblem
 from att_sim import rotations as rot
@@ -64,19 +65,23 @@ def plan_eigenaxis_smooth(problem: ManeuverProblem, samples: int = 401) -> Plan:
     shape = J @ axis * ddp[:, None] + phi * dp[:, None] ** 2 * np.cross(axis, J @ axis)
     duration = max(np.sqrt(phi * np.abs(shape).max() / tmax), _rate_limited_duration(problem, axis, phi * dp.max()))
     q = rot.multiply(problem.q_initial, rot.from_axis_angle(np.tile(axis, (samples, 1)), phi * p))
-    worst = min_margin(q, problem.sensor_axis, problem.cones)
+    zones = problem.zone_sky()
+    m = zones.margins(s * duration, q, true=True)
     status = Status.OPTIMAL
     message = f"eigenaxis slew of {np.degrees(phi):.2f} deg about body {np.round(axis, 4).tolist()}"
-    if worst < 0:
+    if m.size and m.min() < 0:
         status = Status.FAILED
-        message += f"; the path enters a keep-out cone by {np.degrees(-worst):.2f} deg"
+        z = int(np.argmin(m.min(axis=0)))
+        kind = "leaves keep-in" if zones.keep_in[z] else "enters keep-out"
+        what = "cone" if z < len(problem.cones) else "zone"
+        message += f"; the path {kind} {what} {zones.names[z]} by {np.degrees(-m.min()):.2f} deg"
     return Plan(t=s * duration, torque=phi / duration**2 * shape, q=q, omega=(phi * dp / duration)[:, None] * axis,
                 interpolation=Interpolation.LINEAR, method=METHOD, status=status, message=message,
                 wall_time=time.perf_counter() - start, stats={"angle": float(phi), "axis": axis.tolist()})
 
 
 def plan_eigenaxis(problem: ManeuverProblem) -> Plan:
-    """Rest-to-rest bang-bang λ-rotation about the eigenaxis (cones are only checked, not avoided)."""
+    """Rest-to-rest bang-bang λ-rotation about the eigenaxis (zones are only checked, not avoided)."""
     start = time.monotonic()
     why = no_torque_limit(problem)
     if why:
