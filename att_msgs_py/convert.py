@@ -4,17 +4,30 @@ Nodes call these functions; no other module builds or reads message fields by ha
 functions take any object with the message's attributes (rclpy messages, or the objects the
 MCAP decoder returns), so logs and live topics go through the same code. They return raw values:
 deciding whether a value is acceptable is the receiver's job.
-Quaternions are geometry_msgs order (x, y, z, w) = numpy order, body-to-inertial.
+Quaternions are geometry_msgs order (x, y, z, w) = numpy order, body-to-inertial. An epoch is
+a UTC ``datetime`` on the wire as ``builtin_interfaces/Time`` seconds since 1970 (the zero time
+means "no epoch"; ``datetime`` keeps microseconds, so a wire epoch is read to the microsecond).
 """
 from __future__ import annotations
+
+from datetime import datetime, timedelta
 
 import numpy as np
 from builtin_interfaces.msg import Time
 from geometry_msgs.msg import Quaternion, Vector3
 
 from att_msgs.action import ExecuteManeuver
-from att_msgs.msg import ActuatorCommand, ControllerStatus, KeepOutCone, ManeuverPlan, PlanVerification, SpacecraftState
+from att_msgs.msg import (
+    ActuatorCommand,
+    ControllerStatus,
+    KeepOutCone,
+    ManeuverPlan,
+    PlanVerification,
+    SpacecraftState,
+    Zone,
+)
 from att_msgs_py import types
+from att_msgs_py.validation import UNIX_EPOCH
 
 
 def vector3(v) -> Vector3:
@@ -44,6 +57,46 @@ def time_msg(seconds: float) -> Time:
 
 def from_time(msg) -> float:
     return msg.sec + msg.nanosec * 1e-9
+
+
+def epoch_msg(epoch: datetime | None) -> Time:
+    """``epoch`` as seconds and nanoseconds since 1970 (exact: a ``datetime`` has microseconds);
+    None: the zero time. The message refuses seconds beyond int32 (before 1901-12-13T20:45:52Z,
+    after 2038-01-19T03:14:07Z): :func:`att_msgs_py.validation.wire_epoch` checks first."""
+    if epoch is None:
+        return Time()
+    delta = epoch - UNIX_EPOCH
+    sec, microseconds = divmod((delta.days * 86_400 + delta.seconds) * 1_000_000 + delta.microseconds, 1_000_000)
+    return Time(sec=sec, nanosec=microseconds * 1000)
+
+
+def epoch_parts(msg) -> tuple[int, int]:
+    """Raw (sec, nanosec) of a time message, for validation before it is read as an epoch."""
+    return int(msg.sec), int(msg.nanosec)
+
+
+def from_epoch(msg) -> datetime | None:
+    """The UTC epoch of a time message (nanoseconds rounded to the microsecond); None for zero."""
+    sec, nanosec = epoch_parts(msg)
+    if sec == 0 and nanosec == 0:
+        return None
+    return UNIX_EPOCH + timedelta(seconds=sec, microseconds=round(nanosec / 1000))
+
+
+def zone_msg(zone: types.Zone) -> Zone:
+    """A zone on the wire; a body other than "inertial" has no direction (sent as zero)."""
+    return Zone(name=zone.name, body=zone.body, sensor_axis=vector3(zone.sensor_axis),
+                half_angle=float(zone.half_angle), keep_in=bool(zone.keep_in),
+                direction=vector3(np.zeros(3) if zone.direction is None else zone.direction))
+
+
+def zone_from_msg(msg) -> types.Zone:
+    """The zone of a message, values as sent (validation decides: :func:`att_planner.cones.zone_issue`).
+    A zero direction is read as none (the bodies have none); a non-zero one is kept, whatever the body."""
+    direction = from_vector3(msg.direction)
+    return types.Zone(name=msg.name, body=msg.body, sensor_axis=from_vector3(msg.sensor_axis),
+                      half_angle=float(msg.half_angle), keep_in=bool(msg.keep_in),
+                      direction=None if not np.any(direction) else direction)
 
 
 def cone_msg(cone: types.Cone) -> KeepOutCone:
@@ -134,6 +187,8 @@ def plan_msg(plan: types.Plan) -> ManeuverPlan:
     msg.torques = [vector3(u) for u in plan.torque]
     msg.sensor_axis = vector3(plan.sensor_axis)
     msg.cones = [cone_msg(c) for c in plan.cones]
+    msg.epoch = epoch_msg(plan.epoch)
+    msg.zones = [zone_msg(z) for z in plan.zones]
     if plan.verification is not None:
         msg.verification = verification_msg(plan.verification)
     return msg
@@ -152,9 +207,12 @@ def plan_from_msg(msg) -> types.Plan:
         message=msg.message, wall_time=float(msg.solve_seconds), plan_id=msg.plan_id, spacecraft=msg.spacecraft,
         frame_id=msg.header.frame_id, sensor_axis=from_vector3(msg.sensor_axis),
         cones=[types.Cone(*cone_parts(c)) for c in msg.cones], verification=verification_from_msg(msg.verification),
-        # logs recorded before plans were signed have none of the last three fields
+        # logs recorded before plans were signed have none of these three fields, nor (before the
+        # real sky) an epoch and zones
         spacecraft_digest=getattr(msg, "spacecraft_digest", ""), key_id=getattr(msg, "key_id", ""),
-        signature=bytes(getattr(msg, "signature", b"")))
+        signature=bytes(getattr(msg, "signature", b"")),
+        epoch=from_epoch(msg.epoch) if hasattr(msg, "epoch") else None,
+        zones=[zone_from_msg(z) for z in getattr(msg, "zones", [])])
 
 
 # -- the ExecuteManeuver action -----------------------------------------------------------------

@@ -5,8 +5,10 @@ itself: the planner signs every ``ManeuverPlan`` it issues and the controller fl
 whose signature verifies against its configured public key (``cryptography``'s Ed25519, RFC 8032).
 
 What is signed is a canonical encoding of every field of the message but ``signature``
-(:func:`payload`): the header stamp and the ``key_id`` included, values exactly as they travel
-(floats are never re-normalised on the way). Not the CDR bytes themselves: Fast CDR leaves its
+(:func:`payload`): the header stamp and the ``key_id`` included, and every nested field (a plan's
+``epoch`` seconds and nanoseconds, each of its ``zones`` with name, body, sensor axis,
+half-angle, keep-in flag and direction), values exactly as they travel (floats are never
+re-normalised on the way). Not the CDR bytes themselves: Fast CDR leaves its
 alignment padding uninitialised, so the same message serializes to different bytes. Keys are PEM files: a
 PKCS#8 private key (mode 0600) and its SubjectPublicKeyInfo public key, made by ``att-keygen``;
 the bootstrap makes a pair for the demo under ``<venv>/share/att_suite/keys``

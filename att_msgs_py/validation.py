@@ -9,10 +9,12 @@ from __future__ import annotations
 
 import math
 import unicodedata
+from datetime import UTC, datetime, timedelta
 
 import numpy as np
 
 from att_msgs_py.errors import ErrorCode, RequestError
+from att_msgs_py.types import ZONE_BODIES, Zone
 
 UNIT_TOLERANCE = 1e-3          # |‖q‖ − 1| (and unit vectors) accepted and normalised below this
 MAX_NAME_LENGTH = 128          # names, ids and frames
@@ -20,6 +22,9 @@ MAX_TEXT_LENGTH = 1000         # free text (plan messages)
 MAX_PLAN_SAMPLES = 20_000      # knots of a plan (about 1.8 MB on the wire)
 MAX_PLAN_BYTES = 4 * 1024 * 1024   # serialized ManeuverPlan
 MAX_PLAN_DURATION = 86_400.0   # s
+UNIX_EPOCH = datetime(1970, 1, 1, tzinfo=UTC)
+WIRE_EPOCH_MIN = UNIX_EPOCH + timedelta(seconds=-2**31)       # builtin_interfaces/Time has int32 seconds:
+WIRE_EPOCH_MAX = UNIX_EPOCH + timedelta(seconds=2**31 - 1)    # 1901-12-13T20:45:52Z .. 2038-01-19T03:14:07Z
 
 
 def text(value, name: str, code: ErrorCode = ErrorCode.INVALID_TEXT, max_length: int = MAX_NAME_LENGTH) -> str:
@@ -37,6 +42,33 @@ def text(value, name: str, code: ErrorCode = ErrorCode.INVALID_TEXT, max_length:
                            f"{name} contains the control, format or unassigned character U+{ord(bad):04X} at "
                            f"position {value.index(bad)}")
     return value
+
+
+def wire_epoch(sec: int, nanosec: int, name: str, code: ErrorCode = ErrorCode.INVALID_EPOCH) -> datetime | None:
+    """The UTC epoch of a ``builtin_interfaces/Time`` (``sec``, ``nanosec``) as sent: None for the
+    zero time ("no epoch"), else ``sec`` within int32 and ``nanosec`` in [0, 1e9) (nanoseconds
+    rounded to the microsecond of a ``datetime``)."""
+    if not -2**31 <= sec < 2**31:
+        raise RequestError(code, f"{name}.sec = {sec} is outside the int32 range [-2^31, 2^31 - 1] of "
+                                 "builtin_interfaces/Time")
+    if not 0 <= nanosec < 1_000_000_000:
+        raise RequestError(code, f"{name}.nanosec = {nanosec} is outside [0, 999999999]")
+    if sec == 0 and nanosec == 0:
+        return None
+    return UNIX_EPOCH + timedelta(seconds=sec, microseconds=round(nanosec / 1000))
+
+
+def sendable_epoch(epoch: datetime, name: str, code: ErrorCode = ErrorCode.INVALID_EPOCH) -> datetime:
+    """An epoch a message can carry: within the int32 seconds of ``builtin_interfaces/Time``
+    (:data:`WIRE_EPOCH_MIN` .. :data:`WIRE_EPOCH_MAX`) and not 1970-01-01T00:00:00Z exactly (the
+    zero time means "no epoch")."""
+    if not WIRE_EPOCH_MIN <= epoch <= WIRE_EPOCH_MAX:
+        raise RequestError(code, f"{name} {epoch.isoformat()} is outside the builtin_interfaces/Time span "
+                                 f"{WIRE_EPOCH_MIN.isoformat()} .. {WIRE_EPOCH_MAX.isoformat()} (int32 seconds)")
+    if epoch == UNIX_EPOCH:
+        raise RequestError(code, f"{name} is 1970-01-01T00:00:00Z exactly, the zero time that means 'no epoch' on "
+                                 "the wire; shift it by a microsecond")
+    return epoch
 
 
 def finite_array(value, name: str, code: ErrorCode, shape: tuple | None = None) -> np.ndarray:
@@ -94,3 +126,30 @@ def unit_quaternions(q, name: str, code: ErrorCode) -> np.ndarray:
         raise RequestError(code, f"{name}[{bad[0]}] has norm {n[bad[0]]:.6g}; unit quaternions are required "
                                  f"(tolerance {UNIT_TOLERANCE})")
     return q / n[:, None]
+
+
+def zone(value: Zone, name: str, code: ErrorCode = ErrorCode.INVALID_ZONE) -> Zone:
+    """A zone's fields: text name and body, a body of :data:`~att_msgs_py.types.ZONE_BODIES`, a unit
+    sensor axis, a half-angle in (0, pi) (for ``earth_limb`` the margin beyond the limb, in
+    [0, pi/2)), a unit direction for an ``inertial`` zone and none for the others; the zone
+    with its vectors normalised."""
+    text(value.name, f"{name}.name")
+    text(value.body, f"{name}.body")
+    label = f"{name} ('{value.name}')"
+    if value.body not in ZONE_BODIES:
+        raise RequestError(code, f"{label}.body '{value.body}' is not one of {', '.join(ZONE_BODIES)}")
+    axis = unit_vector(value.sensor_axis, f"{label}.sensor_axis", code)
+    limb = value.body == "earth_limb"
+    h = value.half_angle
+    if not (math.isfinite(h) and (0.0 <= h < math.pi / 2 if limb else 0.0 < h < math.pi)):
+        what = "[0, pi/2) (the margin beyond the Earth's limb)" if limb else "(0, pi)"
+        raise RequestError(code, f"{label}.half_angle = {h!r} rad is outside {what}")
+    direction = None
+    if value.body == "inertial":
+        if value.direction is None:
+            raise RequestError(code, f"{label}.direction is the zero vector; an inertial zone needs a unit direction")
+        direction = unit_vector(value.direction, f"{label}.direction", code)
+    elif value.direction is not None:
+        raise RequestError(code, f"{label}.direction is given for body '{value.body}'; only an inertial zone has "
+                                 "one (send zero)")
+    return Zone(value.name, value.body, axis, float(value.half_angle), bool(value.keep_in), direction)

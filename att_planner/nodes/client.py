@@ -4,7 +4,7 @@ Used by ``att-demo``, the integration tests and user scripts::
 
     client = SuiteClient()                       # after rclpy.init()
     client.wait_for_servers(timeout=20)
-    response = client.plan(maneuver_request(q0, qf, sensor, cones))
+    response = client.plan(maneuver_request(q0, qf, sensor, cones))   # epoch=, zones=, tle= for the real sky
     result = client.execute(response.plan.plan_id)
 
 Robust to hostile input and to the other side failing: :func:`maneuver_request` refuses a string
@@ -21,6 +21,7 @@ import math
 import sys
 import time
 from contextlib import contextmanager
+from datetime import datetime
 
 import rclpy
 from rclpy.action import ActionClient
@@ -30,7 +31,7 @@ from att_msgs.action import ExecuteManeuver
 from att_msgs.srv import PlanManeuver, PlanSchedule, SetControllerMode
 from att_msgs_py import convert, qos, signing, topics
 from att_msgs_py.errors import ErrorCode, RequestError
-from att_msgs_py.types import Cone
+from att_msgs_py.types import Cone, Zone
 from att_msgs_py.validation import text
 
 POLL = 0.05                 # s between checks of a pending call or goal
@@ -68,8 +69,11 @@ def check_strings(msg, name: str = "", nul_only: bool = False) -> None:
 
 def maneuver_request(q_initial, q_final, sensor_axis, cones: list[Cone], *, method: str = "",
                      time_budget: float = 0.0, spacecraft: str = "", frame_id: str = "eci",
-                     options: dict | None = None) -> PlanManeuver.Request:
-    """A PlanManeuver request; ValueError when a string holds a NUL or another control character."""
+                     options: dict | None = None, epoch: datetime | None = None, zones: list[Zone] = (),
+                     tle: tuple[str, str] = ("", "")) -> PlanManeuver.Request:
+    """A PlanManeuver request; ValueError when a string holds a NUL or another control character.
+    The real sky: ``epoch`` (UTC start; None: the scenario's), ``zones`` (besides the cones) and the
+    orbit's ``tle`` lines (empty: the scenario's orbit)."""
     req = PlanManeuver.Request()
     req.header.frame_id = frame_id
     req.initial_attitude = convert.quaternion(q_initial)
@@ -79,6 +83,9 @@ def maneuver_request(q_initial, q_final, sensor_axis, cones: list[Cone], *, meth
     req.method, req.time_budget, req.spacecraft = method, float(time_budget), spacecraft
     req.option_names = list((options or {}).keys())
     req.option_values = [float(v) for v in (options or {}).values()]
+    req.epoch = convert.epoch_msg(epoch)
+    req.zones = [convert.zone_msg(z) for z in zones]
+    req.tle_line1, req.tle_line2 = tle
     check_strings(req)
     return req
 

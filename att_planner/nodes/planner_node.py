@@ -2,7 +2,9 @@
 plan on the latched ``/planner/plans`` for the controller and the recorder.
 
 Callbacks only translate: message -> :class:`ManeuverRequest` -> :func:`validate_maneuver` ->
-:func:`plan_maneuver` -> message (:mod:`att_planner.service` holds the logic). Requests run
+:func:`plan_maneuver` -> message (:mod:`att_planner.service` holds the logic). The real sky of a
+request (epoch, zones, TLE) goes in as sent; every plan records its epoch and zones, which its
+signature covers. Requests run
 concurrently (reentrant callback group on a multi-threaded executor), so a long solve never
 blocks a quick request; each request builds its own problem, nothing is shared between requests
 but the read-only method registry.
@@ -97,7 +99,9 @@ class PlannerNode(Node):
                     cones=[convert.cone_parts(c) for c in request.cones],
                     method=request.method, time_budget=request.time_budget, spacecraft=request.spacecraft,
                     option_names=list(request.option_names), option_values=list(request.option_values),
-                    semi_free=request.semi_free, sensor_target=convert.from_vector3(request.sensor_target)),
+                    semi_free=request.semi_free, sensor_target=convert.from_vector3(request.sensor_target),
+                    epoch=convert.epoch_parts(request.epoch), zones=[convert.zone_from_msg(z) for z in request.zones],
+                    tle_line1=request.tle_line1, tle_line2=request.tle_line2),
                 frame_id=self._frame_id, default_spacecraft=self._scenario_name,
                 default_method=self._default_method, default_budget=self._default_budget)
         except RequestError as err:
@@ -108,7 +112,8 @@ class PlannerNode(Node):
         except Exception as exc:  # a fault of the service itself is answered, never left hanging
             outcome = self.internal_error(exc)
         self.answer(response, outcome, valid.spacecraft, valid.method.name, sensor_axis=valid.problem.sensor_axis,
-                    cones=valid.problem.cones, spacecraft_digest=valid.problem.spacecraft.digest)
+                    cones=valid.problem.cones, zones=valid.problem.zones, epoch=valid.problem.epoch,
+                    spacecraft_digest=valid.problem.spacecraft.digest)
         return response
 
     def on_plan_schedule(self, request: PlanSchedule.Request, response: PlanSchedule.Response):
@@ -120,7 +125,8 @@ class PlannerNode(Node):
                 request.spacecraft, request.time_budget,
                 frame_id=self._frame_id, request_frame=request.header.frame_id,
                 default_spacecraft=self._scenario_name, default_budget=self._default_budget,
-                rate_max=self._schedule_rate_max)
+                rate_max=self._schedule_rate_max, epoch=convert.epoch_parts(request.epoch),
+                zones=[convert.zone_from_msg(z) for z in request.zones], tle=(request.tle_line1, request.tle_line2))
         except RequestError as err:
             return self.refuse(response, err, "schedule")
 
@@ -135,6 +141,7 @@ class PlannerNode(Node):
             response.order = outcome.plan.order
             response.passage_times = [float(p.time) for p in outcome.plan.passages]
         self.answer(response, outcome, valid.spacecraft, f"schedule of {len(valid.problem.targets)} targets",
+                    zones=valid.problem.zones, epoch=valid.problem.epoch,
                     spacecraft_digest=valid.problem.spacecraft.digest)
         return response
 

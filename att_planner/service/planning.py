@@ -4,7 +4,10 @@
 the truth dynamics (:mod:`att_planner.verification`) and accepts the plan only if it meets the
 tolerances. A method that fails, raises or runs out of budget without a plan that verifies is
 replaced by the smooth eigenaxis slew when that one verifies (status FALLBACK); otherwise the
-answer is an error. No unverified plan ever leaves. :func:`plan_schedule_request` does the same
+answer is an error. No unverified plan ever leaves. Zones (issue 13) travel in the problem: the
+method plans against their motion (:meth:`ManeuverProblem.zone_sky`), padded like the cones
+(:func:`padded`), and every plan, the fallback's too, is verified against the unpadded zones at
+their true positions. :func:`plan_schedule_request` does the same
 for a schedule (no fallback exists there).
 
 Bounded: a plan of more than :data:`MAX_PLAN_SAMPLES` samples is refused (SIZE_LIMIT) before it is
@@ -91,14 +94,23 @@ class PlanOutcome:
 
 
 def padded(problem: ManeuverProblem, padding: float) -> ManeuverProblem:
-    """The problem with every cone widened by ``padding`` rad (execution margin for the tracking
-    controller), but never so much that the start or goal boresight would fall inside it."""
-    if padding <= 0 or not problem.cones:
+    """The problem with every cone and keep-out zone widened and every keep-in zone narrowed by
+    ``padding`` rad (execution margin for the tracking controller), but never by more than half
+    the room the start or goal leaves it (zones as they are at t = 0), so neither end falls inside."""
+    if padding <= 0 or not (problem.cones or problem.zones):
         return problem
-    ends = endpoint_directions(problem.q_initial, problem.q_final, problem.sensor_axis, problem.sensor_target)
-    room = np.min(direction_margins(np.array(list(ends.values())), problem.cones), axis=0)
-    cones = [Cone(c.direction, c.half_angle + min(padding, 0.5 * r), c.name) for c, r in zip(problem.cones, room)]
-    return replace(problem, cones=cones)
+    cones, zones = problem.cones, problem.zones
+    if cones:
+        ends = endpoint_directions(problem.q_initial, problem.q_final, problem.sensor_axis, problem.sensor_target)
+        room = np.min(direction_margins(np.array(list(ends.values())), cones), axis=0)
+        cones = [Cone(c.direction, c.half_angle + min(padding, 0.5 * r), c.name) for c, r in zip(cones, room)]
+    if zones:
+        zone_sky = problem.zone_sky()
+        ends = [problem.q_initial] + ([problem.q_final] if problem.sensor_target is None else [])
+        room = zone_sky.margins(0.0, np.array(ends), true=True)[:, len(problem.cones):].min(axis=0)
+        zones = [replace(z, half_angle=z.half_angle + (-1 if z.keep_in else 1) * min(padding, 0.5 * max(r, 0.0)))
+                 for z, r in zip(zones, room)]
+    return replace(problem, cones=cones, zones=zones)
 
 
 def run_method(method: Method, problem: ManeuverProblem, options: dict, wait: float | None = None) -> Plan:
@@ -177,7 +189,7 @@ def plan_maneuver(valid: ValidRequest, tol: Tolerances = TOLERANCES, cone_paddin
             return PlanOutcome(ErrorCode.OK, fallback.message, fallback)
     budget_note = " (time budget expired)" if plan.status == Status.BUDGET_EXPIRED else ""
     code = ErrorCode.VERIFICATION_FAILED if "verification" in reason else ErrorCode.SOLVER_FAILED
-    if problem.cones and code == ErrorCode.SOLVER_FAILED and "infeasib" in reason.lower():
+    if (problem.cones or problem.zones) and code == ErrorCode.SOLVER_FAILED and "infeasib" in reason.lower():
         code = ErrorCode.INFEASIBLE
     return PlanOutcome(code, f"no verified plan{budget_note}: {reason}", plan)
 

@@ -7,8 +7,11 @@ tolerances and caps are the constants below (README, "Errors and limits"); metho
 checked by the registry (:mod:`att_planner.methods`). Field checks are the shared ones of
 :mod:`att_msgs_py.validation` (``unit_quaternion`` and ``unit_vector`` are re-exported here): every
 string is free of control characters (INVALID_TEXT) and at most ``MAX_NAME_LENGTH`` characters
-(SIZE_LIMIT). Cones that close the sky between the start and goal sensor directions are refused
-as INFEASIBLE before any solving (:mod:`att_planner.service.sky`).
+(SIZE_LIMIT). Cones and zones that close the sky between the start and goal sensor directions are
+refused as INFEASIBLE before any solving (:mod:`att_planner.service.sky`). The real sky (epoch,
+orbit, zones: issue 13) is checked by :mod:`att_planner.service.real_sky`, then the zones against
+each other and the ends (:func:`att_planner.cones.check_zones`: CONTRADICTORY_ZONES, ZONE_AT_END).
+A request without epoch, TLE and zones is checked and planned exactly as before.
 """
 from __future__ import annotations
 
@@ -22,9 +25,10 @@ from att_msgs_py.errors import ErrorCode, RequestError
 from att_msgs_py.types import Cone
 from att_msgs_py.validation import MAX_NAME_LENGTH, text, unit_quaternion, unit_vector
 from att_planner import methods
-from att_planner.cones import endpoint_in_cone
+from att_planner.cones import check_zones, endpoint_in_cone
 from att_planner.methods import Method
-from att_planner.problem import ManeuverProblem
+from att_planner.problem import MIN_WINDOW, WINDOW_FACTOR, ManeuverProblem
+from att_planner.service.real_sky import RequestSky, check_orbit_window, resolve_sky
 from att_planner.service.sky import closed_sky
 from att_sim import rotations as rot
 from att_sim import scenario as scen
@@ -53,6 +57,10 @@ class ManeuverRequest:
     option_values: list = field(default_factory=list)
     semi_free: bool = False
     sensor_target: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    epoch: tuple = (0, 0)            # (sec, nanosec) as sent; zero: the scenario's epoch
+    zones: list = field(default_factory=list)      # att_msgs_py.types.Zone, as sent
+    tle_line1: str = ""
+    tle_line2: str = ""
 
 
 @dataclass
@@ -128,24 +136,54 @@ def check_cones(raw: list) -> list[Cone]:
     return cones
 
 
-def check_reachable(q0, qf, r, cones: list[Cone], sensor_target) -> None:
-    """Neither end inside a cone (SENSOR_IN_CONE), and the cones do not close the sky between
-    them (INFEASIBLE)."""
+def zone_window(problem: ManeuverProblem, legs: int = 1) -> float:
+    """The zone window (s) of ``problem`` (:meth:`ManeuverProblem.zone_sky`'s default), times
+    ``legs`` for a schedule: the span its orbit must last."""
+    return max(MIN_WINDOW, WINDOW_FACTOR * problem.slew_time_bound()) * legs
+
+
+def check_sky(problem: ManeuverProblem, real: RequestSky, legs: int = 1) -> None:
+    """The orbit lasts the window (ORBIT_TOO_LOW), then the zones' own checks
+    (:func:`att_planner.cones.check_zones`)."""
+    if real.sky is not None:
+        check_orbit_window(real.sky, zone_window(problem, legs))
+    if problem.zones:
+        check_zones(problem)
+
+
+def check_reachable(problem: ManeuverProblem) -> None:
+    """Neither end inside a cone (SENSOR_IN_CONE), and the cones and zones do not close the sky
+    between them for any sensor (INFEASIBLE)."""
+    q0, qf, r, cones, sensor_target = (problem.q_initial, problem.q_final, problem.sensor_axis, problem.cones,
+                                       problem.sensor_target)
     hit = endpoint_in_cone(q0, qf, r, cones, sensor_target)
     if hit is not None:
         label, cone, depth = hit
         raise RequestError(ErrorCode.SENSOR_IN_CONE,
                            f"the {label} is inside cone '{cone.name}' by {np.degrees(depth):.3f} deg")
-    if closed_sky(q0, qf, r, cones, sensor_target):
-        goal = "goal" if sensor_target is None else "sensor_target"
+    if not cones and not problem.zones:
+        return
+    zone_sky = problem.zone_sky()
+    axis = closed_sky(zone_sky, q0, qf, r, sensor_target)
+    if axis is None:
+        return
+    goal = "goal" if sensor_target is None else "sensor_target"
+    if not problem.zones:
         raise RequestError(ErrorCode.INFEASIBLE,
                            f"cones: the {len(cones)} keep-out cones close the sky between the start and {goal} "
                            "sensor directions; no sensor path avoids them")
+    members = np.flatnonzero(np.all(np.isclose(zone_sky.sensor_axes, axis, atol=1e-12), axis=1))
+    raise RequestError(ErrorCode.INFEASIBLE,
+                       f"zones: the {len(members)} zones and cones of sensor axis {np.round(axis, 4).tolist()} "
+                       f"({', '.join(zone_sky.names[i] for i in members[:6])}) close the sky between its start and "
+                       f"{goal} directions over the {zone_sky.window:.0f} s zone window; no path avoids them")
 
 
 def validate_maneuver(req: ManeuverRequest, *, frame_id: str, default_spacecraft: str, default_method: str,
                       default_budget: float) -> ValidRequest:
-    """Check every field of a maneuver request; return the problem or raise RequestError."""
+    """Check every field of a maneuver request; return the problem or raise RequestError. The
+    budget counts from the call."""
+    received = time.monotonic()
     check_frame(req.frame_id, frame_id)
     text(req.method, "method")
     text(req.spacecraft, "spacecraft")
@@ -157,13 +195,16 @@ def validate_maneuver(req: ManeuverRequest, *, frame_id: str, default_spacecraft
     if req.semi_free:
         sensor_target = unit_vector(req.sensor_target, "sensor_target", ErrorCode.INVALID_SENSOR_AXIS)
     name = req.spacecraft or default_spacecraft
-    sc = load_spacecraft(name)
+    scenario = load_scenario(name)
     method = methods.get(req.method or default_method)
     options, limits = method.split(check_options(method, list(req.option_names), list(req.option_values)))
     budget = check_budget(float(req.time_budget), default_budget)
-    check_reachable(q0, qf, r, cones, sensor_target)
-    problem = ManeuverProblem(sc, q0, qf, r, cones, deadline=time.monotonic() + budget, sensor_target=sensor_target,
-                              **limits)
+    real = resolve_sky(*req.epoch, req.zones, req.tle_line1, req.tle_line2, scenario)
+    problem = ManeuverProblem(scenario.spacecraft, q0, qf, r, cones, sensor_target=sensor_target, zones=real.zones,
+                              epoch=real.epoch, sky=real.sky if real.moving else None, **limits)
+    check_sky(problem, real)
+    check_reachable(problem)
+    problem.deadline = received + budget          # set last: the zone sky built by the checks stays cached
     return ValidRequest(problem, method, options, name, budget)
 
 
@@ -175,6 +216,11 @@ class ValidSchedule:
 
 
 def load_spacecraft(name: str) -> Spacecraft:
+    return load_scenario(name).spacecraft
+
+
+def load_scenario(name: str) -> scen.Scenario:
+    """The scenario of a spacecraft configuration name, its spacecraft checked."""
     if len(name) > MAX_NAME_LENGTH or not all(ch.isalnum() or ch in "_-" for ch in name):
         raise RequestError(ErrorCode.UNKNOWN_SPACECRAFT,
                            f"spacecraft '{name[:MAX_NAME_LENGTH]}' must be a configuration name (letters, digits, "
@@ -184,13 +230,13 @@ def load_spacecraft(name: str) -> Spacecraft:
     except KeyError as exc:
         raise RequestError(ErrorCode.UNKNOWN_SPACECRAFT, f"spacecraft: {exc.args[0]}") from None
     try:
-        sc = scen.load(name).spacecraft
+        scenario = scen.load(name)
     except Exception as exc:  # any configuration that does not load is refused, the node keeps serving
         why = exc.message if isinstance(exc, RequestError) else f"{type(exc).__name__}: {exc}"
         raise RequestError(ErrorCode.INVALID_SPACECRAFT, f"spacecraft '{name}': its configuration does not load ({why})"
                            ) from None
-    check_spacecraft(sc, name)
-    return sc
+    check_spacecraft(scenario.spacecraft, name)
+    return scenario
 
 
 def check_budget(budget: float, default: float) -> float:
@@ -226,21 +272,48 @@ def check_targets(names: list, targets: list) -> dict:
     return dict(zip(names, qs))
 
 
+def check_targets_clear(problem: ManeuverProblem) -> None:
+    """No schedule target violates a fixed (inertial) zone (ZONE_AT_END): it could never be passed.
+    A moving zone may clear a target before it is reached: planning and verification judge those."""
+    zone_sky = problem.zone_sky()
+    fixed = np.array([z.body == "inertial" for z in zone_sky.zones], bool)
+    if not fixed.any():
+        return
+    for i, (target, q) in enumerate(problem.targets.items()):
+        m = np.where(fixed, zone_sky.margins(0.0, q, true=True)[0], np.inf)
+        k = int(np.argmin(m))
+        if m[k] < 0:
+            kind = "outside keep-in" if zone_sky.keep_in[k] else "inside keep-out"
+            raise RequestError(ErrorCode.ZONE_AT_END,
+                               f"targets[{i}] ('{target}') is {kind} zone {zone_sky.names[k]} by "
+                               f"{np.degrees(-m[k]):.2f} deg; it can never be passed")
+
+
 def validate_schedule(names: list, targets: list, q_start, q_end, spacecraft: str, time_budget: float, *,
                       frame_id: str, request_frame: str, default_spacecraft: str, default_budget: float,
-                      rate_max: float = math.inf) -> ValidSchedule:
-    """Check a PlanSchedule request: names match targets, unit quaternions, a wheeled spacecraft.
-    ``q_end`` None: end where the schedule started. ``rate_max``: the planner's body-rate bound."""
+                      rate_max: float = math.inf, epoch: tuple = (0, 0), zones: list = (),
+                      tle: tuple = ("", "")) -> ValidSchedule:
+    """Check a PlanSchedule request: names match targets, unit quaternions, a wheeled spacecraft,
+    the real sky as for a maneuver (``epoch`` (sec, nanosec), ``zones``, ``tle`` lines; the orbit
+    must last a window per leg). ``q_end`` None: end where the schedule started. ``rate_max``: the
+    planner's body-rate bound."""
     check_frame(request_frame, frame_id)
     text(spacecraft, "spacecraft")
     checked = check_targets(list(names), list(targets))
     q0 = unit_quaternion(q_start, "start_attitude")
     q1 = q0 if q_end is None else unit_quaternion(q_end, "end_attitude")
     name = spacecraft or default_spacecraft
-    sc = load_spacecraft(name)
+    scenario = load_scenario(name)
+    sc = scenario.spacecraft
     if sc.n_wheels < 3 or not (np.isfinite(sc.wheel_torque_max) and np.isfinite(sc.wheel_speed_max)):
         raise RequestError(ErrorCode.INVALID_SPACECRAFT,
                            f"spacecraft '{name}' needs three or more reaction wheels with finite torque and "
                            "speed limits")
-    problem = ManeuverProblem(sc, q0, q1, targets=checked, rate_max=rate_max)
-    return ValidSchedule(problem, name, check_budget(float(time_budget), default_budget))
+    budget = check_budget(float(time_budget), default_budget)
+    real = resolve_sky(*epoch, list(zones), *tle, scenario)
+    problem = ManeuverProblem(sc, q0, q1, targets=checked, rate_max=rate_max, zones=real.zones, epoch=real.epoch,
+                              sky=real.sky if real.moving else None)
+    if real.zones or real.sky is not None:
+        check_sky(problem, real, legs=len(checked) + 1)
+        check_targets_clear(problem)
+    return ValidSchedule(problem, name, budget)

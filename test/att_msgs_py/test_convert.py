@@ -1,10 +1,19 @@
-"""Message <-> numpy conversions and the rosbag2 message definitions written to logs."""
+"""Message <-> numpy conversions (epoch and zones too), the signature's coverage of them, and the
+rosbag2 message definitions written to logs."""
+import copy
+import math
+from datetime import UTC, datetime
+
 import numpy as np
+import pytest
+from cryptography.hazmat.primitives.asymmetric.ed25519 import Ed25519PrivateKey
 
 from att_msgs.msg import ManeuverPlan as PlanMsg
-from att_msgs_py import convert
+from att_msgs.msg import Zone as ZoneMsg
+from att_msgs_py import convert, signing, validation
+from att_msgs_py.errors import ErrorCode, RequestError
 from att_msgs_py.log.definitions import SEPARATOR, message_definition
-from att_msgs_py.types import Cone, Interpolation, Plan, State, Status, Verification
+from att_msgs_py.types import ZONE_BODIES, Cone, Interpolation, Plan, State, Status, Verification, Zone
 from att_sim import rotations as rot
 
 
@@ -58,3 +67,100 @@ def test_message_definition_has_every_dependency_once():
                          "geometry_msgs/msg/Vector3", "att_msgs/msg/KeepOutCone", "att_msgs/msg/PlanVerification",
                          "att_msgs/msg/Zone"}
     assert len(deps) == len(set(deps)) and text.count(SEPARATOR) == len(deps)
+
+
+def _zones():
+    return [Zone("sun", "sun", np.array([0.0, 1, 0]), math.radians(47)),
+            Zone("limb", "earth_limb", np.array([0.0, 1, 0]), math.radians(10)),
+            Zone("radiator", "sun", np.array([0.0, 0, -1]), math.pi / 2, keep_in=True),
+            Zone("star", "inertial", np.array([1.0, 0, 0]), 0.2, direction=np.array([0.0, 0, 1]))]
+
+
+def test_zone_round_trip_and_body_constants():
+    assert (ZoneMsg.BODY_INERTIAL, ZoneMsg.BODY_SUN, ZoneMsg.BODY_MOON, ZoneMsg.BODY_EARTH_LIMB) == ZONE_BODIES
+    for zone in _zones():
+        msg = convert.zone_msg(zone)
+        back = convert.zone_from_msg(msg)
+        assert (back.name, back.body, back.half_angle, back.keep_in) == (zone.name, zone.body, zone.half_angle,
+                                                                         zone.keep_in)
+        assert np.array_equal(back.sensor_axis, zone.sensor_axis)
+        if zone.direction is None:
+            assert back.direction is None and convert.from_vector3(msg.direction).tolist() == [0, 0, 0]
+        else:
+            assert np.array_equal(back.direction, zone.direction)
+    odd = convert.zone_msg(_zones()[0])
+    odd.direction = convert.vector3([0, 0, 1])       # a direction on a Sun zone is kept for validation to refuse
+    assert convert.zone_from_msg(odd).direction is not None
+
+
+@pytest.mark.parametrize("iso, sec, nanosec", [
+    ("2026-12-21T00:00:00Z", 1797811200, 0),
+    ("2026-12-21T00:00:00.000123Z", 1797811200, 123_000),
+    ("1969-12-31T23:59:59.5Z", -1, 500_000_000),                     # before 1970: negative seconds
+    ("1901-12-13T20:45:52Z", -2**31, 0), ("2038-01-19T03:14:07Z", 2**31 - 1, 0),   # the int32 ends
+])
+def test_epoch_on_the_wire_is_seconds_since_1970(iso, sec, nanosec):
+    epoch = datetime.fromisoformat(iso)
+    msg = convert.epoch_msg(epoch)
+    assert (msg.sec, msg.nanosec) == (sec, nanosec)
+    assert convert.from_epoch(msg) == epoch and validation.wire_epoch(sec, nanosec, "epoch") == epoch
+
+
+def test_zero_time_is_no_epoch_and_wire_epochs_are_checked():
+    assert convert.from_epoch(convert.epoch_msg(None)) is None and validation.wire_epoch(0, 0, "epoch") is None
+    with pytest.raises(RequestError, match=r"epoch.nanosec = 1000000000 is outside") as err:
+        validation.wire_epoch(5, 1_000_000_000, "epoch")
+    assert err.value.code == ErrorCode.INVALID_EPOCH
+    with pytest.raises(RequestError, match="int32"):
+        validation.wire_epoch(2**31, 0, "epoch")
+    with pytest.raises(RequestError, match="2038-01-19T03:14:07"):
+        validation.sendable_epoch(datetime(2045, 1, 1, tzinfo=UTC), "the scenario's epoch")
+    with pytest.raises(RequestError, match="no epoch"):
+        validation.sendable_epoch(validation.UNIX_EPOCH, "epoch")
+
+
+def _sky_plan():
+    k = 3
+    return Plan(t=np.linspace(0, 2, k), torque=np.zeros((k, 3)), q=np.tile(rot.IDENTITY, (k, 1)),
+                omega=np.zeros((k, 3)), plan_id="sky", zones=_zones(),
+                epoch=datetime(2026, 12, 21, 0, 10, 0, 250_000, tzinfo=UTC))
+
+
+def test_plan_round_trips_epoch_and_zones_and_old_logs_have_neither():
+    plan = _sky_plan()
+    back = convert.plan_from_msg(convert.plan_msg(plan))
+    assert back.epoch == plan.epoch and [z.name for z in back.zones] == ["sun", "limb", "radiator", "star"]
+    assert back.zones[2].keep_in and np.array_equal(back.zones[3].direction, [0, 0, 1])
+    assert convert.plan_from_msg(convert.plan_msg(Plan(t=plan.t, torque=plan.torque, q=plan.q,
+                                                       omega=plan.omega))).epoch is None
+
+    class OldPlan:                       # a ManeuverPlan decoded from a log recorded before issue 13
+        def __init__(self, msg):
+            self._msg = msg
+
+        def __getattr__(self, name):
+            if name in ("epoch", "zones", "spacecraft_digest", "key_id", "signature"):
+                raise AttributeError(name)
+            return getattr(self._msg, name)
+
+    old = convert.plan_from_msg(OldPlan(convert.plan_msg(plan)))
+    assert old.epoch is None and old.zones == [] and old.plan_id == "sky"
+
+
+def test_the_signature_covers_the_epoch_and_every_zone_field():
+    key = Ed25519PrivateKey.generate()
+    msg = convert.plan_msg(_sky_plan())
+    signing.sign(msg, key)
+    assert signing.check(signing.payload(msg), msg.signature, msg.key_id, key.public_key()) is None
+    changes = {"epoch": lambda m: setattr(m.epoch, "nanosec", m.epoch.nanosec + 1),
+               "zone body": lambda m: setattr(m.zones[0], "body", "moon"),
+               "zone half-angle": lambda m: setattr(m.zones[1], "half_angle", m.zones[1].half_angle + 1e-12),
+               "zone keep-in": lambda m: setattr(m.zones[0], "keep_in", True),
+               "zone axis": lambda m: setattr(m.zones[2].sensor_axis, "y", 1e-9),
+               "zone direction": lambda m: setattr(m.zones[3].direction, "x", 1e-9),
+               "zone name": lambda m: setattr(m.zones[3], "name", "stars"),
+               "zone dropped": lambda m: setattr(m, "zones", list(m.zones)[:-1])}
+    for what, change in changes.items():
+        forged = copy.deepcopy(msg)
+        change(forged)
+        assert signing.check(signing.payload(forged), forged.signature, forged.key_id, key.public_key()), what
