@@ -104,6 +104,14 @@ class Sky:
         self._tables = {name: HermiteTable(self._direct(body), BODY_STEP, BODY_CHUNK)
                         for name, body in (("sun", self._sun), ("moon", self._moon))}
 
+    def __reduce__(self):
+        """Pickles as its recipe (the DE421 handle does not pickle); tables are rebuilt."""
+        return (Sky, (self.epoch, self.orbit))
+
+    def sun_vector(self, t) -> np.ndarray:
+        """Vector from the spacecraft to the Sun (m): ``sun(t) − position(t)``."""
+        return self.sun(t) - self.position(t)
+
     def _direct(self, body):
         vector = body - self._earth
 
@@ -140,7 +148,7 @@ class Sky:
 
     def sun_direction(self, t) -> np.ndarray:
         """Unit vector from the spacecraft to the Sun."""
-        return _unit(self.sun(t) - self.position(t))
+        return _unit(self.sun_vector(t))
 
     def moon_direction(self, t) -> np.ndarray:
         """Unit vector from the spacecraft to the Moon."""

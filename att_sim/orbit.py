@@ -343,6 +343,10 @@ class TLEOrbit(Orbit):
         self.failure: tuple[float, str] | None = None       # earliest tabulated SGP4 failure (t, message)
         self._table = HermiteTable(self._sample, TLE_STEP, TLE_CHUNK)
 
+    def __reduce__(self):
+        """Pickles as its recipe (skyfield's and SGP4's objects do not pickle); the table is rebuilt."""
+        return (TLEOrbit, (self.epoch, self.line1, self.line2))
+
     @property
     def tle_epoch(self) -> datetime:
         """The element set's epoch (UTC, to the microsecond; skyfield's ``utc_datetime`` loses ~40 µs)."""

@@ -1,5 +1,6 @@
 """The sky seen from the spacecraft (att_sim.ephemeris, issue 13): DE421 Sun and Moon, shadow."""
 import math
+import pickle
 import time
 
 import numpy as np
@@ -139,3 +140,10 @@ def test_speed(sky):
         f(t)
         vector = time.perf_counter() - start
         assert scalar < 100e-6 and vector < 40e-3, (name, scalar, vector)
+
+
+def test_sky_and_tle_orbit_pickle_as_their_recipe(sky):
+    copy = pickle.loads(pickle.dumps(sky))
+    assert copy.epoch == sky.epoch and copy.orbit.line1 == LINE1 and copy.orbit.epoch == sky.orbit.epoch
+    np.testing.assert_array_equal(copy.sun_direction(100.0), sky.sun_direction(100.0))
+    np.testing.assert_allclose(sky.sun_vector(100.0), sky.sun(100.0) - sky.position(100.0))
