@@ -1,7 +1,7 @@
 """Geomagnetic field: IGRF-14 to degree 13, or the tilted dipole of :mod:`att_sim.environment`.
 
 IGRF-14 (IAGA Working Group V-MOD, *International Geomagnetic Reference Field, 14th generation*, 2024,
-doi:10.5281/zenodo.14012302; form as in Alken et al., *Earth Planets Space* 73, 49, 2021, eqs. 1–2).
+doi:10.5281/zenodo.14012302; the form of Alken et al., *Earth Planets Space* 73, 49, 2021, §2).
 The potential, in geocentric spherical coordinates (r, colatitude θ, east longitude φ) of the ITRS::
 
     V = a Σ_{n=1}^{13} Σ_{m=0}^{n} (a/r)^{n+1} [g_n^m(y) cos mφ + h_n^m(y) sin mφ] P_n^m(cos θ),
@@ -9,7 +9,7 @@ The potential, in geocentric spherical coordinates (r, colatitude θ, east longi
 ``a = 6371.2 km``, ``B = −∇V``: ``B_r = Σ (n+1)(a/r)^{n+2} A P``, ``B_θ = −Σ (a/r)^{n+2} A dP/dθ``,
 ``B_φ = −(1/sin θ) Σ (a/r)^{n+2} m (h cos mφ − g sin mφ) P`` with ``A = g cos mφ + h sin mφ``.
 ``P_n^m`` are the Schmidt semi-normalised associated Legendre functions (Winch et al., *Geophys. J.
-Int.* 160, 487, 2005, eqs. 8 and 28), by the recursions
+Int.* 160, 487, 2005), by the recursions
 ``P_n^n = sqrt((2n−1)/2n) sin θ P_{n−1}^{n−1}`` (``P_1^1 = sin θ``) and
 ``P_n^m = [(2n−1) cos θ P_{n−1}^m − sqrt((n−1)² − m²) P_{n−2}^m] / sqrt(n² − m²)``, differentiated
 term by term for ``dP/dθ``. Coefficients: ppigrf's ``IGRF14.shc`` (1900..2025 every 5 years, and
@@ -18,14 +18,15 @@ term by term for ``dP/dθ``. Coefficients: ppigrf's ``IGRF14.shc`` (1900..2025 e
 does (reduced accuracy). Outside 1900–2035 the model is undefined: ``ValueError``. Near the
 geographic poles ``sin θ`` is held at ≥ 1e-12 (a shift of the point by < 10 µm).
 
-Earth rotation (GCRS → ITRS, ``r_ITRS = R(t) r_GCRS``): skyfield's ``framelib.itrs`` (IAU 2000A
-precession–nutation, Earth rotation from UT1 by the built-in ΔT table of :func:`att_sim.epoch.timescale`,
-no polar motion: ≤ 0.5″ ≈ 15 m on the ground). It is tabulated as ``R(t) = R_3(ω t) M(t)``, with
-``ω`` the rate of the Earth rotation angle and ``M`` (precession, nutation, ΔT drift) linear between
-hourly nodes, computed a day at a time: interpolation error < 1e-10 rad (checked by the tests).
+Earth rotation (GCRS → ITRS, ``r_ITRS = R(t) r_GCRS``): skyfield's ``framelib.itrs`` (IAU 2006
+precession, IAU 2000A nutation, Greenwich apparent sidereal time from UT1 by the built-in ΔT table of
+:func:`att_sim.epoch.timescale`; no polar motion: ≤ 0.5″ ≈ 15 m on the ground). It is tabulated as
+``R(t) = R_3(ω t) M(t)``, with ``ω`` the rate of the Earth rotation angle and ``M`` (precession,
+nutation, ΔT drift) linear between hourly nodes, computed a day at a time: interpolation error
+< 1e-10 rad (checked by the tests).
 :meth:`GeomagneticField.track` tabulates the inertial field along a trajectory (cubic spline, 10 s
-nodes, error < 1e-3 nT in LEO) for the simulator's per-stage calls (~5 µs; a direct scalar
-:meth:`GeomagneticField.field_inertial` costs ~0.2 ms).
+nodes, error < 1e-3 nT in LEO) for the simulator's per-stage calls (~3 µs; a direct scalar
+:meth:`GeomagneticField.field_inertial` costs ~0.1 ms).
 
 The ``dipole`` model is :func:`att_sim.environment.dipole_field_components` (Bruni–Celani, Wertz
 H-17) with ``|r|`` in place of the circular orbit's radius: identical on a circular orbit.
@@ -162,7 +163,6 @@ def igrf_field_geocentric(r_ITRS, decimal_year) -> np.ndarray:
     if r.ndim == 1 and np.ndim(decimal_year) == 0:
         x, y, z = r.tolist()
         return 1e-9 * np.array(_kernel(x, y, z, gh, math.sqrt, max))
-    gh = [np.broadcast_to(c, r.shape[:-1]) if np.ndim(c) else c for c in gh]
     return 1e-9 * np.stack(np.broadcast_arrays(*_kernel(r[..., 0], r[..., 1], r[..., 2], gh, np.sqrt,
                                                         np.maximum)), -1)
 
@@ -280,6 +280,13 @@ class GeomagneticField:
 
     def _dipole(self, t, r: np.ndarray) -> np.ndarray:
         """``(μ_m/|r|³)[3 (m̂ᵀr̂) r̂ − m̂]`` (environment's formula at the actual radius)."""
+        if r.ndim == 1 and np.ndim(t) == 0:                            # one time: floats
+            x, y, z = r.tolist()
+            mx, my, mz = self.dipole.axis_at(float(t))
+            norm = math.sqrt(x * x + y * y + z * z)
+            x, y, z = x / norm, y / norm, z / norm
+            k, proj3 = self.dipole.strength / norm**3, 3.0 * (mx * x + my * y + mz * z)
+            return np.array([k * (proj3 * x - mx), k * (proj3 * y - my), k * (proj3 * z - mz)])
         norm = np.linalg.norm(r, axis=-1, keepdims=True)
         r_hat = r / norm
         m_hat = self.dipole.axis(t)
