@@ -203,3 +203,26 @@ def test_default_window_bounds_the_slew():
     # 2 sqrt(φ J/T̄) = 2 sqrt(3e6) ≈ 3464 s, × 4
     assert slow.zone_sky().window == pytest.approx(8 * math.sqrt(3e6), rel=1e-9)
     assert slow.zone_sky(900.0).window == 900.0
+
+
+def test_the_real_sky_of_leo_observatory_fits_within_tolerance():
+    """The issue's TLE (≈ 577 km, 14.96 rev/day) on 2026-12-21: Sun, Moon and Earth limb + 10 deg."""
+    from att_sim.ephemeris import Sky
+    from att_sim.orbit import TLEOrbit
+
+    epoch = "2026-12-21T00:00:00Z"
+    line1 = "1 28485U          26355.00000000  .00000000  00000-0  20000-4 0    07"
+    line2 = "2 28485  20.5600  60.0000 0005000  90.0000  10.0000 14.95764766    08"
+    sky = Sky(epoch, TLEOrbit(epoch, line1, line2))
+    zs = ZoneSky(ZONES[:3], sky, 3000.0)
+    assert zs.moving and zs.fit_error <= FIT_TOLERANCE
+    t = np.random.default_rng(3).uniform(0, 3000, 500)
+    assert np.abs(zs.axes(t) - zs.true_axes(t)).max() <= FIT_TOLERANCE
+    np.testing.assert_allclose(zs.true_axes(t)[:, 1], sky.moon_direction(t), atol=0)
+    altitude = np.linalg.norm(sky.position(t), axis=-1) - R_E
+    assert altitude.min() > 560e3 and altitude.max() < 600e3
+    np.testing.assert_allclose(zs.half_angles(t)[:, 2], np.arcsin(R_E / (R_E + altitude)) + math.radians(10), atol=1e-8)
+    # the limb turns at the orbit rate (2π / 96.3 min ≈ 3.7 deg/min), the Sun barely moves
+    rates = np.linalg.norm(zs.axes_rate(t), axis=-1)
+    assert np.degrees(rates[:, 2]).mean() * 60 == pytest.approx(360 / (1440 / 14.95764766), rel=0.02)
+    assert np.degrees(rates[:, 0]).max() * 60 < 0.1
