@@ -15,7 +15,10 @@ Two control representations, chosen so that a simulator reproduces the plan exac
   to the switching instants of a bang-bang solution, which sit on mesh nodes).
 * ``'linear'``: a control per node, ``u_m = (u_k + u_{k+1})/2`` — linear interpolation.
 
-Path constraints ``g(x, u)`` are imposed at nodes and midpoints; :func:`path_violations` checks them
+Path constraints ``g(x, u)`` or ``g(x, u, t)`` are imposed at nodes and midpoints, a time-dependent one
+at the point's physical time ``t = t0 + T τ`` (``t0``: the sum of the earlier phases' durations),
+an expression of the duration variables, so its derivatives with respect to them are exact (moving
+keep-out zones); :func:`path_violations` checks them
 between those points on the Hermite cubic interpolant and :func:`refine_mesh` bisects the intervals
 where they fail (or where a bang-bang control switches, :func:`switch_intervals`).
 
@@ -53,8 +56,9 @@ def refine_mesh(mesh: np.ndarray, intervals, max_intervals: int | None = None) -
 class Phase:
     """A phase ``ẋ = f(x, u)`` on a mesh, with box bounds and optional path constraints.
 
-    ``dynamics`` and ``path`` are CasADi Functions ``(x, u) -> ẋ`` and ``(x, u) -> g`` (usable both
-    symbolically and numerically). Bounds are arrays (or scalars) broadcast to the sizes.
+    ``dynamics`` and ``path`` are CasADi Functions ``(x, u) -> ẋ`` and ``(x, u) -> g`` or
+    ``(x, u, t) -> g`` (:attr:`timed`; usable both symbolically and numerically). Bounds are
+    arrays (or scalars) broadcast to the sizes.
     """
 
     def __init__(self, dynamics: ca.Function, mesh, *, control: str = "constant",
@@ -78,6 +82,11 @@ class Phase:
         n_path = path.size1_out(0) if path is not None else 0
         self.path_bounds = tuple(np.broadcast_to(np.asarray(b, float), (n_path,)).copy() for b in path_bounds)
         self.name = name
+
+    @property
+    def timed(self) -> bool:
+        """Whether the path constraints depend on time (a third input ``t``)."""
+        return self.path is not None and self.path.n_in() == 3
 
     @property
     def intervals(self) -> int:
@@ -252,6 +261,7 @@ class Transcription:
         w, lbw, ubw = [], [], []
         g, lbg, ubg = [], [], []
         offset = 0
+        t_start = 0.0       # the phase's start time: the earlier phases' durations
         for p, ph in enumerate(self.phases):
             nx, nu, N = ph.n_state, ph.n_control, ph.intervals
             T = sym(f"T{p}")
@@ -287,11 +297,17 @@ class Transcription:
             if ph.path is not None:
                 # Nodes see the control of the interval they start (the last node: the last one).
                 U_nodes = ca.horzcat(U, U[:, -1]) if ph.control == "constant" else U
-                Gn = ph.path.map(N + 1)(X, U_nodes)
-                Gm = ph.path.map(N)(Xm, U_mid)
+                if ph.timed:
+                    mids = (ph.mesh[:-1] + ph.mesh[1:]) / 2
+                    Gn = ph.path.map(N + 1)(X, U_nodes, t_start + T * ca.DM(ph.mesh).T)
+                    Gm = ph.path.map(N)(Xm, U_mid, t_start + T * ca.DM(mids).T)
+                else:
+                    Gn = ph.path.map(N + 1)(X, U_nodes)
+                    Gm = ph.path.map(N)(Xm, U_mid)
                 g += [ca.vec(Gn), ca.vec(Gm)]
                 lbg += [np.tile(ph.path_bounds[0], 2 * N + 1)]
                 ubg += [np.tile(ph.path_bounds[1], 2 * N + 1)]
+            t_start = t_start + T
         self._w = ca.vertcat(*w)
         self.lbw = np.concatenate([np.ravel(v) for v in lbw]).astype(float)
         self.ubw = np.concatenate([np.ravel(v) for v in ubw]).astype(float)
@@ -389,8 +405,10 @@ class Transcription:
                              w[sl["Xm"]].reshape(N, nx), w[sl["U"]].reshape(ph.n_control_samples, nu))
 
 
-def path_violations(solution: PhaseSolution, samples_per_interval: int = 8, tol: float = 0.0):
-    """Check the path constraints between collocation points on the Hermite interpolant.
+def path_violations(solution: PhaseSolution, samples_per_interval: int = 8, tol: float = 0.0,
+                    t_start: float = 0.0):
+    """Check the path constraints between collocation points on the Hermite interpolant
+    (a time-dependent one at ``t_start + duration τ``).
 
     Returns ``(intervals, worst)``: the indices of intervals where some ``g`` leaves its bounds by
     more than ``tol`` and the largest excess found (≤ 0 when everything holds).
@@ -402,7 +420,8 @@ def path_violations(solution: PhaseSolution, samples_per_interval: int = 8, tol:
     tau = (ph.mesh[:-1, None] + np.diff(ph.mesh)[:, None] * s[None, :]).ravel()
     x = solution.state_at(tau)
     u = solution.control_at(tau)
-    gval = np.array(ph.path(x.T, u.T)).T
+    args = (x.T, u.T, (t_start + solution.duration * tau)[None, :]) if ph.timed else (x.T, u.T)
+    gval = np.array(ph.path(*args)).T
     lb, ub = ph.path_bounds
     excess = np.maximum(lb - gval, gval - ub).max(axis=1).reshape(ph.intervals, samples_per_interval).max(axis=1)
     return np.flatnonzero(excess > tol), float(excess.max())

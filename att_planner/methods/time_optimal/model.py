@@ -44,20 +44,26 @@ def rigid_body_dynamics(Jn: np.ndarray) -> ca.Function:
 
 
 def path_function(problem: ManeuverProblem, s: Scaling, cone_margin: float):
-    """Path constraints ``g(x, u) ≤ 0`` (cones, wheel momentum) or None when there are none."""
-    x, u = ca.SX.sym("x", 7), ca.SX.sym("u", 3)
-    r = np.asarray(problem.sensor_axis, float) / np.linalg.norm(problem.sensor_axis)
-    g = []
-    if problem.cones:
-        b = ca.mtimes(symbolic.dcm(x[:4]), ca.DM(r))
-        for c in problem.cones:
-            g.append(ca.dot(ca.DM(c.direction), b) - np.cos(c.half_angle + cone_margin))
+    """Path constraints ``g ≤ 0`` (zones, wheel momentum) or None when there are none.
+
+    Every zone of ``problem.zone_sky()`` (:mod:`att_planner.zones`: the cones, then the zones, each
+    with its own sensor axis ``s_z``, ``b_z = R(q) s_z``) is tightened by ``cone_margin``: keep-out
+    ``a_z · b_z ≤ cos(θ_z + δ)``, keep-in ``a_z · b_z ≥ cos(θ_z − δ)``. When a zone moves, the
+    function is ``(x, u, t) -> g`` with ``t`` the normalised time from the start: ``a_z(t τ_u)``
+    and ``θ_z(t τ_u)`` are the ZoneSky's Chebyshev series of that CasADi expression, so the
+    collocation couples them exactly to ``t_f``. Without motion it is ``(x, u) -> g`` with the
+    zones constant (no time dependence is built)."""
+    x, u, t = ca.SX.sym("x", 7), ca.SX.sym("u", 3), ca.SX.sym("t")
+    zones = problem.zone_sky()
+    g = zones.casadi_constraints(t * s.tu if zones.moving else 0.0, symbolic.dcm(x[:4]), cone_margin)
     if math.isfinite(problem.wheel_momentum_max) and problem.spacecraft.n_wheels:   # no wheels: no momentum
         h_per_rate = s.J0 / s.tu / (problem.wheel_momentum_max * (1 - BOUND_MARGIN))
         h_w = ca.mtimes(ca.DM(problem.spacecraft.wheel_axes_pinv @ s.Jn * h_per_rate), x[4:])
         g += [h_w - 1, -h_w - 1]
     if not g:
         return None
+    if zones.moving:
+        return ca.Function("path", [x, u, t], [ca.vertcat(*g)])
     return ca.Function("path", [x, u], [ca.vertcat(*g)])
 
 

@@ -1,16 +1,24 @@
-"""Time-optimal rest-to-rest slews among keep-out cones (Melton 2012) by direct collocation.
+"""Time-optimal rest-to-rest slews among keep-out and keep-in zones (Melton 2012) by direct collocation.
 
 Problem (normalised: time unit ``τ = sqrt(J0/T̄)``, J0 the largest principal inertia, ``J̃ = J/J0``,
 torque ``u = T/T̄``, rate ``ω̃ = ω τ``)::
 
     min t_f   s.t.  q̇ = ½ q ⊗ [ω̃, 0] + ½ (1 − |q|²) q,    J̃ ω̃̇ = u − ω̃ × J̃ ω̃,    |u_j| ≤ 1,
                     q(0) = q_0,  ω̃(0) = ω̃(t_f) = 0,
-                    wᵢᵀ R(q) r ≤ cos(θᵢ + δ)        (keep-out cone i, tightened by δ),
+                    a_z(t)ᵀ R(q) s_z ≤ cos(θ_z(t) + δ)   (keep-out zone z of sensor s_z, tightened by δ),
+                    a_z(t)ᵀ R(q) s_z ≥ cos(θ_z(t) − δ)   (keep-in zone z),
                     final attitude: vec(q_fᶜ ⊗ q(t_f)) = 0     (q(t_f) = ±q_f: q and −q alike),
                     or semi-free: R(q(t_f)) r ⟂ e₁, e₂ and R(q(t_f)) r · s ≥ 0 (sensor on target s),
                     optional |ω_j| ≤ ω̄ and per-wheel momentum |G⁺ J ω|_i ≤ h̄ (the momentum the
                     wheels would store producing the torque with zero total momentum), both
                     tightened by BOUND_MARGIN at the collocation points.
+
+The zones are ``problem.zone_sky()`` (:mod:`att_planner.zones`: today's cones as inertial zones of
+the sensor ``r``, then Sun, Moon, Earth-limb and inertial zones, each of its own sensor). A zone
+that moves is imposed at each collocation point's physical time ``t = τ_k t_f`` through the
+ZoneSky's Chebyshev series of that CasADi expression, so the NLP's derivatives with respect to t_f
+are exact (no frozen snapshot is iterated); ``t_f`` is then bounded by the series' window. Without
+motion the constraints are constants and the NLP is today's.
 
 The ``½(1 − |q|²) q`` term vanishes on unit quaternions and makes the unit sphere attracting, so the
 discretised norm cannot drift. Transcription: Hermite–Simpson (:mod:`.collocation`, the model in :mod:`.model`)
@@ -21,7 +29,7 @@ Solution process (Melton's two stages, with multi-start because the problem has 
 minima): (1) cheap routes — eigenaxis both ways round, tilted two-leg routes and the cone-riding
 λ-rotation routes of :mod:`att_planner.methods.constrained_axis`, optional plans of other
 methods (:mod:`.routes`) — each turned into a continuous bang-bang guess and solved on a coarse
-mesh; (2) the best converged solution is refined: intervals where the torque switches or a cone
+mesh; (2) the best converged solution is refined: intervals where the torque switches or a zone
 constraint fails between collocation points are bisected and the NLP re-solved from the
 interpolated solution; (3) the torque is integrated
 through the truth dynamics (:mod:`att_planner.verification`); a failure refines again.
@@ -34,11 +42,11 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from att_msgs_py.types import Interpolation, Plan, Status
-from att_planner.cones import blocked_endpoint, margins, min_margin
+from att_planner.cones import blocked_endpoint
 from att_planner.methods.axis_rotations import eigenaxis_leg, goal_attitude, no_torque_limit
 from att_planner.methods.time_optimal import collocation as col
 from att_planner.methods.time_optimal.model import Scaling, plan_arrays, scaling, transcription
-from att_planner.methods.time_optimal.routes import Route, candidate_routes, route_guess, select_routes
+from att_planner.methods.time_optimal.routes import Route, candidate_routes, route_guess, select_routes, zone_margin
 from att_planner.problem import ManeuverProblem
 from att_planner.verification import integrate, measure, rejection
 from att_sim import rotations as rot
@@ -154,7 +162,7 @@ class _Incumbent:
         return rejection(plan.verification) is None, plan, traj
 
     def verified(self, extra: list) -> tuple[bool, Plan]:
-        """Stage 3: verify; refine where the dense truth grid leaves a cone (``extra`` logs the
+        """Stage 3: verify; refine where the dense truth grid enters a zone (``extra`` logs the
         intervals split); fall back to an earlier, coarser solution that passes."""
         run = self.run
         ok, plan, traj = self.check(self.sol)
@@ -180,8 +188,10 @@ class _Incumbent:
 
 
 def _truth_violation_intervals(traj, sol: col.PhaseSolution, s: Scaling, problem) -> np.ndarray:
-    """Mesh intervals containing dense truth samples with a negative cone margin."""
-    m = margins(traj.q, problem.sensor_axis, problem.cones)
+    """Mesh intervals containing dense truth samples with a negative zone margin (each zone at the
+    sample's time)."""
+    zones = problem.zone_sky()
+    m = zones.margins(np.minimum(traj.t, zones.window), traj.q)
     if not m.size:
         return np.array([], int)
     bad_t = traj.t[m.min(axis=1) < 0] / s.tu / sol.duration
@@ -220,7 +230,7 @@ def _routes(problem: ManeuverProblem, s: Scaling, starts: int, warm_starts, smoo
         seconds["smooth_warm_start"] = time.monotonic() - lap
     routes = select_routes(candidate_routes(problem, s), starts)
     return routes + [Route(f"warm start: {p.method}", plan=p, tf_estimate=p.duration / s.tu,
-                           min_margin=min_margin(p.q, problem.sensor_axis, problem.cones))
+                           min_margin=zone_margin(problem, p.t, p.q))
                      for p in warm_starts if len(p.t) > 1]
 
 
@@ -229,13 +239,14 @@ def plan_time_optimal(problem: ManeuverProblem, *, intervals: int = DEFAULT_INTE
                       cone_margin_deg: float = 0.05, warm_starts: tuple = (),
                       smooth_warm_start: bool = False, explore_tol: float = 1e-5, tol: float = 1e-7,
                       max_iter: int = 400, verify_reserve: float = 1.0) -> Plan:
-    """Minimum-time rest-to-rest slew with per-axis torque limits and keep-out cones.
+    """Minimum-time rest-to-rest slew with per-axis torque limits among the problem's zones.
 
     Options: ``intervals`` coarse mesh for the multi-start stage; ``max_intervals`` cap on mesh
     refinement (default 120, or ``intervals`` when larger); ``starts`` number of cheap routes solved
     (best kept, all reported in ``stats['starts']``); ``refine_rounds`` bisection rounds around
     switches / between-node cone violations; ``interpolation`` 'zoh' (torque constant per interval)
-    or 'linear' (torque linear between nodes); ``cone_margin_deg`` tightening of every cone at the collocation points;
+    or 'linear' (torque linear between nodes); ``cone_margin_deg`` tightening of every zone (keep-out
+    and keep-in, moving or not) at the collocation points;
     ``warm_starts`` plans of other methods used as extra starting routes;
     ``smooth_warm_start`` adds the smooth Slepian plan (:func:`att_planner.methods.slepian.plan_slepian`,
     paper basis M = 4, at most a third of the remaining budget) to them;
@@ -264,7 +275,11 @@ def plan_time_optimal(problem: ManeuverProblem, *, intervals: int = DEFAULT_INTE
     lap = time.monotonic()
     routes = _routes(problem, s, starts, warm_starts, smooth_warm_start, seconds)
     tf_scale = max(r.tf_estimate for r in routes if np.isfinite(r.tf_estimate))
-    run = _Solve(problem, s, np.deg2rad(cone_margin_deg), (1e-2 * tf_scale, 10.0 * tf_scale), tol, max_iter,
+    tf_max = 10.0 * tf_scale
+    if problem.zone_sky().moving:      # the zones' series hold on their window only
+        tf_max = min(tf_max, problem.zone_sky().window / s.tu)
+    tf_bounds = (min(1e-2 * tf_scale, 0.5 * tf_max), tf_max)
+    run = _Solve(problem, s, np.deg2rad(cone_margin_deg), tf_bounds, tol, max_iter,
                  max_intervals, None if problem.deadline is None else problem.deadline - verify_reserve, interpolation)
     tr, solved, start_log = _explore(run, routes, intervals, explore_tol)
     stats = {"starts": start_log, "time_unit": s.tu, "seconds": seconds}

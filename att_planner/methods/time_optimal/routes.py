@@ -3,6 +3,12 @@
 Routes are λ-rotation sequences (:mod:`att_planner.methods.axis_rotations`) — eigenaxis both ways
 round, the eigenaxis midpoint tilted, the cone-riding routes of
 :mod:`att_planner.methods.constrained_axis` — or other methods' plans.
+
+Zones that move (:mod:`att_planner.zones`): a route's margin is measured against every zone at the
+physical time the route passes each attitude (its bang-bang timing), and a moving keep-out zone is
+ridden as the cone it is when the sensor passes it: frozen at the time of the eigenaxis route's
+closest approach, then once more at the time of the riding route's own closest approach. Inertial
+zones are constant, so for today's cones every route is what it was.
 """
 from __future__ import annotations
 
@@ -10,8 +16,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from att_msgs_py.types import Plan
-from att_planner.cones import min_margin
+from att_msgs_py.types import Cone, Plan
 from att_planner.methods.axis_rotations import AxisLeg, axis_acceleration, eigenaxis_leg, goal_attitude
 from att_planner.methods.constrained_axis import cone_riding_legs
 from att_planner.methods.time_optimal import collocation as col
@@ -29,6 +34,15 @@ class Route:
     plan: Plan | None = None
     tf_estimate: float = np.inf       # TU
     min_margin: float = np.inf        # rad, along the route
+
+
+def zone_margin(problem: ManeuverProblem, t: np.ndarray, q: np.ndarray) -> float:
+    """Smallest margin (rad) of attitudes ``q`` (K, 4) at times ``t`` (K,) s over every zone of the
+    problem (:meth:`att_planner.zones.ZoneSky.margins`, the fitted motion; a time past the zones'
+    window counts as its end, for a guess only); +inf without zones."""
+    zones = problem.zone_sky()
+    m = zones.margins(np.minimum(t, zones.window), q)
+    return float(m.min()) if m.size else np.inf
 
 
 def _peak_rate(problem: ManeuverProblem, scaling: Scaling, e_body: np.ndarray) -> float:
@@ -161,18 +175,65 @@ def _goal_routes(problem: ManeuverProblem, scaling: Scaling, tilt_deg: float,
             q_mid = rot.multiply(rot.from_axis_angle(n, sign * np.deg2rad(tilt_deg)), q_half)
             routes.append(Route(f"tilted {'+' if sign > 0 else '-'}{name}",
                                  [eigenaxis_leg(q0, q_mid), eigenaxis_leg(q_mid, q_goal)]))
-    for c in range(len(problem.cones)):
+    for z, cone in _ride_cones(problem, scaling, routes[0], ride_margin_deg):
         for side in (+1, -1):
             for finish in ("eigenaxis", "roll"):
-                legs = cone_riding_legs(problem, c, side, np.deg2rad(ride_margin_deg), finish)
+                legs = _ride(problem, scaling, z, cone, side, ride_margin_deg, finish)
                 if legs is not None:
-                    name = problem.cones[c].name or str(c)
-                    routes.append(Route(f"ride {name} {'+' if side > 0 else '-'} {finish}", legs))
+                    routes.append(Route(f"ride {cone.name} {'+' if side > 0 else '-'} {finish}", legs))
     for rt in routes:
-        tf, state, _ = _leg_route_functions(problem, scaling, rt.legs)
-        rt.tf_estimate = tf
-        rt.min_margin = min_margin(state(np.linspace(0.0, tf, 400))[:, :4], problem.sensor_axis, problem.cones)
+        _estimate(problem, scaling, rt)
     return routes
+
+
+def _estimate(problem: ManeuverProblem, scaling: Scaling, route: Route, samples: int = 400) -> np.ndarray:
+    """Set the route's bang-bang duration (TU) and its smallest zone margin along it (every zone
+    at the time the route passes); returns the margins (samples, Z)."""
+    tf, state, _ = _leg_route_functions(problem, scaling, route.legs)
+    t = np.linspace(0.0, tf, samples)
+    zones = problem.zone_sky()
+    m = zones.margins(np.minimum(t * scaling.tu, zones.window), state(t)[:, :4])
+    route.tf_estimate = tf
+    route.min_margin = float(m.min()) if m.size else np.inf
+    return m
+
+
+def _snapshot(problem: ManeuverProblem, scaling: Scaling, route: Route | None, z: int, name: str) -> Cone:
+    """Zone ``z`` as the cone it is when ``route`` comes closest to it (its own timing); a zone
+    that does not move is its own cone (``route`` unused)."""
+    zones = problem.zone_sky()
+    t = 0.0
+    if zones.moving and zones.zones[z].body != "inertial":
+        m = _estimate(problem, scaling, route)
+        t = min(np.linspace(0.0, route.tf_estimate, len(m))[int(np.argmin(m[:, z]))] * scaling.tu, zones.window)
+    return Cone(zones.axes(t)[z], float(zones.half_angles(t)[z]), name)
+
+
+def _ride_cones(problem: ManeuverProblem, scaling: Scaling, eigenaxis: Route, ride_margin_deg: float):
+    """``(z, cone)`` for every keep-out zone: the cone it is when the sensor passes it (module
+    docstring; inertial zones are their own cone). Keep-in zones are not ridden."""
+    zones = problem.zone_sky()
+    for z, zone in enumerate(zones.zones):
+        if zone.keep_in:
+            continue
+        name = zone.name or str(z)
+        cone = _snapshot(problem, scaling, eigenaxis, z, name)
+        if zones.moving and zone.body != "inertial":
+            legs = _ride(problem, scaling, z, cone, +1, ride_margin_deg, "eigenaxis")
+            if legs is not None:
+                cone = _snapshot(problem, scaling, Route("ride", legs), z, name)
+        yield z, cone
+
+
+def _ride(problem: ManeuverProblem, scaling: Scaling, z: int, cone: Cone, side: int, ride_margin_deg: float,
+          finish: str):
+    """:func:`~att_planner.methods.constrained_axis.cone_riding_legs` around ``cone`` with zone
+    ``z``'s own sensor (a semi-free goal is then taken as the attitude it would be)."""
+    sensor = problem.zone_sky().sensor_axes[z]
+    ride = replace(problem, cones=[cone], sensor_axis=sensor)
+    if problem.sensor_target is not None and not np.allclose(sensor, problem.sensor_axis):
+        ride = replace(ride, q_final=goal_attitude(problem), sensor_target=None)
+    return cone_riding_legs(ride, 0, side, np.deg2rad(ride_margin_deg), finish)
 
 
 def select_routes(routes: list[Route], count: int) -> list[Route]:
