@@ -16,6 +16,7 @@ STUDIES = {
     "schedule": "att_planner.tools.bench.schedule",
     "gains": "att_planner.tools.bench.gains",
     "soak": "att_planner.tools.bench.soak",
+    "sky": "att_planner.tools.bench.sky",
 }
 
 
