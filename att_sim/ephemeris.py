@@ -125,6 +125,7 @@ class Sky:
         return self._direct(self._sun)(t)
 
     def direct_moon(self, t) -> np.ndarray:
+        """Geocentric Moon straight from skyfield (slow; for verification)."""
         return self._direct(self._moon)(t)
 
     def _orbit_time(self, t):
@@ -155,6 +156,7 @@ class Sky:
         return _unit(self.moon(t) - self.position(t))
 
     def nadir(self, t) -> np.ndarray:
+        """``−r̂``, the unit vector from the spacecraft to the Earth's centre."""
         return -_unit(self.position(t))
 
     def earth_angular_radius(self, t) -> np.ndarray:

@@ -72,15 +72,18 @@ class CircularOrbit(Orbit):
     def __init__(self, params: env.OrbitParams):
         self.params = params
         self.period = params.period
+        self._plane = params.plane_matrix().tolist()
 
     def position(self, t) -> np.ndarray:
         return env.position(self.params, t)
 
     def state(self, t):
+        """``r`` is computed as :func:`att_sim.environment.position` does (equal to it); ``v = ṙ``."""
         p = self.params
         u = env.argument_of_latitude(p, t)
-        r = p.radius * np.stack(env.direction(p, np.cos(u), np.sin(u)), -1)
-        v = p.radius * p.mean_motion * np.stack(env.direction(p, -np.sin(u), np.cos(u)), -1)
+        cu, su = np.cos(u), np.sin(u)
+        r = p.radius * np.stack(env.direction(p, cu, su, self._plane), -1)
+        v = (p.radius * p.mean_motion) * np.stack(env.direction(p, -su, cu, self._plane), -1)
         return r, v
 
 
@@ -360,11 +363,14 @@ class TLEOrbit(Orbit):
 
     def _sample(self, times):
         at = self.satellite.at(skyfield_times(self.epoch, times))
-        for ti, message in zip(times, at.message):
-            if message and (self.failure is None or ti < self.failure[0]):
-                self.failure = (float(ti), message)
-                break
-        return np.moveaxis(at.position.m, 0, -1)
+        r = np.moveaxis(at.position.m, 0, -1)
+        failed = np.array([bool(m) for m in at.message])
+        if failed.any():
+            r[failed] = np.nan            # an SGP4 error code never passes as a position
+            k = int(np.argmax(failed))
+            if self.failure is None or times[k] < self.failure[0]:
+                self.failure = (float(times[k]), at.message[k])
+        return r
 
     def unchecked_position(self, t) -> np.ndarray:
         return self._table(t)[0]

@@ -34,6 +34,7 @@ def test_circular_is_environment_position_exactly():
     assert np.array_equal(o.position(t), env.position(p, t))
     assert np.array_equal(o.state(t)[0], env.position(p, t))
     assert np.array_equal(o.position(12.5), env.position(p, 12.5))
+    assert np.array_equal(o.state(12.5)[0], env.position(p, 12.5))
     h = 1e-3
     np.testing.assert_allclose(o.state(t)[1], (env.position(p, t + h) - env.position(p, t - h)) / (2 * h), atol=1e-5)
     assert o.period == p.period and o.epoch is None
