@@ -12,8 +12,10 @@ The motion over ``[0, window]`` is represented by Chebyshev series in ``x = (2t 
 on pieces ``[a, b]`` (one piece unless a degree above :data:`MAX_DEGREE` would be needed),
 interpolated at the Chebyshev points of the first kind (Trefethen, *Approximation Theory and
 Approximation Practice*, 2013, ch. 3-4) with the degree raised until the error against the sky on a
-fine grid is at most :data:`FIT_TOLERANCE` (axis: |a_fit − a_true|, an angle bound; half-angle:
-|θ_fit − θ_true|), checked when the ZoneSky is built. The series are summed by Clenshaw's
+fine grid is at most half of :data:`FIT_TOLERANCE` (axis: |a_fit − a_true|, an angle bound;
+half-angle: |θ_fit − θ_true|), checked when the ZoneSky is built: the grid has at least 8 points
+per oscillation of the error of a degree-40 fit, so the error between its points stays within the
+tolerance. The series are summed by Clenshaw's
 recurrence, the same arithmetic in numpy and in CasADi (:meth:`ZoneSky.casadi`), so that
 collocation and SQP constraints are exact functions of a symbolic time; their derivatives are those
 of the series (exact, not finite differences). A fitted axis is unit to within the tolerance
@@ -147,7 +149,7 @@ class ZoneSky:
             x = np.cos(np.pi * (np.arange(n + 1) + 0.5) / (n + 1))
             coef = _chebyshev_interpolant(self._moving_truth(a + (x + 1.0) * (b - a) / 2))
             error = self._error(_clenshaw(xg[:, None], coef), truth)
-            if error <= self.tolerance:
+            if error <= 0.5 * self.tolerance:
                 return coef, error
         return None
 
