@@ -13,11 +13,19 @@ columns are the wheel spin axes in body axes)::
     q̇    = ½ q ⊗ [ω, 0]
 
 A wheel at its speed limit cannot accelerate further: the motor torque pushing it beyond
-``wheel_speed_max`` is cut (the same thing a wheel drive does). ``τ_ext`` adds the direct body
-torque input, magnetorquer torque ``m × B_b`` and optional gravity-gradient torque.
+``wheel_speed_max`` is cut (the same thing a wheel drive does). The limit applies to the speed the
+drive sees, the wheel's speed *relative to the body* ``Ω − Gᵀω`` (Basilisk's ``Omega`` and
+``Omega_max`` are relative speeds too), not to the inertial spin rate ``Ω`` of the state.
+``τ_ext`` adds the direct body torque input, magnetorquer torque ``m × B_b`` and the
+environment's torques (gravity gradient, solar pressure, drag, residual dipole).
 
 Integration: classic RK4 (:func:`rk4`, the suite's one Runge–Kutta step) with quaternion
-renormalisation after every step, inputs held constant over a step (zero-order hold), see :func:`step`.
+renormalisation after every step, see :func:`step`. Actuator inputs are held over a step
+(zero-order hold: that is what a sampled controller commands); the environment — the field in body
+axes and the external torques — is a function of ``(t, x)`` evaluated at every RK4 stage
+(:data:`StageEnvironment`), so a magnetorquer run is fourth-order accurate in the step. Holding the
+field fixed in body axes over a step instead (``Inputs.field_body``, kept for callers that evaluate
+it themselves) is only first-order accurate: the body turns under the held field.
 """
 from __future__ import annotations
 
@@ -76,13 +84,19 @@ class Spacecraft:
 
 @dataclass
 class Inputs:
-    """Actuator inputs held over one integration step (zero-order hold)."""
+    """Actuator inputs held over one integration step (zero-order hold). ``field_body`` and
+    ``gravity_gradient`` are the held-environment form; a :data:`StageEnvironment` replaces both."""
 
     wheel_torque: np.ndarray | None = None   # (N,) motor torques u
     body_torque: np.ndarray | None = None    # (3,) direct body torque, body axes
     dipole: np.ndarray | None = None         # (3,) A m², body axes
-    field_body: np.ndarray | None = None     # (3,) T, body axes (needed with dipole)
-    gravity_gradient: np.ndarray | None = None  # (3,) N m, body axes, precomputed
+    field_body: np.ndarray | None = None     # (3,) T, body axes (needed with dipole), held
+    gravity_gradient: np.ndarray | None = None  # (3,) N m, body axes, precomputed, held
+
+
+StageEnvironment = Callable[[float, np.ndarray], tuple[np.ndarray, np.ndarray]]
+"""``(t, x) -> (B_b, τ_env)``: the geomagnetic field in body axes (T) and the external environment
+torque (N m, body axes) at one RK4 stage's time and state (e.g. :meth:`att_sim.world.Environment.stage`)."""
 
 
 def initial_state(sc: Spacecraft, q=rot.IDENTITY, omega=(0.0, 0.0, 0.0), wheel_speed=None) -> np.ndarray:
@@ -90,32 +104,44 @@ def initial_state(sc: Spacecraft, q=rot.IDENTITY, omega=(0.0, 0.0, 0.0), wheel_s
     return np.concatenate([rot.normalize(np.asarray(q, float)), np.asarray(omega, float), ws])
 
 
-def effective_wheel_torque(sc: Spacecraft, wheel_speed: np.ndarray, u: np.ndarray) -> np.ndarray:
-    """Clip motor torques to their limit and cut those that would push a saturated wheel further."""
+def relative_wheel_speed(sc: Spacecraft, wheel_speed: np.ndarray, omega: np.ndarray) -> np.ndarray:
+    """The wheels' speeds relative to the body ``Ω − Gᵀω`` (rad/s): what a wheel drive measures and limits."""
+    return np.asarray(wheel_speed, float) - sc.wheel_axes.T @ np.asarray(omega, float)
+
+
+def effective_wheel_torque(sc: Spacecraft, wheel_speed: np.ndarray, u: np.ndarray, omega: np.ndarray) -> np.ndarray:
+    """Clip motor torques to their limit and cut those that would push a wheel beyond
+    ``wheel_speed_max`` *relative to the body* (``Ω − Gᵀω``, ``Ω`` the state's inertial spin rate,
+    ``ω`` the body rate) further."""
     u = np.clip(np.asarray(u, float), -sc.wheel_torque_max, sc.wheel_torque_max)
-    saturated = (np.abs(wheel_speed) >= sc.wheel_speed_max) & (np.sign(u) == np.sign(wheel_speed))
+    relative = relative_wheel_speed(sc, wheel_speed, omega)
+    saturated = (np.abs(relative) >= sc.wheel_speed_max) & (np.sign(u) == np.sign(relative))
     return np.where(saturated, 0.0, u)
 
 
-def external_torque(sc: Spacecraft, inputs: Inputs, q: np.ndarray) -> np.ndarray:
+def external_torque(sc: Spacecraft, inputs: Inputs, q: np.ndarray, stage: tuple | None = None) -> np.ndarray:
+    """Body torque ``τ_body + m × B_b + τ_env`` (N m, body axes); ``stage`` = ``(B_b, τ_env)`` of a
+    :data:`StageEnvironment`, else the held ``inputs.field_body`` and ``inputs.gravity_gradient``."""
+    field_b, tau_env = (inputs.field_body, inputs.gravity_gradient) if stage is None else stage
     tau = np.zeros(3) if inputs.body_torque is None else np.array(inputs.body_torque, float)
-    if inputs.dipole is not None and inputs.field_body is not None:
-        tau = tau + rot.cross(inputs.dipole, inputs.field_body)
-    if inputs.gravity_gradient is not None:
-        tau = tau + inputs.gravity_gradient
+    if inputs.dipole is not None and field_b is not None:
+        tau = tau + rot.cross(inputs.dipole, field_b)
+    if tau_env is not None:
+        tau = tau + tau_env
     return tau
 
 
-def derivative(sc: Spacecraft, x: np.ndarray, inputs: Inputs) -> np.ndarray:
-    """Time derivative of the state for inputs held constant (see module docstring)."""
+def derivative(sc: Spacecraft, x: np.ndarray, inputs: Inputs, stage: tuple | None = None) -> np.ndarray:
+    """Time derivative of the state for actuator inputs held constant (see module docstring);
+    ``stage``: the environment ``(B_b, τ_env)`` at this state (:func:`external_torque`)."""
     q, w, ws = x[:4], x[4:7], x[7:]
     out = np.empty_like(x)
     h = sc.inertia @ w
-    torque = external_torque(sc, inputs, q)
+    torque = external_torque(sc, inputs, q, stage)
     if sc.n_wheels:
         h = h + sc.wheel_axes @ (sc.wheel_inertia * ws)
         if inputs.wheel_torque is not None:
-            u = effective_wheel_torque(sc, ws, inputs.wheel_torque)
+            u = effective_wheel_torque(sc, ws, inputs.wheel_torque, w)
             torque = torque - sc.wheel_axes @ u
             out[7:] = u / sc.wheel_inertia if sc.wheel_inertia > 0 else 0.0
         else:
@@ -159,10 +185,14 @@ def renormalised(x: np.ndarray) -> np.ndarray:
     return x
 
 
-def step(sc: Spacecraft, x: np.ndarray, inputs: Inputs, dt: float) -> np.ndarray:
-    """Advance the state by ``dt`` with inputs held constant (ZOH): RK4, then the quaternion
-    renormalised."""
-    return renormalised(rk4(lambda _t, s: derivative(sc, s, inputs), 0.0, x, dt))
+def step(sc: Spacecraft, x: np.ndarray, inputs: Inputs, dt: float,
+         environment: StageEnvironment | None = None, t: float = 0.0) -> np.ndarray:
+    """Advance the state from time ``t`` by ``dt`` with the actuator inputs held (ZOH): RK4, then the
+    quaternion renormalised. ``environment(t, x)`` is evaluated at each of the four stages (the
+    stage's time and state); without it the field and torque held in ``inputs`` act over the step."""
+    if environment is None:
+        return renormalised(rk4(lambda _t, s: derivative(sc, s, inputs), t, x, dt))
+    return renormalised(rk4(lambda tt, s: derivative(sc, s, inputs, environment(tt, s)), t, x, dt))
 
 
 def angular_momentum_inertial(sc: Spacecraft, x: np.ndarray) -> np.ndarray:

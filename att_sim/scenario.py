@@ -1,22 +1,35 @@
 """Scenario files: one YAML per spacecraft/scenario under ``config/``, in ROS 2 parameter-file form.
 
 A scenario file has a ``/**: ros__parameters:`` section shared by every node (the spacecraft and
-its orbit) and one section per node (``simulator``, ``controller``, ``planner``, ``recorder``), so
-the same file is passed to each node with ``--ros-args --params-file``. This module reads the
+its orbit) and one section per node (``simulator``, ``controller``, ``planner``, ``recorder``); each
+node reads its section from the file named by its ``scenario`` parameter. This module reads the
 shared part without ROS, for the planner (which plans for any named spacecraft) and for tools.
 Files are read with ``yaml.safe_load`` only: nothing in them is ever evaluated.
+
+Keys of the shared part: ``frame_id``, ``body_frame_id``, ``spacecraft``, ``orbit`` and the real
+sky's (issue 13; files without them keep today's circular orbit, tilted dipole, gravity gradient
+only as the simulator's parameter): ``epoch`` (ISO 8601 UTC, sim time zero), ``orbit.type``
+(``circular``, ``kepler``, ``tle``: :func:`att_sim.orbit.orbit_from_mapping`), ``field_model``
+(``dipole`` or ``igrf14``), ``environment`` (disturbance switches, residual dipole, facets:
+:func:`environment_from_params`) and ``zones`` (:func:`zones_from_params`). Every key is checked;
+an unknown one is refused (a typo must not silently mean a default).
 """
 from __future__ import annotations
 
 import math
 import os
-from dataclasses import dataclass
+from dataclasses import dataclass, field
+from datetime import datetime
 from pathlib import Path
 
 import numpy as np
 import yaml
 
 from att_msgs_py.errors import ConfigError, ErrorCode, clip
+from att_msgs_py.types import ZONE_BODIES, Zone
+from att_sim import disturbances
+from att_sim import epoch as epochs
+from att_sim import orbit as orbits
 from att_sim.dynamics import Spacecraft
 from att_sim.environment import OrbitParams
 
@@ -53,16 +66,27 @@ class Scenario:
     name: str
     path: Path
     spacecraft: Spacecraft
-    orbit: OrbitParams
+    orbit: OrbitParams | None   # the circular orbit's parameters (None for a kepler or tle orbit)
     frame_id: str
     body_frame_id: str
     node_params: dict          # node name -> its ros__parameters (plain dict)
+    epoch: datetime | None = None                  # UTC of sim time zero (None: no epoch)
+    orbit_model: orbits.Orbit | None = None        # the orbit (CircularOrbit(orbit) without 'type')
+    field_model: str = "dipole"                    # 'dipole' (Bruni–Celani) or 'igrf14'
+    environment: dict = field(default_factory=dict)   # environment_from_params of the 'environment' group
+    zones: list[Zone] = field(default_factory=list)   # zones_from_params of the 'zones' group
 
 
 SPACECRAFT_KEYS = ("inertia", "torque_max", "wheel_axes", "wheel_inertia", "wheel_torque_max", "wheel_speed_max",
                    "dipole_max")
 LIMIT_KEYS = ("torque_max", "wheel_torque_max", "wheel_speed_max", "dipole_max")   # > 0 (.inf: no limit)
 ORBIT_KEYS = ("altitude", "inclination_deg", "raan_deg", "arg0")
+SHARED_KEYS = ("frame_id", "body_frame_id", "spacecraft", "orbit", "epoch", "field_model", "environment", "zones")
+FIELD_MODELS = ("dipole", "igrf14")
+ENVIRONMENT_KEYS = ("gravity_gradient", "solar_pressure", "drag", "drag_coefficient", "residual_dipole", "facets")
+ZONE_KEYS = ("name", "body", "sensor_axis", "half_angle_deg", "keep_in", "direction")
+UNIT_TOLERANCE = 1e-3          # |‖v‖ − 1| accepted for a unit vector of a file (then normalised)
+DEFAULT_DRAG_COEFFICIENT = 2.2
 MAX_FILE_BYTES = 1_000_000     # a scenario file is a few kB
 
 
@@ -137,19 +161,163 @@ def check_document(path, doc) -> dict:
     shared = shared_params(doc)
     if "spacecraft" not in shared:
         raise _invalid(path, "no 'spacecraft' group in '/**: ros__parameters': not a scenario file")
+    unknown = sorted(str(k) for k in set(shared) - set(SHARED_KEYS))
+    if unknown:
+        raise _invalid(path, f"'/**: ros__parameters' has unknown key(s) {clip(', '.join(unknown), 120)} "
+                             f"(known: {', '.join(SHARED_KEYS)})")
     check_spacecraft_group(path, shared["spacecraft"])
     orbit = shared.get("orbit", {})
-    if not isinstance(orbit, dict) or set(orbit) - set(ORBIT_KEYS):
-        raise _invalid(path, f"orbit must be a mapping with keys among {', '.join(ORBIT_KEYS)}")
-    for key in orbit:
-        _numbers(path, orbit, key, f"orbit.{key}")
-    if _as_float(orbit.get("altitude", 1.0)) <= 0:
-        raise _invalid(path, f"orbit.altitude must be positive (m), got {orbit['altitude']!r}")
+    if not isinstance(orbit, dict):
+        raise _invalid(path, f"orbit must be a mapping, got {type(orbit).__name__}")
+    if orbit.get("type", "circular") == "circular":
+        if set(orbit) - {*ORBIT_KEYS, "type"}:
+            raise _invalid(path, f"orbit must be a mapping with keys among type, {', '.join(ORBIT_KEYS)}")
+        for key in set(orbit) - {"type"}:
+            _numbers(path, orbit, key, f"orbit.{key}")
+        if _as_float(orbit.get("altitude", 1.0)) <= 0:
+            raise _invalid(path, f"orbit.altitude must be positive (m), got {orbit['altitude']!r}")
     for key in ("frame_id", "body_frame_id"):
         v = shared.get(key, "x")
         if not (isinstance(v, str) and v and len(v) <= 128 and v.isprintable()):
             raise _invalid(path, f"{key} must be a non-empty printable name of at most 128 characters")
     return shared
+
+
+def _attached(path, what: str, err: ValueError) -> ConfigError:
+    """A model's ValueError sentence as the file's ConfigError (``what``: the group it came from)."""
+    sentence = str(err)
+    return _invalid(path, sentence if sentence.startswith(what) else f"{what}: {sentence}")
+
+
+def epoch_from_params(path, shared: dict) -> datetime | None:
+    if "epoch" not in shared:
+        return None
+    try:
+        return epochs.parse_epoch(shared["epoch"])
+    except ValueError as err:
+        raise _attached(path, "epoch", err) from None
+
+
+def orbit_model_from_params(path, shared: dict, epoch: datetime | None) -> orbits.Orbit:
+    """The ``orbit`` group as an :class:`att_sim.orbit.Orbit` (circular: today's keys and defaults)."""
+    p = shared.get("orbit", {})
+    if p.get("type", "circular") == "circular":
+        return orbits.CircularOrbit(orbit_from_params(p))
+    try:
+        return orbits.orbit_from_mapping(p, epoch)
+    except ValueError as err:
+        raise _attached(path, "orbit", err) from None
+
+
+def field_model_from_params(path, shared: dict, epoch: datetime | None) -> str:
+    model = shared.get("field_model", "dipole")
+    if model not in FIELD_MODELS:
+        raise _invalid(path, f"field_model must be one of {', '.join(FIELD_MODELS)}, got {clip(repr(model), 80)}")
+    if model == "igrf14" and epoch is None:
+        raise _invalid(path, "field_model igrf14 needs the scenario's epoch (the field and the Earth's rotation "
+                             "depend on the date)")
+    return model
+
+
+def _flag(path, group: dict, key: str, label: str) -> bool:
+    v = group.get(key, False)
+    if not isinstance(v, bool):
+        raise _invalid(path, f"{label} must be true or false, got {clip(repr(v), 80)}")
+    return v
+
+
+def _vector3(path, group: dict, key: str, label: str, unit: bool = False) -> np.ndarray:
+    v = _numbers(path, group, key, label)
+    if not isinstance(group[key], list) or v.size != 3:
+        raise _invalid(path, f"{label} must be a list of 3 numbers, got {clip(repr(group[key]), 80)}")
+    if unit:
+        norm = float(np.linalg.norm(v))
+        if abs(norm - 1.0) > UNIT_TOLERANCE:
+            raise _invalid(path, f"{label} must be a unit vector (norm within {UNIT_TOLERANCE:g} of 1), got norm "
+                                 f"{norm:.6g}")
+        v = v / norm
+    return v
+
+
+def environment_from_params(path, shared: dict, epoch: datetime | None) -> dict:
+    """The ``environment`` group, checked: ``gravity_gradient``, ``solar_pressure``, ``drag`` (bools,
+    default false), ``drag_coefficient`` (> 0, default 2.2), ``residual_dipole`` (A m², body, default
+    zero) and ``facets`` (:func:`att_sim.disturbances.facets_from_params`; needed by pressure and
+    drag). Solar pressure needs the epoch (the Sun's position)."""
+    p = shared.get("environment", {})
+    if not isinstance(p, dict):
+        raise _invalid(path, f"environment must be a mapping, got {type(p).__name__}")
+    unknown = sorted(str(k) for k in set(p) - set(ENVIRONMENT_KEYS))
+    if unknown:
+        raise _invalid(path, f"environment has unknown key(s) {clip(', '.join(unknown), 120)} "
+                             f"(known: {', '.join(ENVIRONMENT_KEYS)})")
+    out = {key: _flag(path, p, key, f"environment.{key}") for key in ("gravity_gradient", "solar_pressure", "drag")}
+    cd = float(_numbers(path, p, "drag_coefficient", "environment.drag_coefficient", DEFAULT_DRAG_COEFFICIENT)[0])
+    if not 0.0 < cd <= 10.0:
+        raise _invalid(path, f"environment.drag_coefficient must be in (0, 10], got {cd:g}")
+    out["drag_coefficient"] = cd
+    out["residual_dipole"] = (_vector3(path, p, "residual_dipole", "environment.residual_dipole")
+                              if "residual_dipole" in p else np.zeros(3))
+    facets = p.get("facets", [])
+    if not isinstance(facets, list):
+        raise _invalid(path, f"environment.facets must be a list of facet mappings, got {type(facets).__name__}")
+    try:
+        out["facets"] = disturbances.facets_from_params(facets)
+    except ValueError as err:
+        raise _attached(path, "environment.facets", err) from None
+    for key in ("solar_pressure", "drag"):
+        if out[key] and not out["facets"]:
+            raise _invalid(path, f"environment.{key} needs environment.facets (the surfaces it acts on)")
+    if out["solar_pressure"] and epoch is None:
+        raise _invalid(path, "environment.solar_pressure needs the scenario's epoch (the Sun's position)")
+    return out
+
+
+def zones_from_params(path, shared: dict, epoch: datetime | None) -> list[Zone]:
+    """The ``zones`` group, checked, as :class:`att_msgs_py.types.Zone` (``sensor_axis`` unit in body
+    axes, ``half_angle`` rad, ``direction`` unit inertial only for body ``inertial``).
+    ``half_angle_deg`` is in (0, 180) — for ``earth_limb`` it is the margin beyond the limb, in
+    (−90, 90); ``sun`` and ``moon`` need the epoch."""
+    p = shared.get("zones", [])
+    if not isinstance(p, list):
+        raise _invalid(path, f"zones must be a list of zone mappings, got {type(p).__name__}")
+    zones, names = [], set()
+    for k, z in enumerate(p):
+        label = f"zones[{k}]"
+        if not isinstance(z, dict):
+            raise _invalid(path, f"{label} must be a mapping with keys among {', '.join(ZONE_KEYS)}")
+        unknown = sorted(str(x) for x in set(z) - set(ZONE_KEYS))
+        if unknown:
+            raise _invalid(path, f"{label} has unknown key(s) {clip(', '.join(unknown), 120)} "
+                                 f"(known: {', '.join(ZONE_KEYS)})")
+        missing = [x for x in ("name", "body", "sensor_axis", "half_angle_deg") if x not in z]
+        if missing:
+            raise _invalid(path, f"{label} needs key(s) {', '.join(missing)}")
+        name = z["name"]
+        if not (isinstance(name, str) and name and len(name) <= 128 and name.isprintable()):
+            raise _invalid(path, f"{label}.name must be a non-empty printable name of at most 128 characters")
+        if name in names:
+            raise _invalid(path, f"{label}.name '{name}' is used by an earlier zone")
+        names.add(name)
+        body = z["body"]
+        if body not in ZONE_BODIES:
+            raise _invalid(path, f"{label}.body must be one of {', '.join(ZONE_BODIES)}, got {clip(repr(body), 80)}")
+        if body in ("sun", "moon") and epoch is None:
+            raise _invalid(path, f"{label}.body {body} needs the scenario's epoch (the {body}'s position)")
+        axis = _vector3(path, z, "sensor_axis", f"{label}.sensor_axis", unit=True)
+        angle = float(_numbers(path, z, "half_angle_deg", f"{label}.half_angle_deg")[0])
+        low, high = (-90.0, 90.0) if body == "earth_limb" else (0.0, 180.0)
+        if not low < angle < high:
+            what = "the margin beyond the Earth limb" if body == "earth_limb" else "the cone half-angle"
+            raise _invalid(path, f"{label}.half_angle_deg ({what}) must be in ({low:g}, {high:g}) deg, got {angle:g}")
+        keep_in = _flag(path, z, "keep_in", f"{label}.keep_in")
+        if (body == "inertial") != ("direction" in z):
+            raise _invalid(path, f"{label}.direction is {'needed' if body == 'inertial' else 'only for'} body "
+                                 f"inertial")
+        direction = _vector3(path, z, "direction", f"{label}.direction", unit=True) if body == "inertial" else None
+        zones.append(Zone(name=name, body=body, sensor_axis=axis, half_angle=math.radians(angle), keep_in=keep_in,
+                          direction=direction))
+    return zones
 
 
 def spacecraft_from_params(p: dict) -> Spacecraft:
@@ -198,12 +366,17 @@ def load(name: str) -> Scenario:
     doc = read_document(path)
     shared = check_document(path, doc)
     nodes = {k: v["ros__parameters"] for k, v in doc.items() if k != "/**"}
+    epoch = epoch_from_params(path, shared)
+    orbit_model = orbit_model_from_params(path, shared, epoch)
     return Scenario(
         name=path.stem, path=path,
         spacecraft=spacecraft_from_params(shared["spacecraft"]),
-        orbit=orbit_from_params(shared.get("orbit", {})),
+        orbit=orbit_model.params if isinstance(orbit_model, orbits.CircularOrbit) else None,
         frame_id=shared.get("frame_id", "eci"), body_frame_id=shared.get("body_frame_id", "body"),
-        node_params=nodes)
+        node_params=nodes, epoch=epoch, orbit_model=orbit_model,
+        field_model=field_model_from_params(path, shared, epoch),
+        environment=environment_from_params(path, shared, epoch),
+        zones=zones_from_params(path, shared, epoch))
 
 
 def load_checked(name: str) -> Scenario:

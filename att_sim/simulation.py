@@ -1,8 +1,10 @@
 """The simulator's numerics without ROS: state, actuator inputs, environment, one step at a time.
 
 :class:`Simulation` holds the truth state of :mod:`att_sim.dynamics`, the latest accepted actuator
-command and the orbit/field environment of :mod:`att_sim.environment`. The simulator node is a thin
-adapter around it; tests drive it directly.
+command and the environment of :mod:`att_sim.world` (orbit, field, Sun, disturbances), which is
+evaluated at every RK4 stage; the actuator command is held over a step. The published state carries
+the field and position *at the published state* (its time and attitude). The simulator node is a
+thin adapter around it; tests drive it directly.
 
 Every command and reset is checked field by field first (:class:`Checks`); a refused one changes
 nothing and comes back as a :class:`Refusal` (an :class:`~att_msgs_py.errors.ErrorCode` and a
@@ -23,6 +25,8 @@ from att_msgs_py.types import CONTROL_MODES, Command, ControlMode, State
 from att_sim import dynamics as dyn
 from att_sim import environment as env
 from att_sim import rotations as rot
+from att_sim import world
+from att_sim.orbit import CircularOrbit
 
 MAX_ORBIT_PHASE = 1e6          # rad: |orbit_phase| of a reset (beyond it the phase drowns in rounding)
 
@@ -52,8 +56,7 @@ class Applied:
 
     wheel_torque: np.ndarray
     dipole: np.ndarray = field(default_factory=lambda: np.zeros(3))
-    field_body: np.ndarray = field(default_factory=lambda: np.zeros(3))
-    body_torque: np.ndarray = field(default_factory=lambda: np.zeros(3))   # total torque on the body
+    body_torque: np.ndarray = field(default_factory=lambda: np.zeros(3))   # total torque on the body, step mean
 
 
 def _numbers(value, name: str, code: ErrorCode, shape: tuple) -> np.ndarray:
@@ -77,11 +80,19 @@ def _number(value, name: str, code: ErrorCode, low: float = -math.inf, high: flo
 
 
 class Simulation:
-    def __init__(self, sc: dyn.Spacecraft, orbit: env.OrbitParams, q0=rot.IDENTITY, omega0=(0, 0, 0),
-                 wheel_speed0=None, gravity_gradient: bool = False, checks: Checks = Checks()):
-        self.sc, self.orbit, self.gravity_gradient, self.checks = sc, orbit, gravity_gradient, checks
+    """Truth state, held actuator command and environment. Give ``orbit`` (today's circular orbit
+    with the tilted dipole and optional ``gravity_gradient``) or a :class:`att_sim.world.Environment`
+    (:meth:`for_scenario` builds the scenario's)."""
+
+    def __init__(self, sc: dyn.Spacecraft, orbit: env.OrbitParams | None = None, q0=rot.IDENTITY,
+                 omega0=(0, 0, 0), wheel_speed0=None, gravity_gradient: bool = False, checks: Checks = Checks(),
+                 environment: world.Environment | None = None):
+        if (orbit is None) == (environment is None):
+            raise ValueError("Simulation needs either orbit parameters or an environment, not both")
+        self.sc, self.checks = sc, checks
+        self.environment = world.Environment.circular(sc, orbit, gravity_gradient) if environment is None \
+            else environment
         self.t = 0.0
-        self.arg0 = orbit.arg0
         self.x = dyn.initial_state(sc, q0, omega0, wheel_speed0)
         self.wheel_cmd = np.zeros(sc.n_wheels)
         self.dipole_cmd = np.zeros(3)
@@ -89,6 +100,21 @@ class Simulation:
         self.command_timeout = False
         self.halted, self.halt_reason = False, ""
         self.applied = Applied(np.zeros(sc.n_wheels))
+        self.now = self.environment.sample(self.t, self.x[:4])
+        self.arg0 = self._arg0()
+
+    def _arg0(self) -> float | None:
+        """A circular orbit's argument of latitude at t = 0 (rad; None for an orbit of elements or a TLE)."""
+        orbit = self.environment.orbit
+        return orbit.params.arg0 if isinstance(orbit, CircularOrbit) else None
+
+    @classmethod
+    def for_scenario(cls, scenario, q0=rot.IDENTITY, omega0=(0, 0, 0), wheel_speed0=None,
+                     gravity_gradient: bool | None = None, checks: Checks = Checks()) -> Simulation:
+        """The simulation of a :class:`att_sim.scenario.Scenario` in its environment
+        (``gravity_gradient``, when given, overrides the scenario's)."""
+        return cls(scenario.spacecraft, q0=q0, omega0=omega0, wheel_speed0=wheel_speed0, checks=checks,
+                   environment=world.Environment.from_scenario(scenario, gravity_gradient))
 
     def set_command(self, command: Command) -> Refusal | None:
         """Accept a command (None) or say why it is refused; a refused command changes nothing."""
@@ -141,17 +167,20 @@ class Simulation:
 
     def reset(self, q, omega, wheel_speed, orbit_phase: float) -> Refusal | None:
         """Reset attitude, rate, wheel speeds (empty: zeros) and orbit phase, or say why not (a
-        refused reset changes nothing); sim time keeps running."""
+        refused reset changes nothing); sim time keeps running. ``orbit_phase`` is the argument of
+        latitude now (rad) of a circular orbit; an orbit given by elements or a TLE is fixed by them
+        and its epoch, so there it must be 0 (keep the orbit)."""
         try:
-            x, arg0 = self.check_reset(q, omega, wheel_speed, orbit_phase)
+            x, environment = self.check_reset(q, omega, wheel_speed, orbit_phase)
         except RequestError as err:
             return Refusal(err.code, err.message)
-        self.x, self.arg0 = x, arg0
+        self.x, self.environment = x, environment
         self.halted, self.halt_reason = False, ""
+        self.now, self.arg0 = self.environment.sample(self.t, self.x[:4]), self._arg0()
         return None
 
-    def check_reset(self, q, omega, wheel_speed, orbit_phase: float) -> tuple[np.ndarray, float]:
-        """The state vector and orbit anchor ``arg0`` a reset asks for (RequestError otherwise)."""
+    def check_reset(self, q, omega, wheel_speed, orbit_phase: float) -> tuple[np.ndarray, world.Environment]:
+        """The state vector and environment a reset asks for (RequestError otherwise)."""
         bad, sc = ErrorCode.INVALID_RESET, self.sc
         with np.errstate(over="ignore"):                 # a 1e308 attitude has norm inf: refused below
             q = validation.unit_quaternion(_numbers(q, "attitude", bad, (4,)), "attitude", bad)
@@ -166,45 +195,65 @@ class Simulation:
         if wheel_speed.size != sc.n_wheels:
             raise RequestError(bad, f"wheel_speeds has {wheel_speed.size} entries, the spacecraft has {sc.n_wheels} "
                                     f"wheels (or give none)")
-        if wheel_speed.size and np.max(np.abs(wheel_speed)) > sc.wheel_speed_max:
-            i = int(np.argmax(np.abs(wheel_speed)))
-            raise RequestError(bad, f"wheel_speeds[{i}] = {wheel_speed[i]:.6g} rad/s is beyond wheel_speed_max = "
-                                    f"{sc.wheel_speed_max:g} rad/s")
+        relative = dyn.relative_wheel_speed(sc, wheel_speed, omega)
+        if relative.size and np.max(np.abs(relative)) > sc.wheel_speed_max:
+            i = int(np.argmax(np.abs(relative)))
+            raise RequestError(bad, f"wheel_speeds[{i}] = {wheel_speed[i]:.6g} rad/s is {relative[i]:.6g} rad/s "
+                                    f"relative to the body, beyond wheel_speed_max = {sc.wheel_speed_max:g} rad/s")
         phase = _number(orbit_phase, "orbit_phase", bad, -MAX_ORBIT_PHASE, MAX_ORBIT_PHASE)
-        return dyn.initial_state(sc, q, omega, wheel_speed), phase - self.orbit.mean_motion * self.t
+        environment = self.environment
+        if isinstance(environment.orbit, CircularOrbit):
+            environment = environment.with_phase(self.t, phase)
+        elif phase != 0.0:
+            raise RequestError(bad, f"orbit_phase must be 0 on this {type(environment.orbit).__name__}: its elements "
+                                    f"and epoch fix where the spacecraft is (only a circular orbit takes a phase)")
+        return dyn.initial_state(sc, q, omega, wheel_speed), environment
 
     def position(self) -> np.ndarray:
-        return env.position(self.orbit, self.t, self.arg0)
+        """Spacecraft position now (m, inertial: GCRS with an epoch)."""
+        return self.now.position
 
     def state(self, frame_id: str = "", body_frame_id: str = "") -> State:
-        """The truth state now, with what acted during the last step."""
+        """The truth state now — field and position at this time and attitude — with what acted
+        during the last step (motor torques, dipole, mean body torque)."""
         x, a = self.x, self.applied
         return State(t=self.t, q=x[:4].copy(), omega=x[4:7].copy(), wheel_speeds=x[7:].copy(),
-                     wheel_torques=a.wheel_torque, field_body=a.field_body, dipole=a.dipole,
-                     applied_torque=a.body_torque, position=self.position(), command_timeout=self.command_timeout,
-                     frame_id=frame_id, body_frame_id=body_frame_id)
+                     wheel_torques=a.wheel_torque, field_body=self.now.field_B.copy(), dipole=a.dipole,
+                     applied_torque=a.body_torque, position=self.now.position.copy(),
+                     command_timeout=self.command_timeout, frame_id=frame_id, body_frame_id=body_frame_id)
 
     def inputs(self) -> dyn.Inputs:
-        """Inputs for the next step: limits applied, zero while the command watchdog is tripped."""
-        q, ws = self.x[:4], self.x[7:]
+        """Actuator inputs for the next step: limits applied, zero while the command watchdog is tripped."""
+        w, ws = self.x[4:7], self.x[7:]
         active = not self.command_timeout
-        u = dyn.effective_wheel_torque(self.sc, ws, self.wheel_cmd if active else np.zeros_like(self.wheel_cmd))
+        u = dyn.effective_wheel_torque(self.sc, ws, self.wheel_cmd if active else np.zeros_like(self.wheel_cmd), w)
         m = np.clip(self.dipole_cmd, -self.sc.dipole_max, self.sc.dipole_max) if active else np.zeros(3)
         tau = np.clip(self.body_cmd, -self.sc.body_torque_max, self.sc.body_torque_max) if active else np.zeros(3)
-        b_body = env.field_body(self.orbit, self.t, q, self.arg0)
-        gg = (env.gravity_gradient_torque(self.orbit, self.t, q, self.sc.inertia, self.arg0)
-              if self.gravity_gradient else None)
-        return dyn.Inputs(wheel_torque=u, body_torque=tau, dipole=m, field_body=b_body, gravity_gradient=gg)
+        return dyn.Inputs(wheel_torque=u, body_torque=tau, dipole=m)
 
     def advance(self, dt: float) -> None:
-        """One RK4 step with the inputs held; a non-finite result halts the simulation."""
+        """One RK4 step, the actuator inputs held and the environment evaluated at every stage; a
+        non-finite result or an environment that cannot be evaluated (e.g. a decayed TLE) halts the
+        simulation. The applied body torque reported is the step's RK4-weighted mean."""
         inp = self.inputs()
-        x_new = dyn.step(self.sc, self.x, inp, dt)
-        if not np.all(np.isfinite(x_new)):
+        stages = []
+
+        def stage(t, x):
+            got = self.environment.stage(t, x)
+            stages.append(got)
+            return got
+        try:
+            x_new = dyn.step(self.sc, self.x, inp, dt, stage, self.t)
+            now = self.environment.sample(self.t + dt, x_new[:4]) if np.all(np.isfinite(x_new)) else None
+        except ValueError as err:
+            self.halted = True
+            self.halt_reason = f"environment failed at t = {self.t:.3f} s: {err}; propagation stopped"
+            return
+        if now is None:
             self.halted = True
             self.halt_reason = f"state became non-finite at t = {self.t:.3f} s; propagation stopped"
             return
-        tau = dyn.external_torque(self.sc, inp, self.x[:4]) - self.sc.wheel_axes @ inp.wheel_torque
-        self.applied = Applied(inp.wheel_torque, inp.dipole, inp.field_body, tau)
-        self.x = x_new
+        mean = sum(w * dyn.external_torque(self.sc, inp, None, s) for w, s in zip((1, 2, 2, 1), stages)) / 6.0
+        self.applied = Applied(inp.wheel_torque, inp.dipole, mean - self.sc.wheel_axes @ inp.wheel_torque)
+        self.x, self.now = x_new, now
         self.t += dt

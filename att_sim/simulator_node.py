@@ -6,7 +6,10 @@ no lock or cross-thread wake-up sits in the control loop.
 
 Subscribes ``/actuator/command`` (ActuatorCommand), publishes ``/spacecraft/state``
 (SpacecraftState) at ``publish_rate`` and ``/clock`` at ``clock_rate`` (Hz of sim time), serves
-``/simulator/reset``. Runs at ``real_time_factor`` × wall time (0: as fast as possible).
+``/simulator/reset``. The world is the scenario's (:meth:`att_sim.simulation.Simulation.for_scenario`:
+orbit, field model, disturbances, epoch = sim time zero); the state's position is in the scenario's
+``frame_id`` (GCRS with an epoch) and its field is the one at the published state. Runs at
+``real_time_factor`` × wall time (0: as fast as possible).
 Parameters come from the scenario file (``scenario`` parameter), overridable by ROS parameters;
 each is type- and range-checked, and a bad one stops the node with one line on stderr (exit 2).
 
@@ -49,20 +52,26 @@ class SimulatorNode(Node):
         self.pace = (0.0, 0.0)         # (wall, sim) time the real-time pacing counts from
         self.last_command_time = -np.inf
         self.refused = {"command": 0, "reset": 0}
-        self.sim = Simulation(self.scenario.spacecraft, self.scenario.orbit, q0=param["initial_attitude"],
-                              omega0=param["initial_rate"], gravity_gradient=param["gravity_gradient"],
-                              checks=Checks(command_limit_factor=param["command_limit_factor"],
-                                            max_reset_rate=param["max_reset_rate"],
-                                            body_frame_id=self.scenario.body_frame_id,
-                                            stamp_ahead=self.step, stamp_age=self.command_timeout))
+        try:
+            self.sim = Simulation.for_scenario(
+                self.scenario, q0=param["initial_attitude"], omega0=param["initial_rate"],
+                gravity_gradient=param["gravity_gradient"],
+                checks=Checks(command_limit_factor=param["command_limit_factor"],
+                              max_reset_rate=param["max_reset_rate"], body_frame_id=self.scenario.body_frame_id,
+                              stamp_ahead=self.step, stamp_age=self.command_timeout))
+        except ValueError as err:        # the environment cannot start (e.g. a TLE that fails at t = 0)
+            raise ConfigError(ErrorCode.INVALID_CONFIG, f"scenario '{self.scenario.name}': {clip(err, 300)}") from None
 
         self.state_pub = self.create_publisher(SpacecraftState, topics.STATE, qos.STREAM_QOS)
         self.clock_pub = self.create_publisher(Clock, topics.CLOCK, qos.CLOCK_QOS)
         self.create_subscription(ActuatorCommand, topics.COMMAND, self.on_command, qos.STREAM_QOS)
         self.create_service(ResetSimulator, topics.RESET_SIMULATOR, self.on_reset)
+        e = self.sim.environment
         self.get_logger().info(
             f"scenario '{self.scenario.name}', step {self.step} s, RTF "
-            f"{self.real_time_factor or 'max'}, {self.scenario.spacecraft.n_wheels} wheels")
+            f"{self.real_time_factor or 'max'}, {self.scenario.spacecraft.n_wheels} wheels, "
+            f"{type(e.orbit).__name__}, field {e.field.model}, torques "
+            f"{', '.join(e.torques(0.0, self.sim.x[:4])) or 'none'}")
 
     def read_parameters(self) -> dict:
         """Read and check every parameter (ConfigError naming the first bad one); the timing ones
@@ -96,7 +105,8 @@ class SimulatorNode(Node):
         values = {
             "command_limit_factor": param("command_limit_factor", 2.0, 1.0, inf),
             "max_reset_rate": param("max_reset_rate", 1.0, 0.0, inf, low_open=True),
-            "gravity_gradient": param("gravity_gradient", False),
+            # default: the scenario's environment.gravity_gradient (false without it)
+            "gravity_gradient": param("gravity_gradient", bool(self.scenario.environment.get("gravity_gradient"))),
             "initial_attitude": param("initial_attitude", [0.0, 0.0, 0.0, 1.0], -inf, inf, length=4),
             "initial_rate": param("initial_rate", [0.0, 0.0, 0.0], -inf, inf, length=3)}
         try:

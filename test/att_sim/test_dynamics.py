@@ -64,9 +64,9 @@ def test_wheel_only_slew_turns_the_body_by_the_momentum_exchange_angle():
 def test_saturated_wheel_cannot_accelerate_further():
     sc = dyn.Spacecraft(inertia=np.eye(3) * 5, wheel_inertia=0.01, wheel_torque_max=0.1, wheel_speed_max=100.0)
     x = dyn.initial_state(sc, wheel_speed=[0.0, 0.0, 100.0])
-    u = dyn.effective_wheel_torque(sc, x[7:], [0.1, 0.1, 0.1])
+    u = dyn.effective_wheel_torque(sc, x[7:], [0.1, 0.1, 0.1], x[4:7])
     assert u.tolist() == [0.1, 0.1, 0.0]
-    assert dyn.effective_wheel_torque(sc, x[7:], [0, 0, -0.1])[2] == -0.1
+    assert dyn.effective_wheel_torque(sc, x[7:], [0, 0, -0.1], x[4:7])[2] == -0.1
 
 
 def test_bang_bang_eigenaxis_profile_reaches_the_goal():
@@ -75,3 +75,53 @@ def test_bang_bang_eigenaxis_profile_reaches_the_goal():
     traj = dyn.simulate_profile(sc, dyn.initial_state(sc), [0, half, 2 * half], [[0, 0, 1], [0, 0, -1], [0, 0, 0]])
     assert rot.angle_between(traj.q[-1], rot.from_axis_angle([0, 0, 1], np.pi)) < 1e-5
     assert np.linalg.norm(traj.omega[-1]) < 1e-12
+
+
+def test_wheel_speed_limit_is_on_the_speed_relative_to_the_body():
+    """Ω is the inertial spin rate; the drive limits Ω − Gᵀω (here ω_z = ±0.5 rad/s, Ω_z = 100)."""
+    sc = dyn.Spacecraft(inertia=np.eye(3) * 5, wheel_inertia=0.01, wheel_torque_max=0.1, wheel_speed_max=100.0)
+    u = [0.0, 0.0, 0.1]
+    np.testing.assert_allclose(dyn.relative_wheel_speed(sc, [0, 0, 100.0], [0, 0, 0.5]), [0, 0, 99.5])
+    assert dyn.effective_wheel_torque(sc, [0, 0, 100.0], u, [0, 0, 0.5])[2] == 0.1     # 99.5 relative: free
+    assert dyn.effective_wheel_torque(sc, [0, 0, 99.8], u, [0, 0, -0.5])[2] == 0.0     # 100.3 relative: cut
+    # in the dynamics: the body spins at +0.5 rad/s about z, the wheel is driven from Ω = 99 (98.5
+    # relative): it is cut at 100 relative to the body, Ω ≈ 100.5 (an inertial limit would stop it at 100)
+    x = dyn.initial_state(sc, omega=[0, 0, 0.5], wheel_speed=[0, 0, 99.0])
+    for _ in range(400):
+        x = dyn.step(sc, x, dyn.Inputs(wheel_torque=np.array(u)), 0.01)
+    rel = dyn.relative_wheel_speed(sc, x[7:], x[4:7])[2]
+    assert 100.0 <= rel < 100.0 + 0.1 / 0.01 * 0.01 + 1e-9      # overshoot: at most one step's increment
+    assert x[9] > 100.4
+
+
+# ------------------------------------------------------------ environment at every RK4 stage
+def _constant_dipole_run(dt: float, per_stage: bool, t_end: float = 240.0) -> np.ndarray:
+    """Bruni–Celani spacecraft tumbling at 0.04 rad/s with a constant 8 A m² dipole in the tilted-dipole
+    field: the field in body axes from the stage attitude (per_stage) or held over each step."""
+    from att_sim import environment as env
+    orbit = env.OrbitParams(arg0=0.332)
+    sc = dyn.Spacecraft(inertia=np.diag([27.0, 17.0, 25.0]), dipole_max=10.0)
+    x = dyn.initial_state(sc, rot.IDENTITY, [0.02, 0.02, -0.03])
+    inputs = dyn.Inputs(dipole=np.array([8.0, -5.0, 6.0]))
+
+    def stage(t, s):
+        return env.field_body(orbit, t, s[:4]), None
+    n = int(round(t_end / dt))
+    for k in range(n):
+        t = k * dt
+        if per_stage:
+            x = dyn.step(sc, x, inputs, dt, stage, t)
+        else:
+            held = dyn.Inputs(dipole=inputs.dipole, field_body=env.field_body(orbit, t, x[:4]))
+            x = dyn.step(sc, x, held, dt)
+    return x
+
+
+def test_environment_at_every_stage_is_fourth_order_and_the_held_field_first_order():
+    reference = _constant_dipole_run(0.25, True)
+    errors = {dt: np.linalg.norm(_constant_dipole_run(dt, True) - reference) for dt in (4.0, 2.0, 1.0)}
+    ratios = [errors[4.0] / errors[2.0], errors[2.0] / errors[1.0]]
+    assert min(ratios) > 12 and max(ratios) < 20, ratios        # ≈ 16: fourth order
+    held = {dt: np.linalg.norm(_constant_dipole_run(dt, False) - reference) for dt in (2.0, 1.0)}
+    assert 1.7 < held[2.0] / held[1.0] < 2.5                      # ≈ 2: first order
+    assert held[1.0] > 100 * errors[1.0]
