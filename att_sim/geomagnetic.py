@@ -242,21 +242,26 @@ class GeomagneticField:
             raise ValueError(f"field_model must be one of {', '.join(FIELD_MODELS)}, got {model!r}")
         self.model, self.dipole = model, dipole
         self.epoch = None if epoch is None else ep.parse_epoch(epoch)
-        if model == "igrf14":
-            if self.epoch is None:
-                raise ValueError("field_model 'igrf14' needs an epoch (ISO 8601 UTC), got none")
-            self.decimal_year0 = decimal_year(self.epoch)
-            if not IGRF_YEAR_MIN <= self.decimal_year0 <= IGRF_YEAR_MAX:
-                raise ValueError(f"field_model 'igrf14' needs an epoch from {IGRF_YEAR_MIN:.0f} to "
-                                 f"{IGRF_YEAR_MAX:.0f}, got {ep.format_epoch(self.epoch)}")
-            self._rotation = _RotationTable(self.epoch)
+        if model == "igrf14" and self.epoch is None:
+            raise ValueError("field_model 'igrf14' needs an epoch (ISO 8601 UTC), got none")
+        self.decimal_year0 = None if self.epoch is None else decimal_year(self.epoch)
+        if model == "igrf14" and not IGRF_YEAR_MIN <= self.decimal_year0 <= IGRF_YEAR_MAX:
+            raise ValueError(f"field_model 'igrf14' needs an epoch from {IGRF_YEAR_MIN:.0f} to "
+                             f"{IGRF_YEAR_MAX:.0f}, got {ep.format_epoch(self.epoch)}")
+        self._rotation = None if self.epoch is None else _RotationTable(self.epoch)
+
+    def _need_epoch(self, what: str) -> None:
+        if self.epoch is None:
+            raise ValueError(f"{what} needs an epoch: this {self.model} field has none")
 
     def decimal_year(self, t):
         """Decimal year of ``epoch + t`` (s), advancing by Julian years (the secular variation's clock)."""
+        self._need_epoch("decimal_year")
         return self.decimal_year0 + np.asarray(t, float) / _JULIAN_YEAR
 
     def itrs_rotation(self, t) -> np.ndarray:
         """``R(t)`` with ``r_ITRS = R r_GCRS`` (tabulated skyfield ITRS frame), shape ``t.shape + (3, 3)``."""
+        self._need_epoch("itrs_rotation")
         return self._rotation.matrix(t)
 
     def field_inertial(self, t, r_GCRS) -> np.ndarray:
@@ -313,7 +318,7 @@ class FieldTrack:
         self._pieces = np.moveaxis(self._spline.c, 0, 1).reshape(len(t) - 1, 12).tolist()
 
     def _check(self, t) -> None:
-        if np.any(np.asarray(t) < self.t0) or np.any(np.asarray(t) > self.t1):
+        if not (np.all(np.asarray(t) >= self.t0) and np.all(np.asarray(t) <= self.t1)):   # NaN fails too
             raise ValueError(f"t must be within the field track's span [{self.t0}, {self.t1}] s, got {t}")
 
     def __call__(self, t) -> np.ndarray:

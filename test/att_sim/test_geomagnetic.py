@@ -190,7 +190,11 @@ def test_bad_input_is_refused():
     with pytest.raises(ValueError, match="trailing axis of 3"):
         gm.igrf_field_geocentric([7e6, 0.0], 2026.0)
     track = gm.GeomagneticField("dipole").track(lambda t: env.position(env.OrbitParams(), t), 0.0, 100.0)
-    with pytest.raises(ValueError, match=r"within the field track's span \[0.0, 100.0\]"):
-        track(100.5)
+    for t in (100.5, math.nan, np.array([0.0, -1.0])):
+        with pytest.raises(ValueError, match=r"within the field track's span \[0.0, 100.0\]"):
+            track(t)
+    with pytest.raises(ValueError, match="itrs_rotation needs an epoch: this dipole field has none"):
+        gm.GeomagneticField("dipole").itrs_rotation(0.0)
+    assert gm.GeomagneticField("dipole", EPOCH).itrs_rotation(0.0).shape == (3, 3)
     with pytest.raises(ValueError, match="t1 > t0"):
         gm.GeomagneticField("dipole").track(lambda t: t, 10.0, 10.0)
