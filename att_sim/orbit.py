@@ -37,7 +37,7 @@ from datetime import UTC, datetime, timedelta
 import numpy as np
 
 from att_sim import environment as env
-from att_sim.epoch import parse_epoch, skyfield_times, timescale
+from att_sim.epoch import format_epoch, parse_epoch, skyfield_times, timescale
 
 J2 = 1.08262668e-3          # EGM-96 / Vallado 2013 Table D-1, with R_E = 6378.137 km
 TLE_STEP = 60.0             # s, node spacing of the TLE table
@@ -333,14 +333,14 @@ class TLEOrbit(Orbit):
     """SGP4 propagation of a two-line element set; ``t`` is seconds past ``epoch`` (not the TLE's)."""
 
     def __init__(self, epoch, line1: str, line2: str):
-        from sgp4.api import Satrec
+        from sgp4.api import SGP4_ERRORS, Satrec
         from skyfield.api import EarthSatellite
 
         self.epoch = parse_epoch(epoch)
         self.line1, self.line2 = check_tle(line1, line2)
         self.satrec = Satrec.twoline2rv(self.line1, self.line2)
         if self.satrec.error:
-            raise ValueError(f"TLE elements are rejected by SGP4 (error {self.satrec.error})")
+            raise ValueError(f"TLE elements are rejected by SGP4: {SGP4_ERRORS[self.satrec.error]}")
         self.satellite = EarthSatellite.from_satrec(self.satrec, timescale())
         self.period = 2.0 * math.pi / (self.satrec.no_kozai / 60.0)
         self.failure: tuple[float, str] | None = None       # earliest tabulated SGP4 failure (t, message)
@@ -381,7 +381,7 @@ class TLEOrbit(Orbit):
             bad = np.asarray(t, float).reshape(-1)[np.isnan(r[..., 0]).reshape(-1)][0]
             when, why = self.failure or (bad, "no position")
             raise ValueError(f"orbit: SGP4 cannot propagate the TLE from t = {when:.0f} s past "
-                             f"{self.epoch.isoformat()} ({why}), needed at t = {bad:.0f} s")
+                             f"{format_epoch(self.epoch)} ({why}), needed at t = {bad:.0f} s")
         return r, v
 
 
