@@ -308,3 +308,15 @@ def test_orbit_from_mapping_each_type():
 def test_orbit_from_mapping_bad(mapping, epoch, words):
     with pytest.raises(ValueError, match=words):
         ob.orbit_from_mapping(mapping, epoch)
+
+
+def test_sgp4_error_cases_of_the_verification_file():
+    """33334 is refused at initialisation, 33333 fails after ~20 min (checksums fixed: the file's are wrong)."""
+    tles, _ = _verification()
+    line1, line2 = (fix_checksum(x) for x in tles["33334"])
+    with pytest.raises(ValueError, match="rejected by SGP4: perturbed eccentricity"):
+        ob.TLEOrbit(EPOCH, line1, line2)
+    line1, line2 = (fix_checksum(x) for x in tles["33333"])
+    o = ob.TLEOrbit(ob.TLEOrbit(EPOCH, line1, line2).tle_epoch, line1, line2)
+    with pytest.raises(ValueError, match="semilatus rectum is less than zero"):
+        ob.check_altitude(o, 0.0, 3600.0, minimum=0.0)
