@@ -324,9 +324,10 @@ def truth_settling_time(case: MagnetorquerCase, kp: float, kd: float, h, *, dt: 
                         settings: SimSettings = SimSettings()) -> tuple[float, int]:
     """Settling time (orbits) and status of one case through the simulator's truth path.
 
-    :func:`att_sim.dynamics.step` (RK4, inputs held over the step like the simulator node) with
-    ``Inputs(dipole=m, field_body=B_b)``, ``B_b`` from :func:`att_sim.environment.field_body` and
-    ``m`` from :func:`att_planner.control.magnetorquer.dipole_command` — none of the batch code. The
+    :func:`att_sim.dynamics.step` like the simulator node: the dipole ``m`` of
+    :func:`att_planner.control.magnetorquer.dipole_command` (from the field at the step's start, as a
+    sampled controller sees it) held over the step, the field ``B_b`` of
+    :func:`att_sim.environment.field_body` evaluated at every RK4 stage — none of the batch code. The
     same settling rule as :func:`simulate_settling` (cap, quiet window).
     """
     q0, w0, psi = initial_states(h)
@@ -336,10 +337,11 @@ def truth_settling_time(case: MagnetorquerCase, kp: float, kd: float, h, *, dt: 
     last_exit = 0.0 if np.any(np.abs(q0[0, :3]) > case.nu) else -np.inf
     last_loud, t = 0.0, 0.0
     quiet_q, quiet_time = settings.quiet_fraction * case.nu, settings.quiet_orbits * period
+    def field(tt, s):
+        return env.field_body(case.orbit, tt, s[:4], psi[0], case.dipole), None
     for k in range(1, int(math.ceil(settings.cap_orbits * period / dt)) + 1):
-        b_body = env.field_body(case.orbit, t, x[:4], psi[0], case.dipole)
-        m = dipole_command(x[:4], x[4:7], b_body, kp, kd, case.m_max)
-        x = dyn.step(sc, x, dyn.Inputs(dipole=m, field_body=b_body), dt)
+        m = dipole_command(x[:4], x[4:7], field(t, x)[0], kp, kd, case.m_max)
+        x = dyn.step(sc, x, dyn.Inputs(dipole=m), dt, field, t)
         t = k * dt
         qmax = np.max(np.abs(x[:3]))
         if qmax > case.nu:
