@@ -23,6 +23,7 @@ from att_sim.dynamics import Spacecraft
 
 MIN_WINDOW = 600.0        # s: the shortest default zone window
 WINDOW_FACTOR = 4.0       # the default window: this many times the eigenaxis slew time, at least MIN_WINDOW
+ZONE_SKY_CACHE = 4        # ZoneSkies a problem keeps (one per window asked for)
 
 
 @dataclass
@@ -62,24 +63,35 @@ class ManeuverProblem:
     epoch: datetime | None = None
     sky: object | None = None
     _zone_skies: dict = field(default_factory=dict, init=False, repr=False, compare=False)
+    _default_window: tuple = field(default=(), init=False, repr=False, compare=False)
 
     def time_left(self) -> float:
         return np.inf if self.deadline is None else self.deadline - time.monotonic()
 
     def zone_sky(self, window: float | None = None) -> ZoneSky:
         """The cones (first, as inertial keep-out zones of ``sensor_axis``) and the zones over
-        ``[0, window]`` s, built once per window and field values (cached).
+        ``[0, window]`` s, built once per window and field values (the last :data:`ZONE_SKY_CACHE` kept).
 
         Default window: :data:`WINDOW_FACTOR` × :meth:`slew_time_bound`, at least :data:`MIN_WINDOW`:
         room for detours around the zones. A plan longer than the window cannot be judged against
         the fitted zones (the ZoneSky refuses those times); a method asks for a longer window then.
         """
         if window is None:
-            window = max(MIN_WINDOW, WINDOW_FACTOR * self.slew_time_bound())
-        key = (float(window), tuple(map(id, self.cones)), tuple(map(id, self.zones)), id(self.sky),
-               np.asarray(self.sensor_axis, float).tobytes())
+            bound = (np.asarray(self.q_initial, float).tobytes(), np.asarray(self.q_final, float).tobytes(),
+                     self.sensor_target is None, self.rate_max, self.wheel_momentum_max, id(self.spacecraft),
+                     self.spacecraft.body_torque_max)
+            if self._default_window[:1] != (bound,):
+                self._default_window = (bound, max(MIN_WINDOW, WINDOW_FACTOR * self.slew_time_bound()),
+                                        self.spacecraft)
+            window = self._default_window[1]
+        # by value (the fields of the cones and zones); the sky by identity (the cached ZoneSky holds it)
+        key = (float(window), id(self.sky), np.asarray(self.sensor_axis, float).tobytes(),
+               tuple((c.direction.tobytes(), c.half_angle, c.name) for c in self.cones),
+               tuple((z.name, z.body, z.sensor_axis.tobytes(), z.half_angle, z.keep_in,
+                      None if z.direction is None else z.direction.tobytes()) for z in self.zones))
         if key not in self._zone_skies:
-            self._zone_skies.clear()
+            if len(self._zone_skies) >= ZONE_SKY_CACHE:
+                self._zone_skies.pop(next(iter(self._zone_skies)))      # the oldest
             zones = zones_from_cones(self.cones, self.sensor_axis) + list(self.zones)
             self._zone_skies[key] = ZoneSky(zones, self.sky, float(window))
         return self._zone_skies[key]
