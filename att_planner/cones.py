@@ -14,7 +14,7 @@ import numpy as np
 
 from att_msgs_py.errors import ErrorCode, RequestError
 from att_msgs_py.types import ZONE_BODIES, Cone, Zone
-from att_planner.zones import ZoneSky
+from att_planner.zones import ZoneSky, same_axis
 from att_sim import rotations as rot
 
 
@@ -120,7 +120,7 @@ def contradictory_zones(zone_sky: ZoneSky) -> str:
     names, keep_in, s = zone_sky.names, zone_sky.keep_in, zone_sky.sensor_axes
     for i in np.flatnonzero(keep_in):
         for j in range(len(names)):
-            if j == i or not np.array_equal(s[i], s[j]):
+            if j == i or not same_axis(s[i], s[j]):
                 continue
             gamma = _angle(axes[i], axes[j])
             if not keep_in[j] and gamma + half[i] <= half[j]:
@@ -146,7 +146,7 @@ def zone_at_end(problem, zone_sky: ZoneSky | None = None) -> str:
         ends.append(("goal attitude", zs.margins(0.0, problem.q_final, true=True)[0]))
     else:
         target = np.asarray(problem.sensor_target, float)
-        own = np.all(zs.sensor_axes == np.asarray(problem.sensor_axis, float), axis=1)
+        own = np.array([same_axis(s, problem.sensor_axis) for s in zs.sensor_axes], bool)
         angle = np.arccos(np.clip(zs.true_axes(0.0) @ target / np.linalg.norm(target), -1.0, 1.0))
         m = np.where(zs.keep_in, zs.true_half_angles(0.0) - angle, angle - zs.true_half_angles(0.0))
         ends.append(("sensor_target direction", np.where(own, m, np.inf)))

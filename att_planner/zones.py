@@ -44,6 +44,12 @@ def zones_from_cones(cones: list[Cone], sensor_axis) -> list[Zone]:
             for c in cones]
 
 
+def same_axis(a, b) -> bool:
+    """Whether two sensor axes are the same direction (to 1e-12)."""
+    a, b = np.asarray(a, float), np.asarray(b, float)
+    return bool(np.allclose(a / np.linalg.norm(a), b / np.linalg.norm(b), rtol=0.0, atol=1e-12))
+
+
 def _clenshaw(x, rows):
     """``Σ_j c_j T_j(x)`` by Clenshaw's recurrence for the coefficient vectors ``rows`` (c_0 first);
     ``x`` a numpy column (K, 1) or a CasADi scalar (the rows then CasADi columns)."""
@@ -247,10 +253,11 @@ class ZoneSky:
 
     # ------------------------------------------------------------------ margins
     def margins(self, t, q, true: bool = False) -> np.ndarray:
-        """Margins (rad, ≥ 0 clear) of attitudes ``q`` (K, 4) at times ``t`` (K,) or a scalar, (K, Z):
-        the fitted zones, or with ``true`` the zones straight from the sky."""
-        q = np.asarray(q, float).reshape(-1, 4)
-        t = np.broadcast_to(np.asarray(t, float), (len(q),))
+        """Margins (rad, ≥ 0 clear) of attitudes ``q`` (K, 4) at times ``t`` (K,), (K, Z); either may be
+        a single one (broadcast): the fitted zones, or with ``true`` the zones straight from the sky."""
+        q, t = np.asarray(q, float).reshape(-1, 4), np.asarray(t, float).reshape(-1)
+        K = max(len(q), len(t))
+        q, t = np.broadcast_to(q, (K, 4)), np.broadcast_to(t, (K,))
         Z = len(self.zones)
         out = np.zeros((len(q), Z))
         if not Z:

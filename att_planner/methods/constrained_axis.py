@@ -33,7 +33,7 @@ from att_planner.methods.axis_rotations import (
     no_torque_limit,
 )
 from att_planner.problem import ManeuverProblem
-from att_planner.zones import ZoneSky
+from att_planner.zones import ZoneSky, same_axis
 from att_sim import rotations as rot
 
 METHOD = "constrained_axis"
@@ -80,7 +80,7 @@ def cone_riding_legs(problem: ManeuverProblem, zone_index: int, side: int, ride_
     theta = theta0 if half_angle is None else half_angle
     u, v = rot.orthonormal_basis(w)              # azimuth ψ measured from u towards v
     r = sensor / np.linalg.norm(sensor)
-    own_sensor = np.array_equal(sensor, np.asarray(problem.sensor_axis, float))
+    own_sensor = same_axis(sensor, problem.sensor_axis)
     q0 = rot.normalize(np.asarray(problem.q_initial, float))
     q_goal = goal_attitude(problem)
     b0, bf = rot.dcm(q0) @ r, rot.dcm(q_goal) @ r

@@ -120,10 +120,11 @@ def test_a_zone_rotating_at_the_orbit_rate_margins_by_hand():
     q = rot.from_axis_angle([0.0, 0.0, 1.0], -math.pi / 2)          # body +y -> inertial +x
     t = np.linspace(0, 1200, 7)
     rho = math.asin(R_E / SKY.r)
-    m = zs.margins(t, np.tile(q, (7, 1)))
+    m = zs.margins(t, q)                                              # one attitude over 7 times
     np.testing.assert_allclose(m[:, 0], np.pi - SKY.n * t - rho, atol=1e-8)
     np.testing.assert_allclose(m[:, 1], -(np.pi - SKY.n * t - rho), atol=1e-8)     # keep-in: sign flipped
     np.testing.assert_allclose(zs.margins(t, np.tile(q, (7, 1)), true=True), m, atol=1e-8)
+    assert zs.margins(600.0, np.tile(q, (3, 1))).shape == (3, 2)
 
 
 def test_frozen_zones_stay_where_they_were_at_t0(long_sky):
