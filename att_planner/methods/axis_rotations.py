@@ -57,29 +57,12 @@ def leg_profile(problem: ManeuverProblem, legs: list[AxisLeg], pieces_per_half: 
     (for cone checks). With a gyroscopic term each half is split into ``pieces_per_half`` pieces
     holding the mean torque of the piece (default 32; 1 when the axis is principal).
     """
-    return _profile(problem, legs, pieces_per_half)[:6]
-
-
-def leg_path(problem: ManeuverProblem, legs: list[AxisLeg]) -> tuple[np.ndarray, np.ndarray]:
-    """``(t_dense, q_dense)``: the dense attitude path of :func:`leg_profile` (200 samples per leg,
-    even in angle) with the physical time of each sample, for zones that move: on a leg the angle
-    is ``½ α τ²`` up to half-way, then ``φ − ½ α (T − τ)²``."""
-    out = _profile(problem, legs, 1)
-    return out[6], out[5]
-
-
-def _profile(problem: ManeuverProblem, legs: list[AxisLeg], pieces_per_half: int | None):
     sc = problem.spacecraft
     J = sc.inertia
     q = rot.normalize(np.asarray(problem.q_initial, float))
-    ts, us, qs, ws, durations, dense, dense_t = [0.0], [], [q], [np.zeros(3)], [], [q[None]], [np.zeros(1)]
+    ts, us, qs, ws, durations, dense = [0.0], [], [q], [np.zeros(3)], [], [q[None]]
     t0 = 0.0
-    for leg in legs:
-        if leg.angle <= 1e-12:
-            continue
-        e = rot.dcm(q).T @ leg.axis
-        alpha = axis_acceleration(J, e, leg.angle, sc.body_torque_max)
-        T = 2.0 * np.sqrt(leg.angle / alpha)
+    for leg, q, e, alpha, T in _kinematics(problem, legs):
         gyro = np.cross(e, J @ e)
         n = pieces_per_half or (1 if np.linalg.norm(gyro) < 1e-12 * np.linalg.norm(J) else 32)
         half = T / 2
@@ -96,19 +79,47 @@ def _profile(problem: ManeuverProblem, legs: list[AxisLeg], pieces_per_half: int
         ts += list(t0 + local[1:]) + [t0 + T]
         qs += list(q_knots[1:])
         ws += list(rate[1:, None] * e)
-        swept = leg.angle * np.linspace(0.0, 1.0, 200)
-        dense.append(rot.multiply(_axis_rotation(leg.axis, swept), q))
-        dense_t.append(t0 + np.where(swept <= leg.angle / 2, np.sqrt(2 * swept / alpha),
-                                     T - np.sqrt(2 * np.maximum(leg.angle - swept, 0.0) / alpha)))
-        q = rot.multiply(_axis_rotation(leg.axis, leg.angle), q)
-        qs.append(q)
+        dense.append(rot.multiply(_axis_rotation(leg.axis, leg.angle * np.linspace(0.0, 1.0, 200)), q))
+        qs.append(rot.multiply(_axis_rotation(leg.axis, leg.angle), q))
         ws.append(np.zeros(3))
         durations.append(T)
         t0 += T
     us.append(np.zeros(3))
     torque = np.clip(np.array(us), -sc.body_torque_max, sc.body_torque_max)
-    return (np.array(ts), torque, np.array(qs), np.array(ws), durations, np.concatenate(dense),
-            np.concatenate(dense_t))
+    return (np.array(ts), torque, np.array(qs), np.array(ws), durations, np.concatenate(dense))
+
+
+def leg_path(problem: ManeuverProblem, legs: list[AxisLeg]) -> tuple[np.ndarray, np.ndarray]:
+    """``(t_dense, q_dense)``: the dense attitude path of :func:`leg_profile` (200 samples per leg,
+    even in angle) with the physical time of each sample, for zones that move: on a leg the angle
+    is ``½ α τ²`` up to half-way, then ``φ − ½ α (T − τ)²``."""
+    ts, qs = [np.zeros(1)], [rot.normalize(np.asarray(problem.q_initial, float))[None]]
+    t0 = 0.0
+    for leg, q, _, alpha, T in _kinematics(problem, legs):
+        swept = leg.angle * np.linspace(0.0, 1.0, 200)
+        qs.append(rot.multiply(_axis_rotation(leg.axis, swept), q))
+        ts.append(t0 + np.where(swept <= leg.angle / 2, np.sqrt(2 * swept / alpha),
+                                T - np.sqrt(2 * np.maximum(leg.angle - swept, 0.0) / alpha)))
+        t0 += T
+    return np.concatenate(ts), np.concatenate(qs)
+
+
+def leg_durations(problem: ManeuverProblem, legs: list[AxisLeg]) -> list[float]:
+    """Duration (s) of each leg of non-zero angle: ``2 sqrt(φ / α)`` (module docstring)."""
+    return [T for *_, T in _kinematics(problem, legs)]
+
+
+def _kinematics(problem: ManeuverProblem, legs: list[AxisLeg]):
+    """``(leg, q at its start, body axis e, α, duration)`` of each leg of non-zero angle, in turn."""
+    sc = problem.spacecraft
+    q = rot.normalize(np.asarray(problem.q_initial, float))
+    for leg in legs:
+        if leg.angle <= 1e-12:
+            continue
+        e = rot.dcm(q).T @ leg.axis
+        alpha = axis_acceleration(sc.inertia, e, leg.angle, sc.body_torque_max)
+        yield leg, q, e, alpha, 2.0 * np.sqrt(leg.angle / alpha)
+        q = rot.multiply(_axis_rotation(leg.axis, leg.angle), q)
 
 
 def _semi_free_goal(problem: ManeuverProblem) -> np.ndarray:

@@ -27,8 +27,8 @@ from att_planner.methods.axis_rotations import (
     AxisLeg,
     eigenaxis_leg,
     goal_attitude,
+    leg_durations,
     leg_path,
-    leg_profile,
     legs_plan,
     no_torque_limit,
 )
@@ -74,7 +74,8 @@ def cone_riding_legs(problem: ManeuverProblem, zone_index: int, side: int, ride_
     else:
         zs = problem.zone_sky()
         sensor, name = zs.sensor_axes[zone_index], zs.names[zone_index]
-        w0, theta0 = zs.true_axes(0.0)[zone_index], float(zs.true_half_angles(0.0)[zone_index])
+        w0 = zs.true_axes(0.0)[zone_index] if axis is None else None
+        theta0 = float(zs.true_half_angles(0.0)[zone_index]) if half_angle is None else None
     w = np.asarray(w0 if axis is None else axis, float)
     w = w / np.linalg.norm(w)
     theta = theta0 if half_angle is None else half_angle
@@ -138,7 +139,7 @@ def _moving_ride(problem: ManeuverProblem, zs: ZoneSky, z: int, side: int, ride_
                                 zs.axes(t_c)[z], float(zs.half_angles(t_c)[z]))
         if legs is None:
             return None, t_star, widen
-        d = leg_profile(problem, legs, pieces_per_half=1)[4]
+        d = leg_durations(problem, legs)
         if len(d) < 2 or not zs.moving:
             break
         t_star = min(d[0] + d[1] / 2, zs.window)
