@@ -32,6 +32,7 @@ from att_sim import epoch as epochs
 from att_sim import orbit as orbits
 from att_sim.dynamics import Spacecraft
 from att_sim.environment import OrbitParams
+from att_sim.geomagnetic import GeomagneticField
 
 CONFIG_ENV = "ATT_CONFIG_PATH"
 
@@ -204,9 +205,11 @@ def orbit_model_from_params(path, shared: dict, epoch: datetime | None) -> orbit
     if p.get("type", "circular") == "circular":
         return orbits.CircularOrbit(orbit_from_params(p))
     try:
-        return orbits.orbit_from_mapping(p, epoch)
+        orbit = orbits.orbit_from_mapping(p, epoch)
+        orbits.check_altitude(orbit, 0.0, 0.0)          # SGP4 propagates and the orbit is above 150 km at t = 0
     except ValueError as err:
         raise _attached(path, "orbit", err) from None
+    return orbit
 
 
 def field_model_from_params(path, shared: dict, epoch: datetime | None) -> str:
@@ -216,6 +219,10 @@ def field_model_from_params(path, shared: dict, epoch: datetime | None) -> str:
     if model == "igrf14" and epoch is None:
         raise _invalid(path, "field_model igrf14 needs the scenario's epoch (the field and the Earth's rotation "
                              "depend on the date)")
+    try:
+        GeomagneticField(model, epoch)                   # IGRF-14's span of years
+    except ValueError as err:
+        raise _attached(path, "field_model", err) from None
     return model
 
 
@@ -312,8 +319,8 @@ def zones_from_params(path, shared: dict, epoch: datetime | None) -> list[Zone]:
             raise _invalid(path, f"{label}.half_angle_deg ({what}) must be in ({low:g}, {high:g}) deg, got {angle:g}")
         keep_in = _flag(path, z, "keep_in", f"{label}.keep_in")
         if (body == "inertial") != ("direction" in z):
-            raise _invalid(path, f"{label}.direction is {'needed' if body == 'inertial' else 'only for'} body "
-                                 f"inertial")
+            need = "needed for" if body == "inertial" else "only for"
+            raise _invalid(path, f"{label}.direction (a unit inertial vector) is {need} body inertial")
         direction = _vector3(path, z, "direction", f"{label}.direction", unit=True) if body == "inertial" else None
         zones.append(Zone(name=name, body=body, sensor_axis=axis, half_angle=math.radians(angle), keep_in=keep_in,
                           direction=direction))
