@@ -75,3 +75,26 @@ def test_idle_mode_applies_nothing(sim):
     sim.set_command(command(ControlMode.IDLE, [0.1, 0.1, 0.1], [1, 1, 1], [0.1, 0, 0]))
     sim.advance(0.5)
     assert np.allclose(sim.x[4:7], 0) and np.allclose(sim.applied.body_torque, 0)
+
+
+def test_an_environment_that_fails_halts_propagation_and_changes_nothing():
+    """E.g. SGP4 failing on a decayed TLE: the step is not taken, the reason is kept."""
+    from att_sim import world
+    from att_sim.geomagnetic import GeomagneticField
+    from att_sim.orbit import CircularOrbit
+
+    class Decaying(CircularOrbit):
+        def state(self, t):
+            if t > 1.0:
+                raise ValueError(f"orbit: SGP4 fails near t = {t:.0f} s: decayed")
+            return super().state(t)
+
+    s = scenario.load("swift_demo")
+    e = world.Environment(None, Decaying(s.orbit), GeomagneticField("dipole"), None, s.spacecraft)
+    sim = Simulation(s.spacecraft, environment=e, omega0=[0.01, 0, 0])
+    sim.advance(0.5)
+    sim.advance(0.5)
+    x = sim.x.copy()
+    sim.advance(0.5)
+    assert sim.halted and "environment failed at t = 1.000 s" in sim.halt_reason and "decayed" in sim.halt_reason
+    assert sim.t == 1.0 and np.array_equal(sim.x, x)
