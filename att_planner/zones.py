@@ -125,7 +125,12 @@ class ZoneSky:
                 cache[body] = (self.sky.nadir(t), self.sky.earth_angular_radius(t))
         axes = [np.broadcast_to(cache[self.zones[i].body][0], t.shape + (3,)) for i in self._moving]
         half = [np.broadcast_to(cache[self.zones[i].body][1] + self._half0[i], t.shape) for i in self._moving]
-        return np.concatenate([np.stack(axes, -2).reshape(len(t), -1), np.stack(half, -1)], axis=-1)
+        out = np.concatenate([np.stack(axes, -2).reshape(len(t), -1), np.stack(half, -1)], axis=-1)
+        bad = ~np.isfinite(out).all(axis=-1)
+        if bad.any():
+            raise ValueError(f"the sky is not finite at t = {t[bad][0]:.6g} s (an orbit that decayed or left "
+                             f"its model's span): no zone can be placed there")
+        return out
 
     def _fit(self):
         todo, done = [(0.0, self.window)], []

@@ -106,6 +106,18 @@ def test_outside_the_window_the_fit_refuses_but_the_truth_answers(long_sky):
     assert ZoneSky(ZONES[3:], None, 10.0).axes(1e6).shape == (1, 3)       # inertial: any time
 
 
+def test_a_sky_that_is_not_finite_is_refused_not_fitted_or_judged():
+    class Decayed(CircularSky):
+        def position(self, t):
+            return np.where(np.asarray(t)[..., None] > 400.0, np.nan, super().position(t))
+
+    with pytest.raises(ValueError, match="not finite at t = 4"):
+        ZoneSky(ZONES, Decayed(), 600.0)
+    zs = ZoneSky(ZONES, Decayed(), 300.0)
+    with pytest.raises(ValueError, match="not finite"):
+        zs.margins(np.array([100.0, 500.0]), rot.IDENTITY, true=True)
+
+
 def test_earth_limb_at_580_km_is_66_deg_plus_its_margin():
     zs = ZoneSky(ZONES[2:3], SKY, 600.0)
     expected = math.degrees(math.asin(R_E / (R_E + 580e3)))
