@@ -1,7 +1,8 @@
 """Time-optimal attitude scheduling with reaction wheels through unordered targets.
 
 Olivares & Staffetti (2018): visit every target attitude once, in the fastest order, starting and
-ending at rest, with wheel torques ``|T_u,i| ≤ T̄`` and wheel speeds ``|Ω_i| ≤ Ω̄``; at each target
+ending at rest, with wheel torques ``|T_u,i| ≤ T̄`` and wheel speeds ``|Ω_i| ≤ Ω̄`` (inertial, and
+relative to the body, the speed the truth model of :mod:`att_sim.dynamics` limits); at each target
 the body rate about z is zero (the other rates are free and carry over).
 
 Model (the truth model of :mod:`att_sim.dynamics`, J = I_s the total inertia, G the wheel axes)::
@@ -37,6 +38,11 @@ when the enumeration stops on the bound, no unsolved order can beat the incumben
 and given that the NLPs reach their global minima). :func:`exhaustive_order_search` solves all n!
 orders as an independent check (time reversal maps a schedule of an order onto one of the
 reversed order with the same duration, so pairs must agree).
+
+Zones (issue 13, :mod:`.transcription`): the cones and zones of ``problem.zone_sky()``, moving
+or not, keep-out or keep-in, each of its own sensor, are kept at every node and interval midpoint
+of every leg at its physical time along the tour (a leg starts at the sum of the earlier legs'
+durations), exactly in the phase durations; the leg bounds leave them out (still lower bounds).
 
 Note on the paper's dynamics: ``|Ω| ≤ 710 rad/s`` with ``I_w = 1.69e-4`` gives h̄ = 0.12 N m s and
 t_sat = h̄ / T̄ = 11.9 s; the body-rate bound 0.04 rad/s is implied by the wheel box (|ω_i| ≤ h̄ /

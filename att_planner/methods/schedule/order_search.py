@@ -32,6 +32,8 @@ def leg_bound_matrix(sc: dyn.Spacecraft, q_start, targets: list[np.ndarray], q_e
     order is a lower bound on that order's schedule time (on the same grid, if the leg NLPs reach
     their global minima). Free–free legs are symmetric under time reversal, so each pair is
     solved once. Entries not computed (deadline, solver failure) are 0 (still a valid bound).
+    The leg problems leave out the zones: a relaxation, so the bound stays a bound with zones
+    (moving or not: a leg's start time in the tour is not known here).
     """
     n = len(targets)
     nodes = [q_start, *targets, q_end]
@@ -128,19 +130,31 @@ class OrderSolver:
     substeps: int = SUBSTEPS
     rate_max: float = np.inf
     deadline: float | None = None
+    zones: object = None              # att_planner.zones.ZoneSky or None
+    zone_margin: float = 0.0          # rad, δ of every zone constraint
 
     @classmethod
-    def of(cls, problem: ManeuverProblem, substeps: int = SUBSTEPS) -> OrderSolver:
+    def of(cls, problem: ManeuverProblem, substeps: int = SUBSTEPS, zone_margin: float = 0.0,
+           zone_window: float | None = None) -> OrderSolver:
+        """The solver of ``problem``, its zones fitted over ``zone_window`` s (default: the problem's)."""
         q_start = rot.normalize(np.asarray(problem.q_initial, float))
         q_end = rot.normalize(np.asarray(problem.q_final, float))
         quats = {k: rot.normalize(np.asarray(v, float)) for k, v in problem.targets.items()}
-        return cls(problem.spacecraft, q_start, q_end, quats, substeps, problem.rate_max, problem.deadline)
+        zones = problem.zone_sky(zone_window)
+        return cls(problem.spacecraft, q_start, q_end, quats, substeps, problem.rate_max, problem.deadline,
+                   zones if zones.zones else None, zone_margin)
+
+    @property
+    def moving(self) -> bool:
+        """Whether a zone moves (an order and its reverse then differ)."""
+        return self.zones is not None and self.zones.moving
 
     def expired(self) -> bool:
         return self.deadline is not None and time.monotonic() > self.deadline
 
     def solve(self, order, intervals: int, guess: Solved | None = None, expand: bool | None = None) -> Solved:
-        tr = cached_transcription(self.sc, len(order), intervals, self.substeps, self.rate_max, expand)
+        tr = cached_transcription(self.sc, len(order), intervals, self.substeps, self.rate_max, expand,
+                                  self.zones, self.zone_margin)
         wall = None if self.deadline is None else self.deadline - time.monotonic()
         start_guess = tr.resample(guess.sol) if guess is not None else None
         sol = tr.solve(self.q_start, [self.targets[k] for k in order], self.q_end, guess=start_guess,
@@ -166,7 +180,8 @@ def search_orders(solver: OrderSolver, names: list, intervals: int, candidates: 
     solved: list[Solved] = []
     incumbent = np.inf
     unsolved_bound = np.inf   # smallest leg bound among the orders not solved
-    reversible = rot.angle_between(solver.q_start, solver.q_end) < 1e-9
+    # time reversal maps a tour onto its reverse among zones that do not move, not among moving ones
+    reversible = rot.angle_between(solver.q_start, solver.q_end) < 1e-9 and not solver.moving
     for bound, idx in orders_by_lower_bound(C):
         if bound >= incumbent or len(solved) >= (max_order_solves if prove else candidates) or solver.expired():
             unsolved_bound = bound
@@ -199,7 +214,8 @@ def search_orders(solver: OrderSolver, names: list, intervals: int, candidates: 
 def exhaustive_order_search(problem: ManeuverProblem, *, intervals: int = 8, substeps: int = SUBSTEPS,
                             progress=None) -> list[dict]:
     """Solve the multiphase problem of every order (all n! of them, reversals included, as an
-    independent check of the time-reversal symmetry and of the NLP's local minima) and return
+    independent check of the time-reversal symmetry — which moving zones break — and of the NLP's
+    local minima) and return
     ``[{"order", "tf", "bound", "converged"}]`` sorted by ``tf``; ``bound`` is the leg lower bound
     of :func:`leg_bound_matrix` on the same grid (so ``bound ≤ tf`` must hold for every order)."""
     solver = OrderSolver.of(problem, substeps)

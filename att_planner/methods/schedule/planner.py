@@ -7,7 +7,7 @@ import numpy as np
 
 from att_msgs_py.types import ControlKind, Passage, Plan, Status
 from att_planner.methods.schedule.order_search import OrderSolver, Solved, search_orders
-from att_planner.methods.schedule.transcription import SUBSTEPS
+from att_planner.methods.schedule.transcription import SUBSTEPS, eigenaxis_rest_to_rest_time
 from att_planner.problem import ManeuverProblem
 from att_planner.verification import verify as verify_plan
 from att_sim import rotations as rot
@@ -28,6 +28,36 @@ def _plan(solver: OrderSolver, final: Solved) -> Plan:
                 method=METHOD, nit=sol.nit, passages=passages, stats={"wheel_speed": sol.h * sc.wheel_speed_max})
 
 
+def _finished(solver: OrderSolver, final: Solved, stats: dict, t_begin: float, cpu_begin: float) -> Plan:
+    """The plan of ``final`` with its status, message and timing."""
+    plan = _plan(solver, final)
+    stats.update(iterations=final.sol.nit, ipopt_status=final.sol.return_status,
+                 intervals_used=final.transcription.intervals)
+    status = Status.OPTIMAL if final.sol.converged else Status.FEASIBLE
+    message = f"order {''.join(final.order) if all(len(k) == 1 for k in final.order) else final.order}" \
+              f" t_f = {plan.duration:.2f} s"
+    if solver.expired():
+        status, message = Status.BUDGET_EXPIRED, message + " (deadline reached: best so far)"
+    return _finish(plan, status, message, t_begin, cpu_begin, stats)
+
+
+def _refine_zones(problem: ManeuverProblem, solver: OrderSolver, final: Solved, plan: Plan, rounds: int,
+                  stats: dict, t_begin: float, cpu_begin: float) -> Plan:
+    """While the verified ``plan`` enters a zone between the NLP's points, double the intervals per
+    phase and re-solve its order from it (``rounds`` times at most, within the deadline); the
+    intervals tried go to ``stats['zone_refinements']``."""
+    tried = stats["zone_refinements"] = []
+    while plan.verification.min_cone_margin < 0 and len(tried) < rounds and not solver.expired():
+        finer = solver.solve(final.order, 2 * final.transcription.intervals, guess=final)
+        tried.append(finer.transcription.intervals)
+        if not np.isfinite(finer.tf):
+            break
+        final = finer
+        plan = _finished(solver, final, stats, t_begin, cpu_begin)
+        plan.verification = verify_plan(problem, plan)
+    return plan
+
+
 def _finish(plan: Plan, status: Status, message: str, t_begin: float, cpu_begin: float, stats: dict) -> Plan:
     """Fill status and timing: ``wall_time`` is wall time, ``stats['cpu_seconds']`` the process CPU
     time (the fairer figure on a shared machine)."""
@@ -37,9 +67,21 @@ def _finish(plan: Plan, status: Status, message: str, t_begin: float, cpu_begin:
     return plan
 
 
+def zone_window(problem: ManeuverProblem) -> float | None:
+    """The span (s) the zones are fitted over for a tour, or None (the problem's default) when no
+    zone moves: twice (targets + 1) legs of the longest eigenaxis rest-to-rest transfer between
+    any two of the tour's attitudes, at least the problem's default window."""
+    if all(z.body == "inertial" for z in problem.zones):
+        return None
+    nodes = [problem.q_initial, *problem.targets.values(), problem.q_final]
+    longest = max(eigenaxis_rest_to_rest_time(problem.spacecraft, a, b) for a in nodes for b in nodes)
+    return max(problem.zone_sky().window, 2.0 * len(nodes[1:]) * longest)
+
+
 def plan_schedule(problem: ManeuverProblem, *, order=None, search_intervals: int = 8, intervals: int = 24,
                   substeps: int = SUBSTEPS, candidates: int = 2, prove: bool = False, max_order_solves: int = 1000,
-                  second_start_margin: float = 0.01, verify: bool = True) -> Plan:
+                  second_start_margin: float = 0.01, cone_margin_deg: float = 0.05, zone_refinements: int = 2,
+                  verify: bool = True) -> Plan:
     """Fastest rest-to-rest schedule through every target of ``problem.targets``, in the best order found.
 
     Targets are quaternions [x, y, z, w] (either sign). Start at rest at ``problem.q_initial`` with
@@ -59,6 +101,14 @@ def plan_schedule(problem: ManeuverProblem, *, order=None, search_intervals: int
     not convex). ``order`` (list of names) skips the search. The winner is re-solved on
     ``intervals`` per phase (warm start) and verified (:mod:`att_planner.verification`, every
     passage included). The plan's ``passages`` give the order and the passage times.
+
+    Zones (``problem.zone_sky()``: the cones, then the zones, moving or not, keep-out or keep-in,
+    each of its own sensor): every leg keeps every zone at the nodes and interval midpoints, at
+    their physical time along the whole tour (:mod:`.transcription`), tightened by
+    ``cone_margin_deg``; moving zones are fitted over :func:`zone_window` and break the time
+    reversal (both directions of an order are then solved as distinct orders). When the verified
+    plan still enters a zone between those points, the intervals per phase are doubled and the
+    order re-solved from it, ``zone_refinements`` times at most.
     """
     t_begin, cpu_begin = time.perf_counter(), time.process_time()
     names = list(problem.targets)
@@ -66,7 +116,9 @@ def plan_schedule(problem: ManeuverProblem, *, order=None, search_intervals: int
         raise ValueError("order must list every target name exactly once")
     if candidates < 1 or search_intervals < 1 or intervals < 1:
         raise ValueError("candidates, search_intervals and intervals must be positive")
-    solver = OrderSolver.of(problem, substeps)
+    if not (np.isfinite(cone_margin_deg) and 0.0 <= cone_margin_deg <= 5.0) or zone_refinements < 0:
+        raise ValueError("cone_margin_deg must be in [0, 5] and zone_refinements >= 0")
+    solver = OrderSolver.of(problem, substeps, np.deg2rad(cone_margin_deg), zone_window(problem))
     stats: dict = {"orders_solved": 0, "search_intervals": search_intervals, "intervals": intervals,
                    "substeps": substeps}
     empty = Plan(torque=np.zeros((0, problem.spacecraft.n_wheels)), control_kind=ControlKind.WHEEL_TORQUE,
@@ -92,17 +144,11 @@ def plan_schedule(problem: ManeuverProblem, *, order=None, search_intervals: int
             if fine.tf <= best.tf * (1 + 1e-6):
                 final = fine
             stats["refine_status"] = fine.sol.return_status
-        plan = _plan(solver, final)
-        stats.update(iterations=final.sol.nit, ipopt_status=final.sol.return_status,
-                     intervals_used=final.transcription.intervals)
-        status = Status.OPTIMAL if final.sol.converged else Status.FEASIBLE
-        message = f"order {''.join(final.order) if all(len(k) == 1 for k in final.order) else final.order}" \
-                  f" t_f = {plan.duration:.2f} s"
-        if solver.expired():
-            status, message = Status.BUDGET_EXPIRED, message + " (deadline reached: best so far)"
-        plan = _finish(plan, status, message, t_begin, cpu_begin, stats)
+        plan = _finished(solver, final, stats, t_begin, cpu_begin)
         if verify:
             plan.verification = verify_plan(problem, plan)
+            if solver.zones is not None and plan.verification.min_cone_margin < 0 and zone_refinements:
+                plan = _refine_zones(problem, solver, final, plan, zone_refinements, stats, t_begin, cpu_begin)
         return plan
     except RuntimeError as exc:  # CasADi/IPOPT failures are reported, not raised
         return _finish(empty, Status.FAILED, f"solver error: {exc}", t_begin, cpu_begin, stats)

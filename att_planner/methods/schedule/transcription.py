@@ -1,6 +1,15 @@
 """The multiple-shooting NLP of a minimum-time schedule for a fixed order of targets (model of
 :mod:`att_planner.methods.schedule`): normalisation, one ZOH interval, the multiphase transcription
-and its solver cache."""
+and its solver cache.
+
+Zones (:mod:`att_planner.zones`, the cones first): every zone is imposed at every node and at the
+middle of every interval (the attitude there by one more RK4 step of half the interval from the
+node, the propagation itself unchanged), tightened by a margin δ like the time-optimal NLP's:
+keep-out ``a_z · R(q) s_z ≤ cos(θ_z + δ)``, keep-in ``≥ cos(θ_z − δ)``. A moving zone is evaluated
+at the point's physical time over the whole tour, ``t = t_sat Σ dτ`` of the intervals before it
+(so a leg starts at the sum of the earlier legs' durations), through the ZoneSky's Chebyshev series
+of that CasADi expression: exact in the phase durations. The tour is then bounded by the zones'
+window. Without zones nothing is added: the NLP is the zone-free one."""
 from __future__ import annotations
 
 import time
@@ -105,12 +114,13 @@ class MultiphaseTranscription:
 
     Built once per (number of targets, intervals per phase); the target quaternions of an order
     and the end attitude are NLP parameters, so every order of the same set reuses the solver.
-    Either end may be at rest (h = 0) or a passage (only ω_z = 0), chosen per solve.
+    Either end may be at rest (h = 0) or a passage (only ω_z = 0), chosen per solve. ``zones``: a
+    :class:`att_planner.zones.ZoneSky` (module docstring) with ``zone_margin`` δ (rad), or None.
     """
 
     def __init__(self, sc: dyn.Spacecraft, n_targets: int, intervals: int = 12, substeps: int = SUBSTEPS,
                  rate_max: float = np.inf, bound_margin: float = 1e-6, tol: float = 1e-7,
-                 max_iter: int = 1500, expand: bool | None = None):
+                 max_iter: int = 1500, expand: bool | None = None, zones=None, zone_margin: float = 0.0):
         if intervals < 1 or substeps < 1:
             raise ValueError("intervals and substeps must be positive integers")
         self.sc, self.scale = sc, _scaling(sc)
@@ -138,6 +148,13 @@ class MultiphaseTranscription:
         g += [rate_z @ H[:, 0], rate_z @ H[:, K]]
         n_eq = sum(int(gi.numel()) for gi in g)
         lbg, ubg = [0.0] * n_eq, [0.0] * n_eq
+        # the truth model cuts a wheel's torque at its speed limit relative to the body, Ω − Gᵀω
+        # (att_sim.dynamics): with (1) that is (1 + I_w Gᵀ J⁻¹ G) Ω, linear in h like the rate, so the
+        # bound at the nodes holds everywhere; the box on h keeps the inertial speed within it too
+        relative = ca.DM(np.eye(n_w) - sc.wheel_axes.T @ self.scale.rate_per_h / sc.wheel_speed_max)
+        g.append(ca.vec(relative @ H))
+        lbg += [-(1.0 - bound_margin)] * (n_w * (K + 1))
+        ubg += [1.0 - bound_margin] * (n_w * (K + 1))
         # body-rate box, only where the wheel box does not already imply it (rates are linear in h)
         rate_rows = [i for i in range(3) if np.abs(self.scale.rate_per_h[i]).sum() > rate_max]
         if rate_rows:
@@ -145,6 +162,22 @@ class MultiphaseTranscription:
             g.append(ca.vec(R @ H))
             lbg += [-1.0] * (len(rate_rows) * (K + 1))
             ubg += [1.0] * (len(rate_rows) * (K + 1))
+        self.zones = zones if zones is not None and zones.zones else None
+        if self.zones is not None:
+            q_mid, _ = step(Q[:, :K], H[:, :K], U, dtau / 2)
+            t_nodes = ca.horzcat(0, ca.cumsum(dtau, 1))           # (1, K+1) τ from the start of the tour
+            zone_g = self._zone_function(zone_margin)
+            if self.zones.moving:
+                g += [ca.vec(zone_g.map(K + 1)(Q, t_nodes)), ca.vec(zone_g.map(K)(q_mid, t_nodes[:, :K] + dtau / 2)),
+                      ca.sum1(T)]                                 # the zones' series hold on their window only
+            else:
+                g += [ca.vec(zone_g.map(K + 1)(Q)), ca.vec(zone_g.map(K)(q_mid))]
+            n_zone = len(self.zones.zones) * (2 * K + 1)
+            lbg += [-np.inf] * n_zone
+            ubg += [0.0] * n_zone
+            if self.zones.moving:
+                lbg.append(0.0)
+                ubg.append(self.zones.window / self.scale.t_sat)
         self._x = ca.vertcat(T, ca.vec(Q), ca.vec(H), ca.vec(U))
         self._split = ca.Function("split", [self._x], [T, Q, H, U])
         self._lbg, self._ubg = np.array(lbg), np.array(ubg)
@@ -167,6 +200,15 @@ class MultiphaseTranscription:
         iq0, ih0 = P, P + 4 * (K + 1)
         self._index_q0, self._index_h0 = slice(iq0, iq0 + 4), slice(ih0, ih0 + n_w)
         self._index_hf = slice(ih0 + n_w * K, ih0 + n_w * (K + 1))
+
+    def _zone_function(self, margin: float) -> ca.Function:
+        """``(q, τ) -> g`` (moving zones, τ the tour's normalised time) or ``q -> g`` (none moving):
+        the zone constraints ``g ≤ 0`` of :meth:`att_planner.zones.ZoneSky.casadi_constraints`."""
+        q, tau = ca.SX.sym("q", 4), ca.SX.sym("tau")
+        moving = self.zones.moving
+        g = ca.vertcat(*self.zones.casadi_constraints(tau * self.scale.t_sat if moving else 0.0,
+                                                      symbolic.dcm(q), margin))
+        return ca.Function("zones", [q, tau] if moving else [q], [g])
 
     # -- guesses ----------------------------------------------------------------------------
     def initial_guess(self, q_start, targets_in_order, q_end) -> ScheduleSolution:
@@ -238,11 +280,20 @@ class MultiphaseTranscription:
 _TRANSCRIPTIONS: dict = {}
 
 
+CACHE_SIZE = 64          # NLPs kept (the oldest goes first): zones make an NLP per problem
+
+
 def cached_transcription(sc: dyn.Spacecraft, n_targets: int, intervals: int, substeps: int,
-                         rate_max: float, expand: bool | None = None) -> MultiphaseTranscription:
-    """Solver cache: an NLP depends only on the spacecraft, the number of targets and the grid."""
+                         rate_max: float, expand: bool | None = None, zones=None,
+                         zone_margin: float = 0.0) -> MultiphaseTranscription:
+    """Solver cache: an NLP depends only on the spacecraft, the number of targets, the grid and the
+    zones (a ZoneSky, by identity: the cached NLP holds it, so its id stays unique)."""
+    zone_key = None if zones is None or not zones.zones else (id(zones), float(zone_margin))
     key = (sc.inertia.tobytes(), sc.wheel_axes.tobytes(), sc.wheel_inertia, sc.wheel_torque_max,
-           sc.wheel_speed_max, n_targets, intervals, substeps, rate_max, expand)
+           sc.wheel_speed_max, n_targets, intervals, substeps, rate_max, expand, zone_key)
     if key not in _TRANSCRIPTIONS:
-        _TRANSCRIPTIONS[key] = MultiphaseTranscription(sc, n_targets, intervals, substeps, rate_max, expand=expand)
+        while len(_TRANSCRIPTIONS) >= CACHE_SIZE:
+            _TRANSCRIPTIONS.pop(next(iter(_TRANSCRIPTIONS)))
+        _TRANSCRIPTIONS[key] = MultiphaseTranscription(sc, n_targets, intervals, substeps, rate_max, expand=expand,
+                                                       zones=zones, zone_margin=zone_margin)
     return _TRANSCRIPTIONS[key]
