@@ -13,6 +13,7 @@ import math
 import time
 from dataclasses import dataclass, field
 from datetime import datetime
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -20,6 +21,9 @@ from att_msgs_py.types import Cone, Zone
 from att_planner.zones import ZoneSky, zones_from_cones
 from att_sim import rotations as rot
 from att_sim.dynamics import Spacecraft
+
+if TYPE_CHECKING:          # the annotation only: att_sim.ephemeris loads skyfield
+    from att_sim.ephemeris import Sky
 
 MIN_WINDOW = 600.0        # s: the shortest default zone window
 WINDOW_FACTOR = 4.0       # the default window: this many times the eigenaxis slew time, at least MIN_WINDOW
@@ -61,7 +65,7 @@ class ManeuverProblem:
     wheel_momentum_max: float = math.inf
     zones: list[Zone] = field(default_factory=list)
     epoch: datetime | None = None
-    sky: object | None = None
+    sky: Sky | None = None
     _zone_skies: dict = field(default_factory=dict, init=False, repr=False, compare=False)
     _default_window: tuple = field(default=(), init=False, repr=False, compare=False)
 

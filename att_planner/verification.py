@@ -93,19 +93,19 @@ def verify(problem: ManeuverProblem, plan: Plan, steps: int = VERIFY_STEPS) -> V
 
 
 def rejection(ver: Verification, tol: Tolerances = TOLERANCES) -> str | None:
-    """Why a verified plan is not acceptable, or None."""
-    if ver.final_attitude_error > tol.attitude:
+    """Why a verified plan is not acceptable, or None (a figure that is NaN is never acceptable)."""
+    if not ver.final_attitude_error <= tol.attitude:
         return (f"final attitude error {math.degrees(ver.final_attitude_error):.3f} deg > "
                 f"{math.degrees(tol.attitude):.3f} deg")
-    if ver.final_rate > tol.rate:
+    if not ver.final_rate <= tol.rate:
         return f"final rate {ver.final_rate:.3g} rad/s > {tol.rate:.3g} rad/s"
-    if ver.min_cone_margin < -tol.cone_penetration:
+    if not ver.min_cone_margin >= -tol.cone_penetration:
         return _zone_violation(ver)
     for name in ("torque_ratio", "wheel_speed_ratio", "body_rate_ratio", "wheel_momentum_ratio"):
-        if getattr(ver, name) > tol.limit_ratio:
+        if not getattr(ver, name) <= tol.limit_ratio:
             return f"{name.replace('_ratio', '').replace('_', ' ')} {getattr(ver, name):.6f} x the limit"
     for k, (err, rate) in enumerate(zip(ver.passage_attitude_errors, ver.passage_rates_z)):
-        if err > tol.attitude or rate > tol.rate:
+        if not (err <= tol.attitude and rate <= tol.rate):
             return (f"passage {k} missed: attitude error {math.degrees(err):.3f} deg, "
                     f"|w_z| {rate:.3g} rad/s")
     return None
@@ -116,7 +116,7 @@ def _zone_violation(ver: Verification) -> str:
     depth = math.degrees(-ver.min_cone_margin)
     if not ver.zone_names or len(ver.zone_names) != len(ver.cone_margins):
         return f"enters a keep-out cone by {depth:.3f} deg"
-    k = min(range(len(ver.cone_margins)), key=ver.cone_margins.__getitem__)
+    k = int(np.argmin(np.nan_to_num(ver.cone_margins, nan=-np.inf)))
     if k < len(ver.zone_keep_in) and ver.zone_keep_in[k]:
         return f"leaves keep-in zone {ver.zone_names[k]} by {depth:.3f} deg"
     return f"enters keep-out zone {ver.zone_names[k]} by {depth:.3f} deg"

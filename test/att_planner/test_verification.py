@@ -84,3 +84,13 @@ def test_constrained_axis_rides_round_the_moving_zone(frozen_plan):
     assert plan.duration > frozen.duration               # what the motion costs
     ride = next(c for c in plan.stats["candidates"] if c["route"] == plan.message.removeprefix("route: "))
     assert 0 < ride["ride_time"] < plan.duration and ride["widening"] > 0
+
+
+def test_a_figure_that_is_nan_is_never_acceptable(frozen_plan):
+    ver = frozen_plan[2].verification
+    assert rejection(ver) is None
+    for name in ("final_attitude_error", "final_rate", "min_cone_margin", "torque_ratio", "wheel_speed_ratio"):
+        assert rejection(replace(ver, **{name: math.nan})) is not None, name
+    nan_zone = replace(ver, min_cone_margin=math.nan, cone_margins=[math.nan])
+    assert rejection(nan_zone) == "enters keep-out zone limb by nan deg"
+    assert rejection(replace(ver, passage_attitude_errors=[math.nan], passage_rates_z=[0.0])).startswith("passage 0")
