@@ -5,12 +5,15 @@ executed plan, else the last magnetorquer-PD run, else the whole log), and write
 (default: ``review/`` next to the log):
 
 * ``sky.png`` — the sensor boresight on the celestial sphere (Lambert azimuthal equal-area
-  projection centred on the path), every keep-out cone of the recorded ``ManeuverPlan`` drawn and
-  shaded, start and goal marked, the closest approach to each cone annotated;
+  projection centred on the path), every keep-out cone and zone of the recorded ``ManeuverPlan``
+  drawn and shaded (a moving zone — Sun, Moon, Earth limb — shaded where it is at the plan's start,
+  dashed where it is at its end, with the track of its axis in between; keep-in zones dash-dot;
+  zones of other sensors thin, with those sensors' boresights dotted), start and goal marked, the
+  closest approach to each zone annotated;
 * ``time_histories.png`` — attitude error to goal and to the plan reference, body rates, body
   torque (applied vs planned) and wheel torques (commanded vs applied) with their limits, wheel
-  speeds with their limit, magnetorquer dipoles (commanded vs applied) with saturation, cone
-  margins, controller mode;
+  speeds with their limit, magnetorquer dipoles (commanded vs applied) with saturation, cone and
+  zone margins (moving zones at their true positions at each recorded time), controller mode;
 * ``overview.png`` — a screenshot-sized digest (sky, margins, torque, wheel speeds);
 * ``summary.txt``, ``summary.json`` and ``index.html`` (summary table, figures embedded).
 
@@ -20,8 +23,11 @@ against the planning limit ``torque_max`` and the actuator (wheel) limit, and on
 flagged when exceeded (:func:`.summary.notes`).
 
 Limits come from the scenario named by the plan (``att_sim.scenario.load(plan.spacecraft)``) or
-``--scenario``. Modules: :mod:`.run` (the reviewed segment), :mod:`.summary` (the pure
-:func:`summarize` of a read log), :mod:`.figures` (matplotlib, Agg, in the ``plot_*`` functions).
+``--scenario``; so do the epoch and orbit the moving zones are placed with: the simulator's, whose
+sim time zero is the scenario's epoch (:func:`.summary.zone_sky_for`; a scenario without an epoch
+flew no real sky, and its moving zones are left out with a note). Modules: :mod:`.run` (the
+reviewed segment), :mod:`.summary` (the pure :func:`summarize` of a read log), :mod:`.figures`
+(matplotlib, Agg, in the ``plot_*`` functions).
 """
 from __future__ import annotations
 
@@ -37,7 +43,7 @@ from att_msgs_py.log import read_log
 from att_msgs_py.topics import COMMAND, PLANS, STATE
 from att_planner.tools.review.figures import figure_overview, figure_sky, figure_time_histories
 from att_planner.tools.review.run import extract_run, settling_time
-from att_planner.tools.review.summary import format_summary, notes, spacecraft_for, summarize, summary_of
+from att_planner.tools.review.summary import format_summary, notes, scenario_for, summarize, summary_of, zone_sky_for
 
 __all__ = ["Review", "extract_run", "format_summary", "main", "review", "settling_time", "summarize"]
 
@@ -72,12 +78,14 @@ def review(log_path: str | Path, out_dir: str | Path | None = None, *, plan_id: 
     out.mkdir(parents=True, exist_ok=True)
     log = read_log(log_path, topics=[STATE, COMMAND, PLANS])
     run = extract_run(log, plan_id)
-    sc = spacecraft_for(run, scenario)
-    summary = summary_of(run, sc)
+    found = scenario_for(run, scenario)
+    sc = found.spacecraft if found is not None else None
+    zones, zones_note = zone_sky_for(run, found)
+    summary = summary_of(run, sc, zones, zones_note)
     text = format_summary(summary)
-    figures = {"overview": figure_overview(run, sc, out / "overview.png"),
-               "sky": figure_sky(run, out / "sky.png"),
-               "time histories": figure_time_histories(run, sc, out / "time_histories.png")}
+    figures = {"overview": figure_overview(run, sc, out / "overview.png", zones),
+               "sky": figure_sky(run, out / "sky.png", zones),
+               "time histories": figure_time_histories(run, sc, out / "time_histories.png", zones)}
     (out / "summary.txt").write_text(text + "\n")
     (out / "summary.json").write_text(json.dumps(summary, indent=2) + "\n")
     page = out / "index.html"

@@ -1,4 +1,7 @@
-"""The review's figures (matplotlib, Agg): the sky plot, time histories and the overview."""
+"""The review's figures (matplotlib, Agg): the sky plot, time histories and the overview. Zones
+(the plan's cones and zones, :func:`.summary.zone_sky_for`) are drawn where the simulator flew
+them: a moving zone at the plan's start and end with the track of its axis, margins at each
+recorded time against the zones' true positions."""
 from __future__ import annotations
 
 import math
@@ -7,10 +10,11 @@ from pathlib import Path
 import numpy as np
 
 from att_msgs_py.types import ControlKind, Interpolation, Plan
-from att_planner.cones import boresight, margins
+from att_planner.cones import boresight
 from att_planner.control import tracking
 from att_planner.tools.review.run import MODE_NAMES, Run, reference_error
 from att_planner.tools.review.summary import body_torque_limits, finite_limit
+from att_planner.zones import ZoneSky, same_axis
 from att_sim import rotations as rot
 from att_sim.dynamics import Spacecraft
 
@@ -46,12 +50,66 @@ def _planned_path(plan: Plan, n: int = 400) -> np.ndarray:
 
 
 CONE_COLORS = ["#d62728", "#1f77b4", "#7f7f7f", "#9467bd", "#8c564b", "#e377c2", "#bcbd22", "#17becf"]
+TRACK_POINTS = 120          # samples of a moving zone's axis track over the maneuver
 
 
-def plot_sky(ax, run: Run) -> None:
-    """Boresight path on the celestial sphere with cones, start/goal and closest approaches."""
-    from matplotlib.patches import Circle, PathPatch
+def _draw_cap(ax, direction, half_angle: float, center: np.ndarray, color: str, *, fill: bool, ls: str = "-",
+              lw: float = 1.2) -> None:
+    """The ring of a cap on the projection about ``center``, shaded inside when ``fill`` (a cap
+    holding the projection's antipode is shaded between its ring and the rim)."""
+    from matplotlib.patches import PathPatch
     from matplotlib.path import Path as MplPath
+
+    ring = equal_area(small_circle(direction, half_angle), center)
+    if fill and np.arccos(np.clip(-center @ direction, -1, 1)) < half_angle:
+        rim = 2.0 * np.stack([np.cos(np.linspace(0, 2 * np.pi, 361)), np.sin(np.linspace(0, 2 * np.pi, 361))], 1)
+        # the hole must wind against the rim (matplotlib fills by the non-zero winding rule)
+        winding = np.sum(ring[:-1, 0] * ring[1:, 1] - ring[1:, 0] * ring[:-1, 1])
+        verts = np.vstack([rim, ring[::-1] if winding > 0 else ring])
+        codes = ([MplPath.MOVETO] + [MplPath.LINETO] * 360) * 2
+        ax.add_patch(PathPatch(MplPath(verts, codes), facecolor=color, alpha=0.18, edgecolor="none"))
+    elif fill:
+        ax.fill(ring[:, 0], ring[:, 1], color=color, alpha=0.18, lw=0)
+    ax.plot(ring[:, 0], ring[:, 1], color=color, lw=lw, ls=ls)
+
+
+def _zone_end_time(run: Run) -> float:
+    """Where a moving zone's second ring and its track end: the plan's end for a maneuver, else
+    the segment's."""
+    return float(run.plan.duration) if run.kind == "maneuver" else float(run.t[-1])
+
+
+def _draw_zones(ax, run: Run, zones: ZoneSky, sensor: np.ndarray, center: np.ndarray) -> None:
+    """Every zone: a fixed one as its shaded cap; a moving one shaded where it is at the start, a
+    dashed ring where it is at the end and the track of its axis in between. Keep-in zones are
+    dash-dot rings (outside is forbidden); zones of another sensor than the plotted one are thin."""
+    t_end = _zone_end_time(run)
+    ts = np.linspace(0.0, t_end, TRACK_POINTS)
+    axes, half = zones.true_axes(ts), zones.true_half_angles(ts)
+    for j, zone in enumerate(zones.zones):
+        color = CONE_COLORS[j % len(CONE_COLORS)]
+        own = same_axis(zone.sensor_axis, sensor)
+        ls, lw = ("-." if zone.keep_in else "-"), (1.2 if own else 0.7)
+        a0 = axes[0, j] / np.linalg.norm(axes[0, j])
+        _draw_cap(ax, a0, half[0, j], center, color, fill=own and not zone.keep_in, ls=ls, lw=lw)
+        label = f"{zone.name}\n{math.degrees(half[0, j]):.0f}°" + (" keep-in" if zone.keep_in else "")
+        if zone.body != "inertial":
+            a1 = axes[-1, j] / np.linalg.norm(axes[-1, j])
+            _draw_cap(ax, a1, half[-1, j], center, color, fill=False, ls="--", lw=0.9)
+            track = equal_area(axes[:, j] / np.linalg.norm(axes[:, j], axis=1, keepdims=True), center)
+            ax.plot(track[:, 0], track[:, 1], color=color, lw=1.6, alpha=0.8)
+            ax.annotate("", track[-1], track[-2], arrowprops=dict(arrowstyle="->", color=color, lw=1.4))
+        if not own:
+            label += f"\nsensor {np.round(zone.sensor_axis, 2).tolist()}"
+        cx, cy = equal_area(a0, center)
+        ax.text(cx, cy, label, color=color, fontsize=7 if not own else 8, ha="center", va="center", weight="bold")
+
+
+def plot_sky(ax, run: Run, zones: ZoneSky | None = None) -> None:
+    """Boresight path on the celestial sphere with the zones (moving ones at start and end, with
+    their track), start/goal and closest approaches (true zone positions at each recorded time).
+    Other sensors' boresights are drawn thin and dotted."""
+    from matplotlib.patches import Circle
 
     plan = run.plan
     sensor = plan.sensor_axis if plan is not None else np.array([1.0, 0.0, 0.0])
@@ -71,46 +129,47 @@ def plot_sky(ax, run: Run) -> None:
             x, y = equal_area(vec, center)
             ax.plot(x, y, "+", color="0.55", ms=5)
             ax.text(x + 0.03, y + 0.03, label, fontsize=7, color="0.45")
-    cones = plan.cones if plan is not None else []
-    for j, cone in enumerate(cones):
-        color = CONE_COLORS[j % len(CONE_COLORS)]
-        ring = equal_area(small_circle(cone.direction, cone.half_angle), center)
-        if np.arccos(np.clip(-center @ cone.direction, -1, 1)) < cone.half_angle:
-            # the cone holds the projection's antipode: its inside is the band between ring and rim
-            rim = 2.0 * np.stack([np.cos(np.linspace(0, 2 * np.pi, 361)), np.sin(np.linspace(0, 2 * np.pi, 361))], 1)
-            verts = np.vstack([rim, ring[::-1]])
-            codes = ([MplPath.MOVETO] + [MplPath.LINETO] * 360) * 2
-            ax.add_patch(PathPatch(MplPath(verts, codes), facecolor=color, alpha=0.18, edgecolor="none"))
-        else:
-            ax.fill(ring[:, 0], ring[:, 1], color=color, alpha=0.18, lw=0)
-        ax.plot(ring[:, 0], ring[:, 1], color=color, lw=1.2)
-        cx, cy = equal_area(cone.direction, center)
-        ax.text(cx, cy, f"{cone.name}\n{math.degrees(cone.half_angle):.0f}°", color=color, fontsize=8,
-                ha="center", va="center", weight="bold")
+    has_zones = zones is not None and bool(zones.zones)
+    if has_zones:
+        _draw_zones(ax, run, zones, sensor, center)
     if plan is not None and run.kind == "maneuver":
         planned = equal_area(boresight(_planned_path(plan), sensor), center)
         ax.plot(planned[:, 0], planned[:, 1], "--", color="0.3", lw=1.0, label="planned")
     xy = equal_area(path, center)
     ax.plot(xy[:, 0], xy[:, 1], color="k", lw=1.8, label="recorded")
+    others = {}
+    if has_zones:
+        for z in zones.zones:
+            if not same_axis(z.sensor_axis, sensor):
+                others.setdefault(np.round(z.sensor_axis / np.linalg.norm(z.sensor_axis), 9).tobytes(), z.sensor_axis)
+    for s_other in others.values():
+        other = boresight(run.q, s_other)
+        oxy = equal_area(other / np.linalg.norm(other, axis=1, keepdims=True), center)
+        ax.plot(oxy[:, 0], oxy[:, 1], ":", color="0.35", lw=1.0,
+                label=f"sensor {np.round(s_other, 2).tolist()} (recorded)")
     ax.plot(*xy[0], "o", color="tab:green", ms=12, mfc="none", mew=2.5, label="start", zorder=7)
     gx, gy = equal_area(goal_dir, center)
     ax.plot(gx, gy, "*", color="tab:orange", ms=13, label="goal", zorder=7)
-    if cones:
-        m = margins(run.q, sensor, cones)
-        for j, cone in enumerate(cones):
+    if has_zones:
+        m = zones.margins(run.t, run.q, true=True)
+        for j, zone in enumerate(zones.zones):
             k = int(np.argmin(m[:, j]))
             color = CONE_COLORS[j % len(CONE_COLORS)]
-            ax.plot(*xy[k], "x", color=color, ms=9, mew=2, zorder=6,
-                    label=f"closest to {cone.name}: {math.degrees(m[k, j]):.2f}° at {run.t[k]:.0f} s")
-            outward = xy[k] / max(np.linalg.norm(xy[k]), 1e-9)
-            ax.annotate(f"{math.degrees(m[k, j]):.2f}°", xy[k], xytext=tuple(14 * outward + (0, -4 * j)),
+            b = boresight(run.q[k], zone.sensor_axis)
+            pk = equal_area(b / np.linalg.norm(b), center)
+            ax.plot(*pk, "x", color=color, ms=9, mew=2, zorder=6,
+                    label=f"closest to {zones.names[j]}: {math.degrees(m[k, j]):.2f}° at {run.t[k]:.0f} s")
+            outward = pk / max(np.linalg.norm(pk), 1e-9)
+            ax.annotate(f"{math.degrees(m[k, j]):.2f}°", pk, xytext=tuple(14 * outward + (0, -4 * j)),
                         textcoords="offset points", fontsize=8, color=color, weight="bold", ha="center")
     ax.set_xlim(-2.08, 2.08)
     ax.set_ylim(-2.08, 2.08)
     ax.set_aspect("equal")
     ax.axis("off")
     ax.legend(loc="lower left", fontsize=7, frameon=False, bbox_to_anchor=(-0.02, -0.04))
-    ax.set_title("Boresight on the sky (equal-area, closest approach ×)" if plan is not None
+    moving = has_zones and zones.moving
+    ax.set_title(("Boresight on the sky (equal-area, closest approach ×)" + ("\nmoving zones: shaded at the start, "
+                  "dashed at the end, their axes' tracks" if moving else "")) if plan is not None
                  else "Body x axis on the sky (no plan in the log)", fontsize=10)
 
 
@@ -203,18 +262,19 @@ def plot_dipole(ax, run: Run, sc: Spacecraft | None) -> None:
     ax.legend(loc="upper right", fontsize=7, ncol=2)
 
 
-def plot_margins(ax, run: Run) -> None:
-    cones = run.plan.cones if run.plan is not None else []
-    if cones:
-        m = np.degrees(margins(run.q, run.plan.sensor_axis, cones))
-        for j, cone in enumerate(cones):
-            ax.plot(run.t, m[:, j], color=CONE_COLORS[j % len(CONE_COLORS)], lw=1.0, label=cone.name)
+def plot_margins(ax, run: Run, zones: ZoneSky | None = None) -> None:
+    """Margin to every cone and zone (moving zones at their true positions at each recorded time)."""
+    if zones is not None and zones.zones:
+        m = np.degrees(zones.margins(run.t, run.q, true=True))
+        for j, name in enumerate(zones.names):
+            ax.plot(run.t, m[:, j], color=CONE_COLORS[j % len(CONE_COLORS)], lw=1.0,
+                    ls="-." if zones.keep_in[j] else "-", label=name + (" (in)" if zones.keep_in[j] else ""))
         ax.plot(run.t, m.min(axis=1), color="k", lw=0.9, ls="--", label="minimum")
         ax.axhline(0.0, color="k", lw=0.6)
         ax.legend(loc="upper right", fontsize=7, ncol=2)
     else:
-        ax.text(0.5, 0.5, "no keep-out cones in the log", ha="center", va="center", transform=ax.transAxes)
-    ax.set_ylabel("cone margin [deg]")
+        ax.text(0.5, 0.5, "no keep-out cones or zones in the log", ha="center", va="center", transform=ax.transAxes)
+    ax.set_ylabel("zone margin [deg]" + ("\n(true positions)" if zones is not None and zones.moving else ""))
 
 
 def plot_modes(ax, run: Run) -> None:
@@ -240,7 +300,7 @@ def _time_label(run: Run) -> str:
                                                     else "")
 
 
-def figure_time_histories(run: Run, sc: Spacecraft | None, path: Path) -> Path:
+def figure_time_histories(run: Run, sc: Spacecraft | None, path: Path, zones: ZoneSky | None = None) -> Path:
     plt, fig = _figure(figsize=(13, 12))
     axes = fig.subplots(4, 2, sharex=True)
     plot_attitude_error(axes[0, 0], run)
@@ -249,7 +309,7 @@ def figure_time_histories(run: Run, sc: Spacecraft | None, path: Path) -> Path:
     plot_wheel_torque(axes[1, 1], run, sc)
     plot_wheel_speeds(axes[2, 0], run, sc)
     plot_dipole(axes[2, 1], run, sc)
-    plot_margins(axes[3, 0], run)
+    plot_margins(axes[3, 0], run, zones)
     plot_modes(axes[3, 1], run)
     for ax in axes.ravel():
         ax.grid(alpha=0.3)
@@ -263,23 +323,23 @@ def figure_time_histories(run: Run, sc: Spacecraft | None, path: Path) -> Path:
     return path
 
 
-def figure_sky(run: Run, path: Path) -> Path:
+def figure_sky(run: Run, path: Path, zones: ZoneSky | None = None) -> Path:
     plt, fig = _figure(figsize=(7.5, 7.5))
-    plot_sky(fig.add_subplot(1, 1, 1), run)
+    plot_sky(fig.add_subplot(1, 1, 1), run, zones)
     fig.tight_layout()
     fig.savefig(path, dpi=100)
     plt.close(fig)
     return path
 
 
-def figure_overview(run: Run, sc: Spacecraft | None, path: Path) -> Path:
+def figure_overview(run: Run, sc: Spacecraft | None, path: Path, zones: ZoneSky | None = None) -> Path:
     """Screenshot-sized digest: the sky on the left; margins, body torque, wheel speeds on the right."""
     plt, fig = _figure(figsize=(12, 6.2))
     grid = fig.add_gridspec(3, 2, width_ratios=[1.0, 1.15])
-    plot_sky(fig.add_subplot(grid[:, 0]), run)
+    plot_sky(fig.add_subplot(grid[:, 0]), run, zones)
     right = [fig.add_subplot(grid[0, 1])]
     right += [fig.add_subplot(grid[i, 1], sharex=right[0]) for i in (1, 2)]
-    plot_margins(right[0], run)
+    plot_margins(right[0], run, zones)
     plot_body_torque(right[1], run, sc)
     plot_wheel_speeds(right[2], run, sc)
     for ax in right:

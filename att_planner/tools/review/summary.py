@@ -1,17 +1,21 @@
-"""Figures of merit of a reviewed run (pure): the summary dictionary and its text."""
+"""Figures of merit of a reviewed run (pure): the summary dictionary and its text, and the zones of
+the reviewed plan where the simulator flew them (:func:`zone_sky_for`)."""
 from __future__ import annotations
 
 import math
+from datetime import timedelta
 
 import numpy as np
 
 from att_msgs_py.log import TopicLog
-from att_planner.cones import margins
 from att_planner.tools.review.run import SETTLING_THRESHOLD, Run, extract_run, settling_time
 from att_planner.verification import peak_magnitude
+from att_planner.zones import ZoneSky, zones_from_cones
 from att_sim import rotations as rot
 from att_sim import scenario as scen
 from att_sim.dynamics import Spacecraft
+from att_sim.ephemeris import Sky
+from att_sim.epoch import format_epoch
 
 
 def _ratio(peak: float, limit: float | None):
@@ -23,7 +27,8 @@ def finite_limit(value: float | None) -> float | None:
     return float(value) if value is not None and np.isfinite(value) else None
 
 
-def summarize(log: dict[str, TopicLog], spacecraft: Spacecraft | None = None, plan_id: str | None = None) -> dict:
+def summarize(log: dict[str, TopicLog], spacecraft: Spacecraft | None = None, plan_id: str | None = None,
+              scenario: scen.Scenario | None = None) -> dict:
     """Summary of the reviewed segment of a read log (see :func:`~.run.extract_run`).
 
     Keys: kind, plan (id, method, status, spacecraft); for maneuvers ``executed_time_s`` is the
@@ -32,14 +37,15 @@ def summarize(log: dict[str, TopicLog], spacecraft: Spacecraft | None = None, pl
     settle and hold on its final attitude (``goal_end_s``: when the goal itself ended);
     error_at_plan_end_deg and final_attitude_error_deg (to ``goal``: the plan's final attitude,
     identity for magnetorquer runs) with final_rate_rad_s at the end of the segment, min_margin_deg
-    and closest_approach_s per cone, peak body torque / wheel torque / wheel speed / dipole with
-    when they occur, their actuator ``_limit``, ``_ratio`` and ``_above_limit`` (limits None
-    without ``spacecraft``) and for the body torque also the planning limit (``torque_max``) and
-    ratio, settling_time_s (magnetorquer runs: Bruni & Celani's ν = 0.05 criterion on q_v),
+    and closest_approach_s per cone and zone (moving zones at their true positions, from
+    ``scenario``'s epoch and orbit: :func:`zone_sky_for`), ``zones_note``, peak body torque / wheel
+    torque / wheel speed / dipole with when they occur, their actuator ``_limit``, ``_ratio`` and
+    ``_above_limit`` (limits None without ``spacecraft``) and for the body torque also the planning
+    limit (``torque_max``) and ratio, settling_time_s (magnetorquer runs: Bruni & Celani's ν = 0.05 criterion on q_v),
     command_timeouts.
     """
     run = extract_run(log, plan_id)
-    return summary_of(run, spacecraft)
+    return summary_of(run, spacecraft, *zone_sky_for(run, scenario))
 
 
 def body_torque_limits(sc: Spacecraft | None) -> tuple[float | None, float | None]:
@@ -61,7 +67,57 @@ def _phase(run: Run, t: float) -> str:
     return "maneuver" if t <= run.plan.duration + 1e-9 else "settle/hold"
 
 
-def summary_of(run: Run, spacecraft: Spacecraft | None = None) -> dict:
+class _Later:
+    """``sky`` seen ``offset`` s later (what a :class:`ZoneSky` reads of a sky), so that t = 0 is
+    the reviewed segment's start."""
+
+    def __init__(self, sky: Sky, offset: float):
+        self.sky, self.offset = sky, float(offset)
+
+    def sun_direction(self, t):
+        return self.sky.sun_direction(np.asarray(t, float) + self.offset)
+
+    def moon_direction(self, t):
+        return self.sky.moon_direction(np.asarray(t, float) + self.offset)
+
+    def nadir(self, t):
+        return self.sky.nadir(np.asarray(t, float) + self.offset)
+
+    def earth_angular_radius(self, t):
+        return self.sky.earth_angular_radius(np.asarray(t, float) + self.offset)
+
+
+def zone_sky_for(run: Run, scenario: scen.Scenario | None) -> tuple[ZoneSky | None, str]:
+    """The reviewed plan's cones (first) and zones over the segment, t = 0 at its start, and a note
+    ('' or why moving zones are left out). Moving zones are where the simulator flew them: the
+    scenario's orbit and epoch (its sim time zero), seen at sim time ``run.t0 + t``; without a
+    scenario epoch the simulator flew no real sky and only the fixed zones are kept. None without
+    a plan."""
+    plan = run.plan
+    if plan is None:
+        return None, ""
+    zones = zones_from_cones(plan.cones, plan.sensor_axis) + list(plan.zones)
+    moving = [z for z in zones if z.body != "inertial"]
+    note, sky = "", None
+    if moving and (scenario is None or scenario.epoch is None):
+        zones = [z for z in zones if z.body == "inertial"]
+        note = (f"moving zones ({', '.join(z.name for z in moving)}) are not drawn: "
+                + ("no scenario is known" if scenario is None else f"scenario '{scenario.name}' has no epoch, so the "
+                   "simulator flew no real sky"))
+    elif moving:
+        sky = _Later(Sky(scenario.epoch, scenario.orbit_model), run.t0)
+        flown = scenario.epoch + timedelta(seconds=run.t0)
+        if plan.epoch is not None and abs((flown - plan.epoch).total_seconds()) > 1.0:
+            note = (f"the plan was made for {format_epoch(plan.epoch)} but flown from {format_epoch(flown)} "
+                    f"({(flown - plan.epoch).total_seconds():+.1f} s): zones are shown where they were when flown")
+    window = max(float(run.t[-1]), plan.duration, 1.0)
+    return ZoneSky(zones, sky, window), note
+
+
+def summary_of(run: Run, spacecraft: Spacecraft | None = None, zone_sky: ZoneSky | None = None,
+               zones_note: str = "") -> dict:
+    """The summary of a reviewed run; ``zone_sky`` (:func:`zone_sky_for`; None: the plan's cones)
+    gives the margins."""
     sc = spacecraft
     out = {"kind": run.kind, "start_sim_time_s": run.t0, "executed_time_s": float(run.t[-1] - run.t[0]),
            "state_samples": int(len(run.t)), "command_timeouts": int(np.sum(run.command_timeout)),
@@ -85,15 +141,16 @@ def summary_of(run: Run, spacecraft: Spacecraft | None = None) -> dict:
     else:
         out["final_attitude_error_deg"] = None
     out["final_rate_rad_s"] = float(np.linalg.norm(run.omega[-1]))
-    cones = run.plan.cones if run.plan is not None else []
-    out["min_margin_deg"], out["closest_approach_s"] = {}, {}
-    if cones:
-        m = margins(run.q, run.plan.sensor_axis, cones)
-        for j, c in enumerate(cones):
+    if zone_sky is None and run.plan is not None:
+        zone_sky = ZoneSky(zones_from_cones(run.plan.cones, run.plan.sensor_axis))
+    out["min_margin_deg"], out["closest_approach_s"], out["zones_note"] = {}, {}, zones_note
+    if zone_sky is not None and zone_sky.zones:
+        m = zone_sky.margins(run.t, run.q, true=True)
+        for j, name in enumerate(zone_sky.names):
             k = int(np.argmin(m[:, j]))
-            out["min_margin_deg"][c.name or f"cone{j}"] = float(np.degrees(m[k, j]))
-            out["closest_approach_s"][c.name or f"cone{j}"] = float(run.t[k])
-    out["min_cone_margin_deg"] = min(out["min_margin_deg"].values()) if cones else None
+            out["min_margin_deg"][name] = float(np.degrees(m[k, j]))
+            out["closest_approach_s"][name] = float(run.t[k])
+    out["min_cone_margin_deg"] = min(out["min_margin_deg"].values()) if out["min_margin_deg"] else None
 
     def peak(name, values, limit, t=None):
         v = peak_magnitude(values)
@@ -116,15 +173,21 @@ def summary_of(run: Run, spacecraft: Spacecraft | None = None) -> dict:
     return out
 
 
-def spacecraft_for(run: Run, scenario: str | None = None) -> Spacecraft | None:
-    """Limits from ``scenario`` or the scenario the plan names; None when it cannot be found."""
+def scenario_for(run: Run, scenario: str | None = None) -> scen.Scenario | None:
+    """``scenario`` or the scenario the plan names (limits, epoch, orbit); None when it cannot be found."""
     name = scenario or (run.plan.spacecraft if run.plan is not None else None)
     if not name:
         return None
     try:
-        return scen.load(name).spacecraft
+        return scen.load(name)
     except (KeyError, OSError, ValueError):
         return None
+
+
+def spacecraft_for(run: Run, scenario: str | None = None) -> Spacecraft | None:
+    """Limits from ``scenario`` or the scenario the plan names; None when it cannot be found."""
+    found = scenario_for(run, scenario)
+    return found.spacecraft if found is not None else None
 
 
 def notes(s: dict) -> list[str]:
@@ -137,6 +200,8 @@ def notes(s: dict) -> list[str]:
                    f"change of mode or plan: the maneuver (the plan, t = 0 to {s['maneuver_time_s']:.2f} s) and then "
                    f"{s['after_plan_s']:.2f} s of settle and hold on its final attitude{goal}; final figures are "
                    "taken at the end of the segment.")
+    if s.get("zones_note"):
+        out.append(s["zones_note"][0].upper() + s["zones_note"][1:] + ".")
     planning, actuator = s["body_torque_Nm_planning_limit"], s["body_torque_Nm_limit"]
     if planning is not None and actuator is not None and actuator > planning * (1 + 1e-9):
         out.append(f"Plans use at most the planning limit torque_max = {planning:.4g} N m per body axis, while the "
