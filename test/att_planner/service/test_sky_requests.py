@@ -1,25 +1,29 @@
 """The planner service in the real sky (no ROS): where a request's epoch and orbit come from, zones
 in the problem and through a solver child, the closed-sky test with moving zones and several
-sensors, zone padding, and requests without a sky unchanged."""
+sensors, zone padding, requests without a sky unchanged, and the review of a flown plan's zones."""
 from __future__ import annotations
 
 import math
 import pickle
-from datetime import UTC, datetime
+from datetime import UTC, datetime, timedelta
 
 import numpy as np
 import pytest
 
 from att_msgs_py import convert
 from att_msgs_py.errors import ErrorCode, RequestError
-from att_msgs_py.types import Zone
+from att_msgs_py.types import Plan, Verification, Zone
 from att_planner import methods
 from att_planner.service.planning import padded
 from att_planner.service.sky import relaxed_caps
 from att_planner.service.worker import _Portable, run_isolated, warm_up
+from att_planner.tools.review.figures import figure_sky
+from att_planner.tools.review.run import Run
+from att_planner.tools.review.summary import summary_of, zone_sky_for
 from att_planner.zones import ZoneSky
 from att_sim import rotations as rot
 from att_sim import scenario as scen
+from att_sim.ephemeris import Sky
 from att_sim.orbit import TLEOrbit
 from helpers.maneuver_requests import EARTH, SUN, request, validate
 
@@ -136,3 +140,35 @@ def test_padding_widens_keep_out_narrows_keep_in_and_spares_the_ends():
         assert w.half_angle == pytest.approx(z.half_angle + (-expected if z.keep_in else expected))
     assert wider.zone_sky().margins(0.0, np.array([wider.q_initial, wider.q_final]), true=True).min() > 0
     assert padded(problem, 0.0) is problem
+
+
+def _rest_run(t0: float, plan) -> Run:
+    """A reviewed segment of 100 s from sim time ``t0`` at rest at identity, flying ``plan``."""
+    t = np.linspace(0.0, 100.0, 51)
+    n, zero = len(t), np.zeros((len(t), 3))
+    return Run(kind="maneuver", t0=t0, t=t, q=np.tile(rot.IDENTITY, (n, 1)), omega=zero, wheel_speeds=np.zeros((n, 0)),
+               wheel_torques=np.zeros((n, 0)), dipole=zero, body_torque=zero, command_timeout=np.zeros(n, bool),
+               cmd_t=np.zeros(0), cmd_mode=np.zeros(0, int), cmd_wheel_torques=np.zeros((0, 0)),
+               cmd_dipole=np.zeros((0, 3)), goal=rot.IDENTITY, plan=plan, goal_end=100.0)
+
+
+def test_the_review_places_moving_zones_where_the_simulator_flew_them(tmp_path):
+    leo_scenario = scen.load("leo_observatory")
+    t0 = 3000.0
+    plan = Plan(t=np.array([0.0, 100.0]), torque=np.zeros((2, 3)), q=np.tile(rot.IDENTITY, (2, 1)),
+                omega=np.zeros((2, 3)), sensor_axis=Y, zones=leo_scenario.zones, plan_id="p",
+                epoch=leo_scenario.epoch + timedelta(seconds=t0 - 60.0), spacecraft="leo_observatory",
+                verification=Verification(0.0, 0.0, 0.1, [0.1] * 3, 0.5, 0.0, 0.0, 10))
+    run = _rest_run(t0, plan)
+    zones, note = zone_sky_for(run, leo_scenario)
+    sky = Sky(leo_scenario.epoch, leo_scenario.orbit_model)          # sim time zero is the scenario's epoch
+    assert np.allclose(zones.true_axes(0.0)[1], sky.moon_direction(t0), atol=1e-9)
+    limb = math.acos(sky.nadir(t0 + 50.0) @ Y) - sky.earth_angular_radius(t0 + 50.0) - math.radians(10)
+    assert zones.margins(50.0, rot.IDENTITY, true=True)[0, 2] == pytest.approx(limb, abs=1e-9)
+    assert "flown from 2026-12-21T00:50:00" in note and "(+60.0 s)" in note
+    summary = summary_of(run, leo_scenario.spacecraft, zones, note)
+    assert summary["min_margin_deg"]["earth"] == pytest.approx(
+        math.degrees(zones.margins(run.t, run.q, true=True)[:, 2].min()))
+    assert figure_sky(run, tmp_path / "sky.png", zones).stat().st_size > 10_000
+    dropped, why = zone_sky_for(run, scen.load("swift_demo"))      # no epoch: the simulator flew no real sky
+    assert dropped.zones == [] and "has no epoch" in why
