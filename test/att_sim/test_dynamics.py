@@ -95,7 +95,7 @@ def test_wheel_speed_limit_is_on_the_speed_relative_to_the_body():
 
 
 # ------------------------------------------------------------ environment at every RK4 stage
-def _constant_dipole_run(dt: float, per_stage: bool, t_end: float = 240.0) -> np.ndarray:
+def _constant_dipole_run(dt: float, per_stage: bool, t_end: float = 120.0) -> np.ndarray:
     """Bruni–Celani spacecraft tumbling at 0.04 rad/s with a constant 8 A m² dipole in the tilted-dipole
     field: the field in body axes from the stage attitude (per_stage) or held over each step."""
     from att_sim import environment as env
