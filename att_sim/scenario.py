@@ -12,7 +12,9 @@ only as the simulator's parameter): ``epoch`` (ISO 8601 UTC, sim time zero), ``o
 (``circular``, ``kepler``, ``tle``: :func:`att_sim.orbit.orbit_from_mapping`), ``field_model``
 (``dipole`` or ``igrf14``), ``environment`` (disturbance switches, residual dipole, facets:
 :func:`environment_from_params`) and ``zones`` (:func:`zones_from_params`). Every key is checked;
-an unknown one is refused (a typo must not silently mean a default).
+an unknown one is refused (a typo must not silently mean a default). ``facets`` and ``zones`` are
+lists of mappings, which rcl's parameter-file parser refuses: such a scenario is read by the nodes
+through ``-p scenario:=NAME`` only, never as a ``--params-file``.
 """
 from __future__ import annotations
 
