@@ -116,7 +116,7 @@ def contradictory_zones(zone_sky: ZoneSky) -> str:
     """Why no boresight satisfies the zones of one sensor at t = 0, or '': a keep-in cone entirely
     inside a keep-out cone (γ + θ_in ≤ θ_out), or two keep-in cones that do not meet (γ > θ_1 + θ_2).
     Only pairs are checked: a keep-in cone covered by several keep-out cones together is not."""
-    axes, half = zone_sky.true_axes(0.0), zone_sky.true_half_angles(0.0)
+    axes, half = zone_sky.at(0.0, true=True)
     names, keep_in, s = zone_sky.names, zone_sky.keep_in, zone_sky.sensor_axes
     for i in np.flatnonzero(keep_in):
         for j in range(len(names)):

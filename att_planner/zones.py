@@ -200,6 +200,10 @@ class ZoneSky:
             half[:, self._moving] = v[:, 3 * M:]
         return axes.reshape(t.shape + (Z, 3)), half.reshape(t.shape + (Z,))
 
+    def at(self, t, true: bool = False) -> tuple[np.ndarray, np.ndarray]:
+        """``(axes, half_angles)`` at ``t`` in one evaluation: the fit, or with ``true`` the sky."""
+        return self._assemble(t, self._moving_truth if true else lambda s: self._series(s, False), False)
+
     def axes(self, t) -> np.ndarray:
         """Fitted unit inertial axes ``a_z(t)``, shape ``t.shape + (Z, 3)``."""
         return self._assemble(t, lambda s: self._series(s, False), False)[0]
@@ -218,11 +222,11 @@ class ZoneSky:
 
     def true_axes(self, t) -> np.ndarray:
         """Axes straight from the sky (any t), shape ``t.shape + (Z, 3)``."""
-        return self._assemble(t, lambda s: self._moving_truth(s), False)[0]
+        return self._assemble(t, self._moving_truth, False)[0]
 
     def true_half_angles(self, t) -> np.ndarray:
         """Half-angles straight from the sky (any t), shape ``t.shape + (Z,)``."""
-        return self._assemble(t, lambda s: self._moving_truth(s), False)[1]
+        return self._assemble(t, self._moving_truth, False)[1]
 
     def casadi(self, t):
         """``(axes, half_angles)``: Z CasADi 3-vectors and Z scalars, functions of the CasADi scalar
@@ -268,8 +272,7 @@ class ZoneSky:
         if not Z:
             return out
         R = rot.dcm(q)
-        A, theta = ((self.true_axes(t), self.true_half_angles(t)) if true and self.moving
-                    else (self.axes(t), self.half_angles(t)) if self.moving else (None, None))
+        A, theta = self.at(t, true) if self.moving else (None, None)
         for s, static, moving in self._groups:
             b = R @ s
             b = b / np.linalg.norm(b, axis=-1, keepdims=True)
@@ -285,7 +288,7 @@ class ZoneSky:
     # ------------------------------------------------------------------ the frozen baseline
     def frozen_zones(self) -> list[Zone]:
         """Every zone as it is at t = 0 (true position and size) as an inertial zone."""
-        a0, th0 = self.true_axes(0.0), self.true_half_angles(0.0)
+        a0, th0 = self.at(0.0, true=True)
         return [z if z.body == "inertial" else Zone(z.name, "inertial", z.sensor_axis, float(th0[i]), z.keep_in, a0[i])
                 for i, z in enumerate(self.zones)]
 

@@ -12,8 +12,10 @@ Zones that move: every candidate is judged with the margins of each dense sample
 time (:func:`.axis_rotations.leg_path`, :meth:`att_planner.zones.ZoneSky.margins`), never a
 snapshot. The ride is built about the zone as it is at ``t*``, the middle of the ride, on a circle
 widened by how far the zone's axis and half-angle move during the ride; ``t*`` and that widening
-are found by a few fixed-point iterations (:data:`RIDE_ITERATIONS`) of the construction. Keep-in
-zones are checked, not steered into. A sequence longer than the zones' window
+are found by a few fixed-point iterations (:data:`RIDE_ITERATIONS`) of the construction. When a
+zone moves, two-leg detours are tried too (:func:`_detours`: escape straight away from a zone, or
+through a tilted half-way attitude): a zone rising over the start is fled rather than ridden round.
+Keep-in zones are checked, not steered into. A sequence longer than the zones' window
 (:meth:`ManeuverProblem.zone_sky`) is refused, never judged on extrapolated zones.
 """
 from __future__ import annotations
@@ -38,6 +40,8 @@ from att_sim import rotations as rot
 
 METHOD = "constrained_axis"
 RIDE_ITERATIONS = 4        # fixed-point iterations on the ride time t* and the widening
+ESCAPES = (10.0, 20.0, 45.0)           # deg: first legs of the escape detours (moving zones)
+TILTS = (10.0, 20.0, 30.0, 45.0)       # deg: tilts of the half-way attitude of the tilted detours
 
 
 def _polar(b, w, u, v):
@@ -76,8 +80,7 @@ def cone_riding_legs(problem: ManeuverProblem, zone_index: int, side: int, ride_
         sensor, name = zs.sensor_axes[zone_index], zs.names[zone_index]
         w0 = zs.true_axes(0.0)[zone_index] if axis is None else None
         theta0 = float(zs.true_half_angles(0.0)[zone_index]) if half_angle is None else None
-    w = np.asarray(w0 if axis is None else axis, float)
-    w = w / np.linalg.norm(w)
+    w = w0 if axis is None else np.asarray(axis, float) / np.linalg.norm(axis)
     theta = theta0 if half_angle is None else half_angle
     u, v = rot.orthonormal_basis(w)              # azimuth ψ measured from u towards v
     r = sensor / np.linalg.norm(sensor)
@@ -132,27 +135,59 @@ def _moving_ride(problem: ManeuverProblem, zs: ZoneSky, z: int, side: int, ride_
     ride, on a circle widened by the zone's motion during the ride (how far its axis turns from
     ``a(t*)`` plus the growth of its half-angle), found by fixed-point iteration
     (:data:`RIDE_ITERATIONS`)."""
+    if zs.zones[z].body == "inertial":
+        return cone_riding_legs(problem, z, side, ride_margin, finish), 0.0, 0.0
     t_star, widen, legs = 0.0, 0.0, None
-    for _ in range(RIDE_ITERATIONS if zs.moving else 1):
-        t_c = min(t_star, zs.window)
-        legs = cone_riding_legs(problem, z, side, ride_margin + widen, finish,
-                                zs.axes(t_c)[z], float(zs.half_angles(t_c)[z]))
+    for _ in range(RIDE_ITERATIONS):
+        a_star, th_star = zs.at(min(t_star, zs.window))
+        legs = cone_riding_legs(problem, z, side, ride_margin + widen, finish, a_star[z], float(th_star[z]))
         if legs is None:
             return None, t_star, widen
         d = leg_durations(problem, legs)
-        if len(d) < 2 or not zs.moving:
+        if len(d) < 2:
             break
         t_star = min(d[0] + d[1] / 2, zs.window)
         ts = np.linspace(d[0], min(d[0] + d[1], zs.window), 32)
-        a, th = zs.axes(ts)[:, z], zs.half_angles(ts)[:, z]
-        a_star, th_star = zs.axes(t_star)[z], zs.half_angles(t_star)[z]
+        a, th = (v[:, z] for v in zs.at(ts))
+        a_star, th_star = (v[z] for v in zs.at(t_star))
         drift = np.arccos(np.clip(a @ a_star / np.linalg.norm(a, axis=1) / np.linalg.norm(a_star), -1, 1))
         widen = float(np.max(drift + th - th_star))
     return legs, t_star, widen
 
 
+def _detours(problem: ManeuverProblem, zs: ZoneSky) -> list[tuple[str, list[AxisLeg]]]:
+    """Two-leg routes for a path that a zone overtakes (moving zones): *escape* — a λ-rotation
+    taking a keep-out zone's sensor straight away from the zone's axis (as at t = 0) by
+    :data:`ESCAPES`, then the eigenaxis to the goal; *tilt* — two eigenaxis legs through the
+    half-way attitude of the eigenaxis slew turned by :data:`TILTS` about either normal of the
+    eigenaxis, either way."""
+    q0 = rot.normalize(np.asarray(problem.q_initial, float))
+    q_goal = goal_attitude(problem)
+    routes = []
+    for z in np.flatnonzero(~zs.keep_in):
+        b0 = rot.dcm(q0) @ (zs.sensor_axes[z] / np.linalg.norm(zs.sensor_axes[z]))
+        away = np.cross(zs.true_axes(0.0)[z], b0)
+        if np.linalg.norm(away) < 1e-9:
+            continue
+        away /= np.linalg.norm(away)
+        for angle in np.deg2rad(ESCAPES):
+            q1 = rot.multiply(rot.from_axis_angle(away, angle), q0)
+            routes.append((f"escape {zs.names[z]} {np.rad2deg(angle):.0f} deg then eigenaxis",
+                           [AxisLeg(away, float(angle), f"away from {zs.names[z]}"), eigenaxis_leg(q1, q_goal)]))
+    eig = eigenaxis_leg(q0, q_goal)
+    q_half = rot.multiply(rot.from_axis_angle(eig.axis, eig.angle / 2), q0)
+    for k, normal in enumerate(rot.orthonormal_basis(eig.axis)):
+        for tilt in np.deg2rad(TILTS):
+            for sign in (+1, -1):
+                q_mid = rot.multiply(rot.from_axis_angle(normal, sign * tilt), q_half)
+                routes.append((f"tilt {'+' if sign > 0 else '-'}{np.rad2deg(tilt):.0f} deg about normal {k + 1}",
+                               [eigenaxis_leg(q0, q_mid, "tilted eigenaxis"), eigenaxis_leg(q_mid, q_goal)]))
+    return routes
+
+
 def plan_constrained_axis(problem: ManeuverProblem, *, ride_margin_deg: float = 0.5) -> Plan:
-    """Eigenaxis slew if it clears the zones, else the fastest zone-riding λ-rotation sequence.
+    """Eigenaxis slew if it clears the zones, else the fastest zone-riding (or, zones moving,
+    detour) λ-rotation sequence that clears them.
 
     ``ride_margin_deg``: how far outside the zone boundary the sensor rides (deg, ≥ 0).
     """
@@ -177,12 +212,16 @@ def plan_constrained_axis(problem: ManeuverProblem, *, ride_margin_deg: float = 
                 candidates.append({"route": f"ride {zs.names[z]} {'+' if side > 0 else '-'} then {finish}",
                                    "tf": tf_c, "min_margin": m_c, "ride_time": t_star, "widening": widen,
                                    "legs": legs})
+    if zs.moving:
+        for route, legs in _detours(problem, zs):
+            tf_c, m_c = _legs_time(problem, legs)
+            candidates.append({"route": route, "tf": tf_c, "min_margin": m_c, "legs": legs})
     clear = [c for c in candidates if c["min_margin"] >= 0]
-    stats = {"candidates": [{k: c[k] for k in ("route", "tf", "min_margin", "ride_time", "widening")}
+    stats = {"candidates": [{k: c[k] for k in ("route", "tf", "min_margin", "ride_time", "widening") if k in c}
                             for c in candidates],
              "zone_window": zs.window}
     if not clear:
-        msg = "no zone-riding λ-rotation sequence clears every zone"
+        msg = "no zone-riding or detour λ-rotation sequence clears every zone"
         if any(c["tf"] > zs.window for c in candidates) and zs.moving:
             msg += f" (sequences longer than the zones' window of {zs.window:.0f} s are refused)"
         best = max(candidates, key=lambda c: c["min_margin"]) if candidates else None
