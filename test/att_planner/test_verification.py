@@ -81,7 +81,7 @@ def test_constrained_axis_clears_the_moving_zone(frozen_plan):
     plan = plan_constrained_axis(moving)
     assert plan.status == Status.FEASIBLE and plan.message == "route: tilt +30 deg about normal 2"
     assert plan.verification.min_cone_margin > 0 and rejection(plan.verification) is None
-    assert plan.duration == pytest.approx(480.0, abs=0.5) > frozen.duration      # what the motion costs
+    assert plan.duration == pytest.approx(480.0, abs=0.5) and frozen.duration < 340     # what the motion costs
     # the ride round the limb as it is mid-ride, widened by its motion, clears it too (slower)
     ride = next(c for c in plan.stats["candidates"] if c["route"] == "ride limb + then roll")
     assert ride["min_margin"] > 0 and 0 < ride["ride_time"] < ride["tf"] and ride["widening"] > 0
