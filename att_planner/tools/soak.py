@@ -33,7 +33,7 @@ def run_soak(scenario: str, orbits: float, out_dir: str | Path, sample_period: f
              timeout: float = 3600.0) -> dict:
     s = scen.load(scenario)
     sim_params = s.node_params.get("simulator", {})
-    end_time = orbits * s.orbit.period
+    end_time = orbits * s.orbit_model.period
     out = Path(out_dir)
     suite = start_suite(scenario, out / "soak.mcap", out, env=isolated_env(),
                         nodes=("recorder", "simulator", "controller"),
@@ -62,7 +62,7 @@ def run_soak(scenario: str, orbits: float, out_dir: str | Path, sample_period: f
         growth[name] = {"start_mib": float(np.nanmean(series[n // 4: n // 2])) if n >= 4 else float(series[0]),
                         "end_mib": float(np.nanmean(series[-max(1, n // 4):]))}
     settled_at = settling_time(state["header.stamp"], state["attitude"])       # None: not within the run
-    settling_orbits = None if settled_at is None else settled_at / s.orbit.period
+    settling_orbits = None if settled_at is None else settled_at / s.orbit_model.period
     return {"scenario": scenario, "orbits": orbits, "sim_time": sim_time, "wall_seconds": wall,
             "real_time_factor": sim_time / wall, "state_messages": len(state), "state_expected": expected,
             "command_messages": len(command), "dropped_state": expected - len(state),
