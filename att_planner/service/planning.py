@@ -37,6 +37,8 @@ from att_planner.problem import ManeuverProblem
 from att_planner.service.requests import ValidRequest, ValidSchedule
 from att_planner.service.sky import lattice
 from att_planner.verification import TOLERANCES, VERIFY_STEPS, Tolerances, rejection, verify
+from att_sim.ephemeris import de421
+from att_sim.epoch import timescale
 
 VERIFY_RESERVE = 0.2        # fraction of the time budget kept for verification and fallback
 VERIFY_RESERVE_MIN = 0.25   # s (at most half the budget)
@@ -70,9 +72,12 @@ def timed_verify(problem: ManeuverProblem, plan: Plan) -> Verification:
 
 
 def prepare(spacecraft) -> None:
-    """What the first request would otherwise pay for, done at start: the sky lattice, the imports
-    of the methods' option checks, and a first measure of the verification cost."""
+    """What the first request would otherwise pay for, done at start: the sky lattice, the DE421
+    ephemeris and the time scale of the real sky, the imports of the methods' option checks, and a
+    first measure of the verification cost."""
     lattice()
+    de421()
+    timescale()
     for method in methods.REGISTRY:
         method.validate({})
     problem = ManeuverProblem(spacecraft, np.array([0.0, 0.0, 0.0, 1.0]), np.array([0.0, 0.0, 0.5 ** 0.5, 0.5 ** 0.5]))
