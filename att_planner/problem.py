@@ -32,7 +32,7 @@ ZONE_SKY_CACHE = 4        # ZoneSkies a problem keeps (one per window asked for)
 
 @dataclass
 class ManeuverProblem:
-    """Reorientation of a body-fixed sensor among keep-out cones, from rest to rest.
+    """Reorientation of body-fixed sensors among keep-out cones and zones, from rest to rest.
 
     Attitudes are body-to-inertial quaternions [x, y, z, w]. ``spacecraft.body_torque_max`` is the
     per-axis torque bound T̄ (N m). ``deadline`` is a ``time.monotonic()`` instant after which a
