@@ -213,7 +213,8 @@ class MultiphaseTranscription:
     # -- guesses ----------------------------------------------------------------------------
     def initial_guess(self, q_start, targets_in_order, q_end) -> ScheduleSolution:
         """Slerp between consecutive (sign-aligned) attitudes with eigenaxis durations; wheel
-        momentum from the slerp rate by (1), clipped to the box; zero torque."""
+        momentum from the slerp rate by (1), clipped to the box; zero torque. With zones, the
+        nodes between the passages are pushed out of them (:meth:`_clear_zones`)."""
         P, N, n_w = self.n_phases, self.intervals, self.sc.n_wheels
         chain = _aligned([q_start, *targets_in_order, q_end])
         dur = np.array([max(eigenaxis_rest_to_rest_time(self.sc, a, b), 1.0) for a, b in zip(chain[:-1], chain[1:])])
@@ -227,7 +228,45 @@ class MultiphaseTranscription:
             h = np.clip(np.linalg.lstsq(self.scale.rate_matrix, w_tau, rcond=None)[0], -0.9, 0.9)
             hs.append(np.tile(h, (N, 1)))
         hs[-1][-1] = 0.0
-        return ScheduleSolution(dur, np.vstack(qs), np.vstack(hs), np.zeros((P * N, n_w)), False, "guess", 0, 0.0)
+        q = np.vstack(qs)
+        if self.zones is not None:
+            q = self._clear_zones(q, dur)
+        return ScheduleSolution(dur, q, np.vstack(hs), np.zeros((P * N, n_w)), False, "guess", 0, 0.0)
+
+    def _clear_zones(self, q: np.ndarray, durations: np.ndarray, beyond: float = np.deg2rad(2.0)) -> np.ndarray:
+        """The guess's attitudes ``q`` (K+1, 4) with each node between the passages that violates a
+        zone (at its time) turned so that its boresight lies ``beyond`` outside the zone
+        (keep-out: pushed off the guess's local plane of motion too, so the guess goes round the
+        zone, not along its axis; keep-in: pulled in radially). A slerp through a zone's axis
+        would give the NLP a zero constraint gradient to start from."""
+        N, zs = self.intervals, self.zones
+        t = np.concatenate([[0.0], np.cumsum(np.repeat(durations / N, N))]) * self.scale.t_sat
+        t = np.minimum(t, zs.window)
+        out = q.copy()
+        for k in range(1, len(q) - 1):
+            if k % N == 0:              # the targets are imposed
+                continue
+            for z in np.flatnonzero(zs.margins(t[k], out[k])[0] < 0):
+                s_z = zs.sensor_axes[z] / np.linalg.norm(zs.sensor_axes[z])
+                a, theta = zs.axes(t[k])[z], zs.half_angles(t[k])[z]
+                b = rot.dcm(out[k]) @ s_z
+                radial = b - (b @ a) * a
+                if zs.keep_in[z]:
+                    rho, side = theta - beyond, radial
+                else:                   # off the plane of b_{k-1}, b_{k+1}: round the zone
+                    normal = np.cross(rot.dcm(q[k - 1]) @ s_z, rot.dcm(q[k + 1]) @ s_z)
+                    normal = normal - (normal @ a) * a
+                    rho = theta + beyond
+                    side = radial + (normal / np.linalg.norm(normal) if np.linalg.norm(normal) > 1e-12 else 0.0)
+                if np.linalg.norm(side) < 1e-12:
+                    side = rot.orthonormal_basis(a)[0]
+                side = side / np.linalg.norm(side)
+                target = np.cos(rho) * a + np.sin(rho) * side
+                axis = np.cross(b, target)
+                if np.linalg.norm(axis) > 1e-12:
+                    angle = np.arctan2(np.linalg.norm(axis), b @ target)
+                    out[k] = rot.multiply(rot.from_axis_angle(axis / np.linalg.norm(axis), angle), out[k])
+        return out
 
     def resample(self, sol: ScheduleSolution) -> ScheduleSolution:
         """Interpolate a solution with another number of intervals per phase onto this grid."""

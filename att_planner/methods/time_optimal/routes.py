@@ -16,7 +16,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from att_msgs_py.types import Cone, Plan
+from att_msgs_py.types import Plan
 from att_planner.methods.axis_rotations import AxisLeg, axis_acceleration, eigenaxis_leg, goal_attitude
 from att_planner.methods.constrained_axis import cone_riding_legs
 from att_planner.methods.time_optimal import collocation as col
@@ -175,12 +175,12 @@ def _goal_routes(problem: ManeuverProblem, scaling: Scaling, tilt_deg: float,
             q_mid = rot.multiply(rot.from_axis_angle(n, sign * np.deg2rad(tilt_deg)), q_half)
             routes.append(Route(f"tilted {'+' if sign > 0 else '-'}{name}",
                                  [eigenaxis_leg(q0, q_mid), eigenaxis_leg(q_mid, q_goal)]))
-    for z, cone in _ride_cones(problem, scaling, routes[0], ride_margin_deg):
+    for z, name, cone in _ride_cones(problem, scaling, routes[0], ride_margin_deg):
         for side in (+1, -1):
             for finish in ("eigenaxis", "roll"):
-                legs = _ride(problem, scaling, z, cone, side, ride_margin_deg, finish)
+                legs = _ride(problem, z, cone, side, ride_margin_deg, finish)
                 if legs is not None:
-                    routes.append(Route(f"ride {cone.name} {'+' if side > 0 else '-'} {finish}", legs))
+                    routes.append(Route(f"ride {name} {'+' if side > 0 else '-'} {finish}", legs))
     for rt in routes:
         _estimate(problem, scaling, rt)
     return routes
@@ -198,42 +198,36 @@ def _estimate(problem: ManeuverProblem, scaling: Scaling, route: Route, samples:
     return m
 
 
-def _snapshot(problem: ManeuverProblem, scaling: Scaling, route: Route | None, z: int, name: str) -> Cone:
-    """Zone ``z`` as the cone it is when ``route`` comes closest to it (its own timing); a zone
-    that does not move is its own cone (``route`` unused)."""
+def _snapshot(problem: ManeuverProblem, scaling: Scaling, route: Route, z: int) -> tuple:
+    """``(axis, half-angle)`` of zone ``z`` when ``route`` comes closest to it (its own timing)."""
     zones = problem.zone_sky()
-    t = 0.0
-    if zones.moving and zones.zones[z].body != "inertial":
-        m = _estimate(problem, scaling, route)
-        t = min(np.linspace(0.0, route.tf_estimate, len(m))[int(np.argmin(m[:, z]))] * scaling.tu, zones.window)
-    return Cone(zones.axes(t)[z], float(zones.half_angles(t)[z]), name)
+    m = _estimate(problem, scaling, route)
+    t = min(np.linspace(0.0, route.tf_estimate, len(m))[int(np.argmin(m[:, z]))] * scaling.tu, zones.window)
+    return zones.axes(t)[z], float(zones.half_angles(t)[z])
 
 
 def _ride_cones(problem: ManeuverProblem, scaling: Scaling, eigenaxis: Route, ride_margin_deg: float):
-    """``(z, cone)`` for every keep-out zone: the cone it is when the sensor passes it (module
-    docstring; inertial zones are their own cone). Keep-in zones are not ridden."""
+    """``(z, name, cone)`` for every keep-out zone, ``cone`` the ``(axis, half-angle)`` it is when
+    the sensor passes it (module docstring), None for a zone that does not move (ridden as it is).
+    Keep-in zones are not ridden."""
     zones = problem.zone_sky()
     for z, zone in enumerate(zones.zones):
         if zone.keep_in:
             continue
-        name = zone.name or str(z)
-        cone = _snapshot(problem, scaling, eigenaxis, z, name)
-        if zones.moving and zone.body != "inertial":
-            legs = _ride(problem, scaling, z, cone, +1, ride_margin_deg, "eigenaxis")
+        cone = None
+        if zone.body != "inertial":
+            cone = _snapshot(problem, scaling, eigenaxis, z)
+            legs = _ride(problem, z, cone, +1, ride_margin_deg, "eigenaxis")
             if legs is not None:
-                cone = _snapshot(problem, scaling, Route("ride", legs), z, name)
-        yield z, cone
+                cone = _snapshot(problem, scaling, Route("ride", legs), z)
+        yield z, zone.name or str(z), cone
 
 
-def _ride(problem: ManeuverProblem, scaling: Scaling, z: int, cone: Cone, side: int, ride_margin_deg: float,
-          finish: str):
-    """:func:`~att_planner.methods.constrained_axis.cone_riding_legs` around ``cone`` with zone
-    ``z``'s own sensor (a semi-free goal is then taken as the attitude it would be)."""
-    sensor = problem.zone_sky().sensor_axes[z]
-    ride = replace(problem, cones=[cone], sensor_axis=sensor)
-    if problem.sensor_target is not None and not np.allclose(sensor, problem.sensor_axis):
-        ride = replace(ride, q_final=goal_attitude(problem), sensor_target=None)
-    return cone_riding_legs(ride, 0, side, np.deg2rad(ride_margin_deg), finish)
+def _ride(problem: ManeuverProblem, z: int, cone, side: int, ride_margin_deg: float, finish: str):
+    """:func:`~att_planner.methods.constrained_axis.cone_riding_legs` of zone ``z`` (its own
+    sensor) around ``cone`` (``(axis, half-angle)``, None: the zone as it is)."""
+    axis, half_angle = (None, None) if cone is None else cone
+    return cone_riding_legs(problem, z, side, np.deg2rad(ride_margin_deg), finish, axis, half_angle)
 
 
 def select_routes(routes: list[Route], count: int) -> list[Route]:

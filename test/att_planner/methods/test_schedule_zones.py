@@ -6,7 +6,7 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from att_msgs_py.types import Status, Zone
+from att_msgs_py.types import Cone, Status, Zone
 from att_planner.methods import schedule as sch
 from att_planner.reference import olivares_staffetti as ref
 from att_planner.verification import integrate, rejection, verify
@@ -73,6 +73,20 @@ def test_a_moving_zone_is_kept_on_every_leg_at_its_time_in_the_tour(tour):
     # earlier legs' durations + time in the leg
     assert 0.0 <= back < np.deg2rad(1.0)
     assert 0.0 < plan.passages[0].time < plan.duration
+
+
+def test_a_cone_across_the_tour_and_a_keep_in_zone_of_another_sensor_are_kept():
+    """A cone centred on the sensor's straight path (the slerp guess runs through its axis) and a
+    keep-in zone of body z about inertial z: the tour goes round the cone within the keep-in zone."""
+    z = np.array([0.0, 0.0, 1.0])
+    problem = replace(ref.problem(targets={"t": rot.from_axis_angle(z, np.deg2rad(90.0))}),
+                      cones=[Cone(np.array([C, C, 0.0]), np.deg2rad(15.0), "sun")],
+                      zones=[Zone("antenna", "inertial", z, np.deg2rad(30.0), True, z)])
+    plan = sch.plan_schedule(problem, search_intervals=GRID, intervals=GRID)
+    assert plan.status in (Status.OPTIMAL, Status.FEASIBLE), plan.message
+    ver = plan.verification
+    assert rejection(ver) is None, rejection(ver)
+    assert min(ver.cone_margins) >= 0.0 and ver.zone_keep_in == [False, True]
 
 
 def test_zone_options_are_checked():
