@@ -15,6 +15,7 @@ from att_msgs_py.errors import ErrorCode, RequestError
 from att_msgs_py.types import Zone
 from att_planner.nodes.client import maneuver_request
 from att_planner.service.real_sky import MAX_ZONES
+from att_planner.service.requests import validate_schedule
 from att_sim import rotations as rot
 from att_sim.orbit import tle_checksum
 from helpers.maneuver_requests import GOAL, INF, NAN, request, validate
@@ -181,3 +182,29 @@ def test_a_moving_zone_plan_comes_back_with_its_epoch_and_zones_signed(planner):
     refused = planner.client.plan(no_epoch)
     assert refused.error_code == ErrorCode.INVALID_EPOCH and "moves with the sky" in refused.message
     assert planner.suite.alive()["planner"]
+
+
+def schedule(**fields):
+    """validate_schedule of two targets on the wheeled olivares_staffetti spacecraft, ``fields`` replaced."""
+    args = dict(names=["a", "b"], targets=[rot.from_axis_angle([0, 0, 1], 1.0), rot.from_axis_angle([1, 0, 0], 1.0)],
+                q_start=rot.IDENTITY, q_end=None, spacecraft="olivares_staffetti", time_budget=5.0, request_frame="",
+                epoch=convert.epoch_parts(convert.epoch_msg(EPOCH)), zones=[], tle=TLE)
+    args.update(fields)
+    return validate_schedule(args.pop("names"), args.pop("targets"), args.pop("q_start"), args.pop("q_end"),
+                             args.pop("spacecraft"), args.pop("time_budget"), frame_id="eci",
+                             default_spacecraft="olivares_staffetti", default_budget=5.0, **args)
+
+
+def test_schedule_requests_get_the_same_sky_checks():
+    target_dir = rot.dcm(rot.from_axis_angle([0, 0, 1], 1.0)) @ X
+    cases = [(dict(zones=[inertial(target_dir, 0.2, name="star")]), ErrorCode.ZONE_AT_END,
+              "targets[0] ('a') is inside keep-out zone star"),
+             (dict(epoch=ZERO_EPOCH, tle=("", ""), zones=[SUN]), ErrorCode.INVALID_EPOCH, "moves with the sky"),
+             (dict(tle=(TLE[0], "")), ErrorCode.INVALID_ORBIT, "tle_line2 is empty"),
+             (dict(zones=[zone(body="pluto")]), ErrorCode.INVALID_ZONE, "body 'pluto'")]
+    for fields, code, words in cases:
+        with pytest.raises(RequestError) as err:
+            schedule(**fields)
+        assert (err.value.code, words in err.value.message) == (code, True), err.value.message
+    valid = schedule(zones=[Zone("sun", "sun", Z, math.radians(20))])
+    assert valid.problem.epoch == EPOCH and valid.problem.sky is not None and valid.problem.zones[0].name == "sun"
