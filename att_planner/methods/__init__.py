@@ -111,9 +111,9 @@ SLEPIAN_OPTIONS = {"M": Option(2, 12, True, doc="basis size"), "N": Option(50, 2
 
 # Best first: the default method is the first one.
 REGISTRY = [
-    _slepian("slepian_minimum_time", "smooth torque on a Slepian basis, t_f minimised exactly (issue 3); cone-aware"),
+    _slepian("slepian_minimum_time", "smooth torque on a Slepian basis, t_f minimised exactly (issue 3); zone-aware"),
     Method("time_optimal", "att_planner.methods.time_optimal.planner", "plan_time_optimal",
-           "minimum-time bang-bang slew by direct collocation with IPOPT (Melton 2012); cone-aware",
+           "minimum-time bang-bang slew by direct collocation with IPOPT (Melton 2012); zone-aware",
            {"intervals": Option(4, 200, True), "max_intervals": Option(4, 400, True), "starts": Option(1, 20, True),
             "refine_rounds": Option(0, 6, True), "cone_margin_deg": Option(0.0, 5.0),
             "rate_max": Option(1e-6, 10.0, limit=True, doc="rad/s per body axis"),
@@ -121,16 +121,16 @@ REGISTRY = [
             "smooth_warm_start": Option(0, 1, True)}, check=_time_optimal_check,
            combined=("intervals", "max_intervals")),
     Method("constrained_axis", "att_planner.methods.constrained_axis", "plan_constrained_axis",
-           "eigenaxis bang-bang, or lambda-rotations riding a cone boundary when the eigenaxis path is blocked",
+           "eigenaxis bang-bang, or lambda-rotations riding a zone boundary when the eigenaxis path is blocked (zones at their physical time)",
            {"ride_margin_deg": Option(0.0, 10.0)}, cheap=True),
     Method("eigenaxis_smooth", "att_planner.methods.eigenaxis", "plan_eigenaxis_smooth",
-           "eigenaxis slew with a quintic angle profile (C1 rate, zero torque at both ends); ignores cones",
+           "eigenaxis slew with a quintic angle profile (C1 rate, zero torque at both ends); ignores zones",
            # at most 5000 knots: a plan verified, signed and sent within its budget (+ 1 s)
            {"samples": Option(61, 5000, True, doc="knots of the linear torque profile")}, cheap=True),
     Method("eigenaxis", "att_planner.methods.eigenaxis", "plan_eigenaxis",
-           "eigenaxis bang-bang slew with the largest torque the per-axis limits allow; ignores cones", cheap=True),
-    _slepian("mssa", "Slepian basis, minimum sum of squared coefficients (Celani & Lucarelli); cone-aware"),
-    _slepian("dfsp", "Slepian basis, derivative-free sequential penalty on t_f (Celani & Bruni); cone-aware, slow"),
+           "eigenaxis bang-bang slew with the largest torque the per-axis limits allow; ignores zones", cheap=True),
+    _slepian("mssa", "Slepian basis, minimum sum of squared coefficients (Celani & Lucarelli); zone-aware"),
+    _slepian("dfsp", "Slepian basis, derivative-free sequential penalty on t_f (Celani & Bruni); zone-aware, slow"),
 ]
 METHODS = {m.name: m for m in REGISTRY}
 
