@@ -121,7 +121,7 @@ REGISTRY = [
             "smooth_warm_start": Option(0, 1, True)}, check=_time_optimal_check,
            combined=("intervals", "max_intervals")),
     Method("constrained_axis", "att_planner.methods.constrained_axis", "plan_constrained_axis",
-           "eigenaxis bang-bang, or lambda-rotations riding a zone boundary when the eigenaxis path is blocked (zones at their physical time)",
+           "eigenaxis bang-bang, or lambda-rotations riding a zone boundary when the path is blocked",
            {"ride_margin_deg": Option(0.0, 10.0)}, cheap=True),
     Method("eigenaxis_smooth", "att_planner.methods.eigenaxis", "plan_eigenaxis_smooth",
            "eigenaxis slew with a quintic angle profile (C1 rate, zero torque at both ends); ignores zones",
