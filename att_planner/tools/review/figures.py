@@ -51,6 +51,7 @@ def _planned_path(plan: Plan, n: int = 400) -> np.ndarray:
 
 CONE_COLORS = ["#d62728", "#1f77b4", "#7f7f7f", "#9467bd", "#8c564b", "#e377c2", "#bcbd22", "#17becf"]
 TRACK_POINTS = 120          # samples of a moving zone's axis track over the maneuver
+END_RING = (0, (7, 3))      # line style of a moving zone where it is at the plan's end (long dashes)
 
 
 def _draw_cap(ax, direction, half_angle: float, center: np.ndarray, color: str, *, fill: bool, ls: str = "-",
@@ -81,7 +82,7 @@ def _zone_end_time(run: Run) -> float:
 
 def _draw_zones(ax, run: Run, zones: ZoneSky, sensor: np.ndarray, center: np.ndarray) -> None:
     """Every zone: a fixed one as its shaded cap; a moving one shaded where it is at the start, a
-    dashed ring where it is at the end and the track of its axis in between. Keep-in zones are
+    long-dashed ring where it is at the end and the track of its axis in between. Keep-in zones are
     dash-dot rings (outside is forbidden); zones of another sensor than the plotted one are thin."""
     t_end = _zone_end_time(run)
     ts = np.linspace(0.0, t_end, TRACK_POINTS)
@@ -95,7 +96,7 @@ def _draw_zones(ax, run: Run, zones: ZoneSky, sensor: np.ndarray, center: np.nda
         label = f"{zone.name}\n{math.degrees(half[0, j]):.0f}°" + (" keep-in" if zone.keep_in else "")
         if zone.body != "inertial":
             a1 = axes[-1, j] / np.linalg.norm(axes[-1, j])
-            _draw_cap(ax, a1, half[-1, j], center, color, fill=False, ls="--", lw=0.9)
+            _draw_cap(ax, a1, half[-1, j], center, color, fill=False, ls=END_RING, lw=0.9)
             track = equal_area(axes[:, j] / np.linalg.norm(axes[:, j], axis=1, keepdims=True), center)
             ax.plot(track[:, 0], track[:, 1], color=color, lw=1.6, alpha=0.8)
             ax.annotate("", track[-1], track[-2], arrowprops=dict(arrowstyle="->", color=color, lw=1.4))
@@ -166,10 +167,11 @@ def plot_sky(ax, run: Run, zones: ZoneSky | None = None) -> None:
     ax.set_ylim(-2.08, 2.08)
     ax.set_aspect("equal")
     ax.axis("off")
+    if has_zones and zones.moving:
+        ax.plot([], [], color="0.4", ls=END_RING, lw=0.9, label="moving zone at the plan's end (shaded: start)")
+        ax.plot([], [], color="0.4", lw=1.6, label="moving zone's axis track")
     ax.legend(loc="lower left", fontsize=7, frameon=False, bbox_to_anchor=(-0.02, -0.04))
-    moving = has_zones and zones.moving
-    ax.set_title(("Boresight on the sky (equal-area, closest approach ×)" + ("\nmoving zones: shaded at the start, "
-                  "dashed at the end, their axes' tracks" if moving else "")) if plan is not None
+    ax.set_title("Boresight on the sky (equal-area, closest approach ×)" if plan is not None
                  else "Body x axis on the sky (no plan in the log)", fontsize=10)
 
 
