@@ -133,29 +133,39 @@ def contradictory_zones(zone_sky: ZoneSky) -> str:
     return ""
 
 
+GOAL_CHECK_TIMES = 2001      # times over the zones' window at which a goal is judged against moving zones
+
+
 def zone_at_end(problem, zone_sky: ZoneSky | None = None) -> str:
-    """Why the start or the goal violates a zone at t = 0, or '': the start at t = 0; the goal
-    against the zones at t = 0 too (the arrival time is not known before planning: the
-    verification checks the zones at the true arrival time). For a semi-free goal only the zones of
-    ``problem.sensor_axis`` are checked, on ``sensor_target`` (the roll about it is free)."""
+    """Why the start or the goal violates a zone, or '': the start at t = 0; the goal at every
+    time of the zones' window (``GOAL_CHECK_TIMES`` times over [0, window]): the arrival time is
+    not known before planning, so a goal is refused only when no arrival time in the window clears
+    it (a fixed zone: at t = 0); the verification checks the zones at the true arrival time. For a
+    semi-free goal only the zones of ``problem.sensor_axis`` are checked, on ``sensor_target`` (the
+    roll about it is free)."""
     zs = zone_sky if zone_sky is not None else problem.zone_sky()
     if not zs.zones:
         return ""
-    ends = [("start attitude", zs.margins(0.0, problem.q_initial, true=True)[0])]
+    times = np.linspace(0.0, zs.window, GOAL_CHECK_TIMES) if zs.moving else np.zeros(1)
     if problem.sensor_target is None:
-        ends.append(("goal attitude", zs.margins(0.0, problem.q_final, true=True)[0]))
+        goal = zs.margins(times, problem.q_final, true=True)                    # (K, Z)
+        goal_label = "goal attitude"
     else:
         target = np.asarray(problem.sensor_target, float)
         own = np.array([same_axis(s, problem.sensor_axis) for s in zs.sensor_axes], bool)
-        angle = np.arccos(np.clip(zs.true_axes(0.0) @ target / np.linalg.norm(target), -1.0, 1.0))
-        m = np.where(zs.keep_in, zs.true_half_angles(0.0) - angle, angle - zs.true_half_angles(0.0))
-        ends.append(("sensor_target direction", np.where(own, m, np.inf)))
-    for label, m in ends:
+        angle = np.arccos(np.clip(zs.true_axes(times) @ (target / np.linalg.norm(target)), -1.0, 1.0))
+        theta = zs.true_half_angles(times)
+        goal = np.where(own, np.where(zs.keep_in, theta - angle, angle - theta), np.inf)
+        goal_label = "sensor_target direction"
+    ends = [("start attitude", zs.margins(0.0, problem.q_initial, true=True)[0], "at t = 0"),
+            (goal_label, goal.max(axis=0), "at t = 0" if not zs.moving else
+             f"at every arrival time in [0, {zs.window:.0f}] s (its best)")]
+    for label, m, when in ends:
         if m.size and m.min() < 0:
             k = int(np.argmin(m))
             kind = "outside keep-in" if zs.keep_in[k] else "inside keep-out"
-            return (f"the {label} is {kind} zone {zs.names[k]} at t = 0 ({np.degrees(-m[k]):.2f} deg beyond "
-                    f"its {np.degrees(zs.true_half_angles(0.0)[k]):.2f} deg half-angle)")
+            return (f"the {label} is {kind} zone {zs.names[k]} {when} ({np.degrees(-m[k]):.2f} deg beyond "
+                    f"its {np.degrees(zs.true_half_angles(0.0)[k]):.2f} deg half-angle at t = 0)")
     return ""
 
 

@@ -239,3 +239,13 @@ def test_the_real_sky_of_leo_observatory_fits_within_tolerance():
     rates = np.linalg.norm(zs.axes_rate(t), axis=-1)
     assert np.degrees(rates[:, 2]).mean() * 60 == pytest.approx(360 / (1440 / 14.95764766), rel=0.02)
     assert np.degrees(rates[:, 0]).max() * 60 < 0.1
+
+
+def test_a_goal_inside_a_moving_zone_at_t0_is_refused_only_if_no_arrival_time_clears_it():
+    limb = Zone("limb", "earth_limb", Y, 0.0)                      # 66.4 deg about nadir, nadir turning at 0.062 deg/s
+    leaving = rot.from_axis_angle([0.0, 0.0, 1.0], math.radians(30))   # boresight 60 deg from nadir(0): clear after ~100 s
+    assert SKY.earth_angular_radius(0.0) > math.radians(60)
+    assert cone_checks.zone_issue(_problem([limb], leaving)) is None
+    staying = rot.from_axis_angle([0.0, 0.0, 1.0], math.radians(90))   # boresight at nadir(0): inside for 600 s
+    code, why = cone_checks.zone_issue(_problem([limb], staying))
+    assert code == ErrorCode.ZONE_AT_END and "at every arrival time in [0, 600] s" in why
