@@ -83,7 +83,7 @@ def solve_min_time(man: SmoothManeuver, *, basis_sizes: tuple = (4, 8), starts: 
     candidates += [rng.normal(size=(3, M0)) * start_scale * np.sqrt(Nc) for _ in range(starts)]
     candidates.append(np.zeros((3, M0)))
     explored = []
-    best = None
+    best = closest = None
     start_clock = time.monotonic()
 
     def share(fraction):   # stage deadlines: exploration ≤ 50 %, continuation ≤ 75 % of the budget
@@ -100,18 +100,22 @@ def solve_min_time(man: SmoothManeuver, *, basis_sizes: tuple = (4, 8), starts: 
         explored.append(round(r.tf, 6) if r.feasible else None)
         if r.feasible and (best is None or r.tf < best.tf):
             best = r
+        if not r.feasible and (closest is None or r.stats["violation"] < closest.stats["violation"]):
+            closest = r
+    if best is None and man.moving and closest is not None:
+        best = closest    # the paper basis barely moves near the ends: a larger one may outrun a zone there
     if best is None:
         status = Status.BUDGET_EXPIRED if end and time.monotonic() > end else Status.FAILED
         return slepian_result(man.resized(M=M0), np.zeros((3, M0)), status,
                               "no feasible start found by the coarse multistart", t0, feas_tol, explored=explored)
-    alpha, Mc, path = best.alpha, M0, [("coarse", M0, best.tf)]
+    alpha, Mc, tf_c, path = best.alpha, M0, best.tf, [("coarse", M0, best.tf)]
     for M in basis_sizes[1:]:
         if end is not None and time.monotonic() > share(0.75):
             break
         r = solve_min_time_local(coarse.resized(M=M), _pad_alpha(alpha, Nc, Nc, M), feas_tol=feas_tol,
                                  deadline=share(0.75), end_ratio=end_ratio)
         if r.feasible:
-            alpha, Mc = r.alpha, M
+            alpha, Mc, tf_c = r.alpha, M, r.tf
             path.append(("coarse", M, r.tf))
     fine = man.resized(M=Mc)
     start = _pad_alpha(alpha, Nc, N, Mc)
@@ -120,29 +124,32 @@ def solve_min_time(man: SmoothManeuver, *, basis_sizes: tuple = (4, 8), starts: 
     path.append(("fine", Mc, r.tf))
     stats = dict(explored=explored, continuation=path, iterations=r.stats.get("iterations"))
     if r.feasible:
-        return slepian_result(fine, r.alpha, r.status, r.message, t0, feas_tol, **stats)
+        return slepian_result(fine, r.alpha, r.status, r.message, t0, feas_tol, tf=r.tf, **stats)
     # Refinement unfinished (deadline) or failed: the best of its last iterate and the coarse solution
     # carried over, accepted if it meets the constraints to ``budget_tol`` (well inside the
     # verification's bounds and the cone margin).
     status = Status.BUDGET_EXPIRED if end is not None and time.monotonic() > end else Status.FAILED
-    fallback = min((slepian_result(fine, a, status, r.message, t0, budget_tol, **stats) for a in (r.alpha, start)),
+    fallback = min((slepian_result(fine, a, status, r.message, t0, budget_tol, tf=tf, **stats)
+                    for a, tf in ((r.alpha, r.tf), (start, tf_c))),
                    key=lambda res: (not res.feasible, res.tf))
     if fallback.feasible:
         fallback.message = f"refinement unfinished ({r.message}); constraints met to {budget_tol:g}"
     return fallback
 
 
-def physical_profile(man: SmoothManeuver, alpha: np.ndarray, spacecraft: Spacecraft | None = None) -> dict:
+def physical_profile(man: SmoothManeuver, alpha: np.ndarray, spacecraft: Spacecraft | None = None,
+                     tf: float | None = None) -> dict:
     """Physical-time plan of α: knots t_k = τ_k t_f (K = N+1) and ZOH body torque
-    T_k = T*(τ_k)/t_f² (the last one zero, T_k held on [t_k, t_{k+1})).
+    T_k = T*(τ_k)/t_f² (the last one zero, T_k held on [t_k, t_{k+1})). t_f: ``tf`` (the result's,
+    never below the torque-limited one) or sqrt(J_s T*/T̄).
 
     The q/ω references at the knots are the rigid-body response to exactly this torque from rest
     (one RK4 step per sample, :func:`att_sim.dynamics.simulate_profile`), so the controller tracks
     what the torque does; the ZOH model attitudes R_k lead it by about half a sample.
     Without ``spacecraft`` the references are the model's R_k and ω*(τ_{k−1})/t_f.
     """
-    ev = evaluate(man, alpha)
-    tf = man.tf_from_peak(ev.peak_torque)
+    ev = evaluate(man, alpha, tf=tf)
+    tf = man.tf_from_peak(ev.peak_torque) if tf is None else float(tf)
     N = man.N
     t = np.arange(N + 1) / N * tf
     torque = np.zeros((N + 1, 3))
@@ -212,6 +219,6 @@ def plan_slepian(problem: ManeuverProblem, method: str = DEFAULT_METHOD, M: int 
         if b_end @ final_man.sensor_target < 0.0:   # the 2-row residual also vanishes at the antipode
             return Plan(status=Status.FAILED, message="converged to the antipode of sensor_target",
                         wall_time=time.perf_counter() - t0, **outcome)
-    prof = physical_profile(final_man, res.alpha, problem.spacecraft)
+    prof = physical_profile(final_man, res.alpha, problem.spacecraft, tf=res.tf)
     return Plan(t=prof["t"], torque=prof["torque"], q=prof["q"], omega=prof["omega"], status=res.status,
                 message=res.message, wall_time=time.perf_counter() - t0, **outcome)
