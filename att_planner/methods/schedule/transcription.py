@@ -125,6 +125,7 @@ class MultiphaseTranscription:
             raise ValueError("intervals and substeps must be positive integers")
         self.sc, self.scale = sc, _scaling(sc)
         self.n_targets, self.n_phases, self.intervals = n_targets, n_targets + 1, intervals
+        self.zones = zones if zones is not None and zones.zones else None
         n_w = sc.n_wheels
         P, N = self.n_phases, intervals
         K = P * N
@@ -137,50 +138,15 @@ class MultiphaseTranscription:
         q_end = ca.MX.sym("q_end", 4)
         dtau = ca.repmat(T.T / N, N, 1).reshape((1, K))  # phase p's dτ on intervals p*N ... p*N+N-1
         step = _interval_map(self.scale, substeps).map(K)
-        q_next, h_next = step(Q[:, :K], H[:, :K], U, dtau)
-        g = [ca.vec(Q[:, 1:] - q_next), ca.vec(H[:, 1:] - h_next)]
-        rate_z = ca.DM(self.scale.rate_per_h[2:3, :])
-        for p in range(n_targets):
-            node = (p + 1) * N
-            g += [symbolic.error_vector(Q[:, node], targets[:, p]), rate_z @ H[:, node]]
-        g.append(symbolic.error_vector(Q[:, K], q_end))
-        # ω_z = 0 at both ends: implied by rest (h = 0 bounds), the only condition at a passage
-        g += [rate_z @ H[:, 0], rate_z @ H[:, K]]
-        n_eq = sum(int(gi.numel()) for gi in g)
-        lbg, ubg = [0.0] * n_eq, [0.0] * n_eq
-        # the truth model cuts a wheel's torque at its speed limit relative to the body, Ω − Gᵀω
-        # (att_sim.dynamics): with (1) that is (1 + I_w Gᵀ J⁻¹ G) Ω, linear in h like the rate, so the
-        # bound at the nodes holds everywhere; the box on h keeps the inertial speed within it too
-        relative = ca.DM(np.eye(n_w) - sc.wheel_axes.T @ self.scale.rate_per_h / sc.wheel_speed_max)
-        g.append(ca.vec(relative @ H))
-        lbg += [-(1.0 - bound_margin)] * (n_w * (K + 1))
-        ubg += [1.0 - bound_margin] * (n_w * (K + 1))
-        # body-rate box, only where the wheel box does not already imply it (rates are linear in h)
-        rate_rows = [i for i in range(3) if np.abs(self.scale.rate_per_h[i]).sum() > rate_max]
-        if rate_rows:
-            R = ca.DM(self.scale.rate_per_h[rate_rows, :] / rate_max)
-            g.append(ca.vec(R @ H))
-            lbg += [-1.0] * (len(rate_rows) * (K + 1))
-            ubg += [1.0] * (len(rate_rows) * (K + 1))
-        self.zones = zones if zones is not None and zones.zones else None
+        rows = [self._passage_rows(Q, H, U, dtau, step, targets, q_end),
+                self._wheel_speed_rows(H, bound_margin), self._rate_rows(H, rate_max)]
         if self.zones is not None:
-            q_mid, _ = step(Q[:, :K], H[:, :K], U, dtau / 2)
-            t_nodes = ca.horzcat(0, ca.cumsum(dtau, 1))           # (1, K+1) τ from the start of the tour
-            zone_g = self._zone_function(zone_margin)
-            if self.zones.moving:
-                g += [ca.vec(zone_g.map(K + 1)(Q, t_nodes)), ca.vec(zone_g.map(K)(q_mid, t_nodes[:, :K] + dtau / 2)),
-                      ca.sum1(T)]                                 # the zones' series hold on their window only
-            else:
-                g += [ca.vec(zone_g.map(K + 1)(Q)), ca.vec(zone_g.map(K)(q_mid))]
-            n_zone = len(self.zones.zones) * (2 * K + 1)
-            lbg += [-np.inf] * n_zone
-            ubg += [0.0] * n_zone
-            if self.zones.moving:
-                lbg.append(0.0)
-                ubg.append(self.zones.window / self.scale.t_sat)
+            rows.append(self._zone_rows(T, Q, H, U, dtau, step, zone_margin))
+        g = [expr for block in rows for expr in block[0]]
+        self._lbg = np.concatenate([block[1] for block in rows])
+        self._ubg = np.concatenate([block[2] for block in rows])
         self._x = ca.vertcat(T, ca.vec(Q), ca.vec(H), ca.vec(U))
         self._split = ca.Function("split", [self._x], [T, Q, H, U])
-        self._lbg, self._ubg = np.array(lbg), np.array(ubg)
         nlp = {"x": self._x, "p": ca.vertcat(ca.vec(targets), q_end), "f": ca.sum1(T), "g": ca.vertcat(*g)}
         self.ipopt_options = {"ipopt.print_level": 0, "print_time": 0, "ipopt.tol": tol,
                               "ipopt.max_iter": max_iter, "ipopt.mu_strategy": "adaptive",
@@ -191,6 +157,66 @@ class MultiphaseTranscription:
         self._nlp = nlp
         self._solver = ca.nlpsol("schedule", "ipopt", nlp, self.ipopt_options)
         self._solver_wall = None
+        self._variable_bounds(bound_margin)
+
+    # -- constraint rows: each block is (expressions, lower bounds, upper bounds) ---------------
+    def _passage_rows(self, Q, H, U, dtau, step, targets, q_end):
+        """Equalities: the shooting defects of every interval, each target reached with ω_z = 0
+        at its node, the end attitude, and ω_z = 0 at both ends (implied by rest through the
+        h = 0 bounds, the only condition at a passage)."""
+        K, N = self.n_nodes - 1, self.intervals
+        q_next, h_next = step(Q[:, :K], H[:, :K], U, dtau)
+        g = [ca.vec(Q[:, 1:] - q_next), ca.vec(H[:, 1:] - h_next)]
+        rate_z = ca.DM(self.scale.rate_per_h[2:3, :])
+        for p in range(self.n_targets):
+            node = (p + 1) * N
+            g += [symbolic.error_vector(Q[:, node], targets[:, p]), rate_z @ H[:, node]]
+        g.append(symbolic.error_vector(Q[:, K], q_end))
+        g += [rate_z @ H[:, 0], rate_z @ H[:, K]]
+        n_eq = sum(int(gi.numel()) for gi in g)
+        return g, np.zeros(n_eq), np.zeros(n_eq)
+
+    def _wheel_speed_rows(self, H, bound_margin: float):
+        """The wheel speed relative to the body, Ω − Gᵀω, within its limit at every node.
+
+        The truth model cuts a wheel's torque at that speed (att_sim.dynamics): with (1) it is
+        (1 + I_w Gᵀ J⁻¹ G) Ω, linear in h like the rate, so the bound at the nodes holds
+        everywhere; the box on h keeps the inertial speed within it too."""
+        sc = self.sc
+        relative = ca.DM(np.eye(sc.n_wheels) - sc.wheel_axes.T @ self.scale.rate_per_h / sc.wheel_speed_max)
+        n = sc.n_wheels * self.n_nodes
+        return [ca.vec(relative @ H)], np.full(n, -(1.0 - bound_margin)), np.full(n, 1.0 - bound_margin)
+
+    def _rate_rows(self, H, rate_max: float):
+        """The body-rate box, only on the axes where the wheel box does not already imply it
+        (rates are linear in h)."""
+        rate_rows = [i for i in range(3) if np.abs(self.scale.rate_per_h[i]).sum() > rate_max]
+        if not rate_rows:
+            return [], np.zeros(0), np.zeros(0)
+        R = ca.DM(self.scale.rate_per_h[rate_rows, :] / rate_max)
+        n = len(rate_rows) * self.n_nodes
+        return [ca.vec(R @ H)], np.full(n, -1.0), np.full(n, 1.0)
+
+    def _zone_rows(self, T, Q, H, U, dtau, step, zone_margin: float):
+        """Every zone at every node and interval midpoint (module docstring), at the point's time
+        along the tour when a zone moves; the tour then stays within the zones' window, where
+        their series hold."""
+        K = self.n_nodes - 1
+        q_mid, _ = step(Q[:, :K], H[:, :K], U, dtau / 2)
+        t_nodes = ca.horzcat(0, ca.cumsum(dtau, 1))           # (1, K+1) τ from the start of the tour
+        zone_g = self._zone_function(zone_margin)
+        n_zone = len(self.zones.zones) * (2 * K + 1)
+        lbg, ubg = np.full(n_zone, -np.inf), np.zeros(n_zone)
+        if not self.zones.moving:
+            return [ca.vec(zone_g.map(K + 1)(Q)), ca.vec(zone_g.map(K)(q_mid))], lbg, ubg
+        g = [ca.vec(zone_g.map(K + 1)(Q, t_nodes)), ca.vec(zone_g.map(K)(q_mid, t_nodes[:, :K] + dtau / 2)), ca.sum1(T)]
+        return g, np.append(lbg, 0.0), np.append(ubg, self.zones.window / self.scale.t_sat)
+
+    def _variable_bounds(self, bound_margin: float) -> None:
+        """Box on the decision vector (T, Q, H, U): phase durations in [1e-3, 1e4] τ, quaternion
+        components in ±1.5, wheel momentum and torque within the margin of the unit box; the
+        indices of q₀, h₀ and h_f that a solve pins."""
+        P, K, n_w = self.n_phases, self.n_nodes - 1, self.sc.n_wheels
         limit = 1.0 - bound_margin
         lbx = ca.vertcat(np.full(P, 1e-3), np.full(4 * (K + 1), -1.5), np.full(n_w * (K + 1), -limit),
                          np.full(n_w * K, -limit))

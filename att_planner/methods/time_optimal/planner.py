@@ -234,6 +234,53 @@ def _routes(problem: ManeuverProblem, s: Scaling, starts: int, warm_starts, smoo
                      for p in warm_starts if len(p.t) > 1]
 
 
+def _checked_options(intervals: int, max_intervals: int | None, interpolation: str) -> tuple[int, int]:
+    """The mesh sizes ``(intervals, max_intervals)`` of valid options; ValueError otherwise."""
+    why = option_problem({"intervals": intervals, "max_intervals": max_intervals})
+    if why:
+        raise ValueError(why)
+    if interpolation not in tuple(Interpolation):
+        raise ValueError(f"interpolation must be one of {[str(i) for i in Interpolation]}, not {interpolation!r}")
+    return _mesh_sizes({"intervals": intervals, "max_intervals": max_intervals})
+
+
+def _answer_without_solving(problem: ManeuverProblem, interpolation: str, start: float) -> Plan | None:
+    """The plan when no NLP is needed (a refused problem, or the start already at the goal), else None."""
+    why = no_torque_limit(problem) or blocked_endpoint(problem)
+    if why:
+        return Plan(method=METHOD, status=Status.FAILED, message=why, wall_time=time.monotonic() - start)
+    if eigenaxis_leg(problem.q_initial, goal_attitude(problem)).angle < 1e-9:
+        q0 = rot.normalize(np.asarray(problem.q_initial, float))
+        return Plan(t=np.zeros(1), torque=np.zeros((1, 3)), q=q0[None], omega=np.zeros((1, 3)),
+                    interpolation=interpolation, method=METHOD, status=Status.OPTIMAL, message="already at the goal",
+                    wall_time=time.monotonic() - start, stats={"tf": 0.0})
+    return None
+
+
+def _tf_bounds(problem: ManeuverProblem, s: Scaling, routes: list[Route]) -> tuple[float, float]:
+    """Bounds on the normalised t_f: up to ten times the slowest route's estimate, and within the
+    window of moving zones (their series hold there only)."""
+    tf_scale = max(r.tf_estimate for r in routes if np.isfinite(r.tf_estimate))
+    tf_max = 10.0 * tf_scale
+    if problem.zone_sky().moving:
+        tf_max = min(tf_max, problem.zone_sky().window / s.tu)
+    return min(1e-2 * tf_scale, 0.5 * tf_max), tf_max
+
+
+def _verdict(plan: Plan, ok: bool, run: _Solve, incumbent: _Incumbent, best: str) -> tuple[Status, str]:
+    """Status and message of the refined, verified plan: failed (why), budget expired, or optimal /
+    feasible by IPOPT's last status."""
+    if not ok:
+        ver = plan.verification
+        return Status.FAILED, (f"best solution (t_f = {plan.t[-1]:.4g} s) fails truth verification: {rejection(ver)} "
+                               f"(final error {np.rad2deg(ver.final_attitude_error):.3f} deg, min cone margin "
+                               f"{np.rad2deg(ver.min_cone_margin):.3f} deg)")
+    if run.budget_hit:
+        return Status.BUDGET_EXPIRED, "time budget expired; best verified plan returned"
+    status = Status.OPTIMAL if incumbent.res.status == "Solve_Succeeded" else Status.FEASIBLE
+    return status, f"{best}; {incumbent.sol.phase.intervals} intervals"
+
+
 def plan_time_optimal(problem: ManeuverProblem, *, intervals: int = DEFAULT_INTERVALS, max_intervals: int | None = None,
                       starts: int = 6, refine_rounds: int = 3, interpolation: str = Interpolation.ZOH,
                       cone_margin_deg: float = 0.05, warm_starts: tuple = (),
@@ -256,30 +303,15 @@ def plan_time_optimal(problem: ManeuverProblem, *, intervals: int = DEFAULT_INTE
     ``nit`` and ``nfev`` count IPOPT iterations and objective evaluations over every NLP solved.
     """
     start = time.monotonic()
-    why = option_problem({"intervals": intervals, "max_intervals": max_intervals})
-    if why:
-        raise ValueError(why)
-    intervals, max_intervals = _mesh_sizes({"intervals": intervals, "max_intervals": max_intervals})
-    if interpolation not in tuple(Interpolation):
-        raise ValueError(f"interpolation must be one of {[str(i) for i in Interpolation]}, not {interpolation!r}")
-    why = no_torque_limit(problem) or blocked_endpoint(problem)
-    if why:
-        return Plan(method=METHOD, status=Status.FAILED, message=why, wall_time=time.monotonic() - start)
-    if eigenaxis_leg(problem.q_initial, goal_attitude(problem)).angle < 1e-9:
-        q0 = rot.normalize(np.asarray(problem.q_initial, float))
-        return Plan(t=np.zeros(1), torque=np.zeros((1, 3)), q=q0[None], omega=np.zeros((1, 3)),
-                    interpolation=interpolation, method=METHOD, status=Status.OPTIMAL, message="already at the goal",
-                    wall_time=time.monotonic() - start, stats={"tf": 0.0})
+    intervals, max_intervals = _checked_options(intervals, max_intervals, interpolation)
+    unsolved = _answer_without_solving(problem, interpolation, start)
+    if unsolved is not None:
+        return unsolved
     s = scaling(problem)
     seconds: dict = {}
     lap = time.monotonic()
     routes = _routes(problem, s, starts, warm_starts, smooth_warm_start, seconds)
-    tf_scale = max(r.tf_estimate for r in routes if np.isfinite(r.tf_estimate))
-    tf_max = 10.0 * tf_scale
-    if problem.zone_sky().moving:      # the zones' series hold on their window only
-        tf_max = min(tf_max, problem.zone_sky().window / s.tu)
-    tf_bounds = (min(1e-2 * tf_scale, 0.5 * tf_max), tf_max)
-    run = _Solve(problem, s, np.deg2rad(cone_margin_deg), tf_bounds, tol, max_iter,
+    run = _Solve(problem, s, np.deg2rad(cone_margin_deg), _tf_bounds(problem, s, routes), tol, max_iter,
                  max_intervals, None if problem.deadline is None else problem.deadline - verify_reserve, interpolation)
     tr, solved, start_log = _explore(run, routes, intervals, explore_tol)
     stats = {"starts": start_log, "time_unit": s.tu, "seconds": seconds}
@@ -301,19 +333,9 @@ def plan_time_optimal(problem: ManeuverProblem, *, intervals: int = DEFAULT_INTE
     extra: list = []
     ok, plan = incumbent.verified(extra)
     seconds["verification"] = time.monotonic() - lap
-    ver = plan.verification
     stats.update({"tf": float(plan.t[-1]), "mesh": incumbent.mesh_log, "truth_refinements": extra,
                   "intervals": incumbent.sol.phase.intervals, "ipopt_status": incumbent.res.status})
-    if not ok:
-        status = Status.FAILED
-        message = (f"best solution (t_f = {plan.t[-1]:.4g} s) fails truth verification: {rejection(ver)} (final error "
-                   f"{np.rad2deg(ver.final_attitude_error):.3f} deg, min cone margin "
-                   f"{np.rad2deg(ver.min_cone_margin):.3f} deg)")
-    elif run.budget_hit:
-        status, message = Status.BUDGET_EXPIRED, "time budget expired; best verified plan returned"
-    else:
-        status = Status.OPTIMAL if incumbent.res.status == "Solve_Succeeded" else Status.FEASIBLE
-        message = f"best of {len(start_log)} starts: {best_label}; {incumbent.sol.phase.intervals} intervals"
-    plan.status, plan.message, plan.stats = status, message, stats
+    plan.status, plan.message = _verdict(plan, ok, run, incumbent, f"best of {len(start_log)} starts: {best_label}")
+    plan.stats = stats
     plan.nit, plan.nfev, plan.wall_time = run.nit, run.nfev, time.monotonic() - start
     return plan
