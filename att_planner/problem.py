@@ -76,18 +76,12 @@ class ManeuverProblem:
         """The cones (first, as inertial keep-out zones of ``sensor_axis``) and the zones over
         ``[0, window]`` s, built once per window and field values (the last :data:`ZONE_SKY_CACHE` kept).
 
-        Default window: :data:`WINDOW_FACTOR` × :meth:`slew_time_bound`, at least :data:`MIN_WINDOW`:
-        room for detours around the zones. A plan longer than the window cannot be judged against
-        the fitted zones (the ZoneSky refuses those times); a method asks for a longer window then.
+        Default window: :meth:`default_window`. A plan longer than the window cannot be judged
+        against the fitted zones (the ZoneSky refuses those times); a method asks for a longer
+        window then.
         """
         if window is None:
-            bound = (np.asarray(self.q_initial, float).tobytes(), np.asarray(self.q_final, float).tobytes(),
-                     self.sensor_target is None, self.rate_max, self.wheel_momentum_max, id(self.spacecraft),
-                     self.spacecraft.body_torque_max)
-            if self._default_window[:1] != (bound,):
-                self._default_window = (bound, max(MIN_WINDOW, WINDOW_FACTOR * self.slew_time_bound()),
-                                        self.spacecraft)
-            window = self._default_window[1]
+            window = self.default_window()
         # by value (the fields of the cones and zones); the sky by identity (the cached ZoneSky holds it)
         key = (float(window), id(self.sky), np.asarray(self.sensor_axis, float).tobytes(),
                tuple((c.direction.tobytes(), c.half_angle, c.name) for c in self.cones),
@@ -99,6 +93,17 @@ class ManeuverProblem:
             zones = zones_from_cones(self.cones, self.sensor_axis) + list(self.zones)
             self._zone_skies[key] = ZoneSky(zones, self.sky, float(window))
         return self._zone_skies[key]
+
+    def default_window(self) -> float:
+        """The default zone window (s): :data:`WINDOW_FACTOR` × :meth:`slew_time_bound`, at least
+        :data:`MIN_WINDOW` (room for detours around the zones); computed once per value of the
+        fields the bound reads."""
+        bound = (np.asarray(self.q_initial, float).tobytes(), np.asarray(self.q_final, float).tobytes(),
+                 self.sensor_target is None, self.rate_max, self.wheel_momentum_max, id(self.spacecraft),
+                 self.spacecraft.body_torque_max)
+        if self._default_window[:1] != (bound,):
+            self._default_window = (bound, max(MIN_WINDOW, WINDOW_FACTOR * self.slew_time_bound()), self.spacecraft)
+        return self._default_window[1]
 
     def slew_time_bound(self) -> float:
         """Duration (s) of the rest-to-rest eigenaxis slew to ``q_final`` (or by π for a semi-free

@@ -27,7 +27,7 @@ from att_msgs_py.validation import MAX_NAME_LENGTH, text, unit_quaternion, unit_
 from att_planner import methods
 from att_planner.cones import check_zones, endpoint_in_cone
 from att_planner.methods import Method
-from att_planner.problem import MIN_WINDOW, WINDOW_FACTOR, ManeuverProblem
+from att_planner.problem import ManeuverProblem
 from att_planner.service.real_sky import RequestSky, check_orbit_window, resolve_sky
 from att_planner.service.sky import closed_sky
 from att_sim import rotations as rot
@@ -137,9 +137,9 @@ def check_cones(raw: list) -> list[Cone]:
 
 
 def zone_window(problem: ManeuverProblem, legs: int = 1) -> float:
-    """The zone window (s) of ``problem`` (:meth:`ManeuverProblem.zone_sky`'s default), times
+    """The zone window (s) of ``problem`` (:meth:`ManeuverProblem.default_window`), times
     ``legs`` for a schedule: the span its orbit must last."""
-    return max(MIN_WINDOW, WINDOW_FACTOR * problem.slew_time_bound()) * legs
+    return problem.default_window() * legs
 
 
 def check_sky(problem: ManeuverProblem, real: RequestSky, legs: int = 1) -> None:
