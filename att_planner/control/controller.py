@@ -18,6 +18,14 @@ Laws per mode: IDLE commands nothing; MAGNETORQUER_PD the PD-like law of Bruni &
 (:mod:`.magnetorquer`); SAFE rate damping through the wheels (τ = −k_d ω); PLAN_TRACKING the plan's
 feedforward plus quaternion PD feedback (:mod:`.tracking`) for the plan's duration plus a settle
 time, then a hold of its final attitude.
+
+The feedback's ``min_cone_margin`` covers the plan's cones and zones at their true positions now:
+a :class:`~att_planner.zones.ZoneSky` of the plan, built once when it starts, on the controller's
+``sky`` (:class:`att_sim.ephemeris.Sky` at the scenario epoch, whose time is sim time), evaluated
+straight from the ephemeris at the current state's time (one evaluation per feedback). The truth
+does not depend on the plan's epoch: a plan made for another start instant shows the margins it
+really has. Without a ``sky`` (a scenario with no epoch) the moving zones are left out: the margin
+is that of the cones and inertial zones only.
 """
 from __future__ import annotations
 
@@ -41,13 +49,14 @@ from att_msgs_py.types import (
     Plan,
     State,
 )
-from att_planner.cones import min_margin
 from att_planner.control import tracking
 from att_planner.control.magnetorquer import dipole_command
 from att_planner.control.plan_checks import PlanContext, check_plan, check_start
 from att_planner.control.state_gate import GateConfig, StateGate
+from att_planner.zones import ZoneSky, zones_from_cones
 from att_sim import rotations as rot
 from att_sim.dynamics import Spacecraft
+from att_sim.ephemeris import Sky
 
 
 @dataclass(frozen=True)
@@ -75,10 +84,11 @@ class ControllerConfig:
 
 @dataclass
 class Maneuver:
-    """The plan being executed, from sim time ``t0``."""
+    """The plan being executed, from sim time ``t0``, and its zones (:meth:`Controller.start`)."""
 
     plan: Plan
     t0: float
+    zones: ZoneSky | None = None
     ticks: int = 0
 
 
@@ -110,12 +120,15 @@ class CachedPlan:
 
 MAX_REMEMBERED_IDS = 100_000                   # plan ids whose content is remembered (32 bytes each)
 MAX_REMEMBERED_REFUSALS = 1000                 # refused plan ids whose reason an execute goal is told
+ZONE_FIT_WINDOW = 1.0                          # s: a ZoneSky needs a window; the controller uses its truth only
 
 
 class Controller:
     def __init__(self, context: PlanContext, config: ControllerConfig = ControllerConfig(),
-                 mode: int = ControlMode.IDLE, body_frame_id: str = "body", gate: GateConfig | None = None):
+                 mode: int = ControlMode.IDLE, body_frame_id: str = "body", gate: GateConfig | None = None,
+                 sky: Sky | None = None):
         self.context, self.config, self.mode, self.body_frame_id = context, config, mode, body_frame_id
+        self.sky = sky                                 # the scenario's (time: sim time), None without an epoch
         self.gate = StateGate(context.spacecraft, context.frame_id, body_frame_id, gate or GateConfig())
         self.next_control = -math.inf
         self.maneuver: Maneuver | None = None
@@ -257,9 +270,24 @@ class Controller:
         refused = check_start(plan, self.state, self.context)
         if refused is not None:
             return refused
-        self.maneuver = Maneuver(plan, self.state.t)
+        try:
+            zones = self.zone_sky(plan)
+        except ValueError as err:
+            return RequestError(ErrorCode.INVALID_PLAN, f"plan '{plan.plan_id}': its zones cannot be placed in the "
+                                                        f"sky now: {err}")
+        self.maneuver = Maneuver(plan, self.state.t, zones)
         self.mode = ControlMode.PLAN_TRACKING
         return None
+
+    def zone_sky(self, plan: Plan) -> ZoneSky | None:
+        """The plan's cones and zones on :attr:`sky` (moving zones left out without one); None
+        when there are none. Only its truth is used (any time): the fit is over a short window."""
+        zones = zones_from_cones(plan.cones, plan.sensor_axis) + [z for z in plan.zones
+                                                                  if self.sky is not None or z.body == "inertial"]
+        if not zones:
+            return None
+        moving = any(z.body != "inertial" for z in zones)
+        return ZoneSky(zones, self.sky if moving else None, window=ZONE_FIT_WINDOW)
 
     def abort(self, message: str) -> ManeuverResult:
         """End the running maneuver unsuccessfully (cancelled, or safe mode); safe mode follows."""
@@ -329,7 +357,7 @@ class Controller:
             out.feedback = ManeuverFeedback(
                 elapsed=float(elapsed), progress=float(min(1.0, elapsed / span)),
                 attitude_error=float(rot.angle_between(s.q, ref.q)),
-                min_cone_margin=min_margin(s.q, plan.sensor_axis, plan.cones))
+                min_cone_margin=float(m.zones.margins(s.t, s.q, true=True).min()) if m.zones else math.inf)
         if cancel_requested:
             out.result = self.abort("cancelled")
             return

@@ -3,7 +3,9 @@
 :func:`check_plan` looks at every field of a received plan (cached from ``/planner/plans`` or
 inline in an ``ExecuteManeuver`` goal): sizes and lengths against each other, finiteness, unit
 quaternions, times from 0 strictly increasing and bounded, controls within the spacecraft's
-limits, known vocabularies, bounded strings; then its context: made for this spacecraft
+limits, known vocabularies, bounded strings, its zones (:func:`att_msgs_py.validation.zone`: known
+body, unit axes, half-angle range, an inertial zone's direction) and its epoch (within
+:mod:`att_sim.epoch`'s span; needed by a zone that moves); then its context: made for this spacecraft
 configuration (name and :attr:`~att_sim.dynamics.Spacecraft.digest`) and signed by the configured
 key (:mod:`att_msgs_py.signing`). :func:`check_start` compares a plan's first sample with the
 current state. Each returns ``None`` or a :class:`RequestError` (code and sentence).
@@ -12,18 +14,21 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from datetime import datetime
 
 import numpy as np
 
 from att_msgs_py import signing, validation
 from att_msgs_py.errors import ErrorCode, RequestError
 from att_msgs_py.types import ControlKind, Interpolation, Plan, State, Status
+from att_sim import epoch as epochs
 from att_sim import rotations as rot
 from att_sim.dynamics import Spacecraft
 
 LIMIT_TOLERANCE = 1e-6       # relative: plan controls may touch their limit, not exceed it
 MAX_PLAN_RATE = 10.0         # rad/s, any body axis: beyond it a plan is not a slew
 MAX_CONES = 16
+MAX_ZONES = 16               # zones besides the cones: the planner service's cap (att_planner.service.real_sky)
 
 
 @dataclass(frozen=True)
@@ -98,8 +103,31 @@ def _fields(plan: Plan, sc: Spacecraft, frame_id: str) -> Plan:
         validation.unit_vector(c.direction, f"plan.cones[{i}].direction", code)
         if not (math.isfinite(c.half_angle) and 0.0 < c.half_angle < math.pi / 2):
             raise RequestError(code, f"plan.cones[{i}].half_angle = {c.half_angle!r} rad is outside (0, pi/2)")
+    plan.zones, plan.epoch = _zones(plan)
     plan.t, plan.q, plan.omega, plan.torque, plan.sensor_axis = t, q, omega, torque, axis
     return plan
+
+
+def _zones(plan: Plan) -> tuple[list, datetime | None]:
+    """The plan's zones checked and normalised, and its epoch (None, or a UTC ``datetime`` within
+    the ephemeris span; a moving zone needs one)."""
+    code = ErrorCode.INVALID_PLAN
+    if len(plan.zones) > MAX_ZONES:
+        raise RequestError(ErrorCode.SIZE_LIMIT, f"plan.zones has {len(plan.zones)} zones; at most {MAX_ZONES}")
+    zones = [validation.zone(z, f"plan.zones[{i}]", code) for i, z in enumerate(plan.zones)]
+    epoch = plan.epoch
+    if epoch is not None:
+        if not isinstance(epoch, datetime):
+            raise RequestError(code, f"plan.epoch must be a UTC datetime or none, got {type(epoch).__name__}")
+        try:
+            epoch = epochs.parse_epoch(epoch, "plan.epoch")
+        except ValueError as err:
+            raise RequestError(code, str(err)) from None
+    moving = next((i for i, z in enumerate(zones) if z.body != "inertial"), None)
+    if moving is not None and epoch is None:
+        raise RequestError(code, f"plan.zones[{moving}] ('{zones[moving].name}') moves with the sky (body "
+                                 f"{zones[moving].body}) but plan.epoch is zero: a moving zone needs the epoch")
+    return zones, epoch
 
 
 def check_plan(plan: Plan, payload: bytes, ctx: PlanContext) -> RequestError | None:

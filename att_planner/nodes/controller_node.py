@@ -5,7 +5,8 @@ Subscribes ``/spacecraft/state`` and the latched ``/planner/plans``; publishes
 computed when a state at or after the next control instant arrives, and stamped with that state's
 time (the simulator's lockstep waits for it); serves ``/controller/set_mode`` and the
 ``/controller/execute`` action (ExecuteManeuver), which runs for the maneuver's duration plus
-``settle_time`` and reports progress as feedback.
+``settle_time`` and reports progress as feedback (the zone margins of the feedback are taken
+on the scenario's sky: its epoch and orbit).
 
 Nothing received is trusted (the core's checks, :mod:`att_planner.control.plan_checks` and
 :mod:`att_planner.control.state_gate`): a refused state or plan is logged (at most once a second
@@ -44,6 +45,7 @@ from att_planner.control.controller import Controller, ControllerConfig
 from att_planner.control.plan_checks import PlanContext
 from att_planner.control.state_gate import GateConfig
 from att_sim import scenario as scen
+from att_sim.ephemeris import Sky
 
 
 def publisher_of(info) -> bytes | None:
@@ -65,7 +67,7 @@ class ControllerNode(Node):
         self._core = Controller(self._plan_context(param), self._config(param),
                                 param("initial_mode", int(ControlMode.IDLE),
                                       choices=[int(m) for m in ControlMode if m != ControlMode.PLAN_TRACKING]),
-                                self._scenario.body_frame_id, self._gate_config(param))
+                                self._scenario.body_frame_id, self._gate_config(param), self._sky())
         self._wall_timeout = param("wall_timeout", 2.0, 0.0, 3600.0, low_open=True)
         if param("require_signed_modes", False):
             self._core.mode_key = self._public_key(param, "mode_public_key")
@@ -107,6 +109,11 @@ class ControllerNode(Node):
             max_cached_plans=param("max_cached_plans", d.max_cached_plans, 1, 10_000),
             max_cache_bytes=int(param("max_cache_mb", d.max_cache_bytes / 2**20, 0.0, 4096.0, low_open=True) * 2**20),
             safe_rate_threshold=param("safe_rate_threshold", d.safe_rate_threshold, 0.0, 10.0, low_open=True))
+
+    def _sky(self) -> Sky | None:
+        """The scenario's sky (sim time past its epoch) for the zones' margins; None without an epoch."""
+        s = self._scenario
+        return None if s.epoch is None else Sky(s.epoch, s.orbit_model)
 
     @staticmethod
     def _public_key(param, name: str):

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import replace
+from datetime import UTC, datetime
 
 import numpy as np
 import pytest
@@ -14,7 +15,7 @@ from cryptography.hazmat.primitives.asymmetric.ed25519 import Ed25519PrivateKey
 
 from att_msgs_py import convert, signing, validation
 from att_msgs_py.errors import ErrorCode
-from att_msgs_py.types import Cone, ControlKind, ControlMode, Plan, Status
+from att_msgs_py.types import Cone, ControlKind, ControlMode, Plan, Status, Zone
 from att_planner.control.controller import Controller, ControllerConfig
 from att_planner.methods.eigenaxis import plan_eigenaxis_smooth
 from att_planner.problem import ManeuverProblem
@@ -26,6 +27,13 @@ from helpers.signed_plans import KEY, context, issue
 SWIFT = scenario.load("swift_demo")
 GOAL = rot.from_axis_angle([0, 0, 1], 0.8)
 BIG = validation.MAX_PLAN_SAMPLES + 1
+EPOCH = datetime(2026, 12, 21, tzinfo=UTC)
+SUN = Zone("sun", "sun", [1.0, 0, 0], 0.8)
+
+
+def zoned(*zones, epoch=EPOCH):
+    """A change of the plan: these zones (and the epoch of a real-sky plan)."""
+    return lambda p: replace(p, zones=list(zones), epoch=epoch)
 
 
 def good_plan() -> Plan:
@@ -105,6 +113,35 @@ PLAN_CASES = [
      ErrorCode.SIZE_LIMIT, "17 cones"),
     ("cone name with a control character", lambda p: replace(p, cones=[Cone([0, 0, 1.0], 0.1, "s\x07un")]),
      ErrorCode.INVALID_TEXT, "cones[0].name"),
+    ("unknown zone body", zoned(SUN, replace(SUN, body="jupiter")), ErrorCode.INVALID_PLAN,
+     "plan.zones[1] ('sun').body 'jupiter' is not one of inertial, sun, moon, earth_limb"),
+    ("empty zone body", zoned(replace(SUN, body="")), ErrorCode.INVALID_PLAN, "body '' is not one of"),
+    ("zone body with an escape", zoned(replace(SUN, body="sun\x1b")), ErrorCode.INVALID_TEXT, "zones[0].body"),
+    ("zone name with a bell", zoned(replace(SUN, name="s\x07")), ErrorCode.INVALID_TEXT, "zones[0].name"),
+    ("zone name of 300 characters", zoned(replace(SUN, name="z" * 300)), ErrorCode.SIZE_LIMIT, "zones[0].name"),
+    ("zero zone sensor axis", zoned(replace(SUN, sensor_axis=np.zeros(3))), ErrorCode.INVALID_PLAN,
+     "zones[0] ('sun').sensor_axis is the zero vector"),
+    ("NaN zone sensor axis", zoned(replace(SUN, sensor_axis=[np.nan, 0, 1.0])), ErrorCode.INVALID_PLAN,
+     "sensor_axis has NaN"),
+    ("infinite zone sensor axis", zoned(replace(SUN, sensor_axis=[np.inf, 0, 0])), ErrorCode.INVALID_PLAN,
+     "sensor_axis has NaN or Inf"),
+    ("zone half-angle 0", zoned(replace(SUN, half_angle=0.0)), ErrorCode.INVALID_PLAN, "half_angle = 0.0 rad is "
+                                                                                       "outside (0, pi)"),
+    ("zone half-angle pi", zoned(replace(SUN, half_angle=math.pi)), ErrorCode.INVALID_PLAN, "outside (0, pi)"),
+    ("NaN zone half-angle", zoned(replace(SUN, half_angle=np.nan)), ErrorCode.INVALID_PLAN, "half_angle = nan"),
+    ("negative zone half-angle", zoned(replace(SUN, half_angle=-0.1)), ErrorCode.INVALID_PLAN, "half_angle = -0.1"),
+    ("Earth-limb margin of 1.6 rad", zoned(Zone("e", "earth_limb", [0, 1.0, 0], 1.6)), ErrorCode.INVALID_PLAN,
+     "outside [0, pi/2) (the margin beyond the Earth's limb)"),
+    ("inertial zone without a direction", zoned(Zone("i", "inertial", [0, 1.0, 0], 0.3)), ErrorCode.INVALID_PLAN,
+     "zones[0] ('i').direction is the zero vector; an inertial zone needs a unit direction"),
+    ("inertial zone with a NaN direction", zoned(Zone("i", "inertial", [0, 1.0, 0], 0.3, False, [np.nan, 1.0, 0])),
+     ErrorCode.INVALID_PLAN, "direction has NaN"),
+    ("sun zone with a direction", zoned(replace(SUN, direction=[0, 0, 1.0])), ErrorCode.INVALID_PLAN,
+     "only an inertial zone has one"),
+    ("seventeen zones", zoned(*[replace(SUN, name=f"z{i}") for i in range(17)]), ErrorCode.SIZE_LIMIT,
+     "plan.zones has 17 zones; at most 16"),
+    ("a moving zone without an epoch", zoned(Zone("m", "moon", [1.0, 0, 0], 0.4), epoch=None),
+     ErrorCode.INVALID_PLAN, "plan.zones[0] ('m') moves with the sky (body moon) but plan.epoch is zero"),
 ]
 
 
@@ -121,6 +158,30 @@ def test_a_bad_plan_is_refused_signed_or_not(core, case, change, code, words, ro
         assert "bad" not in core.plans and later.code == code and "refused when it arrived" in later.message
     assert refused.code == code and words in refused.message, refused.message
     assert core.maneuver is None and core.mode == ControlMode.IDLE
+
+
+def test_a_plan_with_checked_zones_and_epoch_is_kept_normalised(core):
+    zones = [SUN, Zone("e", "earth_limb", [0, 1.0, 0], 0.0, True), Zone("i", "inertial", [0, 0, 1.0], 0.2, False,
+                                                                         [0, 0.6, 0.8])]
+    plan, payload = issue(zoned(*zones)(good_plan()), core.context, "z")
+    assert core.receive_plan(plan, payload) is None
+    kept = core.plans["z"].plan
+    assert kept.epoch == EPOCH and [z.body for z in kept.zones] == ["sun", "earth_limb", "inertial"]
+    assert kept.zones[1].keep_in and np.allclose(kept.zones[2].direction, [0, 0.6, 0.8])
+
+
+# epochs no wire message can carry (its int32 seconds span 1901-2038): the core still refuses them
+@pytest.mark.parametrize("epoch, words", [
+    (datetime(1850, 1, 1, tzinfo=UTC), "plan.epoch must be an ISO 8601 UTC time"),
+    (datetime(2051, 6, 1, tzinfo=UTC), "2051-06-01T00:00:00.000000Z"),
+    (datetime(2026, 12, 21), "naive times are refused"),
+    ("2026-12-21T00:00:00Z", "plan.epoch must be a UTC datetime or none, got str"),
+])
+def test_an_epoch_outside_the_ephemeris_span_is_refused(core, epoch, words):
+    plan, payload = issue(zoned(SUN)(good_plan()), core.context, "e")
+    plan.epoch = epoch
+    flown, refused = core.resolve("", plan, payload)
+    assert flown is None and refused.code == ErrorCode.INVALID_PLAN and words in refused.message, refused.message
 
 
 # (case id, message fields changed after the context is filled, the key, expected code, words)

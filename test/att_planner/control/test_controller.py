@@ -1,21 +1,25 @@
 """The controller core without ROS: modes, plan checks, a maneuver flown closed loop on the simulator."""
 import math
 from dataclasses import replace
+from datetime import UTC, datetime
 
 import numpy as np
 import pytest
 
 from att_msgs_py.errors import ErrorCode
-from att_msgs_py.types import ControlKind, ControlMode, Plan, Status
+from att_msgs_py.types import Cone, ControlKind, ControlMode, Plan, Status, Zone
 from att_planner.control.controller import Controller, ControllerConfig
 from att_planner.methods.eigenaxis import plan_eigenaxis_smooth
 from att_planner.problem import ManeuverProblem
 from att_sim import rotations as rot
 from att_sim import scenario
+from att_sim.ephemeris import Sky
+from att_sim.orbit import CircularOrbit
 from att_sim.simulation import Simulation
 from helpers.signed_plans import context, issue
 
 GOAL = rot.from_axis_angle([0.3, -0.5, 1.0], 1.2)
+EPOCH = datetime(2026, 12, 21, tzinfo=UTC)
 CONFIG = ControllerConfig(control_period=0.1, settle_time=10.0, tracking_kp=1.0, tracking_kd=16.0)
 
 
@@ -28,8 +32,9 @@ def world():
     return sim, Controller(ctx, CONFIG, body_frame_id="body"), (plan, payload)
 
 
-def fly(sim, core, seconds, dt=0.05):
-    """Closed loop: the simulator's state into the core, its command back, as the nodes do."""
+def fly(sim, core, seconds, dt=0.05, states=None):
+    """Closed loop: the simulator's state into the core, its command back, as the nodes do (the
+    state of each output appended to ``states`` when given)."""
     outputs = []
     for _ in range(int(round(seconds / dt))):
         assert core.accept_state(sim.state("eci", "body"), wall=sim.t).refused is None
@@ -37,6 +42,8 @@ def fly(sim, core, seconds, dt=0.05):
             out = core.step()
             assert sim.set_command(out.command) is None
             outputs.append(out)
+            if states is not None:
+                states.append(core.state)
         sim.advance(dt)
         if outputs and outputs[-1].result is not None:
             return outputs
@@ -146,3 +153,31 @@ def test_magnetorquer_mode_commands_the_pd_law_and_non_finite_states_are_ignored
     assert core.accept_state(state).refused is None and core.due()
     m = core.step().command.dipole
     assert np.all(np.abs(m) <= s.spacecraft.dipole_max) and np.any(m)
+
+
+def test_feedback_margin_covers_the_zones_at_their_true_position_now():
+    """The cone, an Earth-limb keep-in and a Sun keep-out zone, checked by hand from the sky at the
+    state's time (the maneuver starts 30 s into the sim, the plan's epoch says 0 s: the truth wins)."""
+    s = scenario.load("swift_demo")
+    sky = Sky(EPOCH, CircularOrbit(s.orbit))
+    cone = Cone([0.0, 0.0, -1.0], 0.5, "cone")
+    sun, limb = Zone("sun", "sun", [1.0, 0, 0], 0.3), Zone("limb", "earth_limb", [0, 0, 1.0], 0.05, True)
+    plan = plan_eigenaxis_smooth(ManeuverProblem(s.spacecraft, rot.IDENTITY, GOAL), samples=101)
+    plan.cones, plan.zones, plan.epoch = [cone], [sun, limb], EPOCH
+    ctx = context()
+    flown = {}
+    for name, controller_sky in (("sky", sky), ("none", None)):
+        sim, core = Simulation(s.spacecraft, s.orbit), Controller(ctx, CONFIG, body_frame_id="body", sky=controller_sky)
+        fly(sim, core, 30.0)
+        assert core.start(core.resolve("", *issue(replace(plan), ctx, "z"))[0]) is None
+        states = []
+        outputs = fly(sim, core, 2.0, states=states)
+        flown[name] = [(o.feedback, x) for o, x in zip(outputs, states) if o.feedback is not None]
+    for (fb, state), (fb_none, _) in zip(flown["sky"], flown["none"]):
+        b = rot.dcm(state.q)
+        cone_m = math.acos(np.dot(b[:, 0], cone.direction)) - cone.half_angle
+        sun_m = math.acos(np.dot(b[:, 0], sky.sun_direction(state.t))) - sun.half_angle
+        limb_m = sky.earth_angular_radius(state.t) + limb.half_angle - math.acos(np.dot(b[:, 2], sky.nadir(state.t)))
+        assert state.t > 30.0 and fb.min_cone_margin == pytest.approx(min(cone_m, sun_m, limb_m), abs=1e-9)
+        assert fb_none.min_cone_margin == pytest.approx(cone_m, abs=1e-9)     # no sky: the cone only
+    assert min(limb_m, sun_m) < cone_m            # the zones decide the margin here
