@@ -79,6 +79,9 @@ def slepian_result(man: SmoothManeuver, alpha: np.ndarray, status: str, message:
                          dict(stats, violation=viol, trace_residual=trace_residual(man, ev.R[-1])))
 
 
+MOVING_ROUND_ITERATIONS = 30     # SLSQP iterations per round, moving zones, minimum time
+
+
 class _WorkingSet:
     """Rows of the (many, smooth, mostly slack) sampled constraints handed to SLSQP.
 
@@ -260,6 +263,11 @@ def _sqp(man: SmoothManeuver, x0: np.ndarray, *, min_time: bool, maxiter: int, f
     also resets its quasi-Newton matrix); rounds stop at ``max_total_iterations`` (default:
     ``maxiter``·``max_rounds``).
 
+    Moving zones, minimum time: rounds of at most :data:`MOVING_ROUND_ITERATIONS` iterations, a
+    round that ends at that limit followed by another (same total): the t_f column makes the
+    Lagrangian's curvature change along the path, and a fresh quasi-Newton matrix converges in
+    far fewer iterations than one long run (a third, on the LEO case).
+
     ``end_ratio`` ρ (min-time only) keeps the ends smooth for any basis size:
     |T*_jℓ| ≤ ρ s at ℓ ∈ {1, 2, N−1, N} and |ω*_j(τ_1)|, |ω*_j(τ_N)| ≤ ρ (rad per unit τ). The
     paper basis (M = 4) meets this by itself (its DPSS vanish to ~1e-7 at the ends); from M ≈ 8
@@ -273,6 +281,10 @@ def _sqp(man: SmoothManeuver, x0: np.ndarray, *, min_time: bool, maxiter: int, f
         ws.cones[:] = True
     if max_total_iterations is None:
         max_total_iterations = maxiter * max_rounds
+    short_rounds = man.moving and min_time
+    if short_rounds:
+        maxiter = min(maxiter, MOVING_ROUND_ITERATIONS)
+        max_rounds = max(max_rounds, -(-max_total_iterations // maxiter))
     rows = _Rows(man, cache, ws, min_time, end_ratio, tf)
     z = np.append(x0, cache(x0).peak_torque) if min_time else np.array(x0, float)
     ev0 = rows.ev(z)
@@ -290,8 +302,9 @@ def _sqp(man: SmoothManeuver, x0: np.ndarray, *, min_time: bool, maxiter: int, f
         stopped = deadline is not None and time.monotonic() > deadline
         ev = rows.ev(z)
         peak = z[P] if min_time else ev.peak_torque
+        unfinished = short_rounds and res.status == 9      # this round's iteration limit
         if (stopped or ev.peak_torque > peak_limit or nit >= max_total_iterations
-                or not ws.add_violated(ev, peak, feas_tol)):
+                or not (ws.add_violated(ev, peak, feas_tol) or unfinished)):
             break
         if min_time:                    # restart from a point of the epigraph (moving: t_f never shorter)
             z[P] = max(z[P], ev.peak_torque) if man.moving else ev.peak_torque
