@@ -8,12 +8,14 @@ directions with skyfield directly: the spacecraft from the JSON's TLE (``EarthSa
 TEME → GCRS), the Sun and Moon from the ``de421.bsp`` of skyfield-data (geometric, light time
 ignored: ≤ 0.006° here), the Earth limb as asin(R_E/|r|) + margin about −r̂ (R_E = 6378.137 km,
 WGS-84). It then confirms, to 0.01°: the torque reproduces each plan (final attitude, the JSON's
-margins), the frozen plan enters a zone, the moving one does not.
+margins), the frozen plan enters a zone, the moving one does not. ``ATT_SKY_BENCHMARKS=DIR`` checks
+the sky_<case>.json of another directory (a fresh ``att-bench sky --json`` run).
 """
 from __future__ import annotations
 
 import json
 import math
+import os
 from datetime import datetime
 from functools import lru_cache
 from importlib.resources import files
@@ -22,7 +24,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-BENCHMARKS = Path(__file__).resolve().parents[3] / "benchmarks"
+BENCHMARKS = Path(os.environ.get("ATT_SKY_BENCHMARKS", Path(__file__).resolve().parents[3] / "benchmarks"))
 CASES = ("leo_observatory", "moon_parallax")
 TOL = math.radians(0.01)
 R_EARTH = 6378.137e3          # m, WGS-84 equatorial radius
