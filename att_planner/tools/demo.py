@@ -6,6 +6,14 @@ you set (a random one when it is unset; localhost-only discovery unless
 keep-out maneuver, executes it on the simulator through the controller, stops everything cleanly
 and prints a summary measured from the recorded MCAP, writes the ``att-review`` figures and HTML
 page next to it (``review/``). The last line printed is ``MCAP: <path>``.
+
+The maneuver is the scenario's ``demo:`` section (a scenario without one is refused in one line).
+Its keep-out set is the section's cones and the scenario's ``zones``. With a scenario epoch the
+request carries the maneuver's actual start epoch: the demo reads the simulator's time ``t`` from
+its state, asks for a plan starting at ``epoch + t + start_lead`` (``start_lead``, s of sim time,
+covers the planning) and executes it when the simulator reaches that time, so the moving zones the
+plan avoids are where they are during the flight. The summary's zone margins are taken at each
+recorded state's time on the scenario's sky (Sun, Moon, Earth limb at their true positions).
 """
 from __future__ import annotations
 
@@ -14,41 +22,88 @@ import math
 import os
 import sys
 import time
-from datetime import UTC, datetime
+from datetime import UTC, datetime, timedelta
 from pathlib import Path
 
 import numpy as np
+import rclpy
 
+from att_msgs.msg import SpacecraftState
+from att_msgs_py import convert, qos
 from att_msgs_py.log import read_log
 from att_msgs_py.topics import STATE
 from att_msgs_py.types import Cone
-from att_planner.cones import margins
 from att_planner.nodes.client import client_session, maneuver_request
 from att_planner.tools.launch import isolated_env, join_env, start_suite
 from att_planner.tools.review import review
+from att_planner.zones import ZoneSky, zones_from_cones
 from att_sim import rotations as rot
 from att_sim import scenario as scen
+from att_sim.ephemeris import Sky
+
+DEMO_KEYS = ("initial_attitude", "final_attitude", "sensor_axis")
 
 
 def maneuver_from_scenario(s: scen.Scenario) -> dict:
-    p = s.node_params["demo"]
-    dirs = np.asarray(p["cone_directions"], float).reshape(-1, 3)
-    cones = [Cone(d, math.radians(a), n) for d, a, n in zip(dirs, p["cone_half_angles_deg"], p["cone_names"])]
+    """The ``demo:`` section's maneuver with the scenario's zones; ValueError (one sentence) when
+    the scenario has no such section or it lacks a key."""
+    p = s.node_params.get("demo")
+    if not isinstance(p, dict):
+        raise ValueError(f"scenario '{s.name}' ({s.path}) has no 'demo:' section with the maneuver to fly "
+                         f"({', '.join(DEMO_KEYS)}, optional cones, method, time_budget, start_lead)")
+    missing = [k for k in DEMO_KEYS if k not in p]
+    if missing:
+        raise ValueError(f"scenario '{s.name}' ({s.path}): the 'demo:' section lacks {', '.join(missing)}")
+    dirs = np.asarray(p.get("cone_directions", []), float).reshape(-1, 3)
+    cones = [Cone(d, math.radians(a), n) for d, a, n in zip(dirs, p.get("cone_half_angles_deg", []),
+                                                             p.get("cone_names", []))]
     return {"q0": np.asarray(p["initial_attitude"], float), "qf": np.asarray(p["final_attitude"], float),
-            "sensor": np.asarray(p["sensor_axis"], float), "cones": cones, "method": p.get("method", ""),
-            "time_budget": float(p.get("time_budget", 30.0))}
+            "sensor": np.asarray(p["sensor_axis"], float), "cones": cones, "zones": list(s.zones),
+            "method": p.get("method", ""), "time_budget": float(p.get("time_budget", 30.0)),
+            "start_lead": float(p.get("start_lead", 0.0))}
 
 
-def summarize(mcap_path: Path, maneuver: dict) -> dict:
+def zone_margins(scenario: scen.Scenario, maneuver: dict, t: np.ndarray, q: np.ndarray) -> tuple[list, np.ndarray]:
+    """Names and margins (K, Z) rad of the cones and zones at sim times ``t`` (their true positions
+    on the scenario's sky; moving zones need the scenario's epoch)."""
+    zones = zones_from_cones(maneuver["cones"], maneuver["sensor"]) + maneuver["zones"]
+    if not zones:
+        return [], np.zeros((len(t), 0))
+    sky = Sky(scenario.epoch, scenario.orbit_model) if scenario.epoch is not None else None
+    zone_sky = ZoneSky(zones, sky if any(z.body != "inertial" for z in zones) else None, window=1.0)
+    return [z.name for z in zones], zone_sky.margins(t, q, true=True)
+
+
+def summarize(mcap_path: Path, maneuver: dict, scenario: scen.Scenario) -> dict:
     """Figures measured from the recorded truth state."""
     state = read_log(mcap_path, topics=[STATE])[STATE]
-    q = state["attitude"]
-    m = margins(q, maneuver["sensor"], maneuver["cones"])
-    return {"state_messages": len(state), "sim_time": float(state["header.stamp"][-1]),
+    q, t = state["attitude"], np.asarray(state["header.stamp"], float)
+    names, m = zone_margins(scenario, maneuver, t, q)
+    return {"state_messages": len(state), "sim_time": float(t[-1]),
             "final_attitude_error_deg": float(np.degrees(rot.angle_between(q[-1], maneuver["qf"]))),
             "final_rate": float(np.linalg.norm(state["body_rate"][-1])),
-            "min_cone_margin_deg": float(np.degrees(m.min())),
-            "min_margin_per_cone_deg": {c.name: float(np.degrees(v)) for c, v in zip(maneuver["cones"], m.min(axis=0))}}
+            "min_cone_margin_deg": float(np.degrees(m.min())) if m.size else math.inf,
+            "min_margin_per_cone_deg": {n: float(np.degrees(v)) for n, v in zip(names, m.min(axis=0))}}
+
+
+class SimClock:
+    """The simulator's time as its latest state says, heard on the client's node."""
+
+    def __init__(self, node):
+        self.node, self.t = node, None
+        node.create_subscription(SpacecraftState, STATE, self._on_state, qos.STREAM_QOS)
+
+    def _on_state(self, msg):
+        self.t = convert.from_time(msg.header.stamp)
+
+    def wait(self, until: float = -math.inf, timeout: float = 120.0) -> float:
+        """Spin until a state at or after sim time ``until`` has arrived; its time."""
+        deadline = time.monotonic() + timeout
+        while self.t is None or self.t < until:
+            if time.monotonic() > deadline:
+                raise TimeoutError(f"the simulator's state did not reach t = {until:.1f} s within {timeout:.0f} s")
+            rclpy.spin_once(self.node, timeout_sec=0.05)
+        return self.t
 
 
 def domain_line(env: dict, base: dict | None = None) -> str:
@@ -63,12 +118,20 @@ def domain_line(env: dict, base: dict | None = None) -> str:
 
 
 def request_and_execute(client, scenario: scen.Scenario, maneuver: dict):
-    """Plan the maneuver over the service and execute it; (success, plan message or None)."""
+    """Plan the maneuver over the service (starting at the epoch of the sim time it will be
+    executed at) and execute it then; (success, plan message or None)."""
     client.wait_for_servers(timeout=60)
-    print("[demo] nodes up; requesting the maneuver")
+    clock = SimClock(client)
+    t_now = clock.wait()
+    t_start, epoch = t_now, None
+    if scenario.epoch is not None:
+        t_start = t_now + maneuver["start_lead"]
+        epoch = scenario.epoch + timedelta(seconds=t_start)
+    print(f"[demo] nodes up at sim time {t_now:.1f} s; requesting the maneuver"
+          + (f" to start at {t_start:.1f} s ({epoch.isoformat()})" if epoch else ""))
     response = client.plan(maneuver_request(maneuver["q0"], maneuver["qf"], maneuver["sensor"], maneuver["cones"],
                                             method=maneuver["method"], time_budget=maneuver["time_budget"],
-                                            frame_id=scenario.frame_id))
+                                            frame_id=scenario.frame_id, epoch=epoch, zones=maneuver["zones"]))
     plan = response.plan
     if not response.success:
         print(f"[demo] planner refused: code {response.error_code}: {response.message}")
@@ -88,6 +151,12 @@ def request_and_execute(client, scenario: scen.Scenario, maneuver: dict):
                   f"tracking error {math.degrees(fb.attitude_error):6.3f} deg  cone margin "
                   f"{math.degrees(fb.min_cone_margin):6.2f} deg")
 
+    if epoch is not None:
+        late = clock.wait() - t_start
+        if late > 0:
+            print(f"[demo] planning took longer than start_lead: the flight starts {late:.1f} s of sim time after "
+                  "the plan's epoch (its moving zones are that much further on)")
+        clock.wait(t_start)
     result = client.execute(plan.plan_id, on_feedback=on_feedback)
     print(f"[demo] execution: {result.message} (code {result.error_code}) after {result.duration:.1f} s of sim time")
     return result.success, plan
@@ -99,8 +168,12 @@ def main(argv=None) -> int:
     parser.add_argument("--out", default="runs", help="directory for the MCAP and the node logs")
     args = parser.parse_args(argv)
 
-    scenario = scen.load(args.scenario)
-    maneuver = maneuver_from_scenario(scenario)
+    try:
+        scenario = scen.load(args.scenario)
+        maneuver = maneuver_from_scenario(scenario)
+    except (KeyError, ValueError) as err:       # KeyError: an unknown scenario (its message is the one argument)
+        print(f"att-demo: {err.args[0] if isinstance(err, KeyError) and err.args else err}", file=sys.stderr)
+        return 2
     run_dir = Path(args.out) / f"{scenario.name}_{datetime.now(UTC).strftime('%Y%m%d_%H%M%S')}"
     mcap_path = run_dir / "run.mcap"
     try:
@@ -120,14 +193,14 @@ def main(argv=None) -> int:
     finally:
         codes = suite.stop()
         print(f"[demo] nodes stopped: {codes}")
-    summary = summarize(mcap_path, maneuver)
+    summary = summarize(mcap_path, maneuver, scenario)
     print(f"[demo] summary from the recorded state ({summary['state_messages']} messages, "
           f"{summary['sim_time']:.1f} s):")
     if plan is not None:
         print(f"[demo]   method {plan.method}, maneuver time {plan.duration:.1f} s")
     print(f"[demo]   final attitude error {summary['final_attitude_error_deg']:.4f} deg, final rate "
           f"{summary['final_rate']:.2e} rad/s")
-    print(f"[demo]   minimum cone margin {summary['min_cone_margin_deg']:.2f} deg "
+    print(f"[demo]   minimum zone margin {summary['min_cone_margin_deg']:.2f} deg "
           f"({', '.join(f'{k} {v:.2f}' for k, v in summary['min_margin_per_cone_deg'].items())})")
     try:
         print(f"[demo] review (figures, summary, HTML): {review(mcap_path, run_dir / 'review').html}")
