@@ -129,10 +129,14 @@ def frozen(problem: ManeuverProblem) -> ManeuverProblem:
 
 
 def parse_options(text: str) -> dict:
+    """``K=V,...`` as {K: float(V)} (the registry then checks names and ranges)."""
     out = {}
     for item in filter(None, (s.strip() for s in text.split(","))):
         key, _, value = item.partition("=")
-        out[key.strip()] = float(value)
+        try:
+            out[key.strip()] = float(value)
+        except ValueError:
+            raise ValueError(f"--options item {item!r} must be NAME=NUMBER") from None
     return out
 
 
