@@ -217,6 +217,15 @@ class Evaluation:
 def _static_zones(man: SmoothManeuver, R: np.ndarray, jac: bool):
     """Constant zones: c = σ (b·a − cos(θ + σ m)) and the (N+1, Z, 3) vectors σ b × a, one
     product per distinct sensor (a single sensor: exactly the cone rows of issue 3)."""
+    if len(man.zone_sensors) == 1:      # the fast path of today's cones
+        b = R @ man.zone_sensors[0]
+        values = b @ man.cone_dirs.T - man.cone_cos
+        bw = rot.cross(b[:, None, :], man.cone_dirs[None, :, :]) if jac else None
+        if man.zone_sign.size and man.zone_sign.min() < 0:
+            values *= man.zone_sign
+            if jac:
+                bw *= man.zone_sign[:, None]
+        return values, bw
     Z = len(man.zone_sign)
     values = np.empty((R.shape[0], Z))
     bw = np.empty((R.shape[0], Z, 3)) if jac else None
@@ -276,6 +285,11 @@ def zones_at(man: SmoothManeuver, ev: Evaluation, tf: float | None = None, jac: 
     """``ev`` with its zone rows (and, with ``jac``, their Jacobians; needs ``ev.eta``) evaluated
     at the maneuver time ``tf`` (moving zones; default the plan's t_f = sqrt(J_s T*/T̄)).
     Static zones do not depend on t_f."""
+    return _fill_zones(man, replace(ev), tf, jac)
+
+
+def _fill_zones(man: SmoothManeuver, ev: Evaluation, tf: float | None, jac: bool) -> Evaluation:
+    """:func:`zones_at` in place."""
     if not man.moving:
         values, bw = _static_zones(man, ev.R, jac)
         dtf = None
@@ -283,7 +297,8 @@ def zones_at(man: SmoothManeuver, ev: Evaluation, tf: float | None = None, jac: 
         tf = man.tf_from_peak(ev.peak_torque) if tf is None else float(tf)
         values, bw, dtf = _moving_zones(man, ev.R, tf, jac)
     cones_jac = np.einsum("nxp,ncx->ncp", ev.eta, bw) if jac else None
-    return replace(ev, cones=values, cones_jac=cones_jac, tf=tf if man.moving else None, cones_dtf=dtf)
+    ev.cones, ev.cones_jac, ev.tf, ev.cones_dtf = values, cones_jac, tf if man.moving else None, dtf
+    return ev
 
 
 def evaluate(man: SmoothManeuver, alpha: np.ndarray, jac: bool = False, tf: float | None = None) -> Evaluation:
@@ -310,7 +325,7 @@ def evaluate(man: SmoothManeuver, alpha: np.ndarray, jac: bool = False, tf: floa
         final = man.target_basis @ b_end
     ev = Evaluation(w, torque, R, final, np.zeros((N + 1, 0)))
     if not jac:
-        return zones_at(man, ev, tf)
+        return _fill_zones(man, ev, tf, jac=False)
     P = 3 * M
     # torque: dT_ℓ/dα_jk = J e_j D_ℓk + (ω_ℓ× J − (J ω_ℓ)×) e_j V_ℓk
     D = np.vstack([np.zeros((1, M)), np.diff(V, axis=0)]) / dt
@@ -326,7 +341,7 @@ def evaluate(man: SmoothManeuver, alpha: np.ndarray, jac: bool = False, tf: floa
     else:
         bu = rot.cross(b_end[None, :], man.target_basis)                 # (2, 3)
         ev.final_jac = bu @ ev.eta[N]
-    return zones_at(man, ev, tf, jac=True)
+    return _fill_zones(man, ev, tf, jac=True)
 
 
 def trace_residual(man: SmoothManeuver, R_end: np.ndarray) -> float:
