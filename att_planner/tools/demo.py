@@ -12,7 +12,10 @@ Its keep-out set is the section's cones and the scenario's ``zones``. With a sce
 request carries the maneuver's actual start epoch: the demo reads the simulator's time ``t`` from
 its state, asks for a plan starting at ``epoch + t + start_lead`` (``start_lead``, s of sim time,
 covers the planning) and executes it when the simulator reaches that time, so the moving zones the
-plan avoids are where they are during the flight. The summary's zone margins are taken at each
+plan avoids are where they are during the flight. With ``start_time`` (s of sim time) it first
+waits for ``start_time − start_lead`` and resets the simulator to the initial attitude at rest
+(the spacecraft drifts under the disturbances while nothing controls it), so the slew starts at
+``start_time``: a chosen geometry of the sky. The summary's zone margins are taken at each
 recorded state's time on the scenario's sky (Sun, Moon, Earth limb at their true positions).
 """
 from __future__ import annotations
@@ -29,9 +32,10 @@ import numpy as np
 import rclpy
 
 from att_msgs.msg import SpacecraftState
+from att_msgs.srv import ResetSimulator
 from att_msgs_py import convert, qos
 from att_msgs_py.log import read_log
-from att_msgs_py.topics import STATE
+from att_msgs_py.topics import RESET_SIMULATOR, STATE
 from att_msgs_py.types import Cone
 from att_planner.nodes.client import client_session, maneuver_request
 from att_planner.tools.launch import isolated_env, join_env, start_suite
@@ -50,7 +54,7 @@ def maneuver_from_scenario(s: scen.Scenario) -> dict:
     p = s.node_params.get("demo")
     if not isinstance(p, dict):
         raise ValueError(f"scenario '{s.name}' ({s.path}) has no 'demo:' section with the maneuver to fly "
-                         f"({', '.join(DEMO_KEYS)}, optional cones, method, time_budget, start_lead)")
+                         f"({', '.join(DEMO_KEYS)}, optional cones, method, time_budget, start_lead, start_time)")
     missing = [k for k in DEMO_KEYS if k not in p]
     if missing:
         raise ValueError(f"scenario '{s.name}' ({s.path}): the 'demo:' section lacks {', '.join(missing)}")
@@ -60,7 +64,7 @@ def maneuver_from_scenario(s: scen.Scenario) -> dict:
     return {"q0": np.asarray(p["initial_attitude"], float), "qf": np.asarray(p["final_attitude"], float),
             "sensor": np.asarray(p["sensor_axis"], float), "cones": cones, "zones": list(s.zones),
             "method": p.get("method", ""), "time_budget": float(p.get("time_budget", 30.0)),
-            "start_lead": float(p.get("start_lead", 0.0))}
+            "start_lead": float(p.get("start_lead", 0.0)), "start_time": p.get("start_time")}
 
 
 def zone_margins(scenario: scen.Scenario, maneuver: dict, t: np.ndarray, q: np.ndarray) -> tuple[list, np.ndarray]:
@@ -117,17 +121,37 @@ def domain_line(env: dict, base: dict | None = None) -> str:
             f"({'inherited' if range_set else 'default: this host only'})")
 
 
+def reset_to_start(client, clock: SimClock, maneuver: dict) -> float:
+    """Wait for ``start_time − start_lead`` and reset the simulator to the initial attitude at
+    rest; the sim time of the reset."""
+    t_reset = float(maneuver["start_time"]) - maneuver["start_lead"]
+    print(f"[demo] waiting for sim time {t_reset:.1f} s, then resetting to the initial attitude at rest")
+    t = clock.wait(t_reset, timeout=600.0)
+    reset = client.create_client(ResetSimulator, RESET_SIMULATOR)
+    if not reset.wait_for_service(timeout_sec=30.0):
+        raise TimeoutError(f"service {RESET_SIMULATOR} not available")
+    future = reset.call_async(ResetSimulator.Request(attitude=convert.quaternion(maneuver["q0"]),
+                                                     body_rate=convert.vector3(np.zeros(3))))
+    rclpy.spin_until_future_complete(client, future, timeout_sec=30.0)
+    answer = future.result()
+    if answer is None or not answer.success:
+        raise RuntimeError(f"the simulator refused the reset: {answer.message if answer else 'no answer'}")
+    return t
+
+
 def request_and_execute(client, scenario: scen.Scenario, maneuver: dict):
     """Plan the maneuver over the service (starting at the epoch of the sim time it will be
     executed at) and execute it then; (success, plan message or None)."""
     client.wait_for_servers(timeout=60)
     clock = SimClock(client)
     t_now = clock.wait()
+    if maneuver["start_time"] is not None and scenario.epoch is not None:
+        t_now = reset_to_start(client, clock, maneuver)
     t_start, epoch = t_now, None
     if scenario.epoch is not None:
         t_start = t_now + maneuver["start_lead"]
         epoch = scenario.epoch + timedelta(seconds=t_start)
-    print(f"[demo] nodes up at sim time {t_now:.1f} s; requesting the maneuver"
+    print(f"[demo] sim time {t_now:.1f} s: requesting the maneuver"
           + (f" to start at {t_start:.1f} s ({epoch.isoformat()})" if epoch else ""))
     response = client.plan(maneuver_request(maneuver["q0"], maneuver["qf"], maneuver["sensor"], maneuver["cones"],
                                             method=maneuver["method"], time_budget=maneuver["time_budget"],
