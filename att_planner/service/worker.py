@@ -5,9 +5,9 @@ or crashes (a segfault in a native solver) costs one child process, never the no
 forked from a ``forkserver`` that has already imported the numerics, so starting one is cheap;
 at most ``max_parallel`` solve at once (the rest wait, within their own budget).
 
-A problem with a sky (issue 13) crosses to the child as the recipe of its sky (:class:`_Portable`:
-the epoch and the orbit, a TLE orbit as its epoch and lines), since skyfield's and SGP4's objects
-do not pickle; the child rebuilds the sky (about 0.1 s) and its zone fit.
+A problem with a sky (issue 13) crosses to the child as it is: :class:`att_sim.ephemeris.Sky` and
+:class:`att_sim.orbit.TLEOrbit` pickle as their recipes (epoch and orbit, epoch and lines), since
+skyfield's and SGP4's objects do not; the child rebuilds their tables as it needs them.
 """
 from __future__ import annotations
 
@@ -15,15 +15,11 @@ import multiprocessing
 import os
 import threading
 import time
-from dataclasses import dataclass, replace
-from datetime import datetime
 
 from att_msgs_py.types import Plan, Status
 from att_planner.methods import Method
 from att_planner.problem import ManeuverProblem
 from att_planner.service.planning import run_method
-from att_sim.ephemeris import Sky
-from att_sim.orbit import Orbit, TLEOrbit
 
 _CONTEXT = multiprocessing.get_context("forkserver")
 _CONTEXT.set_forkserver_preload(["att_planner.service.planning", "numpy", "scipy.optimize", "att_sim.ephemeris",
@@ -44,30 +40,7 @@ def warm_up() -> None:
     child.join()
 
 
-@dataclass(frozen=True)
-class _Portable:
-    """A problem without its sky, and what rebuilds the sky: its epoch and orbit (a TLE orbit as
-    ``(epoch, line1, line2)``)."""
-
-    problem: ManeuverProblem
-    epoch: datetime
-    orbit: Orbit | tuple
-
-    @classmethod
-    def of(cls, value):
-        if not isinstance(value, ManeuverProblem) or value.sky is None:
-            return value
-        orbit = value.sky.orbit
-        recipe = (orbit.epoch, orbit.line1, orbit.line2) if isinstance(orbit, TLEOrbit) else orbit
-        return cls(replace(value, sky=None), value.sky.epoch, recipe)
-
-    def restore(self) -> ManeuverProblem:
-        orbit = TLEOrbit(*self.orbit) if isinstance(self.orbit, tuple) else self.orbit
-        return replace(self.problem, sky=Sky(self.epoch, orbit))
-
-
 def _child(conn, function, args: tuple, kwargs: dict) -> None:
-    args = tuple(a.restore() if isinstance(a, _Portable) else a for a in args)
     conn.send(function(*args, **kwargs))
     conn.close()
 
@@ -84,8 +57,7 @@ def call_isolated(function, args: tuple, kwargs: dict, wait: float | None, *, on
     try:
         remaining = None if wait is None else max(0.0, wait - (time.monotonic() - start))
         receiver, sender = _CONTEXT.Pipe(duplex=False)
-        portable = tuple(_Portable.of(a) for a in args)
-        child = _CONTEXT.Process(target=_child, args=(sender, function, portable, kwargs), daemon=True)
+        child = _CONTEXT.Process(target=_child, args=(sender, function, args, kwargs), daemon=True)
         child.start()
         sender.close()
         try:

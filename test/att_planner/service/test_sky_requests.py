@@ -16,7 +16,7 @@ from att_msgs_py.types import Plan, Verification, Zone
 from att_planner import methods
 from att_planner.service.planning import padded
 from att_planner.service.sky import relaxed_caps
-from att_planner.service.worker import _Portable, run_isolated, warm_up
+from att_planner.service.worker import run_isolated, warm_up
 from att_planner.tools.review.figures import figure_sky
 from att_planner.tools.review.run import Run
 from att_planner.tools.review.summary import summary_of, zone_sky_for
@@ -91,8 +91,7 @@ def test_an_unnamed_zone_is_named_by_its_index():
 def test_a_moving_zone_problem_crosses_to_a_solver_child_and_back():
     warm_up()
     problem = validate(sky_request()).problem
-    portable = pickle.loads(pickle.dumps(_Portable.of(problem)))
-    restored = portable.restore()
+    restored = pickle.loads(pickle.dumps(problem))         # the sky and its TLE orbit as their recipes
     assert np.allclose(restored.sky.moon_direction(60.0), problem.sky.moon_direction(60.0), atol=1e-12)
     plan = run_isolated(methods.get("eigenaxis_smooth"), problem, {}, wait=20.0)
     assert plan is not None and "enters keep-out zone moon" in plan.message, plan.message   # the zones, moving
