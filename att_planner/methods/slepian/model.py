@@ -266,7 +266,7 @@ def _sky_at(man: SmoothManeuver, K: int, tf: float, rates: bool):
     """(a_z(t_k), θ_z(t_k) + σ_z m) or, with ``rates``, (dt_k/dt_f, ȧ_z, θ̇_z) at the K sample times
     t_k = τ_k t_f, remembered for the last few t_f (an SQP iteration asks for the same t_f several
     times). Beyond the window: the window's end, and dt_k/dt_f = 0 there."""
-    key = (K, float(tf), rates)
+    key = (K, float(tf), rates, man.zone_margin)
     if key not in man.sky_memo:
         if len(man.sky_memo) > 8:
             man.sky_memo.clear()

@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import time
+from dataclasses import replace
 
 import numpy as np
 
@@ -137,6 +138,27 @@ def solve_min_time(man: SmoothManeuver, *, basis_sizes: tuple = (4, 8), starts: 
     return fallback
 
 
+def seeded_min_time(man: SmoothManeuver, frozen: SmoothManeuver, *, basis_sizes: tuple = (4, 8),
+                    deadline: float | None = None, feas_tol: float = 1e-6, end_ratio: float = 1e-3,
+                    **options) -> SlepianResult | None:
+    """Moving zones: the minimum time against the zones frozen at t = 0 (``frozen``, the static
+    search :func:`solve_min_time`, at most half the time left), then ONE exact local solve of the
+    moving program (zone rows at τ_k t_f, the t_f column) from it at the full N; None when the
+    frozen search finds nothing. The frozen plan only seeds: the result meets the moving zones.
+    The moving multistart alone meets a harder landscape (a random path wanders into a zone that
+    moved there), and finds fewer feasible starts."""
+    half = None if deadline is None else time.monotonic() + 0.5 * max(deadline - time.monotonic(), 0.0)
+    seed = solve_min_time(frozen, basis_sizes=basis_sizes, deadline=half, feas_tol=feas_tol, end_ratio=end_ratio,
+                          **options)
+    if not seed.feasible:
+        return None
+    M = seed.alpha.shape[1]
+    r = solve_min_time_local(man.resized(M=M), seed.alpha, feas_tol=feas_tol, deadline=deadline,
+                             end_ratio=end_ratio if M > PAPER_M else None)
+    r.stats.update(seed_tf=seed.tf, seed_seconds=seed.wall_time)
+    return r
+
+
 def physical_profile(man: SmoothManeuver, alpha: np.ndarray, spacecraft: Spacecraft | None = None,
                      tf: float | None = None) -> dict:
     """Physical-time plan of α: knots t_k = τ_k t_f (K = N+1) and ZOH body torque
@@ -196,7 +218,13 @@ def plan_slepian(problem: ManeuverProblem, method: str = DEFAULT_METHOD, M: int 
     deadline = problem.deadline
     if method == "slepian_minimum_time":
         sizes = tuple(sorted({min(PAPER_M, M), *range(PAPER_M * 2, M, PAPER_M), M}))
-        res = solve_min_time(man, basis_sizes=sizes, deadline=deadline, **options)
+        res = None
+        if man.moving:
+            frozen = replace(problem, cones=[], zones=problem.zone_sky().frozen_zones(), sky=None)
+            res = seeded_min_time(man, build_maneuver(frozen, M=PAPER_M, N=N, W=W, cone_margin=cone_margin),
+                                  basis_sizes=sizes, deadline=deadline, **options)
+        if res is None or not res.feasible:
+            res = solve_min_time(man, basis_sizes=sizes, deadline=deadline, **options)
     elif method == "mssa":
         res = solve_mssa(man, deadline=deadline, **options)
     else:
