@@ -8,13 +8,15 @@ body, unit axes, half-angle range, an inertial zone's direction) and its epoch (
 :mod:`att_sim.epoch`'s span; needed by a zone that moves); then its context: made for this spacecraft
 configuration (name and :attr:`~att_sim.dynamics.Spacecraft.digest`) and signed by the configured
 key (:mod:`att_msgs_py.signing`). :func:`check_start` compares a plan's first sample with the
-current state. Each returns ``None`` or a :class:`RequestError` (code and sentence).
+current state, and the epoch of a plan with moving zones with the current instant (the scenario's
+epoch + sim time; UTC arithmetic, a leap second in between is a second off). Each returns
+``None`` or a :class:`RequestError` (code and sentence).
 """
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from datetime import datetime
+from datetime import datetime, timedelta
 
 import numpy as np
 
@@ -41,6 +43,8 @@ class PlanContext:
     public_key: object                      # Ed25519PublicKey
     max_start_attitude_error: float = math.radians(5.0)   # rad
     max_start_rate_error: float = 0.01                    # rad/s
+    epoch: datetime | None = None           # the scenario's (sim time zero); None: no sky to check against
+    max_start_epoch_error: float = 10.0     # s: a LEO Earth limb moves 0.7 deg in it (orbit rate)
 
 
 def _fields(plan: Plan, sc: Spacecraft, frame_id: str) -> Plan:
@@ -164,4 +168,15 @@ def check_start(plan: Plan, state: State, ctx: PlanContext) -> RequestError | No
         return RequestError(ErrorCode.PLAN_CONTEXT,
                             f"plan '{plan.plan_id}' starts at a rate {rate_error:.4g} rad/s from the current one "
                             f"(at most {ctx.max_start_rate_error:g} rad/s, parameter max_start_rate_error)")
+    moving = any(z.body != "inertial" for z in plan.zones)
+    if moving and ctx.epoch is not None and plan.epoch is not None:
+        now = ctx.epoch + timedelta(seconds=float(state.t))
+        lag = (now - plan.epoch).total_seconds()
+        if abs(lag) > ctx.max_start_epoch_error:
+            when = f"{abs(lag):.1f} s {'later' if lag > 0 else 'earlier'}"
+            return RequestError(ErrorCode.PLAN_CONTEXT,
+                                f"plan '{plan.plan_id}' avoids moving zones as they are from "
+                                f"{epochs.format_epoch(plan.epoch)}, but it would start at {epochs.format_epoch(now)}, "
+                                f"{when} (at most {ctx.max_start_epoch_error:g} s, "
+                                "parameter max_start_epoch_error): request it with the start epoch")
     return None

@@ -131,7 +131,9 @@ class ControllerNode(Node):
             self._scenario.spacecraft, self._scenario.name, self._scenario.frame_id, key,
             max_start_attitude_error=math.radians(param("max_start_attitude_error_deg", 5.0, 0.0, 180.0,
                                                         low_open=True)),
-            max_start_rate_error=param("max_start_rate_error", 0.01, 0.0, 10.0, low_open=True))
+            max_start_rate_error=param("max_start_rate_error", 0.01, 0.0, 10.0, low_open=True),
+            epoch=self._scenario.epoch,
+            max_start_epoch_error=param("max_start_epoch_error", 10.0, 0.0, 86_400.0, low_open=True))
 
     @staticmethod
     def _gate_config(param) -> GateConfig:

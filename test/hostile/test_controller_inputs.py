@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import replace
-from datetime import UTC, datetime
+from datetime import UTC, datetime, timedelta
 
 import numpy as np
 import pytest
@@ -268,6 +268,27 @@ def test_a_plan_far_from_the_current_state_does_not_start(case, state_change, wo
     plan, payload = issue(good_plan(), c.context)
     refused = c.start(c.resolve("", plan, payload)[0])
     assert refused.code == ErrorCode.PLAN_CONTEXT and words in refused.message and c.maneuver is None
+
+
+@pytest.mark.parametrize("offset, zone, words", [
+    (0.0, SUN, None), (-8.0, SUN, None),
+    (-600.0, SUN, "2026-12-20T23:50:00.000000Z, but it would start at 2026-12-21T00:00:00.000000Z, 600.0 s later"),
+    (30.0, Zone("limb", "earth_limb", [0, 1.0, 0], 0.1),
+     "30.0 s earlier (at most 10 s, parameter max_start_epoch_error)"),
+    (-600.0, Zone("i", "inertial", [0, 1.0, 0], 0.1, False, [0, 0, 1.0]), None),     # a fixed zone: no matter
+])
+def test_a_plan_for_moving_zones_at_another_instant_does_not_start(offset, zone, words):
+    """The plan's epoch against the scenario's epoch + sim time (here 0): its moving zones would be
+    elsewhere."""
+    c = Controller(context(epoch=EPOCH), ControllerConfig(), body_frame_id="body")
+    c.accept_state(Simulation(SWIFT.spacecraft, SWIFT.orbit).state("eci", "body"))
+    plan, refused = c.resolve("", *issue(zoned(zone, epoch=EPOCH + timedelta(seconds=offset))(good_plan()), c.context))
+    assert refused is None
+    refused = c.start(plan)
+    if words is None:
+        assert refused is None and c.maneuver is not None
+    else:
+        assert refused.code == ErrorCode.PLAN_CONTEXT and words in refused.message and c.maneuver is None, refused
 
 
 def test_oversized_plan_messages_are_refused(core):
