@@ -134,3 +134,13 @@ def test_att_demo_refuses_a_malformed_domain_in_one_line(tmp_path, monkeypatch, 
     name = "ROS_DOMAIN_ID" if not discovery else "ROS_AUTOMATIC_DISCOVERY_RANGE"
     assert err.count("\n") == 1 and err.startswith(f"att-demo: {name} is '") and "expected" in err, err
     assert list(tmp_path.iterdir()) == []                 # nothing started, nothing written
+
+
+@pytest.mark.parametrize("scenario, words", [("bruni_celani", "demo"), ("no_such_scenario", "unknown")])
+def test_att_demo_refuses_a_scenario_it_cannot_run_in_one_line(tmp_path, capsys, scenario, words):
+    from att_planner.tools import demo
+
+    assert demo.main(["--scenario", scenario, "--out", str(tmp_path)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and err.startswith("att-demo: ") and words in err, err
+    assert list(tmp_path.iterdir()) == []                 # nothing started, nothing written
