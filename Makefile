@@ -10,6 +10,9 @@ PY := $(PREFIX)/bin/python
 BUILD_ENV := PATH=$(PREFIX)/bin:$$PATH CMAKE_PREFIX_PATH=$(PREFIX) AMENT_PREFIX_PATH=$(PREFIX)
 INTERFACES := $(shell find att_msgs_py/interfaces -type f)
 PYTEST_ARGS ?=
+# one BLAS/OpenMP thread: the solvers' matrices are small, and on a loaded 2-core machine threaded BLAS
+# made them 4-5x slower (the benchmarks are run the same way, see BENCHMARKS.md)
+export OMP_NUM_THREADS ?= 1
 
 .PHONY: setup test test-fast lint demo clean
 
