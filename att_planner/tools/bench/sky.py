@@ -22,13 +22,14 @@ kg m², 0.25 N m) with sensor +y and keep-out zones Sun 47°, Moon 23°, Earth l
 
 * ``leo_observatory`` — the issue's: the 135° slew about body x from identity, in the issue's
   580 km / 20.56° TLE orbit, starting 460 s after 2026-12-21T00:00:00Z. The Earth-limb zone
-  (76.4° about nadir, sweeping at orbit rate) then lies 3.5° from the start direction and rises
+  (76.6° about nadir, sweeping at orbit rate) then lies 3.5° from the start direction and rises
   over the first part of the path at ≈ 0.06°/s: the plan made against the frozen limb is overtaken
-  by it. Offsets found by /work/notes/h8_offset_search.py (skyfield and today's cones, outside the
-  suite): the start is clear of the limb from about 5400 s to 515 s (mod the 5776 s period); the
-  frozen plan enters the moving limb from 458 s on (by 0.12° at 460 s, 2.58° at 500 s, where the
-  eigenaxis_smooth plan clears the frozen limb by 1.10° and enters the moving one by 1.76°); the
-  smooth Slepian basis, which barely moves near τ = 0, can outrun the limb only up to about 460 s.
+  by it. The start came from an offset search outside the bench (skyfield directly, the frozen
+  zones as cones): the start direction is clear of the limb from about 5400 s to 515 s (mod the
+  5776 s period); the frozen plan enters the moving limb from 458 s on (by 0.12° at 460 s, 2.58° at
+  500 s, where the eigenaxis_smooth plan clears the frozen limb by 1.10° and enters the moving one
+  by 1.76°); the M = 8 Slepian basis, which barely moves near τ = 0, outruns the limb only up to
+  about 460 s.
 * ``moon_parallax`` — slow motion that still matters: a 120° slew about body axis (1, 0, 0.4)
   in a 700 km sun-synchronous orbit (TLE below), starting 2027-03-20T01:15:00Z with the Moon near
   the zenith, placed 6° from the unconstrained path's midpoint on the side the Moon appears to
