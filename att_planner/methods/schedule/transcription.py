@@ -27,14 +27,19 @@ SUBSTEPS = 1              # RK4 steps per ZOH interval in the schedule NLPs (def
 
 @dataclass(frozen=True)
 class _Scaling:
-    """Normalised units: wheel momentum h = I_w Ω / h̄ ∈ [−1, 1] (h̄ = I_w Ω̄), torque
+    """Normalised units: wheel momentum h = I_w Ω / h̄ (h̄ = I_w Ω̄), torque
     u = T_u / T̄ ∈ [−1, 1], time τ = t / t_sat with t_sat = h̄ / T̄ (so dh/dτ = u).
-    ``rate_matrix`` W maps h to the body rate per unit τ, ω t_sat = W h (equation (1))."""
+    ``rate_matrix`` W maps h to the body rate per unit τ, ω t_sat = W h (equation (1)).
+    The NLP's wheel state is the relative speed ν = (Ω − Gᵀω) / Ω̄ = M h, M = 𝟙 + I_w Gᵀ J⁻¹ G
+    (by (1)), so the truth model's limit |ν| ≤ 1 (att_sim.dynamics) is a box on it: a row M h
+    next to the box on h, 2.5e-5 inside it for the Olivares spacecraft, left IPOPT nearly
+    coincident barriers (in C's fast run one start took 975 iterations to Infeasible_Problem_Detected)."""
 
     t_sat: float
     h_max: float
     rate_matrix: np.ndarray        # (3, N) rad per τ per unit h
     rate_per_h: np.ndarray         # (3, N) rad/s per unit h: ω = rate_per_h @ h
+    relative: np.ndarray           # (N, N) M: ν = M h
 
 
 def _scaling(sc: dyn.Spacecraft) -> _Scaling:
@@ -43,23 +48,25 @@ def _scaling(sc: dyn.Spacecraft) -> _Scaling:
     h_max = sc.wheel_inertia * sc.wheel_speed_max
     t_sat = h_max / sc.wheel_torque_max
     rate_per_h = -np.linalg.solve(sc.inertia, sc.wheel_axes) * h_max
-    return _Scaling(t_sat, h_max, rate_per_h * t_sat, rate_per_h)
+    relative = np.eye(sc.n_wheels) - sc.wheel_axes.T @ rate_per_h / sc.wheel_speed_max
+    return _Scaling(t_sat, h_max, rate_per_h * t_sat, rate_per_h, relative)
 
 
 def _interval_map(scale: _Scaling, substeps: int) -> ca.Function:
-    """One ZOH interval: (q, h, u, dτ) -> (q⁺, h⁺). h is linear in τ (exact), q by RK4
-    (:func:`att_sim.dynamics.rk4` on the CasADi expressions)."""
+    """One ZOH interval: (q, ν, u, dτ) -> (q⁺, ν⁺). ν is linear in τ (exact, dν/dτ = M u), q by
+    RK4 (:func:`att_sim.dynamics.rk4` on the CasADi expressions), ω t_sat = W M⁻¹ ν."""
     n_w = scale.rate_matrix.shape[1]
-    q, h, u, dtau = ca.SX.sym("q", 4), ca.SX.sym("h", n_w), ca.SX.sym("u", n_w), ca.SX.sym("dtau")
-    W = ca.DM(scale.rate_matrix)
+    q, nu, u, dtau = ca.SX.sym("q", 4), ca.SX.sym("nu", n_w), ca.SX.sym("u", n_w), ca.SX.sym("dtau")
+    W = ca.DM(np.linalg.solve(scale.relative.T, scale.rate_matrix.T).T)
+    du = ca.DM(scale.relative) @ u
     step = dtau / substeps
-    qk, hk = q, h
+    qk, nuk = q, nu
     for _ in range(substeps):
-        def qdot(tau, qq, h0=hk):
-            return 0.5 * symbolic.quat_mul(qq, ca.vertcat(W @ (h0 + tau * u), 0))
+        def qdot(tau, qq, nu0=nuk):
+            return 0.5 * symbolic.quat_mul(qq, ca.vertcat(W @ (nu0 + tau * du), 0))
         qk = dyn.rk4(qdot, 0.0, qk, step)
-        hk = hk + step * u
-    return ca.Function("interval", [q, h, u, dtau], [qk, hk])
+        nuk = nuk + step * du
+    return ca.Function("interval", [q, nu, u, dtau], [qk, nuk])
 
 
 def eigenaxis_rest_to_rest_time(sc: dyn.Spacecraft, q_from: np.ndarray, q_to: np.ndarray) -> float:
@@ -97,7 +104,7 @@ class ScheduleSolution:
 
     durations: np.ndarray   # (P,) τ
     q: np.ndarray           # (K+1, 4)
-    h: np.ndarray           # (K+1, N)
+    h: np.ndarray           # (K+1, N) wheel momentum (the NLP's ν = M h, converted)
     u: np.ndarray           # (K, N)
     converged: bool
     return_status: str
@@ -132,21 +139,21 @@ class MultiphaseTranscription:
         self.n_nodes = K + 1
         T = ca.MX.sym("T", P)
         Q = ca.MX.sym("Q", 4, K + 1)
-        H = ca.MX.sym("H", n_w, K + 1)
+        V = ca.MX.sym("V", n_w, K + 1)                       # ν, the relative wheel speed
         U = ca.MX.sym("U", n_w, K)
         targets = ca.MX.sym("targets", 4, max(n_targets, 1))
         q_end = ca.MX.sym("q_end", 4)
         dtau = ca.repmat(T.T / N, N, 1).reshape((1, K))  # phase p's dτ on intervals p*N ... p*N+N-1
         step = _interval_map(self.scale, substeps).map(K)
-        rows = [self._passage_rows(Q, H, U, dtau, step, targets, q_end),
-                self._wheel_speed_rows(H, bound_margin), self._rate_rows(H, rate_max)]
+        rows = [self._passage_rows(Q, V, U, dtau, step, targets, q_end),
+                self._wheel_speed_rows(V, bound_margin), self._rate_rows(V, rate_max)]
         if self.zones is not None:
-            rows.append(self._zone_rows(T, Q, H, U, dtau, step, zone_margin))
+            rows.append(self._zone_rows(T, Q, V, U, dtau, step, zone_margin))
         g = [expr for block in rows for expr in block[0]]
         self._lbg = np.concatenate([block[1] for block in rows])
         self._ubg = np.concatenate([block[2] for block in rows])
-        self._x = ca.vertcat(T, ca.vec(Q), ca.vec(H), ca.vec(U))
-        self._split = ca.Function("split", [self._x], [T, Q, H, U])
+        self._x = ca.vertcat(T, ca.vec(Q), ca.vec(V), ca.vec(U))
+        self._split = ca.Function("split", [self._x], [T, Q, V, U])
         nlp = {"x": self._x, "p": ca.vertcat(ca.vec(targets), q_end), "f": ca.sum1(T), "g": ca.vertcat(*g)}
         self.ipopt_options = {"ipopt.print_level": 0, "print_time": 0, "ipopt.tol": tol,
                               "ipopt.max_iter": max_iter, "ipopt.mu_strategy": "adaptive",
@@ -160,49 +167,56 @@ class MultiphaseTranscription:
         self._variable_bounds(bound_margin)
 
     # -- constraint rows: each block is (expressions, lower bounds, upper bounds) ---------------
-    def _passage_rows(self, Q, H, U, dtau, step, targets, q_end):
+    def _per_nu(self, per_h: np.ndarray) -> np.ndarray:
+        """A map of h written as a map of ν = M h: ``per_h M⁻¹``."""
+        return np.linalg.solve(self.scale.relative.T, per_h.T).T
+
+    def _passage_rows(self, Q, V, U, dtau, step, targets, q_end):
         """Equalities: the shooting defects of every interval, each target reached with ω_z = 0
         at its node, the end attitude, and ω_z = 0 at both ends (implied by rest through the
-        h = 0 bounds, the only condition at a passage)."""
+        ν = 0 bounds, the only condition at a passage)."""
         K, N = self.n_nodes - 1, self.intervals
-        q_next, h_next = step(Q[:, :K], H[:, :K], U, dtau)
-        g = [ca.vec(Q[:, 1:] - q_next), ca.vec(H[:, 1:] - h_next)]
-        rate_z = ca.DM(self.scale.rate_per_h[2:3, :])
+        q_next, nu_next = step(Q[:, :K], V[:, :K], U, dtau)
+        g = [ca.vec(Q[:, 1:] - q_next), ca.vec(V[:, 1:] - nu_next)]
+        rate_z = ca.DM(self._per_nu(self.scale.rate_per_h[2:3, :]))
         for p in range(self.n_targets):
             node = (p + 1) * N
-            g += [symbolic.error_vector(Q[:, node], targets[:, p]), rate_z @ H[:, node]]
+            g += [symbolic.error_vector(Q[:, node], targets[:, p]), rate_z @ V[:, node]]
         g.append(symbolic.error_vector(Q[:, K], q_end))
-        g += [rate_z @ H[:, 0], rate_z @ H[:, K]]
+        g += [rate_z @ V[:, 0], rate_z @ V[:, K]]
         n_eq = sum(int(gi.numel()) for gi in g)
         return g, np.zeros(n_eq), np.zeros(n_eq)
 
-    def _wheel_speed_rows(self, H, bound_margin: float):
-        """The wheel speed relative to the body, Ω − Gᵀω, within its limit at every node.
+    def _wheel_speed_rows(self, V, bound_margin: float):
+        """The inertial wheel speed h = M⁻¹ν within the limit too (as before the truth model limited
+        the relative speed), only on the wheels where the box on ν does not already imply it (none
+        with wheels on principal axes: M is then diagonal, ≥ 1). Both are linear in ν, so the bounds
+        at the nodes hold everywhere."""
+        inverse = self._per_nu(np.eye(self.sc.n_wheels))
+        wheels = [i for i in range(self.sc.n_wheels) if np.abs(inverse[i]).sum() > 1.0]
+        if not wheels:
+            return [], np.zeros(0), np.zeros(0)
+        n = len(wheels) * self.n_nodes
+        limit = 1.0 - bound_margin
+        return [ca.vec(ca.DM(inverse[wheels, :]) @ V)], np.full(n, -limit), np.full(n, limit)
 
-        The truth model cuts a wheel's torque at that speed (att_sim.dynamics): with (1) it is
-        (1 + I_w Gᵀ J⁻¹ G) Ω, linear in h like the rate, so the bound at the nodes holds
-        everywhere; the box on h keeps the inertial speed within it too."""
-        sc = self.sc
-        relative = ca.DM(np.eye(sc.n_wheels) - sc.wheel_axes.T @ self.scale.rate_per_h / sc.wheel_speed_max)
-        n = sc.n_wheels * self.n_nodes
-        return [ca.vec(relative @ H)], np.full(n, -(1.0 - bound_margin)), np.full(n, 1.0 - bound_margin)
-
-    def _rate_rows(self, H, rate_max: float):
-        """The body-rate box, only on the axes where the wheel box does not already imply it
-        (rates are linear in h)."""
-        rate_rows = [i for i in range(3) if np.abs(self.scale.rate_per_h[i]).sum() > rate_max]
+    def _rate_rows(self, V, rate_max: float):
+        """The body-rate box, only on the axes where the box on ν does not already imply it
+        (rates are linear in ν)."""
+        per_nu = self._per_nu(self.scale.rate_per_h)
+        rate_rows = [i for i in range(3) if np.abs(per_nu[i]).sum() > rate_max]
         if not rate_rows:
             return [], np.zeros(0), np.zeros(0)
-        R = ca.DM(self.scale.rate_per_h[rate_rows, :] / rate_max)
+        R = ca.DM(per_nu[rate_rows, :] / rate_max)
         n = len(rate_rows) * self.n_nodes
-        return [ca.vec(R @ H)], np.full(n, -1.0), np.full(n, 1.0)
+        return [ca.vec(R @ V)], np.full(n, -1.0), np.full(n, 1.0)
 
-    def _zone_rows(self, T, Q, H, U, dtau, step, zone_margin: float):
+    def _zone_rows(self, T, Q, V, U, dtau, step, zone_margin: float):
         """Every zone at every node and interval midpoint (module docstring), at the point's time
         along the tour when a zone moves; the tour then stays within the zones' window, where
         their series hold."""
         K = self.n_nodes - 1
-        q_mid, _ = step(Q[:, :K], H[:, :K], U, dtau / 2)
+        q_mid, _ = step(Q[:, :K], V[:, :K], U, dtau / 2)
         t_nodes = ca.horzcat(0, ca.cumsum(dtau, 1))           # (1, K+1) τ from the start of the tour
         zone_g = self._zone_function(zone_margin)
         n_zone = len(self.zones.zones) * (2 * K + 1)
@@ -213,9 +227,9 @@ class MultiphaseTranscription:
         return g, np.append(lbg, 0.0), np.append(ubg, self.zones.window / self.scale.t_sat)
 
     def _variable_bounds(self, bound_margin: float) -> None:
-        """Box on the decision vector (T, Q, H, U): phase durations in [1e-3, 1e4] τ, quaternion
-        components in ±1.5, wheel momentum and torque within the margin of the unit box; the
-        indices of q₀, h₀ and h_f that a solve pins."""
+        """Box on the decision vector (T, Q, V, U): phase durations in [1e-3, 1e4] τ, quaternion
+        components in ±1.5, relative wheel speed ν and torque within the margin of the unit box;
+        the indices of q₀, ν₀ and ν_f that a solve pins."""
         P, K, n_w = self.n_phases, self.n_nodes - 1, self.sc.n_wheels
         limit = 1.0 - bound_margin
         lbx = ca.vertcat(np.full(P, 1e-3), np.full(4 * (K + 1), -1.5), np.full(n_w * (K + 1), -limit),
@@ -239,8 +253,9 @@ class MultiphaseTranscription:
     # -- guesses ----------------------------------------------------------------------------
     def initial_guess(self, q_start, targets_in_order, q_end) -> ScheduleSolution:
         """Slerp between consecutive (sign-aligned) attitudes with eigenaxis durations; wheel
-        momentum from the slerp rate by (1), clipped to the box; zero torque. With zones, the
-        nodes between the passages are pushed out of them (:meth:`_clear_zones`)."""
+        momentum from the slerp rate by (1), clipped to the unit box (:meth:`solve` clips ν to its
+        bounds); zero torque. With zones, the nodes between the passages are pushed out of them
+        (:meth:`_clear_zones`)."""
         P, N, n_w = self.n_phases, self.intervals, self.sc.n_wheels
         chain = _aligned([q_start, *targets_in_order, q_end])
         dur = np.array([max(eigenaxis_rest_to_rest_time(self.sc, a, b), 1.0) for a, b in zip(chain[:-1], chain[1:])])
@@ -251,7 +266,7 @@ class MultiphaseTranscription:
             qs.append(rot.slerp(chain[p], chain[p + 1], s))
             axis, angle = rot.to_axis_angle(rot.multiply(rot.conjugate(chain[p]), chain[p + 1]))
             w_tau = axis * angle / dur[p]
-            h = np.clip(np.linalg.lstsq(self.scale.rate_matrix, w_tau, rcond=None)[0], -0.9, 0.9)
+            h = np.clip(np.linalg.lstsq(self.scale.rate_matrix, w_tau, rcond=None)[0], -1.0, 1.0)
             hs.append(np.tile(h, (N, 1)))
         hs[-1][-1] = 0.0
         q = np.vstack(qs)
@@ -321,7 +336,8 @@ class MultiphaseTranscription:
         if max_wall_time is not None:
             solver = ca.nlpsol("schedule", "ipopt", self._nlp,
                                {**self.ipopt_options, "ipopt.max_wall_time": max(float(max_wall_time), 0.01)})
-        x0 = np.concatenate([guess.durations, guess.q.ravel(), guess.h.ravel(), guess.u.ravel()])
+        relative = self.scale.relative
+        x0 = np.concatenate([guess.durations, guess.q.ravel(), (guess.h @ relative.T).ravel(), guess.u.ravel()])
         lbx, ubx = self._lbx.copy(), self._ubx.copy()
         q0 = rot.normalize(np.asarray(q_start, float))
         lbx[self._index_q0] = ubx[self._index_q0] = q0 if np.dot(q0, guess.q[0]) >= 0 else -q0
@@ -337,9 +353,9 @@ class MultiphaseTranscription:
         out = solver(x0=x0, lbx=lbx, ubx=ubx, lbg=self._lbg, ubg=self._ubg, p=params)
         seconds = time.perf_counter() - start
         stats = solver.stats()
-        T, Q, H, U = (np.array(v) for v in self._split(out["x"]))
-        return ScheduleSolution(T.ravel(), Q.T, H.T, U.T, bool(stats["success"]), str(stats["return_status"]),
-                                int(stats.get("iter_count", 0)), seconds)
+        T, Q, V, U = (np.array(v) for v in self._split(out["x"]))
+        return ScheduleSolution(T.ravel(), Q.T, np.linalg.solve(relative, V).T, U.T, bool(stats["success"]),
+                                str(stats["return_status"]), int(stats.get("iter_count", 0)), seconds)
 
 
 _TRANSCRIPTIONS: dict = {}
