@@ -253,9 +253,10 @@ class MultiphaseTranscription:
     # -- guesses ----------------------------------------------------------------------------
     def initial_guess(self, q_start, targets_in_order, q_end) -> ScheduleSolution:
         """Slerp between consecutive (sign-aligned) attitudes with eigenaxis durations; wheel
-        momentum from the slerp rate by (1), clipped to the unit box (:meth:`solve` clips ν to its
-        bounds); zero torque. With zones, the nodes between the passages are pushed out of them
-        (:meth:`_clear_zones`)."""
+        momentum from the slerp rate by (1), clipped to the box; zero torque. With zones, the
+        nodes between the passages are pushed out of them (:meth:`_clear_zones`) and the momentum
+        follows: each node's from the rotation of the interval before it (else the guess's rates
+        cross the pushed attitudes)."""
         P, N, n_w = self.n_phases, self.intervals, self.sc.n_wheels
         chain = _aligned([q_start, *targets_in_order, q_end])
         dur = np.array([max(eigenaxis_rest_to_rest_time(self.sc, a, b), 1.0) for a, b in zip(chain[:-1], chain[1:])])
@@ -266,13 +267,18 @@ class MultiphaseTranscription:
             qs.append(rot.slerp(chain[p], chain[p + 1], s))
             axis, angle = rot.to_axis_angle(rot.multiply(rot.conjugate(chain[p]), chain[p + 1]))
             w_tau = axis * angle / dur[p]
-            h = np.clip(np.linalg.lstsq(self.scale.rate_matrix, w_tau, rcond=None)[0], -1.0, 1.0)
+            h = np.clip(np.linalg.lstsq(self.scale.rate_matrix, w_tau, rcond=None)[0], -0.9, 0.9)
             hs.append(np.tile(h, (N, 1)))
         hs[-1][-1] = 0.0
         q = np.vstack(qs)
+        h = np.vstack(hs)
         if self.zones is not None:
             q = self._clear_zones(q, dur)
-        return ScheduleSolution(dur, q, np.vstack(hs), np.zeros((P * N, n_w)), False, "guess", 0, 0.0)
+            for k in range(P * N - 1):      # the rates of the moved nodes: node k+1 gets interval k's
+                axis, angle = rot.to_axis_angle(rot.multiply(rot.conjugate(q[k]), q[k + 1]))
+                w_tau = axis * angle / (dur[k // N] / N)
+                h[k + 1] = np.clip(np.linalg.lstsq(self.scale.rate_matrix, w_tau, rcond=None)[0], -0.9, 0.9)
+        return ScheduleSolution(dur, q, h, np.zeros((P * N, n_w)), False, "guess", 0, 0.0)
 
     def _clear_zones(self, q: np.ndarray, durations: np.ndarray, beyond: float = np.deg2rad(2.0)) -> np.ndarray:
         """The guess's attitudes ``q`` (K+1, 4) with each node between the passages that violates a
