@@ -242,8 +242,8 @@ def test_the_real_sky_of_leo_observatory_fits_within_tolerance():
 
 
 def test_a_goal_inside_a_moving_zone_at_t0_is_refused_only_if_no_arrival_time_clears_it():
-    limb = Zone("limb", "earth_limb", Y, 0.0)                      # 66.4 deg about nadir, nadir turning at 0.062 deg/s
-    leaving = rot.from_axis_angle([0.0, 0.0, 1.0], math.radians(30))   # boresight 60 deg from nadir(0): clear after ~100 s
+    limb = Zone("limb", "earth_limb", Y, 0.0)          # 66.4 deg about nadir, nadir turning at 0.062 deg/s
+    leaving = rot.from_axis_angle([0.0, 0.0, 1.0], math.radians(30))   # boresight 60 deg from nadir(0): clear at ~100 s
     assert SKY.earth_angular_radius(0.0) > math.radians(60)
     assert cone_checks.zone_issue(_problem([limb], leaving)) is None
     staying = rot.from_axis_angle([0.0, 0.0, 1.0], math.radians(90))   # boresight at nadir(0): inside for 600 s
