@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import os
 import random
+import time
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -12,6 +13,24 @@ import pytest
 
 from att_planner.nodes.client import SuiteClient, client_session
 from att_planner.tools.launch import Suite, isolated_env, join_env, start_suite
+
+
+def wait_for_controller_step(client: SuiteClient, timeout: float = 30.0) -> None:
+    """Spin until the controller reports a step on a fresh state (a goal sent before its first state
+    is answered NO_STATE: a race, not what the tests are about)."""
+    import rclpy
+
+    from att_msgs.msg import ControllerStatus
+    from att_msgs_py import qos, topics
+
+    stepped = []
+    sub = client.create_subscription(ControllerStatus, topics.CONTROLLER_STATUS,
+                                     lambda m: stepped.append(not m.state_stale), qos.STREAM_QOS)
+    end = time.monotonic() + timeout
+    while not any(stepped) and time.monotonic() < end:
+        rclpy.spin_once(client, timeout_sec=0.05)
+    client.destroy_subscription(sub)
+    assert any(stepped), f"the controller did not step on a state within {timeout:g} s"
 
 
 @pytest.fixture(scope="session", autouse=True)
@@ -41,7 +60,8 @@ class RosSuite:
 def ros_suite(tmp_path_factory):
     """Factory of running suites: ``with ros_suite("swift_demo", params=...) as s:`` starts the
     ``nodes`` of a scenario on a fresh isolated domain (simulator held at t = 0 until the recorder
-    and controller listen), joins a :class:`SuiteClient` to it and waits for the services; on exit
+    and controller listen), joins a :class:`SuiteClient` to it and waits for the services and for
+    the controller's first step on a state (when both run); on exit
     every node is stopped and must have ended."""
 
     @contextmanager
@@ -56,6 +76,8 @@ def ros_suite(tmp_path_factory):
             with client_session(name) as client:
                 if "planner" in nodes and "controller" in nodes:
                     client.wait_for_servers(timeout=60, schedule=schedule)
+                if "simulator" in nodes and "controller" in nodes:
+                    wait_for_controller_step(client)
                 running = RosSuite(suite, client, out / "run.mcap")
                 yield running
         finally:
