@@ -83,26 +83,14 @@ def solve_min_time(man: SmoothManeuver, *, basis_sizes: tuple = (4, 8), starts: 
     candidates = [] if alpha0 is None else [_pad_alpha(alpha0, N, Nc, M0)]
     candidates += [rng.normal(size=(3, M0)) * start_scale * np.sqrt(Nc) for _ in range(starts)]
     candidates.append(np.zeros((3, M0)))
-    explored = []
-    best = closest = None
     start_clock = time.monotonic()
 
     def share(fraction):   # stage deadlines: exploration ≤ 50 %, continuation ≤ 75 % of the budget
         return None if end is None else start_clock + fraction * (end - start_clock)
 
-    for a0 in candidates:
-        if end is not None and time.monotonic() > share(0.5):
-            break
-        limit = 50.0 * best.stats["peak"] if best is not None else np.inf
-        r = solve_min_time_local(coarse, a0, maxiter=explore_maxiter, feas_tol=feas_tol, deadline=share(0.5),
-                                 peak_limit=limit, end_ratio=end_ratio if M0 > PAPER_M else None,
-                                 max_total_iterations=explore_total_iterations)
-        r.stats["peak"] = evaluate(coarse, r.alpha).peak_torque
-        explored.append(round(r.tf, 6) if r.feasible else None)
-        if r.feasible and (best is None or r.tf < best.tf):
-            best = r
-        if not r.feasible and (closest is None or r.stats["violation"] < closest.stats["violation"]):
-            closest = r
+    best, closest, explored = _multistart(coarse, candidates, share(0.5), maxiter=explore_maxiter,
+                                          total_iterations=explore_total_iterations, feas_tol=feas_tol,
+                                          end_ratio=end_ratio if M0 > PAPER_M else None)
     if best is None and man.moving and closest is not None:
         best = closest    # the paper basis barely moves near the ends: a larger one may outrun a zone there
     if best is None:
@@ -136,6 +124,28 @@ def solve_min_time(man: SmoothManeuver, *, basis_sizes: tuple = (4, 8), starts: 
     if fallback.feasible:
         fallback.message = f"refinement unfinished ({r.message}); constraints met to {budget_tol:g}"
     return fallback
+
+
+def _multistart(coarse: SmoothManeuver, candidates: list, deadline: float | None, *, maxiter: int,
+                total_iterations: int, feas_tol: float, end_ratio: float | None):
+    """Stage 1 of :func:`solve_min_time`: a local epigraph solve from each start until ``deadline``
+    (runaway starts, 50 × the best peak torque, are cut). Returns the fastest feasible result, the
+    least-violating infeasible one and each start's t_f (None: infeasible)."""
+    best = closest = None
+    explored = []
+    for a0 in candidates:
+        if deadline is not None and time.monotonic() > deadline:
+            break
+        limit = 50.0 * best.stats["peak"] if best is not None else np.inf
+        r = solve_min_time_local(coarse, a0, maxiter=maxiter, feas_tol=feas_tol, deadline=deadline,
+                                 peak_limit=limit, end_ratio=end_ratio, max_total_iterations=total_iterations)
+        r.stats["peak"] = evaluate(coarse, r.alpha).peak_torque
+        explored.append(round(r.tf, 6) if r.feasible else None)
+        if r.feasible and (best is None or r.tf < best.tf):
+            best = r
+        if not r.feasible and (closest is None or r.stats["violation"] < closest.stats["violation"]):
+            closest = r
+    return best, closest, explored
 
 
 def seeded_min_time(man: SmoothManeuver, frozen: SmoothManeuver, *, basis_sizes: tuple = (4, 8),
