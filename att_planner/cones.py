@@ -12,8 +12,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from att_msgs_py import validation
 from att_msgs_py.errors import ErrorCode, RequestError
-from att_msgs_py.types import ZONE_BODIES, Cone, Zone
+from att_msgs_py.types import Cone, Zone
 from att_planner.zones import ZoneSky, same_axis
 from att_sim import rotations as rot
 
@@ -81,30 +82,16 @@ def blocked_endpoint(problem) -> str:
 
 
 # ---------------------------------------------------------------------- zones (issue 13)
-EARTH_LIMB_MARGIN_MAX = np.pi / 2      # rad: the largest margin beyond the Earth's limb
 
 
 def invalid_zone(index: int, zone: Zone) -> str:
-    """Why ``zone`` (``zones[index]``) cannot be used, or '': an unknown body, a sensor axis or an
-    inertial direction not finite and non-zero, a half-angle outside (0, π) (for ``earth_limb``
-    a margin outside [0, π/2)), a direction given for a body."""
-    field = f"zones[{index}]"
-    if zone.body not in ZONE_BODIES:
-        return f"{field}.body = '{str(zone.body)[:32]}' is not one of {', '.join(ZONE_BODIES)}"
-    for name, v in (("sensor_axis", zone.sensor_axis), ("direction", zone.direction)):
-        if v is None and name == "direction" and zone.body != "inertial":
-            continue
-        v = np.asarray(v if v is not None else [], float)
-        if v.shape != (3,) or not np.isfinite(v).all() or not np.linalg.norm(v) > 0:
-            return f"{field}.{name} must be a finite, non-zero 3-vector"
-        if name == "direction" and zone.body != "inertial" and np.any(v):
-            return f"{field}.direction is only for body inertial (body {zone.body} moves)"
-    h = zone.half_angle
-    if zone.body == "earth_limb":
-        if not (np.isfinite(h) and 0.0 <= h < EARTH_LIMB_MARGIN_MAX):
-            return f"{field}.half_angle = {h!r} rad (the margin beyond the Earth's limb) is outside [0, pi/2)"
-    elif not (np.isfinite(h) and 0.0 < h < np.pi):
-        return f"{field}.half_angle = {h!r} rad is outside (0, pi)"
+    """Why ``zone`` (``zones[index]``) cannot be used, or '': the one zone check of the suite,
+    :func:`att_msgs_py.validation.zone` (known body, unit axes, half-angle range, a direction only
+    for an inertial zone)."""
+    try:
+        validation.zone(zone, f"zones[{index}]")
+    except RequestError as err:
+        return err.message
     return ""
 
 
