@@ -27,7 +27,8 @@ from pathlib import Path
 import numpy as np
 import yaml
 
-from att_msgs_py.errors import ConfigError, ErrorCode, clip
+from att_msgs_py import validation
+from att_msgs_py.errors import ConfigError, ErrorCode, RequestError, clip
 from att_msgs_py.types import ZONE_BODIES, Zone
 from att_sim import disturbances
 from att_sim import epoch as epochs
@@ -286,7 +287,7 @@ def zones_from_params(path, shared: dict, epoch: datetime | None) -> list[Zone]:
     """The ``zones`` group, checked, as :class:`att_msgs_py.types.Zone` (``sensor_axis`` unit in body
     axes, ``half_angle`` rad, ``direction`` unit inertial only for body ``inertial``).
     ``half_angle_deg`` is in (0, 180) — for ``earth_limb`` it is the margin beyond the limb, in
-    (−90, 90); ``sun`` and ``moon`` need the epoch."""
+    [0, 90) (:func:`att_msgs_py.validation.zone`); ``sun`` and ``moon`` need the epoch."""
     p = shared.get("zones", [])
     if not isinstance(p, list):
         raise _invalid(path, f"zones must be a list of zone mappings, got {type(p).__name__}")
@@ -315,17 +316,20 @@ def zones_from_params(path, shared: dict, epoch: datetime | None) -> list[Zone]:
             raise _invalid(path, f"{label}.body {body} needs the scenario's epoch (the {body}'s position)")
         axis = _vector3(path, z, "sensor_axis", f"{label}.sensor_axis", unit=True)
         angle = float(_numbers(path, z, "half_angle_deg", f"{label}.half_angle_deg")[0])
-        low, high = (-90.0, 90.0) if body == "earth_limb" else (0.0, 180.0)
-        if not low < angle < high:
-            what = "the margin beyond the Earth limb" if body == "earth_limb" else "the cone half-angle"
-            raise _invalid(path, f"{label}.half_angle_deg ({what}) must be in ({low:g}, {high:g}) deg, got {angle:g}")
+        limb = body == "earth_limb"
+        if not ((0.0 <= angle < 90.0) if limb else (0.0 < angle < 180.0)):
+            what = "the margin beyond the Earth limb, in [0, 90)" if limb else "the cone half-angle, in (0, 180)"
+            raise _invalid(path, f"{label}.half_angle_deg ({what} deg) got {angle:g}")
         keep_in = _flag(path, z, "keep_in", f"{label}.keep_in")
         if (body == "inertial") != ("direction" in z):
             need = "needed for" if body == "inertial" else "only for"
             raise _invalid(path, f"{label}.direction (a unit inertial vector) is {need} body inertial")
         direction = _vector3(path, z, "direction", f"{label}.direction", unit=True) if body == "inertial" else None
-        zones.append(Zone(name=name, body=body, sensor_axis=axis, half_angle=math.radians(angle), keep_in=keep_in,
-                          direction=direction))
+        try:       # the suite's one zone check (half-angle (0, 180) deg; earth_limb margin [0, 90) deg)
+            zones.append(validation.zone(Zone(name=name, body=body, sensor_axis=axis, half_angle=math.radians(angle),
+                                              keep_in=keep_in, direction=direction), label))
+        except RequestError as err:
+            raise _invalid(path, err.message) from None
     return zones
 
 

@@ -203,6 +203,8 @@ BAD = {
                                         "half_angle_deg": 10.0}]), "zones[0].sensor_axis"),
     "zone angle 180": (dict(zones=[{"name": "x", "body": "moon", "sensor_axis": [0, 1, 0],
                                     "half_angle_deg": 180.0}]), "zones[0].half_angle_deg"),
+    "negative limb margin": (dict(zones=[{"name": "x", "body": "earth_limb", "sensor_axis": [0, 1, 0],
+                                          "half_angle_deg": -5.0}]), "margin beyond the Earth limb, in [0, 90)"),
     "inertial zone without direction": (dict(zones=[{"name": "x", "body": "inertial", "sensor_axis": [0, 1, 0],
                                                      "half_angle_deg": 10.0}]), "zones[0].direction"),
     "direction on a sun zone": (dict(zones=[{"name": "x", "body": "sun", "sensor_axis": [0, 1, 0],
@@ -230,7 +232,7 @@ def test_sun_and_moon_zones_need_an_epoch_and_earth_limb_does_not(tmp_path):
     zone = {"name": "x", "body": "sun", "sensor_axis": [0, 1, 0], "half_angle_deg": 30.0}
     with pytest.raises(ConfigError, match="zones.0..body sun needs the scenario's epoch"):
         scenario.load(_file(tmp_path, **base, zones=[zone]))
-    s = scenario.load(_file(tmp_path, **base, zones=[dict(zone, body="earth_limb", half_angle_deg=-5.0),
+    s = scenario.load(_file(tmp_path, **base, zones=[dict(zone, body="earth_limb", half_angle_deg=5.0),
                                                      dict(zone, name="y", body="inertial", direction=[0, 0, 1])]))
-    assert [z.body for z in s.zones] == ["earth_limb", "inertial"] and s.zones[0].half_angle == math.radians(-5.0)
+    assert [z.body for z in s.zones] == ["earth_limb", "inertial"] and s.zones[0].half_angle == math.radians(5.0)
     assert s.zones[1].direction.tolist() == [0.0, 0.0, 1.0] and s.environment["gravity_gradient"]
