@@ -204,6 +204,10 @@ class ZoneSky:
         """``(axes, half_angles)`` at ``t`` in one evaluation: the fit, or with ``true`` the sky."""
         return self._assemble(t, self._moving_truth if true else lambda s: self._series(s, False), False)
 
+    def rates_at(self, t) -> tuple[np.ndarray, np.ndarray]:
+        """``(d a_z/dt, d θ_z/dt)`` of the fit at ``t`` in one evaluation."""
+        return self._assemble(t, lambda s: self._series(s, True), True)
+
     def axes(self, t) -> np.ndarray:
         """Fitted unit inertial axes ``a_z(t)``, shape ``t.shape + (Z, 3)``."""
         return self._assemble(t, lambda s: self._series(s, False), False)[0]

@@ -275,9 +275,10 @@ def _sky_at(man: SmoothManeuver, K: int, tf: float, rates: bool):
         inside = tau * tf <= sky.window
         t = np.where(inside, tau * tf, sky.window)
         if rates:
-            man.sky_memo[key] = (np.where(inside, tau, 0.0), sky.axes_rate(t), sky.half_angles_rate(t))
+            man.sky_memo[key] = (np.where(inside, tau, 0.0), *sky.rates_at(t))
         else:
-            man.sky_memo[key] = (sky.axes(t), sky.half_angles(t) + man.zone_sign * man.zone_margin)
+            axes, half = sky.at(t)
+            man.sky_memo[key] = (axes, half + man.zone_sign * man.zone_margin)
     return man.sky_memo[key]
 
 
