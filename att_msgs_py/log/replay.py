@@ -34,7 +34,9 @@ from att_msgs_py.log.reader import iter_records
 CLOCK = suite_topics.CLOCK
 CLOCK_TYPE = suite_topics.RECORDED[CLOCK]
 MIN_DEPTH = 1000
-DISCOVERY_SETTLE = 0.5      # s between seeing a subscriber and publishing to it (discovery is two-sided)
+# s between seeing a subscriber and publishing to it: discovery is two-sided (0.5 s lost the first
+# messages on a busy machine)
+DISCOVERY_SETTLE = 2.0
 NAMESPACE = "/replay"
 NAMESPACE_PATTERN = re.compile(r"(/[A-Za-z][A-Za-z0-9_]*)+")
 
