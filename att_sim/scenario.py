@@ -102,6 +102,13 @@ def _invalid(path, message: str) -> ConfigError:
     return ConfigError(ErrorCode.INVALID_CONFIG, f"scenario file {clip(path, 200)}: {message}")
 
 
+def _refuse_unknown(path, group: dict, known: tuple, label: str) -> None:
+    """ConfigError when ``group`` has a key outside ``known`` (a typo must not silently mean a default)."""
+    unknown = sorted(str(k) for k in set(group) - set(known))
+    if unknown:
+        raise _invalid(path, f"{label} has unknown key(s) {clip(', '.join(unknown), 120)} (known: {', '.join(known)})")
+
+
 def _as_float(v) -> float | None:
     """``v`` as a float if it is a YAML number (or a string that reads as one), else None."""
     if isinstance(v, bool) or not isinstance(v, (int, float, str)):
@@ -126,10 +133,7 @@ def check_spacecraft_group(path, p) -> None:
     """The ``spacecraft`` group of a scenario: known keys, numbers, sizes, positive limits."""
     if not isinstance(p, dict):
         raise _invalid(path, f"'/**: ros__parameters: spacecraft' must be a mapping, got {type(p).__name__}")
-    unknown = sorted(set(p) - set(SPACECRAFT_KEYS))
-    if unknown:
-        raise _invalid(path, f"spacecraft has unknown key(s) {clip(', '.join(map(str, unknown)), 120)} "
-                             f"(known: {', '.join(SPACECRAFT_KEYS)})")
+    _refuse_unknown(path, p, SPACECRAFT_KEYS, "spacecraft")
     if "inertia" not in p:
         raise _invalid(path, "spacecraft.inertia is missing (3 principal or 9 row-major numbers, kg m^2)")
     inertia = _numbers(path, p, "inertia", "spacecraft.inertia")
@@ -165,10 +169,7 @@ def check_document(path, doc) -> dict:
     shared = shared_params(doc)
     if "spacecraft" not in shared:
         raise _invalid(path, "no 'spacecraft' group in '/**: ros__parameters': not a scenario file")
-    unknown = sorted(str(k) for k in set(shared) - set(SHARED_KEYS))
-    if unknown:
-        raise _invalid(path, f"'/**: ros__parameters' has unknown key(s) {clip(', '.join(unknown), 120)} "
-                             f"(known: {', '.join(SHARED_KEYS)})")
+    _refuse_unknown(path, shared, SHARED_KEYS, "'/**: ros__parameters'")
     check_spacecraft_group(path, shared["spacecraft"])
     orbit = shared.get("orbit", {})
     if not isinstance(orbit, dict):
@@ -257,10 +258,7 @@ def environment_from_params(path, shared: dict, epoch: datetime | None) -> dict:
     p = shared.get("environment", {})
     if not isinstance(p, dict):
         raise _invalid(path, f"environment must be a mapping, got {type(p).__name__}")
-    unknown = sorted(str(k) for k in set(p) - set(ENVIRONMENT_KEYS))
-    if unknown:
-        raise _invalid(path, f"environment has unknown key(s) {clip(', '.join(unknown), 120)} "
-                             f"(known: {', '.join(ENVIRONMENT_KEYS)})")
+    _refuse_unknown(path, p, ENVIRONMENT_KEYS, "environment")
     out = {key: _flag(path, p, key, f"environment.{key}") for key in ("gravity_gradient", "solar_pressure", "drag")}
     cd = float(_numbers(path, p, "drag_coefficient", "environment.drag_coefficient", DEFAULT_DRAG_COEFFICIENT)[0])
     if not 0.0 < cd <= 10.0:
@@ -296,10 +294,7 @@ def zones_from_params(path, shared: dict, epoch: datetime | None) -> list[Zone]:
         label = f"zones[{k}]"
         if not isinstance(z, dict):
             raise _invalid(path, f"{label} must be a mapping with keys among {', '.join(ZONE_KEYS)}")
-        unknown = sorted(str(x) for x in set(z) - set(ZONE_KEYS))
-        if unknown:
-            raise _invalid(path, f"{label} has unknown key(s) {clip(', '.join(unknown), 120)} "
-                                 f"(known: {', '.join(ZONE_KEYS)})")
+        _refuse_unknown(path, z, ZONE_KEYS, label)
         missing = [x for x in ("name", "body", "sensor_axis", "half_angle_deg") if x not in z]
         if missing:
             raise _invalid(path, f"{label} needs key(s) {', '.join(missing)}")
