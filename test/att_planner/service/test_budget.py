@@ -16,6 +16,7 @@ from att_msgs_py.errors import ErrorCode
 from att_msgs_py.types import Cone, Plan, Status
 from att_msgs_py.validation import MAX_NAME_LENGTH, MAX_PLAN_BYTES, MAX_PLAN_SAMPLES, MAX_TEXT_LENGTH
 from att_planner import methods
+from att_planner.service import planning
 from att_planner.service.planning import plan_maneuver, prepare, run_method
 from att_planner.service.requests import MAX_CONES, ManeuverRequest, validate_maneuver
 from att_planner.service.worker import run_isolated, warm_up
@@ -101,7 +102,11 @@ def test_a_plan_above_the_sample_cap_is_refused_before_verification():
     assert f"{n} samples" in outcome.message and str(MAX_PLAN_SAMPLES) in outcome.message
 
 
-def test_a_plan_too_late_to_verify_is_replaced_by_the_fallback():
+def test_a_plan_too_late_to_verify_is_replaced_by_the_fallback(monkeypatch):
+    # the verification cost is estimated from measured steps: pin it (1 ms a step, 6 s for this plan)
+    # so the plan is too late on a fast idle machine as on a busy one
+    monkeypatch.setattr(planning, "_step_seconds", 1e-3)
+
     def late(method, problem, options, wait):
         time.sleep(max(0.0, problem.deadline - time.monotonic()) + 0.4)       # past the request's budget
         return run_method(methods.get("eigenaxis_smooth"), problem, {"samples": 4001}, wait)
