@@ -10,6 +10,9 @@ translates messages; tests and the Monte Carlo drive the core directly.
   gyro samples, states and measurements and, when a measurement older than its newest state
   arrives, goes back to the state before it and reprocesses everything since (out-of-sequence
   measurements by reprocessing; Bar-Shalom, Li & Kirubarajan 2001 §10.4).
+* **Propagation** on the gyro, its scale factors and misalignments *considered* from their
+  datasheet spread (:func:`.mekf.propagate`): the covariance grows with the rotation the gyro
+  measures, not only with time, so a filter blind through a slew stays honest.
 * **Updates**: every valid star tracker measurement (mounting ``q_SB``: the body attitude is
   ``q_S ⊗ q_SB*``, noise ``R_B = C R_S Cᵀ``); magnetometer and sun-sensor vector updates only while
   no tracker measurement was accepted for ``vector_fallback_after`` s. A magnetometer sample taken
@@ -23,8 +26,10 @@ translates messages; tests and the Monte Carlo drive the core directly.
 * **Health** (``AttitudeEstimate.HEALTH_*``): INITIALISING without an attitude; DIVERGED when the
   covariance stops being positive definite or ``lost_after`` tracker measurements in a row are
   rejected (the estimate is dropped and the filter reinitialises from the next measurements);
-  CONVERGED while an attitude measurement was accepted within ``propagate_timeout`` s and the
-  attitude's 3σ is below ``converged_attitude_sigma``; PROPAGATING otherwise (gyro only).
+  CONVERGED while an attitude fix — a star tracker measurement, or a vector measurement on a
+  spacecraft without trackers — was accepted within ``propagate_timeout`` s and the attitude's 3σ is
+  below ``converged_attitude_sigma``; PROPAGATING otherwise (on the gyro, with at most the coarse
+  aid of the vectors while the trackers are blind).
 
 Inputs are hostile until checked (:mod:`.inputs`): a refused measurement raises
 :class:`~att_msgs_py.errors.RequestError` (320 INVALID_MEASUREMENT, 321 STALE_MEASUREMENT) and
@@ -69,6 +74,8 @@ class EstimatorConfig:
     arw: float = 1e-6                      # rad/√s: σ_v of the gyro model
     rrw: float = 1e-9                      # rad/s/√s: σ_u of the bias random walk
     initial_bias_sigma: float = 1e-5       # rad/s 1σ of the bias prior
+    scale_factor_sigma: float = 0.0        # 1σ of the gyro's scale factors, considered (Schmidt)
+    misalignment_sigma: float = 0.0        # rad 1σ of its misalignments, considered
     gate_probability: float = 0.9999       # chi-square gate of every measurement
     converged_attitude_sigma: float = 1e-3  # rad: 3σ attitude at most this to be CONVERGED
     propagate_timeout: float = 2.0         # s without an accepted attitude measurement: PROPAGATING
@@ -109,6 +116,8 @@ class Estimator:
         self.frame_id, self.body_frame_id = frame_id, body_frame_id
         self.checks = InputChecks(specs, frame_id, body_frame_id)
         self.trackers = {s.name: s for s in specs.star_trackers}
+        variances = np.array([config.scale_factor_sigma**2] * 3 + [config.misalignment_sigma**2] * 6)
+        self.consider = variances if np.any(variances > 0) else None
         self.gates = {k: float(chi2.ppf(config.gate_probability, k)) for k in (3,)}
         self.gyro: deque[tuple[float, np.ndarray, bool]] = deque()       # (t, ω_m, saturated)
         # filter states at the gyro instants, after the measurements up to each; the first is the anchor
@@ -137,6 +146,7 @@ class Estimator:
         tracker_sigma = max((s.about_boresight for s in specs.star_trackers), default=1e-4)
         return EstimatorConfig(publish_period=publish_period, arw=max(g.arw, 1e-9), rrw=max(rrw, 1e-12),
                                initial_bias_sigma=max(3.0 * g.initial_bias, g.bias_instability, 1e-7),
+                               scale_factor_sigma=g.scale_factor, misalignment_sigma=g.misalignment,
                                converged_attitude_sigma=max(10.0 * tracker_sigma, 1e-4))
 
     @property
@@ -187,12 +197,17 @@ class Estimator:
         return out
 
     # -- output -----------------------------------------------------------------------------------
+    @property
+    def last_fix(self) -> float:
+        """Time of the last accepted attitude fix (tracker, or any attitude measurement without trackers)."""
+        return self.last_tracker if self.trackers else self.last_update
+
     def health(self, t: float) -> Health:
         x = self.state
         if x is None:
             return Health.DIVERGED if self.diverged else Health.INITIALISING
         sigma3 = 3.0 * math.sqrt(max(float(np.linalg.eigvalsh(x.P[:3, :3]).max()), 0.0))
-        recent = t - self.last_update <= self.config.propagate_timeout
+        recent = t - self.last_fix <= self.config.propagate_timeout
         return Health.CONVERGED if recent and sigma3 <= self.config.converged_attitude_sigma else Health.PROPAGATING
 
     def estimate(self, t: float, omega_measured: np.ndarray) -> AttitudeEstimate:
@@ -209,7 +224,7 @@ class Estimator:
                    Health.PROPAGATING: "propagating on the gyro", Health.CONVERGED: "converged"}[health]
         return AttitudeEstimate(t=t, q=q.copy(), omega=omega_measured - bias, gyro_bias=bias.copy(),
                                 attitude_covariance=P_att, bias_covariance=P_bias, health=int(health),
-                                time_since_update=t - self.last_update, rejected=self.rejected, message=message,
+                                time_since_update=t - self.last_fix, rejected=self.rejected, message=message,
                                 frame_id=self.frame_id, body_frame_id=self.body_frame_id)
 
     # -- the filter over its history ---------------------------------------------------------------
@@ -251,7 +266,7 @@ class Estimator:
             return x
         dt = t - x.t
         extra = (self.specs.gyro.range * dt) ** 2 if saturated and self.specs.gyro else 0.0
-        x = mekf.propagate(x, omega, dt, self.config.arw, self.config.rrw, extra)
+        x = mekf.propagate(x, omega, dt, self.config.arw, self.config.rrw, self.consider, extra)
         if not mekf.healthy(x.P):
             return self._lose(t, f"covariance not positive definite at t = {t:.3f} s")
         return x
