@@ -14,8 +14,8 @@ from att_sim import dynamics as dyn
 from att_sim import rotations as rot
 from att_sim.actuators import (
     ActuatorSpecs,
-    MagnetorquerSpec,
     Magnetorquers,
+    MagnetorquerSpec,
     WheelDrive,
     WheelDriveSpec,
     actuators_from_params,

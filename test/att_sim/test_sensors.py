@@ -49,7 +49,10 @@ def allan_deviation(rate: np.ndarray, dt: float, taus) -> np.ndarray:
     return np.array(out)
 
 
-def bodies(sun=None, moon=None, nadir=(0.0, 0.0, -1.0), earth_radius=math.radians(66.0), shadow=1.0) -> Bodies:
+EARTH_RADIUS_ANGLE = math.radians(66.0)       # seen from 7000 km
+
+
+def bodies(sun=None, moon=None, nadir=(0.0, 0.0, -1.0), earth_radius=EARTH_RADIUS_ANGLE, shadow=1.0) -> Bodies:
     n = np.asarray(nadir, float)
     return Bodies(-7e6 * n, np.array([2e-5, 0.0, 1e-5]), n, earth_radius,
                   None if sun is None else np.asarray(sun, float) / np.linalg.norm(sun),
