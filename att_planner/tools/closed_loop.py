@@ -44,7 +44,7 @@ class Trace:
     bias_true: list = field(default_factory=list)
     bias_est: list = field(default_factory=list)
     health: list = field(default_factory=list)
-    tracker_valid: list = field(default_factory=list)     # the latest tracker sample of each instant valid
+    tracker_status: list = field(default_factory=list)    # TrackerStatus of the latest tracker sample
     wheel_speeds: list = field(default_factory=list)      # rad/s, relative to the body (truth)
     wheel_torques: list = field(default_factory=list)     # N m, commanded
     dipole: list = field(default_factory=list)            # A m², commanded
@@ -78,7 +78,7 @@ class ClosedLoop:
             scenario, q0=q0, omega0=omega0, wheel_speed0=wheel_speed0, seed=seed,
             checks=Checks(body_frame_id=scenario.body_frame_id))
         self.trace = Trace()
-        self.tracker_valid = True
+        self.tracker_status = 0                 # of the latest tracker measurement (TrackerStatus)
         self.refusals: list[RequestError] = []
         self.next_state = 0.0
         self.result: ManeuverResult | None = None
@@ -107,7 +107,7 @@ class ClosedLoop:
         outcome = None
         if est is not None:
             for m in readings.star_trackers:
-                self.tracker_valid = bool(m.valid)
+                self.tracker_status = int(m.status)
                 self._guard(est.on_star_tracker, m)
             if readings.magnetometer is not None:
                 self._guard(est.on_magnetometer, readings.magnetometer)
@@ -187,7 +187,7 @@ class ClosedLoop:
             tr.bias_est.append(np.full(3, math.nan))
         tr.bias_true.append(sim.sensors.gyro.bias.copy() if sim.sensors and sim.sensors.gyro else np.zeros(3))
         tr.health.append(int(est.health(sim.t)) if est is not None else int(Health.CONVERGED))
-        tr.tracker_valid.append(self.tracker_valid)
+        tr.tracker_status.append(self.tracker_status)
 
 
 def plan_in_process(scenario: Scenario, q0, qf, sensor_axis, cones=(), zones=(), method: str = "",
