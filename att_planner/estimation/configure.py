@@ -37,7 +37,8 @@ def estimator_config(param, s: Scenario) -> EstimatorConfig:
         sun_sigma=param("sun_sigma_deg", d.sun_sigma / DEG, 0.0, 90.0, low_open=True) * DEG,
         sun_threshold=param("sun_threshold", d.sun_threshold, 0.0, 1.0),
         pair_window=param("pair_window", d.pair_window, 0.0, 60.0),
-        max_gyro_gap=param("max_gyro_gap", d.max_gyro_gap, 0.0, 3600.0, low_open=True))
+        max_gyro_gap=param("max_gyro_gap", d.max_gyro_gap, 0.0, 3600.0, low_open=True),
+        resync_timeout=param("resync_timeout", d.resync_timeout, 0.0, 3600.0, low_open=True))
 
 
 def estimator_from_scenario(param, s: Scenario) -> Estimator:

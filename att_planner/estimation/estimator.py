@@ -5,11 +5,15 @@ sun sensors, in the style of :class:`att_planner.control.controller.Controller`:
 translates messages; tests and the Monte Carlo drive the core directly.
 
 * **Time** is the gyro's: each gyro sample (the mean rate over the interval it ends) propagates the
-  filter to its stamp. Other measurements are applied **at the instant they were taken**: a star
-  tracker's message arrives its latency later, so the filter keeps the last ``history`` seconds of
-  gyro samples, states and measurements and, when a measurement older than its newest state
-  arrives, goes back to the state before it and reprocesses everything since (out-of-sequence
-  measurements by reprocessing; Bar-Shalom, Li & Kirubarajan 2001 §10.4).
+  filter to its stamp. Its stamps must move forward by at most ``max_gyro_gap`` (no single message
+  can stall or steer the filter's clock); after ``resync_timeout`` s of wall time without a gyro
+  sample the next one starts a new timeline (a restarted simulator) and the filter starts afresh.
+  A measurement stamped more than ``max_gyro_gap`` ahead of the gyro is refused. Other measurements
+  are applied **at the instant they were taken**: a star tracker's message arrives its latency
+  later, so the filter keeps the last ``history`` seconds of gyro samples, states and measurements
+  and, when a measurement older than its newest state arrives, goes back to the state before it and
+  reprocesses everything since (out-of-sequence measurements by reprocessing; Bar-Shalom, Li &
+  Kirubarajan 2001 §10.4).
 * **Propagation** on the gyro, its scale factors and misalignments *considered* from their
   datasheet spread (:func:`.mekf.propagate`): the covariance grows with the rotation the gyro
   measures, not only with time, so a filter blind through a slew stays honest.
@@ -86,7 +90,9 @@ class EstimatorConfig:
     sun_sigma: float = 0.02                # rad: coarse sun vector error per axis
     sun_threshold: float = 0.05            # a detector above this output is lit
     pair_window: float = 0.5               # s between the two vectors of a QUEST initialisation
-    max_gyro_gap: float = 1.0              # s: a longer gap between gyro samples is reported
+    max_gyro_gap: float = 1.0              # s: a gyro sample further ahead is refused (or a measurement that far
+                                           # ahead of the gyro), unless the gyro was silent for resync_timeout
+    resync_timeout: float = 1.0            # s of wall time without a gyro sample: the next starts a new timeline
 
 
 @dataclass
@@ -133,6 +139,7 @@ class Estimator:
         self.rejected = 0
         self.rejected_in_a_row = 0
         self.next_publish = -math.inf
+        self.last_wall = -math.inf                # when the last gyro sample arrived (monotonic s)
         self.report = Report()
 
     @staticmethod
@@ -154,12 +161,22 @@ class Estimator:
         return self.snapshots[-1][1]
 
     # -- inputs -----------------------------------------------------------------------------------
-    def on_gyro(self, m: GyroMeasurement) -> AttitudeEstimate | None:
+    def on_gyro(self, m: GyroMeasurement, wall: float = 0.0) -> AttitudeEstimate | None:
         """Propagate to the sample's stamp (and apply what arrived meanwhile); the estimate when
-        one is due (every ``publish_period``)."""
-        omega, saturated = self.checks.gyro(m, self.gyro[-1][0] if self.gyro else None)
-        if self.gyro and m.t - self.gyro[-1][0] > self.config.max_gyro_gap:
-            self.report.notes.append(f"gyro gap of {m.t - self.gyro[-1][0]:.3g} s before t = {m.t:.3f} s")
+        one is due (every ``publish_period``). ``wall``: the monotonic time it arrived: a sample more
+        than ``max_gyro_gap`` after the last is refused unless none came for ``resync_timeout`` s, in
+        which case it starts a new timeline (a restarted simulator): the filter starts afresh."""
+        last = self.gyro[-1][0] if self.gyro else None
+        silent = wall - self.last_wall > self.config.resync_timeout
+        omega, saturated = self.checks.gyro(m, None if silent else last)
+        if last is not None and not 0.0 < m.t - last <= self.config.max_gyro_gap:
+            if not silent:
+                raise RequestError(ErrorCode.STALE_MEASUREMENT,
+                                   f"gyro stamp {m.t:.6g} s is {m.t - last:+.6g} s from the last ({last:.6g} s); "
+                                   f"it must move forward by at most max_gyro_gap = {self.config.max_gyro_gap:g} s")
+            self.report.notes.append(f"gyro timeline restarted: {last:.3f} s then {m.t:.3f} s; filter restarted")
+            self._restart()
+        self.last_wall = wall
         if saturated:
             self.report.notes.append(f"gyro saturated at t = {m.t:.3f} s: attitude covariance grown")
         self.gyro.append((m.t, omega, saturated))
@@ -169,6 +186,15 @@ class Estimator:
             return None
         self.next_publish = m.t + self.config.publish_period
         return self.estimate(m.t, omega)
+
+    def _restart(self) -> None:
+        """Forget every state, sample and measurement (a new timeline): initialising again."""
+        self.gyro.clear()
+        self.snapshots = deque([(-math.inf, None)])
+        self.records = []
+        self.diverged, self.lost_at = False, -math.inf
+        self.last_update = self.last_tracker = self.next_publish = -math.inf
+        self.rejected_in_a_row = 0
 
     def on_star_tracker(self, m: StarTrackerMeasurement) -> None:
         """Keep a valid tracker measurement for its instant (an invalid one says only that)."""
@@ -235,6 +261,11 @@ class Estimator:
             raise RequestError(ErrorCode.STALE_MEASUREMENT,
                                f"{record.kind} measurement of t = {record.t:.6g} s is older than the filter's history "
                                f"(from t = {oldest:.6g} s, {self.config.history:g} s)")
+        newest = self.gyro[-1][0] if self.gyro else -math.inf
+        if self.gyro and record.t > newest + self.config.max_gyro_gap:
+            raise RequestError(ErrorCode.STALE_MEASUREMENT,
+                               f"{record.kind} measurement of t = {record.t:.6g} s is ahead of the gyro (t = "
+                               f"{newest:.6g} s) by more than max_gyro_gap = {self.config.max_gyro_gap:g} s")
         self.records.append(record)
         self.records.sort(key=lambda r: r.t)          # stable: equal instants keep their arrival order
         if record.t <= self.snapshots[-1][0]:

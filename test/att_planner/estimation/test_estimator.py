@@ -17,6 +17,7 @@ from att_msgs_py.types import (
     SunSensorMeasurement,
 )
 from att_planner.estimation.estimator import Estimator, EstimatorConfig
+from att_planner.estimation.inputs import Sources
 from att_sim import rotations as rot
 from att_sim.sensors.specs import (
     ARCSEC,
@@ -225,3 +226,32 @@ def test_an_invalid_tracker_measurement_only_says_it_is_blind():
     est.on_star_tracker(StarTrackerMeasurement(0.05, "st", rot.IDENTITY, np.full((3, 3), -1.0), valid=False,
                                                frame_id="eci"))
     assert rot.angle_between(est.on_gyro(gyro(0.05)).q, Q) < 1e-9
+
+
+def test_no_single_gyro_sample_can_steer_the_filters_clock_but_a_restarted_timeline_is_followed():
+    est = estimator()
+    est.on_star_tracker(tracker(0.0, Q))
+    est.on_gyro(gyro(0.0), wall=100.0)
+    with pytest.raises(RequestError) as err:                          # 1e6 s ahead, while the gyro is alive
+        est.on_gyro(gyro(1e6), wall=100.01)
+    assert err.value.code == ErrorCode.STALE_MEASUREMENT
+    assert est.on_gyro(gyro(0.05), wall=100.05).health == Health.CONVERGED
+    with pytest.raises(RequestError):                                 # a tracker far ahead of the gyro
+        est.on_star_tracker(tracker(50.0, Q))
+    # the gyro silent for more than resync_timeout: a new timeline (a restarted simulator) starts afresh
+    e = est.on_gyro(gyro(3.0), wall=102.0)
+    assert e.health == Health.INITIALISING and any("restarted" in n for n in est.take_report().notes)
+    est.on_star_tracker(tracker(3.05, Q))
+    assert est.on_gyro(gyro(3.05), wall=102.05).health == Health.CONVERGED
+
+
+def test_a_second_publisher_of_an_input_is_refused_while_the_first_is_alive():
+    sources = Sources(timeout=1.0)
+    sources.admit("gyro sample", b"a", 0.0)
+    with pytest.raises(RequestError) as err:
+        sources.admit("gyro sample", b"b", 0.5)
+    assert err.value.code == ErrorCode.INVALID_MEASUREMENT
+    sources.admit("star tracker measurement", b"b", 0.5)             # another input: its own publisher
+    sources.admit("gyro sample", b"b", 1.6)                          # the first fell silent: the newcomer takes over
+    with pytest.raises(RequestError):
+        sources.admit("gyro sample", b"a", 1.7)
