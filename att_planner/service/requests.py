@@ -25,7 +25,7 @@ from att_msgs_py.errors import ErrorCode, RequestError
 from att_msgs_py.types import Cone
 from att_msgs_py.validation import MAX_NAME_LENGTH, text, unit_quaternion, unit_vector
 from att_planner import methods
-from att_planner.cones import check_zones, endpoint_in_cone
+from att_planner.cones import BOUNDARY_TOLERANCE, boundary_arc_issue, check_zones, endpoint_in_cone
 from att_planner.methods import Method
 from att_planner.problem import ManeuverProblem
 from att_planner.service.real_sky import RequestSky, check_orbit_window, resolve_sky
@@ -152,15 +152,20 @@ def check_sky(problem: ManeuverProblem, real: RequestSky, legs: int = 1) -> None
 
 
 def check_reachable(problem: ManeuverProblem) -> None:
-    """Neither end inside a cone (SENSOR_IN_CONE), and the cones and zones do not close the sky
-    between them for any sensor (INFEASIBLE)."""
+    """Neither end inside a cone by more than BOUNDARY_TOLERANCE (SENSOR_IN_CONE; on the boundary is
+    plannable), a forced boundary arc that can be flown (INVALID_OPTION), and the cones and zones do
+    not close the sky between the ends for any sensor (INFEASIBLE)."""
     q0, qf, r, cones, sensor_target = (problem.q_initial, problem.q_final, problem.sensor_axis, problem.cones,
                                        problem.sensor_target)
     hit = endpoint_in_cone(q0, qf, r, cones, sensor_target)
     if hit is not None:
         label, cone, depth = hit
         raise RequestError(ErrorCode.SENSOR_IN_CONE,
-                           f"the {label} is inside cone '{cone.name}' by {np.degrees(depth):.3f} deg")
+                           f"the {label} is inside cone '{cone.name}' by {np.degrees(depth):.3g} deg "
+                           f"(more than the boundary tolerance of {BOUNDARY_TOLERANCE:g} rad)")
+    why = boundary_arc_issue(problem)
+    if why:
+        raise RequestError(ErrorCode.INVALID_OPTION, why)
     if not cones and not problem.zones:
         return
     zone_sky = problem.zone_sky()

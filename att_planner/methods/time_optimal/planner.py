@@ -48,7 +48,7 @@ from att_planner.methods.time_optimal import collocation as col
 from att_planner.methods.time_optimal.model import Scaling, plan_arrays, scaling, transcription
 from att_planner.methods.time_optimal.routes import Route, candidate_routes, route_guess, select_routes, zone_margin
 from att_planner.problem import ManeuverProblem
-from att_planner.verification import integrate, measure, rejection
+from att_planner.verification import clearances, integrate, measure, rejection
 from att_sim import rotations as rot
 
 METHOD = "time_optimal"
@@ -188,10 +188,9 @@ class _Incumbent:
 
 
 def _truth_violation_intervals(traj, sol: col.PhaseSolution, s: Scaling, problem) -> np.ndarray:
-    """Mesh intervals containing dense truth samples with a negative zone margin (each zone at the
-    sample's time)."""
-    zones = problem.zone_sky()
-    m = zones.margins(np.minimum(traj.t, zones.window), traj.q)
+    """Mesh intervals containing dense truth samples below a zone's clearance floor
+    (:func:`att_planner.verification.clearances`: each zone at the sample's time)."""
+    m = clearances(problem, traj.t, traj.q, true=False)
     if not m.size:
         return np.array([], int)
     bad_t = traj.t[m.min(axis=1) < 0] / s.tu / sol.duration
