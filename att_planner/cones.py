@@ -30,6 +30,7 @@ from att_sim import rotations as rot
 BOUNDARY_TOLERANCE = 1e-6   # rad: an end direction this far inside a boundary is on it
 END_RADIUS = 0.01           # rad: the neighbourhood of an end direction where margin ≥ −tol suffices
 END_RAMP = 0.1              # fraction of the maneuver over which a planner's tightening ramps up at a boundary end
+SMOOTH_END_RAMP = 0.25      # the same for smooth plans (Slepian basis: the boresight moves 7e-5 rad by τ = 0.05)
 ARC_TOLERANCE = 1e-4        # rad: a forced boundary arc keeps |margin| within this on the dense grid
 
 
@@ -82,14 +83,14 @@ def endpoint_in_cone(q_initial, q_final, sensor_axis, cones: list[Cone],
     return None
 
 
-def end_ramp(tau) -> np.ndarray:
+def end_ramp(tau, length: float = END_RAMP) -> np.ndarray:
     """Weight in [0, 1] of a planner's zone tightening δ at maneuver fractions ``tau`` for a zone
-    with an end on its boundary: ``min(1, (min(τ, 1 − τ)/END_RAMP)⁴)``; the tightening there is
-    ``−tol + (δ + tol)·w``. Quartic, so that even a smooth plan (torque zero at the ends: the
-    boresight moves as t³) clears it; it reaches 0 at τ ≈ 0.018, while a bang-bang slew of a few
-    time units has moved the boresight by less than END_RADIUS."""
+    with an end on its boundary: ``min(1, (min(τ, 1 − τ)/length)⁴)``; the tightening there is
+    ``−tol + (δ + tol)·w``, negative for τ < 0.18 length only, where a bang-bang slew of a few
+    time units (``END_RAMP``) or a smooth one (``SMOOTH_END_RAMP``) has moved the boresight by less
+    than END_RADIUS. Quartic, so that the boresight, which starts from rest, clears it."""
     tau = np.clip(np.asarray(tau, float), 0.0, 1.0)
-    return np.minimum(1.0, np.minimum(tau, 1.0 - tau) / END_RAMP) ** 4
+    return np.minimum(1.0, np.minimum(tau, 1.0 - tau) / length) ** 4
 
 
 def boundary_end_zones(problem, margin: float) -> np.ndarray:
