@@ -98,7 +98,8 @@ class SmoothManeuver:
     keep-out zone, inside a keep-in one) so that the truth integration of the ZOH torque (which
     lags the model by half a sample) stays clear; a zone with an end on its boundary
     (``zone_ramp``, :func:`att_planner.cones.boundary_end_zones`) gets ``−tol + (m + tol) w(τ_k)``
-    instead, w the end ramp of a smooth plan (:func:`att_planner.cones.end_ramp`, ``SMOOTH_END_RAMP``). Static zones (``zone_sky`` None): constant axes
+    instead, w the end ramp of a smooth plan (:func:`att_planner.cones.end_ramp`, ``SMOOTH_END_RAMP``).
+    Static zones (``zone_sky`` None): constant axes
     ``cone_dirs`` and ``cone_cos`` = cos(θ_z + σ_z m). Moving zones: ``zone_sky``
     (:class:`att_planner.zones.ZoneSky`) gives a_z(t), θ_z(t) and their rates, and ``cone_dirs``,
     ``cone_cos`` hold the values at t = 0.
