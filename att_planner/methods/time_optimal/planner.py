@@ -29,10 +29,11 @@ Solution process (Melton's two stages, with multi-start because the problem has 
 minima; option ``global_stage``: his particle swarm, :mod:`.swarm`, as the first start): (1) cheap
 routes — eigenaxis both ways round, tilted two-leg routes and the cone-riding λ-rotation routes of
 :mod:`att_planner.methods.constrained_axis`, optional plans of other methods (:mod:`.routes`) —
-each turned into a continuous bang-bang guess and solved on a coarse mesh; (2) the best converged solution is refined: intervals where the torque switches or a zone
-constraint fails between collocation points are bisected and the NLP re-solved from the
-interpolated solution; (3) the torque is integrated
-through the truth dynamics (:mod:`att_planner.verification`); a failure refines again.
+each turned into a continuous bang-bang guess and solved on a coarse mesh; (2) the best converged
+solution is refined: intervals where the torque switches or a zone constraint fails between
+collocation points are bisected and the NLP re-solved from the interpolated solution; (3) the
+torque is integrated through the truth dynamics (:mod:`att_planner.verification`); a failure
+refines again.
 """
 from __future__ import annotations
 
