@@ -278,7 +278,8 @@ def check_targets(names: list, targets: list) -> dict:
 
 
 def check_targets_clear(problem: ManeuverProblem) -> None:
-    """No schedule target violates a fixed (inertial) zone (ZONE_AT_END): it could never be passed.
+    """No schedule target violates a fixed (inertial) zone by more than BOUNDARY_TOLERANCE
+    (ZONE_AT_END): it could never be passed.
     A moving zone may clear a target before it is reached: planning and verification judge those."""
     zone_sky = problem.zone_sky()
     fixed = np.array([z.body == "inertial" for z in zone_sky.zones], bool)
@@ -287,7 +288,7 @@ def check_targets_clear(problem: ManeuverProblem) -> None:
     for i, (target, q) in enumerate(problem.targets.items()):
         m = np.where(fixed, zone_sky.margins(0.0, q, true=True)[0], np.inf)
         k = int(np.argmin(m))
-        if m[k] < 0:
+        if m[k] < -BOUNDARY_TOLERANCE:
             kind = "outside keep-in" if zone_sky.keep_in[k] else "inside keep-out"
             raise RequestError(ErrorCode.ZONE_AT_END,
                                f"targets[{i}] ('{target}') is {kind} zone {zone_sky.names[k]} by "
