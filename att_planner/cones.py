@@ -96,7 +96,7 @@ def end_ramp(tau, length: float = END_RAMP) -> np.ndarray:
 def boundary_end_zones(problem, margin: float) -> np.ndarray:
     """Which zones of ``problem.zone_sky()`` a planner tightened by ``margin`` rad must ramp
     (:func:`end_ramp`): those whose start or goal (semi-free: ``sensor_target``, for the zones of
-    ``problem.sensor_axis``) has a margin below ``margin`` at t = 0, and the forced boundary arc's cone."""
+    ``problem.sensor_axis``) has a margin below ``margin`` at t = 0."""
     zs = problem.zone_sky()
     if not zs.zones:
         return np.zeros(0, bool)
@@ -109,10 +109,7 @@ def boundary_end_zones(problem, margin: float) -> np.ndarray:
         gamma = np.arccos(np.clip(zs.true_axes(0.0) @ target, -1.0, 1.0))
         theta = zs.true_half_angles(0.0)
         ends.append(np.where(own, np.where(zs.keep_in, theta - gamma, gamma - theta), np.inf))
-    near = np.min(ends, axis=0) < margin
-    if problem.boundary_cone is not None:
-        near[problem.boundary_cone] = True
-    return near
+    return np.min(ends, axis=0) < margin
 
 
 def boundary_arc_issue(problem) -> str:
