@@ -82,6 +82,8 @@ def _print_table(args, rows, semi) -> None:
 def run(args) -> dict:
     if args.case in BOUNDARY_CASES:
         return boundary.run(args)
+    if args.sweep:
+        raise SystemExit(f"att-bench time-optimal: --sweep is for the boundary cases ({', '.join(BOUNDARY_CASES)})")
     rows, payloads = [], {}
     for name, method in METHODS.items():
         problem = replace(case_problem(args.case), deadline=time.monotonic() + args.budget)
