@@ -1,6 +1,7 @@
 """Melton's (2012) boundary cases (issue 19) for ``att-bench time-optimal --case {ba1,ba2,bp1,bp2}``.
 
-For the case: ``time_optimal`` (multi-start, the plan of the JSON), ``time_optimal`` with Melton's
+For the case: ``time_optimal`` (multi-start, the plan of the JSON whatever ``--method``; the others'
+figures under ``plans``), ``time_optimal`` with Melton's
 first stage (``global_stage``: the particle swarm seeds the collocation; compute and IPOPT
 iterations with and without it), ``constrained_axis`` on the case, and the λ-rotation about the
 cone axis (``constrained_axis`` with the forced arc: the BA twin of a BP case). Every plan is

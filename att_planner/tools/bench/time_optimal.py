@@ -32,7 +32,8 @@ TUNABLE = {"time_optimal": ("starts",)}
 def configure(parser):
     parser.add_argument("--case", choices=CASES, required=True)
     parser.add_argument("--method", choices=list(METHODS), default="time_optimal",
-                        help="method whose plan goes to the JSON (all are run and tabulated)")
+                        help="method whose plan goes to the JSON (all are run and tabulated; the boundary "
+                             "cases write time_optimal's)")
     parser.add_argument("--budget", type=float, default=10.0,
                         help="time budget per method, seconds (problem.deadline)")
     parser.add_argument("--starts", type=int, default=6,
