@@ -87,6 +87,17 @@ class ParameterReader:
                                   f"(from {where}); known: {', '.join(sorted(self.used))}")
 
 
+def publisher_of(info) -> bytes | None:
+    """The publisher GID of a received message (None when the middleware does not say)."""
+    gid = (info or {}).get("publisher_gid")
+    return bytes(gid["data"]) if isinstance(gid, dict) and gid.get("data") is not None else None
+
+
+def participant_of(gid: bytes | None) -> bytes | None:
+    """The DDS participant of a publisher GID (its 12-byte GUID prefix): one per node process."""
+    return None if gid is None else gid[:12]
+
+
 def parameter_reader(node, scenario_values: dict, source: str = "") -> ParameterReader:
     return ParameterReader(node, scenario_values, source)
 

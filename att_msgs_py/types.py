@@ -364,7 +364,7 @@ class AttitudeEstimate:
     attitude_covariance: np.ndarray = _empty(3, 3)   # rad², body-frame attitude error
     bias_covariance: np.ndarray = _empty(3, 3)       # (rad/s)²
     health: int = Health.INITIALISING
-    time_since_update: float = math.inf              # s since the last accepted attitude measurement
+    time_since_update: float = math.inf              # s since the last attitude fix (tracker, or vectors without one)
     rejected: int = 0                  # measurements gated out so far
     message: str = ""
     frame_id: str = ""

@@ -31,6 +31,7 @@ from att_sim.orbit import CircularOrbit
 from att_sim.sensors import Readings, SensorSuite, rng
 from att_sim.sensors.specs import SensorSpecs
 
+DEFAULT_STEP = 0.05             # s: the simulator's RK4 step unless its parameter says otherwise
 MAX_ORBIT_PHASE = 1e6          # rad: |orbit_phase| of a reset (beyond it the phase drowns in rounding)
 
 

@@ -46,7 +46,7 @@ from att_msgs_py import convert, qos, topics, validation
 from att_msgs_py.errors import ConfigError, ErrorCode, RequestError, clip
 from att_msgs_py.node_runner import parameter_reader, run_node, spin_until_shutdown
 from att_sim import scenario as scen
-from att_sim.simulation import Checks, Refusal, Simulation
+from att_sim.simulation import DEFAULT_STEP, Checks, Refusal, Simulation
 
 
 class SimulatorNode(Node):
@@ -95,7 +95,7 @@ class SimulatorNode(Node):
                 raise ConfigError(err.code, err.message + hint) from None
 
         inf = math.inf
-        self.step = param("step", 0.05, 0.0, 1.0, low_open=True)
+        self.step = param("step", DEFAULT_STEP, 0.0, 1.0, low_open=True)
         per_step = dict(hint=" (at most 1/step: one per integration step)", low_open=True)
         top = (1 + 1e-9) / self.step
         self.publish_period = 1.0 / param("publish_rate", min(10.0, 1.0 / self.step), 0.0, top, **per_step)

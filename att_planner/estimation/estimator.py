@@ -5,11 +5,18 @@ sun sensors, in the style of :class:`att_planner.control.controller.Controller`:
 translates messages; tests and the Monte Carlo drive the core directly.
 
 * **Time** is the gyro's: each gyro sample (the mean rate over the interval it ends) propagates the
-  filter to its stamp. Other measurements are applied **at the instant they were taken**: a star
-  tracker's message arrives its latency later, so the filter keeps the last ``history`` seconds of
-  gyro samples, states and measurements and, when a measurement older than its newest state
-  arrives, goes back to the state before it and reprocesses everything since (out-of-sequence
-  measurements by reprocessing; Bar-Shalom, Li & Kirubarajan 2001 §10.4).
+  filter to its stamp. Its stamps must move forward by at most ``max_gyro_gap`` (no single message
+  can stall or steer the filter's clock); after ``resync_timeout`` s of wall time without a gyro
+  sample the next one starts a new timeline (a restarted simulator) and the filter starts afresh.
+  A measurement stamped more than ``max_gyro_gap`` ahead of the gyro is refused. Other measurements
+  are applied **at the instant they were taken**: a star tracker's message arrives its latency
+  later, so the filter keeps the last ``history`` seconds of gyro samples, states and measurements
+  and, when a measurement older than its newest state arrives, goes back to the state before it and
+  reprocesses everything since (out-of-sequence measurements by reprocessing; Bar-Shalom, Li &
+  Kirubarajan 2001 §10.4).
+* **Propagation** on the gyro, its scale factors and misalignments *considered* from their
+  datasheet spread (:func:`.mekf.propagate`): the covariance grows with the rotation the gyro
+  measures, not only with time, so a filter blind through a slew stays honest.
 * **Updates**: every valid star tracker measurement (mounting ``q_SB``: the body attitude is
   ``q_S ⊗ q_SB*``, noise ``R_B = C R_S Cᵀ``); magnetometer and sun-sensor vector updates only while
   no tracker measurement was accepted for ``vector_fallback_after`` s. A magnetometer sample taken
@@ -23,8 +30,10 @@ translates messages; tests and the Monte Carlo drive the core directly.
 * **Health** (``AttitudeEstimate.HEALTH_*``): INITIALISING without an attitude; DIVERGED when the
   covariance stops being positive definite or ``lost_after`` tracker measurements in a row are
   rejected (the estimate is dropped and the filter reinitialises from the next measurements);
-  CONVERGED while an attitude measurement was accepted within ``propagate_timeout`` s and the
-  attitude's 3σ is below ``converged_attitude_sigma``; PROPAGATING otherwise (gyro only).
+  CONVERGED while an attitude fix — a star tracker measurement, or a vector measurement on a
+  spacecraft without trackers — was accepted within ``propagate_timeout`` s and the attitude's 3σ is
+  below ``converged_attitude_sigma``; PROPAGATING otherwise (on the gyro, with at most the coarse
+  aid of the vectors while the trackers are blind).
 
 Inputs are hostile until checked (:mod:`.inputs`): a refused measurement raises
 :class:`~att_msgs_py.errors.RequestError` (320 INVALID_MEASUREMENT, 321 STALE_MEASUREMENT) and
@@ -69,6 +78,8 @@ class EstimatorConfig:
     arw: float = 1e-6                      # rad/√s: σ_v of the gyro model
     rrw: float = 1e-9                      # rad/s/√s: σ_u of the bias random walk
     initial_bias_sigma: float = 1e-5       # rad/s 1σ of the bias prior
+    scale_factor_sigma: float = 0.0        # 1σ of the gyro's scale factors, considered (Schmidt)
+    misalignment_sigma: float = 0.0        # rad 1σ of its misalignments, considered
     gate_probability: float = 0.9999       # chi-square gate of every measurement
     converged_attitude_sigma: float = 1e-3  # rad: 3σ attitude at most this to be CONVERGED
     propagate_timeout: float = 2.0         # s without an accepted attitude measurement: PROPAGATING
@@ -79,7 +90,9 @@ class EstimatorConfig:
     sun_sigma: float = 0.02                # rad: coarse sun vector error per axis
     sun_threshold: float = 0.05            # a detector above this output is lit
     pair_window: float = 0.5               # s between the two vectors of a QUEST initialisation
-    max_gyro_gap: float = 1.0              # s: a longer gap between gyro samples is reported
+    max_gyro_gap: float = 1.0              # s: a gyro sample further ahead is refused (or a measurement that far
+                                           # ahead of the gyro), unless the gyro was silent for resync_timeout
+    resync_timeout: float = 1.0            # s of wall time without a gyro sample: the next starts a new timeline
 
 
 @dataclass
@@ -109,6 +122,8 @@ class Estimator:
         self.frame_id, self.body_frame_id = frame_id, body_frame_id
         self.checks = InputChecks(specs, frame_id, body_frame_id)
         self.trackers = {s.name: s for s in specs.star_trackers}
+        variances = np.array([config.scale_factor_sigma**2] * 3 + [config.misalignment_sigma**2] * 6)
+        self.consider = variances if np.any(variances > 0) else None
         self.gates = {k: float(chi2.ppf(config.gate_probability, k)) for k in (3,)}
         self.gyro: deque[tuple[float, np.ndarray, bool]] = deque()       # (t, ω_m, saturated)
         # filter states at the gyro instants, after the measurements up to each; the first is the anchor
@@ -124,6 +139,7 @@ class Estimator:
         self.rejected = 0
         self.rejected_in_a_row = 0
         self.next_publish = -math.inf
+        self.last_wall = -math.inf                # when the last gyro sample arrived (monotonic s)
         self.report = Report()
 
     @staticmethod
@@ -137,6 +153,7 @@ class Estimator:
         tracker_sigma = max((s.about_boresight for s in specs.star_trackers), default=1e-4)
         return EstimatorConfig(publish_period=publish_period, arw=max(g.arw, 1e-9), rrw=max(rrw, 1e-12),
                                initial_bias_sigma=max(3.0 * g.initial_bias, g.bias_instability, 1e-7),
+                               scale_factor_sigma=g.scale_factor, misalignment_sigma=g.misalignment,
                                converged_attitude_sigma=max(10.0 * tracker_sigma, 1e-4))
 
     @property
@@ -144,12 +161,22 @@ class Estimator:
         return self.snapshots[-1][1]
 
     # -- inputs -----------------------------------------------------------------------------------
-    def on_gyro(self, m: GyroMeasurement) -> AttitudeEstimate | None:
+    def on_gyro(self, m: GyroMeasurement, wall: float = 0.0) -> AttitudeEstimate | None:
         """Propagate to the sample's stamp (and apply what arrived meanwhile); the estimate when
-        one is due (every ``publish_period``)."""
-        omega, saturated = self.checks.gyro(m, self.gyro[-1][0] if self.gyro else None)
-        if self.gyro and m.t - self.gyro[-1][0] > self.config.max_gyro_gap:
-            self.report.notes.append(f"gyro gap of {m.t - self.gyro[-1][0]:.3g} s before t = {m.t:.3f} s")
+        one is due (every ``publish_period``). ``wall``: the monotonic time it arrived: a sample more
+        than ``max_gyro_gap`` after the last is refused unless none came for ``resync_timeout`` s, in
+        which case it starts a new timeline (a restarted simulator): the filter starts afresh."""
+        last = self.gyro[-1][0] if self.gyro else None
+        silent = wall - self.last_wall > self.config.resync_timeout
+        omega, saturated = self.checks.gyro(m, None if silent else last)
+        if last is not None and not 0.0 < m.t - last <= self.config.max_gyro_gap:
+            if not silent:
+                raise RequestError(ErrorCode.STALE_MEASUREMENT,
+                                   f"gyro stamp {m.t:.6g} s is {m.t - last:+.6g} s from the last ({last:.6g} s); "
+                                   f"it must move forward by at most max_gyro_gap = {self.config.max_gyro_gap:g} s")
+            self.report.notes.append(f"gyro timeline restarted: {last:.3f} s then {m.t:.3f} s; filter restarted")
+            self._restart()
+        self.last_wall = wall
         if saturated:
             self.report.notes.append(f"gyro saturated at t = {m.t:.3f} s: attitude covariance grown")
         self.gyro.append((m.t, omega, saturated))
@@ -159,6 +186,15 @@ class Estimator:
             return None
         self.next_publish = m.t + self.config.publish_period
         return self.estimate(m.t, omega)
+
+    def _restart(self) -> None:
+        """Forget every state, sample and measurement (a new timeline): initialising again."""
+        self.gyro.clear()
+        self.snapshots = deque([(-math.inf, None)])
+        self.records = []
+        self.diverged, self.lost_at = False, -math.inf
+        self.last_update = self.last_tracker = self.next_publish = -math.inf
+        self.rejected_in_a_row = 0
 
     def on_star_tracker(self, m: StarTrackerMeasurement) -> None:
         """Keep a valid tracker measurement for its instant (an invalid one says only that)."""
@@ -187,12 +223,17 @@ class Estimator:
         return out
 
     # -- output -----------------------------------------------------------------------------------
+    @property
+    def last_fix(self) -> float:
+        """Time of the last accepted attitude fix (tracker, or any attitude measurement without trackers)."""
+        return self.last_tracker if self.trackers else self.last_update
+
     def health(self, t: float) -> Health:
         x = self.state
         if x is None:
             return Health.DIVERGED if self.diverged else Health.INITIALISING
         sigma3 = 3.0 * math.sqrt(max(float(np.linalg.eigvalsh(x.P[:3, :3]).max()), 0.0))
-        recent = t - self.last_update <= self.config.propagate_timeout
+        recent = t - self.last_fix <= self.config.propagate_timeout
         return Health.CONVERGED if recent and sigma3 <= self.config.converged_attitude_sigma else Health.PROPAGATING
 
     def estimate(self, t: float, omega_measured: np.ndarray) -> AttitudeEstimate:
@@ -209,7 +250,7 @@ class Estimator:
                    Health.PROPAGATING: "propagating on the gyro", Health.CONVERGED: "converged"}[health]
         return AttitudeEstimate(t=t, q=q.copy(), omega=omega_measured - bias, gyro_bias=bias.copy(),
                                 attitude_covariance=P_att, bias_covariance=P_bias, health=int(health),
-                                time_since_update=t - self.last_update, rejected=self.rejected, message=message,
+                                time_since_update=t - self.last_fix, rejected=self.rejected, message=message,
                                 frame_id=self.frame_id, body_frame_id=self.body_frame_id)
 
     # -- the filter over its history ---------------------------------------------------------------
@@ -220,6 +261,11 @@ class Estimator:
             raise RequestError(ErrorCode.STALE_MEASUREMENT,
                                f"{record.kind} measurement of t = {record.t:.6g} s is older than the filter's history "
                                f"(from t = {oldest:.6g} s, {self.config.history:g} s)")
+        newest = self.gyro[-1][0] if self.gyro else -math.inf
+        if self.gyro and record.t > newest + self.config.max_gyro_gap:
+            raise RequestError(ErrorCode.STALE_MEASUREMENT,
+                               f"{record.kind} measurement of t = {record.t:.6g} s is ahead of the gyro (t = "
+                               f"{newest:.6g} s) by more than max_gyro_gap = {self.config.max_gyro_gap:g} s")
         self.records.append(record)
         self.records.sort(key=lambda r: r.t)          # stable: equal instants keep their arrival order
         if record.t <= self.snapshots[-1][0]:
@@ -251,7 +297,7 @@ class Estimator:
             return x
         dt = t - x.t
         extra = (self.specs.gyro.range * dt) ** 2 if saturated and self.specs.gyro else 0.0
-        x = mekf.propagate(x, omega, dt, self.config.arw, self.config.rrw, extra)
+        x = mekf.propagate(x, omega, dt, self.config.arw, self.config.rrw, self.consider, extra)
         if not mekf.healthy(x.P):
             return self._lose(t, f"covariance not positive definite at t = {t:.3f} s")
         return x

@@ -106,3 +106,22 @@ class DipoleLog:
     def clean(self, t: float) -> bool:
         before = [on for stamp, on in self.commands if stamp < t - 1e-9]
         return not (before and before[-1])
+
+
+class Sources:
+    """One publisher per input: a message from a second publisher of the same kind is refused while
+    the first was heard within ``timeout`` s of wall time (then the newcomer takes over: a restarted
+    sensor or simulator)."""
+
+    def __init__(self, timeout: float = 1.0):
+        self.timeout = timeout
+        self.known: dict[str, tuple[bytes, float]] = {}          # kind -> (publisher, wall time last heard)
+
+    def admit(self, kind: str, source: bytes | None, wall: float) -> None:
+        """RequestError (320) for a second publisher of ``kind`` while the first one is alive."""
+        if source is None:
+            return
+        known = self.known.get(kind)
+        if known is not None and known[0] != source and wall - known[1] <= self.timeout:
+            raise RequestError(BAD, f"{kind} from a second publisher while the first one is alive; ignored")
+        self.known[kind] = (source, wall)

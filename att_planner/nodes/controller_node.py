@@ -47,21 +47,11 @@ from att_msgs.msg import ActuatorCommand, AttitudeEstimate, ControllerStatus, Ma
 from att_msgs.srv import SetControllerMode
 from att_msgs_py import convert, qos, signing, topics
 from att_msgs_py.errors import ErrorCode, RequestError, clip
-from att_msgs_py.node_runner import parameter_reader, run_node
+from att_msgs_py.node_runner import parameter_reader, participant_of, publisher_of, run_node
 from att_msgs_py.types import ManeuverResult
 from att_planner.control.configure import controller_from_scenario, public_key
+from att_planner.estimation.inputs import Sources
 from att_sim import scenario as scen
-
-
-def publisher_of(info) -> bytes | None:
-    """The publisher GID of a received message (None when the middleware does not say)."""
-    gid = (info or {}).get("publisher_gid")
-    return bytes(gid["data"]) if isinstance(gid, dict) and gid.get("data") is not None else None
-
-
-def participant_of(gid: bytes | None) -> bytes | None:
-    """The DDS participant of a publisher GID (its 12-byte GUID prefix): one per node process."""
-    return None if gid is None else gid[:12]
 
 
 class ControllerNode(Node):
@@ -80,6 +70,7 @@ class ControllerNode(Node):
         self._sim_clock: tuple[bytes, float] | None = None   # (participant, s): its latest /clock
         self._goal = None                     # the goal handle of the running maneuver
         self._waiting = None                  # (estimate, source) that came before any wheel speed
+        self._sources = Sources(self._core.gate.config.resync_timeout)   # one publisher per measurement
         self._done: Future | None = None
 
         self._cmd_pub = self.create_publisher(ActuatorCommand, topics.COMMAND, qos.STREAM_QOS)
@@ -130,8 +121,9 @@ class ControllerNode(Node):
             return
         self._step(outcome, "attitude estimate")
 
-    def on_wheel_speeds(self, msg: JointState):
+    def on_wheel_speeds(self, msg: JointState, info: dict):
         try:
+            self._sources.admit("wheel speed measurement", publisher_of(info), time.monotonic())
             self._core.measured.on_wheel_speeds(convert.wheel_speeds_from_msg(msg))
         except RequestError as err:
             self._report_refusal("wheel speed measurement", err)
@@ -140,8 +132,9 @@ class ControllerNode(Node):
             (estimate, source), self._waiting = self._waiting, None
             self._step(self._core.accept_estimate(estimate, time.monotonic(), source), "attitude estimate")
 
-    def on_magnetometer(self, msg: MagneticField):
+    def on_magnetometer(self, msg: MagneticField, info: dict):
         try:
+            self._sources.admit("magnetometer measurement", publisher_of(info), time.monotonic())
             self._core.measured.on_magnetometer(convert.magnetometer_from_msg(msg))
         except RequestError as err:
             self._report_refusal("magnetometer measurement", err)

@@ -55,7 +55,7 @@ def rate_of(msg) -> float:
 
 def test_killed_controller_then_restarted_controller_damps_the_coasting_spacecraft(ros_suite):
     with ros_suite("swift_demo", nodes=("simulator", "controller"), name="restart_test",
-                   params={"simulator": {"real_time_factor": RTF}}) as s:
+                   params={"simulator": {"real_time_factor": RTF}, "controller": {"state_source": "truth"}}) as s:
         client, suite = s.client, s.suite
         assert client.execute_client.wait_for_server(timeout_sec=30)
         received, statuses = [], []
