@@ -247,7 +247,7 @@ class Simulation:
         w, ws = self.x[4:7], self.x[7:]
         active = not self.command_timeout
         u = self.wheel_cmd if active else np.zeros_like(self.wheel_cmd)
-        if self.wheel_drive is not None:
+        if self.wheel_drive is not None and active:      # the watchdog disables the drives: no torque at all
             u = self.wheel_drive.hold(u)
         u = dyn.effective_wheel_torque(self.sc, ws, u, w)
         m = np.clip(self.dipole_cmd, -self.sc.dipole_max, self.sc.dipole_max) if active else np.zeros(3)

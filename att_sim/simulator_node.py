@@ -26,8 +26,10 @@ is never integrated and is logged at most once a second with the running count. 
 command arrived for ``command_timeout`` s of sim time the actuator inputs are zeroed and the state
 says so. In lockstep, a state that no command answers within ``lockstep_timeout`` s of wall time
 ends the waiting: the simulator free-runs at its real-time factor with zero inputs
-(``command_timeout`` set) until a command answers again. A non-finite state stops the propagation
-(reported, the node stays up).
+(``command_timeout`` set) until a command answers again; with a real-time factor of 0 (as fast
+as possible) it free-runs at real time, so that consumers that fell behind (the estimator and the
+controller after a stall) catch up and answer again instead of drowning in states. A non-finite
+state stops the propagation (reported, the node stays up).
 """
 from __future__ import annotations
 
@@ -47,6 +49,8 @@ from att_msgs_py.errors import ConfigError, ErrorCode, RequestError, clip
 from att_msgs_py.node_runner import parameter_reader, run_node, spin_until_shutdown
 from att_sim import scenario as scen
 from att_sim.simulation import DEFAULT_STEP, Checks, Refusal, Simulation
+
+FREE_RUN_PACE = 1.0        # real-time factor of a free-running simulator whose real_time_factor is 0 (max)
 
 
 class SimulatorNode(Node):
@@ -216,16 +220,18 @@ class SimulatorNode(Node):
             k += 1
             self.publish(k, state_every, clock_every)
             executor.spin_once(timeout_sec=0.0)
-            if self.real_time_factor > 0:
+            pace = self.real_time_factor or (FREE_RUN_PACE if self.free_running else 0.0)
+            if pace > 0:
                 wall0, sim0 = self.pace
-                self.spin_until(lambda: False, wall0 + (self.sim.t - sim0) / self.real_time_factor)
+                self.spin_until(lambda: False, wall0 + (self.sim.t - sim0) / pace)
 
     def listeners(self) -> int:
-        """Nodes subscribed to anything this node publishes but /clock (the state or a sensor):
-        recorder and controller, and the estimator when the controller flies on its estimate."""
-        topics_out = [self.state_pub.topic_name] + [p.topic_name for p in self.sensor_pubs.values()]
-        return len({(i.node_namespace, i.node_name) for topic in topics_out
-                    for i in self.get_subscriptions_info_by_topic(topic)})
+        """Subscriptions to the state, plus the nodes that listen only to the sensors (the estimator,
+        and the controller flying on the estimate): recorder and controller, and the estimator."""
+        def nodes(topic):
+            return {(i.node_namespace, i.node_name) for i in self.get_subscriptions_info_by_topic(topic)}
+        sensor_nodes = set().union(*(nodes(p.topic_name) for p in self.sensor_pubs.values()))
+        return self.state_pub.get_subscription_count() + len(sensor_nodes - nodes(self.state_pub.topic_name))
 
     def spin_until(self, done, deadline: float) -> None:
         """Run callbacks until ``done()`` or the monotonic ``deadline``."""

@@ -82,7 +82,7 @@ def test_killed_controller_then_restarted_controller_damps_the_coasting_spacecra
         assert dead[-1].command_timeout, "inputs zeroed but not flagged"
         coasting = np.linalg.norm(dead[-1].omega)
         assert coasting > 0.005, f"the spacecraft should coast mid-slew (rate {coasting:.4f} rad/s)"
-        suite.start("controller", {"scenario": "swift_demo"})
+        suite.start("controller", {"scenario": "swift_demo", "state_source": "truth"})
         assert suite.wait_for_output("controller", "safe mode", 60), suite.log_text("controller")[-2000:]
         received.clear()
         damped = collect(client, 20.0, received)
