@@ -65,12 +65,12 @@ def clearances(problem: ManeuverProblem, t: np.ndarray, q: np.ndarray, true: boo
     m = zone_sky.margins(t, q, true=true)
     if not m.size:
         return m
-    R = rot.dcm(np.asarray(q, float))
-    s = zone_sky.sensor_axes / np.linalg.norm(zone_sky.sensor_axes, axis=1, keepdims=True)   # (Z, 3)
-    b = np.einsum("kij,zj->kzi", R, s)                                                         # (K, Z, 3)
+    R = rot.dcm(np.asarray(q, float).reshape(-1, 4))
     near = np.zeros(m.shape, bool)
-    for end in (b[0], b[-1]):
-        near |= np.arccos(np.clip(np.einsum("kzi,zi->kz", b, end), -1.0, 1.0)) <= END_RADIUS
+    for s in np.unique(zone_sky.sensor_axes, axis=0):              # once per sensor
+        b = R @ (s / np.linalg.norm(s))
+        close = np.maximum(b @ b[0], b @ b[-1]) >= math.cos(END_RADIUS)
+        near[:, np.all(zone_sky.sensor_axes == s, axis=1)] = close[:, None]
     out = m + BOUNDARY_TOLERANCE * near
     if problem.boundary_cone is not None:
         out[:, problem.boundary_cone] = ARC_TOLERANCE - np.abs(m[:, problem.boundary_cone])

@@ -29,18 +29,21 @@ def _cone_axis(azimuth: float) -> list:
     return [math.cos(azimuth), math.sin(azimuth), 0.0]
 
 
+BUDGET = 20.0       # s, the planner's default: a loaded machine must not turn a boundary test into a budget test
+
+
 def boundary_request(method: str, depth: float = 0.0, **fields) -> ManeuverRequest:
     """Sensor x from identity to 60° about z; the start on the boundary of cone 'a' and the goal on
     that of cone 'b', both ``depth`` rad inside (the path leaves the one and reaches the other from outside)."""
     cones = [(_cone_axis(-TH_A + depth), TH_A, "a"), (_cone_axis(SLEW + TH_B - depth), TH_B, "b")]
     base = dict(frame_id="eci", q_initial=rot.IDENTITY, q_final=rot.from_axis_angle([0, 0, 1], SLEW),
-                sensor_axis=np.array([1.0, 0, 0]), cones=cones, method=method, time_budget=4.0)
+                sensor_axis=np.array([1.0, 0, 0]), cones=cones, method=method, time_budget=BUDGET)
     return ManeuverRequest(**(base | fields))
 
 
 def validate(req: ManeuverRequest):
     return validate_maneuver(req, frame_id="eci", default_spacecraft="swift_demo", default_method=req.method,
-                             default_budget=4.0)
+                             default_budget=BUDGET)
 
 
 @pytest.mark.parametrize("method", [m.name for m in methods.REGISTRY])
@@ -97,7 +100,7 @@ def arc_request(method: str = "time_optimal", option: float = 0.0, **fields) -> 
     problem = boundary_problem("ba2")
     c = problem.cones[0]
     base = dict(frame_id="eci", q_initial=rot.IDENTITY, q_final=rot.IDENTITY, sensor_axis=problem.sensor_axis,
-                cones=[(c.direction, c.half_angle, "moon")], method=method, time_budget=8.0, semi_free=True,
+                cones=[(c.direction, c.half_angle, "moon")], method=method, time_budget=BUDGET, semi_free=True,
                 sensor_target=problem.sensor_target, option_names=["boundary_cone"], option_values=[option])
     return ManeuverRequest(**(base | fields))
 
