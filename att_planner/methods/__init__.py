@@ -109,6 +109,10 @@ def _slepian(variant: str, description: str) -> Method:
 SLEPIAN_OPTIONS = {"M": Option(2, 12, True, doc="basis size"), "N": Option(50, 2000, True, doc="samples"),
                    "W": Option(1e-4, 0.25, doc="half-bandwidth")}
 
+# The forced boundary arc (issue 19): the index of the request's cone whose boundary the sensor rides
+# (at most 16 cones per request); a bound of the maneuver, checked against the cones by the service.
+BOUNDARY_CONE = Option(0, 15, True, limit=True, doc="index of the cone whose boundary the sensor rides")
+
 # Best first: the default method is the first one.
 REGISTRY = [
     _slepian("slepian_minimum_time", "smooth torque on a Slepian basis, t_f minimised exactly (issue 3); zone-aware"),
@@ -118,11 +122,12 @@ REGISTRY = [
             "refine_rounds": Option(0, 6, True), "cone_margin_deg": Option(0.0, 5.0),
             "rate_max": Option(1e-6, 10.0, limit=True, doc="rad/s per body axis"),
             "wheel_momentum_max": Option(1e-6, 1e4, limit=True, doc="N m s per wheel"),
-            "smooth_warm_start": Option(0, 1, True)}, check=_time_optimal_check,
+            "smooth_warm_start": Option(0, 1, True), "global_stage": Option(0, 1, True, doc="particle swarm first"),
+            "boundary_cone": BOUNDARY_CONE}, check=_time_optimal_check,
            combined=("intervals", "max_intervals")),
     Method("constrained_axis", "att_planner.methods.constrained_axis", "plan_constrained_axis",
            "eigenaxis bang-bang, or lambda-rotations riding a zone boundary when the path is blocked",
-           {"ride_margin_deg": Option(0.0, 10.0)}, cheap=True),
+           {"ride_margin_deg": Option(0.0, 10.0), "boundary_cone": BOUNDARY_CONE}, cheap=True),
     Method("eigenaxis_smooth", "att_planner.methods.eigenaxis", "plan_eigenaxis_smooth",
            "eigenaxis slew with a quintic angle profile (C1 rate, zero torque at both ends); ignores zones",
            # at most 5000 knots: a plan verified, signed and sent within its budget (+ 1 s)

@@ -20,7 +20,9 @@ at the point's physical time ``t = t0 + T τ`` (``t0``: the sum of the earlier p
 an expression of the duration variables, so its derivatives with respect to them are exact (moving
 keep-out zones); :func:`path_violations` checks them
 between those points on the Hermite cubic interpolant and :func:`refine_mesh` bisects the intervals
-where they fail (or where a bang-bang control switches, :func:`switch_intervals`).
+where they fail (or where a bang-bang control switches, :func:`switch_intervals`). A phase may give
+the path constraints a last input ``w(τ)``, a known function of the mesh fraction (the ramp of a
+tightening near the ends, issue 19), evaluated at each point.
 
 Phases are joined, bounded and scored through :class:`Transcription` (``add_constraint``,
 ``minimize``), so the same machinery serves a single free-time slew and a multiphase schedule.
@@ -64,7 +66,7 @@ class Phase:
     def __init__(self, dynamics: ca.Function, mesh, *, control: str = "constant",
                  state_bounds=(-np.inf, np.inf), control_bounds=(-np.inf, np.inf),
                  duration_bounds=(0.0, np.inf), path: ca.Function | None = None,
-                 path_bounds=(-np.inf, 0.0), name: str = "phase"):
+                 path_bounds=(-np.inf, 0.0), path_weight=None, name: str = "phase"):
         if control not in CONTROL_KINDS:
             raise ValueError(f"control must be one of {CONTROL_KINDS}, not '{control}'")
         self.dynamics = dynamics
@@ -81,12 +83,21 @@ class Phase:
         self.path = path
         n_path = path.size1_out(0) if path is not None else 0
         self.path_bounds = tuple(np.broadcast_to(np.asarray(b, float), (n_path,)).copy() for b in path_bounds)
+        self.path_weight = path_weight
         self.name = name
 
     @property
     def timed(self) -> bool:
-        """Whether the path constraints depend on time (a third input ``t``)."""
-        return self.path is not None and self.path.n_in() == 3
+        """Whether the path constraints depend on time (a third input ``t``, before the weight)."""
+        return self.path is not None and self.path.n_in() == 3 + (self.path_weight is not None)
+
+    def path_args(self, x, u, t, tau) -> list:
+        """The path function's inputs at points of mesh fractions ``tau``: ``x, u``, then the time
+        ``t`` when :attr:`timed`, then ``path_weight(tau)`` when given."""
+        args = [x, u] + ([t] if self.timed else [])
+        if self.path_weight is not None:
+            args.append(ca.DM(np.asarray(self.path_weight(np.asarray(tau, float)), float)).T)
+        return args
 
     @property
     def intervals(self) -> int:
@@ -100,7 +111,7 @@ class Phase:
         """The same phase on another mesh."""
         return Phase(self.dynamics, mesh, control=self.control, state_bounds=self.state_bounds,
                      control_bounds=self.control_bounds, duration_bounds=self.duration_bounds,
-                     path=self.path, path_bounds=self.path_bounds, name=self.name)
+                     path=self.path, path_bounds=self.path_bounds, path_weight=self.path_weight, name=self.name)
 
 
 @dataclass
@@ -297,13 +308,9 @@ class Transcription:
             if ph.path is not None:
                 # Nodes see the control of the interval they start (the last node: the last one).
                 U_nodes = ca.horzcat(U, U[:, -1]) if ph.control == "constant" else U
-                if ph.timed:
-                    mids = (ph.mesh[:-1] + ph.mesh[1:]) / 2
-                    Gn = ph.path.map(N + 1)(X, U_nodes, t_start + T * ca.DM(ph.mesh).T)
-                    Gm = ph.path.map(N)(Xm, U_mid, t_start + T * ca.DM(mids).T)
-                else:
-                    Gn = ph.path.map(N + 1)(X, U_nodes)
-                    Gm = ph.path.map(N)(Xm, U_mid)
+                mids = (ph.mesh[:-1] + ph.mesh[1:]) / 2
+                Gn = ph.path.map(N + 1)(*ph.path_args(X, U_nodes, t_start + T * ca.DM(ph.mesh).T, ph.mesh))
+                Gm = ph.path.map(N)(*ph.path_args(Xm, U_mid, t_start + T * ca.DM(mids).T, mids))
                 g += [ca.vec(Gn), ca.vec(Gm)]
                 lbg += [np.tile(ph.path_bounds[0], 2 * N + 1)]
                 ubg += [np.tile(ph.path_bounds[1], 2 * N + 1)]
@@ -420,8 +427,7 @@ def path_violations(solution: PhaseSolution, samples_per_interval: int = 8, tol:
     tau = (ph.mesh[:-1, None] + np.diff(ph.mesh)[:, None] * s[None, :]).ravel()
     x = solution.state_at(tau)
     u = solution.control_at(tau)
-    args = (x.T, u.T, (t_start + solution.duration * tau)[None, :]) if ph.timed else (x.T, u.T)
-    gval = np.array(ph.path(*args)).T
+    gval = np.array(ph.path(*ph.path_args(x.T, u.T, (t_start + solution.duration * tau)[None, :], tau))).T
     lb, ub = ph.path_bounds
     excess = np.maximum(lb - gval, gval - ub).max(axis=1).reshape(ph.intervals, samples_per_interval).max(axis=1)
     return np.flatnonzero(excess > tol), float(excess.max())

@@ -8,6 +8,7 @@ from dataclasses import dataclass
 import casadi as ca
 import numpy as np
 
+from att_planner.cones import ARC_TOLERANCE, BOUNDARY_TOLERANCE, boundary_end_zones, end_ramp
 from att_planner.methods import symbolic
 from att_planner.methods.axis_rotations import time_unit
 from att_planner.methods.time_optimal import collocation as col
@@ -17,6 +18,9 @@ from att_sim import rotations as rot
 # Relative tightening of the rate and wheel-momentum bounds at the collocation points, so that
 # the truth trajectory between them stays within the bound itself.
 BOUND_MARGIN = 2e-3
+# The band (rad) outside its boundary in which the collocation points of a forced boundary arc lie:
+# half the verification's ARC_TOLERANCE, the other half for the truth between the points.
+ARC_BAND = 0.5 * ARC_TOLERANCE
 
 
 @dataclass
@@ -44,37 +48,54 @@ def rigid_body_dynamics(Jn: np.ndarray) -> ca.Function:
 
 
 def path_function(problem: ManeuverProblem, s: Scaling, cone_margin: float):
-    """Path constraints ``g ≤ 0`` (zones, wheel momentum) or None when there are none.
+    """Path constraints ``g ≤ 0`` (zones, wheel momentum) and the weight function of the phase
+    (:class:`~.collocation.Phase` ``path_weight``), or None when there are none.
 
     Every zone of ``problem.zone_sky()`` (:mod:`att_planner.zones`: the cones, then the zones, each
-    with its own sensor axis ``s_z``, ``b_z = R(q) s_z``) is tightened by ``cone_margin``: keep-out
-    ``a_z · b_z ≤ cos(θ_z + δ)``, keep-in ``a_z · b_z ≥ cos(θ_z − δ)``. When a zone moves, the
-    function is ``(x, u, t) -> g`` with ``t`` the normalised time from the start: ``a_z(t τ_u)``
+    with its own sensor axis ``s_z``, ``b_z = R(q) s_z``) is tightened by ``δ = cone_margin``: keep-out
+    ``a_z · b_z ≤ cos(θ_z + δ)``, keep-in ``a_z · b_z ≥ cos(θ_z − δ)``. A zone with an end on its
+    boundary (:func:`att_planner.cones.boundary_end_zones`) is tightened by ``−tol + (δ + tol) w(τ)``
+    instead, ``w`` the end ramp (:func:`att_planner.cones.end_ramp`, the path's last input). The
+    forced boundary arc's cone is the band ``0 ≤ margin ≤ ε`` (:data:`ARC_BAND`): ``a · b ≤ cos θ`` and
+    ``a · b ≥ cos(θ + ε)`` (an equality there would repeat the fixed start and the final pointing,
+    which IPOPT cannot solve: rank-deficient constraints). When a zone moves,
+    the function is ``(x, u, t[, w]) -> g`` with ``t`` the normalised time from the start: ``a_z(t τ_u)``
     and ``θ_z(t τ_u)`` are the ZoneSky's Chebyshev series of that CasADi expression, so the
-    collocation couples them exactly to ``t_f``. Without motion it is ``(x, u) -> g`` with the
+    collocation couples them exactly to ``t_f``. Without motion it is ``(x, u[, w]) -> g`` with the
     zones constant (no time dependence is built)."""
-    x, u, t = ca.SX.sym("x", 7), ca.SX.sym("u", 3), ca.SX.sym("t")
+    x, u, t, w = ca.SX.sym("x", 7), ca.SX.sym("u", 3), ca.SX.sym("t"), ca.SX.sym("w")
     zones = problem.zone_sky()
-    g = zones.casadi_constraints(t * s.tu if zones.moving else 0.0, symbolic.dcm(x[:4]), cone_margin)
+    ramped = boundary_end_zones(problem, cone_margin)
+    margins = [-BOUNDARY_TOLERANCE + (cone_margin + BOUNDARY_TOLERANCE) * w if near else cone_margin
+               for near in ramped]
+    R = symbolic.dcm(x[:4])
+    if problem.boundary_cone is not None:
+        margins[problem.boundary_cone] = 0.0
+    g = zones.casadi_constraints(t * s.tu if zones.moving else 0.0, R, margins)
+    if problem.boundary_cone is not None:           # the band 0 ≤ margin ≤ ARC_BAND of the arc's cone
+        cone = problem.cones[problem.boundary_cone]
+        r = np.asarray(problem.sensor_axis, float) / np.linalg.norm(problem.sensor_axis)
+        g.append(ca.cos(cone.half_angle + ARC_BAND) - ca.dot(ca.DM(cone.direction), ca.mtimes(R, ca.DM(r))))
     if math.isfinite(problem.wheel_momentum_max) and problem.spacecraft.n_wheels:   # no wheels: no momentum
         h_per_rate = s.J0 / s.tu / (problem.wheel_momentum_max * (1 - BOUND_MARGIN))
         h_w = ca.mtimes(ca.DM(problem.spacecraft.wheel_axes_pinv @ s.Jn * h_per_rate), x[4:])
         g += [h_w - 1, -h_w - 1]
     if not g:
         return None
-    if zones.moving:
-        return ca.Function("path", [x, u, t], [ca.vertcat(*g)])
-    return ca.Function("path", [x, u], [ca.vertcat(*g)])
+    inputs = [x, u] + ([t] if zones.moving else []) + ([w] if ramped.any() else [])
+    weight = end_ramp if ramped.any() else None
+    return ca.Function("path", inputs, [ca.vertcat(*g)]), weight
 
 
 def transcription(problem: ManeuverProblem, s: Scaling, mesh: np.ndarray, control: str, cone_margin: float,
                   tf_bounds: tuple[float, float]) -> col.Transcription:
     """The minimum-time NLP on ``mesh`` (``control``: 'constant' for ZOH torques, 'linear')."""
     rate_bound = problem.rate_max * s.tu * (1 - BOUND_MARGIN)
+    path = path_function(problem, s, cone_margin)
+    path_args = {} if path is None else dict(path=path[0], path_weight=path[1])
     phase = col.Phase(rigid_body_dynamics(s.Jn), mesh, control=control,
                       state_bounds=([-1.1] * 4 + [-rate_bound] * 3, [1.1] * 4 + [rate_bound] * 3),
-                      control_bounds=(-1.0, 1.0), duration_bounds=tf_bounds,
-                      path=path_function(problem, s, cone_margin), path_bounds=(-np.inf, 0.0), name="slew")
+                      control_bounds=(-1.0, 1.0), duration_bounds=tf_bounds, name="slew", **path_args)
     tr = col.Transcription([phase])
     v = tr.variables(0)
     q0 = rot.normalize(np.asarray(problem.q_initial, float))

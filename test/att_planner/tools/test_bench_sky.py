@@ -2,8 +2,7 @@
 and the study's plumbing on a cheap method.
 
 The check uses nothing of the suite: it integrates each plan's ZOH body torque from rest at
-``q_initial`` with its own RK4 of the rigid body (J ω̇ = T − ω × Jω, q̇ = ½ q ⊗ [ω, 0]; Euler's
-equations, Wie, *Space Vehicle Dynamics and Control*, 2008, §5.2), and computes the zones' true
+``q_initial`` with its own RK4 of the rigid body (:mod:`helpers.own_rk4`), and computes the zones' true
 directions with skyfield directly: the spacecraft from the JSON's TLE (``EarthSatellite``: SGP4,
 TEME → GCRS), the Sun and Moon from the ``de421.bsp`` of skyfield-data (geometric, light time
 ignored: ≤ 0.006° here), the Earth limb as asin(R_E/|r|) + margin about −r̂ (R_E = 6378.137 km,
@@ -24,53 +23,13 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from helpers.own_rk4 import dcm, integrate
+
 BENCHMARKS = Path(os.environ.get("ATT_SKY_BENCHMARKS", Path(__file__).resolve().parents[3] / "benchmarks"))
 CASES = ("leo_observatory", "moon_parallax")
 TOL = math.radians(0.01)
 R_EARTH = 6378.137e3          # m, WGS-84 equatorial radius
 SUBSTEPS = 4                  # RK4 steps per ZOH interval (500 intervals: 2000 steps); the sky at the knots
-
-
-def _dcm(q):
-    """Body-to-inertial rotation matrices of unit quaternions q (K, 4) = (x, y, z, w)."""
-    x, y, z, w = np.moveaxis(np.asarray(q, float), -1, 0)
-    return np.stack([np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)], -1),
-                     np.stack([2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)], -1),
-                     np.stack([2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)], -1)], -2)
-
-
-def _integrate(J, t, torque, q0):
-    """Own RK4 of the rigid body from rest, ZOH torque switched exactly at the knots, on Python
-    floats; returns the states (x, y, z, w, ωx, ωy, ωz) at the knots ``t``."""
-    J = [list(map(float, row)) for row in J]
-    Ji = np.linalg.inv(np.array(J)).tolist()
-
-    def f(x, u):
-        qx, qy, qz, qw, wx, wy, wz = x
-        h = [J[i][0] * wx + J[i][1] * wy + J[i][2] * wz for i in range(3)]
-        r = (u[0] - (wy * h[2] - wz * h[1]), u[1] - (wz * h[0] - wx * h[2]), u[2] - (wx * h[1] - wy * h[0]))
-        return (0.5 * (qw * wx + qy * wz - qz * wy), 0.5 * (qw * wy + qz * wx - qx * wz),
-                0.5 * (qw * wz + qx * wy - qy * wx), -0.5 * (qx * wx + qy * wy + qz * wz),
-                *(Ji[i][0] * r[0] + Ji[i][1] * r[1] + Ji[i][2] * r[2] for i in range(3)))
-
-    def axpy(x, a, k):
-        return [xi + a * ki for xi, ki in zip(x, k)]
-
-    x = [float(v) for v in q0] + [0.0, 0.0, 0.0]
-    knots = [list(x)]
-    for k in range(len(t) - 1):
-        h = (t[k + 1] - t[k]) / SUBSTEPS
-        u = [float(v) for v in torque[k]]
-        for _ in range(SUBSTEPS):
-            k1 = f(x, u)
-            k2 = f(axpy(x, 0.5 * h, k1), u)
-            k3 = f(axpy(x, 0.5 * h, k2), u)
-            k4 = f(axpy(x, h, k3), u)
-            x = [xi + h / 6.0 * (a + 2 * b + 2 * c + d) for xi, a, b, c, d in zip(x, k1, k2, k3, k4)]
-            n = sum(v * v for v in x[:4]) ** 0.5
-            x[:4] = [v / n for v in x[:4]]
-        knots.append(list(x))
-    return np.array(knots)
 
 
 @lru_cache(maxsize=1)
@@ -104,7 +63,7 @@ def _margins(payload, t, q):
     axes, limb = _sky(payload, t)
     out = {}
     for z in payload["zones"]:
-        b = _dcm(q) @ np.asarray(z["sensor_axis"], float)
+        b = dcm(q) @ np.asarray(z["sensor_axis"], float)
         if z["body"] == "inertial":
             a, half = np.broadcast_to(np.asarray(z["direction"], float), b.shape), z["half_angle"]
         elif z["body"] == "earth_limb":
@@ -124,7 +83,7 @@ def checked(request):
     for kind, plan in payload["plans"].items():
         assert plan["t"], f"{request.param}: no {kind} plan in the JSON ({plan['message']})"
         t = np.asarray(plan["t"], float)
-        states = _integrate(payload["J"], t, plan["torque"], payload["q_initial"])
+        states = integrate(payload["J"], t, plan["torque"], payload["q_initial"], SUBSTEPS)
         out[kind] = (t, states, _margins(payload, t, states[:, :4]))
     return payload, out
 
