@@ -82,11 +82,13 @@ class Sky:
 
     @classmethod
     def of(cls, environment) -> Sky:
-        """The sky of an :class:`att_sim.world.Environment` (the onboard models of the scenario)."""
+        """The sky of an :class:`att_sim.world.Environment` (the onboard models of the scenario);
+        the orbit's states are remembered for the last few times asked (a reference differentiates
+        its law at three times, each asking for the orbit more than once)."""
         field_model = environment.field
         itrs = field_model.itrs_rotation if field_model.epoch is not None else earth_turning
         sun = None if environment.sky is None else environment.sky.sun_direction
-        return cls(environment.orbit.state, sun, itrs)
+        return cls(_remembered(environment.orbit.state), sun, itrs)
 
 
 @dataclass
@@ -129,9 +131,23 @@ class FixedAttitude:
         return self.q
 
 
+def _remembered(state: Callable, size: int = 8) -> Callable:
+    """``state`` remembering its last ``size`` results by time."""
+    memory: dict[float, tuple] = {}
+
+    def remembered(t):
+        got = memory.get(t)
+        if got is None:
+            if len(memory) >= size:
+                memory.pop(next(iter(memory)))
+            got = memory[t] = tuple(np.asarray(x, float) for x in state(t))
+        return got
+    return remembered
+
+
 def _unit(v) -> np.ndarray:
     v = np.asarray(v, float)
-    return v / np.linalg.norm(v)
+    return v / math.sqrt(float(v @ v))
 
 
 def directions(sky: Sky) -> dict[str, Callable]:

@@ -18,6 +18,7 @@ STUDIES = {
     "soak": "att_planner.tools.bench.soak",
     "sky": "att_planner.tools.bench.sky",
     "estimation": "att_planner.tools.bench.estimation",
+    "momentum": "att_planner.tools.bench.momentum",
 }
 
 

@@ -53,11 +53,13 @@ def pointing_of(log: dict[str, TopicLog], sc: Spacecraft) -> PointingRun | None:
                        sc.wheel_inertia * sc.wheel_speed_max)
 
 
-def pointing_summary(run: PointingRun) -> dict:
-    """Pointing error while pointing (deg), peak wheel momentum against the limit, dipole duty, and
-    the sim time a wheel first reached its limit (None: never)."""
+def pointing_summary(run: PointingRun, settle: float = 0.0) -> dict:
+    """Pointing error while pointing (deg; from ``settle`` s after the first pointing instant on),
+    peak wheel momentum against the limit, dipole duty, and the sim time a wheel first reached its
+    limit (None: never)."""
     pointing = run.mode == ControlMode.POINTING
-    error = run.error[pointing & np.isfinite(run.error)]
+    start = run.t[pointing][0] if np.any(pointing) else math.inf
+    error = run.error[pointing & np.isfinite(run.error) & (run.t >= start + settle)]
     ratio = np.max(np.abs(run.wheel_momentum), axis=1) / run.limit
     saturated = np.flatnonzero(ratio >= SATURATED)
     return {"pointing_seconds": float(np.sum(pointing) * np.median(np.diff(run.t))) if len(run.t) > 1 else 0.0,
