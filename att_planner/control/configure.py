@@ -57,6 +57,7 @@ def controller_config(param, scenario: Scenario) -> ControllerConfig:
         dumping_gain=param("dumping_gain", d.dumping_gain, 0.0, 10.0, low_open=True),
         null_space_gain=param("null_space_gain", d.null_space_gain, 0.0, 10.0),
         null_space_speed=param("null_space_speed", d.null_space_speed, -1e4, 1e4),
+        handover_blend=param("handover_blend", d.handover_blend, 0.0, 3600.0),
         safe_sun_axis=tuple(_unit_param(param, "safe_sun_axis", list(d.safe_sun_axis))))
 
 

@@ -58,6 +58,7 @@ from att_planner.control.plan_checks import PlanContext, check_start
 from att_planner.control.pointing import pointing_torque
 from att_planner.control.state_gate import GateConfig, StateGate
 from att_planner.guidance import reference as guidance_reference
+from att_planner.guidance.laws import BlendedLaw
 from att_planner.guidance.laws import Sky as GuidanceSky
 from att_planner.guidance.modes import law_of
 from att_planner.zones import ZoneSky, zones_from_cones
@@ -87,6 +88,7 @@ class ControllerConfig:
     null_space_gain: float = 0.05      # 1/s: wheel speeds' null-space component to its bias (more than 3 wheels)
     null_space_speed: float = 0.0      # rad/s: that bias, along each null-space direction
     safe_sun_axis: tuple = (0.0, 0.0, 1.0)   # body axis the safe mode points at the Sun once the rates are damped
+    handover_blend: float = 60.0       # s: a plan ending at rest enters a moving pointing reference this smoothly
 
     @property
     def feedback_every(self) -> int:
@@ -130,6 +132,7 @@ ZONE_FIT_WINDOW = 1.0                          # s: a ZoneSky needs a window; th
 
 
 USABLE = (Health.CONVERGED, Health.PROPAGATING)   # estimates the attitude laws may fly on
+HANDOVER_RATE_MATCH = 1e-4     # rad/s: a plan ending this close to the law's rate hands over directly
 
 
 class Controller:
@@ -458,7 +461,7 @@ class Controller:
         out.status.reference_q, out.status.reference_rate = ref.q, ref.omega
         out.status.attitude_error = float(rot.angle_between(s.q, ref.q))
         if m.after is not None and elapsed >= plan.duration:
-            law = m.after
+            law = self._handover(m.after, plan, s.t)
             out.result = self._end(True, ErrorCode.OK, f"maneuver complete; pointing {law.name}")
             self.mode, self.pointing, self.hold_q = ControlMode.POINTING, law, None
             out.status.message = f"maneuver complete; pointing {law.name}"
@@ -466,6 +469,14 @@ class Controller:
         if elapsed >= plan.duration + self.config.settle_time:
             out.result = self._end(True, ErrorCode.OK, "maneuver complete")
             out.status.message = "maneuver complete; holding the final attitude"
+
+    def _handover(self, law, plan: Plan, t: float):
+        """The pointing law a plan hands over to at its end: the law itself when the plan ends at
+        the law's rate (a slew planned to end on the moving target), else the law entered through
+        :class:`~att_planner.guidance.laws.BlendedLaw` over ``handover_blend`` s (a plan ending at rest)."""
+        law_rate = guidance_reference(law.attitude, t).omega
+        matched = float(np.linalg.norm(plan.omega[-1] - law_rate)) <= HANDOVER_RATE_MATCH
+        return law if matched or self.config.handover_blend <= 0 else BlendedLaw(law, t, self.config.handover_blend)
 
     def _end(self, success: bool, code: ErrorCode, message: str) -> ManeuverResult:
         """Close the running maneuver; its figures are those of the latest state (there is one:

@@ -178,3 +178,31 @@ def ground_line_of_sight(sky: Sky, latitude: float, longitude: float, altitude: 
     def sight(t):
         return _unit(np.asarray(sky.itrs(t)).T @ r_itrs - sky.state(t)[0])
     return sight
+
+
+@dataclass
+class BlendedLaw:
+    """``law`` entered from rest at ``start`` (s) through a time warp (the smooth planner's plans end
+    at rest: issue 15): over ``duration`` s the reference is ``law(start + w(τ))`` with
+    ``w(τ) = τ − τ(1 − τ/T)²``, so it starts on the law's attitude at ``start`` with zero rate, runs
+    up to 4/3 of the law's rate, and joins the law exactly (``w(T) = T``, ``w'(T) = 1``) at
+    ``start + T``; the law itself after."""
+
+    law: object
+    start: float
+    duration: float
+
+    @property
+    def name(self) -> str:
+        return self.law.name
+
+    @property
+    def degenerate(self) -> bool:
+        return self.law.degenerate
+
+    def attitude(self, t: float) -> np.ndarray:
+        tau = t - self.start
+        if tau >= self.duration:
+            return self.law.attitude(t)
+        tau = max(tau, 0.0)
+        return self.law.attitude(self.start + tau - tau * (1.0 - tau / self.duration) ** 2)

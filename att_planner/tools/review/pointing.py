@@ -10,6 +10,7 @@ the pointing error, each wheel's momentum against its limit, the dipoles.
 """
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from pathlib import Path
 
