@@ -323,8 +323,8 @@ def simulate_profile(
     else:
         X = [x.copy()]
         for u_i, du_i, h_i in zip(u, slope, h):
-            x = renormalised(rk4(lambda tau, s, u_i=u_i, du_i=du_i: derivative(sc, s, Inputs(**{kind: u_i + du_i * tau})),
-                                 0.0, x, h_i))
+            x = renormalised(rk4(lambda tau, s, u_i=u_i, du_i=du_i:
+                                 derivative(sc, s, Inputs(**{kind: u_i + du_i * tau})), 0.0, x, h_i))
             X.append(x.copy())
         X = np.array(X)
     return Trajectory(np.concatenate([grid[:1], t0 + h]), X[:, :4], X[:, 4:7], X[:, 7:])

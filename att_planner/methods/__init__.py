@@ -123,6 +123,9 @@ REGISTRY = [
     Method("constrained_axis", "att_planner.methods.constrained_axis", "plan_constrained_axis",
            "eigenaxis bang-bang, or lambda-rotations riding a zone boundary when the path is blocked",
            {"ride_margin_deg": Option(0.0, 10.0)}, cheap=True),
+    Method("graph_smooth", "att_planner.methods.graph_smooth", "plan_graph_smooth",
+           "the constructive first plan: the quickest rest-to-rest legs round the zones on a graph of sensor "
+           "directions (exact checks on every leg), C1 torque zero at every leg's ends; zone-aware", cheap=True),
     Method("eigenaxis_smooth", "att_planner.methods.eigenaxis", "plan_eigenaxis_smooth",
            "eigenaxis slew with a quintic angle profile (C1 rate, zero torque at both ends); ignores zones",
            # at most 5000 knots: a plan verified, signed and sent within its budget (+ 1 s)
