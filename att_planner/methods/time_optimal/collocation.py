@@ -251,7 +251,7 @@ class Transcription:
     ``'SX'`` inlines them (faster evaluations, but a build grows to ~1 s at 60 intervals).
     """
 
-    def __init__(self, phases: list[Phase], symbolic: str = "MX"):
+    def __init__(self, phases: list[Phase], symbolic: str = "MX", duration_copies: bool = False):
         if symbolic not in ("SX", "MX"):
             raise ValueError("symbolic must be 'SX' or 'MX'")
         sym = ca.SX.sym if symbolic == "SX" else ca.MX.sym
@@ -269,18 +269,26 @@ class Transcription:
             Xm = sym(f"Xm{p}", nx, N)
             U = sym(f"U{p}", nu, ph.n_control_samples)
             self._vars.append(PhaseVariables(T, X, Xm, U))
-            sizes = {"T": 1, "X": nx * (N + 1), "Xm": nx * N, "U": nu * ph.n_control_samples}
+            copies = N - 1 if duration_copies else 0
+            Tc = sym(f"Tc{p}", copies)
+            sizes = {"T": 1, "X": nx * (N + 1), "Xm": nx * N, "U": nu * ph.n_control_samples, "Tc": copies}
             sl = {}
             for key, n in sizes.items():
                 sl[key] = slice(offset, offset + n)
                 offset += n
             self._slices.append(sl)
-            w += [T, ca.vec(X), ca.vec(Xm), ca.vec(U)]
+            w += [T, ca.vec(X), ca.vec(Xm), ca.vec(U), Tc]
             for bounds, side in ((lbw, 0), (ubw, 1)):
                 bounds += [[ph.duration_bounds[side]], np.tile(ph.state_bounds[side], 2 * N + 1),
-                           np.tile(ph.control_bounds[side], ph.n_control_samples)]
+                           np.tile(ph.control_bounds[side], ph.n_control_samples), [ph.duration_bounds[side]] * copies]
+            # the duration of each interval: T, or its own copy of T chained to the next (a banded KKT system)
+            Tk = ca.vertcat(T, Tc).T if copies else T                   # (1, N) or scalar
+            if copies:
+                g.append((Tk[1:] - Tk[:-1]).T)
+                lbg.append(np.zeros(copies))
+                ubg.append(np.zeros(copies))
             # Defects, vectorised over intervals with map().
-            h = T * ca.DM(np.diff(ph.mesh)).T                       # (1, N)
+            h = Tk * ca.DM(np.diff(ph.mesh)).T                      # (1, N)
             U_left = U if ph.control == "constant" else U[:, :-1]
             U_right = U if ph.control == "constant" else U[:, 1:]
             U_mid = U if ph.control == "constant" else (U_left + U_right) / 2
@@ -299,8 +307,9 @@ class Transcription:
                 U_nodes = ca.horzcat(U, U[:, -1]) if ph.control == "constant" else U
                 if ph.timed:
                     mids = (ph.mesh[:-1] + ph.mesh[1:]) / 2
-                    Gn = ph.path.map(N + 1)(X, U_nodes, t_start + T * ca.DM(ph.mesh).T)
-                    Gm = ph.path.map(N)(Xm, U_mid, t_start + T * ca.DM(mids).T)
+                    T_nodes = ca.horzcat(Tk, Tk[-1]) if copies else T
+                    Gn = ph.path.map(N + 1)(X, U_nodes, t_start + T_nodes * ca.DM(ph.mesh).T)
+                    Gm = ph.path.map(N)(Xm, U_mid, t_start + Tk * ca.DM(mids).T)
                 else:
                     Gn = ph.path.map(N + 1)(X, U_nodes)
                     Gm = ph.path.map(N)(Xm, U_mid)
@@ -367,8 +376,10 @@ class Transcription:
         """Flat initial-guess vector from one guess per phase (clipped into the variable bounds)."""
         parts = []
         for ph, gs in zip(self.phases, guesses):
+            copies = self._slices[len(parts) // 5]["Tc"]
             parts += [[gs.duration], np.asarray(gs.x, float).ravel(), np.asarray(gs.xm, float).ravel(),
-                      np.asarray(gs.u, float).reshape(ph.n_control_samples, ph.n_control).ravel()]
+                      np.asarray(gs.u, float).reshape(ph.n_control_samples, ph.n_control).ravel(),
+                      np.full(copies.stop - copies.start, gs.duration)]
         w0 = np.concatenate([np.ravel(p) for p in parts])
         return np.clip(w0, self.lbw, self.ubw)
 

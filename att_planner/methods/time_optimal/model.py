@@ -75,7 +75,7 @@ def transcription(problem: ManeuverProblem, s: Scaling, mesh: np.ndarray, contro
                       state_bounds=([-1.1] * 4 + [-rate_bound] * 3, [1.1] * 4 + [rate_bound] * 3),
                       control_bounds=(-1.0, 1.0), duration_bounds=tf_bounds,
                       path=path_function(problem, s, cone_margin), path_bounds=(-np.inf, 0.0), name="slew")
-    tr = col.Transcription([phase])
+    tr = col.Transcription([phase], duration_copies=True)
     v = tr.variables(0)
     q0 = rot.normalize(np.asarray(problem.q_initial, float))
     tr.bound_state(0, 0, np.concatenate([q0, np.zeros(3)]))
