@@ -23,7 +23,7 @@ from att_planner.service.planning import run_method
 
 _CONTEXT = multiprocessing.get_context("forkserver")
 _CONTEXT.set_forkserver_preload(["att_planner.service.planning", "numpy", "scipy.optimize", "att_sim.ephemeris",
-                                 "skyfield.api", "sgp4.api"])
+                                 "skyfield.api", "sgp4.api", "casadi", "att_planner.methods.time_optimal.smooth"])
 _SLOTS = threading.BoundedSemaphore(max(1, os.cpu_count() or 1))
 KILL_GRACE = 0.5            # s after the wait before the child is terminated
 

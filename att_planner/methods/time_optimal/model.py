@@ -43,8 +43,9 @@ def rigid_body_dynamics(Jn: np.ndarray) -> ca.Function:
     return ca.Function("rigid_body", [x, u], [ca.vertcat(q_dot, w_dot)])
 
 
-def path_function(problem: ManeuverProblem, s: Scaling, cone_margin: float):
-    """Path constraints ``g ≤ 0`` (zones, wheel momentum) or None when there are none.
+def path_function(problem: ManeuverProblem, s: Scaling, cone_margin: float, n_state: int = 7):
+    """Path constraints ``g ≤ 0`` (zones, wheel momentum) or None when there are none; ``x`` has
+    ``n_state`` rows, the attitude and rate first.
 
     Every zone of ``problem.zone_sky()`` (:mod:`att_planner.zones`: the cones, then the zones, each
     with its own sensor axis ``s_z``, ``b_z = R(q) s_z``) is tightened by ``cone_margin``: keep-out
@@ -53,12 +54,12 @@ def path_function(problem: ManeuverProblem, s: Scaling, cone_margin: float):
     and ``θ_z(t τ_u)`` are the ZoneSky's Chebyshev series of that CasADi expression, so the
     collocation couples them exactly to ``t_f``. Without motion it is ``(x, u) -> g`` with the
     zones constant (no time dependence is built)."""
-    x, u, t = ca.SX.sym("x", 7), ca.SX.sym("u", 3), ca.SX.sym("t")
+    x, u, t = ca.SX.sym("x", n_state), ca.SX.sym("u", 3), ca.SX.sym("t")
     zones = problem.zone_sky()
     g = zones.casadi_constraints(t * s.tu if zones.moving else 0.0, symbolic.dcm(x[:4]), cone_margin)
     if math.isfinite(problem.wheel_momentum_max) and problem.spacecraft.n_wheels:   # no wheels: no momentum
         h_per_rate = s.J0 / s.tu / (problem.wheel_momentum_max * (1 - BOUND_MARGIN))
-        h_w = ca.mtimes(ca.DM(problem.spacecraft.wheel_axes_pinv @ s.Jn * h_per_rate), x[4:])
+        h_w = ca.mtimes(ca.DM(problem.spacecraft.wheel_axes_pinv @ s.Jn * h_per_rate), x[4:7])
         g += [h_w - 1, -h_w - 1]
     if not g:
         return None
