@@ -27,6 +27,7 @@ Phases are joined, bounded and scored through :class:`Transcription` (``add_cons
 """
 from __future__ import annotations
 
+import copy
 import time
 from dataclasses import dataclass, field
 
@@ -64,7 +65,7 @@ class Phase:
     def __init__(self, dynamics: ca.Function, mesh, *, control: str = "constant",
                  state_bounds=(-np.inf, np.inf), control_bounds=(-np.inf, np.inf),
                  duration_bounds=(0.0, np.inf), path: ca.Function | None = None,
-                 path_bounds=(-np.inf, 0.0), name: str = "phase"):
+                 path_bounds=(-np.inf, 0.0), name: str = "phase", path_parameters=()):
         if control not in CONTROL_KINDS:
             raise ValueError(f"control must be one of {CONTROL_KINDS}, not '{control}'")
         self.dynamics = dynamics
@@ -82,11 +83,18 @@ class Phase:
         n_path = path.size1_out(0) if path is not None else 0
         self.path_bounds = tuple(np.broadcast_to(np.asarray(b, float), (n_path,)).copy() for b in path_bounds)
         self.name = name
+        self.path_parameters = np.asarray(path_parameters, float).ravel()
 
     @property
     def timed(self) -> bool:
-        """Whether the path constraints depend on time (a third input ``t``)."""
-        return self.path is not None and self.path.n_in() == 3
+        """Whether the path constraints depend on time (an input ``t`` after ``x, u``)."""
+        return self.path is not None and self.path.n_in() - bool(self.path_parameters.size) == 3
+
+    def path_values(self, x, u, t=None):
+        """The path constraints at numeric (or symbolic) points: ``path(x, u[, t][, p])`` with the
+        phase's ``path_parameters`` as ``p``."""
+        args = (x, u) + ((t,) if self.timed else ()) + ((self.path_parameters,) if self.path_parameters.size else ())
+        return self.path(*args)
 
     @property
     def intervals(self) -> int:
@@ -100,7 +108,8 @@ class Phase:
         """The same phase on another mesh."""
         return Phase(self.dynamics, mesh, control=self.control, state_bounds=self.state_bounds,
                      control_bounds=self.control_bounds, duration_bounds=self.duration_bounds,
-                     path=self.path, path_bounds=self.path_bounds, name=self.name)
+                     path=self.path, path_bounds=self.path_bounds, name=self.name,
+                     path_parameters=self.path_parameters)
 
 
 @dataclass
@@ -249,12 +258,22 @@ class Transcription:
     :meth:`solve` from as many initial guesses as wanted (the IPOPT instance is reused).
     ``symbolic='MX'`` keeps the mapped dynamics as function calls (builds in tens of ms);
     ``'SX'`` inlines them (faster evaluations, but a build grows to ~1 s at 60 intervals).
+
+    ``parametric``: every phase's mesh fractions and ``path_parameters``, and ``extra_parameters``
+    more values (:attr:`extra`, for the caller's own constraints), are parameters of the NLP rather
+    than constants, taken from :attr:`phases` and :attr:`extra_values` at each :meth:`solve`: one
+    built NLP serves every mesh of its interval counts and every parameter value (:meth:`copy`).
     """
 
-    def __init__(self, phases: list[Phase], symbolic: str = "MX", duration_copies: bool = False):
+    def __init__(self, phases: list[Phase], symbolic: str = "MX", duration_copies: bool = False,
+                 parametric: bool = False, extra_parameters: int = 0):
         if symbolic not in ("SX", "MX"):
             raise ValueError("symbolic must be 'SX' or 'MX'")
         sym = ca.SX.sym if symbolic == "SX" else ca.MX.sym
+        self.parametric = parametric
+        self.extra = sym("extra", extra_parameters)
+        self.extra_values = np.zeros(extra_parameters)
+        params = []
         self.phases = list(phases)
         self._vars: list[PhaseVariables] = []
         self._slices: list[dict] = []
@@ -287,8 +306,12 @@ class Transcription:
                 g.append((Tk[1:] - Tk[:-1]).T)
                 lbg.append(np.zeros(copies))
                 ubg.append(np.zeros(copies))
+            mesh = sym(f"mesh{p}", 1, N + 1) if parametric else ca.DM(ph.mesh).T       # (1, N + 1)
+            path_p = sym(f"path{p}", ph.path_parameters.size) if parametric else ca.DM(ph.path_parameters)
+            if parametric:
+                params += [mesh.T, path_p]
             # Defects, vectorised over intervals with map().
-            h = Tk * ca.DM(np.diff(ph.mesh)).T                      # (1, N)
+            h = Tk * (mesh[1:] - mesh[:-1])                          # (1, N)
             U_left = U if ph.control == "constant" else U[:, :-1]
             U_right = U if ph.control == "constant" else U[:, 1:]
             U_mid = U if ph.control == "constant" else (U_left + U_right) / 2
@@ -305,18 +328,19 @@ class Transcription:
             if ph.path is not None:
                 # Nodes see the control of the interval they start (the last node: the last one).
                 U_nodes = ca.horzcat(U, U[:, -1]) if ph.control == "constant" else U
+                times = ()
                 if ph.timed:
-                    mids = (ph.mesh[:-1] + ph.mesh[1:]) / 2
                     T_nodes = ca.horzcat(Tk, Tk[-1]) if copies else T
-                    Gn = ph.path.map(N + 1)(X, U_nodes, t_start + T_nodes * ca.DM(ph.mesh).T)
-                    Gm = ph.path.map(N)(Xm, U_mid, t_start + Tk * ca.DM(mids).T)
-                else:
-                    Gn = ph.path.map(N + 1)(X, U_nodes)
-                    Gm = ph.path.map(N)(Xm, U_mid)
+                    times = (t_start + T_nodes * mesh, t_start + Tk * (mesh[:-1] + mesh[1:]) / 2)
+                shared = [2 + ph.timed] if ph.path_parameters.size else []       # p: one value for every point
+                extra = (path_p,) if shared else ()
+                Gn = ph.path.map(f"path_nodes{p}", "serial", N + 1, shared, [])(X, U_nodes, *times[:1], *extra)
+                Gm = ph.path.map(f"path_mids{p}", "serial", N, shared, [])(Xm, U_mid, *times[1:], *extra)
                 g += [ca.vec(Gn), ca.vec(Gm)]
                 lbg += [np.tile(ph.path_bounds[0], 2 * N + 1)]
                 ubg += [np.tile(ph.path_bounds[1], 2 * N + 1)]
             t_start = t_start + T
+        self._p = ca.vertcat(*params, self.extra)
         self._w = ca.vertcat(*w)
         self.lbw = np.concatenate([np.ravel(v) for v in lbw]).astype(float)
         self.ubw = np.concatenate([np.ravel(v) for v in ubw]).astype(float)
@@ -368,8 +392,32 @@ class Transcription:
                 "iteration_callback_ignore_errors": False}
         opts.update({f"ipopt.{k}": v for k, v in (ipopt_options or {}).items()})
         opts.update(nlpsol_options or {})
-        self._solver = ca.nlpsol("hermite_simpson", "ipopt", {"x": self._w, "f": self._objective, "g": g}, opts)
+        self._solver = ca.nlpsol("hermite_simpson", "ipopt", {"x": self._w, "p": self._p, "f": self._objective,
+                                                              "g": g}, opts)
         return self
+
+    def copy(self, mesh=None, path_parameters=None, extra_values=None) -> Transcription:
+        """A built parametric NLP for another problem of its shape: the same solver, its own bounds,
+        phase 0 on ``mesh`` (as many intervals) with ``path_parameters``, and ``extra_values``."""
+        if not self.parametric or self._solver is None:
+            raise ValueError("only a built parametric Transcription is copied")
+        out = copy.copy(self)
+        out.lbw, out.ubw, out.lbg, out.ubg = self.lbw.copy(), self.ubw.copy(), self.lbg.copy(), self.ubg.copy()
+        phase = self.phases[0]
+        mesh = phase.mesh if mesh is None else np.asarray(mesh, float)
+        if len(mesh) != len(phase.mesh):
+            raise ValueError(f"a mesh of {len(mesh) - 1} intervals for an NLP of {phase.intervals}")
+        out.phases = [phase.with_mesh(mesh)] + self.phases[1:]
+        if path_parameters is not None:
+            out.phases[0].path_parameters = np.asarray(path_parameters, float).ravel()
+        out.extra_values = self.extra_values if extra_values is None else np.asarray(extra_values, float).ravel()
+        return out
+
+    def set_duration_bounds(self, phase: int, lower: float, upper: float) -> None:
+        """Bounds of a phase's duration (and of its copies)."""
+        for key in ("T", "Tc"):
+            sl = self._slices[phase][key]
+            self.lbw[sl], self.ubw[sl] = lower, upper
 
     # -- solving ----------------------------------------------------------------------------
     def pack(self, guesses: list[PhaseGuess]) -> np.ndarray:
@@ -389,6 +437,11 @@ class Transcription:
             self.build()
         self._callback.deadline = deadline
         args = dict(x0=w0, lbx=self.lbw, ubx=self.ubw, lbg=self.lbg, ubg=self.ubg)
+        if self.parametric:
+            args["p"] = np.concatenate([np.concatenate([ph.mesh, ph.path_parameters]) for ph in self.phases]
+                                       + [self.extra_values])
+        elif self.extra_values.size:
+            raise ValueError("extra parameters need a parametric Transcription")
         if lam_g0 is not None:
             args["lam_g0"] = lam_g0
         if lam_x0 is not None:
@@ -431,8 +484,7 @@ def path_violations(solution: PhaseSolution, samples_per_interval: int = 8, tol:
     tau = (ph.mesh[:-1, None] + np.diff(ph.mesh)[:, None] * s[None, :]).ravel()
     x = solution.state_at(tau)
     u = solution.control_at(tau)
-    args = (x.T, u.T, (t_start + solution.duration * tau)[None, :]) if ph.timed else (x.T, u.T)
-    gval = np.array(ph.path(*args)).T
+    gval = np.array(ph.path_values(x.T, u.T, (t_start + solution.duration * tau)[None, :])).T
     lb, ub = ph.path_bounds
     excess = np.maximum(lb - gval, gval - ub).max(axis=1).reshape(ph.intervals, samples_per_interval).max(axis=1)
     return np.flatnonzero(excess > tol), float(excess.max())

@@ -33,64 +33,148 @@ def scaling(problem: ManeuverProblem) -> Scaling:
     return Scaling(time_unit(problem), J0, J / J0, float(problem.spacecraft.body_torque_max))
 
 
-def rigid_body_dynamics(Jn: np.ndarray) -> ca.Function:
-    """Normalised ``ẋ = f(x, u)`` with ``x = [q (xyzw), ω̃]`` (:mod:`.planner` docstring)."""
-    x, u = ca.SX.sym("x", 7), ca.SX.sym("u", 3)
-    q, w = x[:4], x[4:]
+def rigid_body_dynamics(Jn: np.ndarray, smooth: bool = False) -> ca.Function:
+    """Normalised ``ẋ = f(x, u)`` with ``x = [q (xyzw), ω̃]`` and the torque ``u`` (:mod:`.planner`
+    docstring); ``smooth``: ``x = [q, ω̃, u, u̇]`` and the control the torque's second derivative
+    (:mod:`.smooth`)."""
+    x, c = ca.SX.sym("x", 13 if smooth else 7), ca.SX.sym("c", 3)
+    q, w = x[:4], x[4:7]
+    u = x[7:10] if smooth else c
     Jn_dm = ca.DM(Jn)
     q_dot = 0.5 * symbolic.quat_mul(q, ca.vertcat(w, 0)) + 0.5 * (1 - ca.dot(q, q)) * q
     w_dot = ca.solve(Jn_dm, u - ca.cross(w, ca.mtimes(Jn_dm, w)))
-    return ca.Function("rigid_body", [x, u], [ca.vertcat(q_dot, w_dot)])
+    rates = ca.vertcat(q_dot, w_dot, x[10:], c) if smooth else ca.vertcat(q_dot, w_dot)
+    return ca.Function("smooth_rigid_body" if smooth else "rigid_body", [x, c], [rates])
 
 
-def path_function(problem: ManeuverProblem, s: Scaling, cone_margin: float, n_state: int = 7):
-    """Path constraints ``g ≤ 0`` (zones, wheel momentum) or None when there are none; ``x`` has
-    ``n_state`` rows, the attitude and rate first.
+ZONE_PARAMETERS = 8      # per fixed zone: σ (+1 keep-out, -1 keep-in), sensor (3), axis (3), cos(θ + σ δ)
+
+
+def path_function(problem: ManeuverProblem, s: Scaling, n_state: int = 7, cone_margin: float = 0.0):
+    """``(path, values)``: the path constraints ``g ≤ 0`` (zones, wheel momentum) as a CasADi
+    Function ``(x, u[, t][, p]) -> g`` (``x`` has ``n_state`` rows, the attitude and rate first), and
+    the values of ``p``, the data of the problem it depends on; ``(None, [])`` when there are none.
 
     Every zone of ``problem.zone_sky()`` (:mod:`att_planner.zones`: the cones, then the zones, each
-    with its own sensor axis ``s_z``, ``b_z = R(q) s_z``) is tightened by ``cone_margin``: keep-out
-    ``a_z · b_z ≤ cos(θ_z + δ)``, keep-in ``a_z · b_z ≥ cos(θ_z − δ)``. When a zone moves, the
-    function is ``(x, u, t) -> g`` with ``t`` the normalised time from the start: ``a_z(t τ_u)``
-    and ``θ_z(t τ_u)`` are the ZoneSky's Chebyshev series of that CasADi expression, so the
-    collocation couples them exactly to ``t_f``. Without motion it is ``(x, u) -> g`` with the
-    zones constant (no time dependence is built)."""
-    x, u, t = ca.SX.sym("x", n_state), ca.SX.sym("u", 3), ca.SX.sym("t")
+    with its own sensor axis ``s_z``, ``b_z = R(q) s_z``) is tightened by ``δ`` (:func:`zone_values`):
+    keep-out ``a_z · b_z ≤ cos(θ_z + δ)``, keep-in ``a_z · b_z ≥ cos(θ_z − δ)``. A fixed zone is
+    ``σ_z (a_z · b_z − cos(θ_z + σ_z δ)) ≤ 0`` with its data in ``p`` (:data:`ZONE_PARAMETERS`), so
+    the function depends on the number of fixed zones only. When a zone moves, ``t`` is the
+    normalised time from the start: ``a_z(t τ_u)`` and ``θ_z(t τ_u)`` are the ZoneSky's Chebyshev
+    series of that CasADi expression, so the collocation couples them exactly to ``t_f`` (tightened by
+    ``cone_margin``). The wheels' momentum bound takes its scale from ``p`` too (its last value)."""
     zones = problem.zone_sky()
-    g = zones.casadi_constraints(t * s.tu if zones.moving else 0.0, symbolic.dcm(x[:4]), cone_margin)
-    if math.isfinite(problem.wheel_momentum_max) and problem.spacecraft.n_wheels:   # no wheels: no momentum
-        h_per_rate = s.J0 / s.tu / (problem.wheel_momentum_max * (1 - BOUND_MARGIN))
-        h_w = ca.mtimes(ca.DM(problem.spacecraft.wheel_axes_pinv @ s.Jn * h_per_rate), x[4:7])
+    fixed = [z.body == "inertial" for z in zones.zones]
+    momentum = math.isfinite(problem.wheel_momentum_max) and problem.spacecraft.n_wheels > 0   # no wheels: none
+    x, u, t = ca.SX.sym("x", n_state), ca.SX.sym("u", 3), ca.SX.sym("t")
+    p = ca.SX.sym("p", ZONE_PARAMETERS * sum(fixed) + momentum)
+    R = symbolic.dcm(x[:4])
+    g = []
+    for k in range(sum(fixed)):
+        sign, sensor, axis, cos = (p[ZONE_PARAMETERS * k], p[ZONE_PARAMETERS * k + 1:ZONE_PARAMETERS * k + 4],
+                                   p[ZONE_PARAMETERS * k + 4:ZONE_PARAMETERS * k + 7], p[ZONE_PARAMETERS * k + 7])
+        g.append(sign * (ca.dot(axis, ca.mtimes(R, sensor)) - cos))
+    if zones.moving:
+        g += [c for c, f in zip(zones.casadi_constraints(t * s.tu, R, cone_margin), fixed) if not f]
+    if momentum:
+        h_w = ca.mtimes(ca.DM(problem.spacecraft.wheel_axes_pinv @ s.Jn), x[4:7]) * p[-1]
         g += [h_w - 1, -h_w - 1]
     if not g:
-        return None
-    if zones.moving:
-        return ca.Function("path", [x, u, t], [ca.vertcat(*g)])
-    return ca.Function("path", [x, u], [ca.vertcat(*g)])
+        return None, np.zeros(0)
+    inputs = [x, u] + ([t] if zones.moving else []) + ([p] if p.numel() else [])
+    return ca.Function("path", inputs, [ca.vertcat(*g)]), np.zeros(p.numel())
+
+
+def path_values(problem: ManeuverProblem, s: Scaling, cone_margin: float) -> np.ndarray:
+    """The values of :func:`path_function`'s ``p``: each fixed zone's σ, unit sensor axis, axis and
+    ``cos(θ + σ δ)`` (``δ = cone_margin``), then the momentum bound's scale."""
+    zones = problem.zone_sky()
+    axes, half = zones.at(0.0)
+    values = []
+    for z, zone in enumerate(zones.zones):
+        if zone.body == "inertial":
+            sign = -1.0 if zone.keep_in else 1.0
+            values += [[sign], zones.sensor_axes[z] / np.linalg.norm(zones.sensor_axes[z]), axes[z],
+                       [math.cos(half[z] + sign * cone_margin)]]
+    if math.isfinite(problem.wheel_momentum_max) and problem.spacecraft.n_wheels:
+        values.append([s.J0 / s.tu / (problem.wheel_momentum_max * (1 - BOUND_MARGIN))])
+    return np.concatenate(values) if values else np.zeros(0)
+
+
+def goal_values(problem: ManeuverProblem) -> np.ndarray:
+    """The final-attitude constraint's data: ``q_final``, or the semi-free goal's unit
+    ``sensor_target``, the two rows of a basis normal to it and the unit sensor axis."""
+    if problem.sensor_target is None:
+        return rot.normalize(np.asarray(problem.q_final, float))
+    target = np.asarray(problem.sensor_target, float) / np.linalg.norm(problem.sensor_target)
+    r = np.asarray(problem.sensor_axis, float) / np.linalg.norm(problem.sensor_axis)
+    return np.concatenate([target, *rot.orthonormal_basis(target), r])
+
+
+CACHE_SIZE = 64          # built NLPs kept (the oldest goes first)
+_NLPS: dict = {}
 
 
 def transcription(problem: ManeuverProblem, s: Scaling, mesh: np.ndarray, control: str, cone_margin: float,
-                  tf_bounds: tuple[float, float]) -> col.Transcription:
-    """The minimum-time NLP on ``mesh`` (``control``: 'constant' for ZOH torques, 'linear')."""
-    rate_bound = problem.rate_max * s.tu * (1 - BOUND_MARGIN)
-    phase = col.Phase(rigid_body_dynamics(s.Jn), mesh, control=control,
-                      state_bounds=([-1.1] * 4 + [-rate_bound] * 3, [1.1] * 4 + [rate_bound] * 3),
-                      control_bounds=(-1.0, 1.0), duration_bounds=tf_bounds,
-                      path=path_function(problem, s, cone_margin), path_bounds=(-np.inf, 0.0), name="slew")
-    tr = col.Transcription([phase], duration_copies=True)
-    v = tr.variables(0)
+                  tf_bounds: tuple[float, float], *, torque_accel: float | None = None, tol: float = 1e-7,
+                  max_iter: int = 400, expand: bool = True) -> col.Transcription:
+    """The minimum-time NLP on ``mesh``, built (``control``: 'constant' for ZOH torques, 'linear';
+    ``torque_accel``: the smooth NLP of :mod:`.smooth`, its bound on the torque's second derivative).
+
+    The NLP is built once per shape and kept (:data:`CACHE_SIZE`): the spacecraft's inertia, the
+    number of intervals, the fixed zones' count, moving zones (by their ZoneSky), the bounds on the
+    rate and momentum, the kind of goal and the settings. The mesh, the zones' data, the goal and the
+    momentum scale are its parameters, the start and the duration's bounds its variables' bounds
+    (set here), so a second problem of that shape only copies it (:meth:`.collocation.Transcription.copy`).
+    Moving zones (timed path constraints) keep one t_f; fixed ones chain copies of it per interval
+    (a banded KKT system, far fewer iterations; with moving zones the copies took more)."""
+    smooth = torque_accel is not None
+    zones = problem.zone_sky()
+    path, _ = path_function(problem, s, 13 if smooth else 7, cone_margin)
+    momentum = math.isfinite(problem.wheel_momentum_max)
+    key = (smooth, torque_accel, s.Jn.tobytes(), len(mesh) - 1, control, sum(z.body == "inertial" for z in zones.zones),
+           (id(zones), cone_margin) if zones.moving else None,
+           problem.spacecraft.wheel_axes.tobytes() if momentum else None, problem.rate_max,
+           problem.sensor_target is None, tol, max_iter, expand)
+    if key not in _NLPS:
+        while len(_NLPS) >= CACHE_SIZE:
+            _NLPS.pop(next(iter(_NLPS)))
+        _NLPS[key] = (_build(problem, s, mesh, control, path, torque_accel, not zones.moving)
+                      .build(tol=tol, max_iter=max_iter, nlpsol_options={"expand": expand}), zones)  # zones: kept alive
+    tr = _NLPS[key][0].copy(mesh, path_values(problem, s, cone_margin), goal_values(problem))
     q0 = rot.normalize(np.asarray(problem.q_initial, float))
-    tr.bound_state(0, 0, np.concatenate([q0, np.zeros(3)]))
-    tr.bound_state(0, -1, [-1.1] * 4 + [0.0] * 3, [1.1] * 4 + [0.0] * 3)
+    tr.bound_state(0, 0, np.concatenate([q0, np.zeros(9 if smooth else 3)]))
+    tr.set_duration_bounds(0, *tf_bounds)
+    return tr
+
+
+def _build(problem: ManeuverProblem, s: Scaling, mesh: np.ndarray, control: str, path, torque_accel,
+           duration_copies: bool) -> col.Transcription:
+    """The parametric NLP of :func:`transcription` (not built)."""
+    smooth = torque_accel is not None
+    rate = problem.rate_max * s.tu * (1 - BOUND_MARGIN)
+    rest = 9 if smooth else 3                       # ω̃ (and u, u̇) zero at the end
+    if smooth:
+        bounds = ([-1.1] * 4 + [-rate] * 3 + [-1.0] * 3 + [-np.inf] * 3,
+                  [1.1] * 4 + [rate] * 3 + [1.0] * 3 + [np.inf] * 3)
+        controls = (-torque_accel, torque_accel)
+    else:
+        bounds, controls = ([-1.1] * 4 + [-rate] * 3, [1.1] * 4 + [rate] * 3), (-1.0, 1.0)
+    phase = col.Phase(rigid_body_dynamics(s.Jn, smooth), mesh, control=control, state_bounds=bounds,
+                      control_bounds=controls, path=path, path_bounds=(-np.inf, 0.0), name="slew",
+                      path_parameters=path_values(problem, s, 0.0))
+    goal = goal_values(problem)
+    tr = col.Transcription([phase], duration_copies=duration_copies, parametric=True, extra_parameters=len(goal))
+    v = tr.variables(0)
+    tr.bound_state(0, -1, [-1.1] * 4 + [0.0] * rest, [1.1] * 4 + [0.0] * rest)
     q_end = v.x_end[:4]
     if problem.sensor_target is None:
-        qf = rot.normalize(np.asarray(problem.q_final, float))
-        tr.add_constraint(symbolic.error_vector(q_end, ca.DM(qf)), 0.0, 0.0)
+        tr.add_constraint(symbolic.error_vector(q_end, tr.extra), 0.0, 0.0)
     else:
-        target = np.asarray(problem.sensor_target, float) / np.linalg.norm(problem.sensor_target)
-        r = np.asarray(problem.sensor_axis, float) / np.linalg.norm(problem.sensor_axis)
-        b = ca.mtimes(symbolic.dcm(q_end), ca.DM(r))
-        tr.add_constraint(ca.mtimes(ca.DM(np.stack(rot.orthonormal_basis(target))), b), 0.0, 0.0)
-        tr.add_constraint(ca.dot(ca.DM(target), b), 0.0, np.inf)
+        target, e1, e2, r = (tr.extra[3 * k:3 * k + 3] for k in range(4))
+        b = ca.mtimes(symbolic.dcm(q_end), r)
+        tr.add_constraint(ca.vertcat(ca.dot(e1, b), ca.dot(e2, b)), 0.0, 0.0)
+        tr.add_constraint(ca.dot(target, b), 0.0, np.inf)
     tr.minimize(v.duration)
     return tr
 

@@ -15,7 +15,7 @@ torque's chain of integrators exactly, so the plan samples each interval's quadr
 (:data:`SAMPLES_PER_INTERVAL` knots, linear interpolation between them). The NLP starts from the
 given plans (``warm_starts``: the planner service passes its first plan) or, without them, from
 :func:`att_planner.methods.graph_smooth.plan_graph_smooth`'s plan; the durations of the intervals are
-chained copies of t_f (:class:`.collocation.Transcription`, a banded KKT system). The solution is
+built once per shape (:func:`.model.transcription`, which holds the NLP of both). The solution is
 integrated through the truth dynamics (:mod:`att_planner.verification`); where the dense grid
 enters a zone the mesh is bisected and the NLP solved again (:data:`REFINE_ROUNDS` times at most).
 """
@@ -23,16 +23,14 @@ from __future__ import annotations
 
 import time
 
-import casadi as ca
 import numpy as np
 
 from att_msgs_py.types import Interpolation, Plan, Status
 from att_planner.cones import blocked_endpoint
-from att_planner.methods import symbolic
 from att_planner.methods.axis_rotations import no_torque_limit
 from att_planner.methods.graph_smooth import plan_graph_smooth
 from att_planner.methods.time_optimal import collocation as col
-from att_planner.methods.time_optimal.model import Scaling, path_function, scaling
+from att_planner.methods.time_optimal.model import Scaling, rigid_body_dynamics, scaling, transcription
 from att_planner.methods.time_optimal.planner import CONVERGED_VIOLATION, _truth_violation_intervals
 from att_planner.problem import ManeuverProblem
 from att_planner.verification import integrate, measure, rejection
@@ -43,45 +41,6 @@ DEFAULT_INTERVALS = 40
 DEFAULT_TORQUE_ACCEL = 100.0      # T̄ per τ_u²: a full swing of the torque takes 0.28 τ_u
 SAMPLES_PER_INTERVAL = 4          # plan knots per mesh interval
 REFINE_ROUNDS = 3                 # mesh bisections where the truth enters a zone
-BOUND_MARGIN = 2e-3               # relative tightening of the rate bound (as the time-optimal NLP's)
-
-
-def smooth_dynamics(Jn: np.ndarray) -> ca.Function:
-    """``ẋ = f(x, a)`` of the state ``[q, ω̃, u, u̇]`` (module docstring)."""
-    x, a = ca.SX.sym("x", 13), ca.SX.sym("a", 3)
-    q, w, u, u_dot = x[:4], x[4:7], x[7:10], x[10:]
-    J = ca.DM(Jn)
-    q_dot = 0.5 * symbolic.quat_mul(q, ca.vertcat(w, 0)) + 0.5 * (1 - ca.dot(q, q)) * q
-    return ca.Function("smooth_rigid_body", [x, a],
-                       [ca.vertcat(q_dot, ca.solve(J, u - ca.cross(w, ca.mtimes(J, w))), u_dot, a)])
-
-
-def transcription(problem: ManeuverProblem, s: Scaling, mesh: np.ndarray, cone_margin: float,
-                  tf_bounds: tuple[float, float], torque_accel: float) -> col.Transcription:
-    """The minimum-time NLP of the module docstring on ``mesh``."""
-    rate = problem.rate_max * s.tu * (1 - BOUND_MARGIN)
-    phase = col.Phase(smooth_dynamics(s.Jn), mesh, control="constant",
-                      state_bounds=([-1.1] * 4 + [-rate] * 3 + [-1.0] * 3 + [-np.inf] * 3,
-                                    [1.1] * 4 + [rate] * 3 + [1.0] * 3 + [np.inf] * 3),
-                      control_bounds=(-torque_accel, torque_accel), duration_bounds=tf_bounds,
-                      path=path_function(problem, s, cone_margin, n_state=13), path_bounds=(-np.inf, 0.0),
-                      name="smooth_slew")
-    tr = col.Transcription([phase], duration_copies=True)
-    v = tr.variables(0)
-    tr.bound_state(0, 0, np.concatenate([rot.normalize(np.asarray(problem.q_initial, float)), np.zeros(9)]))
-    tr.bound_state(0, -1, [-1.1] * 4 + [0.0] * 9, [1.1] * 4 + [0.0] * 9)
-    q_end = v.x_end[:4]
-    if problem.sensor_target is None:
-        tr.add_constraint(symbolic.error_vector(q_end, ca.DM(rot.normalize(np.asarray(problem.q_final, float)))),
-                          0.0, 0.0)
-    else:
-        target = np.asarray(problem.sensor_target, float) / np.linalg.norm(problem.sensor_target)
-        r = np.asarray(problem.sensor_axis, float) / np.linalg.norm(problem.sensor_axis)
-        b = ca.mtimes(symbolic.dcm(q_end), ca.DM(r))
-        tr.add_constraint(ca.mtimes(ca.DM(np.stack(rot.orthonormal_basis(target))), b), 0.0, 0.0)
-        tr.add_constraint(ca.dot(ca.DM(target), b), 0.0, np.inf)
-    tr.minimize(v.duration)
-    return tr
 
 
 def guess(plan: Plan, s: Scaling, phase: col.Phase) -> col.PhaseGuess:
@@ -141,11 +100,11 @@ def plan_smooth_collocation(problem: ManeuverProblem, *, intervals: int = DEFAUL
     tf_max = 10.0 * tf_seed if not problem.zone_sky().moving else min(10.0 * tf_seed, problem.zone_sky().window / s.tu)
     bounds = (min(1e-2 * tf_seed, 0.5 * tf_max), tf_max)
     mesh, stats, best = col.uniform_mesh(intervals), {"meshes": []}, None
-    initial = [guess(p, s, col.Phase(smooth_dynamics(s.Jn), mesh)) for p in seeds]
+    initial = [guess(p, s, col.Phase(rigid_body_dynamics(s.Jn, smooth=True), mesh)) for p in seeds]
     nit = nfev = 0
     for _ in range(REFINE_ROUNDS + 1):
-        tr = transcription(problem, s, mesh, np.deg2rad(cone_margin_deg), bounds, torque_accel).build(
-            tol=tol, max_iter=max_iter, nlpsol_options={"expand": True})
+        tr = transcription(problem, s, mesh, "constant", np.deg2rad(cone_margin_deg), bounds,
+                           torque_accel=torque_accel, tol=tol, max_iter=max_iter)
         res = None
         for g in initial:
             res = tr.solve(tr.pack([g]), deadline=problem.deadline)
@@ -165,7 +124,7 @@ def plan_smooth_collocation(problem: ManeuverProblem, *, intervals: int = DEFAUL
         if rejection(plan.verification) is None or not len(bad) or len(mesh) - 1 >= 4 * intervals:
             break
         mesh = col.refine_mesh(mesh, bad, 4 * intervals)
-        initial = [sol.resample(col.Phase(smooth_dynamics(s.Jn), mesh))]
+        initial = [sol.resample(tr.phases[0].with_mesh(mesh))]
     elapsed = time.monotonic() - start
     if best is None:
         statuses = sorted({m["status"] for m in stats["meshes"]})

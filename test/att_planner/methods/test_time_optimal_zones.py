@@ -12,7 +12,7 @@ import pytest
 
 from att_msgs_py.types import Status, Zone
 from att_planner.methods.time_optimal import plan_time_optimal
-from att_planner.methods.time_optimal.model import path_function, scaling
+from att_planner.methods.time_optimal.model import ZONE_PARAMETERS, path_function, path_values, scaling
 from att_planner.problem import ManeuverProblem
 from att_planner.verification import rejection, verify
 from att_sim import rotations as rot
@@ -86,8 +86,8 @@ def test_zone_constraints_are_exact_functions_of_time():
     problem = _sweep_problem()
     s = scaling(problem)
     margin = np.deg2rad(0.05)
-    path = path_function(problem, s, margin)
-    assert path.n_in() == 3
+    path, values = path_function(problem, s, 7, margin)
+    assert path.n_in() == 3 and values.size == 0          # (x, u, t): no fixed zone, no parameter
     x, u, t = ca.SX.sym("x", 7), ca.SX.sym("u", 3), ca.SX.sym("t")
     dgdt = ca.Function("dgdt", [x, u, t], [ca.jacobian(path(x, u, t), t)])
     zs = problem.zone_sky()
@@ -102,8 +102,13 @@ def test_zone_constraints_are_exact_functions_of_time():
         assert float(dgdt(state, np.zeros(3), tn)) == pytest.approx(rate, abs=1e-12)
         # the Sun's direction turns at RATE: |da/dt| = |RATE|, and the fit holds it
         assert np.linalg.norm(zs.axes_rate(ts)[0]) == pytest.approx(abs(RATE), rel=1e-6)
-    # inertial zones build no time dependence
-    assert path_function(replace(problem, zones=zs.frozen_zones(), sky=None), s, margin).n_in() == 2
+    # inertial zones build no time dependence; their data are the function's parameters
+    frozen = replace(problem, zones=zs.frozen_zones(), sky=None)
+    path, values = path_function(frozen, s, 7, margin)
+    assert path.n_in() == 3 and values.size == ZONE_PARAMETERS               # (x, u, p)
+    a, th = zs.at(0.0, true=True)
+    assert float(path(state, np.zeros(3), path_values(frozen, s, margin))) == pytest.approx(
+        a[0] @ b - np.cos(th[0] + margin), abs=1e-12)
 
 
 def test_keep_in_zone_of_a_second_sensor_is_kept(bw_plans):
