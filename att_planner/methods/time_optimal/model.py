@@ -12,6 +12,7 @@ from att_planner.methods import symbolic
 from att_planner.methods.axis_rotations import time_unit
 from att_planner.methods.time_optimal import collocation as col
 from att_planner.problem import ManeuverProblem
+from att_planner.zones import clenshaw
 from att_sim import rotations as rot
 
 # Relative tightening of the rate and wheel-momentum bounds at the collocation points, so that
@@ -48,54 +49,84 @@ def rigid_body_dynamics(Jn: np.ndarray, smooth: bool = False) -> ca.Function:
 
 
 ZONE_PARAMETERS = 8      # per fixed zone: σ (+1 keep-out, -1 keep-in), sensor (3), axis (3), cos(θ + σ δ)
+MOTION_DEGREE = 16       # a moving zone fitted by one Chebyshev series of at most this degree is a parameter
+MOTION_PARAMETERS = 6 + 4 * (MOTION_DEGREE + 1)    # σ, sensor (3), α, β, the series' coefficients (axis, θ + σ δ)
+
+
+def _motion_parametric(zones) -> bool:
+    """Whether every moving zone's fit is one series of degree ≤ :data:`MOTION_DEGREE`."""
+    return all(len(zones.series(z)) == 1 and len(zones.series(z)[0]) <= MOTION_DEGREE + 1
+               for z, zone in enumerate(zones.zones) if zone.body != "inertial")
 
 
 def path_function(problem: ManeuverProblem, s: Scaling, n_state: int = 7, cone_margin: float = 0.0):
-    """``(path, values)``: the path constraints ``g ≤ 0`` (zones, wheel momentum) as a CasADi
-    Function ``(x, u[, t][, p]) -> g`` (``x`` has ``n_state`` rows, the attitude and rate first), and
-    the values of ``p``, the data of the problem it depends on; ``(None, [])`` when there are none.
+    """``(path, parametric)``: the path constraints ``g ≤ 0`` (zones, wheel momentum) as a CasADi
+    Function ``(x, u[, t][, p]) -> g`` (``x`` has ``n_state`` rows, the attitude and rate first;
+    None when there are none), the data of the problem in ``p`` (:func:`path_values`), and whether
+    its moving zones are parameters too.
 
     Every zone of ``problem.zone_sky()`` (:mod:`att_planner.zones`: the cones, then the zones, each
-    with its own sensor axis ``s_z``, ``b_z = R(q) s_z``) is tightened by ``δ`` (:func:`zone_values`):
-    keep-out ``a_z · b_z ≤ cos(θ_z + δ)``, keep-in ``a_z · b_z ≥ cos(θ_z − δ)``. A fixed zone is
-    ``σ_z (a_z · b_z − cos(θ_z + σ_z δ)) ≤ 0`` with its data in ``p`` (:data:`ZONE_PARAMETERS`), so
-    the function depends on the number of fixed zones only. When a zone moves, ``t`` is the
-    normalised time from the start: ``a_z(t τ_u)`` and ``θ_z(t τ_u)`` are the ZoneSky's Chebyshev
-    series of that CasADi expression, so the collocation couples them exactly to ``t_f`` (tightened by
-    ``cone_margin``). The wheels' momentum bound takes its scale from ``p`` too (its last value)."""
+    with its own sensor axis ``s_z``, ``b_z = R(q) s_z``) is tightened by ``δ``: keep-out
+    ``a_z · b_z ≤ cos(θ_z + δ)``, keep-in ``a_z · b_z ≥ cos(θ_z − δ)``, i.e.
+    ``σ_z (a_z · b_z − cos(θ_z + σ_z δ)) ≤ 0``. A fixed zone's data are in ``p``
+    (:data:`ZONE_PARAMETERS`). When a zone moves, ``t`` is the normalised time from the start and
+    ``a_z``, ``θ_z`` are the ZoneSky's Chebyshev series of ``t τ_u``, so the collocation couples them
+    exactly to ``t_f``: their coefficients are in ``p`` too (:data:`MOTION_PARAMETERS`, the series in
+    ``x = α t + β``) when every moving zone is one series of degree ≤ :data:`MOTION_DEGREE`,
+    otherwise the series are constants of the function (tightened by ``cone_margin``). The wheels'
+    momentum bound takes its scale from ``p`` (its last value). So the function depends on the
+    problem's shape only, but for moving zones of many pieces."""
     zones = problem.zone_sky()
     fixed = [z.body == "inertial" for z in zones.zones]
+    parametric = _motion_parametric(zones)
+    moving = 0 if not parametric else len(fixed) - sum(fixed)
     momentum = math.isfinite(problem.wheel_momentum_max) and problem.spacecraft.n_wheels > 0   # no wheels: none
     x, u, t = ca.SX.sym("x", n_state), ca.SX.sym("u", 3), ca.SX.sym("t")
-    p = ca.SX.sym("p", ZONE_PARAMETERS * sum(fixed) + momentum)
+    p = ca.SX.sym("p", ZONE_PARAMETERS * sum(fixed) + MOTION_PARAMETERS * moving + momentum)
     R = symbolic.dcm(x[:4])
     g = []
     for k in range(sum(fixed)):
         sign, sensor, axis, cos = (p[ZONE_PARAMETERS * k], p[ZONE_PARAMETERS * k + 1:ZONE_PARAMETERS * k + 4],
                                    p[ZONE_PARAMETERS * k + 4:ZONE_PARAMETERS * k + 7], p[ZONE_PARAMETERS * k + 7])
         g.append(sign * (ca.dot(axis, ca.mtimes(R, sensor)) - cos))
-    if zones.moving:
+    for k in range(moving):
+        o = ZONE_PARAMETERS * sum(fixed) + MOTION_PARAMETERS * k
+        sign, sensor, alpha, beta = p[o], p[o + 1:o + 4], p[o + 4], p[o + 5]
+        rows = [p[o + 6 + 4 * i:o + 10 + 4 * i] for i in range(MOTION_DEGREE + 1)]
+        value = clenshaw(alpha * t + beta, rows)
+        g.append(sign * (ca.dot(value[:3], ca.mtimes(R, sensor)) - ca.cos(value[3])))
+    if zones.moving and not parametric:
         g += [c for c, f in zip(zones.casadi_constraints(t * s.tu, R, cone_margin), fixed) if not f]
     if momentum:
         h_w = ca.mtimes(ca.DM(problem.spacecraft.wheel_axes_pinv @ s.Jn), x[4:7]) * p[-1]
         g += [h_w - 1, -h_w - 1]
     if not g:
-        return None, np.zeros(0)
+        return None, parametric
     inputs = [x, u] + ([t] if zones.moving else []) + ([p] if p.numel() else [])
-    return ca.Function("path", inputs, [ca.vertcat(*g)]), np.zeros(p.numel())
+    return ca.Function("path", inputs, [ca.vertcat(*g)]), parametric
 
 
 def path_values(problem: ManeuverProblem, s: Scaling, cone_margin: float) -> np.ndarray:
     """The values of :func:`path_function`'s ``p``: each fixed zone's σ, unit sensor axis, axis and
-    ``cos(θ + σ δ)`` (``δ = cone_margin``), then the momentum bound's scale."""
+    ``cos(θ + σ δ)`` (``δ = cone_margin``); each moving zone's σ, unit sensor axis, α = 2 τ_u/(b − a)
+    and β = −(a + b)/(b − a) of its series on [a, b] and the coefficients (zero-padded to
+    :data:`MOTION_DEGREE`, θ's first one raised by σ δ), when they are parameters; then the
+    momentum bound's scale."""
     zones = problem.zone_sky()
     axes, half = zones.at(0.0)
-    values = []
+    fixed, moving = [], []
     for z, zone in enumerate(zones.zones):
+        sign = -1.0 if zone.keep_in else 1.0
+        sensor = zones.sensor_axes[z] / np.linalg.norm(zones.sensor_axes[z])
         if zone.body == "inertial":
-            sign = -1.0 if zone.keep_in else 1.0
-            values += [[sign], zones.sensor_axes[z] / np.linalg.norm(zones.sensor_axes[z]), axes[z],
-                       [math.cos(half[z] + sign * cone_margin)]]
+            fixed += [[sign], sensor, axes[z], [math.cos(half[z] + sign * cone_margin)]]
+        elif _motion_parametric(zones):
+            (coef,), (a, b) = zones.series(z), zones.pieces
+            padded = np.zeros((MOTION_DEGREE + 1, 4))
+            padded[:len(coef)] = coef
+            padded[0, 3] += sign * cone_margin
+            moving += [[sign], sensor, [2 * s.tu / (b - a), -(a + b) / (b - a)], padded.ravel()]
+    values = fixed + moving
     if math.isfinite(problem.wheel_momentum_max) and problem.spacecraft.n_wheels:
         values.append([s.J0 / s.tu / (problem.wheel_momentum_max * (1 - BOUND_MARGIN))])
     return np.concatenate(values) if values else np.zeros(0)
@@ -115,6 +146,21 @@ CACHE_SIZE = 64          # built NLPs kept (the oldest goes first)
 _NLPS: dict = {}
 
 
+def _state_bounds(problem: ManeuverProblem, s: Scaling, smooth: bool):
+    """Bounds of the state: the quaternion's box, the rate bound (tightened by :data:`BOUND_MARGIN`)
+    and, smooth, ``|u| ≤ 1``."""
+    rate = problem.rate_max * s.tu * (1 - BOUND_MARGIN)
+    if not smooth:
+        return [-1.1] * 4 + [-rate] * 3, [1.1] * 4 + [rate] * 3
+    return [-1.1] * 4 + [-rate] * 3 + [-1.0] * 3 + [-np.inf] * 3, [1.1] * 4 + [rate] * 3 + [1.0] * 3 + [np.inf] * 3
+
+
+def _end_bounds(smooth: bool):
+    """Bounds of the last node: at rest (and, smooth, no torque and no torque rate)."""
+    rest = 9 if smooth else 3
+    return [-1.1] * 4 + [0.0] * rest, [1.1] * 4 + [0.0] * rest
+
+
 def transcription(problem: ManeuverProblem, s: Scaling, mesh: np.ndarray, control: str, cone_margin: float,
                   tf_bounds: tuple[float, float], *, torque_accel: float | None = None, tol: float = 1e-7,
                   max_iter: int = 400, expand: bool = True) -> col.Transcription:
@@ -122,7 +168,7 @@ def transcription(problem: ManeuverProblem, s: Scaling, mesh: np.ndarray, contro
     ``torque_accel``: the smooth NLP of :mod:`.smooth`, its bound on the torque's second derivative).
 
     The NLP is built once per shape and kept (:data:`CACHE_SIZE`): the spacecraft's inertia, the
-    number of intervals, the fixed zones' count, moving zones (by their ZoneSky), the bounds on the
+    number of intervals, the zones' count (moving zones of many pieces: their ZoneSky), the bounds on the
     rate and momentum, the kind of goal and the settings. The mesh, the zones' data, the goal and the
     momentum scale are its parameters, the start and the duration's bounds its variables' bounds
     (set here), so a second problem of that shape only copies it (:meth:`.collocation.Transcription.copy`).
@@ -130,10 +176,11 @@ def transcription(problem: ManeuverProblem, s: Scaling, mesh: np.ndarray, contro
     (a banded KKT system, far fewer iterations; with moving zones the copies took more)."""
     smooth = torque_accel is not None
     zones = problem.zone_sky()
-    path, _ = path_function(problem, s, 13 if smooth else 7, cone_margin)
+    path, parametric = path_function(problem, s, 13 if smooth else 7, cone_margin)
     momentum = math.isfinite(problem.wheel_momentum_max)
+    moving = sum(z.body != "inertial" for z in zones.zones)
     key = (smooth, torque_accel, s.Jn.tobytes(), len(mesh) - 1, control, sum(z.body == "inertial" for z in zones.zones),
-           (id(zones), cone_margin) if zones.moving else None,
+           moving if parametric else (id(zones), cone_margin),
            problem.spacecraft.wheel_axes.tobytes() if momentum else None, problem.rate_max,
            problem.sensor_target is None, tol, max_iter, expand)
     if key not in _NLPS:
@@ -152,21 +199,15 @@ def _build(problem: ManeuverProblem, s: Scaling, mesh: np.ndarray, control: str,
            duration_copies: bool) -> col.Transcription:
     """The parametric NLP of :func:`transcription` (not built)."""
     smooth = torque_accel is not None
-    rate = problem.rate_max * s.tu * (1 - BOUND_MARGIN)
-    rest = 9 if smooth else 3                       # ω̃ (and u, u̇) zero at the end
-    if smooth:
-        bounds = ([-1.1] * 4 + [-rate] * 3 + [-1.0] * 3 + [-np.inf] * 3,
-                  [1.1] * 4 + [rate] * 3 + [1.0] * 3 + [np.inf] * 3)
-        controls = (-torque_accel, torque_accel)
-    else:
-        bounds, controls = ([-1.1] * 4 + [-rate] * 3, [1.1] * 4 + [rate] * 3), (-1.0, 1.0)
-    phase = col.Phase(rigid_body_dynamics(s.Jn, smooth), mesh, control=control, state_bounds=bounds,
+    controls = (-torque_accel, torque_accel) if smooth else (-1.0, 1.0)
+    phase = col.Phase(rigid_body_dynamics(s.Jn, smooth), mesh, control=control,
+                      state_bounds=_state_bounds(problem, s, smooth),
                       control_bounds=controls, path=path, path_bounds=(-np.inf, 0.0), name="slew",
                       path_parameters=path_values(problem, s, 0.0))
     goal = goal_values(problem)
     tr = col.Transcription([phase], duration_copies=duration_copies, parametric=True, extra_parameters=len(goal))
     v = tr.variables(0)
-    tr.bound_state(0, -1, [-1.1] * 4 + [0.0] * rest, [1.1] * 4 + [0.0] * rest)
+    tr.bound_state(0, -1, *_end_bounds(smooth))
     q_end = v.x_end[:4]
     if problem.sensor_target is None:
         tr.add_constraint(symbolic.error_vector(q_end, tr.extra), 0.0, 0.0)
