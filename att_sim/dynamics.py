@@ -224,7 +224,7 @@ class Trajectory:
     wheel_speed: np.ndarray  # (K, N)
 
 
-STEPS_PER_CALL = 512       # RK4 steps per call of the compiled body-torque stepper
+STEPS_PER_CALL = 2048      # RK4 steps per call of the compiled body-torque stepper (a verification: one)
 
 
 @functools.cache

@@ -41,7 +41,6 @@ import time
 import numpy as np
 
 from att_msgs_py.types import Interpolation, Plan, Status
-from att_planner.cones import blocked_endpoint
 from att_planner.methods.axis_rotations import eigenaxis_leg, no_torque_limit
 from att_planner.problem import ManeuverProblem
 from att_sim import rotations as rot
@@ -140,30 +139,27 @@ class _Zones:
 
 
 def _nodes(problem: ManeuverProblem, zones: _Zones, start: np.ndarray, goal: np.ndarray, t_ref: float):
-    """Directions (N, 3) of the main sensor: start, goal, then the circles round its keep-out zones;
-    and per node its circle (−1: none), that circle's axis and the node's azimuth about it."""
-    dirs, circle, axis, azimuth = [start, goal], [-1, -1], [np.zeros(3)] * 2, [0.0, 0.0]
+    """Directions (N, 3) of the main sensor: start, goal, then the circles round its keep-out zones
+    (those clear of every zone of that sensor by half :data:`RIDE_MARGIN` at the circle's time); and
+    per node its circle (−1: none), that circle's axis and the node's azimuth about it."""
+    circles = [(z, min(f * t_ref, zones.sky.window)) for z in np.flatnonzero(zones.main & ~zones.keep_in)
+               for f in (SNAPSHOTS if zones.moving[z] else (0.0,))]
     psi = 2 * np.pi * np.arange(NODES_PER_ZONE) / NODES_PER_ZONE
-    count = 0
-    for z in np.flatnonzero(zones.main & ~zones.keep_in):
-        times = [min(f * t_ref, zones.sky.window) for f in (SNAPSHOTS if zones.moving[z] else (0.0,))]
-        for t in times:
-            axes, half = zones.sky.at(t)
-            w = axes[z] / np.linalg.norm(axes[z])
-            u, v = rot.orthonormal_basis(w)
-            rho = half[z] + RIDE_MARGIN
-            if rho >= np.pi / 2:
-                continue
-            points = np.cos(rho) * w + np.sin(rho) * (np.cos(psi)[:, None] * u + np.sin(psi)[:, None] * v)
-            m = zones.sky.margins(t, _pointing(problem.sensor_axis, points))       # (K, Z)
-            keep = (m[:, zones.main] > 0.5 * RIDE_MARGIN).all(axis=1) if zones.main.any() else np.ones(len(points))
-            for k in np.flatnonzero(keep):
-                dirs.append(points[k])
-                circle.append(count)
-                axis.append(w)
-                azimuth.append(psi[k])
-            count += 1
-    return np.array(dirs), np.array(circle), np.array(axis), np.array(azimuth)
+    times = np.array([t for _, t in circles])
+    axes, half = zones.sky.at(times)
+    rho = np.array([half[c, z] for c, (z, _) in enumerate(circles)]) + RIDE_MARGIN
+    w = np.array([axes[c, z] for c, (z, _) in enumerate(circles)]).reshape(-1, 3)
+    w /= np.linalg.norm(w, axis=1, keepdims=True)
+    u = np.array([rot.orthonormal_basis(a)[0] for a in w]).reshape(-1, 3)
+    v = rot.cross(w, u)
+    points = (np.cos(rho)[:, None, None] * w[:, None] + np.sin(rho)[:, None, None] *
+              (np.cos(psi)[None, :, None] * u[:, None] + np.sin(psi)[None, :, None] * v[:, None]))   # (C, K, 3)
+    m = zones.sky.margins(np.repeat(times, NODES_PER_ZONE), _pointing(problem.sensor_axis, points.reshape(-1, 3)))
+    keep = (m[:, zones.main] > 0.5 * RIDE_MARGIN).all(axis=1).reshape(len(circles), NODES_PER_ZONE)
+    keep &= (rho < np.pi / 2)[:, None]
+    c, k = np.nonzero(keep)
+    return (np.vstack([start, goal, points[c, k]]), np.concatenate([[-1, -1], c]),
+            np.vstack([np.zeros((2, 3)), w[c]]), np.concatenate([[0.0, 0.0], psi[k]]))
 
 
 def _pointing(sensor: np.ndarray, directions: np.ndarray) -> np.ndarray:
@@ -293,7 +289,7 @@ def legs_profile(problem: ManeuverProblem, q0: np.ndarray, legs: list):
 def plan_graph_smooth(problem: ManeuverProblem) -> Plan:
     """The constructive plan (module docstring); FAILED when the graph holds no way round the zones."""
     start = time.perf_counter()
-    why = no_torque_limit(problem) or blocked_endpoint(problem)
+    why = no_torque_limit(problem)      # an end inside a zone: no leg leaves or reaches it (FAILED below)
     if why:
         return Plan(method=METHOD, status=Status.FAILED, message=why, wall_time=time.perf_counter() - start)
     q0 = rot.normalize(np.asarray(problem.q_initial, float))

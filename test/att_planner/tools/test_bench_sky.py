@@ -1,119 +1,29 @@
 """``att-bench sky`` (issue 13): an INDEPENDENT check of the committed benchmarks/sky_<case>.json,
 and the study's plumbing on a cheap method.
 
-The check uses nothing of the suite: it integrates each plan's ZOH body torque from rest at
-``q_initial`` with its own RK4 of the rigid body (J ω̇ = T − ω × Jω, q̇ = ½ q ⊗ [ω, 0]; Euler's
-equations, Wie, *Space Vehicle Dynamics and Control*, 2008, §5.2), and computes the zones' true
-directions with skyfield directly: the spacecraft from the JSON's TLE (``EarthSatellite``: SGP4,
-TEME → GCRS), the Sun and Moon from the ``de421.bsp`` of skyfield-data (geometric, light time
-ignored: ≤ 0.006° here), the Earth limb as asin(R_E/|r|) + margin about −r̂ (R_E = 6378.137 km,
-WGS-84). It then confirms, to 0.01°: the torque reproduces each plan (final attitude, the JSON's
-margins), the frozen plan enters a zone, the moving one does not. ``ATT_SKY_BENCHMARKS=DIR`` checks
-the sky_<case>.json of another directory (a fresh ``att-bench sky --json`` run).
+The check uses nothing of the suite (:mod:`helpers.independent`): it integrates each plan's ZOH
+body torque from rest at ``q_initial`` with its own RK4 of the rigid body (4 steps per ZOH interval)
+and computes the zones' true directions with skyfield directly (the JSON's TLE, DE421 from
+skyfield-data, the Earth limb about −r̂). It then confirms, to 0.01°: the torque reproduces each
+plan (final attitude, the JSON's margins), the frozen plan enters a zone, the moving one does not.
+``ATT_SKY_BENCHMARKS=DIR`` checks the sky_<case>.json of another directory (a fresh ``att-bench sky
+--json`` run).
 """
 from __future__ import annotations
 
 import json
 import math
 import os
-from datetime import datetime
-from functools import lru_cache
-from importlib.resources import files
 from pathlib import Path
 
 import numpy as np
 import pytest
 
+from helpers.independent import integrate, margins, sky
+
 BENCHMARKS = Path(os.environ.get("ATT_SKY_BENCHMARKS", Path(__file__).resolve().parents[3] / "benchmarks"))
 CASES = ("leo_observatory", "moon_parallax")
 TOL = math.radians(0.01)
-R_EARTH = 6378.137e3          # m, WGS-84 equatorial radius
-SUBSTEPS = 4                  # RK4 steps per ZOH interval (500 intervals: 2000 steps); the sky at the knots
-
-
-def _dcm(q):
-    """Body-to-inertial rotation matrices of unit quaternions q (K, 4) = (x, y, z, w)."""
-    x, y, z, w = np.moveaxis(np.asarray(q, float), -1, 0)
-    return np.stack([np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)], -1),
-                     np.stack([2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)], -1),
-                     np.stack([2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)], -1)], -2)
-
-
-def _integrate(J, t, torque, q0):
-    """Own RK4 of the rigid body from rest, ZOH torque switched exactly at the knots, on Python
-    floats; returns the states (x, y, z, w, ωx, ωy, ωz) at the knots ``t``."""
-    J = [list(map(float, row)) for row in J]
-    Ji = np.linalg.inv(np.array(J)).tolist()
-
-    def f(x, u):
-        qx, qy, qz, qw, wx, wy, wz = x
-        h = [J[i][0] * wx + J[i][1] * wy + J[i][2] * wz for i in range(3)]
-        r = (u[0] - (wy * h[2] - wz * h[1]), u[1] - (wz * h[0] - wx * h[2]), u[2] - (wx * h[1] - wy * h[0]))
-        return (0.5 * (qw * wx + qy * wz - qz * wy), 0.5 * (qw * wy + qz * wx - qx * wz),
-                0.5 * (qw * wz + qx * wy - qy * wx), -0.5 * (qx * wx + qy * wy + qz * wz),
-                *(Ji[i][0] * r[0] + Ji[i][1] * r[1] + Ji[i][2] * r[2] for i in range(3)))
-
-    def axpy(x, a, k):
-        return [xi + a * ki for xi, ki in zip(x, k)]
-
-    x = [float(v) for v in q0] + [0.0, 0.0, 0.0]
-    knots = [list(x)]
-    for k in range(len(t) - 1):
-        h = (t[k + 1] - t[k]) / SUBSTEPS
-        u = [float(v) for v in torque[k]]
-        for _ in range(SUBSTEPS):
-            k1 = f(x, u)
-            k2 = f(axpy(x, 0.5 * h, k1), u)
-            k3 = f(axpy(x, 0.5 * h, k2), u)
-            k4 = f(axpy(x, h, k3), u)
-            x = [xi + h / 6.0 * (a + 2 * b + 2 * c + d) for xi, a, b, c, d in zip(x, k1, k2, k3, k4)]
-            n = sum(v * v for v in x[:4]) ** 0.5
-            x[:4] = [v / n for v in x[:4]]
-        knots.append(list(x))
-    return np.array(knots)
-
-
-@lru_cache(maxsize=1)
-def _skyfield():
-    """skyfield's built-in time scale and the packaged DE421, opened offline once."""
-    from skyfield.api import load, load_file
-
-    return load.timescale(builtin=True), load_file(str(files("skyfield_data") / "data" / "de421.bsp"))
-
-
-def _sky(payload, t):
-    """(sun, moon, nadir) unit vectors from the spacecraft, (K, 3) each, and asin(R_E/|r|) (K,)."""
-    from skyfield.api import EarthSatellite
-
-    ts, eph = _skyfield()
-    e = datetime.fromisoformat(payload["epoch"].replace("Z", "+00:00"))
-    # UTC seconds = SI seconds: no leap second within a maneuver of these cases
-    tt = ts.utc(e.year, e.month, e.day, e.hour, e.minute, e.second + e.microsecond * 1e-6 + np.asarray(t))
-    r = EarthSatellite(*payload["tle"], ts=ts).at(tt).position.m.T
-    earth = eph["earth"].at(tt).position.m.T
-
-    def unit(v):
-        return v / np.linalg.norm(v, axis=1, keepdims=True)
-    sun = unit(eph["sun"].at(tt).position.m.T - earth - r)
-    moon = unit(eph["moon"].at(tt).position.m.T - earth - r)
-    return {"sun": sun, "moon": moon, "earth_limb": unit(-r)}, np.arcsin(R_EARTH / np.linalg.norm(r, axis=1))
-
-
-def _margins(payload, t, q):
-    """Per-zone margins (rad, ≥ 0 clear) of attitudes q (K, 4) at times t (K,) against the true sky."""
-    axes, limb = _sky(payload, t)
-    out = {}
-    for z in payload["zones"]:
-        b = _dcm(q) @ np.asarray(z["sensor_axis"], float)
-        if z["body"] == "inertial":
-            a, half = np.broadcast_to(np.asarray(z["direction"], float), b.shape), z["half_angle"]
-        elif z["body"] == "earth_limb":
-            a, half = axes["earth_limb"], limb + z["margin"]
-        else:
-            a, half = axes[z["body"]], z["half_angle"]
-        gamma = np.arccos(np.clip(np.sum(a * b, axis=1) / np.linalg.norm(b, axis=1), -1.0, 1.0))
-        out[z["name"]] = half - gamma if z["keep_in"] else gamma - half
-    return out
 
 
 @pytest.fixture(scope="module", params=CASES)
@@ -124,8 +34,8 @@ def checked(request):
     for kind, plan in payload["plans"].items():
         assert plan["t"], f"{request.param}: no {kind} plan in the JSON ({plan['message']})"
         t = np.asarray(plan["t"], float)
-        states = _integrate(payload["J"], t, plan["torque"], payload["q_initial"])
-        out[kind] = (t, states, _margins(payload, t, states[:, :4]))
+        states = integrate(payload["J"], t, plan["torque"], payload["q_initial"])
+        out[kind] = (t, states, margins(payload, t, states[:, :4]))
     return payload, out
 
 
@@ -147,7 +57,7 @@ def test_format_is_the_issues(checked):
 
 def test_earth_limb_half_angle_at_start(checked):
     payload, _ = checked
-    _, limb = _sky(payload, np.zeros(1))
+    _, limb = sky(payload, np.zeros(1))
     for z in payload["zones"]:
         if z["body"] == "earth_limb":
             assert z["half_angle"] == pytest.approx(limb[0] + z["margin"], abs=1e-6)
@@ -155,14 +65,14 @@ def test_earth_limb_half_angle_at_start(checked):
 
 def test_torque_reproduces_each_plan(checked):
     payload, own = checked
-    for kind, (times, states, margins) in own.items():
+    for kind, (times, states, zone_margins) in own.items():
         plan = payload["plans"][kind]
         assert times[-1] == pytest.approx(plan["tf"], rel=1e-12)
         qf = np.asarray(payload["q_final"], float)
         error = 2.0 * math.acos(min(1.0, abs(float(states[-1, :4] @ qf))))
         assert error == pytest.approx(plan["verification"]["final_attitude_error"], abs=TOL)
         assert error < math.radians(0.5) and np.linalg.norm(states[-1, 4:]) < 1e-3
-        for name, m in margins.items():
+        for name, m in zone_margins.items():
             assert m.min() == pytest.approx(plan["verification"]["zone_margins_vs_motion"][name], abs=TOL), (kind, name)
 
 
