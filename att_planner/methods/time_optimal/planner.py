@@ -55,7 +55,7 @@ METHOD = "time_optimal"
 CONVERGED_VIOLATION = 1e-5      # an IPOPT answer counts as solved below this constraint violation
 
 
-DEFAULT_INTERVALS, DEFAULT_MAX_INTERVALS = 30, 120
+DEFAULT_INTERVALS, DEFAULT_MAX_INTERVALS = 16, 120
 
 
 def _mesh_sizes(options: dict) -> tuple[int, int]:
@@ -281,7 +281,7 @@ def _verdict(plan: Plan, ok: bool, run: _Solve, incumbent: _Incumbent, best: str
 
 
 def plan_time_optimal(problem: ManeuverProblem, *, intervals: int = DEFAULT_INTERVALS, max_intervals: int | None = None,
-                      starts: int = 3, refine_rounds: int = 3, interpolation: str = Interpolation.ZOH,
+                      starts: int = 3, refine_rounds: int = 4, interpolation: str = Interpolation.ZOH,
                       cone_margin_deg: float = 0.05, warm_starts: tuple = (),
                       smooth_warm_start: bool = False, explore_tol: float = 1e-5, tol: float = 1e-7,
                       max_iter: int = 400, verify_reserve: float = 1.0) -> Plan:
