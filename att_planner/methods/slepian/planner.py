@@ -101,13 +101,8 @@ def solve_min_time(man: SmoothManeuver, *, basis_sizes: tuple = (4, 8), starts: 
     def share(fraction):   # stage deadlines: exploration ≤ 50 %, continuation ≤ 75 % of the budget
         return None if end is None else start_clock + fraction * (end - start_clock)
 
-    seeded = None
-    for seed in seeds:
-        M = basis_sizes[-1]
-        r = solve_min_time_local(coarse.resized(M=M), _pad_alpha(seed, N, Nc, M), feas_tol=feas_tol,
-                                 deadline=share(0.5), end_ratio=end_ratio if M > PAPER_M else None)
-        if r.feasible and (seeded is None or r.tf < seeded.tf):
-            seeded = r
+    seeded = _seeded(coarse.resized(M=basis_sizes[-1]), [_pad_alpha(a, N, Nc, basis_sizes[-1]) for a in seeds],
+                     share(0.5), feas_tol, end_ratio)
     best, closest, explored = _multistart(coarse, candidates, share(0.5), maxiter=explore_maxiter,
                                           total_iterations=explore_total_iterations, feas_tol=feas_tol,
                                           end_ratio=end_ratio if M0 > PAPER_M else None)
@@ -119,16 +114,7 @@ def solve_min_time(man: SmoothManeuver, *, basis_sizes: tuple = (4, 8), starts: 
         status = Status.BUDGET_EXPIRED if end and time.monotonic() > end else Status.FAILED
         return slepian_result(man.resized(M=M0), np.zeros((3, M0)), status,
                               "no feasible start found by the coarse multistart", t0, feas_tol, explored=explored)
-    Mc = best.alpha.shape[1]
-    alpha, tf_c, path = best.alpha, best.tf, [("coarse", Mc, best.tf)]
-    for M in basis_sizes[1:]:
-        if end is not None and time.monotonic() > share(0.75):
-            break
-        r = solve_min_time_local(coarse.resized(M=M), _pad_alpha(alpha, Nc, Nc, M), feas_tol=feas_tol,
-                                 deadline=share(0.75), end_ratio=end_ratio)
-        if r.feasible:
-            alpha, Mc, tf_c = r.alpha, M, r.tf
-            path.append(("coarse", M, r.tf))
+    alpha, Mc, tf_c, path = _continuation(coarse, best, basis_sizes[1:], share(0.75), feas_tol, end_ratio)
     if seeded is not None and seeded is not best and (Mc < seeded.alpha.shape[1] or seeded.tf < tf_c):
         alpha, Mc, tf_c = seeded.alpha, seeded.alpha.shape[1], seeded.tf
         path.append(("coarse, seeded", Mc, tf_c))
@@ -150,6 +136,35 @@ def solve_min_time(man: SmoothManeuver, *, basis_sizes: tuple = (4, 8), starts: 
     if fallback.feasible:
         fallback.message = f"refinement unfinished ({r.message}); constraints met to {budget_tol:g}"
     return fallback
+
+
+def _continuation(coarse: SmoothManeuver, best: SlepianResult, sizes: tuple, deadline: float | None,
+                  feas_tol: float, end_ratio: float):
+    """Stage 2 of :func:`solve_min_time`: ``best`` carried over the basis ``sizes`` on the coarse grid
+    until ``deadline``; ``(α, M, t_f, path)`` of the last feasible solve."""
+    Mc = best.alpha.shape[1]
+    alpha, tf_c, path = best.alpha, best.tf, [("coarse", Mc, best.tf)]
+    for M in sizes:
+        if deadline is not None and time.monotonic() > deadline:
+            break
+        r = solve_min_time_local(coarse.resized(M=M), _pad_alpha(alpha, coarse.N, coarse.N, M), feas_tol=feas_tol,
+                                 deadline=deadline, end_ratio=end_ratio)
+        if r.feasible:
+            alpha, Mc, tf_c = r.alpha, M, r.tf
+            path.append(("coarse", M, r.tf))
+    return alpha, Mc, tf_c, path
+
+
+def _seeded(coarse: SmoothManeuver, seeds: list, deadline: float | None, feas_tol: float,
+            end_ratio: float) -> SlepianResult | None:
+    """The quickest feasible local solve from ``seeds`` (α on ``coarse``), or None."""
+    best = None
+    for a0 in seeds:
+        r = solve_min_time_local(coarse, a0, feas_tol=feas_tol, deadline=deadline,
+                                 end_ratio=end_ratio if coarse.M > PAPER_M else None)
+        if r.feasible and (best is None or r.tf < best.tf):
+            best = r
+    return best
 
 
 def _multistart(coarse: SmoothManeuver, candidates: list, deadline: float | None, *, maxiter: int,

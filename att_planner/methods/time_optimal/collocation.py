@@ -249,6 +249,37 @@ class _DeadlineCallback(ca.Callback):
         return [1.0 if expired else 0.0]
 
 
+def _phase_constraints(p: int, ph: Phase, v: PhaseVariables, Tk, mesh, path_p, t_start):
+    """``(rows, (lower, upper))`` of phase ``p``: the Hermite–Simpson defects (vectorised over the
+    intervals with ``map``), then the path constraints at the nodes and midpoints; ``Tk`` the
+    intervals' durations (or T), ``mesh`` and ``path_p`` the mesh fractions and path parameters."""
+    X, Xm, U, N, nx = v.X, v.Xm, v.U, ph.intervals, ph.n_state
+    h = Tk * (mesh[1:] - mesh[:-1])                          # (1, N)
+    U_left = U if ph.control == "constant" else U[:, :-1]
+    U_right = U if ph.control == "constant" else U[:, 1:]
+    U_mid = U if ph.control == "constant" else (U_left + U_right) / 2
+    fmap = ph.dynamics.map(N)
+    Fk, Fk1, Fm = fmap(X[:, :-1], U_left), fmap(X[:, 1:], U_right), fmap(Xm, U_mid)
+    H = ca.repmat(h, nx, 1)
+    mid_defect = Xm - (X[:, :-1] + X[:, 1:]) / 2 - H / 8 * (Fk - Fk1)
+    simpson_defect = X[:, 1:] - X[:, :-1] - H / 6 * (Fk + 4 * Fm + Fk1)
+    out = [(ca.vec(mid_defect), (0.0, 0.0)), (ca.vec(simpson_defect), (0.0, 0.0))]
+    if ph.path is not None:
+        # Nodes see the control of the interval they start (the last node: the last one).
+        U_nodes = ca.horzcat(U, U[:, -1]) if ph.control == "constant" else U
+        times = ()
+        if ph.timed:
+            T_nodes = ca.horzcat(Tk, Tk[-1]) if Tk.shape[1] > 1 else Tk
+            times = (t_start + T_nodes * mesh, t_start + Tk * (mesh[:-1] + mesh[1:]) / 2)
+        shared = [2 + ph.timed] if ph.path_parameters.size else []       # p: one value for every point
+        extra = (path_p,) if shared else ()
+        Gn = ph.path.map(f"path_nodes{p}", "serial", N + 1, shared, [])(X, U_nodes, *times[:1], *extra)
+        Gm = ph.path.map(f"path_mids{p}", "serial", N, shared, [])(Xm, U_mid, *times[1:], *extra)
+        out += [(ca.vec(Gn), (np.tile(ph.path_bounds[0], N + 1), np.tile(ph.path_bounds[1], N + 1))),
+                (ca.vec(Gm), (np.tile(ph.path_bounds[0], N), np.tile(ph.path_bounds[1], N)))]
+    return out
+
+
 class Transcription:
     """Hermite–Simpson NLP over one or more phases.
 
@@ -310,35 +341,10 @@ class Transcription:
             path_p = sym(f"path{p}", ph.path_parameters.size) if parametric else ca.DM(ph.path_parameters)
             if parametric:
                 params += [mesh.T, path_p]
-            # Defects, vectorised over intervals with map().
-            h = Tk * (mesh[1:] - mesh[:-1])                          # (1, N)
-            U_left = U if ph.control == "constant" else U[:, :-1]
-            U_right = U if ph.control == "constant" else U[:, 1:]
-            U_mid = U if ph.control == "constant" else (U_left + U_right) / 2
-            fmap = ph.dynamics.map(N)
-            Fk = fmap(X[:, :-1], U_left)
-            Fk1 = fmap(X[:, 1:], U_right)
-            Fm = fmap(Xm, U_mid)
-            H = ca.repmat(h, nx, 1)
-            mid_defect = Xm - (X[:, :-1] + X[:, 1:]) / 2 - H / 8 * (Fk - Fk1)
-            simpson_defect = X[:, 1:] - X[:, :-1] - H / 6 * (Fk + 4 * Fm + Fk1)
-            g += [ca.vec(mid_defect), ca.vec(simpson_defect)]
-            lbg += [np.zeros(2 * nx * N)]
-            ubg += [np.zeros(2 * nx * N)]
-            if ph.path is not None:
-                # Nodes see the control of the interval they start (the last node: the last one).
-                U_nodes = ca.horzcat(U, U[:, -1]) if ph.control == "constant" else U
-                times = ()
-                if ph.timed:
-                    T_nodes = ca.horzcat(Tk, Tk[-1]) if copies else T
-                    times = (t_start + T_nodes * mesh, t_start + Tk * (mesh[:-1] + mesh[1:]) / 2)
-                shared = [2 + ph.timed] if ph.path_parameters.size else []       # p: one value for every point
-                extra = (path_p,) if shared else ()
-                Gn = ph.path.map(f"path_nodes{p}", "serial", N + 1, shared, [])(X, U_nodes, *times[:1], *extra)
-                Gm = ph.path.map(f"path_mids{p}", "serial", N, shared, [])(Xm, U_mid, *times[1:], *extra)
-                g += [ca.vec(Gn), ca.vec(Gm)]
-                lbg += [np.tile(ph.path_bounds[0], 2 * N + 1)]
-                ubg += [np.tile(ph.path_bounds[1], 2 * N + 1)]
+            for rows, bound in _phase_constraints(p, ph, self._vars[-1], Tk, mesh, path_p, t_start):
+                g.append(rows)
+                lbg.append(np.broadcast_to(bound[0], rows.shape[0]))
+                ubg.append(np.broadcast_to(bound[1], rows.shape[0]))
             t_start = t_start + T
         self._p = ca.vertcat(*params, self.extra)
         self._w = ca.vertcat(*w)
