@@ -30,6 +30,7 @@ setup(
             "att-sim = att_sim.simulator_node:main",
             "att-planner = att_planner.nodes.planner_node:main",
             "att-controller = att_planner.nodes.controller_node:main",
+            "att-estimator = att_planner.nodes.estimator_node:main",
             "att-recorder = att_msgs_py.log.recorder_node:main",
             "att-replay = att_msgs_py.log.replay:main",
             "att-review = att_planner.tools.review:main",

@@ -15,16 +15,21 @@ from datetime import datetime, timedelta
 import numpy as np
 from builtin_interfaces.msg import Time
 from geometry_msgs.msg import Quaternion, Vector3
+from sensor_msgs.msg import Imu, JointState, MagneticField
 
 from att_msgs.action import ExecuteManeuver
 from att_msgs.msg import (
     ActuatorCommand,
+    AttitudeEstimate,
+    CoarseSunSensors,
     ControllerStatus,
     KeepOutCone,
     ManeuverPlan,
     PlanStage,
     PlanVerification,
+    SensorTruth,
     SpacecraftState,
+    StarTracker,
     Zone,
 )
 from att_msgs_py import types
@@ -238,3 +243,119 @@ def result_msg(r: types.ManeuverResult) -> ExecuteManeuver.Result:
     return ExecuteManeuver.Result(success=bool(r.success), error_code=int(r.error_code), message=r.message,
                                   duration=float(r.duration), final_attitude_error=float(r.final_attitude_error),
                                   final_rate=float(r.final_rate))
+
+
+# -- sensors and the estimate (issue 14) ----------------------------------------------------------
+
+NOT_PROVIDED = [-1.0] + [0.0] * 8      # a covariance sensor_msgs marks "not provided"
+
+
+def covariance9(c) -> list[float]:
+    """A 3x3 covariance as the row-major float64[9] of a message."""
+    return [float(v) for v in np.asarray(c, float).reshape(9)]
+
+
+def from_covariance9(values) -> np.ndarray:
+    return np.asarray(values, float).reshape(3, 3)
+
+
+def _header(msg, t: float, frame_id: str):
+    msg.header.stamp = time_msg(t)
+    msg.header.frame_id = frame_id
+    return msg
+
+
+def gyro_msg(m: types.GyroMeasurement) -> Imu:
+    """``sensor_msgs/Imu`` with the angular velocity only: orientation and linear acceleration are
+    "not provided" (covariance[0] = -1, as the message defines)."""
+    msg = _header(Imu(), m.t, m.frame_id)
+    msg.orientation.w = 1.0
+    msg.orientation_covariance = NOT_PROVIDED
+    msg.angular_velocity = vector3(m.omega)
+    msg.angular_velocity_covariance = covariance9(m.covariance)
+    msg.linear_acceleration_covariance = NOT_PROVIDED
+    return msg
+
+
+def gyro_from_msg(msg) -> types.GyroMeasurement:
+    return types.GyroMeasurement(t=from_time(msg.header.stamp), omega=from_vector3(msg.angular_velocity),
+                                 covariance=from_covariance9(msg.angular_velocity_covariance),
+                                 frame_id=msg.header.frame_id)
+
+
+def star_tracker_msg(m: types.StarTrackerMeasurement) -> StarTracker:
+    msg = _header(StarTracker(sensor_frame_id=m.name, valid=bool(m.valid), status=int(m.status)), m.t, m.frame_id)
+    msg.attitude = quaternion(m.q if m.valid else [0.0, 0.0, 0.0, 1.0])
+    msg.covariance = covariance9(m.covariance) if m.valid else NOT_PROVIDED
+    return msg
+
+
+def star_tracker_from_msg(msg) -> types.StarTrackerMeasurement:
+    return types.StarTrackerMeasurement(t=from_time(msg.header.stamp), name=msg.sensor_frame_id,
+                                        q=from_quaternion(msg.attitude), covariance=from_covariance9(msg.covariance),
+                                        valid=bool(msg.valid), status=int(msg.status), frame_id=msg.header.frame_id)
+
+
+def magnetometer_msg(m: types.MagnetometerMeasurement) -> MagneticField:
+    msg = _header(MagneticField(), m.t, m.frame_id)
+    msg.magnetic_field = vector3(m.field)
+    msg.magnetic_field_covariance = covariance9(m.covariance)
+    return msg
+
+
+def magnetometer_from_msg(msg) -> types.MagnetometerMeasurement:
+    return types.MagnetometerMeasurement(t=from_time(msg.header.stamp), field=from_vector3(msg.magnetic_field),
+                                         covariance=from_covariance9(msg.magnetic_field_covariance),
+                                         frame_id=msg.header.frame_id)
+
+
+def sun_sensors_msg(m: types.SunSensorMeasurement) -> CoarseSunSensors:
+    msg = _header(CoarseSunSensors(values=[float(v) for v in m.values], noise=float(m.noise)), m.t, m.frame_id)
+    return msg
+
+
+def sun_sensors_from_msg(msg) -> types.SunSensorMeasurement:
+    return types.SunSensorMeasurement(t=from_time(msg.header.stamp), values=np.asarray(msg.values, float),
+                                      noise=float(msg.noise), frame_id=msg.header.frame_id)
+
+
+def wheel_speeds_msg(m: types.WheelSpeedMeasurement) -> JointState:
+    """``sensor_msgs/JointState``: one joint per wheel (``wheel_0``, ...), velocity = speed relative
+    to the body (what the tachometer measures)."""
+    msg = _header(JointState(), m.t, m.frame_id)
+    msg.name = [f"wheel_{i}" for i in range(len(m.speeds))]
+    msg.velocity = [float(v) for v in m.speeds]
+    return msg
+
+
+def wheel_speeds_from_msg(msg) -> types.WheelSpeedMeasurement:
+    return types.WheelSpeedMeasurement(t=from_time(msg.header.stamp), speeds=np.asarray(msg.velocity, float),
+                                       frame_id=msg.header.frame_id)
+
+
+def sensor_truth_msg(m: types.SensorTruth) -> SensorTruth:
+    msg = _header(SensorTruth(), m.t, m.frame_id)
+    msg.gyro_bias = vector3(m.gyro_bias)
+    msg.magnetometer_bias = vector3(m.magnetometer_bias)
+    return msg
+
+
+def estimate_msg(e: types.AttitudeEstimate) -> AttitudeEstimate:
+    msg = _header(AttitudeEstimate(body_frame_id=e.body_frame_id, health=int(e.health), message=e.message,
+                                   time_since_update=float(e.time_since_update),
+                                   rejected_measurements=int(min(e.rejected, 2**32 - 1))), e.t, e.frame_id)
+    msg.attitude = quaternion(e.q)
+    msg.body_rate = vector3(e.omega)
+    msg.gyro_bias = vector3(e.gyro_bias)
+    msg.attitude_covariance = covariance9(e.attitude_covariance)
+    msg.bias_covariance = covariance9(e.bias_covariance)
+    return msg
+
+
+def estimate_from_msg(msg) -> types.AttitudeEstimate:
+    return types.AttitudeEstimate(
+        t=from_time(msg.header.stamp), q=from_quaternion(msg.attitude), omega=from_vector3(msg.body_rate),
+        gyro_bias=from_vector3(msg.gyro_bias), attitude_covariance=from_covariance9(msg.attitude_covariance),
+        bias_covariance=from_covariance9(msg.bias_covariance), health=int(msg.health),
+        time_since_update=float(msg.time_since_update), rejected=int(msg.rejected_measurements),
+        message=msg.message, frame_id=msg.header.frame_id, body_frame_id=msg.body_frame_id)

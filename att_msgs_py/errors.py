@@ -47,6 +47,10 @@ class ErrorCode(IntEnum):
     INVALID_STATE = 310           # a state message with a bad field (discarded, reported)
     STATE_TIME_JUMP = 311         # a state stamp backward or far forward (discarded, reported)
     MODE_NOT_AUTHENTIC = 312      # a mode request unsigned, wrongly signed or replayed (require_signed_modes)
+    ESTIMATE_UNHEALTHY = 313      # state_source estimate: the attitude estimate is not usable (initialising, diverged)
+    # estimator
+    INVALID_MEASUREMENT = 320     # a sensor message with a bad field (discarded, reported)
+    STALE_MEASUREMENT = 321       # a measurement older than the filter's history, or a gyro stamp not moving forward
     # simulator
     INVALID_RESET = 400
     INVALID_COMMAND = 401         # actuator command with a bad field or stamp (refused, reported)

@@ -16,7 +16,6 @@ process exits 0.
 """
 from __future__ import annotations
 
-import math
 import signal
 import sys
 from collections.abc import Callable
@@ -27,8 +26,8 @@ import yaml
 from rcl_interfaces.msg import ParameterDescriptor
 from rclpy.executors import Executor, ExternalShutdownException, SingleThreadedExecutor
 
-from att_msgs_py.errors import ConfigError, ErrorCode, RequestError, clip
-from att_msgs_py.validation import number, text
+from att_msgs_py.errors import ConfigError, ErrorCode, clip
+from att_msgs_py.parameters import checked, coerce
 
 _stop_signalled = False
 
@@ -46,26 +45,8 @@ def spin_until_shutdown(executor: Executor, poll: float = 0.2) -> None:
         executor.spin_once(timeout_sec=poll)
 
 
-def _coerce(name: str, value, default, where: str):
-    """``value`` as the type of ``default`` (an integer is a valid float), or ConfigError."""
-    kind = type(default)
-    if kind is float and isinstance(value, int) and not isinstance(value, bool):
-        value = float(value)
-    if kind is list:
-        if not isinstance(value, (list, tuple)) or not all(
-                isinstance(v, (int, float)) and not isinstance(v, bool) for v in value):
-            raise ConfigError(ErrorCode.INVALID_PARAMETER,
-                              f"parameter '{name}'{where}: expected a list of numbers, got {clip(repr(value), 80)}")
-        return [float(v) for v in value]
-    if not isinstance(value, kind) or (kind is int and isinstance(value, bool)):
-        expected = {float: "a number", int: "an integer", bool: "true or false", str: "a string"}[kind]
-        raise ConfigError(ErrorCode.INVALID_PARAMETER, f"parameter '{name}'{where}: expected {expected}, got "
-                                                       f"{type(value).__name__} {clip(repr(value), 80)}")
-    return value
-
-
 SHARED_PARAMETERS = ("scenario", "use_sim_time", "frame_id", "body_frame_id")
-SHARED_PREFIXES = ("spacecraft.", "orbit.", "qos_overrides.")
+SHARED_PREFIXES = ("spacecraft.", "orbit.", "qos_overrides.", "sensors.", "actuators.", "environment.")
 
 
 class ParameterReader:
@@ -87,27 +68,11 @@ class ParameterReader:
         self.used.add(name)
         in_file = name in self.values
         where = f" (from {self.source})" if in_file and self.source else ""
-        initial = _coerce(name, self.values[name], default, where) if in_file else default
+        initial = coerce(name, self.values[name], default, where) if in_file else default
         value = self.node.declare_parameter(name, initial, ParameterDescriptor(dynamic_typing=True)).value
         if value != initial or type(value) is not type(initial):
             where = " (from the command line or a --params-file)"
-        value = _coerce(name, value, default, where)
-        label = f"parameter '{name}'{where}"
-        try:
-            if low is not None or high is not None:
-                for v in (value if isinstance(value, list) else [value]):
-                    number(v, label, ErrorCode.INVALID_PARAMETER, -math.inf if low is None else low,
-                           math.inf if high is None else high, low_open=low_open)
-            if isinstance(value, str):
-                text(value, label, ErrorCode.INVALID_PARAMETER, max_length=4096)
-        except RequestError as err:
-            raise ConfigError(ErrorCode.INVALID_PARAMETER, err.message) from None
-        if length is not None and len(value) != length:
-            raise ConfigError(ErrorCode.INVALID_PARAMETER, f"{label}: expected {length} numbers, got {len(value)}")
-        if choices is not None and value not in choices:
-            raise ConfigError(ErrorCode.INVALID_PARAMETER,
-                              f"{label}: expected one of {', '.join(map(str, choices))}, got {clip(repr(value), 80)}")
-        return value
+        return checked(name, value, default, where, low, high, low_open=low_open, length=length, choices=choices)
 
     def refuse_unknown(self) -> None:
         """A parameter of this node in the scenario file or on the command line that nothing
@@ -120,6 +85,17 @@ class ParameterReader:
                 raise ConfigError(ErrorCode.INVALID_PARAMETER,
                                   f"unknown {self.node.get_name()} parameter(s) {clip(', '.join(unknown), 120)} "
                                   f"(from {where}); known: {', '.join(sorted(self.used))}")
+
+
+def publisher_of(info) -> bytes | None:
+    """The publisher GID of a received message (None when the middleware does not say)."""
+    gid = (info or {}).get("publisher_gid")
+    return bytes(gid["data"]) if isinstance(gid, dict) and gid.get("data") is not None else None
+
+
+def participant_of(gid: bytes | None) -> bytes | None:
+    """The DDS participant of a publisher GID (its 12-byte GUID prefix): one per node process."""
+    return None if gid is None else gid[:12]
 
 
 def parameter_reader(node, scenario_values: dict, source: str = "") -> ParameterReader:

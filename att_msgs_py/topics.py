@@ -9,6 +9,13 @@ COMMAND = "/actuator/command"
 CONTROLLER_STATUS = "/controller/status"
 PLANS = "/planner/plans"
 CLOCK = "/clock"
+IMU = "/sensors/imu"
+STAR_TRACKER = "/sensors/star_tracker"
+MAGNETOMETER = "/sensors/magnetometer"
+SUN_SENSORS = "/sensors/sun_sensors"
+WHEEL_SPEEDS = "/sensors/wheel_speeds"
+SENSOR_TRUTH = "/simulator/sensor_truth"
+ESTIMATE = "/estimator/attitude"
 
 PLAN_MANEUVER = "/planner/plan_maneuver"
 PLAN_SCHEDULE = "/planner/plan_schedule"
@@ -23,6 +30,13 @@ RECORDED = {
     COMMAND: "att_msgs/msg/ActuatorCommand",
     CONTROLLER_STATUS: "att_msgs/msg/ControllerStatus",
     PLANS: "att_msgs/msg/ManeuverPlan",
+    IMU: "sensor_msgs/msg/Imu",
+    STAR_TRACKER: "att_msgs/msg/StarTracker",
+    MAGNETOMETER: "sensor_msgs/msg/MagneticField",
+    SUN_SENSORS: "att_msgs/msg/CoarseSunSensors",
+    WHEEL_SPEEDS: "sensor_msgs/msg/JointState",
+    SENSOR_TRUTH: "att_msgs/msg/SensorTruth",
+    ESTIMATE: "att_msgs/msg/AttitudeEstimate",
 }
 
 

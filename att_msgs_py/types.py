@@ -286,3 +286,107 @@ class ManeuverResult:
     duration: float = 0.0              # s of sim time
     final_attitude_error: float = math.nan   # rad, to the plan's final attitude
     final_rate: float = math.nan       # rad/s
+
+
+# ---------------------------------------------------------------------------------------------
+# Sensors and the attitude estimate (issue 14)
+# ---------------------------------------------------------------------------------------------
+
+class TrackerStatus(IntEnum):
+    """Why a star tracker measurement is (in)valid: ``att_msgs/StarTracker.STATUS_*``."""
+
+    OK = 0
+    SUN = 1                            # the Sun inside its exclusion angle
+    EARTH = 2                          # the Earth's limb inside its exclusion angle
+    MOON = 3
+    EXCLUDED = 4                       # an inertial exclusion direction
+    RATE = 5                           # turning too fast to track stars
+
+
+class Health(IntEnum):
+    """State of the attitude estimate: ``att_msgs/AttitudeEstimate.HEALTH_*``."""
+
+    INITIALISING = 0                   # no attitude yet (waiting for a tracker or two vectors)
+    CONVERGED = 1                      # attitude measurements flow and the covariance is small
+    PROPAGATING = 2                    # no accepted attitude measurement for a while: gyro only
+    DIVERGED = 3                       # numerically broken or lost: to be reinitialised
+
+
+@dataclass
+class GyroMeasurement:
+    """Mean body rate over the last sample interval (``sensor_msgs/Imu.angular_velocity``)."""
+
+    t: float                           # s of sim time: the end of the interval
+    omega: np.ndarray                  # (3,) rad/s, body axes (nominal mounting)
+    covariance: np.ndarray = _empty(3, 3)   # (rad/s)², the white noise of one sample
+    frame_id: str = ""
+
+
+@dataclass
+class StarTrackerMeasurement:
+    """Attitude of a tracker's sensor frame (``att_msgs/StarTracker``); ``q`` is sensor-to-inertial."""
+
+    t: float                           # s of sim time: the instant measured (the message comes latency later)
+    name: str                          # the tracker (its sensor frame)
+    q: np.ndarray                      # (4,) sensor-to-inertial, x y z w
+    covariance: np.ndarray = _empty(3, 3)   # rad², attitude error about the sensor axes
+    valid: bool = True
+    status: int = TrackerStatus.OK
+    frame_id: str = ""                 # the inertial frame
+
+
+@dataclass
+class MagnetometerMeasurement:
+    """Field in body axes (``sensor_msgs/MagneticField``)."""
+
+    t: float
+    field: np.ndarray                  # (3,) T
+    covariance: np.ndarray = _empty(3, 3)   # T²
+    frame_id: str = ""
+
+
+@dataclass
+class SunSensorMeasurement:
+    """Coarse sun sensor outputs, 1 at normal incidence (``att_msgs/CoarseSunSensors``)."""
+
+    t: float
+    values: np.ndarray                 # (N,) one per detector
+    noise: float = 0.0                 # 1σ of each value
+    frame_id: str = ""
+
+
+@dataclass
+class WheelSpeedMeasurement:
+    """Tachometer speeds relative to the body (``sensor_msgs/JointState.velocity``)."""
+
+    t: float
+    speeds: np.ndarray                 # (N,) rad/s
+    frame_id: str = ""
+
+
+@dataclass
+class SensorTruth:
+    """What the sensors' errors are now (``att_msgs/SensorTruth``): for evaluation only."""
+
+    t: float
+    gyro_bias: np.ndarray = _empty(3)          # rad/s, body axes
+    magnetometer_bias: np.ndarray = _empty(3)  # T
+    frame_id: str = ""
+
+
+@dataclass
+class AttitudeEstimate:
+    """The estimator's output (``att_msgs/AttitudeEstimate``)."""
+
+    t: float
+    q: np.ndarray                      # (4,) body-to-inertial
+    omega: np.ndarray                  # (3,) rad/s: gyro minus the bias estimate
+    gyro_bias: np.ndarray              # (3,) rad/s
+    attitude_covariance: np.ndarray = _empty(3, 3)   # rad², body-frame attitude error
+    bias_covariance: np.ndarray = _empty(3, 3)       # (rad/s)²
+    health: int = Health.INITIALISING
+    time_since_update: float = math.inf              # s since the last attitude fix (tracker, or vectors without one)
+    rejected: int = 0                  # measurements gated out so far
+    message: str = ""
+    frame_id: str = ""
+    body_frame_id: str = ""

@@ -93,6 +93,8 @@ class Inputs:
     dipole: np.ndarray | None = None         # (3,) A m², body axes
     field_body: np.ndarray | None = None     # (3,) T, body axes (needed with dipole), held
     gravity_gradient: np.ndarray | None = None  # (3,) N m, body axes, precomputed, held
+    wheel_drive: Callable | None = None      # (u, ν) -> net wheel torques at relative speeds ν (friction,
+                                             # envelope: att_sim.actuators.WheelDrive); None: ideal motors
 
 
 StageEnvironment = Callable[[float, np.ndarray], tuple[np.ndarray, np.ndarray]]
@@ -143,6 +145,8 @@ def derivative(sc: Spacecraft, x: np.ndarray, inputs: Inputs, stage: tuple | Non
         h = h + sc.wheel_axes @ (sc.wheel_inertia * ws)
         if inputs.wheel_torque is not None:
             u = effective_wheel_torque(sc, ws, inputs.wheel_torque, w)
+            if inputs.wheel_drive is not None:
+                u = inputs.wheel_drive(u, relative_wheel_speed(sc, ws, w))
             torque = torque - sc.wheel_axes @ u
             out[7:] = u / sc.wheel_inertia if sc.wheel_inertia > 0 else 0.0
         else:

@@ -52,8 +52,13 @@ def normalize(q: np.ndarray) -> np.ndarray:
 
 
 def multiply(p: np.ndarray, q: np.ndarray) -> np.ndarray:
-    """Hamilton product ``p ⊗ q`` (scalar last)."""
+    """Hamilton product ``p ⊗ q`` (scalar last). Two single quaternions take the scalar formula
+    (the same operations in the same order as the array one, so the same bits, several times faster)."""
     p, q = np.asarray(p, float), np.asarray(q, float)
+    if p.shape == (4,) and q.shape == (4,):
+        (px, py, pz, pw), (qx, qy, qz, qw) = p.tolist(), q.tolist()
+        return np.array([pw * qx + qw * px + (py * qz - pz * qy), pw * qy + qw * py + (pz * qx - px * qz),
+                         pw * qz + qw * pz + (px * qy - py * qx), pw * qw - (px * qx + py * qy + pz * qz)])
     pv, pw = p[..., :3], p[..., 3:]
     qv, qw = q[..., :3], q[..., 3:]
     v = pw * qv + qw * pv + np.cross(pv, qv)
@@ -178,3 +183,20 @@ def error_vector(q: np.ndarray, q_ref: np.ndarray) -> np.ndarray:
 def propagate_constant_rate(q: np.ndarray, omega: np.ndarray, dt: float) -> np.ndarray:
     """Exact attitude after ``dt`` at constant body rate: ``q ⊗ exp(omega dt)``."""
     return multiply(q, exp_map(np.asarray(omega) * dt))
+
+
+def log_map(q: np.ndarray) -> np.ndarray:
+    """Rotation vector (axis × angle, angle in [0, π]) of a single quaternion: the inverse of :func:`exp_map`."""
+    axis, angle = to_axis_angle(q)
+    return axis * angle
+
+
+OFF_DIAGONAL = ((0, 1), (0, 2), (1, 0), (1, 2), (2, 0), (2, 1))
+
+
+def small_error_matrix(rng: np.random.Generator, scale_sigma: float, misalignment_sigma: float) -> np.ndarray:
+    """``I + S + M``: scale factors on the diagonal, misalignment angles off it, drawn from their 1σ."""
+    m = np.eye(3) + np.diag(rng.normal(0.0, scale_sigma, 3))
+    for (i, j), angle in zip(OFF_DIAGONAL, rng.normal(0.0, misalignment_sigma, 6)):
+        m[i, j] = angle
+    return m

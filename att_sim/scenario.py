@@ -33,9 +33,11 @@ from att_msgs_py.types import ZONE_BODIES, Zone
 from att_sim import disturbances
 from att_sim import epoch as epochs
 from att_sim import orbit as orbits
+from att_sim.actuators import ActuatorSpecs, actuators_from_params
 from att_sim.dynamics import Spacecraft
 from att_sim.environment import OrbitParams
 from att_sim.geomagnetic import GeomagneticField
+from att_sim.sensors.specs import SensorSpecs, sensors_from_params
 
 CONFIG_ENV = "ATT_CONFIG_PATH"
 
@@ -79,13 +81,16 @@ class Scenario:
     field_model: str = "dipole"                    # 'dipole' (Bruni–Celani) or 'igrf14'
     environment: dict = field(default_factory=dict)   # environment_from_params of the 'environment' group
     zones: list[Zone] = field(default_factory=list)   # zones_from_params of the 'zones' group
+    sensors: SensorSpecs = field(default_factory=SensorSpecs)        # the 'sensors' group (issue 14)
+    actuators: ActuatorSpecs = field(default_factory=ActuatorSpecs)  # the 'actuators' group (issue 14)
 
 
 SPACECRAFT_KEYS = ("inertia", "torque_max", "wheel_axes", "wheel_inertia", "wheel_torque_max", "wheel_speed_max",
                    "dipole_max")
 LIMIT_KEYS = ("torque_max", "wheel_torque_max", "wheel_speed_max", "dipole_max")   # > 0 (.inf: no limit)
 ORBIT_KEYS = ("altitude", "inclination_deg", "raan_deg", "arg0")
-SHARED_KEYS = ("frame_id", "body_frame_id", "spacecraft", "orbit", "epoch", "field_model", "environment", "zones")
+SHARED_KEYS = ("frame_id", "body_frame_id", "spacecraft", "orbit", "epoch", "field_model", "environment", "zones",
+               "sensors", "actuators")
 FIELD_MODELS = ("dipole", "igrf14")
 ENVIRONMENT_KEYS = ("gravity_gradient", "solar_pressure", "drag", "drag_coefficient", "residual_dipole", "facets")
 ZONE_KEYS = ("name", "body", "sensor_axis", "half_angle_deg", "keep_in", "direction")
@@ -328,6 +333,20 @@ def zones_from_params(path, shared: dict, epoch: datetime | None) -> list[Zone]:
     return zones
 
 
+def sensors_and_actuators(path, shared: dict, epoch: datetime | None) -> tuple[SensorSpecs, ActuatorSpecs]:
+    """The ``sensors`` (:mod:`att_sim.sensors.specs`) and ``actuators`` (:mod:`att_sim.actuators`)
+    groups, checked; Sun and Moon exclusions and sun sensors need the epoch."""
+    try:
+        sensors = sensors_from_params(shared.get("sensors", {}), epoch is not None)
+    except ValueError as err:
+        raise _attached(path, "sensors", err) from None
+    try:
+        actuators = actuators_from_params(shared.get("actuators", {}))
+    except ValueError as err:
+        raise _attached(path, "actuators", err) from None
+    return sensors, actuators
+
+
 def spacecraft_from_params(p: dict) -> Spacecraft:
     """Build a Spacecraft from the ``spacecraft`` parameter group (SI units)."""
     inertia = np.asarray(p["inertia"], float)
@@ -376,6 +395,7 @@ def load(name: str) -> Scenario:
     nodes = {k: v["ros__parameters"] for k, v in doc.items() if k != "/**"}
     epoch = epoch_from_params(path, shared)
     orbit_model = orbit_model_from_params(path, shared, epoch)
+    sensors, actuators = sensors_and_actuators(path, shared, epoch)
     return Scenario(
         name=path.stem, path=path,
         spacecraft=spacecraft_from_params(shared["spacecraft"]),
@@ -384,7 +404,7 @@ def load(name: str) -> Scenario:
         node_params=nodes, epoch=epoch, orbit_model=orbit_model,
         field_model=field_model_from_params(path, shared, epoch),
         environment=environment_from_params(path, shared, epoch),
-        zones=zones_from_params(path, shared, epoch))
+        zones=zones_from_params(path, shared, epoch), sensors=sensors, actuators=actuators)
 
 
 def load_checked(name: str) -> Scenario:

@@ -26,8 +26,12 @@ from att_sim import dynamics as dyn
 from att_sim import environment as env
 from att_sim import rotations as rot
 from att_sim import world
+from att_sim.actuators import ActuatorSpecs, Magnetorquers, WheelDrive
 from att_sim.orbit import CircularOrbit
+from att_sim.sensors import Readings, SensorSuite, rng
+from att_sim.sensors.specs import SensorSpecs
 
+DEFAULT_STEP = 0.05             # s: the simulator's RK4 step unless its parameter says otherwise
 MAX_ORBIT_PHASE = 1e6          # rad: |orbit_phase| of a reset (beyond it the phase drowns in rounding)
 
 
@@ -82,11 +86,15 @@ def _number(value, name: str, code: ErrorCode, low: float = -math.inf, high: flo
 class Simulation:
     """Truth state, held actuator command and environment. Give ``orbit`` (today's circular orbit
     with the tilted dipole and optional ``gravity_gradient``) or a :class:`att_sim.world.Environment`
-    (:meth:`for_scenario` builds the scenario's)."""
+    (:meth:`for_scenario` builds the scenario's). ``sensors`` and ``actuators`` (issue 14): the
+    datasheets of the sensors :meth:`sense` samples and of the imperfect wheel drives and
+    magnetorquers; ``seed`` (default: the sensors' ``seed``) makes every random stream of the run."""
 
     def __init__(self, sc: dyn.Spacecraft, orbit: env.OrbitParams | None = None, q0=rot.IDENTITY,
                  omega0=(0, 0, 0), wheel_speed0=None, gravity_gradient: bool = False, checks: Checks = Checks(),
-                 environment: world.Environment | None = None):
+                 environment: world.Environment | None = None, sensors: SensorSpecs | None = None,
+                 actuators: ActuatorSpecs | None = None, seed: int | None = None,
+                 frame_id: str = "", body_frame_id: str = ""):
         if (orbit is None) == (environment is None):
             raise ValueError("Simulation needs either orbit parameters or an environment, not both")
         self.sc, self.checks = sc, checks
@@ -102,6 +110,12 @@ class Simulation:
         self.applied = Applied(np.zeros(sc.n_wheels))
         self.now = self.environment.sample(self.t, self.x[:4])
         self.arg0 = self._arg0()
+        sensors, actuators = sensors or SensorSpecs(), actuators or ActuatorSpecs()
+        self.seed = sensors.seed if seed is None else int(seed)
+        self.sensors = SensorSuite(sensors, self.seed, frame_id, body_frame_id) if sensors else None
+        self.wheel_drive = WheelDrive(actuators.wheels, rng(self.seed, "wheel_drive")) if actuators.wheels else None
+        self.magnetorquers = (Magnetorquers(actuators.magnetorquers, rng(self.seed, "magnetorquers"))
+                              if actuators.magnetorquers else None)
 
     def _arg0(self) -> float | None:
         """A circular orbit's argument of latitude at t = 0 (rad; None for an orbit of elements or a TLE)."""
@@ -110,11 +124,14 @@ class Simulation:
 
     @classmethod
     def for_scenario(cls, scenario, q0=rot.IDENTITY, omega0=(0, 0, 0), wheel_speed0=None,
-                     gravity_gradient: bool | None = None, checks: Checks = Checks()) -> Simulation:
-        """The simulation of a :class:`att_sim.scenario.Scenario` in its environment
-        (``gravity_gradient``, when given, overrides the scenario's)."""
+                     gravity_gradient: bool | None = None, checks: Checks = Checks(),
+                     seed: int | None = None) -> Simulation:
+        """The simulation of a :class:`att_sim.scenario.Scenario` in its environment, with its
+        sensors and actuators (``gravity_gradient`` and ``seed``, when given, override the scenario's)."""
         return cls(scenario.spacecraft, q0=q0, omega0=omega0, wheel_speed0=wheel_speed0, checks=checks,
-                   environment=world.Environment.from_scenario(scenario, gravity_gradient))
+                   environment=world.Environment.from_scenario(scenario, gravity_gradient),
+                   sensors=scenario.sensors, actuators=scenario.actuators, seed=seed, frame_id=scenario.frame_id,
+                   body_frame_id=scenario.body_frame_id)
 
     def set_command(self, command: Command) -> Refusal | None:
         """Accept a command (None) or say why it is refused; a refused command changes nothing."""
@@ -176,6 +193,8 @@ class Simulation:
             return Refusal(err.code, err.message)
         self.x, self.environment = x, environment
         self.halted, self.halt_reason = False, ""
+        if self.sensors is not None:
+            self.sensors.gyro_last = None       # a reset is no motion the gyro could have measured
         self.now, self.arg0 = self.environment.sample(self.t, self.x[:4]), self._arg0()
         return None
 
@@ -223,13 +242,27 @@ class Simulation:
                      command_timeout=self.command_timeout, frame_id=frame_id, body_frame_id=body_frame_id)
 
     def inputs(self) -> dyn.Inputs:
-        """Actuator inputs for the next step: limits applied, zero while the command watchdog is tripped."""
+        """Actuator inputs for the next step: limits applied, zero while the command watchdog is
+        tripped; through the imperfect drives and coils when the scenario has them."""
         w, ws = self.x[4:7], self.x[7:]
         active = not self.command_timeout
-        u = dyn.effective_wheel_torque(self.sc, ws, self.wheel_cmd if active else np.zeros_like(self.wheel_cmd), w)
+        u = self.wheel_cmd if active else np.zeros_like(self.wheel_cmd)
+        if self.wheel_drive is not None and active:      # the watchdog disables the drives: no torque at all
+            u = self.wheel_drive.hold(u)
+        u = dyn.effective_wheel_torque(self.sc, ws, u, w)
         m = np.clip(self.dipole_cmd, -self.sc.dipole_max, self.sc.dipole_max) if active else np.zeros(3)
+        if self.magnetorquers is not None:
+            m = self.magnetorquers(m)
         tau = np.clip(self.body_cmd, -self.sc.body_torque_max, self.sc.body_torque_max) if active else np.zeros(3)
-        return dyn.Inputs(wheel_torque=u, body_torque=tau, dipole=m)
+        return dyn.Inputs(wheel_torque=u, body_torque=tau, dipole=m, wheel_drive=self.wheel_drive)
+
+    def sense(self) -> Readings:
+        """What the sensors output now (nothing without sensors): see :class:`att_sim.sensors.SensorSuite`."""
+        if self.sensors is None:
+            return Readings()
+        x = self.x
+        return self.sensors.sample(self.t, x[:4], x[4:7], dyn.relative_wheel_speed(self.sc, x[7:], x[4:7]),
+                                   self.now.field_B, self.applied.dipole, self.environment.bodies(self.t))
 
     def advance(self, dt: float) -> None:
         """One RK4 step, the actuator inputs held and the environment evaluated at every stage; a
@@ -254,6 +287,11 @@ class Simulation:
             self.halt_reason = f"state became non-finite at t = {self.t:.3f} s; propagation stopped"
             return
         mean = sum(w * dyn.external_torque(self.sc, inp, None, s) for w, s in zip((1, 2, 2, 1), stages)) / 6.0
-        self.applied = Applied(inp.wheel_torque, inp.dipole, mean - self.sc.wheel_axes @ inp.wheel_torque)
+        motor = net = inp.wheel_torque          # at the step's start: motor torque, and less friction
+        if self.wheel_drive is not None:
+            speed = dyn.relative_wheel_speed(self.sc, self.x[7:], self.x[4:7])
+            motor = self.wheel_drive.motor(inp.wheel_torque, speed)
+            net = self.wheel_drive(inp.wheel_torque, speed)
+        self.applied = Applied(motor, inp.dipole, mean - self.sc.wheel_axes @ net)
         self.x, self.now = x_new, now
         self.t += dt

@@ -6,7 +6,14 @@ no lock or cross-thread wake-up sits in the control loop.
 
 Subscribes ``/actuator/command`` (ActuatorCommand), publishes ``/spacecraft/state``
 (SpacecraftState) at ``publish_rate`` and ``/clock`` at ``clock_rate`` (Hz of sim time), serves
-``/simulator/reset``. The world is the scenario's (:meth:`att_sim.simulation.Simulation.for_scenario`:
+``/simulator/reset``. With the scenario's sensors (issue 14) it also publishes what they measure,
+each at its own rate (:class:`att_sim.sensors.SensorSuite`): ``/sensors/imu`` (sensor_msgs/Imu),
+``/sensors/star_tracker`` (att_msgs/StarTracker), ``/sensors/magnetometer``
+(sensor_msgs/MagneticField), ``/sensors/sun_sensors`` (att_msgs/CoarseSunSensors),
+``/sensors/wheel_speeds`` (sensor_msgs/JointState) and, for evaluation only,
+``/simulator/sensor_truth`` (the gyro's actual bias); every noise source is drawn from the ``seed``
+parameter (default: the scenario's ``sensors.seed``). The world is the scenario's
+(:meth:`att_sim.simulation.Simulation.for_scenario`:
 orbit, field model, disturbances, epoch = sim time zero); the state's position is in the scenario's
 ``frame_id`` (GCRS with an epoch) and its field is the one at the published state. Runs at
 ``real_time_factor`` × wall time (0: as fast as possible).
@@ -19,8 +26,10 @@ is never integrated and is logged at most once a second with the running count. 
 command arrived for ``command_timeout`` s of sim time the actuator inputs are zeroed and the state
 says so. In lockstep, a state that no command answers within ``lockstep_timeout`` s of wall time
 ends the waiting: the simulator free-runs at its real-time factor with zero inputs
-(``command_timeout`` set) until a command answers again. A non-finite state stops the propagation
-(reported, the node stays up).
+(``command_timeout`` set) until a command answers again; with a real-time factor of 0 (as fast
+as possible) it free-runs at real time, so that consumers that fell behind (the estimator and the
+controller after a stall) catch up and answer again instead of drowning in states. A non-finite
+state stops the propagation (reported, the node stays up).
 """
 from __future__ import annotations
 
@@ -31,14 +40,17 @@ import numpy as np
 import rclpy
 from rclpy.node import Node
 from rosgraph_msgs.msg import Clock
+from sensor_msgs.msg import Imu, JointState, MagneticField
 
-from att_msgs.msg import ActuatorCommand, SpacecraftState
+from att_msgs.msg import ActuatorCommand, CoarseSunSensors, SensorTruth, SpacecraftState, StarTracker
 from att_msgs.srv import ResetSimulator
 from att_msgs_py import convert, qos, topics, validation
 from att_msgs_py.errors import ConfigError, ErrorCode, RequestError, clip
 from att_msgs_py.node_runner import parameter_reader, run_node, spin_until_shutdown
 from att_sim import scenario as scen
-from att_sim.simulation import Checks, Refusal, Simulation
+from att_sim.simulation import DEFAULT_STEP, Checks, Refusal, Simulation
+
+FREE_RUN_PACE = 1.0        # real-time factor of a free-running simulator whose real_time_factor is 0 (max)
 
 
 class SimulatorNode(Node):
@@ -58,12 +70,13 @@ class SimulatorNode(Node):
                 gravity_gradient=param["gravity_gradient"],
                 checks=Checks(command_limit_factor=param["command_limit_factor"],
                               max_reset_rate=param["max_reset_rate"], body_frame_id=self.scenario.body_frame_id,
-                              stamp_ahead=self.step, stamp_age=self.command_timeout))
+                              stamp_ahead=self.step, stamp_age=self.command_timeout), seed=param["seed"])
         except ValueError as err:        # the environment cannot start (e.g. a TLE that fails at t = 0)
             raise ConfigError(ErrorCode.INVALID_CONFIG, f"scenario '{self.scenario.name}': {clip(err, 300)}") from None
 
         self.state_pub = self.create_publisher(SpacecraftState, topics.STATE, qos.STREAM_QOS)
         self.clock_pub = self.create_publisher(Clock, topics.CLOCK, qos.CLOCK_QOS)
+        self.sensor_pubs = self.sensor_publishers()
         self.create_subscription(ActuatorCommand, topics.COMMAND, self.on_command, qos.STREAM_QOS)
         self.create_service(ResetSimulator, topics.RESET_SIMULATOR, self.on_reset)
         e = self.sim.environment
@@ -86,7 +99,7 @@ class SimulatorNode(Node):
                 raise ConfigError(err.code, err.message + hint) from None
 
         inf = math.inf
-        self.step = param("step", 0.05, 0.0, 1.0, low_open=True)
+        self.step = param("step", DEFAULT_STEP, 0.0, 1.0, low_open=True)
         per_step = dict(hint=" (at most 1/step: one per integration step)", low_open=True)
         top = (1 + 1e-9) / self.step
         self.publish_period = 1.0 / param("publish_rate", min(10.0, 1.0 / self.step), 0.0, top, **per_step)
@@ -108,7 +121,8 @@ class SimulatorNode(Node):
             # default: the scenario's environment.gravity_gradient (false without it)
             "gravity_gradient": param("gravity_gradient", bool(self.scenario.environment.get("gravity_gradient"))),
             "initial_attitude": param("initial_attitude", [0.0, 0.0, 0.0, 1.0], -inf, inf, length=4),
-            "initial_rate": param("initial_rate", [0.0, 0.0, 0.0], -inf, inf, length=3)}
+            "initial_rate": param("initial_rate", [0.0, 0.0, 0.0], -inf, inf, length=3),
+            "seed": param("seed", self.scenario.sensors.seed, 0, 2**63 - 1)}
         try:
             values["initial_attitude"] = validation.unit_quaternion(
                 values["initial_attitude"], "parameter 'initial_attitude'", ErrorCode.INVALID_PARAMETER)
@@ -120,6 +134,18 @@ class SimulatorNode(Node):
                                                            f"max_reset_rate = {values['max_reset_rate']:g} rad/s")
         read.refuse_unknown()
         return values
+
+    def sensor_publishers(self) -> dict:
+        """Publishers of the sensors the scenario has, by :class:`att_sim.sensors.Readings` field."""
+        s = self.scenario.sensors
+        wanted = {"gyro": (s.gyro, Imu, topics.IMU),
+                  "star_trackers": (s.star_trackers, StarTracker, topics.STAR_TRACKER),
+                  "magnetometer": (s.magnetometer, MagneticField, topics.MAGNETOMETER),
+                  "sun_sensors": (s.sun_sensors, CoarseSunSensors, topics.SUN_SENSORS),
+                  "wheel_speeds": (s.tachometer, JointState, topics.WHEEL_SPEEDS),
+                  "truth": (s.gyro, SensorTruth, topics.SENSOR_TRUTH)}
+        return {name: self.create_publisher(kind, topic, qos.STREAM_QOS)
+                for name, (present, kind, topic) in wanted.items() if present}
 
     # -- callbacks: translate messages to Simulation calls -------------------------------------
     def on_command(self, msg: ActuatorCommand):
@@ -168,10 +194,10 @@ class SimulatorNode(Node):
         state_every = max(1, round(self.publish_period / self.step))
         clock_every = max(1, round(self.clock_period / self.step))
         give_up = time.monotonic() + self.start_timeout
-        while self.state_pub.get_subscription_count() < self.wait_for_subscribers:
+        while self.listeners() < self.wait_for_subscribers:
             if time.monotonic() > give_up:
-                self.get_logger().warning(f"starting with {self.state_pub.get_subscription_count()} of "
-                                          f"{self.wait_for_subscribers} expected state subscribers")
+                self.get_logger().warning(f"starting with {self.listeners()} of {self.wait_for_subscribers} "
+                                          "expected subscribers")
                 break
             executor.spin_once(timeout_sec=0.05)
         k = 0
@@ -194,9 +220,18 @@ class SimulatorNode(Node):
             k += 1
             self.publish(k, state_every, clock_every)
             executor.spin_once(timeout_sec=0.0)
-            if self.real_time_factor > 0:
+            pace = self.real_time_factor or (FREE_RUN_PACE if self.free_running else 0.0)
+            if pace > 0:
                 wall0, sim0 = self.pace
-                self.spin_until(lambda: False, wall0 + (self.sim.t - sim0) / self.real_time_factor)
+                self.spin_until(lambda: False, wall0 + (self.sim.t - sim0) / pace)
+
+    def listeners(self) -> int:
+        """Subscriptions to the state, plus the nodes that listen only to the sensors (the estimator,
+        and the controller flying on the estimate): recorder and controller, and the estimator."""
+        def nodes(topic):
+            return {(i.node_namespace, i.node_name) for i in self.get_subscriptions_info_by_topic(topic)}
+        sensor_nodes = set().union(*(nodes(p.topic_name) for p in self.sensor_pubs.values()))
+        return self.state_pub.get_subscription_count() + len(sensor_nodes - nodes(self.state_pub.topic_name))
 
     def spin_until(self, done, deadline: float) -> None:
         """Run callbacks until ``done()`` or the monotonic ``deadline``."""
@@ -208,6 +243,7 @@ class SimulatorNode(Node):
 
     def publish(self, k: int, state_every: int, clock_every: int):
         t = self.sim.t
+        self.publish_readings()
         if k % clock_every == 0:
             self.clock_pub.publish(Clock(clock=convert.time_msg(t)))
         if k % state_every == 0:
@@ -227,6 +263,19 @@ class SimulatorNode(Node):
                 f"no command answered the state at t = {self.awaited_stamp:.3f} s within {self.lockstep_timeout:g} s: "
                 f"free-running at RTF {self.real_time_factor or 'max'} with zero actuator inputs until one does",
                 throttle_duration_sec=1.0)
+
+    def publish_readings(self) -> None:
+        """What the sensors measure now (before the state: the estimator's gyro sample must be out
+        before the lockstep waits for the command that answers the state)."""
+        r = self.sim.sense()
+        for name, make in (("gyro", convert.gyro_msg), ("magnetometer", convert.magnetometer_msg),
+                           ("sun_sensors", convert.sun_sensors_msg), ("wheel_speeds", convert.wheel_speeds_msg),
+                           ("truth", convert.sensor_truth_msg)):
+            reading = getattr(r, name)
+            if reading is not None:
+                self.sensor_pubs[name].publish(make(reading))
+        for m in r.star_trackers:
+            self.sensor_pubs["star_trackers"].publish(convert.star_tracker_msg(m))
 
     def state_message(self) -> SpacecraftState:
         return convert.state_msg(self.sim.state(self.scenario.frame_id, self.scenario.body_frame_id))

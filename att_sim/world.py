@@ -63,6 +63,19 @@ class Sample(NamedTuple):
     shadow: float             # visible fraction of the solar disc (1 without a sky)
 
 
+class Bodies(NamedTuple):
+    """What the sensors see at one time (inertial axes): the spacecraft's position, the field, and
+    unit directions from the spacecraft (Sun and Moon None without a sky)."""
+
+    position: np.ndarray      # m
+    field_N: np.ndarray       # T
+    nadir: np.ndarray         # unit, −r̂
+    earth_radius: float       # rad, the Earth's angular radius asin(R_E/|r|)
+    sun: np.ndarray | None    # unit
+    moon: np.ndarray | None   # unit
+    shadow: float             # visible fraction of the solar disc (1 without a sky)
+
+
 class _Now(NamedTuple):
     """What depends on time only."""
 
@@ -158,6 +171,17 @@ class Environment:
             self._cache.pop(next(iter(self._cache)))
         self._cache[t] = got
         return got
+
+    def bodies(self, t: float) -> Bodies:
+        """Position, field and the directions of the Earth, Sun and Moon at time ``t``."""
+        now = self._now(t)
+        rn = float(np.linalg.norm(now.r))
+        sun = moon = None
+        if self.sky is not None:
+            sun = now.sun_N
+            moon = np.asarray(self.sky.moon_direction(t), float)
+        return Bodies(now.r.copy(), now.field_N.copy(), -now.r / rn, math.asin(min(1.0, EARTH_RADIUS / rn)), sun,
+                      moon, now.shadow)
 
     # -- per attitude --------------------------------------------------------------------------
     def torques(self, t: float, q: np.ndarray) -> dict[str, np.ndarray]:

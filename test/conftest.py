@@ -12,7 +12,7 @@ from pathlib import Path
 import pytest
 
 from att_planner.nodes.client import SuiteClient, client_session
-from att_planner.tools.launch import Suite, isolated_env, join_env, start_suite
+from att_planner.tools.launch import Suite, default_nodes, isolated_env, join_env, start_suite
 
 
 def wait_for_controller_step(client: SuiteClient, timeout: float = 30.0) -> None:
@@ -31,6 +31,24 @@ def wait_for_controller_step(client: SuiteClient, timeout: float = 30.0) -> None
         rclpy.spin_once(client, timeout_sec=0.05)
     client.destroy_subscription(sub)
     assert any(stepped), f"the controller did not step on a state within {timeout:g} s"
+
+
+def wait_for_converged_estimate(client: SuiteClient, timeout: float = 30.0) -> None:
+    """Spin until the estimator publishes a converged attitude (a goal sent before it is answered
+    ESTIMATE_UNHEALTHY: a race, not what the tests are about)."""
+    import rclpy
+
+    from att_msgs.msg import AttitudeEstimate
+    from att_msgs_py import qos, topics
+
+    converged = []
+    sub = client.create_subscription(AttitudeEstimate, topics.ESTIMATE,
+                                     lambda m: converged.append(m.health == m.HEALTH_CONVERGED), qos.STREAM_QOS)
+    end = time.monotonic() + timeout
+    while not any(converged) and time.monotonic() < end:
+        rclpy.spin_once(client, timeout_sec=0.05)
+    client.destroy_subscription(sub)
+    assert any(converged), f"the estimate did not converge within {timeout:g} s"
 
 
 @pytest.fixture(scope="session", autouse=True)
@@ -59,15 +77,17 @@ class RosSuite:
 @pytest.fixture(scope="session")
 def ros_suite(tmp_path_factory):
     """Factory of running suites: ``with ros_suite("swift_demo", params=...) as s:`` starts the
-    ``nodes`` of a scenario on a fresh isolated domain (simulator held at t = 0 until the recorder
+    ``nodes`` of a scenario (default: its whole run, :func:`att_planner.tools.launch.default_nodes`)
+    on a fresh isolated domain (simulator held at t = 0 until the recorder
     and controller listen), joins a :class:`SuiteClient` to it and waits for the services and for
     the controller's first step on a state (when both run); on exit
     every node is stopped and must have ended."""
 
     @contextmanager
-    def start(scenario: str, *, nodes=("recorder", "simulator", "controller", "planner"), params=None,
+    def start(scenario: str, *, nodes=None, params=None,
               schedule: bool = False, name: str = "test_client"):
         out = tmp_path_factory.mktemp(name)
+        nodes = default_nodes(scenario) if nodes is None else nodes
         env = isolated_env()
         join_env(env)
         suite = start_suite(scenario, out / "run.mcap", out, env=env, nodes=nodes, params=params)
@@ -78,6 +98,8 @@ def ros_suite(tmp_path_factory):
                     client.wait_for_servers(timeout=60, schedule=schedule)
                 if "simulator" in nodes and "controller" in nodes:
                     wait_for_controller_step(client)
+                if "simulator" in nodes and "estimator" in nodes:
+                    wait_for_converged_estimate(client)
                 running = RosSuite(suite, client, out / "run.mcap")
                 yield running
         finally:

@@ -54,7 +54,9 @@ def flatten(msg, prefix: str = "") -> dict:
         if isinstance(value, (bool, int, float, str, bytes)):
             out[key] = value
         elif isinstance(value, (list, tuple)) or isinstance(value, np.ndarray):
-            if len(value) and not isinstance(value[0], (bool, int, float, np.generic)):
+            if len(value) and isinstance(value[0], str):
+                out[key] = list(value)
+            elif len(value) and not isinstance(value[0], (bool, int, float, np.generic)):
                 items = [flatten(v) for v in value]
                 out[key] = [item.get("", item) for item in items]
                 if items and "" in items[0]:

@@ -40,10 +40,12 @@ from att_msgs_py import signing, validation
 from att_msgs_py.errors import ErrorCode, RequestError
 from att_msgs_py.types import (
     CONTROL_MODES,
+    AttitudeEstimate,
     Command,
     ControlKind,
     ControllerStatus,
     ControlMode,
+    Health,
     ManeuverFeedback,
     ManeuverResult,
     Plan,
@@ -51,6 +53,7 @@ from att_msgs_py.types import (
 )
 from att_planner.control import tracking
 from att_planner.control.magnetorquer import dipole_command
+from att_planner.control.measured_state import MeasuredState
 from att_planner.control.plan_checks import PlanContext, check_plan, check_start
 from att_planner.control.state_gate import GateConfig, StateGate
 from att_planner.zones import ZoneSky, zones_from_cones
@@ -123,11 +126,20 @@ MAX_REMEMBERED_REFUSALS = 1000                 # refused plan ids whose reason a
 ZONE_FIT_WINDOW = 1.0                          # s: a ZoneSky needs a window; the controller uses its truth only
 
 
+USABLE = (Health.CONVERGED, Health.PROPAGATING)   # estimates the attitude laws may fly on
+
+
 class Controller:
     def __init__(self, context: PlanContext, config: ControllerConfig = ControllerConfig(),
                  mode: int = ControlMode.IDLE, body_frame_id: str = "body", gate: GateConfig | None = None,
-                 sky: Sky | None = None):
+                 sky: Sky | None = None, measured: MeasuredState | None = None, friction=None):
+        """``measured``: fly on attitude estimates (:meth:`accept_estimate`) with measured wheel
+        speeds and field, blanking the magnetometer; None: on truth states (:meth:`accept_state`).
+        ``friction``: the wheel drives' expected friction torque at relative speeds ν (a callable,
+        :meth:`att_sim.actuators.WheelDriveSpec.friction`), compensated in every wheel command."""
         self.context, self.config, self.mode, self.body_frame_id = context, config, mode, body_frame_id
+        self.measured, self.friction = measured, friction
+        self.estimate_health: Health | None = None     # of the latest accepted estimate
         self.sky = sky                                 # the scenario's (time: sim time), None without an epoch
         self.gate = StateGate(context.spacecraft, context.frame_id, body_frame_id, gate or GateConfig())
         self.next_control = -math.inf
@@ -176,6 +188,38 @@ class Controller:
             out.note = (f"the spacecraft rotates at {rate:.4g} rad/s (above safe_rate_threshold "
                         f"{self.config.safe_rate_threshold:g} rad/s): rate damping (safe mode)")
         return out
+
+    def accept_estimate(self, estimate: AttitudeEstimate, wall: float = 0.0,
+                        source: bytes | None = None) -> StateOutcome:
+        """Fly on ``estimate`` (with the measured wheel speeds and field) if the state it makes passes
+        the gate; an estimate that cannot be flown (initialising, diverged) ends a maneuver and the
+        attitude modes in safe mode (rate damping on the gyro's rate)."""
+        try:
+            state = self.measured.compose(estimate)
+        except RequestError as err:
+            return StateOutcome(refused=err)
+        out = self.accept_state(state, wall, None, source)
+        if out.refused is not None:
+            return out
+        self.estimate_health = Health(estimate.health)
+        if self.estimate_health in USABLE:
+            return out
+        why = f"the attitude estimate is {self.estimate_health.name.lower()}"
+        if self.maneuver is not None:
+            out.ended = self.abort(f"aborted: {why}")
+            out.note = f"{why}: maneuver aborted, safe mode (rate damping)"
+        elif self.mode in (ControlMode.MAGNETORQUER_PD, ControlMode.PLAN_TRACKING):
+            self.mode, self.hold_q = ControlMode.SAFE, None
+            out.note = f"{why}: safe mode (rate damping)"
+        return out
+
+    def estimate_refusal(self) -> RequestError | None:
+        """Why the attitude laws cannot start now on the estimate (None in truth mode or when they can)."""
+        if self.measured is None or self.estimate_health == Health.CONVERGED:
+            return None
+        health = "none yet" if self.estimate_health is None else self.estimate_health.name.lower()
+        return RequestError(ErrorCode.ESTIMATE_UNHEALTHY, f"the attitude estimate is not converged ({health}); "
+                                                          "attitude modes start on a converged estimate")
 
     def _remember(self, plan: Plan, payload: bytes) -> RequestError | None:
         """Record ``plan``'s id with its content; refuse a different plan under a known id."""
@@ -239,6 +283,9 @@ class Controller:
         if self.maneuver is not None and mode != ControlMode.SAFE:
             return ErrorCode.BUSY, (f"maneuver '{self.maneuver.plan.plan_id}' is executing: only MODE_SAFE "
                                     "(abort) is accepted until it ends or is cancelled"), None
+        refused = self.estimate_refusal() if mode == ControlMode.MAGNETORQUER_PD else None
+        if refused is not None:
+            return refused.code, refused.message, None
         ended = self.abort("aborted by a switch to safe mode") if self.maneuver is not None else None
         self.mode = mode
         return ErrorCode.OK, f"mode set to {mode}", ended
@@ -267,7 +314,7 @@ class Controller:
         """Start flying ``plan`` (resolved) from the latest state, if it starts there."""
         if self.state is None:
             return RequestError(ErrorCode.NO_STATE, "no spacecraft state received yet")
-        refused = check_start(plan, self.state, self.context)
+        refused = self.estimate_refusal() or check_start(plan, self.state, self.context)
         if refused is not None:
             return refused
         try:
@@ -310,15 +357,18 @@ class Controller:
         status = ControllerStatus(mode=self.mode, t=s.t, frame_id=self.body_frame_id)
         out = StepOutput(cmd, status)
         if self.mode == ControlMode.MAGNETORQUER_PD:
-            cmd.dipole = dipole_command(s.q, s.omega, s.field_body, self.config.kp, self.config.kd, self.m_max)
+            blank = self.measured is not None and self.measured.blank(s.t, self.config.control_period)
+            if not blank:
+                cmd.dipole = dipole_command(s.q, s.omega, s.field_body, self.config.kp, self.config.kd, self.m_max)
         elif self.mode == ControlMode.SAFE:
-            cmd.wheel_torques = tracking.wheel_torques(self.spacecraft, -self.config.safe_kd * s.omega, s.omega,
-                                                       s.wheel_speeds)
+            cmd.wheel_torques = self._wheels(-self.config.safe_kd * s.omega)
         elif self.mode == ControlMode.PLAN_TRACKING and self.maneuver is not None:
             self._track(out, cancel_requested)
         elif self.mode == ControlMode.PLAN_TRACKING and self.hold_q is not None:
             cmd.wheel_torques = self._wheel_command(tracking.Reference(self.hold_q, np.zeros(3), np.zeros(3)))
             status.message = "holding the final attitude of the last maneuver"
+        if self.measured is not None:
+            self.measured.dipoles.record(s.t, cmd.dipole)
         return out
 
     def stale_command(self) -> tuple[Command, ControllerStatus]:
@@ -329,11 +379,20 @@ class Controller:
                 ControllerStatus(mode=self.mode, t=t, state_stale=True, message="no state (wall clock)",
                                  frame_id=self.body_frame_id))
 
+    def _wheels(self, body_torque: np.ndarray, wheel_speed: np.ndarray | None = None) -> np.ndarray:
+        """Motor torques that put ``body_torque`` on the body, the expected drive friction compensated
+        (``wheel_speed``: the inertial spin rates the gyroscopic term uses; default the state's)."""
+        s = self.state
+        friction = None
+        if self.friction is not None:
+            friction = self.friction(s.wheel_speeds - self.spacecraft.wheel_axes.T @ s.omega)
+        return tracking.wheel_torques(self.spacecraft, body_torque, s.omega,
+                                      s.wheel_speeds if wheel_speed is None else wheel_speed, friction)
+
     def _wheel_command(self, ref: tracking.Reference) -> np.ndarray:
         """Wheel torques of the tracking law about a body-torque reference."""
         s, c = self.state, self.config
-        tau = tracking.tracking_torque(s.q, s.omega, ref, c.tracking_kp, c.tracking_kd)
-        return tracking.wheel_torques(self.spacecraft, tau, s.omega, s.wheel_speeds)
+        return self._wheels(tracking.tracking_torque(s.q, s.omega, ref, c.tracking_kp, c.tracking_kd))
 
     def _track(self, out: StepOutput, cancel_requested: bool) -> None:
         """One plan-tracking step: command, feedback every ``feedback_period``, the end."""
@@ -345,7 +404,7 @@ class Controller:
             # the plan's wheel torques as feedforward, PD feedback about its reference states
             fb = tracking.tracking_torque(s.q, s.omega, tracking.Reference(ref.q, ref.omega, np.zeros(3)),
                                           self.config.tracking_kp, self.config.tracking_kd)
-            u = ref.torque + tracking.wheel_torques(sc, fb, s.omega, np.zeros(sc.n_wheels))
+            u = ref.torque + self._wheels(fb, np.zeros(sc.n_wheels))
             u = np.clip(u, -sc.wheel_torque_max, sc.wheel_torque_max)
         else:
             u = self._wheel_command(ref)

@@ -67,9 +67,13 @@ def tracking_torque(q, omega, ref: Reference, kp: float, kd: float) -> np.ndarra
     return ref.torque - kp * 2.0 * e - kd * (np.asarray(omega) - ref.omega)
 
 
-def wheel_torques(sc: Spacecraft, body_torque, omega, wheel_speed) -> np.ndarray:
-    """Motor torques u that put ``body_torque`` on the body (gyroscopic wheel term compensated)."""
+def wheel_torques(sc: Spacecraft, body_torque, omega, wheel_speed, friction=None) -> np.ndarray:
+    """Motor torques u that put ``body_torque`` on the body (gyroscopic wheel term compensated);
+    ``friction`` (N m per wheel, the drive friction expected at the measured speeds) is added so
+    the net wheel torque is the one asked for."""
     h_w = sc.wheel_axes @ (sc.wheel_inertia * np.asarray(wheel_speed, float))
     demand = np.asarray(body_torque, float) + np.cross(omega, h_w)
     u = -sc.wheel_axes_pinv @ demand
+    if friction is not None:
+        u = u + friction
     return np.clip(u, -sc.wheel_torque_max, sc.wheel_torque_max)

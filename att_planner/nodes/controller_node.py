@@ -21,10 +21,17 @@ count, and they only serve the state gate's skew check.
 
 Watchdog: when no state came for ``wall_timeout`` s of wall time the controller commands zero
 and reports ``state_stale`` until states flow again.
+
+``state_source`` (issue 14): ``truth`` flies on ``/spacecraft/state``; ``estimate`` (the default of a
+scenario with a gyro) flies on ``/estimator/attitude`` with the wheel speeds of
+``/sensors/wheel_speeds`` and the field of ``/sensors/magnetometer``
+(:class:`att_planner.control.measured_state.MeasuredState`), compensating the wheel drives' expected
+friction (``friction_compensation``, default on when the scenario's ``actuators.wheels`` has some).
+In that mode the state gate's clock check is left out (the estimates come from the estimator, the
+clock from the simulator).
 """
 from __future__ import annotations
 
-import math
 import time
 from collections import Counter
 
@@ -33,30 +40,18 @@ from rclpy.clock import Clock, ClockType
 from rclpy.node import Node
 from rclpy.task import Future
 from rosgraph_msgs.msg import Clock as ClockMsg
+from sensor_msgs.msg import JointState, MagneticField
 
 from att_msgs.action import ExecuteManeuver
-from att_msgs.msg import ActuatorCommand, ControllerStatus, ManeuverPlan, SpacecraftState
+from att_msgs.msg import ActuatorCommand, AttitudeEstimate, ControllerStatus, ManeuverPlan, SpacecraftState
 from att_msgs.srv import SetControllerMode
 from att_msgs_py import convert, qos, signing, topics
-from att_msgs_py.errors import ConfigError, ErrorCode, RequestError, clip
-from att_msgs_py.node_runner import parameter_reader, run_node
-from att_msgs_py.types import ControlMode, ManeuverResult
-from att_planner.control.controller import Controller, ControllerConfig
-from att_planner.control.plan_checks import PlanContext
-from att_planner.control.state_gate import GateConfig
+from att_msgs_py.errors import ErrorCode, RequestError, clip
+from att_msgs_py.node_runner import parameter_reader, participant_of, publisher_of, run_node
+from att_msgs_py.types import ManeuverResult
+from att_planner.control.configure import controller_from_scenario, public_key
+from att_planner.estimation.inputs import Sources
 from att_sim import scenario as scen
-from att_sim.ephemeris import Sky
-
-
-def publisher_of(info) -> bytes | None:
-    """The publisher GID of a received message (None when the middleware does not say)."""
-    gid = (info or {}).get("publisher_gid")
-    return bytes(gid["data"]) if isinstance(gid, dict) and gid.get("data") is not None else None
-
-
-def participant_of(gid: bytes | None) -> bytes | None:
-    """The DDS participant of a publisher GID (its 12-byte GUID prefix): one per node process."""
-    return None if gid is None else gid[:12]
 
 
 class ControllerNode(Node):
@@ -64,24 +59,28 @@ class ControllerNode(Node):
         super().__init__("controller")
         self._scenario = scen.load_checked(parameter_reader(self, {})("scenario", "swift_demo"))
         param = parameter_reader(self, self._scenario.node_params.get("controller", {}), str(self._scenario.path))
-        self._core = Controller(self._plan_context(param), self._config(param),
-                                param("initial_mode", int(ControlMode.IDLE),
-                                      choices=[int(m) for m in ControlMode if m != ControlMode.PLAN_TRACKING]),
-                                self._scenario.body_frame_id, self._gate_config(param), self._sky())
+        self._core = controller_from_scenario(param, self._scenario)
         self._wall_timeout = param("wall_timeout", 2.0, 0.0, 3600.0, low_open=True)
         if param("require_signed_modes", False):
-            self._core.mode_key = self._public_key(param, "mode_public_key")
+            self._core.mode_key = public_key(param, "mode_public_key")
         param.refuse_unknown()
         self._state_wall = time.monotonic()   # no "no state" warning before wall_timeout has passed
         self._stale = False
         self._refused = Counter()             # refused inputs per kind, for the throttled log lines
         self._sim_clock: tuple[bytes, float] | None = None   # (participant, s): its latest /clock
         self._goal = None                     # the goal handle of the running maneuver
+        self._waiting = None                  # (estimate, source) that came before any wheel speed
+        self._sources = Sources(self._core.gate.config.resync_timeout)   # one publisher per measurement
         self._done: Future | None = None
 
         self._cmd_pub = self.create_publisher(ActuatorCommand, topics.COMMAND, qos.STREAM_QOS)
         self._status_pub = self.create_publisher(ControllerStatus, topics.CONTROLLER_STATUS, qos.STREAM_QOS)
-        self.create_subscription(SpacecraftState, topics.STATE, self.on_state, qos.STREAM_QOS)
+        if self._core.measured is None:
+            self.create_subscription(SpacecraftState, topics.STATE, self.on_state, qos.STREAM_QOS)
+        else:
+            self.create_subscription(AttitudeEstimate, topics.ESTIMATE, self.on_estimate, qos.STREAM_QOS)
+            self.create_subscription(JointState, topics.WHEEL_SPEEDS, self.on_wheel_speeds, qos.STREAM_QOS)
+            self.create_subscription(MagneticField, topics.MAGNETOMETER, self.on_magnetometer, qos.STREAM_QOS)
         self.create_subscription(ManeuverPlan, topics.PLANS, self.on_plan, qos.LATCHED_QOS)
         self.create_subscription(ClockMsg, topics.CLOCK, self.on_clock, qos.CLOCK_QOS)
         self.create_service(SetControllerMode, topics.SET_CONTROLLER_MODE, self.on_set_mode)
@@ -89,58 +88,11 @@ class ControllerNode(Node):
         self._action = ActionServer(self, ExecuteManeuver, topics.EXECUTE_MANEUVER, execute_callback=self.execute,
                                     goal_callback=self.on_goal, cancel_callback=lambda _: CancelResponse.ACCEPT)
         c = self._core.config
-        self.get_logger().info(f"scenario '{self._scenario.name}', mode {self._core.mode}, plan key "
+        source = "truth" if self._core.measured is None else "estimate"
+        self.get_logger().info(f"scenario '{self._scenario.name}', state from the {source}, mode {self._core.mode}, "
+                               f"friction compensation {'on' if self._core.friction else 'off'}, plan key "
                                f"{signing.key_id(self._core.context.public_key)}; magnetorquer gains "
                                f"kp={c.kp:.6g} kd={c.kd:.6g} m_max={self._core.m_max:g}")
-
-    def _config(self, param) -> ControllerConfig:
-        d = ControllerConfig()
-        tracking_kd = param("tracking_kd", d.tracking_kd, 0.0)
-        m_max = param("m_max", self._scenario.spacecraft.dipole_max)
-        if not m_max > 0:
-            raise ConfigError(ErrorCode.INVALID_PARAMETER, f"parameter 'm_max': expected a dipole > 0 A m², "
-                                                           f"got {m_max}")
-        return ControllerConfig(
-            control_period=1.0 / param("control_rate", 1.0 / d.control_period, 0.0, 1000.0, low_open=True),
-            settle_time=param("settle_time", d.settle_time, 0.0, 86_400.0),
-            tracking_kp=param("tracking_kp", d.tracking_kp, 0.0), tracking_kd=tracking_kd,
-            kp=param("kp", d.kp, 0.0), kd=param("kd", d.kd, 0.0), m_max=m_max,
-            safe_kd=param("safe_kd", tracking_kd, 0.0),
-            max_cached_plans=param("max_cached_plans", d.max_cached_plans, 1, 10_000),
-            max_cache_bytes=int(param("max_cache_mb", d.max_cache_bytes / 2**20, 0.0, 4096.0, low_open=True) * 2**20),
-            safe_rate_threshold=param("safe_rate_threshold", d.safe_rate_threshold, 0.0, 10.0, low_open=True))
-
-    def _sky(self) -> Sky | None:
-        """The scenario's sky (sim time past its epoch) for the zones' margins; None without an epoch."""
-        s = self._scenario
-        return None if s.epoch is None else Sky(s.epoch, s.orbit_model)
-
-    @staticmethod
-    def _public_key(param, name: str):
-        path = param(name, str(signing.default_key_dir() / signing.PUBLIC_NAME))
-        try:
-            return signing.load_public_key(path)
-        except (OSError, ValueError) as exc:
-            raise ConfigError(ErrorCode.INVALID_CONFIG, f"parameter '{name}': no Ed25519 public key at "
-                                                        f"'{clip(path, 200)}' ({clip(exc, 120)}): run att-keygen, or "
-                                                        "copy the planner's plan_signing.pub") from None
-
-    def _plan_context(self, param) -> PlanContext:
-        key = self._public_key(param, "plan_public_key")
-        return PlanContext(
-            self._scenario.spacecraft, self._scenario.name, self._scenario.frame_id, key,
-            max_start_attitude_error=math.radians(param("max_start_attitude_error_deg", 5.0, 0.0, 180.0,
-                                                        low_open=True)),
-            max_start_rate_error=param("max_start_rate_error", 0.01, 0.0, 10.0, low_open=True),
-            epoch=self._scenario.epoch,
-            max_start_epoch_error=param("max_start_epoch_error", 10.0, 0.0, 86_400.0, low_open=True))
-
-    @staticmethod
-    def _gate_config(param) -> GateConfig:
-        d = GateConfig()
-        return GateConfig(max_state_gap=param("max_state_gap", d.max_state_gap, 0.0, 3600.0, low_open=True),
-                          max_clock_skew=param("max_clock_skew", d.max_clock_skew, 0.0, 3600.0, low_open=True),
-                          resync_timeout=param("resync_timeout", d.resync_timeout, 0.0, 3600.0, low_open=True))
 
     def _report_refusal(self, what: str, err: RequestError) -> None:
         """One clipped log line per second at most per kind of input, with the running count."""
@@ -159,9 +111,38 @@ class ControllerNode(Node):
     def on_state(self, msg: SpacecraftState, info: dict):
         source = publisher_of(info)
         clock = self._sim_clock[1] if self._sim_clock and self._sim_clock[0] == participant_of(source) else None
-        outcome = self._core.accept_state(convert.state_from_msg(msg), time.monotonic(), clock, source)
+        self._step(self._core.accept_state(convert.state_from_msg(msg), time.monotonic(), clock, source), "state")
+
+    def on_estimate(self, msg: AttitudeEstimate, info: dict):
+        estimate, source = convert.estimate_from_msg(msg), publisher_of(info)
+        outcome = self._core.accept_estimate(estimate, time.monotonic(), source)
+        if outcome.refused is not None and outcome.refused.code == ErrorCode.NO_STATE:
+            self._waiting = (estimate, source)   # the first wheel speeds are on their way: answer then
+            return
+        self._step(outcome, "attitude estimate")
+
+    def on_wheel_speeds(self, msg: JointState, info: dict):
+        try:
+            self._sources.admit("wheel speed measurement", publisher_of(info), time.monotonic())
+            self._core.measured.on_wheel_speeds(convert.wheel_speeds_from_msg(msg))
+        except RequestError as err:
+            self._report_refusal("wheel speed measurement", err)
+            return
+        if self._waiting is not None:
+            (estimate, source), self._waiting = self._waiting, None
+            self._step(self._core.accept_estimate(estimate, time.monotonic(), source), "attitude estimate")
+
+    def on_magnetometer(self, msg: MagneticField, info: dict):
+        try:
+            self._sources.admit("magnetometer measurement", publisher_of(info), time.monotonic())
+            self._core.measured.on_magnetometer(convert.magnetometer_from_msg(msg))
+        except RequestError as err:
+            self._report_refusal("magnetometer measurement", err)
+
+    def _step(self, outcome, what: str) -> None:
+        """After a state or estimate: report, and command when a control instant is due."""
         if outcome.refused is not None:
-            self._report_refusal("state", outcome.refused)
+            self._report_refusal(what, outcome.refused)
             return
         if outcome.note:
             self.get_logger().warning(outcome.note)

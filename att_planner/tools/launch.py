@@ -21,6 +21,7 @@ from pathlib import Path
 NODE_MODULES = {
     "simulator": "att_sim.simulator_node",
     "controller": "att_planner.nodes.controller_node",
+    "estimator": "att_planner.nodes.estimator_node",
     "planner": "att_planner.nodes.planner_node",
     "recorder": "att_msgs_py.log.recorder_node",
 }
@@ -114,15 +115,26 @@ class Suite:
         return False
 
 
-def start_suite(scenario: str, mcap_path: str | Path, log_dir: str | Path, *, env: dict | None = None,
-                nodes=("recorder", "simulator", "controller", "planner"), params: dict | None = None) -> Suite:
-    """Start ``nodes`` for ``scenario``; ``params`` maps node name -> extra ROS parameters.
+def default_nodes(scenario: str) -> tuple[str, ...]:
+    """The nodes of a whole run of ``scenario``: recorder, simulator, the estimator when the
+    scenario has a gyro (its controller then flies on the estimate), controller and planner."""
+    from att_sim import scenario as scen
 
-    The simulator holds sim time at zero until the recorder and the controller (those started)
-    subscribe to its state, so every run is recorded and controlled from t = 0.
+    estimator = ("estimator",) if scen.load(scenario).sensors.gyro is not None else ()
+    return ("recorder", "simulator", *estimator, "controller", "planner")
+
+
+def start_suite(scenario: str, mcap_path: str | Path, log_dir: str | Path, *, env: dict | None = None,
+                nodes=None, params: dict | None = None) -> Suite:
+    """Start ``nodes`` (default: :func:`default_nodes`) for ``scenario``; ``params`` maps node name ->
+    extra ROS parameters.
+
+    The simulator holds sim time at zero until the recorder, the controller and the estimator
+    (those started) subscribe to its state or sensors, so every run is recorded and controlled from t = 0.
     """
+    nodes = default_nodes(scenario) if nodes is None else nodes
     suite = Suite(env or isolated_env(), Path(log_dir))
-    consumers = sum(n in nodes for n in ("recorder", "controller"))
+    consumers = sum(n in nodes for n in ("recorder", "controller", "estimator"))
     for name in nodes:
         p = {"scenario": scenario}
         if name == "recorder":

@@ -55,7 +55,7 @@ def rate_of(msg) -> float:
 
 def test_killed_controller_then_restarted_controller_damps_the_coasting_spacecraft(ros_suite):
     with ros_suite("swift_demo", nodes=("simulator", "controller"), name="restart_test",
-                   params={"simulator": {"real_time_factor": RTF}}) as s:
+                   params={"simulator": {"real_time_factor": RTF}, "controller": {"state_source": "truth"}}) as s:
         client, suite = s.client, s.suite
         assert client.execute_client.wait_for_server(timeout_sec=30)
         received, statuses = [], []
@@ -82,7 +82,7 @@ def test_killed_controller_then_restarted_controller_damps_the_coasting_spacecra
         assert dead[-1].command_timeout, "inputs zeroed but not flagged"
         coasting = np.linalg.norm(dead[-1].omega)
         assert coasting > 0.005, f"the spacecraft should coast mid-slew (rate {coasting:.4f} rad/s)"
-        suite.start("controller", {"scenario": "swift_demo"})
+        suite.start("controller", {"scenario": "swift_demo", "state_source": "truth"})
         assert suite.wait_for_output("controller", "safe mode", 60), suite.log_text("controller")[-2000:]
         received.clear()
         damped = collect(client, 20.0, received)

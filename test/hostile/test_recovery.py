@@ -42,7 +42,8 @@ def test_the_first_request_after_a_planner_restart_is_answered(ros_suite):
 
 
 def test_a_goal_whose_controller_dies_is_reported_aborted(ros_suite):
-    with ros_suite("swift_demo", nodes=("simulator", "controller", "planner"), name="controller_killed") as s:
+    with ros_suite("swift_demo", nodes=("simulator", "controller", "planner"), name="controller_killed",
+                   params={"controller": {"state_source": "truth"}}) as s:
         client = s.client
         response = client.plan(maneuver_request(rot.IDENTITY, rot.from_axis_angle([0, 0, 1], math.radians(120)),
                                                 SENSOR, [], method="eigenaxis_smooth"))

@@ -18,7 +18,7 @@ pytestmark = pytest.mark.ros
 
 def test_with_signed_modes_required_only_the_ground_key_changes_the_mode(ros_suite):
     with ros_suite("swift_demo", nodes=("controller",), name="signed_modes_test",
-                   params={"controller": {"require_signed_modes": True}}) as s:
+                   params={"controller": {"require_signed_modes": True, "state_source": "truth"}}) as s:
         client = s.client
         assert client.mode_client.wait_for_service(timeout_sec=30)
         unsigned = client.set_mode(ControlMode.SAFE, key=None)

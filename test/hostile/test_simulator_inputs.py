@@ -313,7 +313,9 @@ def test_a_command_answering_a_state_resumes_the_lockstep(lonely_sim):
     states.clear()
     spin_for(s.client, 3.0, answer_latest)
     resumed = [m for _, m in states if not m.command_timeout]
-    assert resumed and resumed[-1].wheel_torques[0] == pytest.approx(0.05), "the answering commands were not applied"
+    # applied through swift_demo's imperfect drive (quantum 1e-4 N m, noise 2e-4 N m 1 sigma)
+    assert resumed and resumed[-1].wheel_torques[0] == pytest.approx(0.05, abs=1.5e-3), \
+        "the answering commands were not applied"
     assert "lockstep resumed" in s.suite.log_text("simulator")
     s.client.destroy_publisher(pub)
 

@@ -27,7 +27,8 @@ SENSOR = [1.0, 0.0, 0.0]
 @pytest.fixture(scope="module")
 def suite(ros_suite):
     with ros_suite("swift_demo", nodes=("simulator", "controller", "planner"),
-                   params={"simulator": {"real_time_factor": 0.0}, "controller": {"settle_time": 5.0}},
+                   params={"simulator": {"real_time_factor": 0.0},
+                           "controller": {"settle_time": 5.0, "state_source": "truth"}},
                    name="spoofing_test") as s:
         yield s
 

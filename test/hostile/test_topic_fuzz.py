@@ -1,10 +1,11 @@
 """Random valid messages with extreme field values on every subscribed topic while a maneuver runs.
 
-The whole suite runs (recorder, simulator, controller, planner); a maneuver is executing; for each
-message type hypothesis publishes random, well-formed CDR messages (NaN, ±Inf, ±1e308, denormals,
-huge and empty arrays, control characters, any stamp) on the topics the nodes subscribe to. Then:
-no node died, no loop stalled for more than a second (the state and controller-status streams
-kept flowing), and the maneuver ended with an answer: completed, or aborted with a code.
+The whole suite runs (recorder, simulator, estimator, controller, planner: the controller flies on
+the estimate); a maneuver is executing; for each message type hypothesis publishes random,
+well-formed CDR messages (NaN, ±Inf, ±1e308, denormals, huge and empty arrays, control characters,
+any stamp) on the topics the nodes subscribe to, the sensors' and the estimate's included. Then: no
+node died, no loop stalled for more than a second (the state, estimate and controller-status
+streams kept flowing), and the maneuver ended with an answer: completed, or aborted with a code.
 """
 from __future__ import annotations
 
@@ -21,9 +22,19 @@ from hypothesis import strategies as st
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.node import Node
 from rosgraph_msgs.msg import Clock
+from sensor_msgs.msg import Imu, JointState, MagneticField
 
 from att_msgs.action import ExecuteManeuver
-from att_msgs.msg import ActuatorCommand, ControllerStatus, KeepOutCone, ManeuverPlan, SpacecraftState
+from att_msgs.msg import (
+    ActuatorCommand,
+    AttitudeEstimate,
+    CoarseSunSensors,
+    ControllerStatus,
+    KeepOutCone,
+    ManeuverPlan,
+    SpacecraftState,
+    StarTracker,
+)
 from att_msgs_py import qos, topics
 from att_msgs_py.errors import ErrorCode
 from att_planner.nodes.client import maneuver_request
@@ -101,13 +112,70 @@ def statuses(draw):
     return msg
 
 
+def headed(draw, msg, frames=("body", "eci", "")):
+    msg.header.stamp = draw(stamps())
+    msg.header.frame_id = draw(st.sampled_from(frames) | TEXT)
+    return msg
+
+
+def nine():
+    return st.lists(EXTREME, min_size=9, max_size=9)
+
+
+@st.composite
+def imus(draw):
+    return headed(draw, Imu(orientation=draw(quaternions()), angular_velocity=draw(vectors()),
+                            linear_acceleration=draw(vectors()), angular_velocity_covariance=draw(nine())))
+
+
+@st.composite
+def star_trackers(draw):
+    name = draw(st.sampled_from(["st1", ""]) | TEXT)
+    return headed(draw, StarTracker(sensor_frame_id=name, valid=draw(st.booleans()), status=draw(st.integers(0, 255)),
+                                    attitude=draw(quaternions()), covariance=draw(nine())))
+
+
+@st.composite
+def magnetometers(draw):
+    return headed(draw, MagneticField(magnetic_field=draw(vectors()), magnetic_field_covariance=draw(nine())))
+
+
+@st.composite
+def sun_sensor_readings(draw):
+    return headed(draw, CoarseSunSensors(values=draw(st.lists(EXTREME, max_size=12)), noise=draw(EXTREME)))
+
+
+@st.composite
+def wheel_speed_readings(draw):
+    k = draw(st.integers(0, 6))
+    return headed(draw, JointState(name=draw(st.lists(TEXT, max_size=k)), velocity=draw(st.lists(EXTREME, max_size=k)),
+                                   position=draw(st.lists(EXTREME, max_size=k))))
+
+
+@st.composite
+def estimates(draw):
+    return headed(draw, AttitudeEstimate(body_frame_id=draw(st.sampled_from(["body", ""]) | TEXT),
+                                         health=draw(st.integers(0, 255)), attitude=draw(quaternions()),
+                                         body_rate=draw(vectors()), gyro_bias=draw(vectors()),
+                                         attitude_covariance=draw(nine()), bias_covariance=draw(nine()),
+                                         time_since_update=draw(EXTREME), message=draw(TEXT)), ("eci", "", "body"))
+
+
+SENSOR_FUZZ = {topics.IMU: (Imu, imus), topics.STAR_TRACKER: (StarTracker, star_trackers),
+               topics.MAGNETOMETER: (MagneticField, magnetometers),
+               topics.SUN_SENSORS: (CoarseSunSensors, sun_sensor_readings),
+               topics.WHEEL_SPEEDS: (JointState, wheel_speed_readings), topics.ESTIMATE: (AttitudeEstimate, estimates)}
+
+
 class Monitor(Node):
     """Wall-clock arrival times of the state and controller-status streams."""
 
     def __init__(self):
         super().__init__("fuzz_monitor")
-        self.arrivals = {topics.STATE: [], topics.CONTROLLER_STATUS: []}
+        self.arrivals = {topics.STATE: [], topics.CONTROLLER_STATUS: [], topics.ESTIMATE: []}
         self.create_subscription(SpacecraftState, topics.STATE, lambda _: self.arrived(topics.STATE), qos.STREAM_QOS)
+        self.create_subscription(AttitudeEstimate, topics.ESTIMATE, lambda _: self.arrived(topics.ESTIMATE),
+                                 qos.STREAM_QOS)
         self.create_subscription(ControllerStatus, topics.CONTROLLER_STATUS,
                                  lambda _: self.arrived(topics.CONTROLLER_STATUS), qos.STREAM_QOS)
 
@@ -134,10 +202,11 @@ def fuzzed(ros_suite):
         send = client.execute_client.send_goal_async(ExecuteManeuver.Goal(plan_id=response.plan.plan_id))
         rclpy.spin_until_future_complete(client, send, timeout_sec=20)
         assert send.result().accepted
+        kinds = [(topics.STATE, SpacecraftState), (topics.PLANS, ManeuverPlan), (topics.COMMAND, ActuatorCommand),
+                 (topics.CLOCK, Clock), (topics.CONTROLLER_STATUS, ControllerStatus),
+                 *((t, cls) for t, (cls, _) in SENSOR_FUZZ.items())]
         publishers = {t: client.create_publisher(cls, t, qos.LATCHED_QOS if t == topics.PLANS else qos.STREAM_QOS)
-                      for t, cls in ((topics.STATE, SpacecraftState), (topics.PLANS, ManeuverPlan),
-                                     (topics.COMMAND, ActuatorCommand), (topics.CLOCK, Clock),
-                                     (topics.CONTROLLER_STATUS, ControllerStatus))}
+                      for t, cls in kinds}
         state = {"suite": s, "monitor": monitor, "goal": send.result(), "pubs": publishers,
                  "start": time.monotonic(), "published": 0}
         yield state
@@ -182,12 +251,19 @@ def test_random_controller_statuses(fuzzed, msg):
     publish(fuzzed, topics.CONTROLLER_STATUS, msg)
 
 
+@EXAMPLES
+@given(data=st.data())
+@pytest.mark.parametrize("topic", list(SENSOR_FUZZ))
+def test_random_sensor_readings_and_estimates(fuzzed, topic, data):
+    publish(fuzzed, topic, data.draw(SENSOR_FUZZ[topic][1]()))
+
+
 def test_nothing_died_nothing_stalled_and_the_maneuver_got_an_answer(fuzzed):
     s, monitor, client = fuzzed["suite"], fuzzed["monitor"], fuzzed["suite"].client
     end = time.monotonic()
-    assert fuzzed["published"] >= 5 * 3 * 10
+    assert fuzzed["published"] >= 11 * 3 * 10
     assert all(s.suite.alive().values()), s.suite.alive()
-    for topic in (topics.STATE, topics.CONTROLLER_STATUS):
+    for topic in (topics.STATE, topics.CONTROLLER_STATUS, topics.ESTIMATE):
         gap = monitor.largest_gap(topic, fuzzed["start"] + 0.5, end)
         assert gap < 1.0, f"{topic} stalled for {gap:.2f} s while fuzzing"
     done = fuzzed["goal"].get_result_async()
@@ -195,5 +271,6 @@ def test_nothing_died_nothing_stalled_and_the_maneuver_got_an_answer(fuzzed):
     assert done.done(), "the maneuver was never answered"
     result = done.result().result
     assert result.success or result.error_code in (ErrorCode.ABORTED, ErrorCode.STATE_TIME_JUMP), result.message
+    assert "estimator" in s.suite.procs
     if result.success:
         assert result.final_attitude_error < math.radians(1.0)

@@ -34,7 +34,8 @@ GOAL = rot.from_axis_angle([0, 0, 1], 0.4)
 @pytest.fixture(scope="module")
 def suite(ros_suite):
     with ros_suite("swift_demo", nodes=("simulator", "controller", "planner"),
-                   params={"simulator": {"real_time_factor": 4.0}}, name="reliability_test") as s:
+                   params={"simulator": {"real_time_factor": 4.0}, "controller": {"state_source": "truth"}},
+                   name="reliability_test") as s:
         yield s.suite, s.client, s.mcap.parent
 
 

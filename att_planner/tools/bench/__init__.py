@@ -18,6 +18,7 @@ STUDIES = {
     "soak": "att_planner.tools.bench.soak",
     "sky": "att_planner.tools.bench.sky",
     "speed": "att_planner.tools.bench.speed",
+    "estimation": "att_planner.tools.bench.estimation",
 }
 
 

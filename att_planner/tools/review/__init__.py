@@ -15,6 +15,10 @@ executed plan, else the last magnetorquer-PD run, else the whole log), and write
   speeds with their limit, magnetorquer dipoles (commanded vs applied) with saturation, cone and
   zone margins (moving zones at their true positions at each recorded time), controller mode;
 * ``overview.png`` — a screenshot-sized digest (sky, margins, torque, wheel speeds);
+* ``estimation.png`` (a log with the estimator's attitude, issue 14) — the estimation error per
+  body axis with the filter's ±3σ, the gyro bias estimate against the truth, the estimate's health
+  and the trackers' invalid samples, the gyro and magnetometer measured against the truth
+  (:mod:`.estimation`); the summary gains the estimate's figures (``estimation``);
 * ``summary.txt``, ``summary.json`` and ``index.html`` (summary table, figures embedded).
 
 For a maneuver, "executed" is the whole reviewed segment: the maneuver (the plan, t = 0 to its
@@ -41,6 +45,8 @@ from pathlib import Path
 
 from att_msgs_py.log import read_log
 from att_msgs_py.topics import COMMAND, PLANS, STATE
+from att_planner.tools.review.estimation import TOPICS as ESTIMATION_TOPICS
+from att_planner.tools.review.estimation import estimation_of, estimation_summary, figure_estimation
 from att_planner.tools.review.figures import figure_overview, figure_sky, figure_time_histories
 from att_planner.tools.review.run import extract_run, settling_time
 from att_planner.tools.review.summary import format_summary, notes, scenario_for, summarize, summary_of, zone_sky_for
@@ -76,16 +82,20 @@ def review(log_path: str | Path, out_dir: str | Path | None = None, *, plan_id: 
     log_path = Path(log_path)
     out = Path(out_dir) if out_dir is not None else log_path.parent / "review"
     out.mkdir(parents=True, exist_ok=True)
-    log = read_log(log_path, topics=[STATE, COMMAND, PLANS])
+    log = read_log(log_path, topics=sorted({STATE, COMMAND, PLANS, *ESTIMATION_TOPICS}))
     run = extract_run(log, plan_id)
     found = scenario_for(run, scenario)
     sc = found.spacecraft if found is not None else None
     zones, zones_note = zone_sky_for(run, found)
     summary = summary_of(run, sc, zones, zones_note)
-    text = format_summary(summary)
     figures = {"overview": figure_overview(run, sc, out / "overview.png", zones),
                "sky": figure_sky(run, out / "sky.png", zones),
                "time histories": figure_time_histories(run, sc, out / "time_histories.png", zones)}
+    estimation = estimation_of(log, run.t0 + run.t[0], run.t0 + run.t[-1])
+    if estimation is not None:
+        summary["estimation"] = estimation_summary(estimation)
+        figures["estimation"] = figure_estimation(estimation, out / "estimation.png", run.t0)
+    text = format_summary(summary)
     (out / "summary.txt").write_text(text + "\n")
     (out / "summary.json").write_text(json.dumps(summary, indent=2) + "\n")
     page = out / "index.html"

@@ -268,6 +268,13 @@ def format_summary(s: dict, with_notes: bool = True) -> str:
         lines.append(f"settling time         {settled} (|q_i| <= {SETTLING_THRESHOLD})")
     if s["command_timeouts"]:
         lines.append(f"command timeouts      {s['command_timeouts']} state samples with inputs zeroed")
+    e = s.get("estimation")
+    if e:
+        lines.append(f"estimation error      rms {e['attitude_error_rms_arcsec']:.2f} arcsec, max "
+                     f"{e['attitude_error_max_arcsec']:.2f}, final {e['attitude_error_final_arcsec']:.2f}; NEES mean "
+                     f"{e['nees_mean']:.2f} ({e['nees_dof']} dof)")
+        lines.append(f"gyro bias error       {e['bias_error_final_deg_per_h']:.4f} deg/h at the end; tracker invalid "
+                     f"{e['tracker_invalid_seconds']:.1f} s")
     if with_notes:
         lines += [f"note: {n}" for n in notes(s)]
     return "\n".join(lines)

@@ -184,7 +184,9 @@ def test_info_tells_a_complete_file_from_one_to_repair(finished, tmp_path, capsy
     cut.write_bytes(path.read_bytes()[:chunk_ends(path)[3] + 100])
     assert att_log(["info", str(cut)]) == 1
     out = capsys.readouterr().out
-    assert "INCOMPLETE" in out and f"messages  {4 * PER_CHUNK} on 5 channels" in out and "att-log repair" in out
+    channels = len(recorded_topics())
+    assert "INCOMPLETE" in out and "att-log repair" in out
+    assert f"messages  {4 * PER_CHUNK} on {channels} channels" in out
 
 
 def test_repair_never_overwrites_its_input_unless_in_place(finished, tmp_path, capsys):

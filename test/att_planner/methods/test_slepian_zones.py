@@ -159,10 +159,12 @@ def test_static_keep_in_zone_of_another_sensor_is_respected():
     ("earth_obs", "mssa", {"restarts": 4}, 1176.7675894755068),
 ])
 def test_cone_only_plans_are_unchanged(case, method, options, tf):
-    """t_f as before issue 13 (pinned from that code), and the cones given as inertial zones plan identically."""
+    """t_f as before issue 13 (pinned from that code, to the solvers' convergence: MSSA iterates t_f to
+    1e-7, and on another CPU its BLAS rounds differently: 1176.76759 on the machine that pinned it,
+    1176.76731 on an AMD EPYC), and the cones given as inertial zones plan identically (bit for bit)."""
     pb = benchmark_problem(case)
     plan = S.plan_slepian(pb, method=method, N=N_SMALL, W=W_SMALL, **options)
-    assert plan.stats["tf"] == pytest.approx(tf, rel=1e-12)
+    assert plan.stats["tf"] == pytest.approx(tf, rel=1e-6)
     as_zones = replace(pb, cones=[], zones=zones_from_cones(pb.cones, pb.sensor_axis))
     assert not as_zones.zone_sky().moving
     again = S.plan_slepian(as_zones, method=method, N=N_SMALL, W=W_SMALL, **options)

@@ -1,0 +1,75 @@
+"""The controller's state when it flies on measurements (``state_source: estimate``, no ROS).
+
+:class:`MeasuredState` keeps the latest wheel tachometer sample and the latest *clean* magnetometer
+sample (taken while the magnetorquers were off: :class:`~att_planner.estimation.inputs.DipoleLog`),
+each checked like every input, and composes them with an attitude estimate into the
+:class:`~att_msgs_py.types.State` the controller's laws take: attitude and rate from the estimate,
+inertial wheel spin rates ``Ω = ν + Gᵀω`` from the measured relative speeds ``ν``, the field in
+body axes from the magnetometer. It also plans the magnetometer's blanking: the controller
+commands no dipole over the control period that ends at a magnetometer sample.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from att_msgs_py import validation
+from att_msgs_py.errors import ErrorCode, RequestError
+from att_msgs_py.types import AttitudeEstimate, Health, MagnetometerMeasurement, State, WheelSpeedMeasurement
+from att_planner.estimation.inputs import DipoleLog, InputChecks
+from att_sim.dynamics import Spacecraft
+from att_sim.sensors.specs import SensorSpecs
+
+BAD = ErrorCode.INVALID_MEASUREMENT
+
+
+class MeasuredState:
+    def __init__(self, spacecraft: Spacecraft, specs: SensorSpecs, frame_id: str, body_frame_id: str):
+        self.spacecraft, self.specs, self.body_frame_id = spacecraft, specs, body_frame_id
+        self.checks = InputChecks(specs, frame_id, body_frame_id)
+        self.dipoles = DipoleLog()
+        self.wheel_speeds: np.ndarray | None = None     # relative to the body, rad/s
+        self.field = np.zeros(3)                        # T, body axes: the latest clean sample
+        self.magnetometer_period = 1.0 / specs.magnetometer.rate if specs.magnetometer else None
+
+    def on_wheel_speeds(self, m: WheelSpeedMeasurement) -> None:
+        sc = self.spacecraft
+        if not (isinstance(m.t, float | int) and math.isfinite(m.t)):
+            raise RequestError(BAD, f"wheel speed stamp {m.t!r} is not finite")
+        if m.frame_id != self.body_frame_id:
+            raise RequestError(BAD, f"wheel speed header.frame_id '{str(m.frame_id)[:64]}' is not "
+                                    f"'{self.body_frame_id}'")
+        speeds = validation.finite_array(m.speeds, "wheel speed velocity", BAD, (sc.n_wheels,))
+        if speeds.size and np.max(np.abs(speeds)) > 2 * sc.wheel_speed_max:
+            raise RequestError(BAD, f"wheel speed velocity reaches {np.max(np.abs(speeds)):.6g} rad/s, more than "
+                                    f"twice the limit {sc.wheel_speed_max:g}")
+        self.wheel_speeds = speeds
+
+    def on_magnetometer(self, m: MagnetometerMeasurement) -> None:
+        field = self.checks.magnetometer(m)
+        if self.dipoles.clean(m.t):
+            self.field = field
+
+    def blank(self, t: float, period: float) -> bool:
+        """Whether a magnetometer sample falls in the control period (t, t + period]: the coils
+        stay off over it, so that sample is clean."""
+        p = self.magnetometer_period
+        if p is None:
+            return False
+        return (math.floor(t / p + 1e-9) + 1) * p <= t + period + 1e-9
+
+    def compose(self, estimate: AttitudeEstimate) -> State:
+        """The state of ``estimate`` with the measured wheel speeds (made inertial) and field; an
+        estimate of a health the message does not define is refused (310)."""
+        if estimate.health not in tuple(Health):
+            raise RequestError(ErrorCode.INVALID_STATE, f"estimate health {estimate.health!r} is not one of "
+                                                        f"{[int(h) for h in Health]}")
+        n = self.spacecraft.n_wheels
+        if n and self.wheel_speeds is None:
+            raise RequestError(ErrorCode.NO_STATE, "no wheel speed measurement yet")
+        omega = np.asarray(estimate.omega, float)
+        relative = self.wheel_speeds if n else np.zeros(0)
+        inertial = relative + self.spacecraft.wheel_axes.T @ omega if n else relative
+        return State(t=estimate.t, q=np.asarray(estimate.q, float), omega=omega, wheel_speeds=inertial,
+                     field_body=self.field.copy(), frame_id=estimate.frame_id, body_frame_id=estimate.body_frame_id)

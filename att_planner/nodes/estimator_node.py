@@ -1,0 +1,103 @@
+"""Estimator node: a thin ROS adapter around :class:`att_planner.estimation.estimator.Estimator`.
+
+Subscribes ``/sensors/imu`` (sensor_msgs/Imu: its angular velocity), ``/sensors/star_tracker``,
+``/sensors/magnetometer``, ``/sensors/sun_sensors`` and ``/actuator/command`` (the magnetorquer
+commands, for the magnetometer's blanking); publishes ``/estimator/attitude``
+(att_msgs/AttitudeEstimate) at ``publish_rate`` Hz of sim time, on gyro samples. The filter's
+datasheets are the scenario's ``sensors`` group (nominal mountings and noise, never the errors the
+simulator drew); its tuning is this node's parameters, defaulting to values derived from them.
+
+Nothing received is trusted: a refused measurement (320 INVALID_MEASUREMENT, 321
+STALE_MEASUREMENT; a second publisher of an input while the first is alive, too) changes nothing
+and is logged at most once a second per kind with the running count, as are measurements rejected
+by the innovation gate and the filter's notes (initialised, diverged, gyro saturated).
+"""
+from __future__ import annotations
+
+import math
+import time
+from collections import Counter
+
+from rclpy.node import Node
+from sensor_msgs.msg import Imu, MagneticField
+
+from att_msgs.msg import ActuatorCommand, AttitudeEstimate, CoarseSunSensors, StarTracker
+from att_msgs_py import convert, qos, topics
+from att_msgs_py.errors import RequestError, clip
+from att_msgs_py.node_runner import parameter_reader, publisher_of, run_node
+from att_planner.estimation.configure import estimator_from_scenario
+from att_planner.estimation.inputs import Sources
+from att_sim import scenario as scen
+from att_sim.sensors.specs import DEG, HOUR
+
+
+class EstimatorNode(Node):
+    def __init__(self):
+        super().__init__("estimator")
+        s = scen.load_checked(parameter_reader(self, {})("scenario", "swift_demo"))
+        param = parameter_reader(self, s.node_params.get("estimator", {}), str(s.path))
+        self._core = estimator_from_scenario(param, s)
+        param.refuse_unknown()
+        self._refused = Counter()
+        self._sources = Sources(self._core.config.resync_timeout)
+        self._pub = self.create_publisher(AttitudeEstimate, topics.ESTIMATE, qos.STREAM_QOS)
+        self.create_subscription(Imu, topics.IMU, self.on_imu, qos.STREAM_QOS)
+        self.create_subscription(StarTracker, topics.STAR_TRACKER, self.on_star_tracker, qos.STREAM_QOS)
+        self.create_subscription(MagneticField, topics.MAGNETOMETER, self.on_magnetometer, qos.STREAM_QOS)
+        self.create_subscription(CoarseSunSensors, topics.SUN_SENSORS, self.on_sun_sensors, qos.STREAM_QOS)
+        self.create_subscription(ActuatorCommand, topics.COMMAND, self.on_command, qos.STREAM_QOS)
+        c = self._core.config
+        self.get_logger().info(
+            f"scenario '{s.name}': MEKF on {len(s.sensors.star_trackers)} star tracker(s), "
+            f"magnetometer {'yes' if s.sensors.magnetometer else 'no'}, sun sensors "
+            f"{'yes' if s.sensors.sun_sensors else 'no'}; ARW {c.arw * math.sqrt(HOUR) / DEG:.4g} deg/sqrt(h), "
+            f"bias walk {c.rrw * HOUR * math.sqrt(HOUR) / DEG:.4g} deg/h/sqrt(h), gate p = {c.gate_probability}")
+
+    def _report_refusal(self, what: str, err: RequestError) -> None:
+        self._refused[what] += 1
+        self.get_logger().warning(clip(f"{what} refused ({self._refused[what]} so far) [{int(err.code)} "
+                                       f"{err.code.name}]: {err.message}"), throttle_duration_sec=1.0)
+
+    def _guarded(self, what: str, info: dict, call, *args):
+        """Run ``call(*args)`` (a core input) if its publisher is the one of ``what``, logging a
+        refusal; its result otherwise."""
+        try:
+            self._sources.admit(what, publisher_of(info), time.monotonic())
+            return call(*args)
+        except RequestError as err:
+            self._report_refusal(what, err)
+            return None
+
+    # -- callbacks: translate messages to Estimator calls -------------------------------------------
+    # (``info`` has no default: rclpy passes the message info only to two-argument callbacks)
+    def on_imu(self, msg: Imu, info: dict):
+        estimate = self._guarded("gyro sample", info, self._core.on_gyro, convert.gyro_from_msg(msg),
+                                 time.monotonic())
+        report = self._core.take_report()
+        for note in report.notes:
+            self.get_logger().info(clip(note), throttle_duration_sec=1.0)
+        if estimate is not None:
+            self._pub.publish(convert.estimate_msg(estimate))
+
+    def on_star_tracker(self, msg: StarTracker, info: dict):
+        self._guarded("star tracker measurement", info, self._core.on_star_tracker, convert.star_tracker_from_msg(msg))
+
+    def on_magnetometer(self, msg: MagneticField, info: dict):
+        self._guarded("magnetometer measurement", info, self._core.on_magnetometer,
+                      convert.magnetometer_from_msg(msg))
+
+    def on_sun_sensors(self, msg: CoarseSunSensors, info: dict):
+        self._guarded("sun sensor measurement", info, self._core.on_sun_sensors, convert.sun_sensors_from_msg(msg))
+
+    def on_command(self, msg: ActuatorCommand, info: dict):
+        command = convert.command_from_msg(msg)
+        if math.isfinite(command.t) and all(math.isfinite(v) for v in command.dipole):   # else: blanks nothing
+            self._guarded("actuator command", info, self._core.on_dipole_command, command.t, command.dipole)
+
+
+def main(args=None):
+    run_node(EstimatorNode, args)
+
+
+if __name__ == "__main__":
+    main()

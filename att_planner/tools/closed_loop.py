@@ -1,0 +1,213 @@
+"""The simulator, estimator and controller cores wired as their nodes wire them, in one process.
+
+:class:`ClosedLoop` runs :class:`att_sim.simulation.Simulation`, the
+:class:`~att_planner.estimation.estimator.Estimator` and the
+:class:`~att_planner.control.controller.Controller` of a scenario — built by the same functions as
+the nodes (:func:`~att_planner.control.configure.controller_from_scenario`,
+:func:`~att_planner.estimation.configure.estimator_from_scenario`) from the scenario's sections, with
+``overrides`` on top — and passes what the nodes would publish, in the order the simulator publishes
+it: each step the sensors' readings, then the state; the estimator's estimate (or the truth state)
+to the controller; its command, at each control instant, back to the simulator. No DDS: tests, the
+benchmarks and Monte Carlo campaigns fly thousands of maneuvers this way. Plans are signed with the
+loop's own key, as the planner would sign them.
+
+:class:`Trace` records, at every control instant, the truth, the estimate and what was commanded.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+from cryptography.hazmat.primitives.asymmetric.ed25519 import Ed25519PrivateKey
+
+from att_msgs_py import convert, signing
+from att_msgs_py.errors import RequestError
+from att_msgs_py.parameters import SectionReader
+from att_msgs_py.types import Health, ManeuverResult, Plan
+from att_planner.control.configure import controller_from_scenario
+from att_planner.estimation.configure import estimator_from_scenario
+from att_sim import rotations as rot
+from att_sim.scenario import Scenario
+from att_sim.simulation import DEFAULT_STEP, Checks, Simulation
+
+
+@dataclass
+class Trace:
+    """What happened at each control instant (lists while running; :meth:`arrays` to analyse)."""
+
+    t: list = field(default_factory=list)
+    q_true: list = field(default_factory=list)
+    omega_true: list = field(default_factory=list)
+    q_est: list = field(default_factory=list)             # the controller's attitude (estimate or truth)
+    attitude_covariance: list = field(default_factory=list)
+    bias_true: list = field(default_factory=list)
+    bias_est: list = field(default_factory=list)
+    health: list = field(default_factory=list)
+    tracker_status: list = field(default_factory=list)    # TrackerStatus of the latest tracker sample
+    wheel_speeds: list = field(default_factory=list)      # rad/s, relative to the body (truth)
+    wheel_torques: list = field(default_factory=list)     # N m, commanded
+    dipole: list = field(default_factory=list)            # A m², commanded
+    mode: list = field(default_factory=list)
+
+    def arrays(self) -> dict[str, np.ndarray]:
+        return {k: np.asarray(v) for k, v in self.__dict__.items()}
+
+
+class ClosedLoop:
+    def __init__(self, scenario: Scenario, *, overrides: dict | None = None, seed: int | None = None,
+                 q0=rot.IDENTITY, omega0=(0.0, 0.0, 0.0), wheel_speed0=None, simulation: Simulation | None = None):
+        """``overrides``: ``{node: {parameter: value}}`` over the scenario's sections (simulator
+        ``step``/``publish_rate``, every controller and estimator parameter); ``seed``: the noise
+        seed (default the scenario's); ``simulation``: a prepared one (e.g. a dispersed truth)."""
+        overrides = overrides or {}
+        sections = scenario.node_params
+        sim_param = SectionReader(sections.get("simulator", {}), str(scenario.path), overrides.get("simulator"))
+        self.step = sim_param("step", DEFAULT_STEP, 0.0, 1.0, low_open=True)
+        self.publish_period = 1.0 / sim_param("publish_rate", min(10.0, 1.0 / self.step), 0.0,
+                                              (1 + 1e-9) / self.step, low_open=True)
+        self.key = Ed25519PrivateKey.generate()
+        ctl_param = SectionReader(sections.get("controller", {}), str(scenario.path), overrides.get("controller"))
+        self.controller = controller_from_scenario(ctl_param, scenario, key=self.key.public_key())
+        self.estimator = None
+        if self.controller.measured is not None:
+            est_param = SectionReader(sections.get("estimator", {}), str(scenario.path), overrides.get("estimator"))
+            self.estimator = estimator_from_scenario(est_param, scenario)
+        self.scenario = scenario
+        self.sim = simulation or Simulation.for_scenario(
+            scenario, q0=q0, omega0=omega0, wheel_speed0=wheel_speed0, seed=seed,
+            checks=Checks(body_frame_id=scenario.body_frame_id))
+        self.trace = Trace()
+        self.tracker_status = 0                 # of the latest tracker measurement (TrackerStatus)
+        self.refusals: list[RequestError] = []
+        self.next_state = 0.0
+        self.result: ManeuverResult | None = None
+
+    # -- plans ------------------------------------------------------------------------------------
+    def issue(self, plan: Plan, plan_id: str = "plan") -> tuple[Plan, bytes]:
+        """``plan`` with the context a planner fills, signed with the loop's key: (received plan, payload)."""
+        plan.plan_id, plan.spacecraft, plan.frame_id = plan_id, self.scenario.name, self.scenario.frame_id
+        plan.spacecraft_digest = self.scenario.spacecraft.digest
+        msg = convert.plan_msg(plan)
+        signing.sign(msg, self.key)
+        return convert.plan_from_msg(msg), signing.payload(msg)
+
+    def execute(self, plan: Plan, plan_id: str = "plan") -> RequestError | None:
+        """Start flying ``plan`` now (why not, when it cannot start)."""
+        received, payload = self.issue(plan, plan_id)
+        resolved, refused = self.controller.resolve(received.plan_id, received, payload)
+        return refused or self.controller.start(resolved)
+
+    # -- the loop ---------------------------------------------------------------------------------
+    def tick(self) -> None:
+        """One simulator step: readings and state out, the controller's command (when due) in, advance."""
+        sim, ctl, est = self.sim, self.controller, self.estimator
+        readings = sim.sense()
+        t = sim.t
+        outcome = None
+        if est is not None:
+            for m in readings.star_trackers:
+                self.tracker_status = int(m.status)
+                self._guard(est.on_star_tracker, m)
+            if readings.magnetometer is not None:
+                self._guard(est.on_magnetometer, readings.magnetometer)
+                self._guard(ctl.measured.on_magnetometer, readings.magnetometer)
+            if readings.sun_sensors is not None:
+                self._guard(est.on_sun_sensors, readings.sun_sensors)
+            if readings.wheel_speeds is not None:
+                self._guard(ctl.measured.on_wheel_speeds, readings.wheel_speeds)
+            estimate = self._guard(est.on_gyro, readings.gyro) if readings.gyro is not None else None
+            if estimate is not None:
+                outcome = ctl.accept_estimate(estimate)
+        elif t >= self.next_state - 1e-9:
+            self.next_state = t + self.publish_period
+            outcome = ctl.accept_state(sim.state(self.scenario.frame_id, self.scenario.body_frame_id))
+        if outcome is not None:
+            self._outcome(outcome)
+            if ctl.due():
+                out = ctl.step()
+                if out.result is not None:
+                    self.result = out.result
+                refused = sim.set_command(out.command)
+                if refused is not None:
+                    self.refusals.append(RequestError(refused.code, refused.message))
+                if est is not None:
+                    est.on_dipole_command(out.command.t, out.command.dipole)
+                self._record(out.command, readings)
+        sim.advance(self.step)
+
+    def run(self, duration: float) -> None:
+        """Tick for ``duration`` s of sim time (stops early if the simulation halts)."""
+        end = self.sim.t + duration - 1e-9
+        while self.sim.t < end and not self.sim.halted:
+            self.tick()
+
+    def fly(self, plan: Plan, settle: float | None = None) -> ManeuverResult:
+        """Execute ``plan`` now and run until the controller ends it (its duration + settle time);
+        a plan that cannot start comes back as an unsuccessful result with its code."""
+        refused = self.execute(plan)
+        if refused is not None:
+            return ManeuverResult(False, int(refused.code), refused.message)
+        self.result = None
+        limit = self.sim.t + plan.duration + (self.controller.config.settle_time if settle is None else settle) + 10
+        while self.result is None and self.sim.t < limit and not self.sim.halted:
+            self.tick()
+        return self.result or ManeuverResult(False, 305, "the maneuver did not end in time")
+
+    def _guard(self, call, arg):
+        try:
+            return call(arg)
+        except RequestError as err:
+            self.refusals.append(err)
+            return None
+
+    def _outcome(self, outcome) -> None:
+        if outcome.refused is not None:
+            self.refusals.append(outcome.refused)
+        if outcome.ended is not None:
+            self.result = outcome.ended
+
+    def _record(self, command, readings) -> None:
+        tr, sim, est = self.trace, self.sim, self.estimator
+        x = sim.x
+        state = self.controller.state
+        tr.t.append(sim.t)
+        tr.q_true.append(x[:4].copy())
+        tr.omega_true.append(x[4:7].copy())
+        tr.q_est.append(state.q.copy())
+        tr.wheel_speeds.append(x[7:] - sim.sc.wheel_axes.T @ x[4:7])
+        tr.wheel_torques.append(np.asarray(command.wheel_torques, float).copy())
+        tr.dipole.append(np.asarray(command.dipole, float).copy())
+        tr.mode.append(int(command.mode))
+        if est is not None and est.state is not None:
+            tr.attitude_covariance.append(est.state.P[:3, :3].copy())
+            tr.bias_est.append(est.state.bias.copy())
+        else:
+            tr.attitude_covariance.append(np.full((3, 3), math.nan))
+            tr.bias_est.append(np.full(3, math.nan))
+        tr.bias_true.append(sim.sensors.gyro.bias.copy() if sim.sensors and sim.sensors.gyro else np.zeros(3))
+        tr.health.append(int(est.health(sim.t)) if est is not None else int(Health.CONVERGED))
+        tr.tracker_status.append(self.tracker_status)
+
+
+def plan_in_process(scenario: Scenario, q0, qf, sensor_axis, cones=(), zones=(), method: str = "",
+                    time_budget: float = 30.0, epoch: tuple = (0, 0)) -> Plan:
+    """A verified plan as the planner service makes it (same validation, padding, method, fallback and
+    verification; the planner's ``cone_padding_deg`` and ``default_method`` of the scenario), in this
+    process. RequestError when there is none."""
+    from att_planner import methods
+    from att_planner.service.planning import plan_maneuver
+    from att_planner.service.requests import ManeuverRequest, validate_maneuver
+
+    planner = SectionReader(scenario.node_params.get("planner", {}), str(scenario.path))
+    request = ManeuverRequest(scenario.frame_id, np.asarray(q0, float), np.asarray(qf, float),
+                              np.asarray(sensor_axis, float),
+                              [(c.direction, c.half_angle, c.name) for c in cones], method=method,
+                              time_budget=time_budget, spacecraft=scenario.name, epoch=epoch, zones=list(zones))
+    valid = validate_maneuver(request, frame_id=scenario.frame_id, default_spacecraft=scenario.name,
+                              default_method=planner("default_method", "") or methods.REGISTRY[0].name,
+                              default_budget=time_budget)
+    outcome = plan_maneuver(valid, cone_padding=math.radians(planner("cone_padding_deg", 1.0, 0.0, 10.0)))
+    if outcome.code != 0:
+        raise RequestError(outcome.code, outcome.message)
+    return outcome.plan

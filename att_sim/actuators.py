@@ -1,0 +1,124 @@
+"""Imperfect actuators of the truth model (issue 14): wheel drives with friction, quantisation, noise
+and a torque–speed envelope; magnetorquers with quantisation and misalignment.
+
+A scenario's ``/**`` section may hold (datasheet units; every key optional)::
+
+    actuators:
+      wheels: {coulomb_friction_Nm, viscous_friction_Nm_s, friction_speed_rad_s,
+               torque_quantization_Nm, torque_noise_Nm, power_max_W}
+      magnetorquers: {quantization_Am2, misalignment_deg}
+
+Wheel drive (per wheel, ``ν`` the speed relative to the body, ``u`` the commanded motor torque after
+the torque limit): the command is quantised and given white noise once per control step (held), the
+motor delivers at most ``P_max/|ν|`` while it speeds the wheel up (the back-EMF envelope of a
+power-limited drive; braking is not limited), and friction opposes the spin::
+
+    u_net = env(Q(u) + ε, ν) − (c tanh(ν/ν_s) + b ν)
+
+(Coulomb ``c`` smoothed over ``ν_s`` so the integration stays smooth through zero speed, viscous
+``b``; Bialke 1998, "High fidelity mathematical modeling of reaction wheel performance"). The
+planner's model knows none of this: the controller compensates the friction it expects from
+measured wheel speeds. Magnetorquers: ``m_applied = (I + M) Q(m)`` with misalignment ``M`` drawn
+once (six small off-diagonal angles) and quantisation ``Q``.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from att_sim.config_group import Group
+from att_sim.rotations import small_error_matrix
+
+DEG = math.pi / 180.0
+
+
+@dataclass(frozen=True)
+class WheelDriveSpec:
+    coulomb_friction: float = 0.0       # N m
+    viscous_friction: float = 0.0       # N m s/rad
+    friction_speed: float = 1.0         # rad/s: the Coulomb term's smoothing ν_s
+    torque_quantization: float = 0.0    # N m per count; 0: none
+    torque_noise: float = 0.0           # N m 1σ, per control step
+    power_max: float = math.inf         # W: motor torque ≤ P_max/|ν| while speeding the wheel up
+
+    def friction(self, speed: np.ndarray) -> np.ndarray:
+        """Friction torque opposing relative wheel speeds ``speed`` (N m)."""
+        speed = np.asarray(speed, float)
+        return self.coulomb_friction * np.tanh(speed / self.friction_speed) + self.viscous_friction * speed
+
+
+@dataclass(frozen=True)
+class MagnetorquerSpec:
+    quantization: float = 0.0           # A m² per count; 0: none
+    misalignment: float = 0.0           # rad 1σ per off-diagonal element
+
+
+@dataclass(frozen=True)
+class ActuatorSpecs:
+    wheels: WheelDriveSpec | None = None
+    magnetorquers: MagnetorquerSpec | None = None
+
+
+def actuators_from_params(values, label: str = "actuators") -> ActuatorSpecs:
+    """The ``actuators`` group (ValueError naming the field)."""
+    g = Group(values, label)
+    wheels = magnetorquers = None
+    if "wheels" in g:
+        w = g.group("wheels")
+        wheels = WheelDriveSpec(
+            coulomb_friction=w.number("coulomb_friction_Nm", 0.0, 0.0, 10.0),
+            viscous_friction=w.number("viscous_friction_Nm_s", 0.0, 0.0, 10.0),
+            friction_speed=w.number("friction_speed_rad_s", 1.0, 0.0, 1e3, low_open=True),
+            torque_quantization=w.number("torque_quantization_Nm", 0.0, 0.0, 10.0),
+            torque_noise=w.number("torque_noise_Nm", 0.0, 0.0, 10.0),
+            power_max=w.number("power_max_W", math.inf, 0.0, math.inf, low_open=True))
+        w.done()
+    if "magnetorquers" in g:
+        m = g.group("magnetorquers")
+        magnetorquers = MagnetorquerSpec(quantization=m.number("quantization_Am2", 0.0, 0.0, 100.0),
+                                         misalignment=m.number("misalignment_deg", 0.0, 0.0, 10.0) * DEG)
+        m.done()
+    g.read.update(("wheels", "magnetorquers"))
+    g.done()
+    return ActuatorSpecs(wheels, magnetorquers)
+
+
+def quantize(value: np.ndarray, lsb: float) -> np.ndarray:
+    return lsb * np.round(np.asarray(value, float) / lsb) if lsb > 0 else np.asarray(value, float)
+
+
+class WheelDrive:
+    """The wheel drives of one spacecraft (see module docstring)."""
+
+    def __init__(self, spec: WheelDriveSpec, rng: np.random.Generator):
+        self.spec, self.rng = spec, rng
+
+    def hold(self, u: np.ndarray) -> np.ndarray:
+        """The motor torques a command becomes for one step: quantised, with the drive's noise."""
+        u = quantize(u, self.spec.torque_quantization)
+        return u + self.rng.standard_normal(len(u)) * self.spec.torque_noise
+
+    def motor(self, u: np.ndarray, speed: np.ndarray) -> np.ndarray:
+        """Held torques ``u`` within the envelope at relative speeds ``speed``."""
+        if math.isinf(self.spec.power_max):
+            return u
+        accelerating = u * speed > 0
+        limit = self.spec.power_max / np.maximum(np.abs(speed), 1e-12)
+        return np.where(accelerating, np.clip(u, -limit, limit), u)
+
+    def __call__(self, u: np.ndarray, speed: np.ndarray) -> np.ndarray:
+        """Net torque on the wheels (motor minus friction): what :func:`att_sim.dynamics.derivative`
+        applies at each stage."""
+        return self.motor(u, speed) - self.spec.friction(speed)
+
+
+class Magnetorquers:
+    def __init__(self, spec: MagnetorquerSpec, rng: np.random.Generator):
+        self.spec = spec
+        self.transfer = small_error_matrix(rng, 0.0, spec.misalignment)
+
+    def __call__(self, m: np.ndarray) -> np.ndarray:
+        """The dipole the coils produce for the (saturated) command ``m``."""
+        return self.transfer @ quantize(m, self.spec.quantization)

@@ -1,0 +1,119 @@
+"""The spacecraft's sensors (truth side, no ROS): datasheets (:mod:`.specs`), one model per module
+(:mod:`.gyro`, :mod:`.star_tracker`, :mod:`.magnetometer`, :mod:`.sun_sensors`, :mod:`.tachometer`)
+and :class:`SensorSuite`, which samples them at their rates as the simulation advances.
+
+Reproducibility: every random stream of a run (each sensor's drawn errors and noise, the wheel
+drives' and magnetorquers' errors) comes from ``numpy.random.SeedSequence(seed, spawn_key=(k,))``
+with a fixed ``k`` per source (:data:`STREAMS`), so a run is reproduced by its seed alone and a
+source added later does not change the others' streams.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from att_msgs_py.types import (
+    GyroMeasurement,
+    MagnetometerMeasurement,
+    SensorTruth,
+    StarTrackerMeasurement,
+    SunSensorMeasurement,
+    WheelSpeedMeasurement,
+)
+from att_sim import rotations as rot
+from att_sim.sensors.gyro import Gyro
+from att_sim.sensors.magnetometer import Magnetometer
+from att_sim.sensors.specs import SensorSpecs
+from att_sim.sensors.star_tracker import StarTracker
+from att_sim.sensors.sun_sensors import SunSensors
+from att_sim.sensors.tachometer import Tachometer
+from att_sim.world import Bodies
+
+STREAMS = {"gyro": 0, "magnetometer": 1, "sun_sensors": 2, "tachometer": 3, "wheel_drive": 4, "magnetorquers": 5,
+           "star_tracker": 16}      # star tracker i: 16 + i
+
+
+def rng(seed: int, source: str, index: int = 0) -> np.random.Generator:
+    """The random stream of one source of a run (see module docstring)."""
+    return np.random.default_rng(np.random.SeedSequence(seed, spawn_key=(STREAMS[source] + index,)))
+
+
+@dataclass
+class Readings:
+    """The measurements one instant produces (each None or empty when not due)."""
+
+    gyro: GyroMeasurement | None = None
+    star_trackers: list[StarTrackerMeasurement] = field(default_factory=list)
+    magnetometer: MagnetometerMeasurement | None = None
+    sun_sensors: SunSensorMeasurement | None = None
+    wheel_speeds: WheelSpeedMeasurement | None = None
+    truth: SensorTruth | None = None
+
+
+class _Schedule:
+    """Due times of a sensor of ``rate`` Hz: t = 0, 1/rate, 2/rate, ... (counted, never drifting)."""
+
+    def __init__(self, rate: float):
+        self.period, self.count = 1.0 / rate, 0
+
+    def due(self, t: float) -> bool:
+        if t < self.count * self.period - 1e-9:
+            return False
+        self.count = math.floor(t / self.period + 1e-9) + 1
+        return True
+
+
+class SensorSuite:
+    """Every sensor of ``specs``, sampled as :meth:`sample` is called at increasing times."""
+
+    def __init__(self, specs: SensorSpecs, seed: int, frame_id: str = "", body_frame_id: str = ""):
+        self.specs, self.frame_id, self.body_frame_id = specs, frame_id, body_frame_id
+        self.gyro = Gyro(specs.gyro, rng(seed, "gyro")) if specs.gyro else None
+        self.trackers = [StarTracker(s, rng(seed, "star_tracker", i)) for i, s in enumerate(specs.star_trackers)]
+        self.magnetometer = Magnetometer(specs.magnetometer, rng(seed, "magnetometer")) if specs.magnetometer else None
+        self.sun_sensors = SunSensors(specs.sun_sensors, rng(seed, "sun_sensors")) if specs.sun_sensors else None
+        self.tachometer = Tachometer(specs.tachometer, rng(seed, "tachometer")) if specs.tachometer else None
+        rate = {"gyro": specs.gyro, "magnetometer": specs.magnetometer, "sun_sensors": specs.sun_sensors,
+                "tachometer": specs.tachometer}
+        self.schedules = {name: _Schedule(s.rate) for name, s in rate.items() if s is not None}
+        self.tracker_schedules = [_Schedule(s.rate) for s in specs.star_trackers]
+        self.pending: list[tuple[float, StarTrackerMeasurement]] = []        # (release time, measurement)
+        self.gyro_last: tuple[float, np.ndarray] | None = None               # (t, q) of the last gyro sample
+
+    def sample(self, t: float, q: np.ndarray, omega: np.ndarray, relative_wheel_speed: np.ndarray,
+               field_B: np.ndarray, dipole_applied: np.ndarray, bodies: Bodies) -> Readings:
+        """What the sensors output at time ``t`` for the truth state (attitude ``q``, body rate
+        ``omega``, wheel speeds relative to the body) and the environment (``field_B`` in body axes,
+        the applied dipole, ``bodies``). The gyro measures the rotation since its previous sample
+        (at its first sample: ``omega`` over one period); a tracker's measurement of ``t`` comes out
+        at the first call at or after ``t`` + its latency."""
+        out = Readings()
+        body = self.body_frame_id
+        if self.gyro is not None and self.schedules["gyro"].due(t):
+            if self.gyro_last is None:
+                dt = self.schedules["gyro"].period
+                rotation = np.asarray(omega, float) * dt
+            else:
+                dt = t - self.gyro_last[0]
+                rotation = rot.log_map(rot.multiply(rot.conjugate(self.gyro_last[1]), q))
+            self.gyro_last = (t, np.array(q, float))
+            sigma = self.gyro.noise_sigma(dt)
+            out.gyro = GyroMeasurement(t, self.gyro.measure(rotation, dt), np.eye(3) * sigma**2, body)
+            out.truth = SensorTruth(t, self.gyro.bias.copy(), self._magnetometer_bias(), body)
+        for tracker, schedule in zip(self.trackers, self.tracker_schedules):
+            if schedule.due(t):
+                self.pending.append((t + tracker.spec.latency, tracker.measure(t, q, omega, bodies, self.frame_id)))
+        out.star_trackers = [m for release, m in self.pending if release <= t + 1e-9]
+        self.pending = [(release, m) for release, m in self.pending if release > t + 1e-9]
+        if self.tachometer is not None and self.schedules["tachometer"].due(t):
+            out.wheel_speeds = self.tachometer.measure(t, relative_wheel_speed, body)
+        if self.magnetometer is not None and self.schedules["magnetometer"].due(t):
+            out.magnetometer = self.magnetometer.measure(t, field_B, dipole_applied, body)
+        if self.sun_sensors is not None and self.schedules["sun_sensors"].due(t):
+            out.sun_sensors = self.sun_sensors.measure(t, q, bodies, body)
+        return out
+
+    def _magnetometer_bias(self) -> np.ndarray:
+        return self.magnetometer.bias.copy() if self.magnetometer is not None else np.zeros(3)

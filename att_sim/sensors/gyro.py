@@ -1,0 +1,92 @@
+"""Three-axis rate gyro: the mean body rate over each sample interval, with the errors of a datasheet.
+
+Measurement of sample k (interval Δt ending at t_k), in the gyro's nominal (body) axes::
+
+    ω_m,k = Q( sat( (I + S + M) Δθ_k / Δt + b_k + σ_v / √Δt · n_k ) )
+
+* ``Δθ_k``: the true rotation vector over the interval (the gyro integrates: its output is the mean
+  rate, so a propagation over the interval with it is exact for a fixed axis);
+* ``S`` scale factors, ``M`` misalignment (six small off-diagonal angles), drawn once per unit;
+* ``b_k = b_0 + b_flicker,k + b_rrw,k``: turn-on bias (drawn once), the bias instability and the rate
+  random walk ``b_rrw,k+1 = b_rrw,k + σ_u √Δt · n`` (Farrenkopf's model, Markley & Crassidis 2014 §4.7);
+* ``σ_v`` the angle random walk: white rate noise of standard deviation ``σ_v/√Δt`` per sample;
+* ``sat`` the range per axis, ``Q`` quantisation of the angle increment with the remainder carried to
+  the next sample (an integrating gyro's pulse counting: no error accumulates).
+
+Bias instability ``B`` is flicker (1/f) noise, whose Allan deviation is flat at ``√(2 ln 2/π) B =
+0.664 B`` (IEEE Std 952-1997, Annex C). It is realised as a bank of first-order Gauss–Markov processes
+with correlation times spaced by ``r = √10`` over ``FLICKER_SPAN``: a bank of equal variances ``σ²``
+has the one-sided PSD ``Σ 4σ²T/(1 + (2πfT)²) ≈ σ²/(f ln r)`` between its corners, i.e. flicker with
+``h₋₁ = σ²/ln r`` and Allan variance ``2 ln 2 · h₋₁``; hence ``σ = B √(ln r / π)`` per process.
+The simulated unit's Allan deviation recovers the configured ARW and B (test/att_sim/test_sensors.py).
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from scipy.signal import lfilter
+
+from att_sim.rotations import small_error_matrix
+from att_sim.sensors.specs import GyroSpec
+
+FLICKER_SPAN = (1.0, 1e5)          # s: correlation times of the flicker bank (Allan floor between them)
+FLICKER_RATIO = math.sqrt(10.0)    # spacing of the correlation times
+
+
+def flicker_times() -> np.ndarray:
+    """Correlation times of the flicker bank (s)."""
+    lo, hi = FLICKER_SPAN
+    count = int(round(math.log(hi / lo) / math.log(FLICKER_RATIO))) + 1
+    return lo * FLICKER_RATIO ** np.arange(count)
+
+
+class Gyro:
+    """One gyro unit: its drawn errors and the state of its noise (see module docstring)."""
+
+    def __init__(self, spec: GyroSpec, rng: np.random.Generator):
+        self.spec, self.rng = spec, rng
+        self.transfer = small_error_matrix(rng, spec.scale_factor, spec.misalignment)
+        self.turn_on = rng.normal(0.0, spec.initial_bias, 3)
+        self.times = flicker_times()
+        self.flicker_sigma = spec.bias_instability * math.sqrt(math.log(FLICKER_RATIO) / math.pi)
+        self.flicker = rng.normal(0.0, self.flicker_sigma, (len(self.times), 3))   # stationary start
+        self.walk = np.zeros(3)
+        self.carry = np.zeros(3)          # rad: angle not yet output by the quantiser
+        self.bias = self.turn_on + self.flicker.sum(axis=0)
+
+    def noise_sigma(self, dt: float) -> float:
+        """1σ of the white rate noise of one sample (rad/s)."""
+        return self.spec.arw / math.sqrt(dt)
+
+    def _bias(self, n: int, dt: float) -> np.ndarray:
+        """The bias at the end of each of ``n`` intervals (n, 3); advances the noise state."""
+        flicker = np.zeros((n, 3))
+        if self.flicker_sigma > 0:
+            for j, tau in enumerate(self.times):
+                a = math.exp(-dt / tau)
+                drive = self.rng.standard_normal((n, 3)) * (self.flicker_sigma * math.sqrt(1.0 - a * a))
+                path, _ = lfilter([1.0], [1.0, -a], drive, axis=0, zi=(a * self.flicker[j])[None, :])
+                flicker += path
+                self.flicker[j] = path[-1]
+        walk = self.walk + np.cumsum(self.rng.standard_normal((n, 3)) * (self.spec.rrw * math.sqrt(dt)), axis=0)
+        self.walk = walk[-1]
+        bias = self.turn_on + flicker + walk
+        self.bias = bias[-1]
+        return bias
+
+    def measure(self, rotation: np.ndarray, dt: float) -> np.ndarray:
+        """Measured rates for consecutive intervals of ``dt`` s whose true rotation vectors are the
+        rows of ``rotation`` ((n, 3), or (3,) for one sample: then the result is (3,))."""
+        increments = np.atleast_2d(np.asarray(rotation, float))
+        n = len(increments)
+        rate = increments @ self.transfer.T / dt + self._bias(n, dt)
+        rate += self.rng.standard_normal((n, 3)) * self.noise_sigma(dt)
+        rate = np.clip(rate, -self.spec.range, self.spec.range)
+        lsb = self.spec.quantization
+        if lsb > 0:
+            total = self.carry + np.cumsum(rate * dt, axis=0)
+            counted = lsb * np.round(total / lsb)
+            self.carry = total[-1] - counted[-1]
+            rate = np.diff(np.vstack([np.zeros(3), counted]), axis=0) / dt
+        return rate[0] if np.ndim(rotation) == 1 else rate
