@@ -49,21 +49,29 @@ def rigid_body_dynamics(Jn: np.ndarray, smooth: bool = False) -> ca.Function:
 
 
 ZONE_PARAMETERS = 8      # per fixed zone: σ (+1 keep-out, -1 keep-in), sensor (3), axis (3), cos(θ + σ δ)
-MOTION_DEGREE = 16       # a moving zone fitted by one Chebyshev series of at most this degree is a parameter
-MOTION_PARAMETERS = 6 + 4 * (MOTION_DEGREE + 1)    # σ, sensor (3), α, β, the series' coefficients (axis, θ + σ δ)
+MOTION_DEGREES = (8, 16)   # a moving zone fitted by one Chebyshev series of at most such a degree is a parameter
 
 
-def _motion_parametric(zones) -> bool:
-    """Whether every moving zone's fit is one series of degree ≤ :data:`MOTION_DEGREE`."""
-    return all(len(zones.series(z)) == 1 and len(zones.series(z)[0]) <= MOTION_DEGREE + 1
-               for z, zone in enumerate(zones.zones) if zone.body != "inertial")
+def motion_parameters(degree: int) -> int:
+    """Parameters per moving zone: σ, sensor (3), α, β, the series' coefficients (axis, θ + σ δ)."""
+    return 6 + 4 * (degree + 1)
+
+
+def motion_degree(zones) -> int | None:
+    """The smallest of :data:`MOTION_DEGREES` that holds every moving zone's fit when each is one
+    series, else None (no moving zone: the smallest)."""
+    fits = [zones.series(z) for z, zone in enumerate(zones.zones) if zone.body != "inertial"]
+    if any(len(f) > 1 for f in fits):
+        return None
+    needed = max((len(f[0]) - 1 for f in fits), default=0)
+    return next((d for d in MOTION_DEGREES if d >= needed), None)
 
 
 def path_function(problem: ManeuverProblem, s: Scaling, n_state: int = 7, cone_margin: float = 0.0):
-    """``(path, parametric)``: the path constraints ``g ≤ 0`` (zones, wheel momentum) as a CasADi
+    """``(path, degree)``: the path constraints ``g ≤ 0`` (zones, wheel momentum) as a CasADi
     Function ``(x, u[, t][, p]) -> g`` (``x`` has ``n_state`` rows, the attitude and rate first;
-    None when there are none), the data of the problem in ``p`` (:func:`path_values`), and whether
-    its moving zones are parameters too.
+    None when there are none), the data of the problem in ``p`` (:func:`path_values`), and the
+    degree of the moving zones' series in ``p`` (:func:`motion_degree`; None: they are constants).
 
     Every zone of ``problem.zone_sky()`` (:mod:`att_planner.zones`: the cones, then the zones, each
     with its own sensor axis ``s_z``, ``b_z = R(q) s_z``) is tightened by ``δ``: keep-out
@@ -71,18 +79,19 @@ def path_function(problem: ManeuverProblem, s: Scaling, n_state: int = 7, cone_m
     ``σ_z (a_z · b_z − cos(θ_z + σ_z δ)) ≤ 0``. A fixed zone's data are in ``p``
     (:data:`ZONE_PARAMETERS`). When a zone moves, ``t`` is the normalised time from the start and
     ``a_z``, ``θ_z`` are the ZoneSky's Chebyshev series of ``t τ_u``, so the collocation couples them
-    exactly to ``t_f``: their coefficients are in ``p`` too (:data:`MOTION_PARAMETERS`, the series in
-    ``x = α t + β``) when every moving zone is one series of degree ≤ :data:`MOTION_DEGREE`,
+    exactly to ``t_f``: their coefficients are in ``p`` too (:func:`motion_parameters`, the series in
+    ``x = α t + β``) when every moving zone is one series of a degree of :data:`MOTION_DEGREES`,
     otherwise the series are constants of the function (tightened by ``cone_margin``). The wheels'
     momentum bound takes its scale from ``p`` (its last value). So the function depends on the
     problem's shape only, but for moving zones of many pieces."""
     zones = problem.zone_sky()
     fixed = [z.body == "inertial" for z in zones.zones]
-    parametric = _motion_parametric(zones)
-    moving = 0 if not parametric else len(fixed) - sum(fixed)
+    degree = motion_degree(zones)
+    moving = 0 if degree is None else len(fixed) - sum(fixed)
     momentum = math.isfinite(problem.wheel_momentum_max) and problem.spacecraft.n_wheels > 0   # no wheels: none
     x, u, t = ca.SX.sym("x", n_state), ca.SX.sym("u", 3), ca.SX.sym("t")
-    p = ca.SX.sym("p", ZONE_PARAMETERS * sum(fixed) + MOTION_PARAMETERS * moving + momentum)
+    per_zone = 0 if degree is None else motion_parameters(degree)
+    p = ca.SX.sym("p", ZONE_PARAMETERS * sum(fixed) + per_zone * moving + momentum)
     R = symbolic.dcm(x[:4])
     g = []
     for k in range(sum(fixed)):
@@ -90,29 +99,30 @@ def path_function(problem: ManeuverProblem, s: Scaling, n_state: int = 7, cone_m
                                    p[ZONE_PARAMETERS * k + 4:ZONE_PARAMETERS * k + 7], p[ZONE_PARAMETERS * k + 7])
         g.append(sign * (ca.dot(axis, ca.mtimes(R, sensor)) - cos))
     for k in range(moving):
-        o = ZONE_PARAMETERS * sum(fixed) + MOTION_PARAMETERS * k
+        o = ZONE_PARAMETERS * sum(fixed) + per_zone * k
         sign, sensor, alpha, beta = p[o], p[o + 1:o + 4], p[o + 4], p[o + 5]
-        rows = [p[o + 6 + 4 * i:o + 10 + 4 * i] for i in range(MOTION_DEGREE + 1)]
+        rows = [p[o + 6 + 4 * i:o + 10 + 4 * i] for i in range(degree + 1)]
         value = clenshaw(alpha * t + beta, rows)
         g.append(sign * (ca.dot(value[:3], ca.mtimes(R, sensor)) - ca.cos(value[3])))
-    if zones.moving and not parametric:
+    if zones.moving and degree is None:
         g += [c for c, f in zip(zones.casadi_constraints(t * s.tu, R, cone_margin), fixed) if not f]
     if momentum:
         h_w = ca.mtimes(ca.DM(problem.spacecraft.wheel_axes_pinv @ s.Jn), x[4:7]) * p[-1]
         g += [h_w - 1, -h_w - 1]
     if not g:
-        return None, parametric
+        return None, degree
     inputs = [x, u] + ([t] if zones.moving else []) + ([p] if p.numel() else [])
-    return ca.Function("path", inputs, [ca.vertcat(*g)]), parametric
+    return ca.Function("path", inputs, [ca.vertcat(*g)]), degree
 
 
 def path_values(problem: ManeuverProblem, s: Scaling, cone_margin: float) -> np.ndarray:
     """The values of :func:`path_function`'s ``p``: each fixed zone's σ, unit sensor axis, axis and
     ``cos(θ + σ δ)`` (``δ = cone_margin``); each moving zone's σ, unit sensor axis, α = 2 τ_u/(b − a)
     and β = −(a + b)/(b − a) of its series on [a, b] and the coefficients (zero-padded to
-    :data:`MOTION_DEGREE`, θ's first one raised by σ δ), when they are parameters; then the
+    :func:`motion_degree`, θ's first one raised by σ δ), when they are parameters; then the
     momentum bound's scale."""
     zones = problem.zone_sky()
+    degree = motion_degree(zones)
     axes, half = zones.at(0.0)
     fixed, moving = [], []
     for z, zone in enumerate(zones.zones):
@@ -120,9 +130,9 @@ def path_values(problem: ManeuverProblem, s: Scaling, cone_margin: float) -> np.
         sensor = zones.sensor_axes[z] / np.linalg.norm(zones.sensor_axes[z])
         if zone.body == "inertial":
             fixed += [[sign], sensor, axes[z], [math.cos(half[z] + sign * cone_margin)]]
-        elif _motion_parametric(zones):
+        elif degree is not None:
             (coef,), (a, b) = zones.series(z), zones.pieces
-            padded = np.zeros((MOTION_DEGREE + 1, 4))
+            padded = np.zeros((degree + 1, 4))
             padded[:len(coef)] = coef
             padded[0, 3] += sign * cone_margin
             moving += [[sign], sensor, [2 * s.tu / (b - a), -(a + b) / (b - a)], padded.ravel()]
@@ -168,7 +178,8 @@ def transcription(problem: ManeuverProblem, s: Scaling, mesh: np.ndarray, contro
     ``torque_accel``: the smooth NLP of :mod:`.smooth`, its bound on the torque's second derivative).
 
     The NLP is built once per shape and kept (:data:`CACHE_SIZE`): the spacecraft's inertia, the
-    number of intervals, the zones' count (moving zones of many pieces: their ZoneSky), the bounds on the
+    number of intervals, the zones' count and series degree (moving zones of many pieces: their
+    ZoneSky), the bounds on the
     rate and momentum, the kind of goal and the settings. The mesh, the zones' data, the goal and the
     momentum scale are its parameters, the start and the duration's bounds its variables' bounds
     (set here), so a second problem of that shape only copies it (:meth:`.collocation.Transcription.copy`).
@@ -176,11 +187,11 @@ def transcription(problem: ManeuverProblem, s: Scaling, mesh: np.ndarray, contro
     (a banded KKT system, far fewer iterations; with moving zones the copies took more)."""
     smooth = torque_accel is not None
     zones = problem.zone_sky()
-    path, parametric = path_function(problem, s, 13 if smooth else 7, cone_margin)
+    path, degree = path_function(problem, s, 13 if smooth else 7, cone_margin)
     momentum = math.isfinite(problem.wheel_momentum_max)
     moving = sum(z.body != "inertial" for z in zones.zones)
     key = (smooth, torque_accel, s.Jn.tobytes(), len(mesh) - 1, control, sum(z.body == "inertial" for z in zones.zones),
-           moving if parametric else (id(zones), cone_margin),
+           (moving, degree) if degree is not None else (id(zones), cone_margin),
            problem.spacecraft.wheel_axes.tobytes() if momentum else None, problem.rate_max,
            problem.sensor_target is None, tol, max_iter, expand)
     if key not in _NLPS:

@@ -150,7 +150,7 @@ class _Incumbent:
                 return
             sol = self.sol
             bad, _ = col.path_violations(sol, tol=1e-4)
-            split = np.union1d(bad, col.switch_intervals(sol, limit=max(4, sol.phase.intervals // 4)))
+            split = np.union1d(bad, col.switch_intervals(sol, limit=max(4, sol.phase.intervals // 2)))
             if not len(split) or sol.phase.intervals >= self.run.max_intervals:
                 return
             if not self.resolve(col.refine_mesh(sol.phase.mesh, split, self.run.max_intervals)):
@@ -281,7 +281,7 @@ def _verdict(plan: Plan, ok: bool, run: _Solve, incumbent: _Incumbent, best: str
 
 
 def plan_time_optimal(problem: ManeuverProblem, *, intervals: int = DEFAULT_INTERVALS, max_intervals: int | None = None,
-                      starts: int = 3, refine_rounds: int = 4, interpolation: str = Interpolation.ZOH,
+                      starts: int = 3, refine_rounds: int = 3, interpolation: str = Interpolation.ZOH,
                       cone_margin_deg: float = 0.05, warm_starts: tuple = (),
                       smooth_warm_start: bool = False, explore_tol: float = 1e-5, tol: float = 1e-7,
                       max_iter: int = 400, verify_reserve: float = 1.0) -> Plan:

@@ -76,39 +76,35 @@ def request(problem: ManeuverProblem, method: str, budget: float) -> PlanOutcome
     return plan_maneuver(valid, runner=run_method)
 
 
-def timed(problem: ManeuverProblem, method: str, budget: float, repeats: int):
-    """``(last outcome, wall times, CPU times)`` of ``repeats`` requests after one untimed one."""
+def timed(problem: ManeuverProblem, method: str, budget: float, repeats: int) -> dict:
+    """The JSON entry P (module docstring) of ``repeats`` requests after one untimed one: the last
+    one's plan, the median wall and CPU times of the requests and of each stage."""
     request(problem, method, budget)
-    walls, cpus, outcome = [], [], None
+    walls, cpus, stages, outcome = [], [], [], None
     for _ in range(repeats):
         wall, cpu = time.perf_counter(), time.process_time()
         outcome = request(problem, method, budget)
         walls.append(time.perf_counter() - wall)
         cpus.append(time.process_time() - cpu)
-    return outcome, walls, cpus
-
-
-def entry(outcome: PlanOutcome, walls: list, cpus: list) -> dict:
-    """The JSON entry P of a timed request (module docstring)."""
+        stages.append({str(s.name): s.seconds for s in outcome.stages})
     plan, ver = outcome.plan, outcome.verification
     return {"method": plan.method, "tf": plan.duration, "t": plan.t, "torque": plan.torque,
             "interpolation": str(plan.interpolation), "solve_seconds": statistics.median(walls),
-            "solve_cpu_seconds": statistics.median(cpus), "solve_seconds_all": walls, "status": str(plan.status),
-            "stage": str(outcome.stage), "stages": [asdict(s) for s in outcome.stages], "code": int(outcome.code),
+            "solve_cpu_seconds": statistics.median(cpus), "solve_seconds_all": walls,
+            "stage_seconds": {name: statistics.median(s[name] for s in stages) for name in stages[-1]},
+            "status": str(plan.status), "stage": str(outcome.stage), "stages": [asdict(s) for s in outcome.stages],
+            "code": int(outcome.code),
             "verification": dict(asdict(ver), passes=rejection(ver) is None) if ver is not None else {"passes": False}}
 
 
 def run_case(name: str, args) -> dict:
     problem, description = case_problem(name)
     default = methods.REGISTRY[0].name
-    first = timed(problem, default, FIRST_BUDGET, args.repeats)
-    best = timed(problem, default, BEST_BUDGET, args.best_repeats)
-    optimal = timed(problem, "time_optimal", TIME_OPTIMAL_BUDGET, args.best_repeats)
-    out = {"case": name, "first": entry(*first), "best": entry(*best), "time_optimal": entry(*optimal),
-           **description}
+    out = {"case": name, "first": timed(problem, default, FIRST_BUDGET, args.repeats),
+           "best": timed(problem, default, BEST_BUDGET, args.best_repeats),
+           "time_optimal": timed(problem, "time_optimal", TIME_OPTIMAL_BUDGET, args.best_repeats), **description}
     out["time_optimal_tf"] = out["time_optimal"]["tf"]
-    out["time_optimal_seconds"] = statistics.median(s.seconds for o in [optimal[0]] for s in o.stages
-                                                    if s.name == Stage.METHOD)
+    out["time_optimal_seconds"] = out["time_optimal"]["stage_seconds"][Stage.METHOD]
     out["best_tf_ratio"] = out["best"]["tf"] / out["time_optimal_tf"]
     return out
 

@@ -13,8 +13,8 @@ import pytest
 from att_msgs_py.types import Status, Zone
 from att_planner.methods.time_optimal import plan_time_optimal
 from att_planner.methods.time_optimal.model import (
-    MOTION_PARAMETERS,
     ZONE_PARAMETERS,
+    motion_parameters,
     path_function,
     path_values,
     scaling,
@@ -92,10 +92,10 @@ def test_zone_constraints_are_exact_functions_of_time():
     problem = _sweep_problem()
     s = scaling(problem)
     margin = np.deg2rad(0.05)
-    path, parametric = path_function(problem, s, 7, margin)
-    assert parametric and path.n_in() == 4          # (x, u, t, p): the series' coefficients are parameters
+    path, degree = path_function(problem, s, 7, margin)
+    assert degree is not None and path.n_in() == 4          # (x, u, t, p): the series' coefficients are parameters
     values = path_values(problem, s, margin)
-    assert values.size == MOTION_PARAMETERS
+    assert values.size == motion_parameters(degree)
     x, u, t = ca.SX.sym("x", 7), ca.SX.sym("u", 3), ca.SX.sym("t")
     dgdt = ca.Function("dgdt", [x, u, t], [ca.jacobian(path(x, u, t, values), t)])
     zs = problem.zone_sky()
