@@ -219,7 +219,8 @@ def plan_maneuver(valid: ValidRequest, tol: Tolerances = TOLERANCES, cone_paddin
     answer with the quickest verified plan, or the eigenaxis fallback when that is safe.
 
     1. *first*: :data:`FIRST_METHOD`'s constructive plan, in-process (not for a cheap method, which
-       is answered at once): the quick answer, and the seed of the method.
+       is answered at once): the quick answer, and the seed of the method. When it finds no plan
+       among the padded zones, it tries the zones as requested.
     2. *method*: the requested method, seeded with the first plan (``warm_starts``, for a method
        that takes them), when at least :data:`MIN_METHOD_SECONDS` are left of its deadline: the
        request's deadline minus a reserve for verification and fallback (:func:`verify_reserve`).
@@ -238,6 +239,9 @@ def plan_maneuver(valid: ValidRequest, tol: Tolerances = TOLERANCES, cone_paddin
     first = None
     if not valid.method.cheap:
         first = _run_stage(Stage.FIRST, methods.get(FIRST_METHOD), planned, {}, run_method, None, valid, tol, False)
+        if not first.report.verified and planned is not problem:   # the padding may close a way the zones leave
+            first = _run_stage(Stage.FIRST, methods.get(FIRST_METHOD), problem, {}, run_method, None, valid, tol,
+                               False)
         done.append(first)
         first = first if first.report.verified else None
     method_deadline = problem.deadline - verify_reserve(valid.time_budget) if problem.deadline is not None else None

@@ -110,3 +110,20 @@ def test_semi_free_plan_is_judged_on_the_integrated_boresight():
     assert outcome.verification.final_attitude_error < math.radians(0.5)      # boresight error here
     reached = rot.dcm(outcome.plan.q[-1]) @ np.array([1.0, 0, 0])
     assert reached @ target > math.cos(math.radians(0.5))
+
+
+def test_the_first_plan_falls_back_on_the_unpadded_zones():
+    """leo_observatory: the Earth limb rises over the start; padded by 2 deg it overtakes every
+    rest-to-rest leg, so the first plan is searched among the zones as requested (verified against them)."""
+    from att_planner.methods import get
+    from att_planner.methods.graph_smooth import plan_graph_smooth
+    from att_planner.service.planning import padded
+    from att_planner.service.requests import ValidRequest
+    from att_planner.tools.bench.sky import case_problem
+
+    _, problem = case_problem("leo_observatory")
+    assert not plan_graph_smooth(padded(problem, math.radians(2.0))).success
+    valid = ValidRequest(replace(problem, deadline=time.monotonic() + 0.05), get("smooth_collocation"), {}, "x", 0.05)
+    outcome = plan_maneuver(valid, TOLERANCES, cone_padding=math.radians(2.0), runner=run_method)
+    assert outcome.code == ErrorCode.OK and outcome.stage == Stage.FIRST and outcome.plan.method == "graph_smooth"
+    assert outcome.verification.min_cone_margin >= 0
