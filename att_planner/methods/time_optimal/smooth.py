@@ -131,12 +131,13 @@ def plan_smooth_collocation(problem: ManeuverProblem, *, intervals: int = DEFAUL
         mesh = col.refine_mesh(mesh, bad, 4 * intervals)
         initial = [sol.resample(tr.phases[0].with_mesh(mesh))]
     elapsed = time.monotonic() - start
+    expired = problem.deadline is not None and time.monotonic() > problem.deadline
     if best is None:
         statuses = sorted({m["status"] for m in stats["meshes"]})
-        return Plan(method=METHOD, status=Status.FAILED, message=f"no start converged (IPOPT: {', '.join(statuses)})",
-                    wall_time=elapsed, nit=nit, nfev=nfev, stats=stats)
+        return Plan(method=METHOD, status=Status.BUDGET_EXPIRED if expired else Status.FAILED,
+                    message=f"no start converged{' before the deadline' if expired else ''} "
+                            f"(IPOPT: {', '.join(statuses)})", wall_time=elapsed, nit=nit, nfev=nfev, stats=stats)
     why = rejection(best.verification)
-    expired = problem.deadline is not None and time.monotonic() > problem.deadline
     best.status = Status.FAILED if why else Status.BUDGET_EXPIRED if expired else Status.OPTIMAL
     best.message = (f"fails truth verification: {why}" if why else
                     f"t_f = {best.duration:.6g} s, torque C1 (|d2T/dt2| <= {torque_accel:g} T/tu^2), "
