@@ -395,16 +395,17 @@ def load(name: str) -> Scenario:
     nodes = {k: v["ros__parameters"] for k, v in doc.items() if k != "/**"}
     epoch = epoch_from_params(path, shared)
     orbit_model = orbit_model_from_params(path, shared, epoch)
+    field_model = field_model_from_params(path, shared, epoch)
+    environment = environment_from_params(path, shared, epoch)
+    zones = zones_from_params(path, shared, epoch)
     sensors, actuators = sensors_and_actuators(path, shared, epoch)
     return Scenario(
         name=path.stem, path=path,
         spacecraft=spacecraft_from_params(shared["spacecraft"]),
         orbit=orbit_model.params if isinstance(orbit_model, orbits.CircularOrbit) else None,
         frame_id=shared.get("frame_id", "eci"), body_frame_id=shared.get("body_frame_id", "body"),
-        node_params=nodes, epoch=epoch, orbit_model=orbit_model,
-        field_model=field_model_from_params(path, shared, epoch),
-        environment=environment_from_params(path, shared, epoch),
-        zones=zones_from_params(path, shared, epoch), sensors=sensors, actuators=actuators)
+        node_params=nodes, epoch=epoch, orbit_model=orbit_model, field_model=field_model, environment=environment,
+        zones=zones, sensors=sensors, actuators=actuators)
 
 
 def load_checked(name: str) -> Scenario:

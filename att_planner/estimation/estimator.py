@@ -47,7 +47,6 @@ from collections import deque
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.stats import chi2
 
 from att_msgs_py.errors import ErrorCode, RequestError
 from att_msgs_py.types import (
@@ -124,7 +123,9 @@ class Estimator:
         self.trackers = {s.name: s for s in specs.star_trackers}
         variances = np.array([config.scale_factor_sigma**2] * 3 + [config.misalignment_sigma**2] * 6)
         self.consider = variances if np.any(variances > 0) else None
-        self.gates = {k: float(chi2.ppf(config.gate_probability, k)) for k in (3,)}
+        from scipy.special import gammaincinv  # the chi-square quantile; scipy.stats costs seconds to import
+
+        self.gates = {k: 2.0 * float(gammaincinv(k / 2.0, config.gate_probability)) for k in (3,)}
         self.gyro: deque[tuple[float, np.ndarray, bool]] = deque()       # (t, ω_m, saturated)
         # filter states at the gyro instants, after the measurements up to each; the first is the anchor
         self.snapshots: deque[tuple[float, mekf.FilterState | None]] = deque([(-math.inf, None)])

@@ -25,7 +25,6 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from scipy.signal import lfilter
 
 from att_sim.rotations import small_error_matrix
 from att_sim.sensors.specs import GyroSpec
@@ -60,13 +59,20 @@ class Gyro:
         return self.spec.arw / math.sqrt(dt)
 
     def _bias(self, n: int, dt: float) -> np.ndarray:
-        """The bias at the end of each of ``n`` intervals (n, 3); advances the noise state."""
+        """The bias at the end of each of ``n`` intervals (n, 3); advances the noise state. Each
+        flicker process is ``x_k = a x_(k-1) + w_k``: one step directly (the simulator's case), a
+        batch through ``scipy.signal.lfilter`` (imported then: it costs a node seconds at start)."""
         flicker = np.zeros((n, 3))
         if self.flicker_sigma > 0:
             for j, tau in enumerate(self.times):
                 a = math.exp(-dt / tau)
                 drive = self.rng.standard_normal((n, 3)) * (self.flicker_sigma * math.sqrt(1.0 - a * a))
-                path, _ = lfilter([1.0], [1.0, -a], drive, axis=0, zi=(a * self.flicker[j])[None, :])
+                if n == 1:
+                    path = (a * self.flicker[j] + drive[0])[None, :]
+                else:
+                    from scipy.signal import lfilter
+
+                    path, _ = lfilter([1.0], [1.0, -a], drive, axis=0, zi=(a * self.flicker[j])[None, :])
                 flicker += path
                 self.flicker[j] = path[-1]
         walk = self.walk + np.cumsum(self.rng.standard_normal((n, 3)) * (self.spec.rrw * math.sqrt(dt)), axis=0)
