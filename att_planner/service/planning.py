@@ -7,11 +7,11 @@ through the truth dynamics (:mod:`att_planner.verification`) and accepted only i
 tolerances; the quickest accepted plan is returned (the first plan with status BUDGET_EXPIRED when
 the budget left the method no time or ran out in it, FALLBACK when the method failed), the eigenaxis
 slew with status FALLBACK when only it verifies; otherwise the answer is an error. No unverified
-plan ever leaves, and the outcome reports every stage and its time. Zones (issue 13) travel in the problem: the
-method plans against their motion (:meth:`ManeuverProblem.zone_sky`), padded like the cones
-(:func:`padded`), and every plan, the fallback's too, is verified against the unpadded zones at
-their true positions. :func:`plan_schedule_request` does the same
-for a schedule (no fallback exists there).
+plan ever leaves, and the outcome reports every stage and its time. Zones (issue 13) travel in the
+problem: the method plans against their motion (:meth:`ManeuverProblem.zone_sky`), padded like the
+cones (:func:`padded`), and every plan, the fallback's too, is verified against the unpadded zones
+at their true positions. :func:`plan_schedule_request` does the same for a schedule (no fallback
+exists there).
 
 Bounded: a plan of more than :data:`MAX_PLAN_SAMPLES` samples is refused (SIZE_LIMIT) before it is
 verified or sent. Every answer comes within the request's budget plus :data:`ANSWER_GRACE`: the

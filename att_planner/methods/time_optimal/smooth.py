@@ -22,6 +22,7 @@ enters a zone the mesh is bisected and the NLP solved again (:data:`REFINE_ROUND
 from __future__ import annotations
 
 import time
+from dataclasses import replace
 
 import numpy as np
 
@@ -125,7 +126,8 @@ def plan_smooth_collocation(problem: ManeuverProblem, *, intervals: int = DEFAUL
         traj = integrate(problem, plan)
         plan.verification = measure(problem, plan, traj)
         best = plan if best is None or rejection(plan.verification) is None else best
-        bad = _truth_violation_intervals(traj, sol, s, problem)
+        # the plan's times are the solution's slowed by c: the truth's samples back on the solution's mesh
+        bad = _truth_violation_intervals(replace(traj, t=traj.t / plan.stats["slowed_by"]), sol, s, problem)
         if rejection(plan.verification) is None or not len(bad) or len(mesh) - 1 >= 4 * intervals:
             break
         mesh = col.refine_mesh(mesh, bad, 4 * intervals)
