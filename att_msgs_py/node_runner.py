@@ -16,8 +16,10 @@ process exits 0.
 """
 from __future__ import annotations
 
+import math
 import signal
 import sys
+import time
 from collections.abc import Callable
 from pathlib import Path
 
@@ -26,7 +28,7 @@ import yaml
 from rcl_interfaces.msg import ParameterDescriptor
 from rclpy.executors import Executor, ExternalShutdownException, SingleThreadedExecutor
 
-from att_msgs_py.errors import ConfigError, ErrorCode, clip
+from att_msgs_py.errors import ConfigError, ErrorCode, RequestError, clip
 from att_msgs_py.parameters import checked, coerce
 
 _stop_signalled = False
@@ -96,6 +98,25 @@ def publisher_of(info) -> bytes | None:
 def participant_of(gid: bytes | None) -> bytes | None:
     """The DDS participant of a publisher GID (its 12-byte GUID prefix): one per node process."""
     return None if gid is None else gid[:12]
+
+
+class RefusalLog:
+    """A node's refused inputs: counted per kind and logged at most once a second *per kind* (so a
+    flood of one kind cannot hide another; rclpy's own throttling is per call site), clipped, with
+    the running count: ``state refused (55 so far) [311 STATE_TIME_JUMP]: ...``."""
+
+    def __init__(self, logger, period: float = 1.0):
+        self.logger, self.period = logger, period
+        self.counts: dict[str, int] = {}
+        self.logged: dict[str, float] = {}
+
+    def __call__(self, what: str, err: RequestError) -> None:
+        self.counts[what] = self.counts.get(what, 0) + 1
+        now = time.monotonic()
+        if now - self.logged.get(what, -math.inf) >= self.period:
+            self.logged[what] = now
+            self.logger.warning(clip(f"{what} refused ({self.counts[what]} so far) [{int(err.code)} "
+                                     f"{err.code.name}]: {err.message}"))
 
 
 def parameter_reader(node, scenario_values: dict, source: str = "") -> ParameterReader:

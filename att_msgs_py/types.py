@@ -113,8 +113,8 @@ class Verification:
 
     final_attitude_error: float        # rad, to the goal attitude (semi-free: boresight to target)
     final_rate: float                  # rad/s, ‖ω(t_f)‖
-    min_cone_margin: float             # rad over the dense grid and every zone (+inf without zones)
-    cone_margins: list                 # rad, minimum per zone: the cones, then the zones (request order)
+    min_cone_margin: float             # rad over the dense grid and every zone (+inf without zones): the clearance
+    cone_margins: list                 # rad, minimum clearance per zone: the cones, then the zones (request order)
     torque_ratio: float                # max |control| / its limit over the applied samples
     wheel_speed_ratio: float           # max |Ω_i| / limit over the dense grid (0 without wheels)
     rate_max: float                    # rad/s, largest ‖ω‖ over the dense grid
@@ -126,6 +126,7 @@ class Verification:
     passage_rates_z: list = field(default_factory=list)           # rad/s, |ω_z| per passage
     zone_names: list = field(default_factory=list)                # name per entry of cone_margins
     zone_keep_in: list = field(default_factory=list)              # keep-in flag per entry of cone_margins
+    boundary_arc: str = ""             # name of the cone a forced boundary arc rides ('' : none)
 
 
 class Stage(StrEnum):

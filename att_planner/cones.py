@@ -5,6 +5,15 @@ axis ``w_i`` and half-angle ``θ_i`` (:class:`att_msgs_py.types.Cone`) is respec
 ``rᵀ Rᵀ w_i ≤ cos θ_i``. The *margin* is the angle between boresight and cone axis minus the
 half-angle (rad): ≥ 0 means outside the cone.
 
+Boundary ends (issue 19): a start or goal direction within :data:`BOUNDARY_TOLERANCE` of a boundary
+is on it (plannable); only one inside by more is refused (:func:`endpoint_in_cone`). A path that
+leaves such an end is necessarily near the boundary while its boresight is near the end, so the
+verification asks margin ≥ −tol within :data:`END_RADIUS` of the path's own start and final
+boresight, ≥ 0 elsewhere (:func:`att_planner.verification.clearances`), and the planners ramp their
+tightening of such a zone up from −tol over the first and last :data:`END_RAMP` of the maneuver
+(:func:`end_ramp`). A forced boundary arc (``ManeuverProblem.boundary_cone``) keeps the boresight
+on one cone's boundary for the whole maneuver (:func:`boundary_arc_issue`).
+
 The checks of a request's zones (issue 13; :mod:`att_planner.zones`) are here too:
 :func:`zone_issue` gives the code and sentence of the first bad zone, contradiction or violated end.
 """
@@ -17,6 +26,12 @@ from att_msgs_py.errors import ErrorCode, RequestError
 from att_msgs_py.types import Cone, Zone
 from att_planner.zones import ZoneSky, same_axis
 from att_sim import rotations as rot
+
+BOUNDARY_TOLERANCE = 1e-6   # rad: an end direction this far inside a boundary is on it
+END_RADIUS = 0.01           # rad: the neighbourhood of an end direction where margin ≥ −tol suffices
+END_RAMP = 0.1              # fraction of the maneuver over which a planner's tightening ramps up at a boundary end
+SMOOTH_END_RAMP = 0.25      # the same for smooth plans (Slepian basis: the boresight moves 7e-5 rad by τ = 0.05)
+ARC_TOLERANCE = 1e-4        # rad: a forced boundary arc keeps |margin| within this on the dense grid
 
 
 def boresight(q: np.ndarray, sensor_axis: np.ndarray) -> np.ndarray:
@@ -58,23 +73,76 @@ def endpoint_directions(q_initial, q_final, sensor_axis, sensor_target=None) -> 
 
 def endpoint_in_cone(q_initial, q_final, sensor_axis, cones: list[Cone],
                      sensor_target=None) -> tuple[str, Cone, float] | None:
-    """``(name of the end, cone, depth in rad)`` of the first end direction inside a cone, else
-    None: no plan can exist then."""
+    """``(name of the end, cone, depth in rad)`` of the first end direction inside a cone by more
+    than :data:`BOUNDARY_TOLERANCE`, else None (no plan can exist then; one on the boundary is plannable)."""
     for label, direction in endpoint_directions(q_initial, q_final, sensor_axis, sensor_target).items():
         m = direction_margins(direction, cones)
-        if m.size and m.min() < 0:
+        if m.size and m.min() < -BOUNDARY_TOLERANCE:
             k = int(np.argmin(m))
             return label, cones[k], float(-m[k])
     return None
 
 
+def end_ramp(tau, length: float = END_RAMP) -> np.ndarray:
+    """Weight in [0, 1] of a planner's zone tightening δ at maneuver fractions ``tau`` for a zone
+    with an end on its boundary: ``min(1, (min(τ, 1 − τ)/length)⁴)``; the tightening there is
+    ``−tol + (δ + tol)·w``, negative for τ < 0.18 length only, where a bang-bang slew of a few
+    time units (``END_RAMP``) or a smooth one (``SMOOTH_END_RAMP``) has moved the boresight by less
+    than END_RADIUS. Quartic, so that the boresight, which starts from rest, clears it."""
+    tau = np.clip(np.asarray(tau, float), 0.0, 1.0)
+    return np.minimum(1.0, np.minimum(tau, 1.0 - tau) / length) ** 4
+
+
+def boundary_end_zones(problem, margin: float) -> np.ndarray:
+    """Which zones of ``problem.zone_sky()`` a planner tightened by ``margin`` rad must ramp
+    (:func:`end_ramp`): those whose start or goal (semi-free: ``sensor_target``, for the zones of
+    ``problem.sensor_axis``) has a margin below ``margin`` at t = 0."""
+    zs = problem.zone_sky()
+    if not zs.zones:
+        return np.zeros(0, bool)
+    ends = [zs.margins(0.0, problem.q_initial, true=True)[0]]
+    if problem.sensor_target is None:
+        ends.append(zs.margins(0.0, problem.q_final, true=True)[0])
+    else:
+        own = np.array([same_axis(s, problem.sensor_axis) for s in zs.sensor_axes], bool)
+        target = np.asarray(problem.sensor_target, float) / np.linalg.norm(problem.sensor_target)
+        gamma = np.arccos(np.clip(zs.true_axes(0.0) @ target, -1.0, 1.0))
+        theta = zs.true_half_angles(0.0)
+        ends.append(np.where(own, np.where(zs.keep_in, theta - gamma, gamma - theta), np.inf))
+    return np.min(ends, axis=0) < margin
+
+
+def boundary_arc_issue(problem) -> str:
+    """Why the forced boundary arc of ``problem`` (``boundary_cone``: an index into its cones) cannot
+    be flown, or '': no such cone, or the start or goal sensor direction (semi-free: the target) not
+    on that cone's boundary within :data:`BOUNDARY_TOLERANCE`."""
+    index = problem.boundary_cone
+    if index is None:
+        return ""
+    cones = problem.cones
+    if not 0 <= index < len(cones):
+        names = ", ".join(f"{i}: '{c.name}'" for i, c in enumerate(cones)) or "none"
+        return f"option boundary_cone = {index} names no cone of the request (its cones: {names})"
+    cone = cones[index]
+    for label, direction in endpoint_directions(problem.q_initial, problem.q_final, problem.sensor_axis,
+                                                problem.sensor_target).items():
+        m = float(direction_margins(direction, [cone])[0])
+        if abs(m) > BOUNDARY_TOLERANCE:
+            side = "outside" if m > 0 else "inside"
+            return (f"option boundary_cone = {index}: the {label} is {np.degrees(abs(m)):.4g} deg {side} the "
+                    f"boundary of cone '{cone.name}' (a boundary arc starts and ends on it, within "
+                    f"{BOUNDARY_TOLERANCE:g} rad)")
+    return ""
+
+
 def blocked_endpoint(problem) -> str:
-    """Why a problem (``ManeuverProblem``) has no plan because an end lies inside a cone, or
-    violates a zone at t = 0 (:func:`zone_at_end`), or ''."""
+    """Why a problem (``ManeuverProblem``) has no plan because an end lies inside a cone (by more
+    than :data:`BOUNDARY_TOLERANCE`), its boundary arc cannot be flown (:func:`boundary_arc_issue`),
+    or an end violates a zone at t = 0 (:func:`zone_at_end`), or ''."""
     hit = endpoint_in_cone(problem.q_initial, problem.q_final, problem.sensor_axis, problem.cones,
                            problem.sensor_target)
     if hit is None:
-        why = zone_at_end(problem) if problem.zones else ""
+        why = boundary_arc_issue(problem) or (zone_at_end(problem) if problem.zones else "")
         return f"infeasible request: {why}" if why else ""
     label, cone, depth = hit
     return (f"infeasible request: the {label} is inside keep-out cone {cone.name or '(unnamed)'} "
@@ -148,7 +216,7 @@ def zone_at_end(problem, zone_sky: ZoneSky | None = None) -> str:
             (goal_label, goal.max(axis=0), "at t = 0" if not zs.moving else
              f"at every arrival time in [0, {zs.window:.0f}] s (its best)")]
     for label, m, when in ends:
-        if m.size and m.min() < 0:
+        if m.size and m.min() < -BOUNDARY_TOLERANCE:
             k = int(np.argmin(m))
             kind = "outside keep-in" if zs.keep_in[k] else "inside keep-out"
             return (f"the {label} is {kind} zone {zs.names[k]} {when} ({np.degrees(-m[k]):.2f} deg beyond "

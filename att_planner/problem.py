@@ -51,6 +51,9 @@ class ManeuverProblem:
       ``epoch``: the UTC instant of t = 0; ``sky``: the sky seen from the spacecraft
       (:class:`att_sim.ephemeris.Sky`, needed by sun, moon and earth_limb zones).
       :meth:`zone_sky` joins them: what every method and the verification use.
+    * ``boundary_cone``: index of the cone whose boundary the sensor rides for the whole maneuver
+      (a forced boundary arc, Melton 2012's BA cases; :func:`att_planner.cones.boundary_arc_issue`);
+      None: the sensor may go anywhere outside the cones.
     """
 
     spacecraft: Spacecraft
@@ -66,6 +69,7 @@ class ManeuverProblem:
     zones: list[Zone] = field(default_factory=list)
     epoch: datetime | None = None
     sky: Sky | None = None
+    boundary_cone: int | None = None
     # caches keyed by the values they depend on, so ``dataclasses.replace`` copies share them
     _zone_skies: dict = field(default_factory=dict, repr=False, compare=False)
     _default_window: tuple = field(default=(), repr=False, compare=False)

@@ -10,6 +10,13 @@ on its target) and rate, every passage of a schedule (attitude, rate about body 
 (the cones, then the zones: :meth:`ManeuverProblem.zone_sky`) at every dense sample at its TRUE
 position at that sample's time (straight from the sky, not the planners' fit, at any time), and the
 control, wheel-speed (relative to the body), body-rate and wheel-momentum limits.
+
+Zones are judged by their *clearance* above the floor a sample may reach (:func:`clearances`, issue
+19): the margin, plus :data:`~att_planner.cones.BOUNDARY_TOLERANCE` where the boresight is within
+:data:`~att_planner.cones.END_RADIUS` of the path's own start or final boresight (an end may lie on
+a boundary, within the tolerance); for a forced boundary arc's cone
+:data:`~att_planner.cones.ARC_TOLERANCE` − |margin| (the boresight stays on the boundary). The
+reported ``cone_margins`` are these clearances; a plan passes when every one is ≥ 0.
 """
 from __future__ import annotations
 
@@ -19,6 +26,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from att_msgs_py.types import ControlKind, Interpolation, Plan, Verification
+from att_planner.cones import ARC_TOLERANCE, BOUNDARY_TOLERANCE, END_RADIUS
 from att_planner.problem import ManeuverProblem
 from att_sim import dynamics as dyn
 from att_sim import rotations as rot
@@ -32,7 +40,7 @@ class Tolerances:
 
     attitude: float = math.radians(0.5)    # rad: final (semi-free: boresight) and passage attitude error
     rate: float = 1e-3                     # rad/s: final ‖ω‖ and |ω_z| at each passage
-    cone_penetration: float = 0.0          # rad a dense sample may lie inside a cone
+    cone_penetration: float = 0.0          # rad a dense sample may lie below its clearance floor (clearances)
     limit_ratio: float = 1.0 + 1e-6        # control, wheel speed, body rate, wheel momentum / their limits
 
 
@@ -48,6 +56,27 @@ def integrate(problem: ManeuverProblem, plan: Plan, steps: int = VERIFY_STEPS) -
                                 max_step=max(plan.duration, 1e-9) / steps)
 
 
+def clearances(problem: ManeuverProblem, t: np.ndarray, q: np.ndarray, true: bool = True) -> np.ndarray:
+    """Clearance (rad, ≥ 0: acceptable) of every zone at attitudes ``q`` (K, 4) of a path at times
+    ``t`` (K,), (K, Z): the margin at the zone's true position (``true=False``: the planners' fit), +
+    BOUNDARY_TOLERANCE within END_RADIUS of the path's first or last boresight of the zone's sensor;
+    ARC_TOLERANCE − |margin| for the forced boundary arc's cone."""
+    zone_sky = problem.zone_sky()
+    m = zone_sky.margins(t, q, true=true)
+    if not m.size:
+        return m
+    R = rot.dcm(np.asarray(q, float).reshape(-1, 4))
+    near = np.zeros(m.shape, bool)
+    for s in np.unique(zone_sky.sensor_axes, axis=0):              # once per sensor
+        b = R @ (s / np.linalg.norm(s))
+        close = np.maximum(b @ b[0], b @ b[-1]) >= math.cos(END_RADIUS)
+        near[:, np.all(zone_sky.sensor_axes == s, axis=1)] = close[:, None]
+    out = m + BOUNDARY_TOLERANCE * near
+    if problem.boundary_cone is not None:
+        out[:, problem.boundary_cone] = ARC_TOLERANCE - np.abs(m[:, problem.boundary_cone])
+    return out
+
+
 def measure(problem: ManeuverProblem, plan: Plan, traj: dyn.Trajectory) -> Verification:
     """The verification figures of ``plan`` from its integrated trajectory ``traj``."""
     sc = problem.spacecraft
@@ -56,7 +85,7 @@ def measure(problem: ManeuverProblem, plan: Plan, traj: dyn.Trajectory) -> Verif
     applied = controls[:-1] if plan.interpolation == Interpolation.ZOH and len(controls) > 1 else controls
     limit = sc.wheel_torque_max if wheels else sc.body_torque_max
     zone_sky = problem.zone_sky()
-    m = zone_sky.margins(traj.t, traj.q, true=True)
+    m = clearances(problem, traj.t, traj.q)
     if problem.sensor_target is None:
         final_error = float(rot.angle_between(traj.q[-1], problem.q_final))
     else:
@@ -84,6 +113,7 @@ def measure(problem: ManeuverProblem, plan: Plan, traj: dyn.Trajectory) -> Verif
         passage_rates_z=passage_rates,
         zone_names=list(zone_sky.names),
         zone_keep_in=[bool(k) for k in zone_sky.keep_in],
+        boundary_arc="" if problem.boundary_cone is None else zone_sky.names[problem.boundary_cone],
     )
 
 
@@ -117,6 +147,9 @@ def _zone_violation(ver: Verification) -> str:
     if not ver.zone_names or len(ver.zone_names) != len(ver.cone_margins):
         return f"enters a keep-out cone by {depth:.3f} deg"
     k = int(np.argmin(np.nan_to_num(ver.cone_margins, nan=-np.inf)))
+    if ver.boundary_arc and ver.zone_names[k] == ver.boundary_arc:
+        return (f"leaves the boundary of cone {ver.boundary_arc} by {math.degrees(ARC_TOLERANCE) + depth:.5f} deg "
+                f"(more than the boundary arc's {ARC_TOLERANCE:g} rad)")
     if k < len(ver.zone_keep_in) and ver.zone_keep_in[k]:
         return f"leaves keep-in zone {ver.zone_names[k]} by {depth:.3f} deg"
     return f"enters keep-out zone {ver.zone_names[k]} by {depth:.3f} deg"

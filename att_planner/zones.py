@@ -258,13 +258,15 @@ class ZoneSky:
             half[i] = values[3 * M + j]
         return axes, half
 
-    def casadi_constraints(self, t, R, margin: float = 0.0) -> list:
+    def casadi_constraints(self, t, R, margin=0.0) -> list:
         """``g_z(t, R) ≤ 0`` for every zone with the CasADi DCM ``R`` (body to inertial) at the CasADi
-        time ``t``: keep-out ``a·b − cos(θ + margin)``, keep-in ``cos(θ − margin) − a·b``, b = R s_z."""
+        time ``t``: keep-out ``a·b − cos(θ + margin)``, keep-in ``cos(θ − margin) − a·b``, b = R s_z;
+        ``margin`` one for all zones or one (number or CasADi expression) per zone."""
         import casadi as ca
         axes, half = self.casadi(t)
+        margins = margin if isinstance(margin, (list, tuple)) else [margin] * len(self.zones)
         g = []
-        for z, (a, th) in enumerate(zip(axes, half)):
+        for z, (a, th, margin) in enumerate(zip(axes, half, margins)):
             s = self.sensor_axes[z] / np.linalg.norm(self.sensor_axes[z])
             c = ca.dot(a, ca.mtimes(R, ca.DM(s)))
             g.append(ca.cos(th - margin) - c if self.keep_in[z] else c - ca.cos(th + margin))

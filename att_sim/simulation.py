@@ -145,9 +145,10 @@ class Simulation:
         self.body_cmd = np.zeros(3) if idle else body_torque
         return None
 
-    def check_command(self, command: Command) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def check_command(self, command: Command, late_ok: bool = False) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """The command's wheel torques, dipole and body torque, checked (RequestError otherwise):
-        mode, sizes, finiteness, magnitude against the limits, stamp, frame and plan id."""
+        mode, sizes, finiteness, magnitude against the limits, stamp (``late_ok``: however old),
+        frame and plan id."""
         bad, c = ErrorCode.INVALID_COMMAND, self.checks
         if isinstance(command.mode, bool) or not isinstance(command.mode, (int, np.integer)) \
                 or command.mode not in CONTROL_MODES:
@@ -173,7 +174,7 @@ class Simulation:
         if t > self.t + c.stamp_ahead + 1e-9:
             raise RequestError(bad, f"header.stamp t = {t:.6g} s is ahead of the simulation (t = {self.t:.6g} s, at "
                                     f"most {c.stamp_ahead:g} s ahead)")
-        if t < self.t - c.stamp_age - 1e-9:
+        if t < self.t - c.stamp_age - 1e-9 and not late_ok:
             raise RequestError(bad, f"header.stamp t = {t:.6g} s is older than the simulation's t = {self.t:.6g} s "
                                     f"by more than command_timeout = {c.stamp_age:g} s")
         frame = validation.text(command.frame_id, "header.frame_id", bad)
@@ -181,6 +182,15 @@ class Simulation:
             raise RequestError(bad, f"header.frame_id '{frame}' is not the body frame '{c.body_frame_id}' (or empty)")
         validation.text(command.plan_id, "plan_id")
         return wheel_torque, dipole, body_torque
+
+    def late_only(self, command: Command) -> bool:
+        """Whether ``command`` is refused only for being older than ``stamp_age`` (a late answer:
+        every other field passes)."""
+        try:
+            self.check_command(command, late_ok=True)
+        except RequestError:
+            return False
+        return command.t < self.t - self.checks.stamp_age
 
     def reset(self, q, omega, wheel_speed, orbit_phase: float) -> Refusal | None:
         """Reset attitude, rate, wheel speeds (empty: zeros) and orbit phase, or say why not (a

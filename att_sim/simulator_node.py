@@ -27,8 +27,10 @@ command arrived for ``command_timeout`` s of sim time the actuator inputs are ze
 says so. In lockstep, a state that no command answers within ``lockstep_timeout`` s of wall time
 ends the waiting: the simulator free-runs at its real-time factor with zero inputs
 (``command_timeout`` set) until a command answers again; with a real-time factor of 0 (as fast
-as possible) it free-runs at real time, so that consumers that fell behind (the estimator and the
-controller after a stall) catch up and answer again instead of drowning in states. A non-finite
+as possible) it free-runs at real time. A controller that lives but fell behind (after a stall of
+the estimator chain on a loaded machine) shows itself by commands too old to apply: such a command
+from the publisher of the last accepted one puts the simulator back to waiting, so the chain
+catches up and the lockstep resumes instead of the simulator drowning it in states. A non-finite
 state stops the propagation (reported, the node stays up).
 """
 from __future__ import annotations
@@ -46,7 +48,7 @@ from att_msgs.msg import ActuatorCommand, CoarseSunSensors, SensorTruth, Spacecr
 from att_msgs.srv import ResetSimulator
 from att_msgs_py import convert, qos, topics, validation
 from att_msgs_py.errors import ConfigError, ErrorCode, RequestError, clip
-from att_msgs_py.node_runner import parameter_reader, run_node, spin_until_shutdown
+from att_msgs_py.node_runner import parameter_reader, publisher_of, run_node, spin_until_shutdown
 from att_sim import scenario as scen
 from att_sim.simulation import DEFAULT_STEP, Checks, Refusal, Simulation
 
@@ -61,6 +63,7 @@ class SimulatorNode(Node):
         self.answered = False
         self.awaited_stamp = 0.0
         self.free_running = False      # lockstep suspended: no command answered a state in time
+        self.command_source = None     # publisher of the last accepted command
         self.pace = (0.0, 0.0)         # (wall, sim) time the real-time pacing counts from
         self.last_command_time = -np.inf
         self.refused = {"command": 0, "reset": 0}
@@ -148,13 +151,21 @@ class SimulatorNode(Node):
                 for name, (present, kind, topic) in wanted.items() if present}
 
     # -- callbacks: translate messages to Simulation calls -------------------------------------
-    def on_command(self, msg: ActuatorCommand):
+    # (``info`` has no default: rclpy passes the message info only to two-argument callbacks)
+    def on_command(self, msg: ActuatorCommand, info: dict):
         command = convert.command_from_msg(msg)
+        source = publisher_of(info)
         refusal = self.sim.set_command(command)
         if refusal is not None:
             self.report("command", refusal)
+            if self.free_running and source is not None and source == self.command_source and \
+                    self.sim.late_only(command):
+                self.free_running = False        # the controller lives but lags: wait for it to catch up
+                self.get_logger().info(f"a late command (t = {command.t:.3f} s) from the controller at t = "
+                                       f"{self.sim.t:.3f} s: waiting for it to catch up", throttle_duration_sec=1.0)
             return
         self.last_command_time = self.sim.t
+        self.command_source = source
         if command.t >= self.awaited_stamp - 1e-9:
             self.answered = True
         if self.free_running:

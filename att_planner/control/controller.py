@@ -29,14 +29,12 @@ is that of the cones and inertial zones only.
 """
 from __future__ import annotations
 
-import hashlib
 import math
-from collections import OrderedDict
 from dataclasses import dataclass
 
 import numpy as np
 
-from att_msgs_py import signing, validation
+from att_msgs_py import signing
 from att_msgs_py.errors import ErrorCode, RequestError
 from att_msgs_py.types import (
     CONTROL_MODES,
@@ -54,7 +52,8 @@ from att_msgs_py.types import (
 from att_planner.control import tracking
 from att_planner.control.magnetorquer import dipole_command
 from att_planner.control.measured_state import MeasuredState
-from att_planner.control.plan_checks import PlanContext, check_plan, check_start
+from att_planner.control.plan_cache import PlanCache
+from att_planner.control.plan_checks import PlanContext, check_start
 from att_planner.control.state_gate import GateConfig, StateGate
 from att_planner.zones import ZoneSky, zones_from_cones
 from att_sim import rotations as rot
@@ -115,14 +114,6 @@ class StateOutcome:
     ended: ManeuverResult | None = None
 
 
-@dataclass
-class CachedPlan:
-    plan: Plan
-    size: int                                  # bytes of its message
-
-
-MAX_REMEMBERED_IDS = 100_000                   # plan ids whose content is remembered (32 bytes each)
-MAX_REMEMBERED_REFUSALS = 1000                 # refused plan ids whose reason an execute goal is told
 ZONE_FIT_WINDOW = 1.0                          # s: a ZoneSky needs a window; the controller uses its truth only
 
 
@@ -145,9 +136,7 @@ class Controller:
         self.next_control = -math.inf
         self.maneuver: Maneuver | None = None
         self.hold_q: np.ndarray | None = None          # final attitude held after a maneuver
-        self.plans: OrderedDict[str, CachedPlan] = OrderedDict()
-        self.seen: OrderedDict[str, bytes] = OrderedDict()   # plan id -> SHA-256 of its signed bytes
-        self.refused: OrderedDict[str, RequestError] = OrderedDict()   # published plans refused, why
+        self.cache = PlanCache(context, config.max_cached_plans, config.max_cache_bytes)
         self.mode_key = None                           # Ed25519 public key mode requests must verify against
         self.mode_sequence = 0                         # sequence of the last authenticated mode request
 
@@ -164,8 +153,23 @@ class Controller:
         return min(self.config.m_max, self.spacecraft.dipole_max)
 
     @property
+    def plans(self):
+        """The cached plans by id (:class:`~.plan_cache.PlanCache`)."""
+        return self.cache.plans
+
+    @property
     def cache_bytes(self) -> int:
-        return sum(c.size for c in self.plans.values())
+        return self.cache.bytes
+
+    def receive_plan(self, plan: Plan, payload: bytes) -> RequestError | None:
+        """Cache a published plan once it passes its checks (never evicting the one being flown)."""
+        return self.cache.receive(plan, payload, self.maneuver.plan.plan_id if self.maneuver is not None else None)
+
+    def resolve(self, plan_id: str, inline: Plan | None = None,
+                payload: bytes = b"") -> tuple[Plan | None, RequestError | None]:
+        """The plan to execute (``inline`` with its signed ``payload``, or the cached ``plan_id``),
+        or why there is none."""
+        return self.cache.resolve(plan_id, inline, payload)
 
     # -- inputs ---------------------------------------------------------------------------------
     def accept_state(self, state: State, wall: float = 0.0, clock: float | None = None,
@@ -221,46 +225,6 @@ class Controller:
         return RequestError(ErrorCode.ESTIMATE_UNHEALTHY, f"the attitude estimate is not converged ({health}); "
                                                           "attitude modes start on a converged estimate")
 
-    def _remember(self, plan: Plan, payload: bytes) -> RequestError | None:
-        """Record ``plan``'s id with its content; refuse a different plan under a known id."""
-        digest = hashlib.sha256(payload).digest()
-        known = self.seen.get(plan.plan_id)
-        if known is not None and known != digest:
-            return RequestError(ErrorCode.PLAN_ID_REUSED,
-                                f"plan id '{plan.plan_id}' belongs to a different plan this controller received "
-                                "before; refused")
-        self.seen[plan.plan_id] = digest
-        self.seen.move_to_end(plan.plan_id)
-        while len(self.seen) > MAX_REMEMBERED_IDS:
-            self.seen.popitem(last=False)
-        return None
-
-    def admit_plan(self, plan: Plan, payload: bytes) -> RequestError | None:
-        """Check a received plan (:func:`check_plan`) and its id; None when it is usable."""
-        return check_plan(plan, payload, self.context) or self._remember(plan, payload)
-
-    def receive_plan(self, plan: Plan, payload: bytes) -> RequestError | None:
-        """Cache a published plan once it passes :meth:`admit_plan`; the oldest plans go beyond
-        ``max_cached_plans`` or ``max_cache_bytes``, never the one being flown."""
-        refused = self.admit_plan(plan, payload)
-        if refused is not None:
-            key = plan.plan_id[:validation.MAX_NAME_LENGTH]
-            self.refused[key] = refused
-            self.refused.move_to_end(key)
-            while len(self.refused) > MAX_REMEMBERED_REFUSALS:
-                self.refused.popitem(last=False)
-            return refused
-        if plan.plan_id in self.plans:
-            return None
-        self.plans[plan.plan_id] = CachedPlan(plan, len(payload))
-        flying = self.maneuver.plan.plan_id if self.maneuver is not None else None
-        for plan_id in list(self.plans):
-            if len(self.plans) <= self.config.max_cached_plans and self.cache_bytes <= self.config.max_cache_bytes:
-                break
-            if plan_id != flying:
-                del self.plans[plan_id]
-        return None
-
     def authorize_mode(self, payload: bytes, signature: bytes, signer: str, sequence: int) -> RequestError | None:
         """Why a mode request (signed bytes ``payload``) is not authentic, when :attr:`mode_key` is
         set; its ``sequence`` must be above the last accepted one (no replay)."""
@@ -289,26 +253,6 @@ class Controller:
         ended = self.abort("aborted by a switch to safe mode") if self.maneuver is not None else None
         self.mode = mode
         return ErrorCode.OK, f"mode set to {mode}", ended
-
-    def resolve(self, plan_id: str, inline: Plan | None = None,
-                payload: bytes = b"") -> tuple[Plan | None, RequestError | None]:
-        """The plan to execute (``inline`` with its signed ``payload``, or the cached ``plan_id``),
-        or why there is none."""
-        if inline is not None:
-            refused = self.admit_plan(inline, payload)
-            return (None, refused) if refused is not None else (inline, None)
-        try:
-            validation.text(plan_id, "plan_id")
-        except RequestError as err:
-            return None, err
-        cached = self.plans.get(plan_id)
-        if cached is None and plan_id in self.refused:
-            why = self.refused[plan_id]
-            return None, RequestError(why.code, f"plan '{plan_id}' was refused when it arrived: {why.message}")
-        if cached is None:
-            return None, RequestError(ErrorCode.UNKNOWN_PLAN,
-                                      f"plan_id '{plan_id}' is not a plan this controller received")
-        return cached.plan, None
 
     def start(self, plan: Plan) -> RequestError | None:
         """Start flying ``plan`` (resolved) from the latest state, if it starts there."""

@@ -113,6 +113,10 @@ _MOMENTUM_MAX = Option(1e-6, 1e4, limit=True, doc="N m s per wheel")
 SLEPIAN_OPTIONS = {"M": Option(2, 12, True, doc="basis size"), "N": Option(50, 2000, True, doc="samples"),
                    "W": Option(1e-4, 0.25, doc="half-bandwidth")}
 
+# The forced boundary arc (issue 19): the index of the request's cone whose boundary the sensor rides
+# (at most 16 cones per request); a bound of the maneuver, checked against the cones by the service.
+BOUNDARY_CONE = Option(0, 15, True, limit=True, doc="index of the cone whose boundary the sensor rides")
+
 # Best first: the default method is the first one.
 REGISTRY = [
     Method("smooth_collocation", "att_planner.methods.time_optimal.smooth", "plan_smooth_collocation",
@@ -128,11 +132,12 @@ REGISTRY = [
            {"intervals": Option(4, 200, True), "max_intervals": Option(4, 400, True), "starts": Option(1, 20, True),
             "refine_rounds": Option(0, 6, True), "cone_margin_deg": Option(0.0, 5.0),
             "rate_max": _RATE_MAX, "wheel_momentum_max": _MOMENTUM_MAX,
-            "smooth_warm_start": Option(0, 1, True)}, check=_time_optimal_check,
+            "smooth_warm_start": Option(0, 1, True), "global_stage": Option(0, 1, True, doc="particle swarm first"),
+            "boundary_cone": BOUNDARY_CONE}, check=_time_optimal_check,
            combined=("intervals", "max_intervals"), seeded=True),
     Method("constrained_axis", "att_planner.methods.constrained_axis", "plan_constrained_axis",
            "eigenaxis bang-bang, or lambda-rotations riding a zone boundary when the path is blocked",
-           {"ride_margin_deg": Option(0.0, 10.0)}, cheap=True),
+           {"ride_margin_deg": Option(0.0, 10.0), "boundary_cone": BOUNDARY_CONE}, cheap=True),
     Method("graph_smooth", "att_planner.methods.graph_smooth", "plan_graph_smooth",
            "the constructive first plan: the quickest rest-to-rest legs round the zones on a graph of sensor "
            "directions (exact checks on every leg), C1 torque zero at every leg's ends; zone-aware", cheap=True),

@@ -25,6 +25,7 @@ import time
 import numpy as np
 
 from att_msgs_py.types import Plan, Status
+from att_planner.cones import BOUNDARY_TOLERANCE, boundary_arc_issue
 from att_planner.methods.axis_rotations import (
     AxisLeg,
     eigenaxis_leg,
@@ -35,6 +36,7 @@ from att_planner.methods.axis_rotations import (
     no_torque_limit,
 )
 from att_planner.problem import ManeuverProblem
+from att_planner.verification import clearances
 from att_planner.zones import ZoneSky, same_axis
 from att_sim import rotations as rot
 
@@ -53,11 +55,14 @@ def _point(beta, psi, w, u, v):
 
 
 def _great_circle_leg(b_from, b_to, label):
+    """The λ-rotation along the great circle from ``b_from`` to ``b_to``; none (angle 0) below
+    BOUNDARY_TOLERANCE: a rest-to-rest leg of angle ε costs 2 sqrt(ε/α), 3 ms of TU for 1e-6 rad."""
     axis = np.cross(b_from, b_to)
     n = np.linalg.norm(axis)
-    if n < 1e-12:
+    angle = float(np.arctan2(n, b_from @ b_to))
+    if angle < BOUNDARY_TOLERANCE:
         return AxisLeg(np.array([0.0, 0.0, 1.0]), 0.0, label)
-    return AxisLeg(axis / n, float(np.arctan2(n, b_from @ b_to)), label)
+    return AxisLeg(axis / n, angle, label)
 
 
 def cone_riding_legs(problem: ManeuverProblem, zone_index: int, side: int, ride_margin: float, finish: str,
@@ -69,7 +74,9 @@ def cone_riding_legs(problem: ManeuverProblem, zone_index: int, side: int, ride_
 
     ``finish='roll'``: tangent arc to the target direction, then a roll about the sensor;
     ``finish='eigenaxis'``: an eigenaxis rotation from the end of the ride to the goal attitude.
-    None when a boresight end lies inside the riding circle.
+    An end between the boundary and the riding circle joins the circle radially; None when a
+    boresight end lies inside the zone (by more than BOUNDARY_TOLERANCE). With ``ride_margin`` 0
+    and both ends on the boundary the ride is the boundary arc itself.
     """
     if zone_index < len(problem.cones):          # a cone: no need to build the zones
         cone = problem.cones[zone_index]
@@ -91,11 +98,12 @@ def cone_riding_legs(problem: ManeuverProblem, zone_index: int, side: int, ride_
     rho = theta + ride_margin
     beta0, psi0 = _polar(b0, w, u, v)
     betaf, psif = _polar(bf, w, u, v)
-    if min(beta0, betaf) <= rho or rho >= np.pi / 2:
+    if min(beta0, betaf) < theta - BOUNDARY_TOLERANCE or rho >= np.pi / 2:
         return None
-    # Right spherical triangle (w, tangent point, b): cos A = tan ρ / tan β at the cone axis.
-    A0 = np.arccos(np.clip(np.tan(rho) / np.tan(beta0), -1, 1))
-    Af = np.arccos(np.clip(np.tan(rho) / np.tan(betaf), -1, 1))
+    # Right spherical triangle (w, tangent point, b): cos A = tan ρ / tan β at the cone axis; an end
+    # inside the riding circle or on it within BOUNDARY_TOLERANCE (issue 19) joins it radially (A = 0).
+    A0, Af = (0.0 if beta - rho <= BOUNDARY_TOLERANCE else np.arccos(np.clip(np.tan(rho) / np.tan(beta), -1, 1))
+              for beta in (beta0, betaf))
     psi1 = psi0 + side * A0
     ride = np.mod(side * ((psif - side * Af) - psi1), 2 * np.pi)
     p1 = _point(rho, psi1, w, u, v)
@@ -119,13 +127,14 @@ def cone_riding_legs(problem: ManeuverProblem, zone_index: int, side: int, ride_
 
 
 def _legs_time(problem: ManeuverProblem, legs: list[AxisLeg]) -> tuple[float, float]:
-    """(duration, min zone margin along the path at the physical times; −inf beyond the zones'
-    window) of a leg sequence, without simulation."""
+    """(duration, min zone clearance along the path at the physical times
+    (:func:`att_planner.verification.clearances`); −inf beyond the zones' window) of a leg
+    sequence, without simulation."""
     t, q = leg_path(problem, legs)
     zs = problem.zone_sky()
     if zs.moving and t[-1] > zs.window:
         return float(t[-1]), -np.inf
-    m = zs.margins(t, q)
+    m = clearances(problem, t, q, true=False)
     return float(t[-1]), float(m.min()) if m.size else np.inf
 
 
@@ -185,16 +194,39 @@ def _detours(problem: ManeuverProblem, zs: ZoneSky) -> list[tuple[str, list[Axis
     return routes
 
 
+def boundary_arc_legs(problem: ManeuverProblem, side: int) -> list[AxisLeg]:
+    """The λ-rotation about the axis of the forced boundary arc's cone (``problem.boundary_cone``)
+    taking the sensor along its boundary on ``side`` (+1: increasing azimuth), then (a full goal)
+    a roll about the sensor: :func:`cone_riding_legs` riding the boundary itself."""
+    return cone_riding_legs(problem, problem.boundary_cone, side, 0.0, "roll")
+
+
+def _boundary_arc(problem: ManeuverProblem, start: float) -> Plan:
+    """The faster of the two boundary arcs (:func:`boundary_arc_legs`) that keeps clear of the other zones."""
+    candidates = []
+    for side in (+1, -1):
+        legs = boundary_arc_legs(problem, side)
+        tf, margin = _legs_time(problem, legs)
+        candidates.append({"route": f"boundary arc {'+' if side > 0 else '-'}", "tf": tf, "min_margin": margin,
+                           "legs": legs})
+    best = min(candidates, key=lambda c: (c["min_margin"] < 0, c["tf"]))
+    stats = {"candidates": [{k: c[k] for k in ("route", "tf", "min_margin")} for c in candidates]}
+    return legs_plan(problem, METHOD, best["legs"], start, f"route: {best['route']}", stats)
+
+
 def plan_constrained_axis(problem: ManeuverProblem, *, ride_margin_deg: float = 0.5) -> Plan:
     """Eigenaxis slew if it clears the zones, else the fastest zone-riding (or, zones moving,
-    detour) λ-rotation sequence that clears them.
+    detour) λ-rotation sequence that clears them; with a forced boundary arc
+    (``problem.boundary_cone``) the faster boundary arc (the λ-rotation baseline of Melton's BA cases).
 
     ``ride_margin_deg``: how far outside the zone boundary the sensor rides (deg, ≥ 0).
     """
     start = time.monotonic()
-    why = no_torque_limit(problem)
+    why = no_torque_limit(problem) or boundary_arc_issue(problem)
     if why:
         return Plan(method=METHOD, status=Status.FAILED, message=why)
+    if problem.boundary_cone is not None:
+        return _boundary_arc(problem, start)
     zs = problem.zone_sky()
     eig = [eigenaxis_leg(problem.q_initial, goal_attitude(problem))]
     tf, margin = _legs_time(problem, eig)

@@ -1,8 +1,8 @@
 """Eigenaxis slews: the smooth quintic slew (always available, the planner's safe fallback) and
 the bang-bang λ-rotation about the eigenaxis. Both ignore the cones and zones (they do not steer
 round them, moving or not); the smooth slew reports a path that enters one (every zone at its true
-position at each sample's time, :meth:`att_planner.zones.ZoneSky.margins`), the bang-bang plan is
-verified (:mod:`.axis_rotations`), which checks every zone the same way.
+position at each sample's time, judged like the verification: :func:`att_planner.verification.clearances`),
+the bang-bang plan is verified (:mod:`.axis_rotations`), which checks every zone the same way.
 
 Smooth: rotation by φ about the fixed body axis e of ``q_i* ⊗ q_f`` with the quintic (minimum-jerk)
 angle profile θ(t) = φ p(t/T), p(s) = 10s³ − 15s⁴ + 6s⁵: the rate is C¹, zero with zero
@@ -24,6 +24,7 @@ import numpy as np
 from att_msgs_py.types import Interpolation, Plan, Status
 from att_planner.methods.axis_rotations import eigenaxis_leg, goal_attitude, legs_plan, no_torque_limit
 from att_planner.problem import ManeuverProblem
+from att_planner.verification import clearances
 from att_sim import rotations as rot
 
 METHOD = "eigenaxis_smooth"
@@ -66,7 +67,7 @@ def plan_eigenaxis_smooth(problem: ManeuverProblem, samples: int = 401) -> Plan:
     duration = max(np.sqrt(phi * np.abs(shape).max() / tmax), _rate_limited_duration(problem, axis, phi * dp.max()))
     q = rot.multiply(problem.q_initial, rot.from_axis_angle(np.tile(axis, (samples, 1)), phi * p))
     zones = problem.zone_sky()
-    m = zones.margins(s * duration, q, true=True)
+    m = clearances(problem, s * duration, q)
     status = Status.OPTIMAL
     message = f"eigenaxis slew of {np.degrees(phi):.2f} deg about body {np.round(axis, 4).tolist()}"
     if m.size and m.min() < 0:

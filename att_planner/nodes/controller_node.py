@@ -33,7 +33,6 @@ clock from the simulator).
 from __future__ import annotations
 
 import time
-from collections import Counter
 
 from rclpy.action import ActionServer, CancelResponse, GoalResponse
 from rclpy.clock import Clock, ClockType
@@ -46,8 +45,8 @@ from att_msgs.action import ExecuteManeuver
 from att_msgs.msg import ActuatorCommand, AttitudeEstimate, ControllerStatus, ManeuverPlan, SpacecraftState
 from att_msgs.srv import SetControllerMode
 from att_msgs_py import convert, qos, signing, topics
-from att_msgs_py.errors import ErrorCode, RequestError, clip
-from att_msgs_py.node_runner import parameter_reader, participant_of, publisher_of, run_node
+from att_msgs_py.errors import ErrorCode, RequestError
+from att_msgs_py.node_runner import RefusalLog, parameter_reader, participant_of, publisher_of, run_node
 from att_msgs_py.types import ManeuverResult
 from att_planner.control.configure import controller_from_scenario, public_key
 from att_planner.estimation.inputs import Sources
@@ -66,7 +65,7 @@ class ControllerNode(Node):
         param.refuse_unknown()
         self._state_wall = time.monotonic()   # no "no state" warning before wall_timeout has passed
         self._stale = False
-        self._refused = Counter()             # refused inputs per kind, for the throttled log lines
+        self._refusals = RefusalLog(self.get_logger())   # refused inputs, logged once a second per kind
         self._sim_clock: tuple[bytes, float] | None = None   # (participant, s): its latest /clock
         self._goal = None                     # the goal handle of the running maneuver
         self._waiting = None                  # (estimate, source) that came before any wheel speed
@@ -94,12 +93,6 @@ class ControllerNode(Node):
                                f"{signing.key_id(self._core.context.public_key)}; magnetorquer gains "
                                f"kp={c.kp:.6g} kd={c.kd:.6g} m_max={self._core.m_max:g}")
 
-    def _report_refusal(self, what: str, err: RequestError) -> None:
-        """One clipped log line per second at most per kind of input, with the running count."""
-        self._refused[what] += 1
-        self.get_logger().warning(clip(f"{what} refused ({self._refused[what]} so far) [{int(err.code)} "
-                                       f"{err.code.name}]: {err.message}"), throttle_duration_sec=1.0)
-
     # -- inputs ---------------------------------------------------------------------------------
     # (``info`` has no default: rclpy passes the message info only to two-argument callbacks)
     def on_clock(self, msg: ClockMsg, info: dict):
@@ -126,7 +119,7 @@ class ControllerNode(Node):
             self._sources.admit("wheel speed measurement", publisher_of(info), time.monotonic())
             self._core.measured.on_wheel_speeds(convert.wheel_speeds_from_msg(msg))
         except RequestError as err:
-            self._report_refusal("wheel speed measurement", err)
+            self._refusals("wheel speed measurement", err)
             return
         if self._waiting is not None:
             (estimate, source), self._waiting = self._waiting, None
@@ -137,12 +130,12 @@ class ControllerNode(Node):
             self._sources.admit("magnetometer measurement", publisher_of(info), time.monotonic())
             self._core.measured.on_magnetometer(convert.magnetometer_from_msg(msg))
         except RequestError as err:
-            self._report_refusal("magnetometer measurement", err)
+            self._refusals("magnetometer measurement", err)
 
     def _step(self, outcome, what: str) -> None:
         """After a state or estimate: report, and command when a control instant is due."""
         if outcome.refused is not None:
-            self._report_refusal(what, outcome.refused)
+            self._refusals(what, outcome.refused)
             return
         if outcome.note:
             self.get_logger().warning(outcome.note)
@@ -164,13 +157,13 @@ class ControllerNode(Node):
     def on_plan(self, msg: ManeuverPlan):
         refused = self._core.receive_plan(convert.plan_from_msg(msg), signing.payload(msg))
         if refused is not None:
-            self._report_refusal("published plan", refused)
+            self._refusals("published plan", refused)
 
     def on_set_mode(self, request, response):
         refused = self._core.authorize_mode(signing.payload(request), bytes(request.signature), request.key_id,
                                             int(request.sequence))
         if refused is not None:
-            self._report_refusal("mode request", refused)
+            self._refusals("mode request", refused)
             response.success, response.error_code, response.message = False, int(refused.code), refused.message
             return response
         code, message, ended = self._core.set_mode(int(request.mode))
@@ -192,7 +185,7 @@ class ControllerNode(Node):
         if plan is not None:
             refused = self._core.start(plan)
         if refused is not None:
-            self._report_refusal("execute goal", refused)
+            self._refusals("execute goal", refused)
             goal_handle.abort()
             return convert.result_msg(ManeuverResult(False, int(refused.code), refused.message))
         self._goal, self._done = goal_handle, Future(executor=self.executor)

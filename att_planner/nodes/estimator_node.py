@@ -16,7 +16,6 @@ from __future__ import annotations
 
 import math
 import time
-from collections import Counter
 
 from rclpy.node import Node
 from sensor_msgs.msg import Imu, MagneticField
@@ -24,7 +23,7 @@ from sensor_msgs.msg import Imu, MagneticField
 from att_msgs.msg import ActuatorCommand, AttitudeEstimate, CoarseSunSensors, StarTracker
 from att_msgs_py import convert, qos, topics
 from att_msgs_py.errors import RequestError, clip
-from att_msgs_py.node_runner import parameter_reader, publisher_of, run_node
+from att_msgs_py.node_runner import RefusalLog, parameter_reader, publisher_of, run_node
 from att_planner.estimation.configure import estimator_from_scenario
 from att_planner.estimation.inputs import Sources
 from att_sim import scenario as scen
@@ -38,7 +37,7 @@ class EstimatorNode(Node):
         param = parameter_reader(self, s.node_params.get("estimator", {}), str(s.path))
         self._core = estimator_from_scenario(param, s)
         param.refuse_unknown()
-        self._refused = Counter()
+        self._refusals = RefusalLog(self.get_logger())
         self._sources = Sources(self._core.config.resync_timeout)
         self._pub = self.create_publisher(AttitudeEstimate, topics.ESTIMATE, qos.STREAM_QOS)
         self.create_subscription(Imu, topics.IMU, self.on_imu, qos.STREAM_QOS)
@@ -53,11 +52,6 @@ class EstimatorNode(Node):
             f"{'yes' if s.sensors.sun_sensors else 'no'}; ARW {c.arw * math.sqrt(HOUR) / DEG:.4g} deg/sqrt(h), "
             f"bias walk {c.rrw * HOUR * math.sqrt(HOUR) / DEG:.4g} deg/h/sqrt(h), gate p = {c.gate_probability}")
 
-    def _report_refusal(self, what: str, err: RequestError) -> None:
-        self._refused[what] += 1
-        self.get_logger().warning(clip(f"{what} refused ({self._refused[what]} so far) [{int(err.code)} "
-                                       f"{err.code.name}]: {err.message}"), throttle_duration_sec=1.0)
-
     def _guarded(self, what: str, info: dict, call, *args):
         """Run ``call(*args)`` (a core input) if its publisher is the one of ``what``, logging a
         refusal; its result otherwise."""
@@ -65,7 +59,7 @@ class EstimatorNode(Node):
             self._sources.admit(what, publisher_of(info), time.monotonic())
             return call(*args)
         except RequestError as err:
-            self._report_refusal(what, err)
+            self._refusals(what, err)
             return None
 
     # -- callbacks: translate messages to Estimator calls -------------------------------------------

@@ -109,14 +109,15 @@ class PlanOutcome:
 def padded(problem: ManeuverProblem, padding: float) -> ManeuverProblem:
     """The problem with every cone and keep-out zone widened and every keep-in zone narrowed by
     ``padding`` rad (execution margin for the tracking controller), but never by more than half
-    the room the start or goal leaves it (zones as they are at t = 0), so neither end falls inside."""
+    the room the start or goal leaves it (zones as they are at t = 0), so neither end falls inside;
+    a cone or zone with an end on its boundary is not padded."""
     if padding <= 0 or not (problem.cones or problem.zones):
         return problem
     cones, zones = problem.cones, problem.zones
     if cones:
         ends = endpoint_directions(problem.q_initial, problem.q_final, problem.sensor_axis, problem.sensor_target)
         room = np.min(direction_margins(np.array(list(ends.values())), cones), axis=0)
-        cones = [Cone(c.direction, c.half_angle + min(padding, 0.5 * r), c.name) for c, r in zip(cones, room)]
+        cones = [Cone(c.direction, c.half_angle + min(padding, 0.5 * max(r, 0.0)), c.name) for c, r in zip(cones, room)]
     if zones:
         zone_sky = problem.zone_sky()
         ends = [problem.q_initial] + ([problem.q_final] if problem.sensor_target is None else [])

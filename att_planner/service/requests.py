@@ -25,7 +25,7 @@ from att_msgs_py.errors import ErrorCode, RequestError
 from att_msgs_py.types import Cone
 from att_msgs_py.validation import MAX_NAME_LENGTH, text, unit_quaternion, unit_vector
 from att_planner import methods
-from att_planner.cones import check_zones, endpoint_in_cone
+from att_planner.cones import BOUNDARY_TOLERANCE, boundary_arc_issue, check_zones, endpoint_in_cone
 from att_planner.methods import Method
 from att_planner.problem import ManeuverProblem
 from att_planner.service.real_sky import RequestSky, check_orbit_window, resolve_sky
@@ -152,15 +152,20 @@ def check_sky(problem: ManeuverProblem, real: RequestSky, legs: int = 1) -> None
 
 
 def check_reachable(problem: ManeuverProblem) -> None:
-    """Neither end inside a cone (SENSOR_IN_CONE), and the cones and zones do not close the sky
-    between them for any sensor (INFEASIBLE)."""
+    """Neither end inside a cone by more than BOUNDARY_TOLERANCE (SENSOR_IN_CONE; on the boundary is
+    plannable), a forced boundary arc that can be flown (INVALID_OPTION), and the cones and zones do
+    not close the sky between the ends for any sensor (INFEASIBLE)."""
     q0, qf, r, cones, sensor_target = (problem.q_initial, problem.q_final, problem.sensor_axis, problem.cones,
                                        problem.sensor_target)
     hit = endpoint_in_cone(q0, qf, r, cones, sensor_target)
     if hit is not None:
         label, cone, depth = hit
         raise RequestError(ErrorCode.SENSOR_IN_CONE,
-                           f"the {label} is inside cone '{cone.name}' by {np.degrees(depth):.3f} deg")
+                           f"the {label} is inside cone '{cone.name}' by {np.degrees(depth):.3g} deg "
+                           f"(more than the boundary tolerance of {BOUNDARY_TOLERANCE:g} rad)")
+    why = boundary_arc_issue(problem)
+    if why:
+        raise RequestError(ErrorCode.INVALID_OPTION, why)
     if not cones and not problem.zones:
         return
     zone_sky = problem.zone_sky()
@@ -273,7 +278,8 @@ def check_targets(names: list, targets: list) -> dict:
 
 
 def check_targets_clear(problem: ManeuverProblem) -> None:
-    """No schedule target violates a fixed (inertial) zone (ZONE_AT_END): it could never be passed.
+    """No schedule target violates a fixed (inertial) zone by more than BOUNDARY_TOLERANCE
+    (ZONE_AT_END): it could never be passed.
     A moving zone may clear a target before it is reached: planning and verification judge those."""
     zone_sky = problem.zone_sky()
     fixed = np.array([z.body == "inertial" for z in zone_sky.zones], bool)
@@ -282,7 +288,7 @@ def check_targets_clear(problem: ManeuverProblem) -> None:
     for i, (target, q) in enumerate(problem.targets.items()):
         m = np.where(fixed, zone_sky.margins(0.0, q, true=True)[0], np.inf)
         k = int(np.argmin(m))
-        if m[k] < 0:
+        if m[k] < -BOUNDARY_TOLERANCE:
             kind = "outside keep-in" if zone_sky.keep_in[k] else "inside keep-out"
             raise RequestError(ErrorCode.ZONE_AT_END,
                                f"targets[{i}] ('{target}') is {kind} zone {zone_sky.names[k]} by "

@@ -76,3 +76,24 @@ def test_signal_stops_node_cleanly(loop, signum, delay, from_thread):
             proc.wait()
     assert proc.returncode == 0, out
     assert out.strip().endswith("closed"), out
+
+
+def test_refusals_are_logged_once_a_second_per_kind_with_their_count():
+    from att_msgs_py.errors import ErrorCode, RequestError
+    from att_msgs_py.node_runner import RefusalLog
+
+    class Logger:
+        lines: list = []
+
+        def warning(self, line):
+            self.lines.append(line)
+
+    log = RefusalLog(Logger(), period=3600.0)
+    for _ in range(1000):                                 # a flood of one kind...
+        log("state", RequestError(ErrorCode.STATE_TIME_JUMP, "stamp jumps"))
+    log("published plan", RequestError(ErrorCode.PLAN_NOT_AUTHENTIC, "not signed " + "x" * 1000))
+    log("state", RequestError(ErrorCode.STATE_TIME_JUMP, "stamp jumps"))
+    # ...does not hide another kind
+    assert Logger.lines[0] == "state refused (1 so far) [311 STATE_TIME_JUMP]: stamp jumps"
+    assert len(Logger.lines) == 2 and Logger.lines[1].startswith("published plan refused (1 so far) [306 ")
+    assert len(Logger.lines[1]) <= 400 and log.counts == {"state": 1001, "published plan": 1}

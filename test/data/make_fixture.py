@@ -1,14 +1,15 @@
 """Regenerate ``test/data/swift_short.mcap``, the regression log of ``test/test_review_replay.py``.
 
-Runs the suite (recorder, simulator, controller, planner as processes on an isolated domain,
-as fast as possible, states, clock and commands at 10 Hz, 5 s hold) through one short keep-out maneuver
-of the ``swift_demo`` spacecraft: 45° about body y with the sensor along body x, Sun/Earth/Moon
+Runs the suite (recorder, simulator, estimator, controller, planner as processes on an isolated
+domain, as fast as possible, states, clock and commands at 10 Hz, the sensors at their rates, 5 s
+hold; the controller on the estimate) through one short keep-out maneuver of the ``swift_demo``
+spacecraft: 45° about body y with the sensor along body x, Sun/Earth/Moon
 cones (the path ends 14° from the Moon cone). Run it from the repository root when the log format
 changes on purpose:
 
     .venv/bin/python test/data/make_fixture.py
 
-and commit the new file (it must stay under 300 KB).
+and commit the new file (it must stay under 1 MB: noisy sensor streams compress poorly).
 """
 from __future__ import annotations
 
@@ -44,7 +45,7 @@ def main() -> int:
     join_env(env)
     # the simulator starts once the plan is ready, so the log holds little idle time before the maneuver
     suite = start_suite("swift_demo", work / "run.mcap", work, env=env, params=PARAMS,
-                        nodes=("recorder", "controller", "planner"))
+                        nodes=("recorder", "estimator", "controller", "planner"))
     from att_msgs_py.errors import ErrorCode
     from att_planner.nodes.client import client_session, maneuver_request
 

@@ -1,9 +1,7 @@
-"""An INDEPENDENT check of a benchmark's plans: nothing of the suite, only numpy and skyfield.
+"""Zones judged INDEPENDENTLY of the suite, for the checks of the benchmarks' plans (flown by
+:mod:`helpers.own_rk4`): nothing of the suite, only numpy and skyfield.
 
-:func:`integrate` flies a plan's torque samples from rest with its own RK4 of the rigid body
-(J ω̇ = T − ω × Jω, q̇ = ½ q ⊗ [ω, 0]; Euler's equations, Wie, *Space Vehicle Dynamics and Control*,
-2008, §5.2), the samples held (``zoh``) or interpolated linearly (``linear``, at each RK4 stage's
-time), on Python floats. :func:`margins` gives each zone's margin against the true sky: the
+:func:`margins` gives each zone's margin against the true sky: the
 spacecraft from the JSON's TLE through skyfield's ``EarthSatellite`` (SGP4, TEME → GCRS), the Sun and
 Moon from the ``de421.bsp`` of skyfield-data (geometric, light time ignored: ≤ 0.006° in these
 cases), the Earth limb as asin(R_E/|r|) + margin about −r̂ (R_E = 6378.137 km, WGS-84); fixed cones
@@ -17,54 +15,9 @@ from importlib.resources import files
 
 import numpy as np
 
+from helpers.own_rk4 import dcm
+
 R_EARTH = 6378.137e3          # m, WGS-84 equatorial radius
-SUBSTEPS = 4                  # RK4 steps per knot interval
-
-
-def dcm(q):
-    """Body-to-inertial rotation matrices of unit quaternions q (K, 4) = (x, y, z, w)."""
-    x, y, z, w = np.moveaxis(np.asarray(q, float), -1, 0)
-    return np.stack([np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)], -1),
-                     np.stack([2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)], -1),
-                     np.stack([2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)], -1)], -2)
-
-
-def integrate(J, t, torque, q0, interpolation="zoh", substeps=SUBSTEPS, dense=False):
-    """The rigid body from rest at ``q0`` under the torque samples; the states (x, y, z, w, ωx, ωy, ωz)
-    at the knots ``t`` (``dense``: ``(times, states)`` after every RK4 step)."""
-    J = [list(map(float, row)) for row in J]
-    Ji = np.linalg.inv(np.array(J)).tolist()
-    torque = [[float(v) for v in row] for row in torque]
-
-    def f(x, u):
-        qx, qy, qz, qw, wx, wy, wz = x
-        h = [J[i][0] * wx + J[i][1] * wy + J[i][2] * wz for i in range(3)]
-        r = (u[0] - (wy * h[2] - wz * h[1]), u[1] - (wz * h[0] - wx * h[2]), u[2] - (wx * h[1] - wy * h[0]))
-        return (0.5 * (qw * wx + qy * wz - qz * wy), 0.5 * (qw * wy + qz * wx - qx * wz),
-                0.5 * (qw * wz + qx * wy - qy * wx), -0.5 * (qx * wx + qy * wy + qz * wz),
-                *(Ji[i][0] * r[0] + Ji[i][1] * r[1] + Ji[i][2] * r[2] for i in range(3)))
-
-    def axpy(x, a, k):
-        return [xi + a * ki for xi, ki in zip(x, k)]
-
-    x = [float(v) for v in q0] + [0.0, 0.0, 0.0]
-    knots, times, states = [list(x)], [float(t[0])], [list(x)]
-    for k in range(len(t) - 1):
-        h = (t[k + 1] - t[k]) / substeps
-        a, b = torque[k], torque[k + 1] if interpolation == "linear" else torque[k]
-        for i in range(substeps):
-            u0, um, u1 = ([ai + (bi - ai) * (i + f) / substeps for ai, bi in zip(a, b)] for f in (0.0, 0.5, 1.0))
-            k1 = f(x, u0)
-            k2 = f(axpy(x, 0.5 * h, k1), um)
-            k3 = f(axpy(x, 0.5 * h, k2), um)
-            k4 = f(axpy(x, h, k3), u1)
-            x = [xi + h / 6.0 * (p + 2 * q + 2 * r + s) for xi, p, q, r, s in zip(x, k1, k2, k3, k4)]
-            n = sum(v * v for v in x[:4]) ** 0.5
-            x[:4] = [v / n for v in x[:4]]
-            times.append(t[k] + (i + 1) * h)
-            states.append(list(x))
-        knots.append(list(x))
-    return (np.array(times), np.array(states)) if dense else np.array(knots)
 
 
 def attitude_error(q, q_goal) -> float:

@@ -1,7 +1,8 @@
 """The regression log ``test/data/swift_short.mcap`` and what it holds.
 
 Recorded by the suite (``test/data/make_fixture.py`` regenerates it when the format changes on
-purpose): a 45° keep-out maneuver of the swift_demo spacecraft, states and commands at 10 Hz.
+purpose): a 45° keep-out maneuver of the swift_demo spacecraft, states and commands at 10 Hz, the
+sensors at their rates and the estimate the controller flew on.
 """
 import math
 from pathlib import Path
@@ -10,7 +11,8 @@ from att_msgs_py import topics
 from att_sim import rotations as rot
 
 FIXTURE = Path(__file__).parents[1] / "data" / "swift_short.mcap"
-TOPIC_TYPES = dict(topics.RECORDED)
+CHANNEL_TYPES = dict(topics.RECORDED)                   # every recorded topic has a channel
+TOPIC_TYPES = {t: name for t, name in topics.RECORDED.items() if t != topics.SUN_SENSORS}   # with messages
 STATE_FIELDS = {"header.stamp", "header.frame_id", "body_frame_id", "attitude", "body_rate", "wheel_speeds",
                 "wheel_torques", "magnetic_field_body", "dipole", "applied_torque", "position", "command_timeout"}
 GOAL = rot.from_axis_angle([0, 1, 0], math.radians(-45))      # the fixture's maneuver (make_fixture.py)

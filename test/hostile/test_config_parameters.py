@@ -95,6 +95,26 @@ BAD_SCENARIOS = {
     "node section without ros__parameters": (edited(simulator={"step": 0.1}), "section 'simulator'"),
     "a file over 1 MB": ("# " + "x" * 1_100_000 + "\n" + yaml.safe_dump(BASE), "bytes"),
     "not UTF-8": (b"\xff\xfe/**: \x00\x81", "cannot be read"),
+    # sensors and actuators (issue 14)
+    "sensors a list": (edited(sensors=[1, 2]), "sensors must be a mapping"),
+    "sensors unknown kind": (edited(sensors={"lidar": {}}), "sensors has unknown key(s) lidar"),
+    "gyro ARW negative": (edited(sensors={"gyro": {"arw_deg_per_sqrt_h": -0.1}}), "sensors.gyro.arw_deg_per_sqrt_h"),
+    "gyro rate text": (edited(sensors={"gyro": {"rate_hz": "fast"}}), "sensors.gyro.rate_hz"),
+    "gyro key typo": (edited(sensors={"gyro": {"arw_deg_per_sqrt_hr": 0.1}}), "unknown key(s) arw_deg_per_sqrt_hr"),
+    "tracker without a name": (edited(sensors={"star_trackers": [{"rate_hz": 5.0}]}),
+                               "sensors.star_trackers[0].name"),
+    "tracker mounting not unit": (edited(sensors={"star_trackers": [{"name": "a", "mounting": [0, 0, 0, 3]}]}),
+                                  "sensors.star_trackers[0].mounting"),
+    "tracker Sun exclusion without an epoch": (
+        edited(sensors={"star_trackers": [{"name": "a", "exclusions": [{"body": "sun", "half_angle_deg": 30}]}]}),
+        "needs the scenario's epoch"),
+    "sun sensors without an epoch": (edited(sensors={"sun_sensors": {}}), "sensors.sun_sensors needs"),
+    "seed text": (edited(sensors={"seed": "lucky"}), "sensors.seed"),
+    "magnetometer noise NaN": (edited(sensors={"magnetometer": {"noise_nT": float("nan")}}),
+                               "sensors.magnetometer.noise_nT"),
+    "actuators unknown kind": (edited(actuators={"thrusters": {}}), "actuators has unknown key(s) thrusters"),
+    "wheel friction negative": (edited(actuators={"wheels": {"coulomb_friction_Nm": -1.0}}),
+                                "actuators.wheels.coulomb_friction_Nm"),
 }
 
 
@@ -192,6 +212,20 @@ NODE_CASES = {
     "controller: not a scenario": ("controller", ["-p", "scenario:=controller_gains"], C, ["not a scenario"]),
     "planner: unknown scenario": ("planner", ["-p", "scenario:=no_such_scenario"], C, ["no_such_scenario"]),
     "planner: not a scenario": ("planner", ["-p", "scenario:=controller_gains"], C, ["not a scenario"]),
+    # issue 14: the simulator's seed, the controller's state source, the estimator's tuning
+    "simulator seed negative": (SIM, ["-p", "seed:=-1"], P, ["'seed'"]),
+    "simulator seed text": (SIM, ["-p", "seed:=lucky"], P, ["'seed'", "integer"]),
+    "controller state_source unknown": ("controller", ["-p", "state_source:=oracle"], P,
+                                        ["'state_source'", "truth, estimate"]),
+    "controller estimate without tachometers": ("controller", ["-p", "scenario:=olivares_staffetti", "-p",
+                                                               "state_source:=estimate"], P,
+                                                ["'state_source'", "wheel_tachometer"]),
+    "estimator: a scenario without a gyro": ("estimator", ["-p", "scenario:=bruni_celani"], C, ["no gyro"]),
+    "estimator: gate probability 1.5": ("estimator", ["-p", "gate_probability:=1.5"], P, ["'gate_probability'"]),
+    "estimator: publish_rate above the gyro's": ("estimator", ["-p", "publish_rate:=100.0"], P, ["'publish_rate'"]),
+    "estimator: history zero": ("estimator", ["-p", "history:=0.0"], P, ["'history'"]),
+    "estimator: unknown parameter (typo)": ("estimator", ["-p", "gate_probabilty:=0.99"], P, ["gate_probabilty"]),
+    "estimator: unknown scenario": ("estimator", ["-p", "scenario:=no_such_scenario"], C, ["no_such_scenario"]),
 }
 RCL_PARSE_ERROR = re.compile(r"^\[ERROR\] \[[\d.]+\] \[rcl\]: Failed to parse global arguments$")
 REFUSAL = re.compile(r"^(\w+)\.py: \[(\d+) (\w+)\] (.+)$")

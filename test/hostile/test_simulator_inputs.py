@@ -321,6 +321,27 @@ def test_a_command_answering_a_state_resumes_the_lockstep(lonely_sim):
 
 
 @pytest.mark.ros
+def test_a_late_command_of_the_controller_makes_the_simulator_wait_for_it(lonely_sim):
+    """A controller that lives but lags (its commands too old to apply) is waited for, not drowned:
+    its late command puts the free-running simulator back to waiting; another publisher's is ignored."""
+    s, states, now = lonely_sim
+    pub = s.client.create_publisher(ActuatorCommand, topics.COMMAND, qos.STREAM_QOS)
+    stranger = s.client.create_publisher(ActuatorCommand, topics.COMMAND, qos.STREAM_QOS)
+    spin_for(s.client, 1.0)
+    pub.publish(command_msg(now()))                      # the controller: its last accepted command
+    spin_for(s.client, 2.0)                              # then silent: free-running again
+    assert s.suite.log_text("simulator").count("waiting for it to catch up") == 0
+    stranger.publish(command_msg(now() - 5.0))
+    spin_for(s.client, 1.0)
+    assert s.suite.log_text("simulator").count("waiting for it to catch up") == 0
+    pub.publish(command_msg(now() - 5.0))                # late, from the controller
+    spin_for(s.client, 1.0)
+    assert "waiting for it to catch up" in s.suite.log_text("simulator")
+    s.client.destroy_publisher(pub)
+    s.client.destroy_publisher(stranger)
+
+
+@pytest.mark.ros
 def test_hostile_resets_over_the_service_are_refused(lonely_sim):
     s, states, _ = lonely_sim
     client = s.client.create_client(ResetSimulator, topics.RESET_SIMULATOR)

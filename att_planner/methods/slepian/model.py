@@ -7,6 +7,7 @@ from typing import Any
 import numpy as np
 from scipy.signal.windows import dpss
 
+from att_planner.cones import BOUNDARY_TOLERANCE, SMOOTH_END_RAMP, boundary_end_zones, end_ramp
 from att_planner.problem import ManeuverProblem
 from att_sim import rotations as rot
 
@@ -95,7 +96,10 @@ class SmoothManeuver:
     (+1 keep-out, −1 keep-in) and constraint c_kz = σ_z (a_z(t_k)·R_k s_z − cos(θ_z(t_k) + σ_z m)) ≤ 0
     at t_k = τ_k t_f. The optimiser keeps the angular margin m = ``zone_margin`` (outside a
     keep-out zone, inside a keep-in one) so that the truth integration of the ZOH torque (which
-    lags the model by half a sample) stays clear. Static zones (``zone_sky`` None): constant axes
+    lags the model by half a sample) stays clear; a zone with an end on its boundary
+    (``zone_ramp``, :func:`att_planner.cones.boundary_end_zones`) gets ``−tol + (m + tol) w(τ_k)``
+    instead, w the end ramp of a smooth plan (:func:`att_planner.cones.end_ramp`, ``SMOOTH_END_RAMP``).
+    Static zones (``zone_sky`` None): constant axes
     ``cone_dirs`` and ``cone_cos`` = cos(θ_z + σ_z m). Moving zones: ``zone_sky``
     (:class:`att_planner.zones.ZoneSky`) gives a_z(t), θ_z(t) and their rates, and ``cone_dirs``,
     ``cone_cos`` hold the values at t = 0.
@@ -117,6 +121,7 @@ class SmoothManeuver:
     zone_sensor_index: np.ndarray = field(default_factory=lambda: np.zeros(0, int))   # (Z,) row per zone
     zone_sign: np.ndarray = field(default_factory=lambda: np.zeros(0))   # (Z,) +1 keep-out, −1 keep-in
     zone_margin: float = 0.0
+    zone_ramp: np.ndarray = field(default_factory=lambda: np.zeros(0, bool))   # (Z,) margins ramped at the ends
     zone_sky: Any = None                                     # ZoneSky of moving zones, else None
     sky_memo: dict = field(default_factory=dict, compare=False, repr=False)   # (K, t_f, rates) → zone sky arrays
 
@@ -184,7 +189,7 @@ def build_maneuver(problem: ManeuverProblem, M: int = PAPER_M, N: int = PAPER_N,
     return SmoothManeuver(slepian_basis(N, W, M), J / scale, scale, float(problem.spacecraft.body_torque_max),
                           rot.dcm(problem.q_initial), rot.dcm(problem.q_final), r, dirs, cos, target, tbasis, W,
                           np.array(sensors), np.array(index, int), sign, float(cone_margin),
-                          sky if sky.moving else None)
+                          boundary_end_zones(problem, cone_margin), sky if sky.moving else None)
 
 
 @dataclass
@@ -214,12 +219,30 @@ class Evaluation:
         return float(np.abs(self.torque).max())
 
 
+def _tightening(man: SmoothManeuver, K: int):
+    """The angular tightening of every zone at the K samples: ``zone_margin``, ramped at the ends
+    for the ``zone_ramp`` zones ((K, Z); a scalar when none is ramped)."""
+    if not man.zone_ramp.any():
+        return man.zone_margin
+    w = end_ramp(np.arange(K) / (K - 1), SMOOTH_END_RAMP)
+    ramp = -BOUNDARY_TOLERANCE + (man.zone_margin + BOUNDARY_TOLERANCE) * w
+    return np.where(man.zone_ramp, ramp[:, None], man.zone_margin)
+
+
+def _zone_cos(man: SmoothManeuver, K: int) -> np.ndarray:
+    """cos(θ_z + σ_z δ_kz) of the static zones: ``cone_cos`` (Z,), or (K, Z) with ramped zones."""
+    if not man.zone_ramp.any():
+        return man.cone_cos
+    theta = np.arccos(man.cone_cos) - man.zone_sign * man.zone_margin
+    return np.cos(theta + man.zone_sign * _tightening(man, K))
+
+
 def _static_zones(man: SmoothManeuver, R: np.ndarray, jac: bool):
     """Constant zones: c = σ (b·a − cos(θ + σ m)) and the (N+1, Z, 3) vectors σ b × a, one
     product per distinct sensor (a single sensor: exactly the cone rows of issue 3)."""
     if len(man.zone_sensors) == 1:      # the fast path of today's cones
         b = R @ man.zone_sensors[0]
-        values = b @ man.cone_dirs.T - man.cone_cos
+        values = b @ man.cone_dirs.T - _zone_cos(man, R.shape[0])
         bw = rot.cross(b[:, None, :], man.cone_dirs[None, :, :]) if jac else None
         if man.zone_sign.size and man.zone_sign.min() < 0:
             values *= man.zone_sign
@@ -228,13 +251,14 @@ def _static_zones(man: SmoothManeuver, R: np.ndarray, jac: bool):
         return values, bw
     Z = len(man.zone_sign)
     values = np.empty((R.shape[0], Z))
+    cos = np.broadcast_to(_zone_cos(man, R.shape[0]), values.shape)
     bw = np.empty((R.shape[0], Z, 3)) if jac else None
     for u, s in enumerate(man.zone_sensors):
         sel = man.zone_sensor_index == u
         if not sel.any():
             continue
         b = R @ s
-        values[:, sel] = b @ man.cone_dirs[sel].T - man.cone_cos[sel]
+        values[:, sel] = b @ man.cone_dirs[sel].T - cos[:, sel]
         if jac:
             bw[:, sel] = rot.cross(b[:, None, :], man.cone_dirs[sel][None, :, :])
     if np.any(man.zone_sign < 0):
@@ -278,7 +302,7 @@ def _sky_at(man: SmoothManeuver, K: int, tf: float, rates: bool):
             man.sky_memo[key] = (np.where(inside, tau, 0.0), *sky.rates_at(t))
         else:
             axes, half = sky.at(t)
-            man.sky_memo[key] = (axes, half + man.zone_sign * man.zone_margin)
+            man.sky_memo[key] = (axes, half + man.zone_sign * _tightening(man, K))
     return man.sky_memo[key]
 
 

@@ -20,7 +20,9 @@ at the point's physical time ``t = t0 + T τ`` (``t0``: the sum of the earlier p
 an expression of the duration variables, so its derivatives with respect to them are exact (moving
 keep-out zones); :func:`path_violations` checks them
 between those points on the Hermite cubic interpolant and :func:`refine_mesh` bisects the intervals
-where they fail (or where a bang-bang control switches, :func:`switch_intervals`).
+where they fail (or where a bang-bang control switches, :func:`switch_intervals`). A phase may give
+the path constraints a last input ``w(τ)``, a known function of the mesh fraction (the ramp of a
+tightening near the ends, issue 19), evaluated at each point.
 
 Phases are joined, bounded and scored through :class:`Transcription` (``add_constraint``,
 ``minimize``), so the same machinery serves a single free-time slew and a multiphase schedule.
@@ -57,15 +59,17 @@ def refine_mesh(mesh: np.ndarray, intervals, max_intervals: int | None = None) -
 class Phase:
     """A phase ``ẋ = f(x, u)`` on a mesh, with box bounds and optional path constraints.
 
-    ``dynamics`` and ``path`` are CasADi Functions ``(x, u) -> ẋ`` and ``(x, u) -> g`` or
-    ``(x, u, t) -> g`` (:attr:`timed`; usable both symbolically and numerically). Bounds are
-    arrays (or scalars) broadcast to the sizes.
+    ``dynamics`` and ``path`` are CasADi Functions ``(x, u) -> ẋ`` and ``(x, u[, t][, w][, p]) -> g``
+    (usable both symbolically and numerically): ``t`` the time (:attr:`timed`), ``w`` the value of
+    ``path_weight(τ)`` at the point's mesh fraction, ``p`` the phase's ``path_parameters`` (the same
+    at every point; parameters of a parametric :class:`Transcription`). Bounds are arrays (or
+    scalars) broadcast to the sizes.
     """
 
     def __init__(self, dynamics: ca.Function, mesh, *, control: str = "constant",
                  state_bounds=(-np.inf, np.inf), control_bounds=(-np.inf, np.inf),
                  duration_bounds=(0.0, np.inf), path: ca.Function | None = None,
-                 path_bounds=(-np.inf, 0.0), name: str = "phase", path_parameters=()):
+                 path_bounds=(-np.inf, 0.0), path_weight=None, name: str = "phase", path_parameters=()):
         if control not in CONTROL_KINDS:
             raise ValueError(f"control must be one of {CONTROL_KINDS}, not '{control}'")
         self.dynamics = dynamics
@@ -82,19 +86,24 @@ class Phase:
         self.path = path
         n_path = path.size1_out(0) if path is not None else 0
         self.path_bounds = tuple(np.broadcast_to(np.asarray(b, float), (n_path,)).copy() for b in path_bounds)
+        self.path_weight = path_weight
         self.name = name
         self.path_parameters = np.asarray(path_parameters, float).ravel()
 
     @property
     def timed(self) -> bool:
         """Whether the path constraints depend on time (an input ``t`` after ``x, u``)."""
-        return self.path is not None and self.path.n_in() - bool(self.path_parameters.size) == 3
+        return self.path is not None and self.path.n_in() == (
+            3 + (self.path_weight is not None) + bool(self.path_parameters.size))
 
-    def path_values(self, x, u, t=None):
-        """The path constraints at numeric (or symbolic) points: ``path(x, u[, t][, p])`` with the
-        phase's ``path_parameters`` as ``p``."""
-        args = (x, u) + ((t,) if self.timed else ()) + ((self.path_parameters,) if self.path_parameters.size else ())
-        return self.path(*args)
+    def path_args(self, x, u, t, tau) -> list:
+        """The path function's inputs at points of mesh fractions ``tau``: ``x, u``, then the time
+        ``t`` when :attr:`timed`, then ``path_weight(tau)`` when given, then the phase's
+        ``path_parameters`` when there are any (one value for every point)."""
+        args = [x, u] + ([t] if self.timed else [])
+        if self.path_weight is not None:
+            args.append(ca.DM(np.asarray(self.path_weight(np.asarray(tau, float)), float)).T)
+        return args + ([self.path_parameters] if self.path_parameters.size else [])
 
     @property
     def intervals(self) -> int:
@@ -108,8 +117,8 @@ class Phase:
         """The same phase on another mesh."""
         return Phase(self.dynamics, mesh, control=self.control, state_bounds=self.state_bounds,
                      control_bounds=self.control_bounds, duration_bounds=self.duration_bounds,
-                     path=self.path, path_bounds=self.path_bounds, name=self.name,
-                     path_parameters=self.path_parameters)
+                     path=self.path, path_bounds=self.path_bounds, path_weight=self.path_weight,
+                     name=self.name, path_parameters=self.path_parameters)
 
 
 @dataclass
@@ -267,14 +276,17 @@ def _phase_constraints(p: int, ph: Phase, v: PhaseVariables, Tk, mesh, path_p, t
     if ph.path is not None:
         # Nodes see the control of the interval they start (the last node: the last one).
         U_nodes = ca.horzcat(U, U[:, -1]) if ph.control == "constant" else U
-        times = ()
+        times = weights = ()
         if ph.timed:
             T_nodes = ca.horzcat(Tk, Tk[-1]) if Tk.shape[1] > 1 else Tk
             times = (t_start + T_nodes * mesh, t_start + Tk * (mesh[:-1] + mesh[1:]) / 2)
-        shared = [2 + ph.timed] if ph.path_parameters.size else []       # p: one value for every point
+        if ph.path_weight is not None:          # of the phase's own mesh (a weighted path is not parametric)
+            weights = tuple(ca.DM(np.asarray(ph.path_weight(tau), float)).T
+                            for tau in (ph.mesh, (ph.mesh[:-1] + ph.mesh[1:]) / 2))
+        shared = [2 + ph.timed + len(weights[:1])] if ph.path_parameters.size else []   # p: one value for all
         extra = (path_p,) if shared else ()
-        Gn = ph.path.map(f"path_nodes{p}", "serial", N + 1, shared, [])(X, U_nodes, *times[:1], *extra)
-        Gm = ph.path.map(f"path_mids{p}", "serial", N, shared, [])(Xm, U_mid, *times[1:], *extra)
+        Gn = ph.path.map(f"path_nodes{p}", "serial", N + 1, shared, [])(X, U_nodes, *times[:1], *weights[:1], *extra)
+        Gm = ph.path.map(f"path_mids{p}", "serial", N, shared, [])(Xm, U_mid, *times[1:], *weights[1:], *extra)
         out += [(ca.vec(Gn), (np.tile(ph.path_bounds[0], N + 1), np.tile(ph.path_bounds[1], N + 1))),
                 (ca.vec(Gm), (np.tile(ph.path_bounds[0], N), np.tile(ph.path_bounds[1], N)))]
     return out
@@ -490,7 +502,7 @@ def path_violations(solution: PhaseSolution, samples_per_interval: int = 8, tol:
     tau = (ph.mesh[:-1, None] + np.diff(ph.mesh)[:, None] * s[None, :]).ravel()
     x = solution.state_at(tau)
     u = solution.control_at(tau)
-    gval = np.array(ph.path_values(x.T, u.T, (t_start + solution.duration * tau)[None, :])).T
+    gval = np.array(ph.path(*ph.path_args(x.T, u.T, (t_start + solution.duration * tau)[None, :], tau))).T
     lb, ub = ph.path_bounds
     excess = np.maximum(lb - gval, gval - ub).max(axis=1).reshape(ph.intervals, samples_per_interval).max(axis=1)
     return np.flatnonzero(excess > tol), float(excess.max())

@@ -8,6 +8,7 @@ from dataclasses import dataclass
 import casadi as ca
 import numpy as np
 
+from att_planner.cones import ARC_TOLERANCE, BOUNDARY_TOLERANCE, boundary_end_zones, end_ramp
 from att_planner.methods import symbolic
 from att_planner.methods.axis_rotations import time_unit
 from att_planner.methods.time_optimal import collocation as col
@@ -18,6 +19,9 @@ from att_sim import rotations as rot
 # Relative tightening of the rate and wheel-momentum bounds at the collocation points, so that
 # the truth trajectory between them stays within the bound itself.
 BOUND_MARGIN = 2e-3
+# The band (rad) outside its boundary in which the collocation points of a forced boundary arc lie:
+# half the verification's ARC_TOLERANCE, the other half for the truth between the points.
+ARC_BAND = 0.5 * ARC_TOLERANCE
 
 
 @dataclass
@@ -171,6 +175,54 @@ def _end_bounds(smooth: bool):
     return [-1.1] * 4 + [0.0] * rest, [1.1] * 4 + [0.0] * rest
 
 
+def weighted_path_function(problem: ManeuverProblem, s: Scaling, cone_margin: float, n_state: int = 7):
+    """The path constraints of a problem with a boundary end or a forced boundary arc
+    (:func:`boundary_case`): ``g ≤ 0`` (zones, wheel momentum) and the weight function of the phase
+    (:class:`~.collocation.Phase` ``path_weight``), or None when there are none; ``x`` has
+    ``n_state`` rows, the attitude and rate first. The problem's data are constants of the function.
+
+    Every zone of ``problem.zone_sky()`` (:mod:`att_planner.zones`: the cones, then the zones, each
+    with its own sensor axis ``s_z``, ``b_z = R(q) s_z``) is tightened by ``δ = cone_margin``: keep-out
+    ``a_z · b_z ≤ cos(θ_z + δ)``, keep-in ``a_z · b_z ≥ cos(θ_z − δ)``. A zone with an end on its
+    boundary (:func:`att_planner.cones.boundary_end_zones`) is tightened by ``−tol + (δ + tol) w(τ)``
+    instead, ``w`` the end ramp (:func:`att_planner.cones.end_ramp`, the path's last input). The
+    forced boundary arc's cone is the band ``0 ≤ margin ≤ ε`` (:data:`ARC_BAND`): ``a · b ≤ cos θ`` and
+    ``a · b ≥ cos(θ + ε)`` (an equality there would repeat the fixed start and the final pointing,
+    which IPOPT cannot solve: rank-deficient constraints). When a zone moves,
+    the function is ``(x, u, t[, w]) -> g`` with ``t`` the normalised time from the start: ``a_z(t τ_u)``
+    and ``θ_z(t τ_u)`` are the ZoneSky's Chebyshev series of that CasADi expression, so the
+    collocation couples them exactly to ``t_f``. Without motion it is ``(x, u[, w]) -> g`` with the
+    zones constant (no time dependence is built)."""
+    x, u, t, w = ca.SX.sym("x", n_state), ca.SX.sym("u", 3), ca.SX.sym("t"), ca.SX.sym("w")
+    zones = problem.zone_sky()
+    ramped = boundary_end_zones(problem, cone_margin)
+    margins = [-BOUNDARY_TOLERANCE + (cone_margin + BOUNDARY_TOLERANCE) * w if near else cone_margin
+               for near in ramped]
+    R = symbolic.dcm(x[:4])
+    if problem.boundary_cone is not None:
+        margins[problem.boundary_cone] = 0.0
+    g = zones.casadi_constraints(t * s.tu if zones.moving else 0.0, R, margins)
+    if problem.boundary_cone is not None:           # the band 0 ≤ margin ≤ ARC_BAND of the arc's cone
+        cone = problem.cones[problem.boundary_cone]
+        r = np.asarray(problem.sensor_axis, float) / np.linalg.norm(problem.sensor_axis)
+        g.append(ca.cos(cone.half_angle + ARC_BAND) - ca.dot(ca.DM(cone.direction), ca.mtimes(R, ca.DM(r))))
+    if math.isfinite(problem.wheel_momentum_max) and problem.spacecraft.n_wheels:   # no wheels: no momentum
+        h_per_rate = s.J0 / s.tu / (problem.wheel_momentum_max * (1 - BOUND_MARGIN))
+        h_w = ca.mtimes(ca.DM(problem.spacecraft.wheel_axes_pinv @ s.Jn * h_per_rate), x[4:7])
+        g += [h_w - 1, -h_w - 1]
+    if not g:
+        return None
+    inputs = [x, u] + ([t] if zones.moving else []) + ([w] if ramped.any() else [])
+    weight = end_ramp if ramped.any() else None
+    return ca.Function("path", inputs, [ca.vertcat(*g)]), weight
+
+
+def boundary_case(problem: ManeuverProblem, cone_margin: float) -> bool:
+    """Whether the problem has an end on a zone's boundary (ramped tightening) or a forced boundary
+    arc: its path constraints are :func:`weighted_path_function`'s, built for it alone."""
+    return problem.boundary_cone is not None or bool(boundary_end_zones(problem, cone_margin).any())
+
+
 def transcription(problem: ManeuverProblem, s: Scaling, mesh: np.ndarray, control: str, cone_margin: float,
                   tf_bounds: tuple[float, float], *, torque_accel: float | None = None, tol: float = 1e-7,
                   max_iter: int = 400, expand: bool = True) -> col.Transcription:
@@ -184,9 +236,16 @@ def transcription(problem: ManeuverProblem, s: Scaling, mesh: np.ndarray, contro
     momentum scale are its parameters, the start and the duration's bounds its variables' bounds
     (set here), so a second problem of that shape only copies it (:meth:`.collocation.Transcription.copy`).
     Moving zones (timed path constraints) keep one t_f; fixed ones chain copies of it per interval
-    (a banded KKT system, far fewer iterations; with moving zones the copies took more)."""
+    (a banded KKT system, far fewer iterations; with moving zones the copies took more). A problem
+    with a boundary end or a forced boundary arc (:func:`boundary_case`, issue 19) gets an NLP of its
+    own, with :func:`weighted_path_function`'s constraints."""
     smooth = torque_accel is not None
     zones = problem.zone_sky()
+    options = dict(tol=tol, max_iter=max_iter, nlpsol_options={"expand": expand})
+    if boundary_case(problem, cone_margin):            # its path constraints are built for it alone
+        path, weight = weighted_path_function(problem, s, cone_margin, 13 if smooth else 7) or (None, None)
+        tr = _build(problem, s, mesh, control, path, torque_accel, not zones.moving, weight).build(**options)
+        return _start(tr.copy(mesh, extra_values=goal_values(problem)), problem, smooth, tf_bounds)
     path, degree = path_function(problem, s, 13 if smooth else 7, cone_margin)
     momentum = math.isfinite(problem.wheel_momentum_max)
     moving = sum(z.body != "inertial" for z in zones.zones)
@@ -197,9 +256,14 @@ def transcription(problem: ManeuverProblem, s: Scaling, mesh: np.ndarray, contro
     if key not in _NLPS:
         while len(_NLPS) >= CACHE_SIZE:
             _NLPS.pop(next(iter(_NLPS)))
-        _NLPS[key] = (_build(problem, s, mesh, control, path, torque_accel, not zones.moving)
-                      .build(tol=tol, max_iter=max_iter, nlpsol_options={"expand": expand}), zones)  # zones: kept alive
+        _NLPS[key] = (_build(problem, s, mesh, control, path, torque_accel, not zones.moving,
+                             path_parameters=path_values(problem, s, 0.0)).build(**options), zones)  # zones: kept alive
     tr = _NLPS[key][0].copy(mesh, path_values(problem, s, cone_margin), goal_values(problem))
+    return _start(tr, problem, smooth, tf_bounds)
+
+
+def _start(tr: col.Transcription, problem: ManeuverProblem, smooth: bool, tf_bounds) -> col.Transcription:
+    """``tr`` from the problem's start at rest, its duration within ``tf_bounds``."""
     q0 = rot.normalize(np.asarray(problem.q_initial, float))
     tr.bound_state(0, 0, np.concatenate([q0, np.zeros(9 if smooth else 3)]))
     tr.set_duration_bounds(0, *tf_bounds)
@@ -207,14 +271,14 @@ def transcription(problem: ManeuverProblem, s: Scaling, mesh: np.ndarray, contro
 
 
 def _build(problem: ManeuverProblem, s: Scaling, mesh: np.ndarray, control: str, path, torque_accel,
-           duration_copies: bool) -> col.Transcription:
-    """The parametric NLP of :func:`transcription` (not built)."""
+           duration_copies: bool, weight=None, path_parameters=()) -> col.Transcription:
+    """The parametric NLP of :func:`transcription` (not built): the mesh and the goal its parameters,
+    and ``path_parameters`` the path's (``weight``: the path's weight of the mesh fractions)."""
     smooth = torque_accel is not None
     controls = (-torque_accel, torque_accel) if smooth else (-1.0, 1.0)
     phase = col.Phase(rigid_body_dynamics(s.Jn, smooth), mesh, control=control,
-                      state_bounds=_state_bounds(problem, s, smooth),
-                      control_bounds=controls, path=path, path_bounds=(-np.inf, 0.0), name="slew",
-                      path_parameters=path_values(problem, s, 0.0))
+                      state_bounds=_state_bounds(problem, s, smooth), control_bounds=controls, path=path,
+                      path_bounds=(-np.inf, 0.0), path_weight=weight, name="slew", path_parameters=path_parameters)
     goal = goal_values(problem)
     tr = col.Transcription([phase], duration_copies=duration_copies, parametric=True, extra_parameters=len(goal))
     v = tr.variables(0)

@@ -26,13 +26,14 @@ with one torque per mesh interval (zero-order hold), so that the simulator repro
 with ``interpolation='zoh'`` and bang-bang switches land on mesh nodes.
 
 Solution process (Melton's two stages, with multi-start because the problem has many local
-minima): (1) cheap routes — eigenaxis both ways round, tilted two-leg routes and the cone-riding
-λ-rotation routes of :mod:`att_planner.methods.constrained_axis`, optional plans of other
-methods (:mod:`.routes`) — each turned into a continuous bang-bang guess and solved on a coarse
-mesh; (2) the best converged solution is refined: intervals where the torque switches or a zone
-constraint fails between collocation points are bisected and the NLP re-solved from the
-interpolated solution; (3) the torque is integrated
-through the truth dynamics (:mod:`att_planner.verification`); a failure refines again.
+minima; option ``global_stage``: his particle swarm, :mod:`.swarm`, as the first start): (1) cheap
+routes — eigenaxis both ways round, tilted two-leg routes and the cone-riding λ-rotation routes of
+:mod:`att_planner.methods.constrained_axis`, optional plans of other methods (:mod:`.routes`) —
+each turned into a continuous bang-bang guess and solved on a coarse mesh; (2) the best converged
+solution is refined: intervals where the torque switches or a zone constraint fails between
+collocation points are bisected and the NLP re-solved from the interpolated solution; (3) the
+torque is integrated through the truth dynamics (:mod:`att_planner.verification`); a failure
+refines again.
 """
 from __future__ import annotations
 
@@ -47,8 +48,9 @@ from att_planner.methods.axis_rotations import eigenaxis_leg, goal_attitude, no_
 from att_planner.methods.time_optimal import collocation as col
 from att_planner.methods.time_optimal.model import Scaling, plan_arrays, scaling, transcription
 from att_planner.methods.time_optimal.routes import Route, candidate_routes, route_guess, select_routes, zone_margin
+from att_planner.methods.time_optimal.swarm import swarm_plan
 from att_planner.problem import ManeuverProblem
-from att_planner.verification import integrate, measure, rejection
+from att_planner.verification import clearances, integrate, measure, rejection
 from att_sim import rotations as rot
 
 METHOD = "time_optimal"
@@ -190,10 +192,9 @@ class _Incumbent:
 
 
 def _truth_violation_intervals(traj, sol: col.PhaseSolution, s: Scaling, problem) -> np.ndarray:
-    """Mesh intervals containing dense truth samples with a negative zone margin (each zone at the
-    sample's time)."""
-    zones = problem.zone_sky()
-    m = zones.margins(np.minimum(traj.t, zones.window), traj.q)
+    """Mesh intervals containing dense truth samples below a zone's clearance floor
+    (:func:`att_planner.verification.clearances`: each zone at the sample's time)."""
+    m = clearances(problem, traj.t, traj.q, true=False)
     if not m.size:
         return np.array([], int)
     bad_t = traj.t[m.min(axis=1) < 0] / s.tu / sol.duration
@@ -283,7 +284,8 @@ def _verdict(plan: Plan, ok: bool, run: _Solve, incumbent: _Incumbent, best: str
 def plan_time_optimal(problem: ManeuverProblem, *, intervals: int = DEFAULT_INTERVALS, max_intervals: int | None = None,
                       starts: int = 3, refine_rounds: int = 3, interpolation: str = Interpolation.ZOH,
                       cone_margin_deg: float = 0.05, warm_starts: tuple = (),
-                      smooth_warm_start: bool = False, explore_tol: float = 1e-5, tol: float = 1e-7,
+                      smooth_warm_start: bool = False, global_stage: bool = False, explore_tol: float = 1e-5,
+                      tol: float = 1e-7,
                       max_iter: int = 400, verify_reserve: float = 1.0) -> Plan:
     """Minimum-time rest-to-rest slew with per-axis torque limits among the problem's zones.
 
@@ -296,6 +298,10 @@ def plan_time_optimal(problem: ManeuverProblem, *, intervals: int = DEFAULT_INTE
     ``warm_starts`` plans of other methods used as extra starting routes;
     ``smooth_warm_start`` adds the smooth Slepian plan (:func:`att_planner.methods.slepian.plan_slepian`,
     paper basis M = 4, at most a third of the remaining budget) to them;
+    ``global_stage`` runs Melton's first stage (:func:`.swarm.swarm_plan`: a particle swarm over a
+    Chebyshev torque parametrisation) and solves from its plan alone, the routes too only if that
+    start does not converge or ends slower than the bang-bang time of a route that clears every zone
+    (``stats['global_stage']``: its iterations, cost, t_f; its seconds under ``seconds``);
     ``explore_tol``/``tol`` IPOPT tolerances of the two stages; ``max_iter`` per solve;
     ``verify_reserve`` seconds kept before ``problem.deadline`` for the final verification.
     The bounds ``problem.rate_max`` and ``problem.wheel_momentum_max`` are imposed when finite.
@@ -312,10 +318,27 @@ def plan_time_optimal(problem: ManeuverProblem, *, intervals: int = DEFAULT_INTE
     routes = _routes(problem, s, starts, warm_starts, smooth_warm_start, seconds)
     run = _Solve(problem, s, np.deg2rad(cone_margin_deg), _tf_bounds(problem, s, routes), tol, max_iter,
                  max_intervals, None if problem.deadline is None else problem.deadline - verify_reserve, interpolation)
-    tr, solved, start_log = _explore(run, routes, intervals, explore_tol)
-    stats = {"starts": start_log, "time_unit": s.tu, "seconds": seconds}
+    stats = {"time_unit": s.tu, "seconds": seconds}
+    solved = []
+    if global_stage:         # Melton's two stages: the swarm's plan is the one start, the routes a fallback
+        lap = time.monotonic()
+        swarm = swarm_plan(problem, s, routes[0].tf_estimate)
+        seconds["global_stage"] = time.monotonic() - lap
+        stats["global_stage"] = {"iterations": swarm.nit, "evaluations": swarm.nfev, "cost": swarm.stats["cost"],
+                                 "tf": swarm.stats["tf"]}
+        tr, solved, start_log = _explore(run, [Route("swarm", plan=swarm, tf_estimate=swarm.duration / s.tu,
+                                                     min_margin=zone_margin(problem, swarm.t, swarm.q))],
+                                         intervals, explore_tol)
+    clear = [rt.tf_estimate for rt in routes if rt.min_margin >= 0]
+    if not solved or (clear and solved[0][0] > min(clear)):     # no swarm, or a start worse than a clear route
+        tr_routes, more, more_log = _explore(run, routes, intervals, explore_tol)
+        start_log = start_log + more_log if global_stage else more_log
+        if not solved or (more and more[0][0] < solved[0][0]):
+            tr, solved = tr_routes, more
+    stats["starts"] = start_log
     # the smooth warm start has its own entry
-    seconds["routes_and_starts"] = time.monotonic() - lap - seconds.get("smooth_warm_start", 0.0)
+    seconds["routes_and_starts"] = (time.monotonic() - lap - seconds.get("smooth_warm_start", 0.0)
+                                    - seconds.get("global_stage", 0.0))
     lap = time.monotonic()
     outcome = dict(method=METHOD, stats=stats)
     if not solved:

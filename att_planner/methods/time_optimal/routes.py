@@ -18,10 +18,11 @@ import numpy as np
 
 from att_msgs_py.types import Plan
 from att_planner.methods.axis_rotations import AxisLeg, axis_acceleration, eigenaxis_leg, goal_attitude
-from att_planner.methods.constrained_axis import cone_riding_legs
+from att_planner.methods.constrained_axis import boundary_arc_legs, cone_riding_legs
 from att_planner.methods.time_optimal import collocation as col
 from att_planner.methods.time_optimal.model import BOUND_MARGIN, Scaling
 from att_planner.problem import ManeuverProblem
+from att_planner.verification import clearances
 from att_sim import rotations as rot
 
 
@@ -140,13 +141,18 @@ def route_guess(problem, scaling, route: Route, phase: col.Phase) -> col.PhaseGu
 def candidate_routes(problem: ManeuverProblem, scaling: Scaling, tilt_deg: float = 45.0,
                      ride_margin_deg: float = 2.0) -> list[Route]:
     """Cheap, diverse routes: eigenaxis both ways, the eigenaxis midpoint tilted about two axes
-    perpendicular to it (±), and every cone-riding λ-rotation sequence. Each gets its bang-bang
-    duration estimate and its minimum cone margin.
+    perpendicular to it (±), every cone-riding λ-rotation sequence and, for a forced boundary arc,
+    the λ-rotations along it (:func:`~att_planner.methods.constrained_axis.boundary_arc_legs`).
+    Each gets its bang-bang duration estimate and its smallest zone clearance.
 
     With a semi-free target whose ``q_final`` also points the sensor at it, the routes to
     ``q_final`` are added (labelled "full goal"): every fully specified plan is feasible for the
     semi-free problem, so they seed the semi-free search with the fully specified optima."""
     routes = _goal_routes(problem, scaling, tilt_deg, ride_margin_deg)
+    if problem.boundary_cone is not None:
+        for side in (+1, -1):
+            routes.append(Route(f"boundary arc {'+' if side > 0 else '-'}", boundary_arc_legs(problem, side)))
+            _estimate(problem, scaling, routes[-1])
     if problem.sensor_target is not None:
         r = np.asarray(problem.sensor_axis, float)
         b = rot.dcm(rot.normalize(np.asarray(problem.q_final, float))) @ r
@@ -187,12 +193,12 @@ def _goal_routes(problem: ManeuverProblem, scaling: Scaling, tilt_deg: float,
 
 
 def _estimate(problem: ManeuverProblem, scaling: Scaling, route: Route, samples: int = 400) -> np.ndarray:
-    """Set the route's bang-bang duration (TU) and its smallest zone margin along it (every zone
-    at the time the route passes); returns the margins (samples, Z)."""
+    """Set the route's bang-bang duration (TU) and its smallest zone clearance along it (every zone
+    at the time the route passes, :func:`att_planner.verification.clearances`); returns the
+    clearances (samples, Z)."""
     tf, state, _ = _leg_route_functions(problem, scaling, route.legs)
     t = np.linspace(0.0, tf, samples)
-    zones = problem.zone_sky()
-    m = zones.margins(np.minimum(t * scaling.tu, zones.window), state(t)[:, :4])
+    m = clearances(problem, np.minimum(t * scaling.tu, problem.zone_sky().window), state(t)[:, :4], true=False)
     route.tf_estimate = tf
     route.min_margin = float(m.min()) if m.size else np.inf
     return m

@@ -14,8 +14,11 @@ settle), so anyone can recompute them from the log:
 "final_pointing_error_deg", "min_cone_margin_deg", "tracker_invalid_seconds", "tracker_sigma_arcsec",
 "success", "message", "truth_loop": {the same for the run on the truth}}``.
 
-``final_pointing_error_deg`` is the true attitude's angle to the goal at the end of the segment;
-``min_cone_margin_deg`` the smallest margin of the true attitude to the demo's cones and zones.
+``final_pointing_error_deg`` is the true attitude's angle to the goal at the end of the segment, and
+``final_pointing_sigmas`` that error against the star tracker's noise in body axes (``√(eᵀ R_B⁻¹ e)``,
+``R_B = C R_S Cᵀ`` through its mounting: "within 3σ" is ≤ 3); ``pointing_bound_deg`` is 3× the
+tracker's 1σ attitude error (root sum square of its three axes); ``min_cone_margin_deg`` the
+smallest margin of the true attitude to the demo's cones and zones.
 """
 from __future__ import annotations
 
@@ -37,7 +40,8 @@ from att_sim import rotations as rot
 from att_sim import scenario as scen
 
 FIGURES = ("attitude_error_rms_arcsec", "attitude_error_max_arcsec", "bias_error_final_deg_per_h", "nees_mean",
-           "final_pointing_error_deg", "min_cone_margin_deg", "tracker_invalid_seconds")
+           "final_pointing_error_deg", "final_pointing_sigmas", "pointing_bound_deg", "min_cone_margin_deg",
+           "tracker_invalid_seconds")
 
 
 def configure(parser):
@@ -73,8 +77,15 @@ def figures(mcap: Path, scenario: scen.Scenario, maneuver: dict) -> dict:
     summary = estimation_summary(estimation)
     _, margins = zone_margins(scenario, maneuver, run.t0 + run.t, run.q)
     tracker = scenario.sensors.star_trackers[0] if scenario.sensors.star_trackers else None
+    error = 2 * rot.error_vector(run.q[-1], maneuver["qf"])            # goal -> truth, body axes
+    pointing = {}
+    if tracker is not None:
+        C = rot.dcm(tracker.mounting)
+        pointing = {"final_pointing_sigmas": float(np.sqrt(error @ np.linalg.solve(C @ tracker.covariance @ C.T,
+                                                                                    error))),
+                    "pointing_bound_deg": float(np.degrees(3 * np.sqrt(np.trace(tracker.covariance))))}
     return {"mcap": str(mcap), "estimate_topic": ESTIMATE, "truth_topic": STATE,
-            **{k: summary[k] for k in FIGURES if k in summary}, "nees_dof": summary["nees_dof"],
+            **{k: summary[k] for k in FIGURES if k in summary}, "nees_dof": summary["nees_dof"], **pointing,
             "final_pointing_error_deg": float(np.degrees(rot.angle_between(run.q[-1], maneuver["qf"]))),
             "min_cone_margin_deg": float(np.degrees(margins.min())) if margins.size else math.inf,
             "segment_s": [t0, t1], "health_seconds": summary["health_seconds"],
@@ -91,6 +102,6 @@ def run(args) -> dict:
     print(f"\nestimation: {scenario.name} demo maneuver, closed loop ({platform.node()}, {platform.processor() or ''})")
     print(f"{'figure':<32} {'on the estimate':>16} {'on the truth':>14}")
     for key in FIGURES:
-        print(f"{key:<32} {estimate[key]:>16.4g} {truth[key]:>14.4g}")
+        print(f"{key:<32} {estimate.get(key, math.nan):>16.4g} {truth.get(key, math.nan):>14.4g}")
     print(f"{'success':<32} {estimate['success']!s:>16} {truth['success']!s:>14}")
     return {**estimate, "truth_loop": truth}

@@ -1,5 +1,8 @@
 """Time-optimal keep-out slews (issue 4): eigenaxis, constrained axis and collocation compared.
 
+``att-bench time-optimal --case {ba1,ba2,bp1,bp2} [--sweep]`` runs Melton's boundary cases instead
+(issue 19, :mod:`.boundary`).
+
 ``att-bench time-optimal --case {bilimoria_wie,swift} [--method M] [--budget S] --json PATH`` runs
 every method on the case, re-verifies each plan from rest at identity through the truth dynamics
 (:func:`att_planner.verification.verify`, the suite's one verification and tolerances), prints a
@@ -16,7 +19,8 @@ import numpy as np
 from att_planner.methods.constrained_axis import plan_constrained_axis
 from att_planner.methods.eigenaxis import plan_eigenaxis
 from att_planner.methods.time_optimal import plan_time_optimal
-from att_planner.reference.time_optimal_cases import CASES, PUBLISHED, case_problem
+from att_planner.reference.time_optimal_cases import BOUNDARY_CASES, CASES, PUBLISHED, case_problem
+from att_planner.tools.bench import boundary
 from att_planner.verification import rejection, verify
 from att_sim import rotations as rot
 
@@ -28,11 +32,14 @@ TUNABLE = {"time_optimal": ("starts",)}
 def configure(parser):
     parser.add_argument("--case", choices=CASES, required=True)
     parser.add_argument("--method", choices=list(METHODS), default="time_optimal",
-                        help="method whose plan goes to the JSON (all are run and tabulated)")
+                        help="method whose plan goes to the JSON (all are run and tabulated; the boundary "
+                             "cases write time_optimal's)")
     parser.add_argument("--budget", type=float, default=10.0,
                         help="time budget per method, seconds (problem.deadline)")
     parser.add_argument("--starts", type=int, default=6,
                         help="number of cheap routes time_optimal solves (all are listed)")
+    parser.add_argument("--sweep", action="store_true",
+                        help="boundary cases: BA, BP and the lambda-rotation over orientations of the cone axis")
 
 
 def _verification(problem, plan) -> dict:
@@ -74,6 +81,10 @@ def _print_table(args, rows, semi) -> None:
 
 
 def run(args) -> dict:
+    if args.case in BOUNDARY_CASES:
+        return boundary.run(args)
+    if args.sweep:
+        raise SystemExit(f"att-bench time-optimal: --sweep is for the boundary cases ({', '.join(BOUNDARY_CASES)})")
     rows, payloads = [], {}
     for name, method in METHODS.items():
         problem = replace(case_problem(args.case), deadline=time.monotonic() + args.budget)

@@ -159,7 +159,8 @@ def test_a_complete_file_is_copied_without_loss_and_reported_complete(finished, 
     path, original = finished
     out = tmp_path / "copy.mcap"
     assert att_log(["repair", str(path), "-o", str(out)]) == 0
-    assert "was complete and indexed: copied 400 messages on 5 topics" in capsys.readouterr().out
+    topics = len(recorded_topics())
+    assert f"was complete and indexed: copied 400 messages on {topics} topics" in capsys.readouterr().out
     assert records_of(out) == original
     source, copy = Scan(path, 0), Scan(out, 0)
     list(scan_records(path, source))

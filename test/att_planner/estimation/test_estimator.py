@@ -4,6 +4,7 @@ its code while the filter carries on."""
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -255,3 +256,18 @@ def test_a_second_publisher_of_an_input_is_refused_while_the_first_is_alive():
     sources.admit("gyro sample", b"b", 1.6)                          # the first fell silent: the newcomer takes over
     with pytest.raises(RequestError):
         sources.admit("gyro sample", b"a", 1.7)
+
+
+def test_a_covariance_that_stops_being_positive_definite_loses_the_estimate_which_reinitialises():
+    est = estimator()
+    est.on_star_tracker(tracker(0.0, Q))
+    est.on_gyro(gyro(0.0))
+    t, x = est.snapshots[-1]
+    broken = np.array(x.P)
+    broken[0, 0] = -1e-6                                             # e.g. rounding gone wrong
+    est.snapshots[-1] = (t, replace(x, P=broken))
+    e = est.on_gyro(gyro(0.05))
+    assert e.health == Health.DIVERGED and any("positive definite" in n for n in est.take_report().notes)
+    assert np.allclose(e.attitude_covariance, np.eye(3) * math.pi**2)   # published as lost, not as known
+    est.on_star_tracker(tracker(0.1, Q))
+    assert est.on_gyro(gyro(0.1)).health == Health.CONVERGED

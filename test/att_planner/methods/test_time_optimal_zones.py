@@ -14,6 +14,7 @@ from att_msgs_py.types import Status, Zone
 from att_planner.methods.time_optimal import plan_time_optimal
 from att_planner.methods.time_optimal.model import (
     ZONE_PARAMETERS,
+    boundary_case,
     motion_parameters,
     path_function,
     path_values,
@@ -92,6 +93,7 @@ def test_zone_constraints_are_exact_functions_of_time():
     problem = _sweep_problem()
     s = scaling(problem)
     margin = np.deg2rad(0.05)
+    assert not boundary_case(problem, margin)               # no end on a boundary: no end ramp
     path, degree = path_function(problem, s, 7, margin)
     assert degree is not None and path.n_in() == 4          # (x, u, t, p): the series' coefficients are parameters
     values = path_values(problem, s, margin)

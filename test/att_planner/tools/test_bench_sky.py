@@ -1,9 +1,9 @@
 """``att-bench sky`` (issue 13): an INDEPENDENT check of the committed benchmarks/sky_<case>.json,
 and the study's plumbing on a cheap method.
 
-The check uses nothing of the suite (:mod:`helpers.independent`): it integrates each plan's ZOH
-body torque from rest at ``q_initial`` with its own RK4 of the rigid body (4 steps per ZOH interval)
-and computes the zones' true directions with skyfield directly (the JSON's TLE, DE421 from
+The check uses nothing of the suite: it integrates each plan's ZOH body torque from rest at
+``q_initial`` with its own RK4 of the rigid body (:mod:`helpers.own_rk4`), and computes the zones'
+true directions with skyfield directly (:mod:`helpers.independent`: the JSON's TLE, DE421 from
 skyfield-data, the Earth limb about −r̂). It then confirms, to 0.01°: the torque reproduces each
 plan (final attitude, the JSON's margins), the frozen plan enters a zone, the moving one does not.
 ``ATT_SKY_BENCHMARKS=DIR`` checks the sky_<case>.json of another directory (a fresh ``att-bench sky
@@ -19,11 +19,13 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from helpers.independent import integrate, margins, sky
+from helpers.independent import margins, sky
+from helpers.own_rk4 import integrate
 
 BENCHMARKS = Path(os.environ.get("ATT_SKY_BENCHMARKS", Path(__file__).resolve().parents[3] / "benchmarks"))
 CASES = ("leo_observatory", "moon_parallax")
 TOL = math.radians(0.01)
+SUBSTEPS = 4                  # RK4 steps per ZOH interval (500 intervals: 2000 steps); the sky at the knots
 
 
 @pytest.fixture(scope="module", params=CASES)
@@ -34,7 +36,7 @@ def checked(request):
     for kind, plan in payload["plans"].items():
         assert plan["t"], f"{request.param}: no {kind} plan in the JSON ({plan['message']})"
         t = np.asarray(plan["t"], float)
-        states = integrate(payload["J"], t, plan["torque"], payload["q_initial"])
+        states = integrate(payload["J"], t, plan["torque"], payload["q_initial"], SUBSTEPS)
         out[kind] = (t, states, margins(payload, t, states[:, :4]))
     return payload, out
 

@@ -4,8 +4,8 @@ study's plumbing on one quick run.
 For every case and every plan of the JSON (the first, the best smooth and the time-optimal one) the
 check flies the torque samples from rest at ``q_initial`` with its own RK4 of the rigid body (8
 steps per knot interval, the samples held or interpolated linearly as the plan's ``interpolation``
-says) and the zones' true directions from skyfield (:mod:`helpers.independent`: nothing of the
-suite), then confirms: the final attitude error and every zone's smallest margin are the JSON's
+says, :mod:`helpers.own_rk4`) and the zones' true directions from skyfield (:mod:`helpers.independent`:
+nothing of the suite), then confirms: the final attitude error and every zone's smallest margin are the JSON's
 (to 0.01°), the plan reaches the goal (0.5°, 1e-3 rad/s) and stays clear, the torque keeps its
 limit and the smooth plans' torque vanishes at both ends; the best smooth plan is within 1.25 × the
 time-optimal t_f. ``ATT_SPEED_BENCHMARKS=DIR`` checks the speed.json of another directory.
@@ -20,7 +20,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from helpers.independent import attitude_error, integrate, margins
+from helpers.independent import attitude_error, margins
+from helpers.own_rk4 import integrate
 
 BENCHMARKS = Path(os.environ.get("ATT_SPEED_BENCHMARKS", Path(__file__).resolve().parents[3] / "benchmarks"))
 KINDS = ("first", "best", "time_optimal")
@@ -36,7 +37,7 @@ def flown():
         for kind in KINDS:
             plan = case[kind]
             t, states = integrate(case["J"], np.asarray(plan["t"], float), plan["torque"], case["q_initial"],
-                                  plan["interpolation"], substeps=8, dense=True)
+                                  substeps=8, dense=True, interpolation=plan["interpolation"])
             out[case["case"], kind] = (t, states, margins(case, t, states[:, :4]))
     return payload, out
 

@@ -46,7 +46,8 @@ def test_summary_of_the_fixture_matches_independent_figures(log):
     assert s["final_attitude_error_deg"] == pytest.approx(math.degrees(rot.angle_between(state["attitude"][-1], GOAL)))
     assert s["final_attitude_error_deg"] < 0.1
     cones = [Cone(c["direction"], c["half_angle"], c["name"]) for c in plans["cones"][0]]
-    m = np.degrees(margins(state["attitude"], [1, 0, 0], cones).min(axis=0))
+    segment = state["header.stamp"] >= s["start_sim_time_s"] - 1e-9         # the reviewed segment's states
+    m = np.degrees(margins(state["attitude"][segment], [1, 0, 0], cones).min(axis=0))
     assert s["min_margin_deg"] == pytest.approx(dict(zip(["sun", "earth", "moon"], m)), abs=1e-9)
     assert 10 < s["min_margin_deg"]["moon"] < 20 and s["min_cone_margin_deg"] == pytest.approx(m.min())
     assert s["closest_approach_s"]["moon"] > 0.8 * s["maneuver_time_s"]     # the path ends nearest the Moon
@@ -158,7 +159,8 @@ def test_review_cli_writes_figures_html_and_summary(tmp_path, capsys):
         png = (tmp_path / f"{name}.png").read_bytes()
         assert png[:8] == b"\x89PNG\r\n\x1a\n" and len(png) > 20_000
     page = (tmp_path / "index.html").read_text()
-    assert page.count("data:image/png;base64,") == 3 and "final attitude error" in page
+    assert page.count("data:image/png;base64,") == 4 and "final attitude error" in page   # estimation.png too
+    assert "estimation error" in page
     assert page.count('<p class="note">') == 2 and "&quot;executed&quot; is the whole reviewed segment" in page
     assert "planning limit torque_max = 0.1 N m" in page and "note:" not in page
     summary = json.loads((tmp_path / "summary.json").read_text())
