@@ -18,9 +18,10 @@ so for a zone axis a::
 whose extremes over [0, φ] are at the ends or at ϑ* = atan2(B, A) (the maximum ``(n·b)(n·a) + √(A²+B²)``)
 and ϑ* + π (the minimum), in closed form (:func:`arc_cosines`). Every zone of every sensor is
 checked on every leg with :data:`EDGE_MARGIN` (each sensor's direction follows from the attitude
-the leg starts from). A zone that moves is checked as the cap about its axis at mid-leg, widened
-by how far its axis turns and its half-angle grows within the leg's time window (sampled at
-:data:`SWEEP_SAMPLES` times, plus the largest step between samples).
+the leg starts from), but a leg from the start or to the goal only with −BOUNDARY_TOLERANCE from a
+zone that end lies on (issue 19: an end on a boundary). A zone that moves is checked in
+:data:`PIECES` time pieces of the leg, each as the cap about its axis at mid-piece widened by how
+far it can move in half a piece (its largest speed over the window).
 
 **Search.** Dijkstra on the arrival time: a node keeps the attitude and time of its first arrival,
 so the duration of every leg leaving it, and the time window of its moving-zone check, are exact.
@@ -41,6 +42,7 @@ import time
 import numpy as np
 
 from att_msgs_py.types import Interpolation, Plan, Status
+from att_planner.cones import BOUNDARY_TOLERANCE, boundary_end_zones
 from att_planner.methods.axis_rotations import eigenaxis_leg, no_torque_limit
 from att_planner.problem import ManeuverProblem
 from att_sim import rotations as rot
@@ -101,6 +103,7 @@ class _Zones:
         r = np.asarray(problem.sensor_axis, float) / np.linalg.norm(problem.sensor_axis)
         self.main = np.array([np.allclose(s, r, atol=1e-12) for s in self.sensors], bool)
         self.axes, self.half = self.sky.at(0.0)
+        self.ends = boundary_end_zones(problem, EDGE_MARGIN)      # zones an end lies (nearly) on
         self.speed = np.zeros(len(self.sensors))
         if self.moving.any():
             t = np.linspace(0.0, self.sky.window, SPEED_SAMPLES)
@@ -109,20 +112,22 @@ class _Zones:
             self.speed = 1.05 * (np.linalg.norm(a_dot, axis=-1) + np.abs(th_dot)).max(axis=0)
 
     @staticmethod
-    def _ok(low, high, keep_in, half):
+    def _ok(low, high, keep_in, half, margin):
         with np.errstate(invalid="ignore"):       # NaN (beyond the zones' window) is never clear
-            return np.where(keep_in, low >= np.cos(np.maximum(half - EDGE_MARGIN, 0.0)),
-                            high <= np.cos(half + EDGE_MARGIN))
+            return np.where(keep_in, low >= np.cos(np.maximum(half - margin, 0.0)), high <= np.cos(half + margin))
 
-    def clear(self, q: np.ndarray, n: np.ndarray, phi: np.ndarray, t0: float, durations: np.ndarray) -> np.ndarray:
+    def clear(self, q: np.ndarray, n: np.ndarray, phi: np.ndarray, t0: float, durations: np.ndarray,
+              ending: np.ndarray) -> np.ndarray:
         """Which legs (rotations about ``n`` (E, 3) by ``phi`` (E,) from attitude ``q``, leaving at
-        ``t0`` for ``durations``) keep every sensor clear of every zone by :data:`EDGE_MARGIN`."""
+        ``t0`` for ``durations``) keep every sensor clear of every zone by :data:`EDGE_MARGIN`; a leg
+        from the start or to the goal (``ending``) only −BOUNDARY_TOLERANCE from a zone an end lies on."""
         ok = np.ones(len(phi), bool)
+        margin = np.where(ending[:, None] & self.ends[None], -BOUNDARY_TOLERANCE, EDGE_MARGIN)    # (E, Z)
         b = rot.dcm(q) @ self.sensors.T                                   # (3, Z) sensor directions at q
         fixed = ~self.moving
         if fixed.any():
             low, high = arc_cosines(b.T[fixed][None], n[:, None], phi[:, None], self.axes[fixed])
-            ok &= self._ok(low, high, self.keep_in[fixed], self.half[fixed]).all(axis=1)
+            ok &= self._ok(low, high, self.keep_in[fixed], self.half[fixed], margin[:, fixed]).all(axis=1)
         if self.moving.any():
             m = self.moving
             angles = phi[:, None] * _PIECE_ANGLES[None]                      # (E, PIECES + 1)
@@ -134,7 +139,7 @@ class _Zones:
             half = np.where(self.keep_in[m], half[..., m] - widen, half[..., m] + widen)
             half[beyond] = np.nan
             low, high = arc_cosines(start, n[:, None, None], np.diff(angles, axis=1)[..., None], axes[..., m, :])
-            ok &= self._ok(low, high, self.keep_in[m], half).all(axis=(1, 2))
+            ok &= self._ok(low, high, self.keep_in[m], half, margin[:, None, m]).all(axis=(1, 2))
         return ok
 
 
@@ -250,7 +255,8 @@ def search(problem: ManeuverProblem, zones: _Zones, q0: np.ndarray, q_goal: np.n
         keep = ~settled[targets]
         targets, n, phi = targets[keep], n[keep], phi[keep]
         T = leg_durations(problem, attitude[u], n, phi)
-        ok = zones.clear(attitude[u], n, phi, arrival[u], T) & (arrival[u] + T < arrival[targets])
+        ending = (u == 0) | (targets == end) | (targets == 1)
+        ok = zones.clear(attitude[u], n, phi, arrival[u], T, ending) & (arrival[u] + T < arrival[targets])
         if not ok.any():
             continue
         targets, n, phi, T = targets[ok], n[ok], phi[ok], T[ok]

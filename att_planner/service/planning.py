@@ -4,9 +4,9 @@
 (:data:`FIRST_METHOD`, tens of milliseconds), then the requested method seeded with it as long as
 the budget allows, then, if neither verified, the smooth eigenaxis slew. Each plan is integrated
 through the truth dynamics (:mod:`att_planner.verification`) and accepted only if it meets the
-tolerances; the quickest accepted plan is returned (the first plan with status BUDGET_EXPIRED when
-the budget left the method no time or ran out in it, FALLBACK when the method failed), the eigenaxis
-slew with status FALLBACK when only it verifies; otherwise the answer is an error. No unverified
+tolerances; the method's accepted plan is returned, else the first plan (status BUDGET_EXPIRED
+when the budget left the method no time or ran out in it, FALLBACK when the method failed), else
+the eigenaxis slew with status FALLBACK when only it verifies; otherwise the answer is an error. No unverified
 plan ever leaves, and the outcome reports every stage and its time. Zones (issue 13) travel in the
 problem: the method plans against their motion (:meth:`ManeuverProblem.zone_sky`), padded like the
 cones (:func:`padded`), and every plan, the fallback's too, is verified against the unpadded zones
@@ -202,14 +202,11 @@ def _run_stage(name: Stage, method: Method, problem: ManeuverProblem, options: d
 def _first_plan_answer(first: _Stage, method: _Stage | None, valid: ValidRequest) -> tuple[Status, str]:
     """Status and message of the first plan returned instead of the method's: BUDGET_EXPIRED when the
     budget left no time for the method (or ran out in it), FALLBACK when the method failed or its plan
-    was rejected, the first plan's own when the method's verified plan was not quicker."""
+    was rejected."""
     note = f"returning the first plan ({first.plan.message})"
     if method is None:
         return Status.BUDGET_EXPIRED, (f"time budget of {valid.time_budget:g} s: no time left for {valid.method.name} "
                                        f"after the first plan; {note}")
-    if method.report.verified:
-        return first.plan.status, (f"{valid.method.name} plan (t_f = {method.plan.duration:.6g} s) is not quicker "
-                                   f"than the first plan; {note}")
     status = Status.BUDGET_EXPIRED if method.plan.status == Status.BUDGET_EXPIRED else Status.FALLBACK
     return status, f"{method.reason}; {note}"
 
@@ -217,7 +214,8 @@ def _first_plan_answer(first: _Stage, method: _Stage | None, valid: ValidRequest
 def plan_maneuver(valid: ValidRequest, tol: Tolerances = TOLERANCES, cone_padding: float = 0.0,
                   runner: Callable = run_method) -> PlanOutcome:
     """Plan in stages with zones padded by ``cone_padding`` rad, verify against the requested zones,
-    answer with the quickest verified plan, or the eigenaxis fallback when that is safe.
+    answer with the method's verified plan, else the first plan, else the eigenaxis fallback when that
+    is safe.
 
     1. *first*: :data:`FIRST_METHOD`'s constructive plan, in-process (not for a cheap method, which
        is answered at once): the quick answer, and the seed of the method. When it finds no plan
@@ -262,7 +260,7 @@ def plan_maneuver(valid: ValidRequest, tol: Tolerances = TOLERANCES, cone_paddin
             Stage.METHOD, valid.method.name, 0.0, message=f"not run: {wait:.3f} s left of its deadline after the "
                                                            f"first plan (at least {MIN_METHOD_SECONDS:g} s needed)")))
     reports = [s.report for s in done]
-    if method is not None and method.report.verified and (first is None or method.plan.duration <= first.plan.duration):
+    if method is not None and method.report.verified:
         return PlanOutcome(ErrorCode.OK, method.plan.message or method.plan.status, method.plan, Stage.METHOD, reports)
     if first is not None:
         first.plan.status, first.plan.message = _first_plan_answer(first, method, valid)

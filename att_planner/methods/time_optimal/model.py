@@ -2,13 +2,14 @@
 normalisation, the CasADi rigid-body model, path constraints and the Hermite–Simpson transcription."""
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 
 import casadi as ca
 import numpy as np
 
-from att_planner.cones import ARC_TOLERANCE, BOUNDARY_TOLERANCE, boundary_end_zones, end_ramp
+from att_planner.cones import ARC_TOLERANCE, BOUNDARY_TOLERANCE, END_RAMP, SMOOTH_END_RAMP, boundary_end_zones, end_ramp
 from att_planner.methods import symbolic
 from att_planner.methods.axis_rotations import time_unit
 from att_planner.methods.time_optimal import collocation as col
@@ -175,7 +176,8 @@ def _end_bounds(smooth: bool):
     return [-1.1] * 4 + [0.0] * rest, [1.1] * 4 + [0.0] * rest
 
 
-def weighted_path_function(problem: ManeuverProblem, s: Scaling, cone_margin: float, n_state: int = 7):
+def weighted_path_function(problem: ManeuverProblem, s: Scaling, cone_margin: float, n_state: int = 7,
+                           ramp: float = END_RAMP):
     """The path constraints of a problem with a boundary end or a forced boundary arc
     (:func:`boundary_case`): ``g ≤ 0`` (zones, wheel momentum) and the weight function of the phase
     (:class:`~.collocation.Phase` ``path_weight``), or None when there are none; ``x`` has
@@ -185,7 +187,8 @@ def weighted_path_function(problem: ManeuverProblem, s: Scaling, cone_margin: fl
     with its own sensor axis ``s_z``, ``b_z = R(q) s_z``) is tightened by ``δ = cone_margin``: keep-out
     ``a_z · b_z ≤ cos(θ_z + δ)``, keep-in ``a_z · b_z ≥ cos(θ_z − δ)``. A zone with an end on its
     boundary (:func:`att_planner.cones.boundary_end_zones`) is tightened by ``−tol + (δ + tol) w(τ)``
-    instead, ``w`` the end ramp (:func:`att_planner.cones.end_ramp`, the path's last input). The
+    instead, ``w`` the end ramp (:func:`att_planner.cones.end_ramp` over ``ramp`` of the maneuver,
+    the path's last input: a smooth plan leaves its ends more slowly than a bang-bang one). The
     forced boundary arc's cone is the band ``0 ≤ margin ≤ ε`` (:data:`ARC_BAND`): ``a · b ≤ cos θ`` and
     ``a · b ≥ cos(θ + ε)`` (an equality there would repeat the fixed start and the final pointing,
     which IPOPT cannot solve: rank-deficient constraints). When a zone moves,
@@ -213,7 +216,7 @@ def weighted_path_function(problem: ManeuverProblem, s: Scaling, cone_margin: fl
     if not g:
         return None
     inputs = [x, u] + ([t] if zones.moving else []) + ([w] if ramped.any() else [])
-    weight = end_ramp if ramped.any() else None
+    weight = functools.partial(end_ramp, length=ramp) if ramped.any() else None
     return ca.Function("path", inputs, [ca.vertcat(*g)]), weight
 
 
@@ -243,7 +246,8 @@ def transcription(problem: ManeuverProblem, s: Scaling, mesh: np.ndarray, contro
     zones = problem.zone_sky()
     options = dict(tol=tol, max_iter=max_iter, nlpsol_options={"expand": expand})
     if boundary_case(problem, cone_margin):            # its path constraints are built for it alone
-        path, weight = weighted_path_function(problem, s, cone_margin, 13 if smooth else 7) or (None, None)
+        path, weight = weighted_path_function(problem, s, cone_margin, 13 if smooth else 7,
+                                              SMOOTH_END_RAMP if smooth else END_RAMP) or (None, None)
         tr = _build(problem, s, mesh, control, path, torque_accel, not zones.moving, weight).build(**options)
         return _start(tr.copy(mesh, extra_values=goal_values(problem)), problem, smooth, tf_bounds)
     path, degree = path_function(problem, s, 13 if smooth else 7, cone_margin)
