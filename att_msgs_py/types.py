@@ -36,6 +36,7 @@ class ControlMode(IntEnum):
     MAGNETORQUER_PD = 1
     PLAN_TRACKING = 2
     SAFE = 3
+    POINTING = 4                       # a guidance law (PointingMode) tracked through the wheels
 
 
 CONTROL_MODES = tuple(int(m) for m in ControlMode)   # the values a command or set_mode may carry
@@ -265,6 +266,11 @@ class ControllerStatus:
     state_stale: bool = False
     message: str = ""
     frame_id: str = ""
+    guidance: str = ""                                  # the pointing mode's kind (POINTING)
+    reference_q: np.ndarray = _empty(4)                 # tracked attitude now (zero: none)
+    reference_rate: np.ndarray = _empty(3)              # rad/s, reference axes
+    attitude_error: float = math.nan                    # rad, from the reference
+    dumping: bool = False
 
 
 @dataclass
@@ -391,3 +397,28 @@ class AttitudeEstimate:
     message: str = ""
     frame_id: str = ""
     body_frame_id: str = ""
+
+
+# ---------------------------------------------------------------------------------------------
+# Pointing modes (issue 15)
+# ---------------------------------------------------------------------------------------------
+
+POINTING_KINDS = ("inertial", "nadir", "sun", "ground", "inertial_target")
+SECONDARY_KINDS = ("velocity", "orbit_normal", "sun", "nadir", "north", "inertial")
+
+
+@dataclass
+class PointingMode:
+    """A pointing mode (``att_msgs/PointingMode``): see the message for the fields' meaning."""
+
+    kind: str
+    attitude: np.ndarray = _empty(4)           # inertial: all zero = the current attitude
+    primary_axis: np.ndarray = field(default_factory=lambda: np.array([0.0, 0.0, 1.0]))
+    secondary_axis: np.ndarray = field(default_factory=lambda: np.array([1.0, 0.0, 0.0]))
+    secondary: str = "velocity"
+    secondary_direction: np.ndarray = _empty(3)
+    yaw: float = 0.0
+    latitude: float = 0.0
+    longitude: float = 0.0
+    altitude: float = 0.0
+    target_direction: np.ndarray = _empty(3)
