@@ -25,6 +25,7 @@ from att_msgs.msg import (
     ControllerStatus,
     KeepOutCone,
     ManeuverPlan,
+    PlanStage,
     PlanVerification,
     PointingMode,
     SensorTruth,
@@ -238,6 +239,17 @@ def plan_from_msg(msg) -> types.Plan:
         signature=bytes(getattr(msg, "signature", b"")),
         epoch=from_epoch(msg.epoch) if hasattr(msg, "epoch") else None,
         zones=[zone_from_msg(z) for z in getattr(msg, "zones", [])])
+
+
+def stage_msg(stage: types.StageReport) -> PlanStage:
+    return PlanStage(name=str(stage.name), method=stage.method, seconds=float(stage.seconds), status=str(stage.status),
+                     verified=bool(stage.verified), duration=float(stage.duration), message=stage.message)
+
+
+def stage_from_msg(msg) -> types.StageReport:
+    """The stage of a message (``name`` and ``status`` the strings sent)."""
+    return types.StageReport(name=msg.name, method=msg.method, seconds=float(msg.seconds), status=msg.status,
+                             verified=bool(msg.verified), duration=float(msg.duration), message=msg.message)
 
 
 # -- the ExecuteManeuver action -----------------------------------------------------------------

@@ -6,7 +6,7 @@ messages and back. Conventions (the whole suite): SI units, quaternions ``[x, y,
 (body-to-inertial), body rates in body axes.
 
 The vocabularies (:class:`Status`, :class:`ControlMode`, :class:`ControlKind`,
-:class:`Interpolation`) are written here once; the constants of the .msg files carry the same
+:class:`Interpolation`, :class:`Stage`) are written here once; the constants of the .msg files carry the same
 values, which a test checks.
 """
 from __future__ import annotations
@@ -128,6 +128,28 @@ class Verification:
     zone_names: list = field(default_factory=list)                # name per entry of cone_margins
     zone_keep_in: list = field(default_factory=list)              # keep-in flag per entry of cone_margins
     boundary_arc: str = ""             # name of the cone a forced boundary arc rides ('' : none)
+
+
+class Stage(StrEnum):
+    """The stages of a maneuver answer: ``att_msgs/PlanStage.STAGE_*``."""
+
+    FIRST = "first"              # the constructive first plan
+    METHOD = "method"            # the requested method, seeded with the first plan
+    FALLBACK = "fallback"        # the eigenaxis slew
+
+
+@dataclass
+class StageReport:
+    """One stage of a maneuver answer (``att_msgs/PlanStage``): which method ran, how long it and
+    the verification of its plan took, how it ended."""
+
+    name: Stage
+    method: str
+    seconds: float
+    status: str = ""                   # the method's Status ("" when it did not run)
+    verified: bool = False
+    duration: float = math.nan         # s, t_f of its plan
+    message: str = ""
 
 
 @dataclass(frozen=True)
