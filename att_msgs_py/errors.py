@@ -30,9 +30,11 @@ class ErrorCode(IntEnum):
     INVALID_ZONE = 153            # an unknown body, a bad sensor axis, half-angle or direction of a zone
     ZONE_AT_END = 154             # the start or goal violates a zone (keep-out entered / keep-in left)
     CONTRADICTORY_ZONES = 155     # zones no direction can satisfy together (e.g. keep-in inside keep-out)
+    INVALID_WHEEL_SPEEDS = 160    # wheel_speeds of the wrong length, not finite, or beyond the wheels' limit
     # planner: solving
     SOLVER_FAILED = 200           # the method failed and no fallback plan was possible
     VERIFICATION_FAILED = 201     # the plan did not survive integration through the dynamics
+    WHEEL_SATURATION = 202        # no slower plan keeps every wheel within its speed limit
     # controller
     UNKNOWN_PLAN = 300
     INVALID_PLAN = 301

@@ -51,6 +51,8 @@ class ManeuverProblem:
       ``epoch``: the UTC instant of t = 0; ``sky``: the sky seen from the spacecraft
       (:class:`att_sim.ephemeris.Sky`, needed by sun, moon and earth_limb zones).
       :meth:`zone_sky` joins them: what every method and the verification use.
+    * ``wheel_speeds``: the wheels' speeds at the start; the verification follows them along the plan
+      (:func:`att_planner.verification.wheel_speeds_along`) against ``wheel_speed_max``.
     * ``boundary_cone``: index of the cone whose boundary the sensor rides for the whole maneuver
       (a forced boundary arc, Melton 2012's BA cases; :func:`att_planner.cones.boundary_arc_issue`);
       None: the sensor may go anywhere outside the cones.
@@ -70,6 +72,7 @@ class ManeuverProblem:
     epoch: datetime | None = None
     sky: Sky | None = None
     boundary_cone: int | None = None
+    wheel_speeds: np.ndarray | None = None      # rad/s relative to the body at the start (at rest); None: stopped
     # caches keyed by the values they depend on, so ``dataclasses.replace`` copies share them
     _zone_skies: dict = field(default_factory=dict, repr=False, compare=False)
     _default_window: tuple = field(default=(), repr=False, compare=False)

@@ -48,9 +48,12 @@ TOLERANCES = Tolerances()
 
 
 def integrate(problem: ManeuverProblem, plan: Plan, steps: int = VERIFY_STEPS) -> dyn.Trajectory:
-    """The plan's controls integrated from the problem's start (at rest, wheels stopped)."""
+    """The plan's controls integrated from the problem's start at rest: a wheel-torque plan from the
+    problem's wheel speeds, a body-torque plan with the wheels stopped (the rigid body it was planned
+    for; :func:`wheel_speeds_along` gives the wheels that produce its torque)."""
     sc = problem.spacecraft
-    x0 = dyn.initial_state(sc, problem.q_initial)
+    wheels = plan.control_kind == ControlKind.WHEEL_TORQUE and problem.wheel_speeds is not None
+    x0 = dyn.initial_state(sc, problem.q_initial, wheel_speed=problem.wheel_speeds if wheels else None)
     return dyn.simulate_profile(sc, x0, plan.t, plan.torque, kind=str(plan.control_kind),
                                 interpolation=str(plan.interpolation),
                                 max_step=max(plan.duration, 1e-9) / steps)
@@ -103,7 +106,7 @@ def measure(problem: ManeuverProblem, plan: Plan, traj: dyn.Trajectory) -> Verif
         min_cone_margin=float(m.min()) if m.size else math.inf,
         cone_margins=[float(v) for v in m.min(axis=0)] if m.size else [],
         torque_ratio=_ratio(peak_magnitude(applied), limit),
-        wheel_speed_ratio=_ratio(peak_magnitude(_relative_wheel_speeds(sc, traj)), sc.wheel_speed_max),
+        wheel_speed_ratio=_ratio(peak_magnitude(wheel_speeds_along(problem, plan, traj)), sc.wheel_speed_max),
         rate_max=float(np.linalg.norm(traj.omega, axis=1).max()),
         dense_samples=len(traj.t),
         duration=plan.duration,
@@ -172,7 +175,35 @@ def _wheel_momentum(sc: dyn.Spacecraft, traj: dyn.Trajectory, wheels: bool) -> n
     return traj.omega @ (sc.wheel_axes_pinv @ sc.inertia).T
 
 
-def _relative_wheel_speeds(sc: dyn.Spacecraft, traj: dyn.Trajectory) -> np.ndarray:
+def wheel_speeds_along(problem: ManeuverProblem, plan: Plan, traj: dyn.Trajectory) -> np.ndarray:
     """The wheels' speeds relative to the body along the trajectory, ``Ω − Gᵀω`` (K, N): what the
-    truth model limits (:func:`att_sim.dynamics.relative_wheel_speed`)."""
-    return traj.wheel_speed - traj.omega @ sc.wheel_axes
+    truth model limits (:func:`att_sim.dynamics.relative_wheel_speed`). A wheel-torque plan
+    integrates its wheels; a body-torque plan's are :func:`body_plan_wheel_speeds` (the two parts summed)."""
+    sc = problem.spacecraft
+    if plan.control_kind == ControlKind.WHEEL_TORQUE:
+        return traj.wheel_speed - traj.omega @ sc.wheel_axes
+    stored, slew = body_plan_wheel_speeds(problem, traj.q, traj.omega)
+    return stored + slew
+
+
+def body_plan_wheel_speeds(problem: ManeuverProblem, q: np.ndarray, omega: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The relative speeds (K, N) of the wheels that fly a body-torque plan through attitudes ``q``
+    and rates ``omega``, in two parts: (stored, slew).
+
+    The wheels exchange momentum with the body, and the total ``H_N = R (J ω + G I_w Ω)`` is
+    conserved: from the start at rest with speeds ``Ω₀`` (the problem's ``wheel_speeds``, else
+    stopped) the wheels hold ``I_w Ω = I_w Ω₀ + G⁺ (Rᵀ H_N − J ω − G I_w Ω₀)`` (the change shared by
+    the pseudo-inverse, as the controller distributes a torque; a null-space spin stays). *stored*:
+    ``Ω₀ + G⁺ (Rᵀ H_N − G I_w Ω₀) / I_w``, what the stored momentum becomes as the body turns;
+    *slew*: ``−G⁺ J ω / I_w − Gᵀ ω``, the slew's own share (∝ ω)."""
+    sc = problem.spacecraft
+    zeros = np.zeros((len(q), sc.n_wheels))
+    if not (sc.n_wheels and sc.wheel_inertia > 0):
+        return zeros, zeros.copy()
+    speeds0 = np.zeros(sc.n_wheels) if problem.wheel_speeds is None else np.asarray(problem.wheel_speeds, float)
+    h0_B = sc.wheel_axes @ (sc.wheel_inertia * speeds0)
+    H_N = rot.dcm(q[0]) @ h0_B
+    h_B = np.einsum("kji,j->ki", rot.dcm(q), H_N)                          # R_kᵀ H_N
+    stored = speeds0 + (h_B - h0_B) @ sc.wheel_axes_pinv.T / sc.wheel_inertia
+    slew = -omega @ (sc.wheel_axes_pinv @ sc.inertia).T / sc.wheel_inertia - omega @ sc.wheel_axes
+    return stored, slew

@@ -70,10 +70,11 @@ def check_strings(msg, name: str = "", nul_only: bool = False) -> None:
 def maneuver_request(q_initial, q_final, sensor_axis, cones: list[Cone], *, method: str = "",
                      time_budget: float = 0.0, spacecraft: str = "", frame_id: str = "eci",
                      options: dict | None = None, epoch: datetime | None = None, zones: list[Zone] = (),
-                     tle: tuple[str, str] = ("", "")) -> PlanManeuver.Request:
+                     tle: tuple[str, str] = ("", ""), wheel_speeds=()) -> PlanManeuver.Request:
     """A PlanManeuver request; ValueError when a string holds a NUL or another control character.
     The real sky: ``epoch`` (UTC start; None: the scenario's), ``zones`` (besides the cones) and the
-    orbit's ``tle`` lines (empty: the scenario's orbit)."""
+    orbit's ``tle`` lines (empty: the scenario's orbit); ``wheel_speeds``: the wheels' speeds at the
+    start (rad/s relative to the body; empty: stopped), kept within their limit along the plan."""
     req = PlanManeuver.Request()
     req.header.frame_id = frame_id
     req.initial_attitude = convert.quaternion(q_initial)
@@ -86,6 +87,7 @@ def maneuver_request(q_initial, q_final, sensor_axis, cones: list[Cone], *, meth
     req.epoch = convert.epoch_msg(epoch)
     req.zones = [convert.zone_msg(z) for z in zones]
     req.tle_line1, req.tle_line2 = tle
+    req.wheel_speeds = [float(v) for v in wheel_speeds]
     check_strings(req)
     return req
 

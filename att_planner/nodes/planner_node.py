@@ -103,7 +103,8 @@ class PlannerNode(Node):
                     option_names=list(request.option_names), option_values=list(request.option_values),
                     semi_free=request.semi_free, sensor_target=convert.from_vector3(request.sensor_target),
                     epoch=convert.epoch_parts(request.epoch), zones=[convert.zone_from_msg(z) for z in request.zones],
-                    tle_line1=request.tle_line1, tle_line2=request.tle_line2),
+                    tle_line1=request.tle_line1, tle_line2=request.tle_line2,
+                    wheel_speeds=list(request.wheel_speeds)),
                 frame_id=self._frame_id, default_spacecraft=self._scenario_name,
                 default_method=self._default_method, default_budget=self._default_budget)
         except RequestError as err:
@@ -115,6 +116,7 @@ class PlannerNode(Node):
             outcome = self.internal_error(exc)
         response.stage = str(outcome.stage)
         response.stages = [convert.stage_msg(stage) for stage in outcome.stages]
+        response.slowdown = outcome.slowdown
         self.answer(response, outcome, valid.spacecraft, valid.method.name, sensor_axis=valid.problem.sensor_axis,
                     cones=valid.problem.cones, zones=valid.problem.zones, epoch=valid.problem.epoch,
                     spacecraft_digest=valid.problem.spacecraft.digest)

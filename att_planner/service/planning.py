@@ -39,6 +39,7 @@ from att_planner.methods.eigenaxis import plan_eigenaxis_smooth
 from att_planner.problem import ManeuverProblem
 from att_planner.service.requests import ValidRequest, ValidSchedule
 from att_planner.service.sky import lattice
+from att_planner.service.wheels import slow_for_wheels
 from att_planner.verification import TOLERANCES, VERIFY_STEPS, Tolerances, rejection, verify
 from att_sim.ephemeris import de421
 from att_sim.epoch import timescale
@@ -51,6 +52,7 @@ ANSWER_MARGIN = 0.3         # s of that kept for building, signing and sending t
 FALLBACK_SAMPLES = 401      # knots of the eigenaxis fallback (its default)
 FIRST_METHOD = "graph_smooth"   # the constructive first plan of every request for a method that is not cheap
 MIN_METHOD_SECONDS = 0.05   # s of its deadline the requested method needs at least, after the first plan
+WHEEL_SPEED = "wheel speed"     # how rejection() names a wheel beyond its speed limit
 _step_seconds = 2e-4        # running estimate of the wall time of one verification step (s)
 
 
@@ -100,6 +102,12 @@ class PlanOutcome:
     plan: Plan | None
     stage: Stage | str = ""                                   # the stage whose plan is returned
     stages: list[StageReport] = field(default_factory=list)   # every stage, in order
+
+    @property
+    def slowdown(self) -> float:
+        """How many times slower than its method planned it the plan flies (1: as planned; :mod:`.wheels`)."""
+        accepted = self.plan is not None and self.code == ErrorCode.OK
+        return float(self.plan.stats.get("slowdown", 1.0)) if accepted else 1.0
 
     @property
     def verification(self) -> Verification | None:
@@ -193,10 +201,29 @@ def _run_stage(name: Stage, method: Method, problem: ManeuverProblem, options: d
         else:
             plan.verification = timed_verify(valid.problem, plan)
             why = rejection(plan.verification, tol)
+            if why is not None and why.startswith(WHEEL_SPEED):
+                plan, why = _slowed_for_wheels(valid.problem, plan, why, tol)
             reason = "" if why is None else f"{method.name} plan rejected by verification: {why}"
     report = StageReport(name, method.name, time.perf_counter() - start, str(plan.status), not reason,
                          plan.duration if len(plan.t) else float("nan"), reason or plan.message)
     return _Stage(plan, report, reason, bool(oversize))
+
+
+def _slowed_for_wheels(problem: ManeuverProblem, plan: Plan, why: str, tol: Tolerances) -> tuple[Plan, str | None]:
+    """``plan`` slowed in time to keep its wheels within their speed limit (:mod:`.wheels`) and verified
+    again, with why it is still not acceptable (None: it is); the plan as it was when it cannot be slowed."""
+    slowed, why_not = slow_for_wheels(problem, plan)
+    if slowed is None:
+        return plan, f"{why}; not slowed: {why_not}"
+    slowed.verification = timed_verify(problem, slowed)
+    again = rejection(slowed.verification, tol)
+    if again is not None:
+        return plan, f"{why}; slowed {slowed.stats['slowdown']:.3f} times it is rejected too: {again}"
+    before, after = plan.verification.wheel_speed_ratio, slowed.verification.wheel_speed_ratio
+    slowed.message = (f"{plan.message}; slowed {slowed.stats['slowdown']:.3f} times (t_f {plan.duration:.6g} -> "
+                      f"{slowed.duration:.6g} s) to keep the wheels within their speed limit ({before:.3f} -> "
+                      f"{after:.3f} of it)")
+    return slowed, None
 
 
 def _first_plan_answer(first: _Stage, method: _Stage | None, valid: ValidRequest) -> tuple[Status, str]:
@@ -279,6 +306,9 @@ def plan_maneuver(valid: ValidRequest, tol: Tolerances = TOLERANCES, cone_paddin
             return PlanOutcome(ErrorCode.OK, fallback.message, fallback, Stage.FALLBACK, reports)
     budget_note = " (time budget expired)" if plan.status == Status.BUDGET_EXPIRED else ""
     code = ErrorCode.VERIFICATION_FAILED if "verification" in reason else ErrorCode.SOLVER_FAILED
+    saturating = [s.reason for s in done if f"verification: {WHEEL_SPEED}" in s.reason]
+    if saturating:
+        code, reason = ErrorCode.WHEEL_SATURATION, saturating[0]
     if (problem.cones or problem.zones) and code == ErrorCode.SOLVER_FAILED and "infeasib" in reason.lower():
         code = ErrorCode.INFEASIBLE
     return PlanOutcome(code, f"no verified plan{budget_note}: {reason}", plan, stages=reports)

@@ -23,7 +23,7 @@ import numpy as np
 
 from att_msgs_py.errors import ErrorCode, RequestError
 from att_msgs_py.types import Cone
-from att_msgs_py.validation import MAX_NAME_LENGTH, text, unit_quaternion, unit_vector
+from att_msgs_py.validation import MAX_NAME_LENGTH, finite_array, text, unit_quaternion, unit_vector
 from att_planner import methods
 from att_planner.cones import BOUNDARY_TOLERANCE, boundary_arc_issue, check_zones, endpoint_in_cone
 from att_planner.methods import Method
@@ -61,6 +61,7 @@ class ManeuverRequest:
     zones: list = field(default_factory=list)      # att_msgs_py.types.Zone, as sent
     tle_line1: str = ""
     tle_line2: str = ""
+    wheel_speeds: list = field(default_factory=list)   # rad/s relative to the body at the start; empty: stopped
 
 
 @dataclass
@@ -206,7 +207,8 @@ def validate_maneuver(req: ManeuverRequest, *, frame_id: str, default_spacecraft
     budget = check_budget(float(req.time_budget), default_budget)
     real = resolve_sky(*req.epoch, req.zones, req.tle_line1, req.tle_line2, scenario)
     problem = ManeuverProblem(scenario.spacecraft, q0, qf, r, cones, sensor_target=sensor_target, zones=real.zones,
-                              epoch=real.epoch, sky=real.sky if real.moving else None, **limits)
+                              epoch=real.epoch, sky=real.sky if real.moving else None,
+                              wheel_speeds=check_wheel_speeds(req.wheel_speeds, scenario.spacecraft), **limits)
     check_sky(problem, real)
     check_reachable(problem)
     problem.deadline = received + budget          # set last: the zone sky built by the checks stays cached
@@ -242,6 +244,23 @@ def load_scenario(name: str) -> scen.Scenario:
                            ) from None
     check_spacecraft(scenario.spacecraft, name)
     return scenario
+
+
+def check_wheel_speeds(speeds, sc: Spacecraft) -> np.ndarray | None:
+    """The wheels' speeds at the start: none (stopped), or one finite speed per wheel within its limit."""
+    if len(speeds) == 0:
+        return None
+    if len(speeds) != sc.n_wheels:
+        raise RequestError(ErrorCode.INVALID_WHEEL_SPEEDS,
+                           f"wheel_speeds has {len(speeds)} values; the spacecraft has {sc.n_wheels} wheels "
+                           "(or give none)")
+    out = finite_array(speeds, "wheel_speeds", ErrorCode.INVALID_WHEEL_SPEEDS)
+    over = np.flatnonzero(np.abs(out) > sc.wheel_speed_max)
+    if over.size:
+        raise RequestError(ErrorCode.INVALID_WHEEL_SPEEDS,
+                           f"wheel_speeds[{over[0]}] = {out[over[0]]:g} rad/s is beyond the wheels' limit of "
+                           f"{sc.wheel_speed_max:g} rad/s")
+    return out
 
 
 def check_budget(budget: float, default: float) -> float:
