@@ -113,7 +113,7 @@ class Verification:
     """
 
     final_attitude_error: float        # rad, to the goal attitude (semi-free: boresight to target)
-    final_rate: float                  # rad/s, ‖ω(t_f)‖
+    final_rate: float                  # rad/s, ‖ω(t_f)‖ (a moving goal: ‖ω(t_f) − ω_goal(t_f)‖)
     min_cone_margin: float             # rad over the dense grid and every zone (+inf without zones): the clearance
     cone_margins: list                 # rad, minimum clearance per zone: the cones, then the zones (request order)
     torque_ratio: float                # max |control| / its limit over the applied samples

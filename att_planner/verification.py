@@ -6,7 +6,8 @@ plans by them; nothing is taken from a planner's own model. The integration is
 :func:`att_sim.dynamics.simulate_profile` (RK4 with inputs switched exactly at the knots for
 zero-order hold, :data:`VERIFY_STEPS` steps over the plan at least), from the problem's initial
 attitude at rest with the wheels stopped. Checked: the final attitude (semi-free: the boresight
-on its target) and rate, every passage of a schedule (attitude, rate about body z), every zone
+on its target; a moving goal: its attitude at the final time) and rate (a moving goal: relative to
+its rate), every passage of a schedule (attitude, rate about body z), every zone
 (the cones, then the zones: :meth:`ManeuverProblem.zone_sky`) at every dense sample at its TRUE
 position at that sample's time (straight from the sky, not the planners' fit, at any time), and the
 control, wheel-speed (relative to the body), body-rate and wheel-momentum limits.
@@ -89,7 +90,12 @@ def measure(problem: ManeuverProblem, plan: Plan, traj: dyn.Trajectory) -> Verif
     limit = sc.wheel_torque_max if wheels else sc.body_torque_max
     zone_sky = problem.zone_sky()
     m = clearances(problem, traj.t, traj.q)
-    if problem.sensor_target is None:
+    final_rate = float(np.linalg.norm(traj.omega[-1]))
+    if problem.goal_motion is not None:            # the moving goal where and as fast as it is at t_f
+        q_goal, omega_goal = problem.goal_motion(float(traj.t[-1]))
+        final_error = float(rot.angle_between(traj.q[-1], q_goal))
+        final_rate = float(np.linalg.norm(traj.omega[-1] - omega_goal))
+    elif problem.sensor_target is None:
         final_error = float(rot.angle_between(traj.q[-1], problem.q_final))
     else:
         reached = rot.dcm(traj.q[-1]) @ np.asarray(problem.sensor_axis, float)
@@ -102,7 +108,7 @@ def measure(problem: ManeuverProblem, plan: Plan, traj: dyn.Trajectory) -> Verif
         passage_rates.append(float(abs(traj.omega[k, 2])))
     return Verification(
         final_attitude_error=final_error,
-        final_rate=float(np.linalg.norm(traj.omega[-1])),
+        final_rate=final_rate,
         min_cone_margin=float(m.min()) if m.size else math.inf,
         cone_margins=[float(v) for v in m.min(axis=0)] if m.size else [],
         torque_ratio=_ratio(peak_magnitude(applied), limit),

@@ -133,6 +133,7 @@ ZONE_FIT_WINDOW = 1.0                          # s: a ZoneSky needs a window; th
 
 USABLE = (Health.CONVERGED, Health.PROPAGATING)   # estimates the attitude laws may fly on
 HANDOVER_RATE_MATCH = 1e-4     # rad/s: a plan ending this close to the law's rate hands over directly
+HANDOVER_ATTITUDE_MATCH = 1e-3  # rad: ... and this close to its attitude (else: through the blend)
 
 
 class Controller:
@@ -471,11 +472,13 @@ class Controller:
             out.status.message = "maneuver complete; holding the final attitude"
 
     def _handover(self, law, plan: Plan, t: float):
-        """The pointing law a plan hands over to at its end: the law itself when the plan ends at
-        the law's rate (a slew planned to end on the moving target), else the law entered through
+        """The pointing law a plan hands over to at its end: the law itself when the plan ends on
+        the law's attitude at its rate (a slew planned to end on the moving target, flown when
+        planned), else the law entered through
         :class:`~att_planner.guidance.laws.BlendedLaw` over ``handover_blend`` s (a plan ending at rest)."""
-        law_rate = guidance_reference(law.attitude, t).omega
-        matched = float(np.linalg.norm(plan.omega[-1] - law_rate)) <= HANDOVER_RATE_MATCH
+        ref = guidance_reference(law.attitude, t)
+        matched = (float(np.linalg.norm(plan.omega[-1] - ref.omega)) <= HANDOVER_RATE_MATCH
+                   and rot.angle_between(plan.q[-1], ref.q) <= HANDOVER_ATTITUDE_MATCH)
         return law if matched or self.config.handover_blend <= 0 else BlendedLaw(law, t, self.config.handover_blend)
 
     def _end(self, success: bool, code: ErrorCode, message: str) -> ManeuverResult:

@@ -104,7 +104,8 @@ class PlannerNode(Node):
                     semi_free=request.semi_free, sensor_target=convert.from_vector3(request.sensor_target),
                     epoch=convert.epoch_parts(request.epoch), zones=[convert.zone_from_msg(z) for z in request.zones],
                     tle_line1=request.tle_line1, tle_line2=request.tle_line2,
-                    wheel_speeds=list(request.wheel_speeds)),
+                    wheel_speeds=list(request.wheel_speeds),
+                    end_pointing=convert.pointing_from_msg(request.end_pointing)),
                 frame_id=self._frame_id, default_spacecraft=self._scenario_name,
                 default_method=self._default_method, default_budget=self._default_budget)
         except RequestError as err:

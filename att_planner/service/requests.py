@@ -22,12 +22,13 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from att_msgs_py.errors import ErrorCode, RequestError
-from att_msgs_py.types import Cone
+from att_msgs_py.types import Cone, PointingMode
 from att_msgs_py.validation import MAX_NAME_LENGTH, finite_array, text, unit_quaternion, unit_vector
 from att_planner import methods
 from att_planner.cones import BOUNDARY_TOLERANCE, boundary_arc_issue, check_zones, endpoint_in_cone
 from att_planner.methods import Method
 from att_planner.problem import ManeuverProblem
+from att_planner.service.moving_goal import goal_motion
 from att_planner.service.real_sky import RequestSky, check_orbit_window, resolve_sky
 from att_planner.service.sky import closed_sky
 from att_sim import rotations as rot
@@ -39,6 +40,7 @@ MAX_OPTIONS = 16
 MAX_TIME_BUDGET = 600.0        # s
 MAX_TARGETS = 20               # schedule targets (the order search is exponential in their number)
 SAME_TARGET = 1e-6             # rad: schedule targets closer than this are one attitude (q and -q too)
+END_POINTING_METHOD = "time_optimal"   # the method that ends a slew on a moving pointing mode
 
 
 @dataclass
@@ -62,6 +64,7 @@ class ManeuverRequest:
     tle_line1: str = ""
     tle_line2: str = ""
     wheel_speeds: list = field(default_factory=list)   # rad/s relative to the body at the start; empty: stopped
+    end_pointing: PointingMode | None = None           # end on this mode's attitude and rate (kind ''/None: at rest)
 
 
 @dataclass
@@ -209,6 +212,8 @@ def validate_maneuver(req: ManeuverRequest, *, frame_id: str, default_spacecraft
     problem = ManeuverProblem(scenario.spacecraft, q0, qf, r, cones, sensor_target=sensor_target, zones=real.zones,
                               epoch=real.epoch, sky=real.sky if real.moving else None,
                               wheel_speeds=check_wheel_speeds(req.wheel_speeds, scenario.spacecraft), **limits)
+    if req.end_pointing is not None and req.end_pointing.kind:
+        _end_on_pointing(problem, req, method, scenario)
     check_sky(problem, real)
     check_reachable(problem)
     problem.deadline = received + budget          # set last: the zone sky built by the checks stays cached
@@ -244,6 +249,20 @@ def load_scenario(name: str) -> scen.Scenario:
                            ) from None
     check_spacecraft(scenario.spacecraft, name)
     return scenario
+
+
+def _end_on_pointing(problem: ManeuverProblem, req: ManeuverRequest, method: Method, scenario: scen.Scenario) -> None:
+    """Make ``problem``'s goal the moving one of ``req.end_pointing`` (:mod:`.moving_goal`); its
+    ``q_final`` the law's attitude after the eigenaxis slew time to where the law is at the start."""
+    if method.name != END_POINTING_METHOD:
+        raise RequestError(ErrorCode.INVALID_OPTION,
+                           f"end_pointing: a slew that ends on a pointing mode is planned by {END_POINTING_METHOD}; "
+                           f"{method.name} plans rest-to-rest (execute it with point_after: the controller blends)")
+    if req.semi_free:
+        raise RequestError(ErrorCode.INVALID_OPTION, "end_pointing and semi_free exclude each other")
+    problem.goal_motion = goal_motion(req.end_pointing, scenario, problem.epoch, problem.q_initial)
+    problem.q_final = problem.goal_motion(0.0)[0]
+    problem.q_final = problem.goal_motion(problem.slew_time_bound())[0]
 
 
 def check_wheel_speeds(speeds, sc: Spacecraft) -> np.ndarray | None:

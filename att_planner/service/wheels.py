@@ -50,6 +50,8 @@ def slow_for_wheels(problem: ManeuverProblem, plan: Plan) -> tuple[Plan | None, 
     sc = problem.spacecraft
     if plan.control_kind != ControlKind.BODY_TORQUE:
         return None, "a wheel-torque plan is not slowed (its wheels' gyroscopic torque does not scale)"
+    if problem.goal_motion is not None:
+        return None, "a plan that ends on a moving goal is not slowed (it would miss the goal)"
     traj = integrate(problem, plan)
     stored, slew = body_plan_wheel_speeds(problem, traj.q, traj.omega)
     c = smallest_slowdown(stored, slew, sc.wheel_speed_max * (1.0 - LIMIT_MARGIN))

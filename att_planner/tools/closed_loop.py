@@ -194,7 +194,8 @@ class ClosedLoop:
 
 
 def plan_in_process(scenario: Scenario, q0, qf, sensor_axis, cones=(), zones=(), method: str = "",
-                    time_budget: float = 30.0, epoch: tuple = (0, 0), wheel_speeds=()) -> Plan:
+                    time_budget: float = 30.0, epoch: tuple = (0, 0), wheel_speeds=(),
+                    end_pointing: PointingMode | None = None) -> Plan:
     """A verified plan as the planner service makes it (same validation, padding, method, fallback and
     verification; the planner's ``cone_padding_deg`` and ``default_method`` of the scenario), in this
     process. RequestError when there is none."""
@@ -207,7 +208,7 @@ def plan_in_process(scenario: Scenario, q0, qf, sensor_axis, cones=(), zones=(),
                               np.asarray(sensor_axis, float),
                               [(c.direction, c.half_angle, c.name) for c in cones], method=method,
                               time_budget=time_budget, spacecraft=scenario.name, epoch=epoch, zones=list(zones),
-                              wheel_speeds=list(wheel_speeds))
+                              wheel_speeds=list(wheel_speeds), end_pointing=end_pointing)
     valid = validate_maneuver(request, frame_id=scenario.frame_id, default_spacecraft=scenario.name,
                               default_method=planner("default_method", "") or methods.REGISTRY[0].name,
                               default_budget=time_budget)

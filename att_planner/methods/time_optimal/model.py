@@ -147,14 +147,50 @@ def path_values(problem: ManeuverProblem, s: Scaling, cone_margin: float) -> np.
     return np.concatenate(values) if values else np.zeros(0)
 
 
-def goal_values(problem: ManeuverProblem) -> np.ndarray:
+GOAL_DEGREE = 16         # the Chebyshev series of a moving goal's attitude and rate over the window
+
+
+def goal_kind(problem: ManeuverProblem) -> str:
+    """'moving' (a pointing law's attitude and rate at t_f), 'fixed' (``q_final`` at rest) or 'semi' (semi-free)."""
+    if problem.goal_motion is not None:
+        return "moving"
+    return "fixed" if problem.sensor_target is None else "semi"
+
+
+def goal_values(problem: ManeuverProblem, s: Scaling) -> np.ndarray:
     """The final-attitude constraint's data: ``q_final``, or the semi-free goal's unit
-    ``sensor_target``, the two rows of a basis normal to it and the unit sensor axis."""
+    ``sensor_target``, the two rows of a basis normal to it and the unit sensor axis, or a moving
+    goal's series (:func:`moving_goal_values`)."""
+    if problem.goal_motion is not None:
+        return moving_goal_values(problem, s)
     if problem.sensor_target is None:
         return rot.normalize(np.asarray(problem.q_final, float))
     target = np.asarray(problem.sensor_target, float) / np.linalg.norm(problem.sensor_target)
     r = np.asarray(problem.sensor_axis, float) / np.linalg.norm(problem.sensor_axis)
     return np.concatenate([target, *rot.orthonormal_basis(target), r])
+
+
+def goal_window(problem: ManeuverProblem) -> float:
+    """The span (s) over which a moving goal is fitted, and t_f bounded: the zone window."""
+    return problem.zone_sky().window
+
+
+def moving_goal_values(problem: ManeuverProblem, s: Scaling) -> np.ndarray:
+    """A moving goal as parameters: ``α = 2 τ_u / W``, ``β = −1`` and the :data:`GOAL_DEGREE`
+    Chebyshev coefficients of its attitude (sign-continuous) and normalised rate ``ω τ_u`` in
+    ``x = α t̃ + β`` (``t̃`` the normalised time) over the window ``[0, W]`` (:func:`goal_window`),
+    interpolated at the Chebyshev points of the first kind."""
+    window = goal_window(problem)
+    n = 2 * (GOAL_DEGREE + 1)
+    x = np.sort(np.cos(np.pi * (np.arange(n) + 0.5) / n))
+    samples = []
+    for t in 0.5 * (x + 1.0) * window:
+        q, w = problem.goal_motion(float(t))
+        if samples and np.dot(q, samples[-1][:4]) < 0:
+            q = -q
+        samples.append(np.concatenate([q, np.asarray(w, float) * s.tu]))
+    coef = np.polynomial.chebyshev.chebfit(x, np.array(samples), GOAL_DEGREE)
+    return np.concatenate([[2.0 * s.tu / window, -1.0], coef.ravel()])
 
 
 CACHE_SIZE = 64          # built NLPs kept (the oldest goes first)
@@ -249,28 +285,32 @@ def transcription(problem: ManeuverProblem, s: Scaling, mesh: np.ndarray, contro
         path, weight = weighted_path_function(problem, s, cone_margin, 13 if smooth else 7,
                                               SMOOTH_END_RAMP if smooth else END_RAMP) or (None, None)
         tr = _build(problem, s, mesh, control, path, torque_accel, not zones.moving, weight).build(**options)
-        return _start(tr.copy(mesh, extra_values=goal_values(problem)), problem, smooth, tf_bounds)
+        return _start(tr.copy(mesh, extra_values=goal_values(problem, s)), problem, s, smooth, tf_bounds)
     path, degree = path_function(problem, s, 13 if smooth else 7, cone_margin)
     momentum = math.isfinite(problem.wheel_momentum_max)
     moving = sum(z.body != "inertial" for z in zones.zones)
     key = (smooth, torque_accel, s.Jn.tobytes(), len(mesh) - 1, control, sum(z.body == "inertial" for z in zones.zones),
            (moving, degree) if degree is not None else (id(zones), cone_margin),
            problem.spacecraft.wheel_axes.tobytes() if momentum else None, problem.rate_max,
-           problem.sensor_target is None, tol, max_iter, expand)
+           goal_kind(problem), tol, max_iter, expand)
     if key not in _NLPS:
         while len(_NLPS) >= CACHE_SIZE:
             _NLPS.pop(next(iter(_NLPS)))
         _NLPS[key] = (_build(problem, s, mesh, control, path, torque_accel, not zones.moving,
                              path_parameters=path_values(problem, s, 0.0)).build(**options), zones)  # zones: kept alive
-    tr = _NLPS[key][0].copy(mesh, path_values(problem, s, cone_margin), goal_values(problem))
-    return _start(tr, problem, smooth, tf_bounds)
+    tr = _NLPS[key][0].copy(mesh, path_values(problem, s, cone_margin), goal_values(problem, s))
+    return _start(tr, problem, s, smooth, tf_bounds)
 
 
-def _start(tr: col.Transcription, problem: ManeuverProblem, smooth: bool, tf_bounds) -> col.Transcription:
-    """``tr`` from the problem's start at rest, its duration within ``tf_bounds``."""
+def _start(tr: col.Transcription, problem: ManeuverProblem, s: Scaling, smooth: bool, tf_bounds) -> col.Transcription:
+    """``tr`` from the problem's start at rest, its duration within ``tf_bounds`` (and a moving
+    goal's window)."""
     q0 = rot.normalize(np.asarray(problem.q_initial, float))
     tr.bound_state(0, 0, np.concatenate([q0, np.zeros(9 if smooth else 3)]))
-    tr.set_duration_bounds(0, *tf_bounds)
+    lower, upper = tf_bounds
+    if problem.goal_motion is not None:
+        upper = min(upper, goal_window(problem) / s.tu)
+    tr.set_duration_bounds(0, min(lower, 0.5 * upper), upper)
     return tr
 
 
@@ -283,11 +323,20 @@ def _build(problem: ManeuverProblem, s: Scaling, mesh: np.ndarray, control: str,
     phase = col.Phase(rigid_body_dynamics(s.Jn, smooth), mesh, control=control,
                       state_bounds=_state_bounds(problem, s, smooth), control_bounds=controls, path=path,
                       path_bounds=(-np.inf, 0.0), path_weight=weight, name="slew", path_parameters=path_parameters)
-    goal = goal_values(problem)
+    goal = goal_values(problem, s)
     tr = col.Transcription([phase], duration_copies=duration_copies, parametric=True, extra_parameters=len(goal))
     v = tr.variables(0)
-    tr.bound_state(0, -1, *_end_bounds(smooth))
     q_end = v.x_end[:4]
+    if problem.goal_motion is not None:            # on the moving goal at t_f, at its rate
+        if smooth:
+            raise ValueError("a moving goal is time_optimal's: the smooth plans end at rest")
+        rows = [tr.extra[2 + 7 * i:9 + 7 * i] for i in range(GOAL_DEGREE + 1)]
+        target = clenshaw(tr.extra[0] * v.duration + tr.extra[1], rows)
+        tr.add_constraint(symbolic.error_vector(q_end, target[:4]), 0.0, 0.0)
+        tr.add_constraint(v.x_end[4:7] - target[4:7], 0.0, 0.0)
+        tr.minimize(v.duration)
+        return tr
+    tr.bound_state(0, -1, *_end_bounds(smooth))
     if problem.sensor_target is None:
         tr.add_constraint(symbolic.error_vector(q_end, tr.extra), 0.0, 0.0)
     else:

@@ -4,6 +4,7 @@ through the time-warp blend, then nadir pointing; in process, on the truth."""
 from __future__ import annotations
 
 import math
+from datetime import timedelta
 
 import numpy as np
 import pytest
@@ -14,7 +15,7 @@ from att_planner.guidance.laws import BlendedLaw, Sky
 from att_planner.guidance.modes import law_of
 from att_planner.methods.eigenaxis import plan_eigenaxis_smooth
 from att_planner.problem import ManeuverProblem
-from att_planner.tools.closed_loop import ClosedLoop
+from att_planner.tools.closed_loop import ClosedLoop, plan_in_process
 from att_sim import rotations as rot
 from att_sim import scenario as scen
 from att_sim import world
@@ -55,3 +56,32 @@ def test_a_slew_onto_nadir_hands_over_without_a_jump():
     assert np.max(error[t > end + 60 + 20]) < math.radians(0.005)
     truth = [rot.angle_between(q, law.attitude(tt)) for q, tt in zip(trace["q_true"], t)]
     assert max(truth[-200:]) < math.radians(0.005)
+
+
+def test_a_time_optimal_slew_ends_on_nadir_at_its_rate_and_hands_over_directly():
+    """The time-optimal planner meets the moving goal (nadir at t_f, with its rate); flown when it
+    was planned for, the controller takes the law itself (no blend): the error of the slew's end
+    carries over without a jump and dies out."""
+    s = scen.load("leo_momentum")
+    law = law_of(PointingMode("nadir"), Sky.of(world.Environment.from_scenario(s)), 0.0, rot.IDENTITY)
+    q0 = rot.multiply(law.attitude(0.0), rot.from_axis_angle([1, 0, 0], math.radians(40)))
+    loop = ClosedLoop(s, overrides={"controller": {"state_source": "truth", "momentum_dumping": False}}, q0=q0)
+    loop.run(0.5)
+    t0 = loop.controller.state.t                 # the maneuver starts from the latest state
+    start = s.epoch + timedelta(seconds=t0)
+    epoch = (int(start.timestamp()), round(start.timestamp() % 1 * 1e9))
+    plan = plan_in_process(s, q0, q0, [0, 0, 1], method="time_optimal", epoch=epoch,
+                           end_pointing=PointingMode("nadir"))
+    end = t0 + plan.duration
+    goal = reference(law.attitude, end)
+    assert rot.angle_between(plan.q[-1], goal.q) < 1e-5
+    assert np.linalg.norm(plan.omega[-1] - goal.omega) < 1e-6 < 0.5 * np.linalg.norm(goal.omega)
+    assert loop.execute(plan, after=PointingMode("nadir")) is None
+    loop.run(plan.duration + 120.0)
+    assert loop.controller.pointing.name == "nadir" and not isinstance(loop.controller.pointing, BlendedLaw)
+    trace = loop.trace.arrays()
+    t, error = trace["t"], trace["attitude_error"]
+    # the braking's tracking error carries over the handover (0.019 deg measured) and dies out
+    around = error[(t > end - 10) & (t < end + 120)]
+    assert np.max(around) < math.radians(0.03), np.degrees(around.max())
+    assert np.max(error[t > end + 70]) < math.radians(0.003), np.degrees(error[t > end + 70].max())

@@ -1,0 +1,35 @@
+"""Slews that end on a moving target (issue 15): the goal of a maneuver request with ``end_pointing``.
+
+The plan must reach, at its final time, the attitude and body rate of the pointing law the
+controller will hand over to (:mod:`att_planner.guidance`): the law of the scenario's own models
+(orbit, field, Sun — the controller's), at sim time ``offset + t`` for plan time ``t``, ``offset``
+the plan's epoch after the scenario's. The time-optimal method fits it over the zone window and
+meets it exactly at t_f (:func:`att_planner.methods.time_optimal.model.moving_goal_values`); the
+verification measures the reached attitude and rate against the law itself.
+"""
+from __future__ import annotations
+
+from collections.abc import Callable
+from datetime import datetime
+
+import numpy as np
+
+from att_msgs_py.types import PointingMode
+from att_planner.guidance import reference
+from att_planner.guidance.laws import Sky
+from att_planner.guidance.modes import law_of
+from att_sim import world
+from att_sim.scenario import Scenario
+
+
+def goal_motion(mode: PointingMode, scenario: Scenario, epoch: datetime | None,
+                q_start: np.ndarray) -> Callable[[float], tuple[np.ndarray, np.ndarray]]:
+    """``t ↦ (q, ω)`` of ``mode``'s law at plan time ``t`` (RequestError 314 for a bad mode)."""
+    offset = 0.0 if epoch is None or scenario.epoch is None else (epoch - scenario.epoch).total_seconds()
+    law = law_of(mode, Sky.of(world.Environment.from_scenario(scenario)), offset, q_start)
+
+    def motion(t: float) -> tuple[np.ndarray, np.ndarray]:
+        ref = reference(law.attitude, offset + t)
+        return ref.q, ref.omega
+
+    return motion

@@ -1,0 +1,62 @@
+"""Requests for a slew that ends on a pointing mode (issue 15): planned by time_optimal only, not
+with a semi-free goal, the mode checked field by field; the goal's law is the controller's."""
+from __future__ import annotations
+
+import math
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from att_msgs_py.errors import ErrorCode, RequestError
+from att_msgs_py.types import PointingMode
+from att_planner.guidance import reference
+from att_planner.guidance.laws import Sky
+from att_planner.guidance.modes import law_of
+from att_planner.service.moving_goal import goal_motion
+from att_planner.service.requests import ManeuverRequest, validate_maneuver
+from att_sim import rotations as rot
+from att_sim import scenario as scen
+from att_sim import world
+
+LEO = scen.load("leo_momentum")
+NADIR = PointingMode("nadir")
+
+
+def validate(method="time_optimal", mode=NADIR, **fields):
+    req = ManeuverRequest(LEO.frame_id, rot.IDENTITY, rot.IDENTITY, np.array([0.0, 0.0, 1.0]), [], method=method,
+                          time_budget=10.0, spacecraft=LEO.name, end_pointing=mode, **fields)
+    return validate_maneuver(req, frame_id=LEO.frame_id, default_spacecraft=LEO.name, default_method="",
+                             default_budget=10.0)
+
+
+def test_the_goal_is_the_controllers_law_shifted_by_the_plans_epoch():
+    later = LEO.epoch.replace(second=LEO.epoch.second + 30)
+    motion = goal_motion(PointingMode("nadir"), LEO, later, rot.IDENTITY)
+    law = law_of(PointingMode("nadir"), Sky.of(world.Environment.from_scenario(LEO)), 0.0, rot.IDENTITY)
+    q, w = motion(100.0)
+    ref = reference(law.attitude, 130.0)
+    assert rot.angle_between(q, ref.q) < 1e-12 and np.allclose(w, ref.omega, atol=1e-15)
+
+
+def test_a_valid_request_carries_the_moving_goal_and_a_first_guess_of_its_end():
+    valid = validate()
+    problem = valid.problem
+    assert problem.goal_motion is not None
+    start = replace(problem, q_final=problem.goal_motion(0.0)[0])      # where the goal is at the start
+    arrival = start.slew_time_bound()
+    assert arrival > 60.0
+    assert rot.angle_between(problem.q_final, problem.goal_motion(arrival)[0]) < 1e-9
+
+
+@pytest.mark.parametrize("fields, code, words", [
+    ({"method": "smooth_collocation"}, ErrorCode.INVALID_OPTION, "time_optimal"),
+    ({"semi_free": True, "sensor_target": np.array([1.0, 0.0, 0.0])}, ErrorCode.INVALID_OPTION, "semi_free"),
+    ({"mode": PointingMode("sideways")}, ErrorCode.INVALID_POINTING, "pointing.kind"),
+    ({"mode": PointingMode("nadir", primary_axis=np.array([0.0, 0.0, math.nan]))}, ErrorCode.INVALID_POINTING,
+     "pointing.primary_axis"),
+])
+def test_bad_end_pointing_requests_are_refused_naming_the_field(fields, code, words):
+    with pytest.raises(RequestError) as err:
+        validate(**fields)
+    assert err.value.code == code and words in err.value.message
