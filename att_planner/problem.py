@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import math
 import time
-from collections.abc import Callable
 from dataclasses import dataclass, field
 from datetime import datetime
 from typing import TYPE_CHECKING
@@ -23,7 +22,8 @@ from att_planner.zones import ZoneSky, zones_from_cones
 from att_sim import rotations as rot
 from att_sim.dynamics import Spacecraft
 
-if TYPE_CHECKING:          # the annotation only: att_sim.ephemeris loads skyfield
+if TYPE_CHECKING:          # the annotations only: att_sim.ephemeris loads skyfield
+    from att_planner.service.moving_goal import MovingGoal
     from att_sim.ephemeris import Sky
 
 MIN_WINDOW = 600.0        # s: the shortest default zone window
@@ -52,7 +52,8 @@ class ManeuverProblem:
       ``epoch``: the UTC instant of t = 0; ``sky``: the sky seen from the spacecraft
       (:class:`att_sim.ephemeris.Sky`, needed by sun, moon and earth_limb zones).
       :meth:`zone_sky` joins them: what every method and the verification use.
-    * ``goal_motion``: a goal that moves (a pointing law, issue 15): ``t ↦ (q, ω)``, the attitude and
+    * ``goal_motion``: a goal that moves (a pointing law, issue 15:
+      :class:`att_planner.service.moving_goal.MovingGoal`): ``t ↦ (q, ω)``, the attitude and
       body rate the plan must reach at its final time ``t`` (``q_final``: its attitude at a first
       estimate of that time, for guesses); None: ``q_final`` at rest.
     * ``wheel_speeds``: the wheels' speeds at the start; the verification follows them along the plan
@@ -77,7 +78,7 @@ class ManeuverProblem:
     sky: Sky | None = None
     boundary_cone: int | None = None
     wheel_speeds: np.ndarray | None = None      # rad/s relative to the body at the start (at rest); None: stopped
-    goal_motion: Callable[[float], tuple[np.ndarray, np.ndarray]] | None = None   # t -> (q, ω) of a moving goal
+    goal_motion: MovingGoal | None = None       # t -> (q, ω) of a moving goal
     # caches keyed by the values they depend on, so ``dataclasses.replace`` copies share them
     _zone_skies: dict = field(default_factory=dict, repr=False, compare=False)
     _default_window: tuple = field(default=(), repr=False, compare=False)

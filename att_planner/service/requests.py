@@ -28,7 +28,7 @@ from att_planner import methods
 from att_planner.cones import BOUNDARY_TOLERANCE, boundary_arc_issue, check_zones, endpoint_in_cone
 from att_planner.methods import Method
 from att_planner.problem import ManeuverProblem
-from att_planner.service.moving_goal import goal_motion
+from att_planner.service.moving_goal import MovingGoal, goal_law
 from att_planner.service.real_sky import RequestSky, check_orbit_window, resolve_sky
 from att_planner.service.sky import closed_sky
 from att_sim import rotations as rot
@@ -260,9 +260,10 @@ def _end_on_pointing(problem: ManeuverProblem, req: ManeuverRequest, method: Met
                            f"{method.name} plans rest-to-rest (execute it with point_after: the controller blends)")
     if req.semi_free:
         raise RequestError(ErrorCode.INVALID_OPTION, "end_pointing and semi_free exclude each other")
-    problem.goal_motion = goal_motion(req.end_pointing, scenario, problem.epoch, problem.q_initial)
-    problem.q_final = problem.goal_motion(0.0)[0]
-    problem.q_final = problem.goal_motion(problem.slew_time_bound())[0]
+    law = goal_law(req.end_pointing, scenario, problem.epoch, problem.q_initial)
+    problem.q_final = law(0.0)[0]
+    problem.q_final = law(problem.slew_time_bound())[0]
+    problem.goal_motion = MovingGoal(law, problem.zone_sky().window)
 
 
 def check_wheel_speeds(speeds, sc: Spacecraft) -> np.ndarray | None:

@@ -83,6 +83,7 @@ class ClosedLoop:
         self.refusals: list[RequestError] = []
         self.next_state = 0.0
         self.result: ManeuverResult | None = None
+        self.on_step = None     # called with (controller output, truth state) after each control step
 
     # -- plans ------------------------------------------------------------------------------------
     def issue(self, plan: Plan, plan_id: str = "plan") -> tuple[Plan, bytes]:
@@ -136,6 +137,8 @@ class ClosedLoop:
                 if est is not None:
                     est.on_dipole_command(out.command.t, out.command.dipole)
                 self._record(out, readings)
+                if self.on_step is not None:
+                    self.on_step(out, sim.state(self.scenario.frame_id, self.scenario.body_frame_id))
         sim.advance(self.step)
 
     def run(self, duration: float) -> None:

@@ -72,8 +72,39 @@ def motion_degree(zones) -> int | None:
     return next((d for d in MOTION_DEGREES if d >= needed), None)
 
 
+def wheel_rows(problem: ManeuverProblem) -> int:
+    """Wheels whose speeds the plan keeps within their limit (none without wheels or a finite limit)."""
+    sc = problem.spacecraft
+    return sc.n_wheels if sc.n_wheels and sc.wheel_inertia > 0 and math.isfinite(sc.wheel_speed_max) else 0
+
+
+def wheel_speed_values(problem: ManeuverProblem, s: Scaling) -> np.ndarray:
+    """The data of :func:`wheel_speed_constraints`: ``M₁ = G⁺ / (I_w Ω̄)``, ``M₂ = (G⁺ J / I_w + Gᵀ) / (τ_u Ω̄)``
+    (column-major), ``a = (Ω₀ − G⁺ G Ω₀) / Ω̄`` and ``H_N`` (N m s), ``Ω̄`` the limit tightened by
+    :data:`BOUND_MARGIN`: the relative speeds over ``Ω̄`` are ``a + M₁ Rᵀ H_N − M₂ ω̃``
+    (:func:`att_planner.verification.body_plan_wheel_speeds`)."""
+    sc = problem.spacecraft
+    limit = sc.wheel_speed_max * (1 - BOUND_MARGIN)
+    speeds0 = np.zeros(sc.n_wheels) if problem.wheel_speeds is None else np.asarray(problem.wheel_speeds, float)
+    h0_B = sc.wheel_axes @ (sc.wheel_inertia * speeds0)
+    M1 = sc.wheel_axes_pinv / (sc.wheel_inertia * limit)
+    M2 = (sc.wheel_axes_pinv @ sc.inertia / sc.wheel_inertia + sc.wheel_axes.T) / (s.tu * limit)
+    a = (speeds0 - sc.wheel_axes_pinv @ h0_B / sc.wheel_inertia) / limit
+    H_N = rot.dcm(rot.normalize(np.asarray(problem.q_initial, float))) @ h0_B
+    return np.concatenate([M1.ravel(order="F"), M2.ravel(order="F"), a, H_N])
+
+
+def wheel_speed_constraints(R, w, p, n: int) -> list:
+    """``g ≤ 0`` keeping ``n`` wheels' relative speeds within ``±Ω̄`` at attitude ``R`` and normalised
+    rate ``w`` (``p``: :func:`wheel_speed_values`)."""
+    M1, M2 = ca.reshape(p[:3 * n], n, 3), ca.reshape(p[3 * n:6 * n], n, 3)
+    a, H_N = p[6 * n:7 * n], p[7 * n:7 * n + 3]
+    v = a + ca.mtimes(M1, ca.mtimes(R.T, H_N)) - ca.mtimes(M2, w)
+    return [v - 1, -v - 1]
+
+
 def path_function(problem: ManeuverProblem, s: Scaling, n_state: int = 7, cone_margin: float = 0.0):
-    """``(path, degree)``: the path constraints ``g ≤ 0`` (zones, wheel momentum) as a CasADi
+    """``(path, degree)``: the path constraints ``g ≤ 0`` (zones, wheel speeds, wheel momentum) as a CasADi
     Function ``(x, u[, t][, p]) -> g`` (``x`` has ``n_state`` rows, the attitude and rate first;
     None when there are none), the data of the problem in ``p`` (:func:`path_values`), and the
     degree of the moving zones' series in ``p`` (:func:`motion_degree`; None: they are constants).
@@ -88,15 +119,18 @@ def path_function(problem: ManeuverProblem, s: Scaling, n_state: int = 7, cone_m
     ``x = α t + β``) when every moving zone is one series of a degree of :data:`MOTION_DEGREES`,
     otherwise the series are constants of the function (tightened by ``cone_margin``). The wheels'
     momentum bound takes its scale from ``p`` (its last value). So the function depends on the
-    problem's shape only, but for moving zones of many pieces."""
+    problem's shape only, but for moving zones of many pieces. The wheels' speeds relative to the body
+    stay within their limit (:func:`wheel_speed_constraints`, their data in ``p`` too: the momentum
+    stored at the start and the slew's)."""
     zones = problem.zone_sky()
     fixed = [z.body == "inertial" for z in zones.zones]
     degree = motion_degree(zones)
     moving = 0 if degree is None else len(fixed) - sum(fixed)
     momentum = math.isfinite(problem.wheel_momentum_max) and problem.spacecraft.n_wheels > 0   # no wheels: none
+    wheels = wheel_rows(problem)
     x, u, t = ca.SX.sym("x", n_state), ca.SX.sym("u", 3), ca.SX.sym("t")
     per_zone = 0 if degree is None else motion_parameters(degree)
-    p = ca.SX.sym("p", ZONE_PARAMETERS * sum(fixed) + per_zone * moving + momentum)
+    p = ca.SX.sym("p", ZONE_PARAMETERS * sum(fixed) + per_zone * moving + 7 * wheels + 3 * bool(wheels) + momentum)
     R = symbolic.dcm(x[:4])
     g = []
     for k in range(sum(fixed)):
@@ -111,6 +145,9 @@ def path_function(problem: ManeuverProblem, s: Scaling, n_state: int = 7, cone_m
         g.append(sign * (ca.dot(value[:3], ca.mtimes(R, sensor)) - ca.cos(value[3])))
     if zones.moving and degree is None:
         g += [c for c, f in zip(zones.casadi_constraints(t * s.tu, R, cone_margin), fixed) if not f]
+    if wheels:
+        o = ZONE_PARAMETERS * sum(fixed) + per_zone * moving
+        g += wheel_speed_constraints(R, x[4:7], p[o:o + 7 * wheels + 3], wheels)
     if momentum:
         h_w = ca.mtimes(ca.DM(problem.spacecraft.wheel_axes_pinv @ s.Jn), x[4:7]) * p[-1]
         g += [h_w - 1, -h_w - 1]
@@ -141,19 +178,16 @@ def path_values(problem: ManeuverProblem, s: Scaling, cone_margin: float) -> np.
             padded[:len(coef)] = coef
             padded[0, 3] += sign * cone_margin
             moving += [[sign], sensor, [2 * s.tu / (b - a), -(a + b) / (b - a)], padded.ravel()]
-    values = fixed + moving
+    values = fixed + moving + ([wheel_speed_values(problem, s)] if wheel_rows(problem) else [])
     if math.isfinite(problem.wheel_momentum_max) and problem.spacecraft.n_wheels:
         values.append([s.J0 / s.tu / (problem.wheel_momentum_max * (1 - BOUND_MARGIN))])
     return np.concatenate(values) if values else np.zeros(0)
 
 
-GOAL_DEGREE = 16         # the Chebyshev series of a moving goal's attitude and rate over the window
-
-
 def goal_kind(problem: ManeuverProblem) -> str:
     """'moving' (a pointing law's attitude and rate at t_f), 'fixed' (``q_final`` at rest) or 'semi' (semi-free)."""
     if problem.goal_motion is not None:
-        return "moving"
+        return f"moving {len(problem.goal_motion.coefficients)}"
     return "fixed" if problem.sensor_target is None else "semi"
 
 
@@ -170,27 +204,13 @@ def goal_values(problem: ManeuverProblem, s: Scaling) -> np.ndarray:
     return np.concatenate([target, *rot.orthonormal_basis(target), r])
 
 
-def goal_window(problem: ManeuverProblem) -> float:
-    """The span (s) over which a moving goal is fitted, and t_f bounded: the zone window."""
-    return problem.zone_sky().window
-
-
 def moving_goal_values(problem: ManeuverProblem, s: Scaling) -> np.ndarray:
-    """A moving goal as parameters: ``α = 2 τ_u / W``, ``β = −1`` and the :data:`GOAL_DEGREE`
-    Chebyshev coefficients of its attitude (sign-continuous) and normalised rate ``ω τ_u`` in
-    ``x = α t̃ + β`` (``t̃`` the normalised time) over the window ``[0, W]`` (:func:`goal_window`),
-    interpolated at the Chebyshev points of the first kind."""
-    window = goal_window(problem)
-    n = 2 * (GOAL_DEGREE + 1)
-    x = np.sort(np.cos(np.pi * (np.arange(n) + 0.5) / n))
-    samples = []
-    for t in 0.5 * (x + 1.0) * window:
-        q, w = problem.goal_motion(float(t))
-        if samples and np.dot(q, samples[-1][:4]) < 0:
-            q = -q
-        samples.append(np.concatenate([q, np.asarray(w, float) * s.tu]))
-    coef = np.polynomial.chebyshev.chebfit(x, np.array(samples), GOAL_DEGREE)
-    return np.concatenate([[2.0 * s.tu / window, -1.0], coef.ravel()])
+    """A moving goal (:class:`att_planner.service.moving_goal.MovingGoal`) as parameters:
+    ``α = 2 τ_u / W``, ``β = −1`` and its series' coefficients of the attitude and the normalised
+    rate ``ω τ_u`` in ``x = α t̃ + β`` (``t̃`` the normalised time) over its window ``[0, W]``."""
+    goal = problem.goal_motion
+    coefficients = goal.coefficients * np.r_[np.ones(4), np.full(3, s.tu)]
+    return np.concatenate([[2.0 * s.tu / goal.window, -1.0], coefficients.ravel()])
 
 
 CACHE_SIZE = 64          # built NLPs kept (the oldest goes first)
@@ -245,6 +265,8 @@ def weighted_path_function(problem: ManeuverProblem, s: Scaling, cone_margin: fl
         cone = problem.cones[problem.boundary_cone]
         r = np.asarray(problem.sensor_axis, float) / np.linalg.norm(problem.sensor_axis)
         g.append(ca.cos(cone.half_angle + ARC_BAND) - ca.dot(ca.DM(cone.direction), ca.mtimes(R, ca.DM(r))))
+    if wheel_rows(problem):
+        g += wheel_speed_constraints(R, x[4:7], ca.DM(wheel_speed_values(problem, s)), wheel_rows(problem))
     if math.isfinite(problem.wheel_momentum_max) and problem.spacecraft.n_wheels:   # no wheels: no momentum
         h_per_rate = s.J0 / s.tu / (problem.wheel_momentum_max * (1 - BOUND_MARGIN))
         h_w = ca.mtimes(ca.DM(problem.spacecraft.wheel_axes_pinv @ s.Jn * h_per_rate), x[4:7])
@@ -291,7 +313,7 @@ def transcription(problem: ManeuverProblem, s: Scaling, mesh: np.ndarray, contro
     moving = sum(z.body != "inertial" for z in zones.zones)
     key = (smooth, torque_accel, s.Jn.tobytes(), len(mesh) - 1, control, sum(z.body == "inertial" for z in zones.zones),
            (moving, degree) if degree is not None else (id(zones), cone_margin),
-           problem.spacecraft.wheel_axes.tobytes() if momentum else None, problem.rate_max,
+           problem.spacecraft.wheel_axes.tobytes() if momentum else None, wheel_rows(problem), problem.rate_max,
            goal_kind(problem), tol, max_iter, expand)
     if key not in _NLPS:
         while len(_NLPS) >= CACHE_SIZE:
@@ -309,7 +331,7 @@ def _start(tr: col.Transcription, problem: ManeuverProblem, s: Scaling, smooth: 
     tr.bound_state(0, 0, np.concatenate([q0, np.zeros(9 if smooth else 3)]))
     lower, upper = tf_bounds
     if problem.goal_motion is not None:
-        upper = min(upper, goal_window(problem) / s.tu)
+        upper = min(upper, problem.goal_motion.window / s.tu)
     tr.set_duration_bounds(0, min(lower, 0.5 * upper), upper)
     return tr
 
@@ -330,7 +352,7 @@ def _build(problem: ManeuverProblem, s: Scaling, mesh: np.ndarray, control: str,
     if problem.goal_motion is not None:            # on the moving goal at t_f, at its rate
         if smooth:
             raise ValueError("a moving goal is time_optimal's: the smooth plans end at rest")
-        rows = [tr.extra[2 + 7 * i:9 + 7 * i] for i in range(GOAL_DEGREE + 1)]
+        rows = [tr.extra[2 + 7 * i:9 + 7 * i] for i in range((len(goal) - 2) // 7)]
         target = clenshaw(tr.extra[0] * v.duration + tr.extra[1], rows)
         tr.add_constraint(symbolic.error_vector(q_end, target[:4]), 0.0, 0.0)
         tr.add_constraint(v.x_end[4:7] - target[4:7], 0.0, 0.0)

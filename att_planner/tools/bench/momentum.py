@@ -16,23 +16,27 @@ transient), which also holds the reference attitude the controller tracked:
 from __future__ import annotations
 
 import math
+import multiprocessing
 import time
+from concurrent.futures import ProcessPoolExecutor
 from datetime import UTC, datetime
 from pathlib import Path
 
 import numpy as np
 import rclpy
+from rclpy.serialization import serialize_message
 
-from att_msgs.msg import SpacecraftState
+from att_msgs.msg import ActuatorCommand, ControllerStatus, SpacecraftState
 from att_msgs.srv import ResetSimulator
 from att_msgs_py import convert, qos, topics
-from att_msgs_py.log import read_log
+from att_msgs_py.log import LogWriter, read_log
 from att_msgs_py.types import ControlMode, PointingMode
 from att_planner.control.momentum import null_space
 from att_planner.guidance import reference
 from att_planner.guidance.laws import Sky
 from att_planner.guidance.modes import law_of
 from att_planner.nodes.client import client_session
+from att_planner.tools.closed_loop import ClosedLoop
 from att_planner.tools.launch import isolated_env, join_env, start_suite
 from att_planner.tools.review.pointing import SATURATED, TOPICS, pointing_of, pointing_summary
 from att_sim import scenario as scen
@@ -46,6 +50,9 @@ def configure(parser):
     parser.add_argument("--scenario", default="leo_momentum", help="a scenario with wheels and magnetorquers")
     parser.add_argument("--orbits", type=float, default=15.0, help="orbits flown with dumping (and at most without)")
     parser.add_argument("--out", default="bench_out/momentum", help="directory for the runs' logs")
+    parser.add_argument("--in-process", action="store_true",
+                        help="fly the simulator's and the controller's cores in this process (no DDS: several "
+                             "times faster; the same figures from the same topics)")
 
 
 def start_state(s: scen.Scenario, t: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -106,13 +113,59 @@ def fly(s: scen.Scenario, dumping: bool, seconds: float, out: Path) -> dict:
             "rtf": sim_seconds / wall if wall > 0 else math.inf}
 
 
+def fly_in_process(s: scen.Scenario, dumping: bool, seconds: float, out: Path) -> dict:
+    """:func:`fly` with the cores of the simulator and the controller in this process
+    (:class:`~att_planner.tools.closed_loop.ClosedLoop`, no DDS): the state, command and status each
+    control step written to the MCAP as the nodes publish them."""
+    run_dir = out / f"{s.name}_{'dumping' if dumping else 'no_dumping'}_in_process_{datetime.now(UTC):%Y%m%d_%H%M%S}"
+    run_dir.mkdir(parents=True, exist_ok=True)
+    mcap = run_dir / "run.mcap"
+    q0, w0, wheels0 = start_state(s, 0.0)
+    loop = ClosedLoop(s, q0=q0, omega0=w0, wheel_speed0=wheels0,
+                      overrides={"controller": {"state_source": "truth", "momentum_dumping": dumping}})
+    log = LogWriter(mcap)
+    for topic, msg_type in ((topics.STATE, SpacecraftState), (topics.COMMAND, ActuatorCommand),
+                            (topics.CONTROLLER_STATUS, ControllerStatus)):
+        log.add_topic(topic, f"att_msgs/msg/{msg_type.__name__}")
+    limit, saturated = s.spacecraft.wheel_speed_max, []
+
+    def record(step, state):
+        stamp = int(round(state.t * 1e9))
+        for topic, msg in ((topics.STATE, convert.state_msg(state)),
+                           (topics.COMMAND, convert.command_msg(step.command)),
+                           (topics.CONTROLLER_STATUS, convert.controller_status_msg(step.status))):
+            log.write(topic, serialize_message(msg), stamp)
+        ratio = np.max(np.abs(state.wheel_speeds - s.spacecraft.wheel_axes.T @ state.omega)) / limit
+        if not dumping and ratio >= SATURATED:
+            saturated.append(state.t)
+
+    wall0 = time.monotonic()
+    loop.run(loop.step)
+    code, why, _ = loop.controller.set_mode(ControlMode.POINTING, PointingMode("nadir"))
+    if code:
+        raise RuntimeError(f"the controller refused nadir pointing: {why}")
+    loop.on_step = record
+    while loop.sim.t < seconds and not saturated and not loop.sim.halted:
+        loop.run(60.0)
+    wall = time.monotonic() - wall0
+    log.close()
+    run = pointing_of(read_log(mcap, topics=TOPICS), s.spacecraft)
+    figures = pointing_summary(run, settle=SETTLE)
+    sim_seconds = float(run.state_t[-1] - run.state_t[0])
+    return {**figures, "mcap": str(mcap), "sim_seconds": sim_seconds, "wall_seconds": wall,
+            "rtf": sim_seconds / wall if wall > 0 else math.inf, "in_process": True}
+
+
 def run(args) -> dict:
     s = scen.load(args.scenario)
     period = getattr(s.orbit_model, "period", None) or 2 * math.pi / s.orbit.mean_motion
     seconds = args.orbits * period
     out = Path(args.out)
-    on = fly(s, True, seconds, out)
-    off = fly(s, False, seconds, out)
+    if args.in_process:         # the two flights side by side, one process each
+        with ProcessPoolExecutor(2, mp_context=multiprocessing.get_context("spawn")) as pool:
+            on, off = pool.map(fly_in_process, [s, s], [True, False], [seconds, seconds], [out, out])
+    else:
+        on, off = fly(s, True, seconds, out), fly(s, False, seconds, out)
     print(f"\nmomentum: {s.name}, nadir pointing, {args.orbits:g} orbits of {period:.0f} s")
     print(f"{'':<28} {'dumping on':>14} {'dumping off':>14}")
     for key in ("peak_wheel_speed_ratio", "pointing_error_rms_deg", "pointing_error_max_deg", "dipole_duty",

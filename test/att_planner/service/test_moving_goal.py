@@ -3,18 +3,21 @@ with a semi-free goal, the mode checked field by field; the goal's law is the co
 from __future__ import annotations
 
 import math
+import pickle
 from dataclasses import replace
 
 import numpy as np
 import pytest
 
 from att_msgs_py.errors import ErrorCode, RequestError
-from att_msgs_py.types import PointingMode
+from att_msgs_py.types import PointingMode, Stage
 from att_planner.guidance import reference
 from att_planner.guidance.laws import Sky
 from att_planner.guidance.modes import law_of
-from att_planner.service.moving_goal import goal_motion
+from att_planner.service.moving_goal import goal_law
+from att_planner.service.planning import plan_maneuver
 from att_planner.service.requests import ManeuverRequest, validate_maneuver
+from att_planner.service.worker import run_isolated, warm_up
 from att_sim import rotations as rot
 from att_sim import scenario as scen
 from att_sim import world
@@ -32,7 +35,7 @@ def validate(method="time_optimal", mode=NADIR, **fields):
 
 def test_the_goal_is_the_controllers_law_shifted_by_the_plans_epoch():
     later = LEO.epoch.replace(second=LEO.epoch.second + 30)
-    motion = goal_motion(PointingMode("nadir"), LEO, later, rot.IDENTITY)
+    motion = goal_law(PointingMode("nadir"), LEO, later, rot.IDENTITY)
     law = law_of(PointingMode("nadir"), Sky.of(world.Environment.from_scenario(LEO)), 0.0, rot.IDENTITY)
     q, w = motion(100.0)
     ref = reference(law.attitude, 130.0)
@@ -60,3 +63,21 @@ def test_bad_end_pointing_requests_are_refused_naming_the_field(fields, code, wo
     with pytest.raises(RequestError) as err:
         validate(**fields)
     assert err.value.code == code and words in err.value.message
+
+
+def test_the_goal_travels_to_a_child_process_as_its_series_and_is_met_there():
+    """The law's sky does not pickle; its series does, within 1e-9 (quaternion components) and 1e-11 rad/s of it over the
+    window, and the planner's child process meets the goal the parent verifies against the law."""
+    valid = validate()
+    goal = valid.problem.goal_motion
+    copy = pickle.loads(pickle.dumps(goal))
+    assert copy.law is None
+    for t in np.linspace(0.0, goal.window, 37):
+        (q, w), (q_copy, w_copy) = goal(t), copy(t)
+        assert np.abs(q - np.sign(q @ q_copy) * q_copy).max() < 1e-9 and np.abs(w - w_copy).max() < 1e-11
+    warm_up()
+    outcome = plan_maneuver(validate(), runner=run_isolated)
+    assert outcome.code == ErrorCode.OK and outcome.stage == Stage.METHOD, outcome.message
+    assert [s.name for s in outcome.stages] == [Stage.METHOD]          # no rest-to-rest first plan
+    ver = outcome.plan.verification
+    assert ver.final_attitude_error < 1e-4 and ver.final_rate < 1e-6
