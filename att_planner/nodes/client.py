@@ -31,7 +31,7 @@ from att_msgs.action import ExecuteManeuver
 from att_msgs.srv import PlanManeuver, PlanSchedule, SetControllerMode
 from att_msgs_py import convert, qos, signing, topics
 from att_msgs_py.errors import ErrorCode, RequestError
-from att_msgs_py.types import Cone, Zone
+from att_msgs_py.types import Cone, PointingMode, Zone
 from att_msgs_py.validation import text
 
 POLL = 0.05                 # s between checks of a pending call or goal
@@ -70,11 +70,13 @@ def check_strings(msg, name: str = "", nul_only: bool = False) -> None:
 def maneuver_request(q_initial, q_final, sensor_axis, cones: list[Cone], *, method: str = "",
                      time_budget: float = 0.0, spacecraft: str = "", frame_id: str = "eci",
                      options: dict | None = None, epoch: datetime | None = None, zones: list[Zone] = (),
-                     tle: tuple[str, str] = ("", ""), wheel_speeds=()) -> PlanManeuver.Request:
+                     tle: tuple[str, str] = ("", ""), wheel_speeds=(),
+                     end_pointing: PointingMode | None = None) -> PlanManeuver.Request:
     """A PlanManeuver request; ValueError when a string holds a NUL or another control character.
     The real sky: ``epoch`` (UTC start; None: the scenario's), ``zones`` (besides the cones) and the
     orbit's ``tle`` lines (empty: the scenario's orbit); ``wheel_speeds``: the wheels' speeds at the
-    start (rad/s relative to the body; empty: stopped), kept within their limit along the plan."""
+    start (rad/s relative to the body; empty: stopped), kept within their limit along the plan;
+    ``end_pointing``: a pointing mode the plan ends on, at its attitude and rate (method time_optimal)."""
     req = PlanManeuver.Request()
     req.header.frame_id = frame_id
     req.initial_attitude = convert.quaternion(q_initial)
@@ -88,6 +90,8 @@ def maneuver_request(q_initial, q_final, sensor_axis, cones: list[Cone], *, meth
     req.zones = [convert.zone_msg(z) for z in zones]
     req.tle_line1, req.tle_line2 = tle
     req.wheel_speeds = [float(v) for v in wheel_speeds]
+    if end_pointing is not None:
+        req.end_pointing = convert.pointing_msg(end_pointing)
     check_strings(req)
     return req
 
