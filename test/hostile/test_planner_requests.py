@@ -16,7 +16,7 @@ from att_msgs.action import ExecuteManeuver
 from att_msgs.msg import ManeuverPlan
 from att_msgs_py import convert, qos, signing, topics
 from att_msgs_py.errors import ErrorCode, RequestError
-from att_msgs_py.types import Cone
+from att_msgs_py.types import Cone, PointingMode
 from att_planner.nodes.client import check_strings, maneuver_request
 from att_planner.service.planning import plan_maneuver, run_method
 from att_planner.service.requests import MAX_CONES, MAX_OPTIONS, MAX_TARGETS, validate_schedule
@@ -140,6 +140,26 @@ MANEUVER_CASES = {
     "absolute path spacecraft": (dict(spacecraft="/etc/passwd"), ErrorCode.UNKNOWN_SPACECRAFT, "configuration name"),
     "yaml file spacecraft": (dict(spacecraft="swift_demo.yaml"), ErrorCode.UNKNOWN_SPACECRAFT, "configuration name"),
     "wrong frame": (dict(frame_id="map"), ErrorCode.INVALID_FRAME, "header.frame_id 'map' is not"),
+    # the wheels at the start (swift_demo: three, 630 rad/s)
+    "wheel speeds short": (dict(wheel_speeds=[0.0, 0.0]), ErrorCode.INVALID_WHEEL_SPEEDS, "wheel_speeds has 2 values"),
+    "wheel speeds long": (dict(wheel_speeds=[0.0] * 10_000), ErrorCode.INVALID_WHEEL_SPEEDS, "10000 values"),
+    "wheel speed nan": (dict(wheel_speeds=[0.0, NAN, 0.0]), ErrorCode.INVALID_WHEEL_SPEEDS, "wheel_speeds has NaN"),
+    "wheel speed -inf": (dict(wheel_speeds=[-INF, 0.0, 0.0]), ErrorCode.INVALID_WHEEL_SPEEDS, "wheel_speeds"),
+    "wheel speed beyond": (dict(wheel_speeds=[0.0, -630.5, 0.0]), ErrorCode.INVALID_WHEEL_SPEEDS,
+                           "wheel_speeds[1] = -630.5 rad/s is beyond"),
+    # a slew that ends on a pointing mode
+    "end pointing, other method": (dict(end_pointing=PointingMode("nadir")), ErrorCode.INVALID_OPTION,
+                                   "end_pointing: a slew that ends on a pointing mode is planned by time_optimal"),
+    "end pointing, semi-free": (dict(end_pointing=PointingMode("nadir"), method="time_optimal", semi_free=True,
+                                     sensor_target=[0, 1, 0]), ErrorCode.INVALID_OPTION, "semi_free"),
+    "end pointing, unknown kind": (dict(end_pointing=PointingMode("sideways"), method="time_optimal"),
+                                   ErrorCode.INVALID_POINTING, "pointing.kind 'sideways' is not one of"),
+    "end pointing, control character": (dict(end_pointing=PointingMode("nadir\x7f"), method="time_optimal"),
+                                        ErrorCode.INVALID_TEXT, "pointing.kind contains the control"),
+    "end pointing, ground nan": (dict(end_pointing=PointingMode("ground", latitude=NAN), method="time_optimal"),
+                                 ErrorCode.INVALID_POINTING, "pointing.latitude"),
+    "end pointing, parallel axes": (dict(end_pointing=PointingMode("nadir", secondary_axis=np.array([0, 0, 1.0])),
+                                         method="time_optimal"), ErrorCode.INVALID_POINTING, "pointing"),
 }
 
 
