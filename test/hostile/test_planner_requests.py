@@ -358,3 +358,21 @@ def test_plans_are_signed_and_bound_to_their_spacecraft_and_published_as_answere
         assert signing.check(signing.payload(forged), forged.signature, forged.key_id, public) is not None
     finally:
         node.destroy_subscription(sub)
+
+
+@pytest.mark.ros
+def test_the_node_slows_a_plan_for_its_wheels_says_so_and_refuses_a_bad_end_pointing(planner):
+    """Over the wire: wheel z at -600 rad/s and a slew about +z (which spins it further down) is
+    answered slowed (``slowdown`` > 1, the message says so, the wheels within their limit); a bad
+    ``end_pointing`` is refused naming the field, and the node keeps serving."""
+    req = maneuver_request(rot.IDENTITY, rot.from_axis_angle([0, 0, 1], math.pi / 2), X, [],
+                           method="eigenaxis_smooth", wheel_speeds=[0.0, 0.0, -600.0])
+    answer = planner.client.plan(req)
+    assert answer.success and answer.slowdown > 1.5 and "slowed" in answer.message, answer.message
+    assert answer.plan.verification.wheel_speed_ratio <= 1.0
+    bad = maneuver_request(rot.IDENTITY, GOAL, X, [], method="time_optimal",
+                           end_pointing=PointingMode("ground", latitude=2.0))
+    refused = planner.client.plan(bad)
+    assert (refused.success, refused.error_code) == (False, ErrorCode.INVALID_POINTING)
+    assert "pointing.latitude" in refused.message
+    assert planner.client.plan(good_request()).success and planner.suite.alive()["planner"]
