@@ -162,7 +162,7 @@ def path_values(problem: ManeuverProblem, s: Scaling, cone_margin: float) -> np.
     ``cos(θ + σ δ)`` (``δ = cone_margin``); each moving zone's σ, unit sensor axis, α = 2 τ_u/(b − a)
     and β = −(a + b)/(b − a) of its series on [a, b] and the coefficients (zero-padded to
     :func:`motion_degree`, θ's first one raised by σ δ), when they are parameters; then the
-    momentum bound's scale."""
+    wheels' data (:func:`wheel_speed_values`) and the momentum bound's scale."""
     zones = problem.zone_sky()
     degree = motion_degree(zones)
     axes, half = zones.at(0.0)
