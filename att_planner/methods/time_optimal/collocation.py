@@ -39,9 +39,10 @@ import numpy as np
 from att_planner.methods.time_optimal.anytime import DeadlineCallback
 
 CONTROL_KINDS = ("constant", "linear")
-# IPOPT's MUMPS with the AMD ordering and without its own scalings (IPOPT scales the NLP): the same
-# iterates, and about a third less CPU per iteration on the slews' KKT systems of a few hundred to
-# two thousand rows (default: 0.17 s, these: 0.10 s for swift's three exploration solves)
+# IPOPT options for MUMPS with the AMD ordering and without its own scalings (IPOPT scales the NLP):
+# on the bang-bang slews the same iterates at a fifth to a third less CPU (swift's three exploration
+# solves: 0.10 s, the defaults 0.12-0.17 s); not on the smooth ones, whose iterations they changed
+# (earth_obs 28 -> 70, swift 25 -> 22)
 MUMPS_OPTIONS = {"mumps_pivot_order": 0, "mumps_scaling": 0, "mumps_permuting_scaling": 0}
 
 
@@ -379,7 +380,7 @@ class Transcription:
                 "ipopt.constr_viol_tol": 1e-8, "ipopt.acceptable_constr_viol_tol": 1e-6,
                 "ipopt.mu_strategy": "adaptive", "iteration_callback": self._callback,
                 "iteration_callback_ignore_errors": False}
-        opts.update({f"ipopt.{k}": v for k, v in {**MUMPS_OPTIONS, **(ipopt_options or {})}.items()})
+        opts.update({f"ipopt.{k}": v for k, v in (ipopt_options or {}).items()})
         opts.update(nlpsol_options or {})
         self._solver = ca.nlpsol("hermite_simpson", "ipopt", {"x": self._w, "p": self._p, "f": self._objective,
                                                               "g": g}, opts)
