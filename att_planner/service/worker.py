@@ -1,13 +1,12 @@
-"""Run a planning method in a child process that is answered without, and killed, if it overruns.
+"""Run a planning method in a child process that is killed if it overruns its time.
 
 Flight-software style isolation for the planner node: a solver that ignores its deadline, hangs
 or crashes (a segfault in a native solver) costs one worker process, never the node. Workers are
 forked from a ``forkserver`` that has already imported the numerics and serve one task after
 another, so what a method keeps between problems (its NLPs built for a shape, the compiled
-integrator) serves the next request too; a worker that overruns is answered without, gets
-:data:`ADOPT_SECONDS` to finish in the background (then serves on with its caches) and is killed if it
-does not; one that dies is replaced by a new one. At most ``max_parallel`` solve at once (the rest wait,
-within their own budget).
+integrator) serves the next request too; a worker that overruns is killed and one that dies is
+replaced by a new one. At most ``max_parallel`` solve at once (the rest wait, within their own
+budget).
 
 A problem with a sky (issue 13) crosses to the child as it is: :class:`att_sim.ephemeris.Sky` and
 :class:`att_sim.orbit.TLEOrbit` pickle as their recipes (epoch and orbit, epoch and lines), since
@@ -30,7 +29,6 @@ _CONTEXT.set_forkserver_preload(["att_planner.service.planning", "numpy", "scipy
                                  "skyfield.api", "sgp4.api", "casadi", "att_planner.methods.time_optimal.smooth"])
 _SLOTS = threading.BoundedSemaphore(max(1, os.cpu_count() or 1))
 KILL_GRACE = 0.5            # s after the wait before the child is terminated
-ADOPT_SECONDS = 10.0        # s an overrunning worker may still take to finish in the background (one at a time)
 
 
 def set_max_parallel(n: int) -> None:
@@ -47,7 +45,6 @@ def warm_up() -> None:
 
 _IDLE: list = []                # (process, connection) of the workers waiting for a task, the last used last
 _IDLE_LOCK = threading.Lock()
-_ADOPTING = threading.BoundedSemaphore(1)     # overrunning workers finishing in the background
 
 
 def _serve(conn) -> None:
@@ -76,24 +73,6 @@ def _worker():
     return process, conn
 
 
-def _finish_or_retire(process, conn, adopting: threading.BoundedSemaphore) -> None:
-    """Wait up to :data:`ADOPT_SECONDS` for an overrunning worker's late answer (dropped), then keep
-    the worker for the next task (its caches warm: a first request that builds a method's NLPs on a
-    loaded machine overruns, and a fresh worker in its place would build them again, and overrun,
-    at every request); retire it if it does not answer."""
-    try:
-        if process.is_alive() and conn.poll(ADOPT_SECONDS):
-            conn.recv()
-            with _IDLE_LOCK:
-                _IDLE.append((process, conn))
-            return
-    except (EOFError, OSError):
-        pass
-    finally:
-        adopting.release()
-    _retire(process, conn)
-
-
 def _retire(process, conn) -> None:
     """Stop a worker (it overran or died): terminate, then kill."""
     if process.is_alive():
@@ -109,8 +88,7 @@ def call_isolated(function, args: tuple, kwargs: dict, wait: float | None, *, on
     """``function(*args, **kwargs)`` in a worker process (``function`` importable by name).
 
     Returns its result, ``None`` when it has not answered within ``wait`` s (+ grace; the worker
-    then gets :data:`ADOPT_SECONDS` in the background to finish, if no other is finishing, and is
-    killed if it does not), or ``on_death(message)`` when the worker died without answering.
+    is then killed), or ``on_death(message)`` when the worker died without answering.
     """
     start = time.monotonic()
     if not _SLOTS.acquire(timeout=wait):
@@ -128,10 +106,6 @@ def call_isolated(function, args: tuple, kwargs: dict, wait: float | None, *, on
                 return result
             if not process.is_alive():
                 return on_death(f"solver process died (exit code {process.exitcode})")
-            adopting = _ADOPTING
-            if adopting.acquire(blocking=False):        # answered without it; it may finish in the background
-                threading.Thread(target=_finish_or_retire, args=(process, conn, adopting), daemon=True).start()
-                process = None
             return None
         except (EOFError, OSError):
             process.join(1.0)

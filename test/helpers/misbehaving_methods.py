@@ -13,14 +13,3 @@ def plan_crashes(problem, **options):
 
 def plan_raises(problem, **options):
     raise RuntimeError("solver exploded")
-
-
-_CALLS = 0
-
-
-def count_after(seconds):
-    """This worker's pid and how many tasks it has run, after ``seconds``."""
-    global _CALLS
-    time.sleep(seconds)
-    _CALLS += 1
-    return os.getpid(), _CALLS

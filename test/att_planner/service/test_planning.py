@@ -3,7 +3,6 @@ faults, budget expiry and fallbacks, semi-free goals judged on the integrated bo
 from __future__ import annotations
 
 import math
-import threading
 import time
 from dataclasses import replace
 
@@ -13,13 +12,11 @@ import pytest
 from att_msgs_py.errors import ErrorCode
 from att_msgs_py.types import Stage, Status
 from att_planner.methods import Method
-from att_planner.service import worker
 from att_planner.service.planning import plan_maneuver, run_method
-from att_planner.service.worker import call_isolated, run_isolated, warm_up
+from att_planner.service.worker import run_isolated, warm_up
 from att_planner.verification import TOLERANCES
 from att_sim import rotations as rot
 from helpers.maneuver_requests import EARTH, request, validate
-from helpers.misbehaving_methods import count_after
 
 
 @pytest.fixture(scope="module", autouse=True)
@@ -63,18 +60,6 @@ def test_faulty_cheap_solver_gives_a_verified_eigenaxis_fallback_within_the_budg
     assert outcome.stage == Stage.FALLBACK and [s.name for s in outcome.stages] == [Stage.METHOD, Stage.FALLBACK]
     assert outcome.verification.min_cone_margin > 0
     assert outcome.verification.final_attitude_error < math.radians(1)
-
-
-def test_a_worker_that_overruns_a_little_is_answered_without_and_then_serves_on(monkeypatch):
-    """Its late answer is dropped and the worker kept (a first NLP build on a loaded machine overruns:
-    a fresh worker in its place would build again, and overrun, at every request)."""
-    monkeypatch.setattr(worker, "_ADOPTING", threading.BoundedSemaphore(1))   # the hung solvers above: theirs
-    start = time.monotonic()
-    assert call_isolated(count_after, (1.5,), {}, 0.1, on_death=str) is None      # wait 0.1 s + 0.5 s grace
-    assert time.monotonic() - start < 1.2
-    time.sleep(1.5)
-    pid, calls = call_isolated(count_after, (0.0,), {}, 5.0, on_death=str)
-    assert calls == 2 and call_isolated(count_after, (0.0,), {}, 5.0, on_death=str) == (pid, 3)
 
 
 def test_no_fallback_when_the_eigenaxis_enters_a_cone():
