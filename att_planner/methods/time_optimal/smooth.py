@@ -18,6 +18,9 @@ given plans (``warm_starts``: the planner service passes its first plan) or, wit
 built once per shape (:func:`.model.transcription`, which holds the NLP of both). The solution is
 integrated through the truth dynamics (:mod:`att_planner.verification`); where the dense grid
 enters a zone the mesh is bisected and the NLP solved again (:data:`REFINE_ROUNDS` times at most).
+Anytime: when the deadline stops IPOPT before it converges, the iterate of least t_f that met the
+constraints (:data:`.anytime.INCUMBENT_VIOLATION`) becomes the plan, if it verifies (on
+leo_observatory IPOPT reaches t_f within 0.2 % of its optimum in half its iterations, then polishes).
 """
 from __future__ import annotations
 
@@ -42,6 +45,11 @@ DEFAULT_INTERVALS = 30
 DEFAULT_TORQUE_ACCEL = 100.0      # T̄ per τ_u²: a full swing of the torque takes 0.28 τ_u
 SAMPLES_PER_INTERVAL = 8          # plan knots per mesh interval
 REFINE_ROUNDS = 3                 # mesh bisections where the truth enters a zone
+
+
+def expired_at(problem: ManeuverProblem) -> bool:
+    """Whether the problem's deadline has passed."""
+    return problem.deadline is not None and time.monotonic() > problem.deadline
 
 
 def guess(plan: Plan, s: Scaling, phase: col.Phase) -> col.PhaseGuess:
@@ -91,7 +99,8 @@ def plan_smooth_collocation(problem: ManeuverProblem, *, intervals: int = DEFAUL
     times as many); ``torque_accel`` the bound on the torque's second derivative (T̄ per τ_u²);
     ``cone_margin_deg`` tightening of every zone at the collocation points; ``warm_starts`` plans to
     start from (the first that converges is refined; without any, graph_smooth's plan). Honours
-    ``problem.deadline``: the last verified plan (status BUDGET_EXPIRED) or none.
+    ``problem.deadline``: the last verified plan (status BUDGET_EXPIRED) — a converged solution's,
+    or that of the feasible iterate of least t_f where the deadline stopped IPOPT — or none.
     """
     start = time.monotonic()
     why = no_torque_limit(problem) or blocked_endpoint(problem)
@@ -111,29 +120,32 @@ def plan_smooth_collocation(problem: ManeuverProblem, *, intervals: int = DEFAUL
     for _ in range(REFINE_ROUNDS + 1):
         tr = transcription(problem, s, mesh, "constant", np.deg2rad(cone_margin_deg), bounds,
                            torque_accel=torque_accel, tol=tol, max_iter=max_iter)
-        res = None
+        w = incumbent = None
         for g in initial:
             res = tr.solve(tr.pack([g]), deadline=problem.deadline)
             nit, nfev = nit + res.nit, nfev + res.nfev
             stats["meshes"].append({"intervals": len(mesh) - 1, "tf": res.objective * s.tu, "status": res.status,
                                     "iterations": res.nit, "seconds": res.wall_time})
+            incumbent = incumbent if res.incumbent is None else res.incumbent
             if res.success and res.constraint_violation < CONVERGED_VIOLATION:
+                w = res.w
                 break
-        if not (res.success and res.constraint_violation < CONVERGED_VIOLATION):
+        if w is None and (incumbent is None or not expired_at(problem)):
             break
-        sol = tr.phase_solution(res.w)
+        # not converged when the deadline came: the feasible iterate of least t_f, if it verifies
+        sol = tr.phase_solution(incumbent if w is None else w)
         plan = smooth_plan(sol, s)
         traj = integrate(problem, plan)
         plan.verification = measure(problem, plan, traj)
         best = plan if best is None or rejection(plan.verification) is None else best
         # the plan's times are the solution's slowed by c: the truth's samples back on the solution's mesh
         bad = _truth_violation_intervals(replace(traj, t=traj.t / plan.stats["slowed_by"]), sol, s, problem)
-        if rejection(plan.verification) is None or not len(bad) or len(mesh) - 1 >= 4 * intervals:
+        if w is None or rejection(plan.verification) is None or not len(bad) or len(mesh) - 1 >= 4 * intervals:
             break
         mesh = col.refine_mesh(mesh, bad, 4 * intervals)
         initial = [sol.resample(tr.phases[0].with_mesh(mesh))]
     elapsed = time.monotonic() - start
-    expired = problem.deadline is not None and time.monotonic() > problem.deadline
+    expired = expired_at(problem)
     if best is None:
         statuses = sorted({m["status"] for m in stats["meshes"]})
         return Plan(method=METHOD, status=Status.BUDGET_EXPIRED if expired else Status.FAILED,

@@ -6,7 +6,7 @@ import pytest
 from att_planner.methods.time_optimal import collocation as col
 
 
-def _double_integrator(control, intervals=10):
+def _double_integrator(control, intervals=10, max_iter=1000):
     x, u = ca.SX.sym("x", 2), ca.SX.sym("u", 1)
     f = ca.Function("f", [x, u], [ca.vertcat(x[1], u)])
     phase = col.Phase(f, col.uniform_mesh(intervals), control=control, control_bounds=(-1, 1),
@@ -15,7 +15,7 @@ def _double_integrator(control, intervals=10):
     tr.bound_state(0, 0, [0, 0])
     tr.bound_state(0, -1, [1, 0])
     tr.minimize(tr.variables(0).duration)
-    tr.build()
+    tr.build(max_iter=max_iter)
     guess = col.guess_from_functions(phase, 3.0, lambda t: np.stack([t / 3, np.full_like(t, 1 / 3)], -1),
                                      lambda t: np.zeros((len(t), 1)))
     return tr, tr.solve(tr.pack([guess]))
@@ -36,6 +36,22 @@ def test_collocation_linear_control_cannot_beat_the_bang_bang_bound():
     tr, res = _double_integrator("linear")
     assert res.success
     assert 2.0 - 1e-6 <= tr.phase_solution(res.w).duration < 2.1
+
+
+def test_an_unconverged_solve_keeps_its_feasible_iterate_of_least_time():
+    # stopped after 3 IPOPT iterations no iterate meets the constraints; after 5 and 6 one does, and its
+    # zero-order-hold torques, integrated exactly, bring the double integrator to rest at x = 1
+    assert _double_integrator("constant", max_iter=3)[1].incumbent is None
+    for max_iter in (5, 6):
+        tr, res = _double_integrator("constant", max_iter=max_iter)
+        assert not res.success and res.incumbent is not None
+        sol = tr.phase_solution(res.incumbent)
+        x = v = 0.0
+        for h, u in zip(np.diff(sol.phase.mesh) * sol.duration, sol.u[:, 0]):
+            x, v = x + v * h + 0.5 * u * h**2, v + u * h
+        assert x == pytest.approx(1.0, abs=1e-3) and v == pytest.approx(0.0, abs=1e-9)
+        assert 2.0 - 1e-6 <= sol.duration < 2.001
+    assert _double_integrator("constant")[1].incumbent is None        # converged: the answer itself
 
 
 def test_refine_mesh_bisects_only_the_listed_intervals_within_the_cap():
