@@ -66,8 +66,9 @@ def test_bad_end_pointing_requests_are_refused_naming_the_field(fields, code, wo
 
 
 def test_the_goal_travels_to_a_child_process_as_its_series_and_is_met_there():
-    """The law's sky does not pickle; its series does, within 1e-9 (quaternion components) and 1e-11 rad/s of it over the
-    window, and the planner's child process meets the goal the parent verifies against the law."""
+    """The law's sky does not pickle; its series does, within 1e-9 (quaternion components) and
+    1e-11 rad/s of it over the window, and the planner's child process meets the goal the parent
+    verifies against the law."""
     valid = validate()
     goal = valid.problem.goal_motion
     copy = pickle.loads(pickle.dumps(goal))
