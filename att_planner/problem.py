@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import math
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from datetime import datetime
 from typing import TYPE_CHECKING
@@ -18,13 +19,42 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from att_msgs_py.types import Cone, Zone
-from att_planner.zones import ZoneSky, zones_from_cones
+from att_planner.zones import ZoneSky, clenshaw, zones_from_cones
 from att_sim import rotations as rot
 from att_sim.dynamics import Spacecraft
 
 if TYPE_CHECKING:          # the annotations only: att_sim.ephemeris loads skyfield
-    from att_planner.service.moving_goal import MovingGoal
     from att_sim.ephemeris import Sky
+
+GOAL_DEGREE = 16         # of a moving goal's series of the attitude (sign-continuous) and the rate
+
+
+class MovingGoal:
+    """A goal that moves (a pointing law, issue 15): ``t ↦ (q, ω)`` from the law in this process, or
+    from its Chebyshev series over ``[0, window]`` (the Chebyshev points of the first kind) after
+    pickling: a planner's child process gets the series, the verification the law."""
+
+    def __init__(self, law: Callable[[float], tuple[np.ndarray, np.ndarray]], window: float):
+        self.law, self.window = law, float(window)
+        n = 2 * (GOAL_DEGREE + 1)
+        x = np.sort(np.cos(np.pi * (np.arange(n) + 0.5) / n))         # Chebyshev points of the first kind
+        samples = []
+        for t in 0.5 * (x + 1.0) * self.window:
+            q, w = law(float(t))
+            if samples and np.dot(q, samples[-1][:4]) < 0:
+                q = -q
+            samples.append(np.concatenate([q, w]))
+        self.coefficients = np.polynomial.chebyshev.chebfit(x, np.array(samples), GOAL_DEGREE)   # (degree + 1, 7)
+
+    def __call__(self, t: float) -> tuple[np.ndarray, np.ndarray]:
+        if self.law is not None:
+            return self.law(t)
+        value = clenshaw(np.array([[2.0 * t / self.window - 1.0]]), list(self.coefficients))[0]
+        return value[:4] / np.linalg.norm(value[:4]), value[4:]
+
+    def __getstate__(self) -> dict:
+        return {**self.__dict__, "law": None}          # the law's sky does not travel: its series does
+
 
 MIN_WINDOW = 600.0        # s: the shortest default zone window
 WINDOW_FACTOR = 4.0       # the default window: this many times the eigenaxis slew time, at least MIN_WINDOW
@@ -53,7 +83,7 @@ class ManeuverProblem:
       (:class:`att_sim.ephemeris.Sky`, needed by sun, moon and earth_limb zones).
       :meth:`zone_sky` joins them: what every method and the verification use.
     * ``goal_motion``: a goal that moves (a pointing law, issue 15:
-      :class:`att_planner.service.moving_goal.MovingGoal`): ``t ↦ (q, ω)``, the attitude and
+      :class:`MovingGoal`, made by :mod:`att_planner.service.moving_goal`): ``t ↦ (q, ω)``, the attitude and
       body rate the plan must reach at its final time ``t`` (``q_final``: its attitude at a first
       estimate of that time, for guesses); None: ``q_final`` at rest.
     * ``wheel_speeds``: the wheels' speeds at the start; the verification follows them along the plan

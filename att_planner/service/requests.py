@@ -27,8 +27,8 @@ from att_msgs_py.validation import MAX_NAME_LENGTH, finite_array, text, unit_qua
 from att_planner import methods
 from att_planner.cones import BOUNDARY_TOLERANCE, boundary_arc_issue, check_zones, endpoint_in_cone
 from att_planner.methods import Method
-from att_planner.problem import ManeuverProblem
-from att_planner.service.moving_goal import MovingGoal, goal_law
+from att_planner.problem import ManeuverProblem, MovingGoal
+from att_planner.service.moving_goal import goal_law
 from att_planner.service.real_sky import RequestSky, check_orbit_window, resolve_sky
 from att_planner.service.sky import closed_sky
 from att_sim import rotations as rot

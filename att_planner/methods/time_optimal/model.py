@@ -205,7 +205,7 @@ def goal_values(problem: ManeuverProblem, s: Scaling) -> np.ndarray:
 
 
 def moving_goal_values(problem: ManeuverProblem, s: Scaling) -> np.ndarray:
-    """A moving goal (:class:`att_planner.service.moving_goal.MovingGoal`) as parameters:
+    """A moving goal (:class:`att_planner.problem.MovingGoal`) as parameters:
     ``α = 2 τ_u / W``, ``β = −1`` and its series' coefficients of the attitude and the normalised
     rate ``ω τ_u`` in ``x = α t̃ + β`` (``t̃`` the normalised time) over its window ``[0, W]``."""
     goal = problem.goal_motion

