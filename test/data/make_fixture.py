@@ -60,7 +60,7 @@ def main() -> int:
             suite.start("simulator", {"scenario": "swift_demo", "wait_for_subscribers": 3, **PARAMS["simulator"]})
             for _ in range(40):
                 result = client.execute(response.plan.plan_id)
-                if result.error_code != ErrorCode.NO_STATE:
+                if result.error_code not in (ErrorCode.NO_STATE, ErrorCode.ESTIMATE_UNHEALTHY):   # not yet
                     break
                 time.sleep(0.25)
             plan = response.plan
