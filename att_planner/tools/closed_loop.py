@@ -21,7 +21,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from cryptography.hazmat.primitives.asymmetric.ed25519 import Ed25519PrivateKey
 
-from att_msgs_py import convert, signing
+from att_msgs_py import convert, signing, topics
 from att_msgs_py.errors import RequestError
 from att_msgs_py.parameters import SectionReader
 from att_msgs_py.types import Health, ManeuverResult, Plan
@@ -82,6 +82,7 @@ class ClosedLoop:
         self.refusals: list[RequestError] = []
         self.next_state = 0.0
         self.result: ManeuverResult | None = None
+        self.tap = None     # optional (topic, t, mirror object) of everything the nodes would publish: a log
 
     # -- plans ------------------------------------------------------------------------------------
     def issue(self, plan: Plan, plan_id: str = "plan") -> tuple[Plan, bytes]:
@@ -104,6 +105,11 @@ class ClosedLoop:
         sim, ctl, est = self.sim, self.controller, self.estimator
         readings = sim.sense()
         t = sim.t
+        state_due = t >= self.next_state - 1e-9
+        if state_due:
+            self.next_state = t + self.publish_period
+        if self.tap is not None:
+            self._tap_readings(t, readings, state_due)
         outcome = None
         if est is not None:
             for m in readings.star_trackers:
@@ -118,9 +124,10 @@ class ClosedLoop:
                 self._guard(ctl.measured.on_wheel_speeds, readings.wheel_speeds)
             estimate = self._guard(est.on_gyro, readings.gyro) if readings.gyro is not None else None
             if estimate is not None:
+                if self.tap is not None:
+                    self.tap(topics.ESTIMATE, t, estimate)
                 outcome = ctl.accept_estimate(estimate)
-        elif t >= self.next_state - 1e-9:
-            self.next_state = t + self.publish_period
+        elif state_due:
             outcome = ctl.accept_state(sim.state(self.scenario.frame_id, self.scenario.body_frame_id))
         if outcome is not None:
             self._outcome(outcome)
@@ -128,6 +135,9 @@ class ClosedLoop:
                 out = ctl.step()
                 if out.result is not None:
                     self.result = out.result
+                if self.tap is not None:
+                    self.tap(topics.COMMAND, t, out.command)
+                    self.tap(topics.CONTROLLER_STATUS, t, out.status)
                 refused = sim.set_command(out.command)
                 if refused is not None:
                     self.refusals.append(RequestError(refused.code, refused.message))
@@ -166,6 +176,17 @@ class ClosedLoop:
             self.refusals.append(outcome.refused)
         if outcome.ended is not None:
             self.result = outcome.ended
+
+    def _tap_readings(self, t: float, readings, state_due: bool) -> None:
+        """Hand the tap what the simulator publishes now: the sensors' readings, then the state."""
+        for topic, m in ((topics.IMU, readings.gyro), (topics.MAGNETOMETER, readings.magnetometer),
+                         (topics.SUN_SENSORS, readings.sun_sensors), (topics.WHEEL_SPEEDS, readings.wheel_speeds),
+                         (topics.SENSOR_TRUTH, readings.truth), *((topics.STAR_TRACKER, m) for m in
+                                                                  readings.star_trackers)):
+            if m is not None:
+                self.tap(topic, t, m)
+        if state_due:
+            self.tap(topics.STATE, t, self.sim.state(self.scenario.frame_id, self.scenario.body_frame_id))
 
     def _record(self, command, readings) -> None:
         tr, sim, est = self.trace, self.sim, self.estimator
