@@ -4,7 +4,7 @@ A campaign file (YAML, ``yaml.safe_load``; one mapping ``campaign:``) names a sc
 how the truth departs from the model the plan was made with::
 
     campaign:
-      scenario: swift_demo          # a file stem under config/ or a path
+      scenario: swift_demo          # a scenario name: a file stem under config/ or $ATT_CONFIG_PATH
       seed: 16                      # campaign seed s
       runs: 1000                    # default run count (att-mc --runs overrides)
       settle_tolerance_deg: 0.01    # settling: the error to the goal stays below this after the plan

@@ -24,7 +24,7 @@ from pathlib import Path
 from att_msgs_py.errors import RequestError
 from att_planner.tools.monte_carlo import report
 from att_planner.tools.monte_carlo.cluster import ClusterError, client_for, local_workers, stream
-from att_planner.tools.monte_carlo.run import Setup, dispersed, prepare
+from att_planner.tools.monte_carlo.run import checked, planned
 from att_planner.tools.tune import ProgressBar
 from att_sim import dispersions as disp
 
@@ -72,24 +72,17 @@ def rerun_parser() -> argparse.ArgumentParser:
     return p
 
 
-def checked_setup(path: str, runs: list[tuple[int, int]] | None = None) -> Setup:
-    """The campaign's setup; every run's draw is checked first (ValueError naming the seed)."""
-    setup = prepare(disp.load_campaign(path))
-    for _, seed in runs or ():
-        dispersed(setup, seed)
-    return setup
-
-
 def run_campaign(args) -> int:
     campaign = disp.load_campaign(args.campaign)
     count = args.runs or campaign.runs
     runs = [(i, disp.run_seed(campaign.seed, i)) for i in range(count)]
-    setup = checked_setup(args.campaign, runs)
+    setup = checked(campaign, [seed for _, seed in runs])
     workers = args.workers or local_workers()
     rows, interrupted = [], False
-    bar = None if args.no_progress else ProgressBar()
     with client_for(args.scheduler, workers, args.timeout) as client:
+        setup = planned(setup)
         workers = len(client.scheduler_info().get("workers", {})) or workers
+        bar = None if args.no_progress else ProgressBar()
         chunk = args.chunk or max(1, min(25, count // (4 * workers)))
         start = time.monotonic()
         chunks = stream(client, setup, runs, chunk)
@@ -116,7 +109,7 @@ def run_campaign(args) -> int:
                              plan=plan)
     path = args.json or args.out / "summary.json"
     path.parent.mkdir(parents=True, exist_ok=True)
-    path.write_text(json.dumps(summary, indent=2) + "\n")
+    path.write_text(json.dumps(summary, indent=2, allow_nan=False) + "\n")
     e = summary["final_error_deg"]
     print(f"att-mc: {summary['runs']} runs in {wall:.1f} s on {workers} workers "
           f"({summary['runs_per_second'] or 0:.3f} runs/s), success {100 * (summary['success_rate'] or 0):.1f} %, "
@@ -127,10 +120,10 @@ def run_campaign(args) -> int:
 def rerun(args) -> int:
     from att_planner.tools.monte_carlo.log import write_run_log
 
-    setup = checked_setup(args.campaign, [(-1, args.seed)])
+    setup = planned(checked(disp.load_campaign(args.campaign), [args.seed]))
     row = write_run_log(setup, args.seed, args.mcap)
     if args.json is not None:
-        args.json.write_text(json.dumps(row, indent=2) + "\n")
+        args.json.write_text(json.dumps({k: report.plain(v) for k, v in row.items()}, indent=2) + "\n")
     print(f"att-mc: seed {args.seed}: {'success' if row['success'] else 'FAILED: ' + row['reason']}, final error "
           f"{row['final_error_deg']:.5f} deg, min margin {row['min_margin_deg']:.3f} deg; MCAP: {args.mcap}")
     return 0

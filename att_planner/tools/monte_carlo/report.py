@@ -73,11 +73,17 @@ def rank_correlations(rows: list[dict], outcome: str = "final_error_deg") -> dic
     return out
 
 
+def plain(value):
+    """``value`` for strict JSON: a non-finite float becomes None (no margin without zones, a run
+    that never settled)."""
+    return value if not isinstance(value, float) or math.isfinite(value) else None
+
+
 def worst(rows: list[dict], count: int = WORST) -> list[dict]:
     """The failed runs first, then the largest final errors: run, seed and outcomes."""
     def badness(r):
         return (bool(r["success"]), -np.nan_to_num(r["final_error_deg"], nan=np.inf))
-    return [{k: r[k] for k in ("run", "seed", *OUTCOMES) if k != "cpu_seconds"}
+    return [{k: plain(r[k]) for k in ("run", "seed", *OUTCOMES) if k != "cpu_seconds"}
             for r in sorted(rows, key=badness)[:count]]
 
 

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -41,18 +41,25 @@ class Setup:
     plan: Plan
 
 
-def prepare(campaign: disp.Campaign) -> Setup:
-    """The campaign's scenario, its ``demo:`` maneuver and the plan for it, made once on the
-    nominal model as the planner service makes it (ValueError naming what is missing; RequestError
-    when there is no plan)."""
+def checked(campaign: disp.Campaign, seeds=()) -> Setup:
+    """The campaign's scenario and its ``demo:`` maneuver, not yet planned, with the draw of every
+    seed of ``seeds`` checked (ValueError naming what is missing or the seed of a non-physical draw)."""
     try:
         scenario = scen.load(campaign.scenario)
     except KeyError as exc:
         raise ValueError(f"campaign {campaign.path}: campaign.scenario: {exc.args[0]}") from None
-    maneuver = maneuver_from_scenario(scenario)
-    plan = plan_in_process(scenario, maneuver["q0"], maneuver["qf"], maneuver["sensor"], maneuver["cones"],
-                           maneuver["zones"], maneuver["method"], maneuver["time_budget"])
-    return Setup(campaign, scenario, maneuver, plan)
+    setup = Setup(campaign, scenario, maneuver_from_scenario(scenario), Plan())
+    for seed in seeds:
+        dispersed(setup, seed)
+    return setup
+
+
+def planned(setup: Setup) -> Setup:
+    """``setup`` with the plan for its maneuver, made once on the nominal model as the planner
+    service makes it (RequestError when there is none)."""
+    s, m = setup.scenario, setup.maneuver
+    plan = plan_in_process(s, m["q0"], m["qf"], m["sensor"], m["cones"], m["zones"], m["method"], m["time_budget"])
+    return replace(setup, plan=plan)
 
 
 def dispersed(setup: Setup, seed: int) -> tuple[disp.Truth, dict]:
