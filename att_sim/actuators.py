@@ -108,9 +108,8 @@ class WheelDrive:
         """Held torques ``u`` within the envelope at relative speeds ``speed``."""
         if math.isinf(self.spec.power_max):
             return u
-        accelerating = u * speed > 0
         limit = self.spec.power_max / np.maximum(np.abs(speed), 1e-12)
-        return np.where(accelerating, np.clip(u, -limit, limit), u)
+        return np.where(u * speed > 0, np.minimum(np.maximum(u, -limit), limit), u)
 
     def __call__(self, u: np.ndarray, speed: np.ndarray) -> np.ndarray:
         """Net torque on the wheels (motor minus friction): what :func:`att_sim.dynamics.derivative`

@@ -16,6 +16,7 @@ realised by reaction wheels: the body receives ``−G u − ω × G h_w`` so
 """
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -36,9 +37,10 @@ def rotation_vector_rate(phi, omega) -> np.ndarray:
     """dφ/dt of the rotation ``exp(φ)`` turning at body rate ``omega``: ``J_r⁻¹(φ) ω`` =
     ω + ½ φ × ω + (1/θ²)(1 − (θ/2) cot(θ/2)) φ × (φ × ω), θ = |φ| (< 2π)."""
     phi, omega = np.asarray(phi, float), np.asarray(omega, float)
-    theta = float(np.linalg.norm(phi))
-    c = (1.0 - 0.5 * theta / np.tan(0.5 * theta)) / theta**2 if theta > 1e-4 else 1.0 / 12.0 + theta**2 / 720.0
-    return omega + 0.5 * np.cross(phi, omega) + c * np.cross(phi, np.cross(phi, omega))
+    theta = math.sqrt(phi @ phi)
+    c = (1.0 - 0.5 * theta / math.tan(0.5 * theta)) / theta**2 if theta > 1e-4 else 1.0 / 12.0 + theta**2 / 720.0
+    turn = rot.cross(phi, omega)
+    return omega + 0.5 * turn + c * rot.cross(phi, turn)
 
 
 def plan_reference(plan: Plan, t: float) -> Reference:
@@ -49,7 +51,7 @@ def plan_reference(plan: Plan, t: float) -> Reference:
     if t >= t_knots[-1]:
         return Reference(q[-1], np.zeros(3), np.zeros(3))
     t = max(t, t_knots[0])
-    k = int(np.clip(np.searchsorted(t_knots, t, side="right") - 1, 0, len(t_knots) - 2))
+    k = min(max(int(np.searchsorted(t_knots, t, side="right")) - 1, 0), len(t_knots) - 2)
     s = (t - t_knots[k]) / (t_knots[k + 1] - t_knots[k])
     h = t_knots[k + 1] - t_knots[k]
     axis, angle = rot.to_axis_angle(rot.multiply(rot.conjugate(q[k]), q[k + 1]))
@@ -72,8 +74,8 @@ def wheel_torques(sc: Spacecraft, body_torque, omega, wheel_speed, friction=None
     ``friction`` (N m per wheel, the drive friction expected at the measured speeds) is added so
     the net wheel torque is the one asked for."""
     h_w = sc.wheel_axes @ (sc.wheel_inertia * np.asarray(wheel_speed, float))
-    demand = np.asarray(body_torque, float) + np.cross(omega, h_w)
+    demand = np.asarray(body_torque, float) + rot.cross(omega, h_w)
     u = -sc.wheel_axes_pinv @ demand
     if friction is not None:
         u = u + friction
-    return np.clip(u, -sc.wheel_torque_max, sc.wheel_torque_max)
+    return np.minimum(np.maximum(u, -sc.wheel_torque_max), sc.wheel_torque_max)
