@@ -25,7 +25,9 @@ from att_msgs.msg import (
     ControllerStatus,
     KeepOutCone,
     ManeuverPlan,
+    PlanStage,
     PlanVerification,
+    PointingMode,
     SensorTruth,
     SpacecraftState,
     StarTracker,
@@ -155,10 +157,29 @@ def command_from_msg(msg) -> types.Command:
 
 def controller_status_msg(s: types.ControllerStatus) -> ControllerStatus:
     msg = ControllerStatus(mode=int(s.mode), plan_id=s.plan_id, plan_progress=float(s.plan_progress),
-                           state_stale=bool(s.state_stale), message=s.message)
+                           state_stale=bool(s.state_stale), message=s.message, guidance=s.guidance,
+                           reference_attitude=quaternion(s.reference_q), reference_rate=vector3(s.reference_rate),
+                           attitude_error=float(s.attitude_error), dumping=bool(s.dumping))
     msg.header.stamp = time_msg(s.t)
     msg.header.frame_id = s.frame_id
     return msg
+
+
+def pointing_msg(p: types.PointingMode) -> PointingMode:
+    return PointingMode(kind=p.kind, attitude=quaternion(p.attitude), primary_axis=vector3(p.primary_axis),
+                        secondary_axis=vector3(p.secondary_axis), secondary=p.secondary,
+                        secondary_direction=vector3(p.secondary_direction), yaw=float(p.yaw),
+                        latitude=float(p.latitude), longitude=float(p.longitude), altitude=float(p.altitude),
+                        target_direction=vector3(p.target_direction))
+
+
+def pointing_from_msg(msg) -> types.PointingMode:
+    return types.PointingMode(kind=msg.kind, attitude=from_quaternion(msg.attitude),
+                              primary_axis=from_vector3(msg.primary_axis),
+                              secondary_axis=from_vector3(msg.secondary_axis), secondary=msg.secondary,
+                              secondary_direction=from_vector3(msg.secondary_direction), yaw=float(msg.yaw),
+                              latitude=float(msg.latitude), longitude=float(msg.longitude),
+                              altitude=float(msg.altitude), target_direction=from_vector3(msg.target_direction))
 
 
 # -- plans -------------------------------------------------------------------------------------
@@ -218,6 +239,17 @@ def plan_from_msg(msg) -> types.Plan:
         signature=bytes(getattr(msg, "signature", b"")),
         epoch=from_epoch(msg.epoch) if hasattr(msg, "epoch") else None,
         zones=[zone_from_msg(z) for z in getattr(msg, "zones", [])])
+
+
+def stage_msg(stage: types.StageReport) -> PlanStage:
+    return PlanStage(name=str(stage.name), method=stage.method, seconds=float(stage.seconds), status=str(stage.status),
+                     verified=bool(stage.verified), duration=float(stage.duration), message=stage.message)
+
+
+def stage_from_msg(msg) -> types.StageReport:
+    """The stage of a message (``name`` and ``status`` the strings sent)."""
+    return types.StageReport(name=msg.name, method=msg.method, seconds=float(msg.seconds), status=msg.status,
+                             verified=bool(msg.verified), duration=float(msg.duration), message=msg.message)
 
 
 # -- the ExecuteManeuver action -----------------------------------------------------------------

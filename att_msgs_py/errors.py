@@ -48,6 +48,7 @@ class ErrorCode(IntEnum):
     STATE_TIME_JUMP = 311         # a state stamp backward or far forward (discarded, reported)
     MODE_NOT_AUTHENTIC = 312      # a mode request unsigned, wrongly signed or replayed (require_signed_modes)
     ESTIMATE_UNHEALTHY = 313      # state_source estimate: the attitude estimate is not usable (initialising, diverged)
+    INVALID_POINTING = 314        # a pointing mode with a bad field (kind, axes, target) or no attitude now
     # estimator
     INVALID_MEASUREMENT = 320     # a sensor message with a bad field (discarded, reported)
     STALE_MEASUREMENT = 321       # a measurement older than the filter's history, or a gyro stamp not moving forward

@@ -6,7 +6,7 @@ messages and back. Conventions (the whole suite): SI units, quaternions ``[x, y,
 (body-to-inertial), body rates in body axes.
 
 The vocabularies (:class:`Status`, :class:`ControlMode`, :class:`ControlKind`,
-:class:`Interpolation`) are written here once; the constants of the .msg files carry the same
+:class:`Interpolation`, :class:`Stage`) are written here once; the constants of the .msg files carry the same
 values, which a test checks.
 """
 from __future__ import annotations
@@ -36,6 +36,7 @@ class ControlMode(IntEnum):
     MAGNETORQUER_PD = 1
     PLAN_TRACKING = 2
     SAFE = 3
+    POINTING = 4                       # a guidance law (PointingMode) tracked through the wheels
 
 
 CONTROL_MODES = tuple(int(m) for m in ControlMode)   # the values a command or set_mode may carry
@@ -127,6 +128,28 @@ class Verification:
     zone_names: list = field(default_factory=list)                # name per entry of cone_margins
     zone_keep_in: list = field(default_factory=list)              # keep-in flag per entry of cone_margins
     boundary_arc: str = ""             # name of the cone a forced boundary arc rides ('' : none)
+
+
+class Stage(StrEnum):
+    """The stages of a maneuver answer: ``att_msgs/PlanStage.STAGE_*``."""
+
+    FIRST = "first"              # the constructive first plan
+    METHOD = "method"            # the requested method, seeded with the first plan
+    FALLBACK = "fallback"        # the eigenaxis slew
+
+
+@dataclass
+class StageReport:
+    """One stage of a maneuver answer (``att_msgs/PlanStage``): which method ran, how long it and
+    the verification of its plan took, how it ended."""
+
+    name: Stage
+    method: str
+    seconds: float
+    status: str = ""                   # the method's Status ("" when it did not run)
+    verified: bool = False
+    duration: float = math.nan         # s, t_f of its plan
+    message: str = ""
 
 
 @dataclass(frozen=True)
@@ -243,6 +266,11 @@ class ControllerStatus:
     state_stale: bool = False
     message: str = ""
     frame_id: str = ""
+    guidance: str = ""                                  # the pointing mode's kind (POINTING)
+    reference_q: np.ndarray = _empty(4)                 # tracked attitude now (zero: none)
+    reference_rate: np.ndarray = _empty(3)              # rad/s, reference axes
+    attitude_error: float = math.nan                    # rad, from the reference
+    dumping: bool = False
 
 
 @dataclass
@@ -369,3 +397,28 @@ class AttitudeEstimate:
     message: str = ""
     frame_id: str = ""
     body_frame_id: str = ""
+
+
+# ---------------------------------------------------------------------------------------------
+# Pointing modes (issue 15)
+# ---------------------------------------------------------------------------------------------
+
+POINTING_KINDS = ("inertial", "nadir", "sun", "ground", "inertial_target")
+SECONDARY_KINDS = ("velocity", "orbit_normal", "sun", "nadir", "north", "inertial")
+
+
+@dataclass
+class PointingMode:
+    """A pointing mode (``att_msgs/PointingMode``): see the message for the fields' meaning."""
+
+    kind: str
+    attitude: np.ndarray = _empty(4)           # inertial: all zero = the current attitude
+    primary_axis: np.ndarray = field(default_factory=lambda: np.array([0.0, 0.0, 1.0]))
+    secondary_axis: np.ndarray = field(default_factory=lambda: np.array([1.0, 0.0, 0.0]))
+    secondary: str = "velocity"
+    secondary_direction: np.ndarray = _empty(3)
+    yaw: float = 0.0
+    latitude: float = 0.0
+    longitude: float = 0.0
+    altitude: float = 0.0
+    target_direction: np.ndarray = _empty(3)

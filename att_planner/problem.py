@@ -70,8 +70,9 @@ class ManeuverProblem:
     epoch: datetime | None = None
     sky: Sky | None = None
     boundary_cone: int | None = None
-    _zone_skies: dict = field(default_factory=dict, init=False, repr=False, compare=False)
-    _default_window: tuple = field(default=(), init=False, repr=False, compare=False)
+    # caches keyed by the values they depend on, so ``dataclasses.replace`` copies share them
+    _zone_skies: dict = field(default_factory=dict, repr=False, compare=False)
+    _default_window: tuple = field(default=(), repr=False, compare=False)
 
     def time_left(self) -> float:
         return np.inf if self.deadline is None else self.deadline - time.monotonic()

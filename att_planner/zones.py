@@ -50,7 +50,7 @@ def same_axis(a, b) -> bool:
     return bool(np.allclose(a / np.linalg.norm(a), b / np.linalg.norm(b), rtol=0.0, atol=1e-12))
 
 
-def _clenshaw(x, rows):
+def clenshaw(x, rows):
     """``Σ_j c_j T_j(x)`` by Clenshaw's recurrence for the coefficient vectors ``rows`` (c_0 first);
     ``x`` a numpy column (K, 1) or a CasADi scalar (the rows then CasADi columns)."""
     b1 = b2 = 0.0
@@ -159,7 +159,7 @@ class ZoneSky:
         for n in DEGREES:
             x = np.cos(np.pi * (np.arange(n + 1) + 0.5) / (n + 1))
             coef = _chebyshev_interpolant(self._moving_truth(a + (x + 1.0) * (b - a) / 2))
-            error = self._error(_clenshaw(xg[:, None], coef), truth)
+            error = self._error(clenshaw(xg[:, None], coef), truth)
             if error <= 0.5 * self.tolerance:
                 return coef, error
         return None
@@ -185,7 +185,7 @@ class ZoneSky:
             if mask.any():
                 a, b = self.pieces[p], self.pieces[p + 1]
                 x = ((2.0 * t[mask] - (a + b)) / (b - a))[:, None]
-                out[mask] = _clenshaw(x, dcoef) if derivative else _clenshaw(x, coef)
+                out[mask] = clenshaw(x, dcoef) if derivative else clenshaw(x, coef)
         return out
 
     def _assemble(self, t, values, rates: bool):
@@ -232,6 +232,12 @@ class ZoneSky:
         """Half-angles straight from the sky (any t), shape ``t.shape + (Z,)``."""
         return self._assemble(t, self._moving_truth, False)[1]
 
+    def series(self, z: int) -> list[np.ndarray]:
+        """The fit of moving zone ``z``: per piece (:attr:`pieces`) its Chebyshev coefficients
+        (degree + 1, 4), the axis' three then the half-angle's, summed by :func:`clenshaw`."""
+        j, M = int(np.flatnonzero(self._moving == z)[0]), len(self._moving)
+        return [c[:, [3 * j, 3 * j + 1, 3 * j + 2, 3 * M + j]] for c in self._coef]
+
     def casadi(self, t):
         """``(axes, half_angles)``: Z CasADi 3-vectors and Z scalars, functions of the CasADi scalar
         ``t`` (SX or MX) by the same Clenshaw sums as :meth:`axes` (pieces chosen by ``if_else``).
@@ -245,7 +251,7 @@ class ZoneSky:
         values = None
         for p in range(len(self._coef) - 1, -1, -1):
             a, b = self.pieces[p], self.pieces[p + 1]
-            v = _clenshaw((2.0 * t - (a + b)) / (b - a), [ca.DM(c) for c in self._coef[p]])
+            v = clenshaw((2.0 * t - (a + b)) / (b - a), [ca.DM(c) for c in self._coef[p]])
             values = v if values is None else ca.if_else(t < b, v, values)
         for j, i in enumerate(self._moving):
             axes[i] = values[3 * j:3 * j + 3]

@@ -29,6 +29,7 @@ it themselves) is only first-order accurate: the body turns under the held field
 """
 from __future__ import annotations
 
+import functools
 import hashlib
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -157,12 +158,16 @@ def derivative(sc: Spacecraft, x: np.ndarray, inputs: Inputs, stage: tuple | Non
         else:
             out[7:] = 0.0
     out[4:7] = sc.inertia_inv @ (torque - rot.cross(w, h))
-    # q_dot = ½ q ⊗ [ω, 0], on Python floats (a fraction of the cost of numpy scalars)
-    qx, qy, qz, qw = q.tolist()
-    wx, wy, wz = w.tolist()
-    out[:4] = (0.5 * (qw * wx + qy * wz - qz * wy), 0.5 * (qw * wy + qz * wx - qx * wz),
-               0.5 * (qw * wz + qx * wy - qy * wx), -0.5 * (qx * wx + qy * wy + qz * wz))
+    out[:4] = quaternion_rate(q.tolist(), w.tolist())     # on Python floats: a fraction of numpy scalars' cost
     return out
+
+
+def quaternion_rate(q, w) -> tuple:
+    """``q̇ = ½ q ⊗ [ω, 0]`` component by component, for floats and CasADi scalars alike."""
+    qx, qy, qz, qw = q
+    wx, wy, wz = w
+    return (0.5 * (qw * wx + qy * wz - qz * wy), 0.5 * (qw * wy + qz * wx - qx * wz),
+            0.5 * (qw * wz + qx * wy - qy * wx), -0.5 * (qx * wx + qy * wy + qz * wz))
 
 
 def rk4(f: Callable, t, x, dt, work: tuple | None = None):
@@ -229,6 +234,59 @@ class Trajectory:
     wheel_speed: np.ndarray  # (K, N)
 
 
+STEPS_PER_CALL = 2048      # RK4 steps per call of the compiled body-torque stepper (a verification: one)
+
+
+@functools.cache
+def _body_torque_stepper():
+    """``(x0, U, dU, h, p) -> X``: :data:`STEPS_PER_CALL` RK4 steps of the rigid body from ``x0`` = (q, ω)
+    under the body torque ``U_i + dU_i τ`` (τ from the step's start: ZOH with ``dU = 0``, linear
+    interpolation), step ``h_i`` (0: the state is kept), quaternion renormalised after each step, as
+    :func:`step` does; ``p`` = (J, J⁻¹, G I_w Ω) column-major, the wheels' momentum constant (no motor
+    torque). CasADi code, compiled once into the cache (:mod:`att_sim.codegen`)."""
+    import casadi as ca
+
+    from att_sim.codegen import compiled
+
+    x, u, du, h, p = ca.SX.sym("x", 7), ca.SX.sym("u", 3), ca.SX.sym("du", 3), ca.SX.sym("h"), ca.SX.sym("p", 21)
+    J, J_inv, h_wheels = ca.reshape(p[:9], 3, 3), ca.reshape(p[9:18], 3, 3), p[18:]
+
+    def f(tau, s):
+        w = s[4:]
+        w_dot = ca.mtimes(J_inv, u + du * tau - ca.cross(w, ca.mtimes(J, w) + h_wheels))
+        return ca.vertcat(*quaternion_rate(ca.vertsplit(s[:4]), ca.vertsplit(w)), w_dot)
+
+    x_next = rk4(f, 0.0, x, h)
+    steps = ca.Function("body_torque_step", [x, u, du, h, p], [ca.vertcat(x_next[:4] / ca.norm_2(x_next[:4]),
+                                                                           x_next[4:])])
+    steps = steps.mapaccum("body_torque_steps", STEPS_PER_CALL)
+    xs, us, dus, hs, ps = (ca.MX.sym(n, k, m) for n, k, m in (("x", 7, 1), ("u", 3, STEPS_PER_CALL),
+                                                               ("du", 3, STEPS_PER_CALL), ("h", 1, STEPS_PER_CALL),
+                                                               ("p", 21, 1)))
+    return compiled(ca.Function("body_torque_profile", [xs, us, dus, hs, ps],
+                                [steps(xs, us, dus, hs, ca.repmat(ps, 1, STEPS_PER_CALL))]))
+
+
+def _body_torque_steps(sc: Spacecraft, x0: np.ndarray, u: np.ndarray, du: np.ndarray, h: np.ndarray) -> np.ndarray:
+    """The states (S, 7 + N) after each of the S steps ``(u_i, du_i, h_i)`` of the compiled stepper."""
+    stepper = _body_torque_stepper()
+    p = np.concatenate([sc.inertia.ravel("F"), sc.inertia_inv.ravel("F"),
+                        sc.wheel_axes @ (sc.wheel_inertia * x0[7:]) if sc.n_wheels else np.zeros(3)])
+    S = len(h)
+    pad = -S % STEPS_PER_CALL
+    u, du = (np.vstack([a, np.zeros((pad, 3))]).T for a in (u, du))
+    h = np.concatenate([h, np.zeros(pad)])[None]
+    x = x0[:7]
+    out = []
+    for k in range(0, S + pad, STEPS_PER_CALL):
+        block = np.asarray(stepper(x, u[:, k:k + STEPS_PER_CALL], du[:, k:k + STEPS_PER_CALL],
+                                   h[:, k:k + STEPS_PER_CALL], p))
+        out.append(block.T)
+        x = block[:, -1]
+    states = np.concatenate(out)[:S]
+    return np.hstack([states, np.broadcast_to(x0[7:], (S, len(x0) - 7))])
+
+
 def simulate_profile(
     sc: Spacecraft,
     x0: np.ndarray,
@@ -245,7 +303,10 @@ def simulate_profile(
     ``kind`` is 'body_torque' (values are body torques, (K, 3)) or 'wheel_torque' (motor torques,
     (K, N)). ZOH profiles are integrated with steps aligned to the knots (exact input switching);
     each knot interval is split into substeps no longer than ``max_step`` (default: 1/400 of the
-    duration; every interval gets at least one step). Returns the state at every substep.
+    duration; every interval gets at least one step). Returns the state at every substep. Body
+    torques take the compiled stepper (:func:`_body_torque_stepper`: the same RK4 of the same
+    equations, the wheels' momentum held, as :func:`step` without motor torques), motor torques
+    :func:`step`'s loop.
     """
     t_knots = np.asarray(t_knots, float)
     values = np.asarray(values, float).reshape(len(t_knots), -1)
@@ -257,23 +318,23 @@ def simulate_profile(
     if interpolation not in tuple(Interpolation):
         raise ValueError(f"unknown interpolation '{interpolation}' (use 'zoh' or 'linear')")
     kind = str(ControlKind(kind))           # the Inputs field the values go to
-    ts, xs = [grid[0]], [np.array(x0, float)]
+    n = np.maximum(1, np.ceil(np.diff(grid) / max_step - 1e-9).astype(int))      # steps per knot interval
+    h = np.repeat(np.diff(grid) / n, n)
+    t0 = np.repeat(grid[:-1], n) + (np.arange(n.sum()) - np.repeat(np.cumsum(n) - n, n)) * h   # each step's start
+    k = np.minimum(np.searchsorted(t_knots, np.repeat(grid[:-1], n), side="right") - 1, len(t_knots) - 1)
+    slope = np.zeros((len(k), values.shape[1]))
+    if interpolation == Interpolation.LINEAR:       # the input evaluated at the RK4 stage times
+        inner = k + 1 < len(t_knots)
+        slope[inner] = (values[k[inner] + 1] - values[k[inner]]) / (t_knots[k[inner] + 1] - t_knots[k[inner]])[:, None]
+    u = values[k] + slope * (t0 - t_knots[k])[:, None]          # the input at each step's start
     x = np.array(x0, float)
-    for a, b in zip(grid[:-1], grid[1:]):
-        n = max(1, int(np.ceil((b - a) / max_step - 1e-9)))
-        h = (b - a) / n
-        k = min(np.searchsorted(t_knots, a, side="right") - 1, len(t_knots) - 1)
-        u_a = values[k] if a <= t_knots[-1] else np.zeros(values.shape[1])
-        slope = ((values[k + 1] - values[k]) / (t_knots[k + 1] - t_knots[k])
-                 if interpolation == Interpolation.LINEAR and k + 1 < len(t_knots) else np.zeros_like(u_a))
-        for i in range(n):
-            t0 = a + i * h
-            if interpolation == Interpolation.ZOH:
-                x = step(sc, x, Inputs(**{kind: u_a}), h)
-            else:       # linear: the input evaluated at the RK4 stage times
-                x = renormalised(rk4(lambda tt, xx, u=u_a, du=slope, tk=t_knots[k]:
-                                     derivative(sc, xx, Inputs(**{kind: u + du * (tt - tk)})), t0, x, h))
-            ts.append(t0 + h)
-            xs.append(x.copy())
-    X = np.array(xs)
-    return Trajectory(np.array(ts), X[:, :4], X[:, 4:7], X[:, 7:])
+    if kind == ControlKind.BODY_TORQUE:
+        X = np.vstack([x, _body_torque_steps(sc, x, u, slope, h)])
+    else:
+        X = [x.copy()]
+        for u_i, du_i, h_i in zip(u, slope, h):
+            x = renormalised(rk4(lambda tau, s, u_i=u_i, du_i=du_i:
+                                 derivative(sc, s, Inputs(**{kind: u_i + du_i * tau})), 0.0, x, h_i))
+            X.append(x.copy())
+        X = np.array(X)
+    return Trajectory(np.concatenate([grid[:1], t0 + h]), X[:, :4], X[:, 4:7], X[:, 7:])

@@ -93,6 +93,7 @@ class Sky:
     def __init__(self, epoch, orbit: Orbit):
         self.epoch = parse_epoch(epoch)
         self.orbit = orbit
+        self._last_position = None
         if getattr(orbit, "epoch", None) is None:
             self.orbit_offset = 0.0
         else:
@@ -142,7 +143,14 @@ class Sky:
         return self._tables["moon"](t)[0]
 
     def position(self, t) -> np.ndarray:
-        return self.orbit.position(self._orbit_time(t))
+        """Geocentric GCRS position of the spacecraft (m). The last array of times is remembered:
+        every direction of a zone sky asks for the same times once per body."""
+        if np.ndim(t) == 0:
+            return self.orbit.position(self._orbit_time(t))
+        times, last = np.asarray(t, float), self._last_position
+        if last is None or last[0].shape != times.shape or not np.array_equal(last[0], times):
+            last = self._last_position = (times.copy(), self.orbit.position(self._orbit_time(times)))
+        return last[1]
 
     def velocity(self, t) -> np.ndarray:
         return self.orbit.state(self._orbit_time(t))[1]

@@ -10,6 +10,8 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
+
 from att_msgs_py import signing
 from att_msgs_py.errors import ConfigError, ErrorCode, clip
 from att_msgs_py.types import ControlMode
@@ -17,6 +19,8 @@ from att_planner.control.controller import Controller, ControllerConfig
 from att_planner.control.measured_state import MeasuredState
 from att_planner.control.plan_checks import PlanContext
 from att_planner.control.state_gate import GateConfig
+from att_planner.guidance.laws import Sky as GuidanceSky
+from att_sim import world
 from att_sim.ephemeris import Sky
 from att_sim.scenario import Scenario
 
@@ -48,7 +52,23 @@ def controller_config(param, scenario: Scenario) -> ControllerConfig:
         safe_kd=param("safe_kd", tracking_kd, 0.0),
         max_cached_plans=param("max_cached_plans", d.max_cached_plans, 1, 10_000),
         max_cache_bytes=int(param("max_cache_mb", d.max_cache_bytes / 2**20, 0.0, 4096.0, low_open=True) * 2**20),
-        safe_rate_threshold=param("safe_rate_threshold", d.safe_rate_threshold, 0.0, 10.0, low_open=True))
+        safe_rate_threshold=param("safe_rate_threshold", d.safe_rate_threshold, 0.0, 10.0, low_open=True),
+        dumping=param("momentum_dumping", d.dumping),
+        dumping_gain=param("dumping_gain", d.dumping_gain, 0.0, 10.0, low_open=True),
+        null_space_gain=param("null_space_gain", d.null_space_gain, 0.0, 10.0),
+        null_space_speed=param("null_space_speed", d.null_space_speed, -1e4, 1e4),
+        handover_blend=param("handover_blend", d.handover_blend, 0.0, 3600.0),
+        safe_sun_axis=tuple(_unit_param(param, "safe_sun_axis", list(d.safe_sun_axis))))
+
+
+def _unit_param(param, name: str, default: list) -> np.ndarray:
+    """A parameter that is a unit vector (3 numbers, norm within 1e-3 of 1), normalised."""
+    v = np.asarray(param(name, default, -1.0, 1.0, length=3), float)
+    norm = float(np.linalg.norm(v))
+    if abs(norm - 1.0) > 1e-3:
+        raise ConfigError(ErrorCode.INVALID_PARAMETER, f"parameter '{name}': expected a unit vector, got norm "
+                                                       f"{norm:.6g}")
+    return v / norm
 
 
 def plan_context(param, scenario: Scenario, key=None) -> PlanContext:
@@ -87,7 +107,8 @@ def controller_from_scenario(param, scenario: Scenario, key=None) -> Controller:
     compensate = param("friction_compensation", bool(wheels and (wheels.coulomb_friction or wheels.viscous_friction)))
     sky = None if scenario.epoch is None else Sky(scenario.epoch, scenario.orbit_model)
     mode = param("initial_mode", int(ControlMode.IDLE),
-                 choices=[int(m) for m in ControlMode if m != ControlMode.PLAN_TRACKING])
+                 choices=[int(m) for m in ControlMode if m not in (ControlMode.PLAN_TRACKING, ControlMode.POINTING)])
     return Controller(plan_context(param, scenario, key), controller_config(param, scenario), mode,
                       scenario.body_frame_id, gate_config(param), sky, measured_state(source, scenario),
-                      wheels.friction if compensate and wheels else None)
+                      wheels.friction if compensate and wheels else None,
+                      GuidanceSky.of(world.Environment.from_scenario(scenario)))

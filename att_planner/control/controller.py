@@ -29,14 +29,12 @@ is that of the cones and inertial zones only.
 """
 from __future__ import annotations
 
-import hashlib
 import math
-from collections import OrderedDict
 from dataclasses import dataclass
 
 import numpy as np
 
-from att_msgs_py import signing, validation
+from att_msgs_py import signing
 from att_msgs_py.errors import ErrorCode, RequestError
 from att_msgs_py.types import (
     CONTROL_MODES,
@@ -49,13 +47,20 @@ from att_msgs_py.types import (
     ManeuverFeedback,
     ManeuverResult,
     Plan,
+    PointingMode,
     State,
 )
-from att_planner.control import tracking
+from att_planner.control import momentum, tracking
 from att_planner.control.magnetorquer import dipole_command
 from att_planner.control.measured_state import MeasuredState
-from att_planner.control.plan_checks import PlanContext, check_plan, check_start
+from att_planner.control.plan_cache import PlanCache
+from att_planner.control.plan_checks import PlanContext, check_start
+from att_planner.control.pointing import pointing_torque
 from att_planner.control.state_gate import GateConfig, StateGate
+from att_planner.guidance import reference as guidance_reference
+from att_planner.guidance.laws import BlendedLaw
+from att_planner.guidance.laws import Sky as GuidanceSky
+from att_planner.guidance.modes import law_of
 from att_planner.zones import ZoneSky, zones_from_cones
 from att_sim import rotations as rot
 from att_sim.dynamics import Spacecraft
@@ -78,6 +83,12 @@ class ControllerConfig:
     max_cached_plans: int = 50
     max_cache_bytes: int = 64 * 1024 * 1024   # serialized plans kept
     safe_rate_threshold: float = 0.005  # rad/s: found rotating faster at start, the controller damps (safe mode)
+    dumping: bool = False              # magnetorquer momentum dumping (issue 15)
+    dumping_gain: float = 1e-3         # 1/s: k of m = k (Δh × B)/|B|²
+    null_space_gain: float = 0.05      # 1/s: wheel speeds' null-space component to its bias (more than 3 wheels)
+    null_space_speed: float = 0.0      # rad/s: that bias, along each null-space direction
+    safe_sun_axis: tuple = (0.0, 0.0, 1.0)   # body axis the safe mode points at the Sun once the rates are damped
+    handover_blend: float = 60.0       # s: a plan ending at rest enters a moving pointing reference this smoothly
 
     @property
     def feedback_every(self) -> int:
@@ -87,12 +98,14 @@ class ControllerConfig:
 
 @dataclass
 class Maneuver:
-    """The plan being executed, from sim time ``t0``, and its zones (:meth:`Controller.start`)."""
+    """The plan being executed, from sim time ``t0``, its zones (:meth:`Controller.start`) and the
+    pointing law it hands over to at its end (None: hold its final attitude after a settle time)."""
 
     plan: Plan
     t0: float
     zones: ZoneSky | None = None
     ticks: int = 0
+    after: object = None
 
 
 @dataclass
@@ -115,28 +128,23 @@ class StateOutcome:
     ended: ManeuverResult | None = None
 
 
-@dataclass
-class CachedPlan:
-    plan: Plan
-    size: int                                  # bytes of its message
-
-
-MAX_REMEMBERED_IDS = 100_000                   # plan ids whose content is remembered (32 bytes each)
-MAX_REMEMBERED_REFUSALS = 1000                 # refused plan ids whose reason an execute goal is told
 ZONE_FIT_WINDOW = 1.0                          # s: a ZoneSky needs a window; the controller uses its truth only
 
 
 USABLE = (Health.CONVERGED, Health.PROPAGATING)   # estimates the attitude laws may fly on
+HANDOVER_RATE_MATCH = 1e-4     # rad/s: a plan ending this close to the law's rate hands over directly
 
 
 class Controller:
     def __init__(self, context: PlanContext, config: ControllerConfig = ControllerConfig(),
                  mode: int = ControlMode.IDLE, body_frame_id: str = "body", gate: GateConfig | None = None,
-                 sky: Sky | None = None, measured: MeasuredState | None = None, friction=None):
+                 sky: Sky | None = None, measured: MeasuredState | None = None, friction=None,
+                 guidance_sky: GuidanceSky | None = None):
         """``measured``: fly on attitude estimates (:meth:`accept_estimate`) with measured wheel
         speeds and field, blanking the magnetometer; None: on truth states (:meth:`accept_state`).
         ``friction``: the wheel drives' expected friction torque at relative speeds ν (a callable,
-        :meth:`att_sim.actuators.WheelDriveSpec.friction`), compensated in every wheel command."""
+        :meth:`att_sim.actuators.WheelDriveSpec.friction`), compensated in every wheel command.
+        ``guidance_sky``: the onboard orbit, Sun and Earth the pointing laws look at (issue 15)."""
         self.context, self.config, self.mode, self.body_frame_id = context, config, mode, body_frame_id
         self.measured, self.friction = measured, friction
         self.estimate_health: Health | None = None     # of the latest accepted estimate
@@ -145,9 +153,11 @@ class Controller:
         self.next_control = -math.inf
         self.maneuver: Maneuver | None = None
         self.hold_q: np.ndarray | None = None          # final attitude held after a maneuver
-        self.plans: OrderedDict[str, CachedPlan] = OrderedDict()
-        self.seen: OrderedDict[str, bytes] = OrderedDict()   # plan id -> SHA-256 of its signed bytes
-        self.refused: OrderedDict[str, RequestError] = OrderedDict()   # published plans refused, why
+        self.cache = PlanCache(context, config.max_cached_plans, config.max_cache_bytes)
+        self.guidance_sky = guidance_sky
+        self.pointing = None                           # the pointing law of MODE_POINTING (guidance.laws)
+        self.safe_law = None                           # the safe mode's Sun pointing, built when first used
+        self.dumping = config.dumping
         self.mode_key = None                           # Ed25519 public key mode requests must verify against
         self.mode_sequence = 0                         # sequence of the last authenticated mode request
 
@@ -164,8 +174,23 @@ class Controller:
         return min(self.config.m_max, self.spacecraft.dipole_max)
 
     @property
+    def plans(self):
+        """The cached plans by id (:class:`~.plan_cache.PlanCache`)."""
+        return self.cache.plans
+
+    @property
     def cache_bytes(self) -> int:
-        return sum(c.size for c in self.plans.values())
+        return self.cache.bytes
+
+    def receive_plan(self, plan: Plan, payload: bytes) -> RequestError | None:
+        """Cache a published plan once it passes its checks (never evicting the one being flown)."""
+        return self.cache.receive(plan, payload, self.maneuver.plan.plan_id if self.maneuver is not None else None)
+
+    def resolve(self, plan_id: str, inline: Plan | None = None,
+                payload: bytes = b"") -> tuple[Plan | None, RequestError | None]:
+        """The plan to execute (``inline`` with its signed ``payload``, or the cached ``plan_id``),
+        or why there is none."""
+        return self.cache.resolve(plan_id, inline, payload)
 
     # -- inputs ---------------------------------------------------------------------------------
     def accept_state(self, state: State, wall: float = 0.0, clock: float | None = None,
@@ -208,8 +233,8 @@ class Controller:
         if self.maneuver is not None:
             out.ended = self.abort(f"aborted: {why}")
             out.note = f"{why}: maneuver aborted, safe mode (rate damping)"
-        elif self.mode in (ControlMode.MAGNETORQUER_PD, ControlMode.PLAN_TRACKING):
-            self.mode, self.hold_q = ControlMode.SAFE, None
+        elif self.mode in (ControlMode.MAGNETORQUER_PD, ControlMode.PLAN_TRACKING, ControlMode.POINTING):
+            self.mode, self.hold_q, self.pointing = ControlMode.SAFE, None, None
             out.note = f"{why}: safe mode (rate damping)"
         return out
 
@@ -220,46 +245,6 @@ class Controller:
         health = "none yet" if self.estimate_health is None else self.estimate_health.name.lower()
         return RequestError(ErrorCode.ESTIMATE_UNHEALTHY, f"the attitude estimate is not converged ({health}); "
                                                           "attitude modes start on a converged estimate")
-
-    def _remember(self, plan: Plan, payload: bytes) -> RequestError | None:
-        """Record ``plan``'s id with its content; refuse a different plan under a known id."""
-        digest = hashlib.sha256(payload).digest()
-        known = self.seen.get(plan.plan_id)
-        if known is not None and known != digest:
-            return RequestError(ErrorCode.PLAN_ID_REUSED,
-                                f"plan id '{plan.plan_id}' belongs to a different plan this controller received "
-                                "before; refused")
-        self.seen[plan.plan_id] = digest
-        self.seen.move_to_end(plan.plan_id)
-        while len(self.seen) > MAX_REMEMBERED_IDS:
-            self.seen.popitem(last=False)
-        return None
-
-    def admit_plan(self, plan: Plan, payload: bytes) -> RequestError | None:
-        """Check a received plan (:func:`check_plan`) and its id; None when it is usable."""
-        return check_plan(plan, payload, self.context) or self._remember(plan, payload)
-
-    def receive_plan(self, plan: Plan, payload: bytes) -> RequestError | None:
-        """Cache a published plan once it passes :meth:`admit_plan`; the oldest plans go beyond
-        ``max_cached_plans`` or ``max_cache_bytes``, never the one being flown."""
-        refused = self.admit_plan(plan, payload)
-        if refused is not None:
-            key = plan.plan_id[:validation.MAX_NAME_LENGTH]
-            self.refused[key] = refused
-            self.refused.move_to_end(key)
-            while len(self.refused) > MAX_REMEMBERED_REFUSALS:
-                self.refused.popitem(last=False)
-            return refused
-        if plan.plan_id in self.plans:
-            return None
-        self.plans[plan.plan_id] = CachedPlan(plan, len(payload))
-        flying = self.maneuver.plan.plan_id if self.maneuver is not None else None
-        for plan_id in list(self.plans):
-            if len(self.plans) <= self.config.max_cached_plans and self.cache_bytes <= self.config.max_cache_bytes:
-                break
-            if plan_id != flying:
-                del self.plans[plan_id]
-        return None
 
     def authorize_mode(self, payload: bytes, signature: bytes, signer: str, sequence: int) -> RequestError | None:
         """Why a mode request (signed bytes ``payload``) is not authentic, when :attr:`mode_key` is
@@ -274,8 +259,10 @@ class Controller:
         self.mode_sequence = sequence
         return None
 
-    def set_mode(self, mode: int) -> tuple[ErrorCode, str, ManeuverResult | None]:
-        """Change the mode; the result of a maneuver this aborts comes back too."""
+    def set_mode(self, mode: int, pointing: PointingMode | None = None,
+                 dumping: bool | None = None) -> tuple[ErrorCode, str, ManeuverResult | None]:
+        """Change the mode (MODE_POINTING: to the law of ``pointing``) and, when given, switch the
+        momentum dumping; the result of a maneuver this aborts comes back too."""
         if mode not in CONTROL_MODES:
             return ErrorCode.INVALID_MODE, f"mode {mode} is not one of {CONTROL_MODES} (ActuatorCommand.MODE_*)", None
         if mode == ControlMode.PLAN_TRACKING:
@@ -283,47 +270,53 @@ class Controller:
         if self.maneuver is not None and mode != ControlMode.SAFE:
             return ErrorCode.BUSY, (f"maneuver '{self.maneuver.plan.plan_id}' is executing: only MODE_SAFE "
                                     "(abort) is accepted until it ends or is cancelled"), None
-        refused = self.estimate_refusal() if mode == ControlMode.MAGNETORQUER_PD else None
-        if refused is not None:
-            return refused.code, refused.message, None
-        ended = self.abort("aborted by a switch to safe mode") if self.maneuver is not None else None
-        self.mode = mode
-        return ErrorCode.OK, f"mode set to {mode}", ended
-
-    def resolve(self, plan_id: str, inline: Plan | None = None,
-                payload: bytes = b"") -> tuple[Plan | None, RequestError | None]:
-        """The plan to execute (``inline`` with its signed ``payload``, or the cached ``plan_id``),
-        or why there is none."""
-        if inline is not None:
-            refused = self.admit_plan(inline, payload)
-            return (None, refused) if refused is not None else (inline, None)
+        law = None
         try:
-            validation.text(plan_id, "plan_id")
+            if mode in (ControlMode.MAGNETORQUER_PD, ControlMode.POINTING):
+                refused = self.estimate_refusal()
+                if refused is not None:
+                    raise refused
+            if mode == ControlMode.POINTING:
+                law = self.pointing_law(pointing)
         except RequestError as err:
-            return None, err
-        cached = self.plans.get(plan_id)
-        if cached is None and plan_id in self.refused:
-            why = self.refused[plan_id]
-            return None, RequestError(why.code, f"plan '{plan_id}' was refused when it arrived: {why.message}")
-        if cached is None:
-            return None, RequestError(ErrorCode.UNKNOWN_PLAN,
-                                      f"plan_id '{plan_id}' is not a plan this controller received")
-        return cached.plan, None
+            return err.code, err.message, None
+        ended = self.abort("aborted by a switch to safe mode") if self.maneuver is not None else None
+        self.mode, self.pointing = mode, law
+        if dumping is not None:
+            self.dumping = bool(dumping)
+        what = f"pointing {law.name}" if law is not None else f"mode set to {mode}"
+        return ErrorCode.OK, f"{what}; momentum dumping {'on' if self.dumping else 'off'}", ended
 
-    def start(self, plan: Plan) -> RequestError | None:
-        """Start flying ``plan`` (resolved) from the latest state, if it starts there."""
+    def pointing_law(self, pointing: PointingMode | None):
+        """The law of a requested pointing mode, checked now (RequestError: 304 without a state,
+        314 for a bad field or no attitude)."""
+        if self.state is None:
+            raise RequestError(ErrorCode.NO_STATE, "no spacecraft state received yet")
+        if pointing is None:
+            raise RequestError(ErrorCode.INVALID_POINTING, "MODE_POINTING needs a pointing mode")
+        if self.guidance_sky is None:
+            raise RequestError(ErrorCode.INVALID_POINTING, "this controller has no orbit to point from")
+        return law_of(pointing, self.guidance_sky, self.state.t, self.state.q)
+
+    def start(self, plan: Plan, after: PointingMode | None = None) -> RequestError | None:
+        """Start flying ``plan`` (resolved) from the latest state, if it starts there; at its end
+        hand over to the pointing mode ``after`` (None: hold its final attitude)."""
         if self.state is None:
             return RequestError(ErrorCode.NO_STATE, "no spacecraft state received yet")
         refused = self.estimate_refusal() or check_start(plan, self.state, self.context)
         if refused is not None:
             return refused
         try:
+            law = None if after is None else self.pointing_law(after)
+        except RequestError as err:
+            return err
+        try:
             zones = self.zone_sky(plan)
         except ValueError as err:
             return RequestError(ErrorCode.INVALID_PLAN, f"plan '{plan.plan_id}': its zones cannot be placed in the "
                                                         f"sky now: {err}")
-        self.maneuver = Maneuver(plan, self.state.t, zones)
-        self.mode = ControlMode.PLAN_TRACKING
+        self.maneuver = Maneuver(plan, self.state.t, zones, after=law)
+        self.mode, self.pointing = ControlMode.PLAN_TRACKING, None
         return None
 
     def zone_sky(self, plan: Plan) -> ZoneSky | None:
@@ -361,12 +354,16 @@ class Controller:
             if not blank:
                 cmd.dipole = dipole_command(s.q, s.omega, s.field_body, self.config.kp, self.config.kd, self.m_max)
         elif self.mode == ControlMode.SAFE:
-            cmd.wheel_torques = self._wheels(-self.config.safe_kd * s.omega)
+            self._safe(out)
+        elif self.mode == ControlMode.POINTING and self.pointing is not None:
+            self._point(out, self.pointing)
         elif self.mode == ControlMode.PLAN_TRACKING and self.maneuver is not None:
             self._track(out, cancel_requested)
         elif self.mode == ControlMode.PLAN_TRACKING and self.hold_q is not None:
             cmd.wheel_torques = self._wheel_command(tracking.Reference(self.hold_q, np.zeros(3), np.zeros(3)))
             status.message = "holding the final attitude of the last maneuver"
+            status.reference_q, status.attitude_error = self.hold_q, float(rot.angle_between(s.q, self.hold_q))
+        status.dumping = self.dumping
         if self.measured is not None:
             self.measured.dipoles.record(s.t, cmd.dipole)
         return out
@@ -381,13 +378,53 @@ class Controller:
 
     def _wheels(self, body_torque: np.ndarray, wheel_speed: np.ndarray | None = None) -> np.ndarray:
         """Motor torques that put ``body_torque`` on the body, the expected drive friction compensated
-        (``wheel_speed``: the inertial spin rates the gyroscopic term uses; default the state's)."""
-        s = self.state
-        friction = None
+        (``wheel_speed``: the inertial spin rates the gyroscopic term uses; default the state's), and
+        with more than three wheels the null-space control of their speeds (no body torque)."""
+        s, sc, c = self.state, self.spacecraft, self.config
+        extra = momentum.null_space_torques(sc, s.wheel_speeds, c.null_space_speed, c.null_space_gain)
         if self.friction is not None:
-            friction = self.friction(s.wheel_speeds - self.spacecraft.wheel_axes.T @ s.omega)
-        return tracking.wheel_torques(self.spacecraft, body_torque, s.omega,
-                                      s.wheel_speeds if wheel_speed is None else wheel_speed, friction)
+            extra = extra + self.friction(s.wheel_speeds - sc.wheel_axes.T @ s.omega)
+        return tracking.wheel_torques(sc, body_torque, s.omega, s.wheel_speeds if wheel_speed is None else wheel_speed,
+                                      extra)
+
+    def _point(self, out: StepOutput, law) -> None:
+        """Track ``law``'s reference (feedforward + PD) through the wheels, dumping momentum with the
+        magnetorquers when that is on (their torque fed forward to the wheels)."""
+        s, sc, c = self.state, self.spacecraft, self.config
+        ref = guidance_reference(law.attitude, s.t)
+        tau = pointing_torque(sc, s.q, s.omega, ref, c.tracking_kp, c.tracking_kd)
+        blank = self.measured is not None and self.measured.blank(s.t, c.control_period)
+        if self.dumping and not blank and sc.n_wheels:
+            h_wheels = sc.wheel_axes @ (sc.wheel_inertia * s.wheel_speeds)
+            out.command.dipole = momentum.desaturation_dipole(h_wheels, np.zeros(3), s.field_body, c.dumping_gain,
+                                                              self.m_max)
+        out.command.wheel_torques = self._wheels(tau - rot.cross(out.command.dipole, s.field_body))
+        st = out.status
+        st.guidance, st.reference_q, st.reference_rate = law.name, ref.q, ref.omega
+        st.attitude_error = float(rot.angle_between(s.q, ref.q))
+        if law.degenerate:
+            st.message = f"pointing {law.name}: the directions are parallel now; holding the last attitude"
+
+    def _safe(self, out: StepOutput) -> None:
+        """Rate damping (τ = −k_d ω); once the rates are below ``safe_rate_threshold``, with a Sun to
+        see and an attitude to trust, the safe Sun pointing (``safe_sun_axis`` on the Sun, the orbit
+        normal as secondary)."""
+        s, c = self.state, self.config
+        sun_ok = self.guidance_sky is not None and self.guidance_sky.sun is not None and \
+            (self.measured is None or self.estimate_health in USABLE)
+        if not sun_ok or float(np.linalg.norm(s.omega)) > c.safe_rate_threshold:
+            out.command.wheel_torques = self._wheels(-c.safe_kd * s.omega)
+            return
+        if self.safe_law is None:
+            axis = np.asarray(c.safe_sun_axis, float)
+            mode = PointingMode("sun", primary_axis=axis, secondary_axis=rot.orthonormal_basis(axis)[0],
+                                secondary="orbit_normal")
+            try:
+                self.safe_law = law_of(mode, self.guidance_sky, s.t, s.q)
+            except RequestError:
+                out.command.wheel_torques = self._wheels(-c.safe_kd * s.omega)
+                return
+        self._point(out, self.safe_law)
 
     def _wheel_command(self, ref: tracking.Reference) -> np.ndarray:
         """Wheel torques of the tracking law about a body-torque reference."""
@@ -421,9 +458,25 @@ class Controller:
             out.result = self.abort("cancelled")
             return
         out.status.plan_progress = float(min(1.0, elapsed / max(plan.duration, 1e-9)))
+        out.status.reference_q, out.status.reference_rate = ref.q, ref.omega
+        out.status.attitude_error = float(rot.angle_between(s.q, ref.q))
+        if m.after is not None and elapsed >= plan.duration:
+            law = self._handover(m.after, plan, s.t)
+            out.result = self._end(True, ErrorCode.OK, f"maneuver complete; pointing {law.name}")
+            self.mode, self.pointing, self.hold_q = ControlMode.POINTING, law, None
+            out.status.message = f"maneuver complete; pointing {law.name}"
+            return
         if elapsed >= plan.duration + self.config.settle_time:
             out.result = self._end(True, ErrorCode.OK, "maneuver complete")
             out.status.message = "maneuver complete; holding the final attitude"
+
+    def _handover(self, law, plan: Plan, t: float):
+        """The pointing law a plan hands over to at its end: the law itself when the plan ends at
+        the law's rate (a slew planned to end on the moving target), else the law entered through
+        :class:`~att_planner.guidance.laws.BlendedLaw` over ``handover_blend`` s (a plan ending at rest)."""
+        law_rate = guidance_reference(law.attitude, t).omega
+        matched = float(np.linalg.norm(plan.omega[-1] - law_rate)) <= HANDOVER_RATE_MATCH
+        return law if matched or self.config.handover_blend <= 0 else BlendedLaw(law, t, self.config.handover_blend)
 
     def _end(self, success: bool, code: ErrorCode, message: str) -> ManeuverResult:
         """Close the running maneuver; its figures are those of the latest state (there is one:

@@ -12,7 +12,8 @@ Body torque demand::
 
 (a quaternion PD in body axes; Wie, *Space Vehicle Dynamics and Control*, §7.3). The demand is
 realised by reaction wheels: the body receives ``−G u − ω × G h_w`` so
-``u = −G⁺ (τ + ω × G I_w Ω)`` (pseudo-inverse for any number of wheels), clipped to the limit.
+``u = −G⁺ (τ + ω × G I_w Ω)`` (pseudo-inverse for any number of wheels), scaled down as a whole
+to the limit when a wheel would exceed it.
 """
 from __future__ import annotations
 
@@ -69,13 +70,18 @@ def tracking_torque(q, omega, ref: Reference, kp: float, kd: float) -> np.ndarra
     return ref.torque - kp * 2.0 * e - kd * (np.asarray(omega) - ref.omega)
 
 
-def wheel_torques(sc: Spacecraft, body_torque, omega, wheel_speed, friction=None) -> np.ndarray:
-    """Motor torques u that put ``body_torque`` on the body (gyroscopic wheel term compensated);
-    ``friction`` (N m per wheel, the drive friction expected at the measured speeds) is added so
-    the net wheel torque is the one asked for."""
+def wheel_torques(sc: Spacecraft, body_torque, omega, wheel_speed, extra=None) -> np.ndarray:
+    """Motor torques u that put ``body_torque`` on the body (gyroscopic wheel term compensated),
+    distributed by the pseudo-inverse (least norm, any number of wheels) and, when a wheel would
+    exceed its limit, scaled down as a whole (the torque keeps its direction, rather than being
+    bent by clipping one wheel); ``extra`` (N m per wheel: the drive friction expected at the
+    measured speeds, null-space torques) is added after, and clipped."""
     h_w = sc.wheel_axes @ (sc.wheel_inertia * np.asarray(wheel_speed, float))
     demand = np.asarray(body_torque, float) + rot.cross(omega, h_w)
     u = -sc.wheel_axes_pinv @ demand
-    if friction is not None:
-        u = u + friction
+    peak = float(np.max(np.abs(u))) if u.size else 0.0
+    if peak > sc.wheel_torque_max:
+        u = u * (sc.wheel_torque_max / peak)
+    if extra is not None:
+        u = u + extra
     return np.minimum(np.maximum(u, -sc.wheel_torque_max), sc.wheel_torque_max)

@@ -10,7 +10,8 @@ problem (and are verified), the others are passed to the function.
 A new method: write ``plan_<name>(problem, **options) -> Plan`` in a module of this package and
 add an entry to :data:`REGISTRY` (its options, ranges and, if some combinations cannot run, a hook).
 Entries travel to the planner's child processes, so they must pickle: hooks are module-level
-functions, never lambdas.
+functions, never lambdas. A method marked ``seeded`` takes ``warm_starts``, a tuple of plans to start
+from: the planner service passes its first plan (:mod:`att_planner.service.planning`).
 """
 from __future__ import annotations
 
@@ -44,6 +45,7 @@ class Method:
     options: dict = field(default_factory=dict)
     fixed: dict = field(default_factory=dict)     # keyword arguments always passed
     cheap: bool = False                           # closed form: run in-process, no child process
+    seeded: bool = False                          # takes ``warm_starts``: plans to start from (the first plan)
     # combinations the method cannot run: check(options with ``fixed``) -> why, of the ``combined`` options
     check: Callable[[dict], str | None] | None = None
     combined: tuple = ()
@@ -99,12 +101,14 @@ def _time_optimal_check(options: dict) -> str | None:
     return option_problem(options)
 
 
-def _slepian(variant: str, description: str) -> Method:
+def _slepian(variant: str, description: str, seeded: bool = False) -> Method:
     return Method(variant, "att_planner.methods.slepian.planner", "plan_slepian", description, SLEPIAN_OPTIONS,
-                  fixed={"method": variant}, check=_slepian_check,
-                  combined=("M", "N", "W"))
+                  fixed={"method": variant}, check=_slepian_check, combined=("M", "N", "W"), seeded=seeded)
 
 
+# Bounds of the maneuver the collocation methods take as options.
+_RATE_MAX = Option(1e-6, 10.0, limit=True, doc="rad/s per body axis")
+_MOMENTUM_MAX = Option(1e-6, 1e4, limit=True, doc="N m s per wheel")
 # Basis size, DPSS length and half-bandwidth of the Slepian methods (issue 3).
 SLEPIAN_OPTIONS = {"M": Option(2, 12, True, doc="basis size"), "N": Option(50, 2000, True, doc="samples"),
                    "W": Option(1e-4, 0.25, doc="half-bandwidth")}
@@ -115,19 +119,28 @@ BOUNDARY_CONE = Option(0, 15, True, limit=True, doc="index of the cone whose bou
 
 # Best first: the default method is the first one.
 REGISTRY = [
-    _slepian("slepian_minimum_time", "smooth torque on a Slepian basis, t_f minimised exactly (issue 3); zone-aware"),
+    Method("smooth_collocation", "att_planner.methods.time_optimal.smooth", "plan_smooth_collocation",
+           "minimum time with a C1 torque (its second derivative bounded; torque and its rate zero at both ends) "
+           "by Hermite-Simpson collocation with IPOPT, started from the first plan (issue 18); zone-aware",
+           {"intervals": Option(4, 200, True), "torque_accel": Option(1.0, 1e4, doc="|d2T/dt2| in T/tu^2"),
+            "cone_margin_deg": Option(0.0, 5.0), "rate_max": _RATE_MAX, "wheel_momentum_max": _MOMENTUM_MAX},
+           seeded=True),
+    _slepian("slepian_minimum_time", "smooth torque on a Slepian basis, t_f minimised exactly (issue 3); zone-aware",
+             seeded=True),
     Method("time_optimal", "att_planner.methods.time_optimal.planner", "plan_time_optimal",
            "minimum-time bang-bang slew by direct collocation with IPOPT (Melton 2012); zone-aware",
            {"intervals": Option(4, 200, True), "max_intervals": Option(4, 400, True), "starts": Option(1, 20, True),
             "refine_rounds": Option(0, 6, True), "cone_margin_deg": Option(0.0, 5.0),
-            "rate_max": Option(1e-6, 10.0, limit=True, doc="rad/s per body axis"),
-            "wheel_momentum_max": Option(1e-6, 1e4, limit=True, doc="N m s per wheel"),
+            "rate_max": _RATE_MAX, "wheel_momentum_max": _MOMENTUM_MAX,
             "smooth_warm_start": Option(0, 1, True), "global_stage": Option(0, 1, True, doc="particle swarm first"),
             "boundary_cone": BOUNDARY_CONE}, check=_time_optimal_check,
-           combined=("intervals", "max_intervals")),
+           combined=("intervals", "max_intervals"), seeded=True),
     Method("constrained_axis", "att_planner.methods.constrained_axis", "plan_constrained_axis",
            "eigenaxis bang-bang, or lambda-rotations riding a zone boundary when the path is blocked",
            {"ride_margin_deg": Option(0.0, 10.0), "boundary_cone": BOUNDARY_CONE}, cheap=True),
+    Method("graph_smooth", "att_planner.methods.graph_smooth", "plan_graph_smooth",
+           "the constructive first plan: the quickest rest-to-rest legs round the zones on a graph of sensor "
+           "directions (exact checks on every leg), C1 torque zero at every leg's ends; zone-aware", cheap=True),
     Method("eigenaxis_smooth", "att_planner.methods.eigenaxis", "plan_eigenaxis_smooth",
            "eigenaxis slew with a quintic angle profile (C1 rate, zero torque at both ends); ignores zones",
            # at most 5000 knots: a plan verified, signed and sent within its budget (+ 1 s)

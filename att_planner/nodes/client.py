@@ -169,27 +169,38 @@ class SuiteClient(Node):
     def schedule(self, request: PlanSchedule.Request, timeout: float = 300.0) -> PlanSchedule.Response:
         return self._call(self.schedule_client, request, timeout)
 
-    def set_mode(self, mode: int, timeout: float = 10.0, key=DEFAULT_KEY) -> SetControllerMode.Response:
-        """Change the controller's mode; the request is signed with ``key`` (an Ed25519 private key;
-        by default the key file of :func:`att_msgs_py.signing.default_key_dir` when there is one,
-        ``None``: unsigned), which a controller with ``require_signed_modes`` needs."""
+    def set_mode(self, mode: int, timeout: float = 10.0, key=DEFAULT_KEY, pointing=None,
+                 dumping: bool | None = None) -> SetControllerMode.Response:
+        """Change the controller's mode (MODE_POINTING: to ``pointing``, an
+        :class:`att_msgs_py.types.PointingMode`) and, when ``dumping`` is given, switch the momentum
+        dumping; the request is signed with ``key`` (an Ed25519 private key; by default the key file
+        of :func:`att_msgs_py.signing.default_key_dir` when there is one, ``None``: unsigned), which
+        a controller with ``require_signed_modes`` needs."""
         if key is DEFAULT_KEY:
             path = signing.default_key_dir() / signing.PRIVATE_NAME
             key = signing.load_private_key(path) if path.is_file() else None
         request = SetControllerMode.Request(mode=mode, sequence=time.time_ns())
+        if pointing is not None:
+            request.pointing = convert.pointing_msg(pointing)
+        if dumping is not None:
+            request.dumping = request.DUMPING_ON if dumping else request.DUMPING_OFF
         if key is not None:
             signing.sign(request, key)
         return self._call(self.mode_client, request, timeout)
 
     def execute(self, plan_id: str = "", plan=None, timeout: float = 600.0, on_feedback=None,
-                retries: int = 10, stall_timeout: float = STALL_TIMEOUT) -> ExecuteManeuver.Result:
-        """Run a plan on the controller and wait for the result. A plan just published may not have
-        reached the controller yet: UNKNOWN_PLAN is retried ``retries`` times, 0.5 s apart. A
-        controller that falls silent (no feedback for ``stall_timeout`` s of wall time) gives an
-        ABORTED result (:meth:`_await_result`)."""
-        goal = ExecuteManeuver.Goal(plan_id=plan_id, use_inline_plan=plan is not None)
+                retries: int = 10, stall_timeout: float = STALL_TIMEOUT, pointing_after=None) -> ExecuteManeuver.Result:
+        """Run a plan on the controller and wait for the result (``pointing_after``: a
+        :class:`att_msgs_py.types.PointingMode` the controller hands over to at the plan's end). A
+        plan just published may not have reached the controller yet: UNKNOWN_PLAN is retried
+        ``retries`` times, 0.5 s apart. A controller that falls silent (no feedback for
+        ``stall_timeout`` s of wall time) gives an ABORTED result (:meth:`_await_result`)."""
+        goal = ExecuteManeuver.Goal(plan_id=plan_id, use_inline_plan=plan is not None,
+                                    point_after=pointing_after is not None)
         if plan is not None:
             goal.plan = plan
+        if pointing_after is not None:
+            goal.pointing_after = convert.pointing_msg(pointing_after)
         check_strings(goal, "goal", nul_only=True)
         for _ in range(retries + 1):
             heard = [time.monotonic(), None]            # wall time of the last sign of life, last feedback

@@ -166,7 +166,16 @@ class ControllerNode(Node):
             self._refusals("mode request", refused)
             response.success, response.error_code, response.message = False, int(refused.code), refused.message
             return response
-        code, message, ended = self._core.set_mode(int(request.mode))
+        dumping = {request.DUMPING_KEEP: None, request.DUMPING_ON: True, request.DUMPING_OFF: False}
+        if int(request.dumping) not in dumping:
+            code, message, ended = ErrorCode.INVALID_MODE, f"dumping {request.dumping} is not DUMPING_KEEP/ON/OFF", None
+        else:
+            code, message, ended = self._core.set_mode(int(request.mode), convert.pointing_from_msg(request.pointing),
+                                                       dumping[int(request.dumping)])
+        if code != ErrorCode.OK:
+            self._refusals("mode request", RequestError(code, message))
+        else:
+            self.get_logger().info(f"mode request accepted: {message}")
         if ended is not None:
             self.finish(ended)
         response.success, response.error_code, response.message = code == ErrorCode.OK, int(code), message
@@ -183,7 +192,8 @@ class ControllerNode(Node):
         inline = convert.plan_from_msg(goal.plan) if goal.use_inline_plan else None
         plan, refused = self._core.resolve(goal.plan_id, inline, signing.payload(goal.plan) if inline else b"")
         if plan is not None:
-            refused = self._core.start(plan)
+            refused = self._core.start(plan, convert.pointing_from_msg(goal.pointing_after) if goal.point_after
+                                       else None)
         if refused is not None:
             self._refusals("execute goal", refused)
             goal_handle.abort()

@@ -2,7 +2,9 @@
 plan on the latched ``/planner/plans`` for the controller and the recorder.
 
 Callbacks only translate: message -> :class:`ManeuverRequest` -> :func:`validate_maneuver` ->
-:func:`plan_maneuver` -> message (:mod:`att_planner.service` holds the logic). The real sky of a
+:func:`plan_maneuver` -> message (:mod:`att_planner.service` holds the logic); the response names
+the stage whose plan it carries and reports every stage's time (anytime planning: a request's
+``time_budget`` of 50 ms is answered with the verified first plan). The real sky of a
 request (epoch, zones, TLE) goes in as sent; every plan records its epoch and zones, which its
 signature covers. Requests run
 concurrently (reentrant callback group on a multi-threaded executor), so a long solve never
@@ -111,6 +113,8 @@ class PlannerNode(Node):
             outcome = plan_maneuver(valid, self._tolerances, self._cone_padding, runner)
         except Exception as exc:  # a fault of the service itself is answered, never left hanging
             outcome = self.internal_error(exc)
+        response.stage = str(outcome.stage)
+        response.stages = [convert.stage_msg(stage) for stage in outcome.stages]
         self.answer(response, outcome, valid.spacecraft, valid.method.name, sensor_axis=valid.problem.sensor_axis,
                     cones=valid.problem.cones, zones=valid.problem.zones, epoch=valid.problem.epoch,
                     spacecraft_digest=valid.problem.spacecraft.digest)

@@ -1,14 +1,17 @@
-"""The planner's service logic without ROS: solve with the requested method, verify, fall back.
+"""The planner's service logic without ROS: a first plan, the requested method, verify, fall back.
 
-:func:`plan_maneuver` runs a validated request's method, integrates the returned torques through
-the truth dynamics (:mod:`att_planner.verification`) and accepts the plan only if it meets the
-tolerances. A method that fails, raises or runs out of budget without a plan that verifies is
-replaced by the smooth eigenaxis slew when that one verifies (status FALLBACK); otherwise the
-answer is an error. No unverified plan ever leaves. Zones (issue 13) travel in the problem: the
-method plans against their motion (:meth:`ManeuverProblem.zone_sky`), padded like the cones
-(:func:`padded`), and every plan, the fallback's too, is verified against the unpadded zones at
-their true positions. :func:`plan_schedule_request` does the same
-for a schedule (no fallback exists there).
+:func:`plan_maneuver` answers in stages (anytime planning, issue 18): the constructive first plan
+(:data:`FIRST_METHOD`, tens of milliseconds), then the requested method seeded with it as long as
+the budget allows, then, if neither verified, the smooth eigenaxis slew. Each plan is integrated
+through the truth dynamics (:mod:`att_planner.verification`) and accepted only if it meets the
+tolerances; the method's accepted plan is returned, else the first plan (status BUDGET_EXPIRED
+when the budget left the method no time or ran out in it, FALLBACK when the method failed), else
+the eigenaxis slew with status FALLBACK when only it verifies; otherwise the answer is an error. No unverified
+plan ever leaves, and the outcome reports every stage and its time. Zones (issue 13) travel in the
+problem: the method plans against their motion (:meth:`ManeuverProblem.zone_sky`), padded like the
+cones (:func:`padded`), and every plan, the fallback's too, is verified against the unpadded zones
+at their true positions. :func:`plan_schedule_request` does the same for a schedule (no fallback
+exists there).
 
 Bounded: a plan of more than :data:`MAX_PLAN_SAMPLES` samples is refused (SIZE_LIMIT) before it is
 verified or sent. Every answer comes within the request's budget plus :data:`ANSWER_GRACE`: the
@@ -21,12 +24,12 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
 from att_msgs_py.errors import ErrorCode
-from att_msgs_py.types import Cone, Plan, Status, Verification
+from att_msgs_py.types import Cone, Plan, Stage, StageReport, Status, Verification
 from att_msgs_py.validation import MAX_PLAN_SAMPLES
 from att_planner import methods
 from att_planner.cones import direction_margins, endpoint_directions
@@ -40,12 +43,14 @@ from att_planner.verification import TOLERANCES, VERIFY_STEPS, Tolerances, rejec
 from att_sim.ephemeris import de421
 from att_sim.epoch import timescale
 
-VERIFY_RESERVE = 0.2        # fraction of the time budget kept for verification and fallback
-VERIFY_RESERVE_MIN = 0.25   # s (at most half the budget)
+VERIFY_RESERVE = 0.1        # fraction of the time budget kept for verification and fallback
+VERIFY_RESERVE_MIN = 0.1    # s (at most half the budget)
 VERIFY_RESERVE_MAX = 3.0    # s
 ANSWER_GRACE = 1.0          # s an answer may come after the request's time budget
 ANSWER_MARGIN = 0.3         # s of that kept for building, signing and sending the answer
 FALLBACK_SAMPLES = 401      # knots of the eigenaxis fallback (its default)
+FIRST_METHOD = "graph_smooth"   # the constructive first plan of every request for a method that is not cheap
+MIN_METHOD_SECONDS = 0.05   # s of its deadline the requested method needs at least, after the first plan
 _step_seconds = 2e-4        # running estimate of the wall time of one verification step (s)
 
 
@@ -73,8 +78,8 @@ def timed_verify(problem: ManeuverProblem, plan: Plan) -> Verification:
 
 def prepare(spacecraft) -> None:
     """What the first request would otherwise pay for, done at start: the sky lattice, the DE421
-    ephemeris and the time scale of the real sky, the imports of the methods' option checks, and a
-    first measure of the verification cost."""
+    ephemeris and the time scale of the real sky, the imports of the methods' option checks, the
+    compiled integrator, a first plan and a first measure of the verification cost."""
     lattice()
     de421()
     timescale()
@@ -82,6 +87,7 @@ def prepare(spacecraft) -> None:
         method.validate({})
     problem = ManeuverProblem(spacecraft, np.array([0.0, 0.0, 0.0, 1.0]), np.array([0.0, 0.0, 0.5 ** 0.5, 0.5 ** 0.5]))
     timed_verify(problem, plan_eigenaxis_smooth(problem, samples=FALLBACK_SAMPLES))
+    timed_verify(problem, run_method(methods.get(FIRST_METHOD), problem, {}))
 
 
 @dataclass
@@ -92,6 +98,8 @@ class PlanOutcome:
     code: ErrorCode
     message: str
     plan: Plan | None
+    stage: Stage | str = ""                                   # the stage whose plan is returned
+    stages: list[StageReport] = field(default_factory=list)   # every stage, in order
 
     @property
     def verification(self) -> Verification | None:
@@ -150,54 +158,130 @@ def _no_time_to_verify(valid: ValidRequest, plan: Plan, fallback: bool) -> str:
     need = verify_cost(len(plan.t)) + (verify_cost(FALLBACK_SAMPLES) if fallback else 0.0)
     if time.monotonic() + need <= due:
         return ""
-    return (f"{valid.method.name} returned its plan of {len(plan.t)} samples too late to verify it within the time "
-            f"budget of {valid.time_budget:g} s (+{ANSWER_GRACE:g} s)")
+    return (f"{plan.method or 'the method'} returned its plan of {len(plan.t)} samples too late to verify it within "
+            f"the time budget of {valid.time_budget:g} s (+{ANSWER_GRACE:g} s)")
+
+
+@dataclass
+class _Stage:
+    """A stage's plan, its report, why the plan cannot be returned ('' when it verified) and whether
+    that is its size (:func:`too_many_samples`)."""
+
+    plan: Plan
+    report: StageReport
+    reason: str = ""
+    oversize: bool = False
+
+
+def _run_stage(name: Stage, method: Method, problem: ManeuverProblem, options: dict, runner: Callable,
+               wait: float | None, valid: ValidRequest, tol: Tolerances, fallback: bool) -> _Stage:
+    """Run ``method`` through ``runner`` and verify its plan against the unpadded problem when that
+    still fits the budget (:func:`_no_time_to_verify`, ``fallback``: with the fallback's)."""
+    start = time.perf_counter()
+    plan = runner(method, problem, options, wait)
+    if plan is None:
+        plan = Plan(method=method.name, status=Status.BUDGET_EXPIRED,
+                    message=f"time budget of {valid.time_budget:g} s expired before {method.name} returned a plan")
+    reason = plan.message or str(plan.status)
+    oversize = too_many_samples(plan) if plan.success else ""
+    if oversize:
+        reason = oversize
+    elif plan.success:
+        reason = _no_time_to_verify(valid, plan, fallback)
+        if reason:
+            plan.status = Status.BUDGET_EXPIRED
+        else:
+            plan.verification = timed_verify(valid.problem, plan)
+            why = rejection(plan.verification, tol)
+            reason = "" if why is None else f"{method.name} plan rejected by verification: {why}"
+    report = StageReport(name, method.name, time.perf_counter() - start, str(plan.status), not reason,
+                         plan.duration if len(plan.t) else float("nan"), reason or plan.message)
+    return _Stage(plan, report, reason, bool(oversize))
+
+
+def _first_plan_answer(first: _Stage, method: _Stage | None, valid: ValidRequest) -> tuple[Status, str]:
+    """Status and message of the first plan returned instead of the method's: BUDGET_EXPIRED when the
+    budget left no time for the method (or ran out in it), FALLBACK when the method failed or its plan
+    was rejected."""
+    note = f"returning the first plan ({first.plan.message})"
+    if method is None:
+        return Status.BUDGET_EXPIRED, (f"time budget of {valid.time_budget:g} s: no time left for {valid.method.name} "
+                                       f"after the first plan; {note}")
+    status = Status.BUDGET_EXPIRED if method.plan.status == Status.BUDGET_EXPIRED else Status.FALLBACK
+    return status, f"{method.reason}; {note}"
 
 
 def plan_maneuver(valid: ValidRequest, tol: Tolerances = TOLERANCES, cone_padding: float = 0.0,
                   runner: Callable = run_method) -> PlanOutcome:
-    """Plan with cones widened by ``cone_padding`` rad, verify against the requested cones, fall
-    back to the eigenaxis slew when that is safe.
+    """Plan in stages with zones padded by ``cone_padding`` rad, verify against the requested zones,
+    answer with the method's verified plan, else the first plan, else the eigenaxis fallback when that
+    is safe.
 
-    The method gets the request's deadline minus a reserve for verification and fallback
-    (:func:`verify_reserve`). ``runner`` executes it (:func:`run_method` in-process, or
-    :func:`att_planner.service.worker.run_isolated` in a child process that is killed if it
-    overruns); ``None`` from the runner means it overran.
+    1. *first*: :data:`FIRST_METHOD`'s constructive plan, in-process (not for a cheap method, which
+       is answered at once): the quick answer, and the seed of the method. When it finds no plan
+       among the padded zones, it tries the zones as requested.
+    2. *method*: the requested method, seeded with the first plan (``warm_starts``, for a method
+       that takes them), when at least :data:`MIN_METHOD_SECONDS` are left of its deadline: the
+       request's deadline minus a reserve for verification and fallback (:func:`verify_reserve`).
+       ``runner`` executes it (:func:`run_method` in-process, or
+       :func:`att_planner.service.worker.run_isolated` in a child process that is killed if it
+       overruns); ``None`` from the runner means it overran.
+    3. *fallback*: the smooth eigenaxis slew, when no stage's plan verified and it is safe.
+
+    Every stage is reported (:class:`StageReport`) with its wall time, and the outcome names the
+    stage whose plan it returns.
     """
     problem = valid.problem
+    planned = padded(problem, cone_padding)
+    can_fall_back = problem.sensor_target is None and valid.method.name != FALLBACK_METHOD
+    done: list[_Stage] = []
+    first = None
+    if not valid.method.cheap:
+        first = _run_stage(Stage.FIRST, methods.get(FIRST_METHOD), planned, {}, run_method, None, valid, tol, False)
+        if not first.report.verified and planned is not problem:   # the padding may close a way the zones leave
+            first = _run_stage(Stage.FIRST, methods.get(FIRST_METHOD), problem, {}, run_method, None, valid, tol,
+                               False)
+        done.append(first)
+        first = first if first.report.verified else None
     method_deadline = problem.deadline - verify_reserve(valid.time_budget) if problem.deadline is not None else None
     wait = None if method_deadline is None else max(0.0, method_deadline - time.monotonic())
-    plan = runner(valid.method, replace(padded(problem, cone_padding), deadline=method_deadline), valid.options, wait)
-    if plan is None:
-        plan = Plan(method=valid.method.name, status=Status.BUDGET_EXPIRED,
-                    message=f"time budget of {valid.time_budget:g} s expired before {valid.method.name} "
-                            "returned a plan")
-    oversize = too_many_samples(plan)
-    if oversize:
-        return PlanOutcome(ErrorCode.SIZE_LIMIT, oversize, None)
-    can_fall_back = problem.sensor_target is None and valid.method.name != FALLBACK_METHOD
-    reason = plan.message or plan.status
-    late = _no_time_to_verify(valid, plan, can_fall_back) if plan.success else ""
-    if late:
-        reason, plan.status = late, Status.BUDGET_EXPIRED
-    elif plan.success:
-        plan.verification = timed_verify(problem, plan)
-        reason = rejection(plan.verification, tol)
-        if reason is None:
-            return PlanOutcome(ErrorCode.OK, plan.message or plan.status, plan)
-        reason = f"{valid.method.name} plan rejected by verification: {reason}"
+    method = None
+    if first is None or wait is None or wait >= MIN_METHOD_SECONDS:
+        options = dict(valid.options)
+        if first is not None and valid.method.seeded:
+            options["warm_starts"] = (first.plan,)
+        method = _run_stage(Stage.METHOD, valid.method, replace(planned, deadline=method_deadline), options, runner,
+                            wait, valid, tol, can_fall_back and first is None)
+        done.append(method)
+        if first is None and method.oversize:
+            return PlanOutcome(ErrorCode.SIZE_LIMIT, method.reason, None, stages=[s.report for s in done])
+    else:
+        done.append(_Stage(Plan(method=valid.method.name), StageReport(
+            Stage.METHOD, valid.method.name, 0.0, message=f"not run: {wait:.3f} s left of its deadline after the "
+                                                           f"first plan (at least {MIN_METHOD_SECONDS:g} s needed)")))
+    reports = [s.report for s in done]
+    if method is not None and method.report.verified:
+        return PlanOutcome(ErrorCode.OK, method.plan.message or method.plan.status, method.plan, Stage.METHOD, reports)
+    if first is not None:
+        first.plan.status, first.plan.message = _first_plan_answer(first, method, valid)
+        return PlanOutcome(ErrorCode.OK, first.plan.message, first.plan, Stage.FIRST, reports)
+    plan, reason = method.plan, method.reason
     if can_fall_back:           # the smooth eigenaxis slew, if it is safe
+        start = time.perf_counter()
         fallback = plan_eigenaxis_smooth(problem, samples=FALLBACK_SAMPLES)
         fallback.verification = timed_verify(problem, fallback)
-        if fallback.status != Status.FAILED and rejection(fallback.verification, tol) is None:
+        safe = fallback.status != Status.FAILED and rejection(fallback.verification, tol) is None
+        reports.append(StageReport(Stage.FALLBACK, FALLBACK_METHOD, time.perf_counter() - start, str(fallback.status),
+                                   safe, fallback.duration, fallback.message))
+        if safe:
             fallback.status = Status.FALLBACK
             fallback.message = f"{reason}; returning the eigenaxis fallback ({fallback.message})"
-            return PlanOutcome(ErrorCode.OK, fallback.message, fallback)
+            return PlanOutcome(ErrorCode.OK, fallback.message, fallback, Stage.FALLBACK, reports)
     budget_note = " (time budget expired)" if plan.status == Status.BUDGET_EXPIRED else ""
     code = ErrorCode.VERIFICATION_FAILED if "verification" in reason else ErrorCode.SOLVER_FAILED
     if (problem.cones or problem.zones) and code == ErrorCode.SOLVER_FAILED and "infeasib" in reason.lower():
         code = ErrorCode.INFEASIBLE
-    return PlanOutcome(code, f"no verified plan{budget_note}: {reason}", plan)
+    return PlanOutcome(code, f"no verified plan{budget_note}: {reason}", plan, stages=reports)
 
 
 def plan_schedule_request(valid: ValidSchedule, tol: Tolerances = TOLERANCES, *, runner: Callable) -> PlanOutcome:

@@ -1,9 +1,12 @@
 """Run a planning method in a child process that is killed if it overruns its time.
 
 Flight-software style isolation for the planner node: a solver that ignores its deadline, hangs
-or crashes (a segfault in a native solver) costs one child process, never the node. Children are
-forked from a ``forkserver`` that has already imported the numerics, so starting one is cheap;
-at most ``max_parallel`` solve at once (the rest wait, within their own budget).
+or crashes (a segfault in a native solver) costs one worker process, never the node. Workers are
+forked from a ``forkserver`` that has already imported the numerics and serve one task after
+another, so what a method keeps between problems (its NLPs built for a shape, the compiled
+integrator) serves the next request too; a worker that overruns is killed and one that dies is
+replaced by a new one. At most ``max_parallel`` solve at once (the rest wait, within their own
+budget).
 
 A problem with a sky (issue 13) crosses to the child as it is: :class:`att_sim.ephemeris.Sky` and
 :class:`att_sim.orbit.TLEOrbit` pickle as their recipes (epoch and orbit, epoch and lines), since
@@ -23,7 +26,7 @@ from att_planner.service.planning import run_method
 
 _CONTEXT = multiprocessing.get_context("forkserver")
 _CONTEXT.set_forkserver_preload(["att_planner.service.planning", "numpy", "scipy.optimize", "att_sim.ephemeris",
-                                 "skyfield.api", "sgp4.api"])
+                                 "skyfield.api", "sgp4.api", "casadi", "att_planner.methods.time_optimal.smooth"])
 _SLOTS = threading.BoundedSemaphore(max(1, os.cpu_count() or 1))
 KILL_GRACE = 0.5            # s after the wait before the child is terminated
 
@@ -40,48 +43,81 @@ def warm_up() -> None:
     child.join()
 
 
-def _child(conn, function, args: tuple, kwargs: dict) -> None:
-    conn.send(function(*args, **kwargs))
+_IDLE: list = []                # (process, connection) of the workers waiting for a task, the last used last
+_IDLE_LOCK = threading.Lock()
+
+
+def _serve(conn) -> None:
+    """A worker: run each ``(function, args, kwargs)`` received and send its result back, until the
+    pipe closes."""
+    while True:
+        try:
+            function, args, kwargs = conn.recv()
+        except EOFError:
+            return
+        conn.send(function(*args, **kwargs))
+
+
+def _worker():
+    """An idle worker (the one used last: its caches are the warmest), or a new one."""
+    with _IDLE_LOCK:
+        while _IDLE:
+            process, conn = _IDLE.pop()
+            if process.is_alive():
+                return process, conn
+            conn.close()
+    conn, theirs = _CONTEXT.Pipe()
+    process = _CONTEXT.Process(target=_serve, args=(theirs,), daemon=True)
+    process.start()
+    theirs.close()
+    return process, conn
+
+
+def _retire(process, conn) -> None:
+    """Stop a worker (it overran or died): terminate, then kill."""
+    if process.is_alive():
+        process.terminate()
+        process.join(1.0)
+        if process.is_alive():
+            process.kill()
+    process.join()
     conn.close()
 
 
 def call_isolated(function, args: tuple, kwargs: dict, wait: float | None, *, on_death):
-    """``function(*args, **kwargs)`` in a child process (``function`` importable by name).
+    """``function(*args, **kwargs)`` in a worker process (``function`` importable by name).
 
-    Returns its result, ``None`` when it has not answered within ``wait`` s (+ grace; the child
-    is then killed), or ``on_death(message)`` when the child died without answering.
+    Returns its result, ``None`` when it has not answered within ``wait`` s (+ grace; the worker
+    is then killed), or ``on_death(message)`` when the worker died without answering.
     """
     start = time.monotonic()
     if not _SLOTS.acquire(timeout=wait):
         return None
     try:
         remaining = None if wait is None else max(0.0, wait - (time.monotonic() - start))
-        receiver, sender = _CONTEXT.Pipe(duplex=False)
-        child = _CONTEXT.Process(target=_child, args=(sender, function, args, kwargs), daemon=True)
-        child.start()
-        sender.close()
+        process, conn = _worker()
         try:
-            if receiver.poll(None if remaining is None else remaining + KILL_GRACE):
-                return receiver.recv()
-            if not child.is_alive():
-                return on_death(f"solver process died (exit code {child.exitcode})")
+            conn.send((function, args, kwargs))
+            if conn.poll(None if remaining is None else remaining + KILL_GRACE):
+                result = conn.recv()
+                with _IDLE_LOCK:
+                    _IDLE.append((process, conn))
+                process = None            # kept for the next task
+                return result
+            if not process.is_alive():
+                return on_death(f"solver process died (exit code {process.exitcode})")
             return None
-        except EOFError:
-            child.join(1.0)
-            return on_death(f"solver process died (exit code {child.exitcode})")
+        except (EOFError, OSError):
+            process.join(1.0)
+            return on_death(f"solver process died (exit code {process.exitcode})")
         finally:
-            if child.is_alive():
-                child.terminate()
-                child.join(1.0)
-                if child.is_alive():
-                    child.kill()
-            child.join()
-            receiver.close()
+            if process is not None:
+                _retire(process, conn)
     finally:
         _SLOTS.release()
 
 
 def run_isolated(method: Method, problem: ManeuverProblem, options: dict, wait: float | None) -> Plan | None:
-    """A planning method in a child; ``None`` when it has not answered within ``wait`` s (+ grace)."""
+    """A planning method in a worker; ``None`` when it has not answered within ``wait`` s (+ grace)."""
     return call_isolated(run_method, (method, problem, options), {}, wait,
                          on_death=lambda message: Plan(method=method.name, status=Status.FAILED, message=message))

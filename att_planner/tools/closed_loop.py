@@ -24,7 +24,7 @@ from cryptography.hazmat.primitives.asymmetric.ed25519 import Ed25519PrivateKey
 from att_msgs_py import convert, signing, topics
 from att_msgs_py.errors import RequestError
 from att_msgs_py.parameters import SectionReader
-from att_msgs_py.types import Health, ManeuverResult, Plan
+from att_msgs_py.types import Health, ManeuverResult, Plan, PointingMode
 from att_planner.control.configure import controller_from_scenario
 from att_planner.estimation.configure import estimator_from_scenario
 from att_sim import rotations as rot
@@ -49,6 +49,7 @@ class Trace:
     wheel_torques: list = field(default_factory=list)     # N m, commanded
     dipole: list = field(default_factory=list)            # A m², commanded
     mode: list = field(default_factory=list)
+    attitude_error: list = field(default_factory=list)    # rad, from the controller's reference (status)
 
     def arrays(self) -> dict[str, np.ndarray]:
         return {k: np.asarray(v) for k, v in self.__dict__.items()}
@@ -93,11 +94,12 @@ class ClosedLoop:
         signing.sign(msg, self.key)
         return convert.plan_from_msg(msg), signing.payload(msg)
 
-    def execute(self, plan: Plan, plan_id: str = "plan") -> RequestError | None:
-        """Start flying ``plan`` now (why not, when it cannot start)."""
+    def execute(self, plan: Plan, plan_id: str = "plan", after: PointingMode | None = None) -> RequestError | None:
+        """Start flying ``plan`` now, handing over to the pointing mode ``after`` at its end (why
+        not, when it cannot start)."""
         received, payload = self.issue(plan, plan_id)
         resolved, refused = self.controller.resolve(received.plan_id, received, payload)
-        return refused or self.controller.start(resolved)
+        return refused or self.controller.start(resolved, after)
 
     # -- the loop ---------------------------------------------------------------------------------
     def tick(self) -> None:
@@ -143,7 +145,7 @@ class ClosedLoop:
                     self.refusals.append(RequestError(refused.code, refused.message))
                 if est is not None:
                     est.on_dipole_command(out.command.t, out.command.dipole)
-                self._record(out.command, readings)
+                self._record(out, readings)
         sim.advance(self.step)
 
     def run(self, duration: float) -> None:
@@ -188,8 +190,8 @@ class ClosedLoop:
         if state_due:
             self.tap(topics.STATE, t, self.sim.state(self.scenario.frame_id, self.scenario.body_frame_id))
 
-    def _record(self, command, readings) -> None:
-        tr, sim, est = self.trace, self.sim, self.estimator
+    def _record(self, out, readings) -> None:
+        tr, sim, est, command = self.trace, self.sim, self.estimator, out.command
         x = sim.x
         state = self.controller.state
         tr.t.append(sim.t)
@@ -200,6 +202,7 @@ class ClosedLoop:
         tr.wheel_torques.append(np.asarray(command.wheel_torques, float).copy())
         tr.dipole.append(np.asarray(command.dipole, float).copy())
         tr.mode.append(int(command.mode))
+        tr.attitude_error.append(float(out.status.attitude_error))
         if est is not None and est.state is not None:
             tr.attitude_covariance.append(est.state.P[:3, :3].copy())
             tr.bias_est.append(est.state.bias.copy())

@@ -1,9 +1,9 @@
 """The vocabularies of att_msgs_py.types are the .msg constants, and the mirror types round-trip."""
 import numpy as np
 
-from att_msgs.msg import ActuatorCommand, ControllerStatus, ManeuverPlan
+from att_msgs.msg import ActuatorCommand, ControllerStatus, ManeuverPlan, PlanStage
 from att_msgs_py import convert
-from att_msgs_py.types import Command, ControlMode, Plan, Status
+from att_msgs_py.types import Command, ControlMode, Plan, Stage, StageReport, Status
 from att_msgs_py.types import ControllerStatus as Status_
 
 
@@ -18,6 +18,17 @@ def test_control_modes_are_the_actuator_command_constants():
 def test_plan_statuses_are_the_maneuver_plan_constants():
     assert {str(s) for s in Status} == set(constants(ManeuverPlan, "STATUS_").values())
     assert len(Status) == len(constants(ManeuverPlan, "STATUS_"))
+
+
+def test_stage_names_are_the_plan_stage_constants():
+    assert {s.name: str(s) for s in Stage} == constants(PlanStage, "STAGE_")
+
+
+def test_stage_report_round_trips():
+    report = StageReport(Stage.METHOD, "slepian_minimum_time", 0.61, Status.OPTIMAL, True, 3.7, "seeded")
+    assert convert.stage_from_msg(convert.stage_msg(report)) == report
+    empty = convert.stage_from_msg(convert.stage_msg(StageReport(Stage.FALLBACK, "eigenaxis_smooth", 0.0)))
+    assert empty.status == "" and not empty.verified and np.isnan(empty.duration)
 
 
 def test_command_and_status_round_trip():

@@ -56,7 +56,8 @@ def main() -> int:
             if not response.success:
                 print(f"planner refused: {response.message}")
                 return 1
-            suite.start("simulator", {"scenario": "swift_demo", **PARAMS["simulator"]})
+            # sim time stays at zero until the recorder, the estimator and the controller listen
+            suite.start("simulator", {"scenario": "swift_demo", "wait_for_subscribers": 3, **PARAMS["simulator"]})
             for _ in range(40):
                 result = client.execute(response.plan.plan_id)
                 if result.error_code != ErrorCode.NO_STATE:
@@ -70,6 +71,11 @@ def main() -> int:
         codes = suite.stop()
     if any(codes.values()):
         print(f"a node exited with an error: {codes} (logs in {work})")
+        return 1
+    from att_msgs_py.log import read_log
+    first_state = read_log(work / "run.mcap")["/spacecraft/state"]["header.stamp"][0]
+    if first_state > 0.0:
+        print(f"the recorder missed the states before t = {first_state:.2f} s (logs in {work})")
         return 1
     shutil.copyfile(work / "run.mcap", FIXTURE)
     shutil.rmtree(work)

@@ -1,7 +1,8 @@
-"""An integration of ZOH torque profiles that uses nothing of the suite, for the independent checks
+"""An integration of torque profiles that uses nothing of the suite, for the independent checks
 of the committed benchmark JSONs: its own RK4 of the rigid body (J ω̇ = T − ω × Jω,
 q̇ = ½ q ⊗ [ω, 0]; Euler's equations, Wie, *Space Vehicle Dynamics and Control*, 2008, §5.2) on
-Python floats, quaternions (x, y, z, w) body-to-inertial."""
+Python floats, quaternions (x, y, z, w) body-to-inertial; the torque samples held (ZOH) or
+interpolated linearly (at each RK4 stage's time)."""
 from __future__ import annotations
 
 import numpy as np
@@ -15,10 +16,11 @@ def dcm(q):
                      np.stack([2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)], -1)], -2)
 
 
-def integrate(J, t, torque, q0, substeps: int = 4, dense: bool = False):
+def integrate(J, t, torque, q0, substeps: int = 4, dense: bool = False, interpolation: str = "zoh"):
     """RK4 from rest at ``q0``, the torque of knot k held to knot k + 1 (switched exactly at the
-    knots), ``substeps`` steps per interval; the states (x, y, z, w, ωx, ωy, ωz) at the knots ``t``,
-    or with ``dense`` ``(times, states)`` after every step."""
+    knots; ``interpolation='linear'``: interpolated to knot k + 1), ``substeps`` steps per interval;
+    the states (x, y, z, w, ωx, ωy, ωz) at the knots ``t``, or with ``dense`` ``(times, states)`` after
+    every step."""
     J = [list(map(float, row)) for row in J]
     Ji = np.linalg.inv(np.array(J)).tolist()
 
@@ -37,12 +39,14 @@ def integrate(J, t, torque, q0, substeps: int = 4, dense: bool = False):
     times, states = [float(t[0])], [list(x)]
     for k in range(len(t) - 1):
         h = (t[k + 1] - t[k]) / substeps
-        u = [float(v) for v in torque[k]]
+        a = [float(v) for v in torque[k]]
+        b = [float(v) for v in torque[k + 1]] if interpolation == "linear" else a
         for j in range(substeps):
-            k1 = f(x, u)
-            k2 = f(axpy(x, 0.5 * h, k1), u)
-            k3 = f(axpy(x, 0.5 * h, k2), u)
-            k4 = f(axpy(x, h, k3), u)
+            u0, um, u1 = ([ai + (bi - ai) * (j + f) / substeps for ai, bi in zip(a, b)] for f in (0.0, 0.5, 1.0))
+            k1 = f(x, u0)
+            k2 = f(axpy(x, 0.5 * h, k1), um)
+            k3 = f(axpy(x, 0.5 * h, k2), um)
+            k4 = f(axpy(x, h, k3), u1)
             x = [xi + h / 6.0 * (a + 2 * b + 2 * c + d) for xi, a, b, c, d in zip(x, k1, k2, k3, k4)]
             n = sum(v * v for v in x[:4]) ** 0.5
             x[:4] = [v / n for v in x[:4]]

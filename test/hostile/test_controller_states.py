@@ -142,8 +142,9 @@ def test_a_controller_that_starts_on_a_spinning_spacecraft_damps_it(rate, mode):
     assert (np.linalg.norm(sim.x[4:7]) < 0.3 * w0) == (mode == ControlMode.SAFE)
 
 
-@pytest.mark.parametrize("mode, code", [(255, ErrorCode.INVALID_MODE), (4, ErrorCode.INVALID_MODE),
-                                        (int(ControlMode.PLAN_TRACKING), ErrorCode.INVALID_MODE)])
+@pytest.mark.parametrize("mode, code", [(255, ErrorCode.INVALID_MODE), (5, ErrorCode.INVALID_MODE),
+                                        (int(ControlMode.PLAN_TRACKING), ErrorCode.INVALID_MODE),
+                                        (int(ControlMode.POINTING), ErrorCode.INVALID_POINTING)])   # no pointing mode
 def test_bad_mode_requests_are_refused(loop, mode, code):
     core, _ = loop
     assert core.set_mode(mode)[0] == code and core.mode == ControlMode.IDLE

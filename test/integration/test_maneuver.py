@@ -7,10 +7,11 @@ import math
 import numpy as np
 import pytest
 
+from att_msgs_py import convert
 from att_msgs_py.errors import ErrorCode
 from att_msgs_py.log import read_log
 from att_msgs_py.topics import COMMAND, PLANS, STATE
-from att_msgs_py.types import Cone
+from att_msgs_py.types import Cone, Stage, Status
 from att_planner.cones import margins
 from att_planner.nodes.client import maneuver_request
 from att_sim import rotations as rot
@@ -39,6 +40,24 @@ def test_bad_request_is_refused_and_the_next_good_one_is_served(suite):
                                         method="eigenaxis_smooth"))
     assert good.success, good.message
     assert all(suite.suite.alive().values())
+
+
+def test_a_quick_answer_is_the_first_stage_and_every_stage_is_reported(suite):
+    """A 50 ms budget: the verified first plan (graph_smooth), the default method not run; a 20 s
+    budget: the default method's plan, quicker than the first plan it was seeded with."""
+    client = suite.client
+    quick = client.plan(maneuver_request(rot.IDENTITY, GOAL, SENSOR, CONES, time_budget=0.05))
+    assert quick.success and quick.stage == Stage.FIRST, quick.message
+    first, method = (convert.stage_from_msg(s) for s in quick.stages)
+    assert (first.name, first.method, first.verified) == (Stage.FIRST, "graph_smooth", True)
+    assert quick.plan.method == "graph_smooth" and quick.plan.status == Status.BUDGET_EXPIRED
+    assert first.duration == pytest.approx(quick.plan.duration) and 0 < first.seconds < 1.0
+    assert method.name == Stage.METHOD and method.status == "" and not method.verified
+    best = client.plan(maneuver_request(rot.IDENTITY, GOAL, SENSOR, CONES, time_budget=20))
+    assert best.success and best.stage == Stage.METHOD, best.message
+    first, method = (convert.stage_from_msg(s) for s in best.stages)
+    assert first.verified and method.verified and method.method == best.plan.method == "smooth_collocation"
+    assert method.duration == pytest.approx(best.plan.duration) and method.duration < first.duration
 
 
 def test_maneuver_is_planned_executed_and_recorded(suite):

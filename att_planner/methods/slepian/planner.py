@@ -8,6 +8,7 @@ import numpy as np
 
 from att_msgs_py.types import ControlKind, Interpolation, Plan, Status
 from att_planner.cones import blocked_endpoint
+from att_planner.methods.graph_smooth import plan_graph_smooth
 from att_planner.methods.slepian.dfsp import solve_dfsp
 from att_planner.methods.slepian.model import (
     DEFAULT_METHOD,
@@ -52,11 +53,20 @@ def _pad_alpha(alpha: np.ndarray, N_from: int, N_to: int, M_to: int) -> np.ndarr
     return out * np.sqrt(N_to)
 
 
+def plan_alpha(man: SmoothManeuver, plan: Plan) -> np.ndarray:
+    """α (3, M) whose rates are closest to a plan's (least squares: the basis is orthonormal):
+    ω*(τ) = t_f ω(τ t_f) at the middle of each of the N samples."""
+    tau = (np.arange(man.N) + 0.5) / man.N * plan.duration
+    w = np.stack([np.interp(tau, plan.t, plan.omega[:, j]) for j in range(3)], axis=-1) * plan.duration
+    return (man.basis.T @ w).T
+
+
 def solve_min_time(man: SmoothManeuver, *, basis_sizes: tuple = (4, 8), starts: int = 6, seed: int = 0,
                    start_scale: float = 0.5, explore_N: int = EXPLORE_N, explore_maxiter: int = 60,
                    explore_total_iterations: int = 150,
                    end_ratio: float = 1e-3, alpha0: np.ndarray | None = None, time_budget: float | None = None,
-                   deadline: float | None = None, feas_tol: float = 1e-6, budget_tol: float = 5e-4) -> SlepianResult:
+                   deadline: float | None = None, feas_tol: float = 1e-6, budget_tol: float = 5e-4,
+                   seeds: tuple = ()) -> SlepianResult:
     """Ours: minimum t_f, exactly (epigraph SQP with exact gradients), with global search.
 
     1. Multistart on a coarse grid (``explore_N`` samples, same N·W so the same Slepian
@@ -68,6 +78,9 @@ def solve_min_time(man: SmoothManeuver, *, basis_sizes: tuple = (4, 8), starts: 
        conventions exactly. ``end_ratio`` keeps torque and rate ≈ 0 at both ends for M > 4.
     With a deadline (``time_budget`` or ``deadline``) stage 1 stops at half the budget and stage
     2 at three quarters, so the refinement always gets its turn.
+    ``seeds``: α (3, M ≤ the final basis size, at N) of other plans (:func:`plan_alpha`), each solved
+    first on the coarse grid with the final basis; the quickest of them and of the continuation is
+    refined, so a feasible seed gives a plan when the multistart finds no feasible start.
     ``man`` fixes N and W (its own M is ignored in favour of ``basis_sizes``).
     """
     t0 = time.perf_counter()
@@ -88,24 +101,23 @@ def solve_min_time(man: SmoothManeuver, *, basis_sizes: tuple = (4, 8), starts: 
     def share(fraction):   # stage deadlines: exploration ≤ 50 %, continuation ≤ 75 % of the budget
         return None if end is None else start_clock + fraction * (end - start_clock)
 
+    seeded = _seeded(coarse.resized(M=basis_sizes[-1]), [_pad_alpha(a, N, Nc, basis_sizes[-1]) for a in seeds],
+                     share(0.5), feas_tol, end_ratio)
     best, closest, explored = _multistart(coarse, candidates, share(0.5), maxiter=explore_maxiter,
                                           total_iterations=explore_total_iterations, feas_tol=feas_tol,
                                           end_ratio=end_ratio if M0 > PAPER_M else None)
     if best is None and man.moving and closest is not None:
         best = closest    # the paper basis barely moves near the ends: a larger one may outrun a zone there
+    if best is None and seeded is not None:
+        best, basis_sizes = seeded, basis_sizes[-1:]
     if best is None:
         status = Status.BUDGET_EXPIRED if end and time.monotonic() > end else Status.FAILED
         return slepian_result(man.resized(M=M0), np.zeros((3, M0)), status,
                               "no feasible start found by the coarse multistart", t0, feas_tol, explored=explored)
-    alpha, Mc, tf_c, path = best.alpha, M0, best.tf, [("coarse", M0, best.tf)]
-    for M in basis_sizes[1:]:
-        if end is not None and time.monotonic() > share(0.75):
-            break
-        r = solve_min_time_local(coarse.resized(M=M), _pad_alpha(alpha, Nc, Nc, M), feas_tol=feas_tol,
-                                 deadline=share(0.75), end_ratio=end_ratio)
-        if r.feasible:
-            alpha, Mc, tf_c = r.alpha, M, r.tf
-            path.append(("coarse", M, r.tf))
+    alpha, Mc, tf_c, path = _continuation(coarse, best, basis_sizes[1:], share(0.75), feas_tol, end_ratio)
+    if seeded is not None and seeded is not best and (Mc < seeded.alpha.shape[1] or seeded.tf < tf_c):
+        alpha, Mc, tf_c = seeded.alpha, seeded.alpha.shape[1], seeded.tf
+        path.append(("coarse, seeded", Mc, tf_c))
     fine = man.resized(M=Mc)
     start = _pad_alpha(alpha, Nc, N, Mc)
     r = solve_min_time_local(fine, start, feas_tol=feas_tol, deadline=end,
@@ -124,6 +136,35 @@ def solve_min_time(man: SmoothManeuver, *, basis_sizes: tuple = (4, 8), starts: 
     if fallback.feasible:
         fallback.message = f"refinement unfinished ({r.message}); constraints met to {budget_tol:g}"
     return fallback
+
+
+def _continuation(coarse: SmoothManeuver, best: SlepianResult, sizes: tuple, deadline: float | None,
+                  feas_tol: float, end_ratio: float):
+    """Stage 2 of :func:`solve_min_time`: ``best`` carried over the basis ``sizes`` on the coarse grid
+    until ``deadline``; ``(α, M, t_f, path)`` of the last feasible solve."""
+    Mc = best.alpha.shape[1]
+    alpha, tf_c, path = best.alpha, best.tf, [("coarse", Mc, best.tf)]
+    for M in sizes:
+        if deadline is not None and time.monotonic() > deadline:
+            break
+        r = solve_min_time_local(coarse.resized(M=M), _pad_alpha(alpha, coarse.N, coarse.N, M), feas_tol=feas_tol,
+                                 deadline=deadline, end_ratio=end_ratio)
+        if r.feasible:
+            alpha, Mc, tf_c = r.alpha, M, r.tf
+            path.append(("coarse", M, r.tf))
+    return alpha, Mc, tf_c, path
+
+
+def _seeded(coarse: SmoothManeuver, seeds: list, deadline: float | None, feas_tol: float,
+            end_ratio: float) -> SlepianResult | None:
+    """The quickest feasible local solve from ``seeds`` (α on ``coarse``), or None."""
+    best = None
+    for a0 in seeds:
+        r = solve_min_time_local(coarse, a0, feas_tol=feas_tol, deadline=deadline,
+                                 end_ratio=end_ratio if coarse.M > PAPER_M else None)
+        if r.feasible and (best is None or r.tf < best.tf):
+            best = r
+    return best
 
 
 def _multistart(coarse: SmoothManeuver, candidates: list, deadline: float | None, *, maxiter: int,
@@ -199,7 +240,8 @@ def physical_profile(man: SmoothManeuver, alpha: np.ndarray, spacecraft: Spacecr
 
 
 def plan_slepian(problem: ManeuverProblem, method: str = DEFAULT_METHOD, M: int | None = None,
-                 N: int = PAPER_N, W: float = PAPER_W, cone_margin: float = 1e-3, **options) -> Plan:
+                 N: int = PAPER_N, W: float = PAPER_W, cone_margin: float = 1e-3, warm_starts: tuple = (),
+                 **options) -> Plan:
     """Smooth rest-to-rest keep-out-cone plan (Slepian rate basis), body torque with ZOH.
 
     ``method``: 'slepian_minimum_time' (ours, default; M is the final basis size of the
@@ -233,8 +275,14 @@ def plan_slepian(problem: ManeuverProblem, method: str = DEFAULT_METHOD, M: int 
             frozen = replace(problem, cones=[], zones=problem.zone_sky().frozen_zones(), sky=None)
             res = seeded_min_time(man, build_maneuver(frozen, M=PAPER_M, N=N, W=W, cone_margin=cone_margin),
                                   basis_sizes=sizes, deadline=deadline, **options)
+        seeds = tuple(plan_alpha(man.resized(M=M), p) for p in warm_starts if p.success and len(p.t) > 1)
         if res is None or not res.feasible:
-            res = solve_min_time(man, basis_sizes=sizes, deadline=deadline, **options)
+            res = solve_min_time(man, basis_sizes=sizes, deadline=deadline, seeds=seeds, **options)
+        if not res.feasible and not seeds and (deadline is None or time.monotonic() < deadline):
+            first = plan_graph_smooth(problem)      # no feasible start: the constructive plan as a seed
+            if first.success:
+                res = solve_min_time(man, basis_sizes=sizes, deadline=deadline,
+                                     seeds=(plan_alpha(man.resized(M=M), first),), **{**options, "starts": 0})
     elif method == "mssa":
         res = solve_mssa(man, deadline=deadline, **options)
     else:

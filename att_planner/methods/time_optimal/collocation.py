@@ -29,6 +29,7 @@ Phases are joined, bounded and scored through :class:`Transcription` (``add_cons
 """
 from __future__ import annotations
 
+import copy
 import time
 from dataclasses import dataclass, field
 
@@ -58,15 +59,17 @@ def refine_mesh(mesh: np.ndarray, intervals, max_intervals: int | None = None) -
 class Phase:
     """A phase ``ẋ = f(x, u)`` on a mesh, with box bounds and optional path constraints.
 
-    ``dynamics`` and ``path`` are CasADi Functions ``(x, u) -> ẋ`` and ``(x, u) -> g`` or
-    ``(x, u, t) -> g`` (:attr:`timed`; usable both symbolically and numerically). Bounds are
-    arrays (or scalars) broadcast to the sizes.
+    ``dynamics`` and ``path`` are CasADi Functions ``(x, u) -> ẋ`` and ``(x, u[, t][, w][, p]) -> g``
+    (usable both symbolically and numerically): ``t`` the time (:attr:`timed`), ``w`` the value of
+    ``path_weight(τ)`` at the point's mesh fraction, ``p`` the phase's ``path_parameters`` (the same
+    at every point; parameters of a parametric :class:`Transcription`). Bounds are arrays (or
+    scalars) broadcast to the sizes.
     """
 
     def __init__(self, dynamics: ca.Function, mesh, *, control: str = "constant",
                  state_bounds=(-np.inf, np.inf), control_bounds=(-np.inf, np.inf),
                  duration_bounds=(0.0, np.inf), path: ca.Function | None = None,
-                 path_bounds=(-np.inf, 0.0), path_weight=None, name: str = "phase"):
+                 path_bounds=(-np.inf, 0.0), path_weight=None, name: str = "phase", path_parameters=()):
         if control not in CONTROL_KINDS:
             raise ValueError(f"control must be one of {CONTROL_KINDS}, not '{control}'")
         self.dynamics = dynamics
@@ -85,19 +88,22 @@ class Phase:
         self.path_bounds = tuple(np.broadcast_to(np.asarray(b, float), (n_path,)).copy() for b in path_bounds)
         self.path_weight = path_weight
         self.name = name
+        self.path_parameters = np.asarray(path_parameters, float).ravel()
 
     @property
     def timed(self) -> bool:
-        """Whether the path constraints depend on time (a third input ``t``, before the weight)."""
-        return self.path is not None and self.path.n_in() == 3 + (self.path_weight is not None)
+        """Whether the path constraints depend on time (an input ``t`` after ``x, u``)."""
+        return self.path is not None and self.path.n_in() == (
+            3 + (self.path_weight is not None) + bool(self.path_parameters.size))
 
     def path_args(self, x, u, t, tau) -> list:
         """The path function's inputs at points of mesh fractions ``tau``: ``x, u``, then the time
-        ``t`` when :attr:`timed`, then ``path_weight(tau)`` when given."""
+        ``t`` when :attr:`timed`, then ``path_weight(tau)`` when given, then the phase's
+        ``path_parameters`` when there are any (one value for every point)."""
         args = [x, u] + ([t] if self.timed else [])
         if self.path_weight is not None:
             args.append(ca.DM(np.asarray(self.path_weight(np.asarray(tau, float)), float)).T)
-        return args
+        return args + ([self.path_parameters] if self.path_parameters.size else [])
 
     @property
     def intervals(self) -> int:
@@ -111,7 +117,8 @@ class Phase:
         """The same phase on another mesh."""
         return Phase(self.dynamics, mesh, control=self.control, state_bounds=self.state_bounds,
                      control_bounds=self.control_bounds, duration_bounds=self.duration_bounds,
-                     path=self.path, path_bounds=self.path_bounds, path_weight=self.path_weight, name=self.name)
+                     path=self.path, path_bounds=self.path_bounds, path_weight=self.path_weight,
+                     name=self.name, path_parameters=self.path_parameters)
 
 
 @dataclass
@@ -251,6 +258,40 @@ class _DeadlineCallback(ca.Callback):
         return [1.0 if expired else 0.0]
 
 
+def _phase_constraints(p: int, ph: Phase, v: PhaseVariables, Tk, mesh, path_p, t_start):
+    """``(rows, (lower, upper))`` of phase ``p``: the Hermite–Simpson defects (vectorised over the
+    intervals with ``map``), then the path constraints at the nodes and midpoints; ``Tk`` the
+    intervals' durations (or T), ``mesh`` and ``path_p`` the mesh fractions and path parameters."""
+    X, Xm, U, N, nx = v.X, v.Xm, v.U, ph.intervals, ph.n_state
+    h = Tk * (mesh[1:] - mesh[:-1])                          # (1, N)
+    U_left = U if ph.control == "constant" else U[:, :-1]
+    U_right = U if ph.control == "constant" else U[:, 1:]
+    U_mid = U if ph.control == "constant" else (U_left + U_right) / 2
+    fmap = ph.dynamics.map(N)
+    Fk, Fk1, Fm = fmap(X[:, :-1], U_left), fmap(X[:, 1:], U_right), fmap(Xm, U_mid)
+    H = ca.repmat(h, nx, 1)
+    mid_defect = Xm - (X[:, :-1] + X[:, 1:]) / 2 - H / 8 * (Fk - Fk1)
+    simpson_defect = X[:, 1:] - X[:, :-1] - H / 6 * (Fk + 4 * Fm + Fk1)
+    out = [(ca.vec(mid_defect), (0.0, 0.0)), (ca.vec(simpson_defect), (0.0, 0.0))]
+    if ph.path is not None:
+        # Nodes see the control of the interval they start (the last node: the last one).
+        U_nodes = ca.horzcat(U, U[:, -1]) if ph.control == "constant" else U
+        times = weights = ()
+        if ph.timed:
+            T_nodes = ca.horzcat(Tk, Tk[-1]) if Tk.shape[1] > 1 else Tk
+            times = (t_start + T_nodes * mesh, t_start + Tk * (mesh[:-1] + mesh[1:]) / 2)
+        if ph.path_weight is not None:          # of the phase's own mesh (a weighted path is not parametric)
+            weights = tuple(ca.DM(np.asarray(ph.path_weight(tau), float)).T
+                            for tau in (ph.mesh, (ph.mesh[:-1] + ph.mesh[1:]) / 2))
+        shared = [2 + ph.timed + len(weights[:1])] if ph.path_parameters.size else []   # p: one value for all
+        extra = (path_p,) if shared else ()
+        Gn = ph.path.map(f"path_nodes{p}", "serial", N + 1, shared, [])(X, U_nodes, *times[:1], *weights[:1], *extra)
+        Gm = ph.path.map(f"path_mids{p}", "serial", N, shared, [])(Xm, U_mid, *times[1:], *weights[1:], *extra)
+        out += [(ca.vec(Gn), (np.tile(ph.path_bounds[0], N + 1), np.tile(ph.path_bounds[1], N + 1))),
+                (ca.vec(Gm), (np.tile(ph.path_bounds[0], N), np.tile(ph.path_bounds[1], N)))]
+    return out
+
+
 class Transcription:
     """Hermite–Simpson NLP over one or more phases.
 
@@ -260,12 +301,22 @@ class Transcription:
     :meth:`solve` from as many initial guesses as wanted (the IPOPT instance is reused).
     ``symbolic='MX'`` keeps the mapped dynamics as function calls (builds in tens of ms);
     ``'SX'`` inlines them (faster evaluations, but a build grows to ~1 s at 60 intervals).
+
+    ``parametric``: every phase's mesh fractions and ``path_parameters``, and ``extra_parameters``
+    more values (:attr:`extra`, for the caller's own constraints), are parameters of the NLP rather
+    than constants, taken from :attr:`phases` and :attr:`extra_values` at each :meth:`solve`: one
+    built NLP serves every mesh of its interval counts and every parameter value (:meth:`copy`).
     """
 
-    def __init__(self, phases: list[Phase], symbolic: str = "MX"):
+    def __init__(self, phases: list[Phase], symbolic: str = "MX", duration_copies: bool = False,
+                 parametric: bool = False, extra_parameters: int = 0):
         if symbolic not in ("SX", "MX"):
             raise ValueError("symbolic must be 'SX' or 'MX'")
         sym = ca.SX.sym if symbolic == "SX" else ca.MX.sym
+        self.parametric = parametric
+        self.extra = sym("extra", extra_parameters)
+        self.extra_values = np.zeros(extra_parameters)
+        params = []
         self.phases = list(phases)
         self._vars: list[PhaseVariables] = []
         self._slices: list[dict] = []
@@ -280,41 +331,34 @@ class Transcription:
             Xm = sym(f"Xm{p}", nx, N)
             U = sym(f"U{p}", nu, ph.n_control_samples)
             self._vars.append(PhaseVariables(T, X, Xm, U))
-            sizes = {"T": 1, "X": nx * (N + 1), "Xm": nx * N, "U": nu * ph.n_control_samples}
+            copies = N - 1 if duration_copies else 0
+            Tc = sym(f"Tc{p}", copies)
+            sizes = {"T": 1, "X": nx * (N + 1), "Xm": nx * N, "U": nu * ph.n_control_samples, "Tc": copies}
             sl = {}
             for key, n in sizes.items():
                 sl[key] = slice(offset, offset + n)
                 offset += n
             self._slices.append(sl)
-            w += [T, ca.vec(X), ca.vec(Xm), ca.vec(U)]
+            w += [T, ca.vec(X), ca.vec(Xm), ca.vec(U), Tc]
             for bounds, side in ((lbw, 0), (ubw, 1)):
                 bounds += [[ph.duration_bounds[side]], np.tile(ph.state_bounds[side], 2 * N + 1),
-                           np.tile(ph.control_bounds[side], ph.n_control_samples)]
-            # Defects, vectorised over intervals with map().
-            h = T * ca.DM(np.diff(ph.mesh)).T                       # (1, N)
-            U_left = U if ph.control == "constant" else U[:, :-1]
-            U_right = U if ph.control == "constant" else U[:, 1:]
-            U_mid = U if ph.control == "constant" else (U_left + U_right) / 2
-            fmap = ph.dynamics.map(N)
-            Fk = fmap(X[:, :-1], U_left)
-            Fk1 = fmap(X[:, 1:], U_right)
-            Fm = fmap(Xm, U_mid)
-            H = ca.repmat(h, nx, 1)
-            mid_defect = Xm - (X[:, :-1] + X[:, 1:]) / 2 - H / 8 * (Fk - Fk1)
-            simpson_defect = X[:, 1:] - X[:, :-1] - H / 6 * (Fk + 4 * Fm + Fk1)
-            g += [ca.vec(mid_defect), ca.vec(simpson_defect)]
-            lbg += [np.zeros(2 * nx * N)]
-            ubg += [np.zeros(2 * nx * N)]
-            if ph.path is not None:
-                # Nodes see the control of the interval they start (the last node: the last one).
-                U_nodes = ca.horzcat(U, U[:, -1]) if ph.control == "constant" else U
-                mids = (ph.mesh[:-1] + ph.mesh[1:]) / 2
-                Gn = ph.path.map(N + 1)(*ph.path_args(X, U_nodes, t_start + T * ca.DM(ph.mesh).T, ph.mesh))
-                Gm = ph.path.map(N)(*ph.path_args(Xm, U_mid, t_start + T * ca.DM(mids).T, mids))
-                g += [ca.vec(Gn), ca.vec(Gm)]
-                lbg += [np.tile(ph.path_bounds[0], 2 * N + 1)]
-                ubg += [np.tile(ph.path_bounds[1], 2 * N + 1)]
+                           np.tile(ph.control_bounds[side], ph.n_control_samples), [ph.duration_bounds[side]] * copies]
+            # the duration of each interval: T, or its own copy of T chained to the next (a banded KKT system)
+            Tk = ca.vertcat(T, Tc).T if copies else T                   # (1, N) or scalar
+            if copies:
+                g.append((Tk[1:] - Tk[:-1]).T)
+                lbg.append(np.zeros(copies))
+                ubg.append(np.zeros(copies))
+            mesh = sym(f"mesh{p}", 1, N + 1) if parametric else ca.DM(ph.mesh).T       # (1, N + 1)
+            path_p = sym(f"path{p}", ph.path_parameters.size) if parametric else ca.DM(ph.path_parameters)
+            if parametric:
+                params += [mesh.T, path_p]
+            for rows, bound in _phase_constraints(p, ph, self._vars[-1], Tk, mesh, path_p, t_start):
+                g.append(rows)
+                lbg.append(np.broadcast_to(bound[0], rows.shape[0]))
+                ubg.append(np.broadcast_to(bound[1], rows.shape[0]))
             t_start = t_start + T
+        self._p = ca.vertcat(*params, self.extra)
         self._w = ca.vertcat(*w)
         self.lbw = np.concatenate([np.ravel(v) for v in lbw]).astype(float)
         self.ubw = np.concatenate([np.ravel(v) for v in ubw]).astype(float)
@@ -366,16 +410,42 @@ class Transcription:
                 "iteration_callback_ignore_errors": False}
         opts.update({f"ipopt.{k}": v for k, v in (ipopt_options or {}).items()})
         opts.update(nlpsol_options or {})
-        self._solver = ca.nlpsol("hermite_simpson", "ipopt", {"x": self._w, "f": self._objective, "g": g}, opts)
+        self._solver = ca.nlpsol("hermite_simpson", "ipopt", {"x": self._w, "p": self._p, "f": self._objective,
+                                                              "g": g}, opts)
         return self
+
+    def copy(self, mesh=None, path_parameters=None, extra_values=None) -> Transcription:
+        """A built parametric NLP for another problem of its shape: the same solver, its own bounds,
+        phase 0 on ``mesh`` (as many intervals) with ``path_parameters``, and ``extra_values``."""
+        if not self.parametric or self._solver is None:
+            raise ValueError("only a built parametric Transcription is copied")
+        out = copy.copy(self)
+        out.lbw, out.ubw, out.lbg, out.ubg = self.lbw.copy(), self.ubw.copy(), self.lbg.copy(), self.ubg.copy()
+        phase = self.phases[0]
+        mesh = phase.mesh if mesh is None else np.asarray(mesh, float)
+        if len(mesh) != len(phase.mesh):
+            raise ValueError(f"a mesh of {len(mesh) - 1} intervals for an NLP of {phase.intervals}")
+        out.phases = [phase.with_mesh(mesh)] + self.phases[1:]
+        if path_parameters is not None:
+            out.phases[0].path_parameters = np.asarray(path_parameters, float).ravel()
+        out.extra_values = self.extra_values if extra_values is None else np.asarray(extra_values, float).ravel()
+        return out
+
+    def set_duration_bounds(self, phase: int, lower: float, upper: float) -> None:
+        """Bounds of a phase's duration (and of its copies)."""
+        for key in ("T", "Tc"):
+            sl = self._slices[phase][key]
+            self.lbw[sl], self.ubw[sl] = lower, upper
 
     # -- solving ----------------------------------------------------------------------------
     def pack(self, guesses: list[PhaseGuess]) -> np.ndarray:
         """Flat initial-guess vector from one guess per phase (clipped into the variable bounds)."""
         parts = []
         for ph, gs in zip(self.phases, guesses):
+            copies = self._slices[len(parts) // 5]["Tc"]
             parts += [[gs.duration], np.asarray(gs.x, float).ravel(), np.asarray(gs.xm, float).ravel(),
-                      np.asarray(gs.u, float).reshape(ph.n_control_samples, ph.n_control).ravel()]
+                      np.asarray(gs.u, float).reshape(ph.n_control_samples, ph.n_control).ravel(),
+                      np.full(copies.stop - copies.start, gs.duration)]
         w0 = np.concatenate([np.ravel(p) for p in parts])
         return np.clip(w0, self.lbw, self.ubw)
 
@@ -385,6 +455,11 @@ class Transcription:
             self.build()
         self._callback.deadline = deadline
         args = dict(x0=w0, lbx=self.lbw, ubx=self.ubw, lbg=self.lbg, ubg=self.ubg)
+        if self.parametric:
+            args["p"] = np.concatenate([np.concatenate([ph.mesh, ph.path_parameters]) for ph in self.phases]
+                                       + [self.extra_values])
+        elif self.extra_values.size:
+            raise ValueError("extra parameters need a parametric Transcription")
         if lam_g0 is not None:
             args["lam_g0"] = lam_g0
         if lam_x0 is not None:

@@ -2,17 +2,19 @@
 normalisation, the CasADi rigid-body model, path constraints and the Hermite–Simpson transcription."""
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 
 import casadi as ca
 import numpy as np
 
-from att_planner.cones import ARC_TOLERANCE, BOUNDARY_TOLERANCE, boundary_end_zones, end_ramp
+from att_planner.cones import ARC_TOLERANCE, BOUNDARY_TOLERANCE, END_RAMP, SMOOTH_END_RAMP, boundary_end_zones, end_ramp
 from att_planner.methods import symbolic
 from att_planner.methods.axis_rotations import time_unit
 from att_planner.methods.time_optimal import collocation as col
 from att_planner.problem import ManeuverProblem
+from att_planner.zones import clenshaw
 from att_sim import rotations as rot
 
 # Relative tightening of the rate and wheel-momentum bounds at the collocation points, so that
@@ -37,25 +39,156 @@ def scaling(problem: ManeuverProblem) -> Scaling:
     return Scaling(time_unit(problem), J0, J / J0, float(problem.spacecraft.body_torque_max))
 
 
-def rigid_body_dynamics(Jn: np.ndarray) -> ca.Function:
-    """Normalised ``ẋ = f(x, u)`` with ``x = [q (xyzw), ω̃]`` (:mod:`.planner` docstring)."""
-    x, u = ca.SX.sym("x", 7), ca.SX.sym("u", 3)
-    q, w = x[:4], x[4:]
+def rigid_body_dynamics(Jn: np.ndarray, smooth: bool = False) -> ca.Function:
+    """Normalised ``ẋ = f(x, u)`` with ``x = [q (xyzw), ω̃]`` and the torque ``u`` (:mod:`.planner`
+    docstring); ``smooth``: ``x = [q, ω̃, u, u̇]`` and the control the torque's second derivative
+    (:mod:`.smooth`)."""
+    x, c = ca.SX.sym("x", 13 if smooth else 7), ca.SX.sym("c", 3)
+    q, w = x[:4], x[4:7]
+    u = x[7:10] if smooth else c
     Jn_dm = ca.DM(Jn)
     q_dot = 0.5 * symbolic.quat_mul(q, ca.vertcat(w, 0)) + 0.5 * (1 - ca.dot(q, q)) * q
     w_dot = ca.solve(Jn_dm, u - ca.cross(w, ca.mtimes(Jn_dm, w)))
-    return ca.Function("rigid_body", [x, u], [ca.vertcat(q_dot, w_dot)])
+    rates = ca.vertcat(q_dot, w_dot, x[10:], c) if smooth else ca.vertcat(q_dot, w_dot)
+    return ca.Function("smooth_rigid_body" if smooth else "rigid_body", [x, c], [rates])
 
 
-def path_function(problem: ManeuverProblem, s: Scaling, cone_margin: float):
-    """Path constraints ``g ≤ 0`` (zones, wheel momentum) and the weight function of the phase
-    (:class:`~.collocation.Phase` ``path_weight``), or None when there are none.
+ZONE_PARAMETERS = 8      # per fixed zone: σ (+1 keep-out, -1 keep-in), sensor (3), axis (3), cos(θ + σ δ)
+MOTION_DEGREES = (8, 16)   # a moving zone fitted by one Chebyshev series of at most such a degree is a parameter
+
+
+def motion_parameters(degree: int) -> int:
+    """Parameters per moving zone: σ, sensor (3), α, β, the series' coefficients (axis, θ + σ δ)."""
+    return 6 + 4 * (degree + 1)
+
+
+def motion_degree(zones) -> int | None:
+    """The smallest of :data:`MOTION_DEGREES` that holds every moving zone's fit when each is one
+    series, else None (no moving zone: the smallest)."""
+    fits = [zones.series(z) for z, zone in enumerate(zones.zones) if zone.body != "inertial"]
+    if any(len(f) > 1 for f in fits):
+        return None
+    needed = max((len(f[0]) - 1 for f in fits), default=0)
+    return next((d for d in MOTION_DEGREES if d >= needed), None)
+
+
+def path_function(problem: ManeuverProblem, s: Scaling, n_state: int = 7, cone_margin: float = 0.0):
+    """``(path, degree)``: the path constraints ``g ≤ 0`` (zones, wheel momentum) as a CasADi
+    Function ``(x, u[, t][, p]) -> g`` (``x`` has ``n_state`` rows, the attitude and rate first;
+    None when there are none), the data of the problem in ``p`` (:func:`path_values`), and the
+    degree of the moving zones' series in ``p`` (:func:`motion_degree`; None: they are constants).
+
+    Every zone of ``problem.zone_sky()`` (:mod:`att_planner.zones`: the cones, then the zones, each
+    with its own sensor axis ``s_z``, ``b_z = R(q) s_z``) is tightened by ``δ``: keep-out
+    ``a_z · b_z ≤ cos(θ_z + δ)``, keep-in ``a_z · b_z ≥ cos(θ_z − δ)``, i.e.
+    ``σ_z (a_z · b_z − cos(θ_z + σ_z δ)) ≤ 0``. A fixed zone's data are in ``p``
+    (:data:`ZONE_PARAMETERS`). When a zone moves, ``t`` is the normalised time from the start and
+    ``a_z``, ``θ_z`` are the ZoneSky's Chebyshev series of ``t τ_u``, so the collocation couples them
+    exactly to ``t_f``: their coefficients are in ``p`` too (:func:`motion_parameters`, the series in
+    ``x = α t + β``) when every moving zone is one series of a degree of :data:`MOTION_DEGREES`,
+    otherwise the series are constants of the function (tightened by ``cone_margin``). The wheels'
+    momentum bound takes its scale from ``p`` (its last value). So the function depends on the
+    problem's shape only, but for moving zones of many pieces."""
+    zones = problem.zone_sky()
+    fixed = [z.body == "inertial" for z in zones.zones]
+    degree = motion_degree(zones)
+    moving = 0 if degree is None else len(fixed) - sum(fixed)
+    momentum = math.isfinite(problem.wheel_momentum_max) and problem.spacecraft.n_wheels > 0   # no wheels: none
+    x, u, t = ca.SX.sym("x", n_state), ca.SX.sym("u", 3), ca.SX.sym("t")
+    per_zone = 0 if degree is None else motion_parameters(degree)
+    p = ca.SX.sym("p", ZONE_PARAMETERS * sum(fixed) + per_zone * moving + momentum)
+    R = symbolic.dcm(x[:4])
+    g = []
+    for k in range(sum(fixed)):
+        sign, sensor, axis, cos = (p[ZONE_PARAMETERS * k], p[ZONE_PARAMETERS * k + 1:ZONE_PARAMETERS * k + 4],
+                                   p[ZONE_PARAMETERS * k + 4:ZONE_PARAMETERS * k + 7], p[ZONE_PARAMETERS * k + 7])
+        g.append(sign * (ca.dot(axis, ca.mtimes(R, sensor)) - cos))
+    for k in range(moving):
+        o = ZONE_PARAMETERS * sum(fixed) + per_zone * k
+        sign, sensor, alpha, beta = p[o], p[o + 1:o + 4], p[o + 4], p[o + 5]
+        rows = [p[o + 6 + 4 * i:o + 10 + 4 * i] for i in range(degree + 1)]
+        value = clenshaw(alpha * t + beta, rows)
+        g.append(sign * (ca.dot(value[:3], ca.mtimes(R, sensor)) - ca.cos(value[3])))
+    if zones.moving and degree is None:
+        g += [c for c, f in zip(zones.casadi_constraints(t * s.tu, R, cone_margin), fixed) if not f]
+    if momentum:
+        h_w = ca.mtimes(ca.DM(problem.spacecraft.wheel_axes_pinv @ s.Jn), x[4:7]) * p[-1]
+        g += [h_w - 1, -h_w - 1]
+    if not g:
+        return None, degree
+    inputs = [x, u] + ([t] if zones.moving else []) + ([p] if p.numel() else [])
+    return ca.Function("path", inputs, [ca.vertcat(*g)]), degree
+
+
+def path_values(problem: ManeuverProblem, s: Scaling, cone_margin: float) -> np.ndarray:
+    """The values of :func:`path_function`'s ``p``: each fixed zone's σ, unit sensor axis, axis and
+    ``cos(θ + σ δ)`` (``δ = cone_margin``); each moving zone's σ, unit sensor axis, α = 2 τ_u/(b − a)
+    and β = −(a + b)/(b − a) of its series on [a, b] and the coefficients (zero-padded to
+    :func:`motion_degree`, θ's first one raised by σ δ), when they are parameters; then the
+    momentum bound's scale."""
+    zones = problem.zone_sky()
+    degree = motion_degree(zones)
+    axes, half = zones.at(0.0)
+    fixed, moving = [], []
+    for z, zone in enumerate(zones.zones):
+        sign = -1.0 if zone.keep_in else 1.0
+        sensor = zones.sensor_axes[z] / np.linalg.norm(zones.sensor_axes[z])
+        if zone.body == "inertial":
+            fixed += [[sign], sensor, axes[z], [math.cos(half[z] + sign * cone_margin)]]
+        elif degree is not None:
+            (coef,), (a, b) = zones.series(z), zones.pieces
+            padded = np.zeros((degree + 1, 4))
+            padded[:len(coef)] = coef
+            padded[0, 3] += sign * cone_margin
+            moving += [[sign], sensor, [2 * s.tu / (b - a), -(a + b) / (b - a)], padded.ravel()]
+    values = fixed + moving
+    if math.isfinite(problem.wheel_momentum_max) and problem.spacecraft.n_wheels:
+        values.append([s.J0 / s.tu / (problem.wheel_momentum_max * (1 - BOUND_MARGIN))])
+    return np.concatenate(values) if values else np.zeros(0)
+
+
+def goal_values(problem: ManeuverProblem) -> np.ndarray:
+    """The final-attitude constraint's data: ``q_final``, or the semi-free goal's unit
+    ``sensor_target``, the two rows of a basis normal to it and the unit sensor axis."""
+    if problem.sensor_target is None:
+        return rot.normalize(np.asarray(problem.q_final, float))
+    target = np.asarray(problem.sensor_target, float) / np.linalg.norm(problem.sensor_target)
+    r = np.asarray(problem.sensor_axis, float) / np.linalg.norm(problem.sensor_axis)
+    return np.concatenate([target, *rot.orthonormal_basis(target), r])
+
+
+CACHE_SIZE = 64          # built NLPs kept (the oldest goes first)
+_NLPS: dict = {}
+
+
+def _state_bounds(problem: ManeuverProblem, s: Scaling, smooth: bool):
+    """Bounds of the state: the quaternion's box, the rate bound (tightened by :data:`BOUND_MARGIN`)
+    and, smooth, ``|u| ≤ 1``."""
+    rate = problem.rate_max * s.tu * (1 - BOUND_MARGIN)
+    if not smooth:
+        return [-1.1] * 4 + [-rate] * 3, [1.1] * 4 + [rate] * 3
+    return [-1.1] * 4 + [-rate] * 3 + [-1.0] * 3 + [-np.inf] * 3, [1.1] * 4 + [rate] * 3 + [1.0] * 3 + [np.inf] * 3
+
+
+def _end_bounds(smooth: bool):
+    """Bounds of the last node: at rest (and, smooth, no torque and no torque rate)."""
+    rest = 9 if smooth else 3
+    return [-1.1] * 4 + [0.0] * rest, [1.1] * 4 + [0.0] * rest
+
+
+def weighted_path_function(problem: ManeuverProblem, s: Scaling, cone_margin: float, n_state: int = 7,
+                           ramp: float = END_RAMP):
+    """The path constraints of a problem with a boundary end or a forced boundary arc
+    (:func:`boundary_case`): ``g ≤ 0`` (zones, wheel momentum) and the weight function of the phase
+    (:class:`~.collocation.Phase` ``path_weight``), or None when there are none; ``x`` has
+    ``n_state`` rows, the attitude and rate first. The problem's data are constants of the function.
 
     Every zone of ``problem.zone_sky()`` (:mod:`att_planner.zones`: the cones, then the zones, each
     with its own sensor axis ``s_z``, ``b_z = R(q) s_z``) is tightened by ``δ = cone_margin``: keep-out
     ``a_z · b_z ≤ cos(θ_z + δ)``, keep-in ``a_z · b_z ≥ cos(θ_z − δ)``. A zone with an end on its
     boundary (:func:`att_planner.cones.boundary_end_zones`) is tightened by ``−tol + (δ + tol) w(τ)``
-    instead, ``w`` the end ramp (:func:`att_planner.cones.end_ramp`, the path's last input). The
+    instead, ``w`` the end ramp (:func:`att_planner.cones.end_ramp` over ``ramp`` of the maneuver,
+    the path's last input: a smooth plan leaves its ends more slowly than a bang-bang one). The
     forced boundary arc's cone is the band ``0 ≤ margin ≤ ε`` (:data:`ARC_BAND`): ``a · b ≤ cos θ`` and
     ``a · b ≥ cos(θ + ε)`` (an equality there would repeat the fixed start and the final pointing,
     which IPOPT cannot solve: rank-deficient constraints). When a zone moves,
@@ -63,7 +196,7 @@ def path_function(problem: ManeuverProblem, s: Scaling, cone_margin: float):
     and ``θ_z(t τ_u)`` are the ZoneSky's Chebyshev series of that CasADi expression, so the
     collocation couples them exactly to ``t_f``. Without motion it is ``(x, u[, w]) -> g`` with the
     zones constant (no time dependence is built)."""
-    x, u, t, w = ca.SX.sym("x", 7), ca.SX.sym("u", 3), ca.SX.sym("t"), ca.SX.sym("w")
+    x, u, t, w = ca.SX.sym("x", n_state), ca.SX.sym("u", 3), ca.SX.sym("t"), ca.SX.sym("w")
     zones = problem.zone_sky()
     ramped = boundary_end_zones(problem, cone_margin)
     margins = [-BOUNDARY_TOLERANCE + (cone_margin + BOUNDARY_TOLERANCE) * w if near else cone_margin
@@ -78,39 +211,90 @@ def path_function(problem: ManeuverProblem, s: Scaling, cone_margin: float):
         g.append(ca.cos(cone.half_angle + ARC_BAND) - ca.dot(ca.DM(cone.direction), ca.mtimes(R, ca.DM(r))))
     if math.isfinite(problem.wheel_momentum_max) and problem.spacecraft.n_wheels:   # no wheels: no momentum
         h_per_rate = s.J0 / s.tu / (problem.wheel_momentum_max * (1 - BOUND_MARGIN))
-        h_w = ca.mtimes(ca.DM(problem.spacecraft.wheel_axes_pinv @ s.Jn * h_per_rate), x[4:])
+        h_w = ca.mtimes(ca.DM(problem.spacecraft.wheel_axes_pinv @ s.Jn * h_per_rate), x[4:7])
         g += [h_w - 1, -h_w - 1]
     if not g:
         return None
     inputs = [x, u] + ([t] if zones.moving else []) + ([w] if ramped.any() else [])
-    weight = end_ramp if ramped.any() else None
+    weight = functools.partial(end_ramp, length=ramp) if ramped.any() else None
     return ca.Function("path", inputs, [ca.vertcat(*g)]), weight
 
 
+def boundary_case(problem: ManeuverProblem, cone_margin: float) -> bool:
+    """Whether the problem has an end on a zone's boundary (ramped tightening) or a forced boundary
+    arc: its path constraints are :func:`weighted_path_function`'s, built for it alone."""
+    return problem.boundary_cone is not None or bool(boundary_end_zones(problem, cone_margin).any())
+
+
 def transcription(problem: ManeuverProblem, s: Scaling, mesh: np.ndarray, control: str, cone_margin: float,
-                  tf_bounds: tuple[float, float]) -> col.Transcription:
-    """The minimum-time NLP on ``mesh`` (``control``: 'constant' for ZOH torques, 'linear')."""
-    rate_bound = problem.rate_max * s.tu * (1 - BOUND_MARGIN)
-    path = path_function(problem, s, cone_margin)
-    path_args = {} if path is None else dict(path=path[0], path_weight=path[1])
-    phase = col.Phase(rigid_body_dynamics(s.Jn), mesh, control=control,
-                      state_bounds=([-1.1] * 4 + [-rate_bound] * 3, [1.1] * 4 + [rate_bound] * 3),
-                      control_bounds=(-1.0, 1.0), duration_bounds=tf_bounds, name="slew", **path_args)
-    tr = col.Transcription([phase])
-    v = tr.variables(0)
+                  tf_bounds: tuple[float, float], *, torque_accel: float | None = None, tol: float = 1e-7,
+                  max_iter: int = 400, expand: bool = True) -> col.Transcription:
+    """The minimum-time NLP on ``mesh``, built (``control``: 'constant' for ZOH torques, 'linear';
+    ``torque_accel``: the smooth NLP of :mod:`.smooth`, its bound on the torque's second derivative).
+
+    The NLP is built once per shape and kept (:data:`CACHE_SIZE`): the spacecraft's inertia, the
+    number of intervals, the zones' count and series degree (moving zones of many pieces: their
+    ZoneSky), the bounds on the
+    rate and momentum, the kind of goal and the settings. The mesh, the zones' data, the goal and the
+    momentum scale are its parameters, the start and the duration's bounds its variables' bounds
+    (set here), so a second problem of that shape only copies it (:meth:`.collocation.Transcription.copy`).
+    Moving zones (timed path constraints) keep one t_f; fixed ones chain copies of it per interval
+    (a banded KKT system, far fewer iterations; with moving zones the copies took more). A problem
+    with a boundary end or a forced boundary arc (:func:`boundary_case`, issue 19) gets an NLP of its
+    own, with :func:`weighted_path_function`'s constraints."""
+    smooth = torque_accel is not None
+    zones = problem.zone_sky()
+    options = dict(tol=tol, max_iter=max_iter, nlpsol_options={"expand": expand})
+    if boundary_case(problem, cone_margin):            # its path constraints are built for it alone
+        path, weight = weighted_path_function(problem, s, cone_margin, 13 if smooth else 7,
+                                              SMOOTH_END_RAMP if smooth else END_RAMP) or (None, None)
+        tr = _build(problem, s, mesh, control, path, torque_accel, not zones.moving, weight).build(**options)
+        return _start(tr.copy(mesh, extra_values=goal_values(problem)), problem, smooth, tf_bounds)
+    path, degree = path_function(problem, s, 13 if smooth else 7, cone_margin)
+    momentum = math.isfinite(problem.wheel_momentum_max)
+    moving = sum(z.body != "inertial" for z in zones.zones)
+    key = (smooth, torque_accel, s.Jn.tobytes(), len(mesh) - 1, control, sum(z.body == "inertial" for z in zones.zones),
+           (moving, degree) if degree is not None else (id(zones), cone_margin),
+           problem.spacecraft.wheel_axes.tobytes() if momentum else None, problem.rate_max,
+           problem.sensor_target is None, tol, max_iter, expand)
+    if key not in _NLPS:
+        while len(_NLPS) >= CACHE_SIZE:
+            _NLPS.pop(next(iter(_NLPS)))
+        _NLPS[key] = (_build(problem, s, mesh, control, path, torque_accel, not zones.moving,
+                             path_parameters=path_values(problem, s, 0.0)).build(**options), zones)  # zones: kept alive
+    tr = _NLPS[key][0].copy(mesh, path_values(problem, s, cone_margin), goal_values(problem))
+    return _start(tr, problem, smooth, tf_bounds)
+
+
+def _start(tr: col.Transcription, problem: ManeuverProblem, smooth: bool, tf_bounds) -> col.Transcription:
+    """``tr`` from the problem's start at rest, its duration within ``tf_bounds``."""
     q0 = rot.normalize(np.asarray(problem.q_initial, float))
-    tr.bound_state(0, 0, np.concatenate([q0, np.zeros(3)]))
-    tr.bound_state(0, -1, [-1.1] * 4 + [0.0] * 3, [1.1] * 4 + [0.0] * 3)
+    tr.bound_state(0, 0, np.concatenate([q0, np.zeros(9 if smooth else 3)]))
+    tr.set_duration_bounds(0, *tf_bounds)
+    return tr
+
+
+def _build(problem: ManeuverProblem, s: Scaling, mesh: np.ndarray, control: str, path, torque_accel,
+           duration_copies: bool, weight=None, path_parameters=()) -> col.Transcription:
+    """The parametric NLP of :func:`transcription` (not built): the mesh and the goal its parameters,
+    and ``path_parameters`` the path's (``weight``: the path's weight of the mesh fractions)."""
+    smooth = torque_accel is not None
+    controls = (-torque_accel, torque_accel) if smooth else (-1.0, 1.0)
+    phase = col.Phase(rigid_body_dynamics(s.Jn, smooth), mesh, control=control,
+                      state_bounds=_state_bounds(problem, s, smooth), control_bounds=controls, path=path,
+                      path_bounds=(-np.inf, 0.0), path_weight=weight, name="slew", path_parameters=path_parameters)
+    goal = goal_values(problem)
+    tr = col.Transcription([phase], duration_copies=duration_copies, parametric=True, extra_parameters=len(goal))
+    v = tr.variables(0)
+    tr.bound_state(0, -1, *_end_bounds(smooth))
     q_end = v.x_end[:4]
     if problem.sensor_target is None:
-        qf = rot.normalize(np.asarray(problem.q_final, float))
-        tr.add_constraint(symbolic.error_vector(q_end, ca.DM(qf)), 0.0, 0.0)
+        tr.add_constraint(symbolic.error_vector(q_end, tr.extra), 0.0, 0.0)
     else:
-        target = np.asarray(problem.sensor_target, float) / np.linalg.norm(problem.sensor_target)
-        r = np.asarray(problem.sensor_axis, float) / np.linalg.norm(problem.sensor_axis)
-        b = ca.mtimes(symbolic.dcm(q_end), ca.DM(r))
-        tr.add_constraint(ca.mtimes(ca.DM(np.stack(rot.orthonormal_basis(target))), b), 0.0, 0.0)
-        tr.add_constraint(ca.dot(ca.DM(target), b), 0.0, np.inf)
+        target, e1, e2, r = (tr.extra[3 * k:3 * k + 3] for k in range(4))
+        b = ca.mtimes(symbolic.dcm(q_end), r)
+        tr.add_constraint(ca.vertcat(ca.dot(e1, b), ca.dot(e2, b)), 0.0, 0.0)
+        tr.add_constraint(ca.dot(target, b), 0.0, np.inf)
     tr.minimize(v.duration)
     return tr
 

@@ -57,7 +57,7 @@ METHOD = "time_optimal"
 CONVERGED_VIOLATION = 1e-5      # an IPOPT answer counts as solved below this constraint violation
 
 
-DEFAULT_INTERVALS, DEFAULT_MAX_INTERVALS = 30, 120
+DEFAULT_INTERVALS, DEFAULT_MAX_INTERVALS = 16, 120
 
 
 def _mesh_sizes(options: dict) -> tuple[int, int]:
@@ -110,8 +110,10 @@ class _Solve:
         self.nfev += res.nfev
         return res
 
-    def transcription(self, mesh: np.ndarray) -> col.Transcription:
-        return transcription(self.problem, self.scaling, mesh, self.control, self.cone_margin, self.tf_bounds)
+    def transcription(self, mesh: np.ndarray, tol: float | None = None) -> col.Transcription:
+        """The built NLP on ``mesh`` (:func:`.model.transcription`: built once per shape)."""
+        return transcription(self.problem, self.scaling, mesh, self.control, self.cone_margin, self.tf_bounds,
+                             tol=self.tol if tol is None else tol, max_iter=self.max_iter)
 
     def plan(self, sol: col.PhaseSolution) -> Plan:
         t, torque, q, omega = plan_arrays(sol, self.scaling)
@@ -131,7 +133,7 @@ class _Incumbent:
     def resolve(self, new_mesh) -> bool:
         """Re-solve on ``new_mesh`` from the interpolated incumbent; keep it if it converged."""
         run = self.run
-        new_tr = run.transcription(new_mesh).build(tol=run.tol, max_iter=run.max_iter)
+        new_tr = run.transcription(new_mesh)
         new_res = run.solve(new_tr, self.sol.resample(new_tr.phases[0]))
         self.mesh_log.append({"intervals": new_tr.phases[0].intervals, "tf": new_res.objective * run.scaling.tu,
                               "status": new_res.status, "seconds": new_res.wall_time})
@@ -150,7 +152,7 @@ class _Incumbent:
                 return
             sol = self.sol
             bad, _ = col.path_violations(sol, tol=1e-4)
-            split = np.union1d(bad, col.switch_intervals(sol, limit=max(4, sol.phase.intervals // 4)))
+            split = np.union1d(bad, col.switch_intervals(sol, limit=max(4, sol.phase.intervals // 2)))
             if not len(split) or sol.phase.intervals >= self.run.max_intervals:
                 return
             if not self.resolve(col.refine_mesh(sol.phase.mesh, split, self.run.max_intervals)):
@@ -202,10 +204,7 @@ def _truth_violation_intervals(traj, sol: col.PhaseSolution, s: Scaling, problem
 def _explore(run: _Solve, routes: list[Route], intervals: int, explore_tol: float):
     """Stage 1: every route solved on the coarse mesh; ``(transcription, solved, log)`` with
     ``solved`` a list of (t_f, route label, result) of the converged ones."""
-    # expand=True (SX evaluation) costs ~0.5 s to build but halves every solve: worth it for the
-    # several starts of this stage, not for the single solve per refined mesh below.
-    tr = run.transcription(col.uniform_mesh(intervals)).build(
-        tol=explore_tol, max_iter=run.max_iter, nlpsol_options={"expand": len(routes) > 2})
+    tr = run.transcription(col.uniform_mesh(intervals), explore_tol)
     log, solved = [], []
     for rt in routes:
         if run.expired():
@@ -283,7 +282,7 @@ def _verdict(plan: Plan, ok: bool, run: _Solve, incumbent: _Incumbent, best: str
 
 
 def plan_time_optimal(problem: ManeuverProblem, *, intervals: int = DEFAULT_INTERVALS, max_intervals: int | None = None,
-                      starts: int = 6, refine_rounds: int = 3, interpolation: str = Interpolation.ZOH,
+                      starts: int = 3, refine_rounds: int = 3, interpolation: str = Interpolation.ZOH,
                       cone_margin_deg: float = 0.05, warm_starts: tuple = (),
                       smooth_warm_start: bool = False, global_stage: bool = False, explore_tol: float = 1e-5,
                       tol: float = 1e-7,

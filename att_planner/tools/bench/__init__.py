@@ -17,7 +17,9 @@ STUDIES = {
     "gains": "att_planner.tools.bench.gains",
     "soak": "att_planner.tools.bench.soak",
     "sky": "att_planner.tools.bench.sky",
+    "speed": "att_planner.tools.bench.speed",
     "estimation": "att_planner.tools.bench.estimation",
+    "momentum": "att_planner.tools.bench.momentum",
 }
 
 

@@ -19,6 +19,9 @@ executed plan, else the last magnetorquer-PD run, else the whole log), and write
   body axis with the filter's ±3σ, the gyro bias estimate against the truth, the estimate's health
   and the trackers' invalid samples, the gyro and magnetometer measured against the truth
   (:mod:`.estimation`); the summary gains the estimate's figures (``estimation``);
+* ``pointing.png`` (a log with a pointing mode, issue 15) — the mode timeline with the guidance,
+  the pointing error from the reference, each wheel's momentum against its limit, the dipoles
+  (:mod:`.pointing`); the summary gains ``pointing``;
 * ``summary.txt``, ``summary.json`` and ``index.html`` (summary table, figures embedded).
 
 For a maneuver, "executed" is the whole reviewed segment: the maneuver (the plan, t = 0 to its
@@ -44,10 +47,11 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from att_msgs_py.log import read_log
-from att_msgs_py.topics import COMMAND, PLANS, STATE
+from att_msgs_py.topics import COMMAND, CONTROLLER_STATUS, PLANS, STATE
 from att_planner.tools.review.estimation import TOPICS as ESTIMATION_TOPICS
 from att_planner.tools.review.estimation import estimation_of, estimation_summary, figure_estimation
 from att_planner.tools.review.figures import figure_overview, figure_sky, figure_time_histories
+from att_planner.tools.review.pointing import figure_pointing, pointing_of, pointing_summary
 from att_planner.tools.review.run import extract_run, settling_time
 from att_planner.tools.review.summary import format_summary, notes, scenario_for, summarize, summary_of, zone_sky_for
 
@@ -82,7 +86,7 @@ def review(log_path: str | Path, out_dir: str | Path | None = None, *, plan_id: 
     log_path = Path(log_path)
     out = Path(out_dir) if out_dir is not None else log_path.parent / "review"
     out.mkdir(parents=True, exist_ok=True)
-    log = read_log(log_path, topics=sorted({STATE, COMMAND, PLANS, *ESTIMATION_TOPICS}))
+    log = read_log(log_path, topics=sorted({STATE, COMMAND, PLANS, CONTROLLER_STATUS, *ESTIMATION_TOPICS}))
     run = extract_run(log, plan_id)
     found = scenario_for(run, scenario)
     sc = found.spacecraft if found is not None else None
@@ -95,6 +99,10 @@ def review(log_path: str | Path, out_dir: str | Path | None = None, *, plan_id: 
     if estimation is not None:
         summary["estimation"] = estimation_summary(estimation)
         figures["estimation"] = figure_estimation(estimation, out / "estimation.png", run.t0)
+    pointing = pointing_of(log, sc) if sc is not None else None
+    if pointing is not None:
+        summary["pointing"] = pointing_summary(pointing)
+        figures["pointing"] = figure_pointing(pointing, out / "pointing.png")
     text = format_summary(summary)
     (out / "summary.txt").write_text(text + "\n")
     (out / "summary.json").write_text(json.dumps(summary, indent=2) + "\n")

@@ -286,7 +286,7 @@ def plot_modes(ax, run: Run) -> None:
         ax.plot(run.t[run.command_timeout], np.full(int(np.sum(run.command_timeout)), -0.5), "r|",
                 label="command timeout")
     ax.set_yticks(list(MODE_NAMES), list(MODE_NAMES.values()), fontsize=7)
-    ax.set_ylim(-1, 3.5)
+    ax.set_ylim(-1, max(MODE_NAMES) + 0.5)
     ax.legend(loc="upper right", fontsize=7)
 
 

@@ -13,7 +13,7 @@ from att_planner.control import tracking
 from att_sim import rotations as rot
 
 MODE_NAMES = {ControlMode.IDLE: "idle", ControlMode.MAGNETORQUER_PD: "magnetorquer PD",
-              ControlMode.PLAN_TRACKING: "plan tracking", ControlMode.SAFE: "safe"}
+              ControlMode.PLAN_TRACKING: "plan tracking", ControlMode.SAFE: "safe", ControlMode.POINTING: "pointing"}
 SETTLING_THRESHOLD = 0.05        # ν of Bruni & Celani: settled when every |q_i| (vector part) stays ≤ ν
 
 

@@ -275,6 +275,13 @@ def format_summary(s: dict, with_notes: bool = True) -> str:
                      f"{e['nees_mean']:.2f} ({e['nees_dof']} dof)")
         lines.append(f"gyro bias error       {e['bias_error_final_deg_per_h']:.4f} deg/h at the end; tracker invalid "
                      f"{e['tracker_invalid_seconds']:.1f} s")
+    pt = s.get("pointing")
+    if pt:
+        rms = "n/a" if pt["pointing_error_rms_deg"] is None else f"{pt['pointing_error_rms_deg']:.5f} deg"
+        sat = "never" if pt["saturation_time_s"] is None else f"at t = {pt['saturation_time_s']:.0f} s"
+        lines.append(f"pointing              {pt['pointing_seconds']:.0f} s, error rms {rms}; peak wheel speed "
+                     f"{pt['peak_wheel_speed_ratio']:.3f} of its limit (saturated {sat}); dipole duty "
+                     f"{pt['dipole_duty']:.2f}")
     if with_notes:
         lines += [f"note: {n}" for n in notes(s)]
     return "\n".join(lines)

@@ -113,7 +113,7 @@ def test_plans_of_other_methods_serve_as_warm_starts():
 
 def test_deadline_returns_quickly_with_a_status_that_says_so():
     problem = case_problem("swift")
-    problem.deadline = time.monotonic() + 1.5
+    problem.deadline = time.monotonic() + 1.02        # 20 ms to solve (a second is kept for the verification)
     t0 = time.monotonic()
     plan = plan_time_optimal(problem)
     assert time.monotonic() - t0 < 4.0

@@ -12,7 +12,14 @@ import pytest
 
 from att_msgs_py.types import Status, Zone
 from att_planner.methods.time_optimal import plan_time_optimal
-from att_planner.methods.time_optimal.model import path_function, scaling
+from att_planner.methods.time_optimal.model import (
+    ZONE_PARAMETERS,
+    boundary_case,
+    motion_parameters,
+    path_function,
+    path_values,
+    scaling,
+)
 from att_planner.problem import ManeuverProblem
 from att_planner.verification import rejection, verify
 from att_sim import rotations as rot
@@ -86,10 +93,13 @@ def test_zone_constraints_are_exact_functions_of_time():
     problem = _sweep_problem()
     s = scaling(problem)
     margin = np.deg2rad(0.05)
-    path, weight = path_function(problem, s, margin)
-    assert path.n_in() == 3 and weight is None          # no end on a boundary: no end ramp
+    assert not boundary_case(problem, margin)               # no end on a boundary: no end ramp
+    path, degree = path_function(problem, s, 7, margin)
+    assert degree is not None and path.n_in() == 4          # (x, u, t, p): the series' coefficients are parameters
+    values = path_values(problem, s, margin)
+    assert values.size == motion_parameters(degree)
     x, u, t = ca.SX.sym("x", 7), ca.SX.sym("u", 3), ca.SX.sym("t")
-    dgdt = ca.Function("dgdt", [x, u, t], [ca.jacobian(path(x, u, t), t)])
+    dgdt = ca.Function("dgdt", [x, u, t], [ca.jacobian(path(x, u, t, values), t)])
     zs = problem.zone_sky()
     q = rot.from_axis_angle([0.2, 0.3, 1.0], 1.1)
     b = rot.dcm(q) @ X
@@ -97,13 +107,18 @@ def test_zone_constraints_are_exact_functions_of_time():
     for tn in (0.0, 1.3, 2.9):
         ts = tn * s.tu
         a, th = zs.axes(ts)[0], zs.half_angles(ts)[0]
-        assert float(path(state, np.zeros(3), tn)) == pytest.approx(a @ b - np.cos(th + margin), abs=1e-12)
+        assert float(path(state, np.zeros(3), tn, values)) == pytest.approx(a @ b - np.cos(th + margin), abs=1e-12)
         rate = s.tu * (zs.axes_rate(ts)[0] @ b + np.sin(th + margin) * zs.half_angles_rate(ts)[0])
         assert float(dgdt(state, np.zeros(3), tn)) == pytest.approx(rate, abs=1e-12)
         # the Sun's direction turns at RATE: |da/dt| = |RATE|, and the fit holds it
         assert np.linalg.norm(zs.axes_rate(ts)[0]) == pytest.approx(abs(RATE), rel=1e-6)
-    # inertial zones build no time dependence
-    assert path_function(replace(problem, zones=zs.frozen_zones(), sky=None), s, margin)[0].n_in() == 2
+    # inertial zones build no time dependence; their data are the function's parameters
+    frozen = replace(problem, zones=zs.frozen_zones(), sky=None)
+    path, _ = path_function(frozen, s, 7, margin)
+    assert path.n_in() == 3 and path_values(frozen, s, margin).size == ZONE_PARAMETERS       # (x, u, p)
+    a, th = zs.at(0.0, true=True)
+    assert float(path(state, np.zeros(3), path_values(frozen, s, margin))) == pytest.approx(
+        a[0] @ b - np.cos(th[0] + margin), abs=1e-12)
 
 
 def test_keep_in_zone_of_a_second_sensor_is_kept(bw_plans):

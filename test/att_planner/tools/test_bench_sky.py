@@ -2,77 +2,30 @@
 and the study's plumbing on a cheap method.
 
 The check uses nothing of the suite: it integrates each plan's ZOH body torque from rest at
-``q_initial`` with its own RK4 of the rigid body (:mod:`helpers.own_rk4`), and computes the zones' true
-directions with skyfield directly: the spacecraft from the JSON's TLE (``EarthSatellite``: SGP4,
-TEME → GCRS), the Sun and Moon from the ``de421.bsp`` of skyfield-data (geometric, light time
-ignored: ≤ 0.006° here), the Earth limb as asin(R_E/|r|) + margin about −r̂ (R_E = 6378.137 km,
-WGS-84). It then confirms, to 0.01°: the torque reproduces each plan (final attitude, the JSON's
-margins), the frozen plan enters a zone, the moving one does not. ``ATT_SKY_BENCHMARKS=DIR`` checks
-the sky_<case>.json of another directory (a fresh ``att-bench sky --json`` run).
+``q_initial`` with its own RK4 of the rigid body (:mod:`helpers.own_rk4`), and computes the zones'
+true directions with skyfield directly (:mod:`helpers.independent`: the JSON's TLE, DE421 from
+skyfield-data, the Earth limb about −r̂). It then confirms, to 0.01°: the torque reproduces each
+plan (final attitude, the JSON's margins), the frozen plan enters a zone, the moving one does not.
+``ATT_SKY_BENCHMARKS=DIR`` checks the sky_<case>.json of another directory (a fresh ``att-bench sky
+--json`` run).
 """
 from __future__ import annotations
 
 import json
 import math
 import os
-from datetime import datetime
-from functools import lru_cache
-from importlib.resources import files
 from pathlib import Path
 
 import numpy as np
 import pytest
 
-from helpers.own_rk4 import dcm, integrate
+from helpers.independent import margins, sky
+from helpers.own_rk4 import integrate
 
 BENCHMARKS = Path(os.environ.get("ATT_SKY_BENCHMARKS", Path(__file__).resolve().parents[3] / "benchmarks"))
 CASES = ("leo_observatory", "moon_parallax")
 TOL = math.radians(0.01)
-R_EARTH = 6378.137e3          # m, WGS-84 equatorial radius
 SUBSTEPS = 4                  # RK4 steps per ZOH interval (500 intervals: 2000 steps); the sky at the knots
-
-
-@lru_cache(maxsize=1)
-def _skyfield():
-    """skyfield's built-in time scale and the packaged DE421, opened offline once."""
-    from skyfield.api import load, load_file
-
-    return load.timescale(builtin=True), load_file(str(files("skyfield_data") / "data" / "de421.bsp"))
-
-
-def _sky(payload, t):
-    """(sun, moon, nadir) unit vectors from the spacecraft, (K, 3) each, and asin(R_E/|r|) (K,)."""
-    from skyfield.api import EarthSatellite
-
-    ts, eph = _skyfield()
-    e = datetime.fromisoformat(payload["epoch"].replace("Z", "+00:00"))
-    # UTC seconds = SI seconds: no leap second within a maneuver of these cases
-    tt = ts.utc(e.year, e.month, e.day, e.hour, e.minute, e.second + e.microsecond * 1e-6 + np.asarray(t))
-    r = EarthSatellite(*payload["tle"], ts=ts).at(tt).position.m.T
-    earth = eph["earth"].at(tt).position.m.T
-
-    def unit(v):
-        return v / np.linalg.norm(v, axis=1, keepdims=True)
-    sun = unit(eph["sun"].at(tt).position.m.T - earth - r)
-    moon = unit(eph["moon"].at(tt).position.m.T - earth - r)
-    return {"sun": sun, "moon": moon, "earth_limb": unit(-r)}, np.arcsin(R_EARTH / np.linalg.norm(r, axis=1))
-
-
-def _margins(payload, t, q):
-    """Per-zone margins (rad, ≥ 0 clear) of attitudes q (K, 4) at times t (K,) against the true sky."""
-    axes, limb = _sky(payload, t)
-    out = {}
-    for z in payload["zones"]:
-        b = dcm(q) @ np.asarray(z["sensor_axis"], float)
-        if z["body"] == "inertial":
-            a, half = np.broadcast_to(np.asarray(z["direction"], float), b.shape), z["half_angle"]
-        elif z["body"] == "earth_limb":
-            a, half = axes["earth_limb"], limb + z["margin"]
-        else:
-            a, half = axes[z["body"]], z["half_angle"]
-        gamma = np.arccos(np.clip(np.sum(a * b, axis=1) / np.linalg.norm(b, axis=1), -1.0, 1.0))
-        out[z["name"]] = half - gamma if z["keep_in"] else gamma - half
-    return out
 
 
 @pytest.fixture(scope="module", params=CASES)
@@ -84,7 +37,7 @@ def checked(request):
         assert plan["t"], f"{request.param}: no {kind} plan in the JSON ({plan['message']})"
         t = np.asarray(plan["t"], float)
         states = integrate(payload["J"], t, plan["torque"], payload["q_initial"], SUBSTEPS)
-        out[kind] = (t, states, _margins(payload, t, states[:, :4]))
+        out[kind] = (t, states, margins(payload, t, states[:, :4]))
     return payload, out
 
 
@@ -106,7 +59,7 @@ def test_format_is_the_issues(checked):
 
 def test_earth_limb_half_angle_at_start(checked):
     payload, _ = checked
-    _, limb = _sky(payload, np.zeros(1))
+    _, limb = sky(payload, np.zeros(1))
     for z in payload["zones"]:
         if z["body"] == "earth_limb":
             assert z["half_angle"] == pytest.approx(limb[0] + z["margin"], abs=1e-6)
@@ -114,14 +67,14 @@ def test_earth_limb_half_angle_at_start(checked):
 
 def test_torque_reproduces_each_plan(checked):
     payload, own = checked
-    for kind, (times, states, margins) in own.items():
+    for kind, (times, states, zone_margins) in own.items():
         plan = payload["plans"][kind]
         assert times[-1] == pytest.approx(plan["tf"], rel=1e-12)
         qf = np.asarray(payload["q_final"], float)
         error = 2.0 * math.acos(min(1.0, abs(float(states[-1, :4] @ qf))))
         assert error == pytest.approx(plan["verification"]["final_attitude_error"], abs=TOL)
         assert error < math.radians(0.5) and np.linalg.norm(states[-1, 4:]) < 1e-3
-        for name, m in margins.items():
+        for name, m in zone_margins.items():
             assert m.min() == pytest.approx(plan["verification"]["zone_margins_vs_motion"][name], abs=TOL), (kind, name)
 
 

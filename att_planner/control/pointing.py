@@ -1,0 +1,35 @@
+"""Tracking a guidance reference (issue 15, no ROS): feedforward plus quaternion PD feedback.
+
+With the body's attitude error from the reference ``q_e = q_R* ⊗ q`` and ``C = R(q_e)ᵀ`` (reference
+axes to body axes), the reference rate and acceleration in body axes are ``ω_r = C ω_R`` and
+``ω̇_r = C ω̇_R``, and the body torque demanded is (Schaub & Junkins, *Analytical Mechanics of Space
+Systems*, §8.3; Basilisk ``mrpFeedback``)::
+
+    τ = J (ω̇_r − ω × ω_r) + ω × J ω − K_p 2 sign(e_w) e_v − K_d (ω − ω_r)
+
+The wheels' own gyroscopic term ``ω × G I_w Ω`` is compensated where the demand becomes wheel
+torques (:func:`att_planner.control.tracking.wheel_torques`). A constant-rate reference (nadir on a
+circular orbit) is then held with no steady error: the feedforward carries the whole torque.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from att_planner.guidance import Reference
+from att_sim import rotations as rot
+from att_sim.dynamics import Spacecraft
+
+
+def body_reference(q, ref: Reference) -> tuple[np.ndarray, np.ndarray]:
+    """The reference rate and acceleration in body axes at attitude ``q``."""
+    C = rot.dcm(rot.multiply(rot.conjugate(ref.q), q)).T
+    return C @ ref.omega, C @ ref.omega_dot
+
+
+def pointing_torque(sc: Spacecraft, q, omega, ref: Reference, kp: float, kd: float) -> np.ndarray:
+    """Body torque (N m) that tracks ``ref`` from attitude ``q`` and rate ``omega`` (module docstring)."""
+    omega = np.asarray(omega, float)
+    w_r, w_r_dot = body_reference(q, ref)
+    J = sc.inertia
+    feedforward = J @ (w_r_dot - rot.cross(omega, w_r)) + rot.cross(omega, J @ omega)
+    return feedforward - kp * 2.0 * rot.error_vector(q, ref.q) - kd * (omega - w_r)

@@ -1,0 +1,208 @@
+"""Pointing laws: the reference attitude of each pointing mode as a function of time (no ROS).
+
+Every law is the **two-vector alignment** (:func:`two_vector_attitude`): a primary body axis ``p``
+exactly on a primary direction ``P(t)``, a secondary body axis ``s`` as close as possible to a
+secondary direction ``S(t)`` (the standard construction of Wertz 1978 §12.2 and of Basilisk's
+pointing guidance: the triads ``(p, p×s/|p×s|, p×(p×s)/…)`` and the same of ``(P, S)`` are matched).
+The directions (inertial axes, unit, seen from the spacecraft):
+
+* ``nadir``: ``P = −r̂`` (the primary axis, default body +z, on the Earth's centre), ``S = v⊥``
+  (the velocity without its radial part: the secondary axis, default body +x, along-track: LVLH),
+  then a ``yaw`` about the primary axis;
+* ``sun``: ``P`` = the Sun from the spacecraft;
+* ``ground``: ``P`` = the line of sight to a point of latitude, longitude (geodetic, WGS-84) and
+  altitude, carried by the Earth's rotation (GCRS→ITRS through skyfield's ITRS frame, as the
+  geomagnetic field; without an epoch the inertial frame turns at the Earth's rate from t = 0);
+* ``inertial_target``: ``P`` a fixed inertial direction; ``inertial``: a fixed attitude.
+
+Secondary directions: ``velocity`` (v⊥), ``orbit_normal`` (r × v), ``sun``, ``nadir``, ``north``
+(the inertial +z) or ``inertial`` (a given direction). Where the primary and secondary directions
+become parallel the law has no attitude; :func:`two_vector_attitude` raises, and the law keeps its
+last attitude (:class:`TwoVectorLaw` notes it) so the controller never sees a jump.
+"""
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from att_sim import rotations as rot
+from att_sim.geomagnetic import EARTH_ROTATION_RATE
+
+WGS84_A = 6378137.0                       # m, equatorial radius
+WGS84_F = 1.0 / 298.257223563             # flattening
+WGS84_E2 = WGS84_F * (2.0 - WGS84_F)      # first eccentricity squared
+PARALLEL = 1e-6                           # |P × S| (unit vectors) below this: no attitude
+
+
+def two_vector_attitude(primary_body, secondary_body, primary, secondary) -> np.ndarray:
+    """The body-to-inertial quaternion putting ``primary_body`` on ``primary`` and
+    ``secondary_body`` as close as possible to ``secondary`` (all unit-normalised here); ValueError
+    when either pair is parallel (within :data:`PARALLEL`): then no rotation about the primary is
+    defined."""
+    frames = []
+    for a, b, what in ((primary_body, secondary_body, "body axes"), (primary, secondary, "directions")):
+        a = np.asarray(a, float) / np.linalg.norm(a)
+        b = np.asarray(b, float) / np.linalg.norm(b)
+        c = rot.cross(a, b)
+        n = float(np.linalg.norm(c))
+        if not n > PARALLEL:
+            raise ValueError(f"the primary and secondary {what} are parallel: no attitude about the primary")
+        c /= n
+        frames.append(np.column_stack([a, c, rot.cross(a, c)]))
+    body, inertial = frames
+    return rot.normalize(rot.from_dcm(inertial @ body.T))
+
+
+def earth_turning(t: float) -> np.ndarray:
+    """Without an epoch: the Earth-fixed frame turning about the inertial z axis at the Earth's rate
+    from t = 0 (``R_3(ω_E t)``, inertial to Earth-fixed)."""
+    c, s = math.cos(EARTH_ROTATION_RATE * t), math.sin(EARTH_ROTATION_RATE * t)
+    return np.array([[c, s, 0.0], [-s, c, 0.0], [0.0, 0.0, 1.0]])
+
+
+def geodetic_to_itrs(latitude: float, longitude: float, altitude: float) -> np.ndarray:
+    """ITRS position (m) of a geodetic latitude, longitude (rad) and altitude (m) on WGS-84."""
+    s, c = math.sin(latitude), math.cos(latitude)
+    n = WGS84_A / math.sqrt(1.0 - WGS84_E2 * s * s)
+    return np.array([(n + altitude) * c * math.cos(longitude), (n + altitude) * c * math.sin(longitude),
+                     (n * (1.0 - WGS84_E2) + altitude) * s])
+
+
+@dataclass
+class Sky:
+    """What the laws look at: ``state(t) -> (r, v)`` (inertial, m and m/s), ``sun(t)`` (unit, from
+    the spacecraft; None without an epoch) and ``itrs(t)`` (the GCRS→ITRS rotation matrix)."""
+
+    state: Callable
+    sun: Callable | None
+    itrs: Callable
+
+    @classmethod
+    def of(cls, environment) -> Sky:
+        """The sky of an :class:`att_sim.world.Environment` (the onboard models of the scenario);
+        the orbit's states are remembered for the last few times asked (a reference differentiates
+        its law at three times, each asking for the orbit more than once)."""
+        field_model = environment.field
+        itrs = field_model.itrs_rotation if field_model.epoch is not None else earth_turning
+        sun = None if environment.sky is None else environment.sky.sun_direction
+        return cls(_remembered(environment.orbit.state), sun, itrs)
+
+
+@dataclass
+class TwoVectorLaw:
+    """A pointing law: ``primary_axis`` (body) on ``primary(t)``, ``secondary_axis`` (body) as close as
+    possible to ``secondary(t)``, then ``yaw`` (rad) about the primary axis."""
+
+    name: str
+    primary_axis: np.ndarray
+    secondary_axis: np.ndarray
+    primary: Callable
+    secondary: Callable
+    yaw: float = 0.0
+    last: np.ndarray | None = field(default=None, repr=False)
+    degenerate: bool = False                   # the last attitude asked for was held, not computed
+
+    def attitude(self, t: float) -> np.ndarray:
+        try:
+            q = two_vector_attitude(self.primary_axis, self.secondary_axis, self.primary(t), self.secondary(t))
+        except ValueError:
+            if self.last is None:
+                raise
+            self.degenerate = True
+            return self.last
+        if self.yaw:
+            q = rot.multiply(q, rot.from_axis_angle(self.primary_axis, self.yaw))
+        self.degenerate, self.last = False, q
+        return q
+
+
+@dataclass
+class FixedAttitude:
+    """Inertial hold."""
+
+    q: np.ndarray
+    name: str = "inertial"
+    degenerate: bool = False
+
+    def attitude(self, t: float) -> np.ndarray:
+        return self.q
+
+
+def _remembered(state: Callable, size: int = 8) -> Callable:
+    """``state`` remembering its last ``size`` results by time."""
+    memory: dict[float, tuple] = {}
+
+    def remembered(t):
+        got = memory.get(t)
+        if got is None:
+            if len(memory) >= size:
+                memory.pop(next(iter(memory)))
+            got = memory[t] = tuple(np.asarray(x, float) for x in state(t))
+        return got
+    return remembered
+
+
+def _unit(v) -> np.ndarray:
+    v = np.asarray(v, float)
+    return v / math.sqrt(float(v @ v))
+
+
+def directions(sky: Sky) -> dict[str, Callable]:
+    """The named directions of :data:`SECONDARY` as functions of time (unit, inertial)."""
+    def nadir(t):
+        return -_unit(sky.state(t)[0])
+
+    def velocity(t):
+        r, v = sky.state(t)
+        r_hat = _unit(r)
+        return _unit(v - (v @ r_hat) * r_hat)
+
+    def orbit_normal(t):
+        r, v = sky.state(t)
+        return _unit(rot.cross(r, v))
+
+    out = {"nadir": nadir, "velocity": velocity, "orbit_normal": orbit_normal,
+           "north": lambda t: np.array([0.0, 0.0, 1.0])}
+    if sky.sun is not None:
+        out["sun"] = lambda t: _unit(sky.sun(t))
+    return out
+
+
+def ground_line_of_sight(sky: Sky, latitude: float, longitude: float, altitude: float) -> Callable:
+    """The unit line of sight from the spacecraft to a ground point, as a function of time."""
+    r_itrs = geodetic_to_itrs(latitude, longitude, altitude)
+
+    def sight(t):
+        return _unit(np.asarray(sky.itrs(t)).T @ r_itrs - sky.state(t)[0])
+    return sight
+
+
+@dataclass
+class BlendedLaw:
+    """``law`` entered from rest at ``start`` (s) through a time warp (the smooth planner's plans end
+    at rest: issue 15): over ``duration`` s the reference is ``law(start + w(τ))`` with
+    ``w(τ) = τ − τ(1 − τ/T)²``, so it starts on the law's attitude at ``start`` with zero rate, runs
+    up to 4/3 of the law's rate, and joins the law exactly (``w(T) = T``, ``w'(T) = 1``) at
+    ``start + T``; the law itself after."""
+
+    law: object
+    start: float
+    duration: float
+
+    @property
+    def name(self) -> str:
+        return self.law.name
+
+    @property
+    def degenerate(self) -> bool:
+        return self.law.degenerate
+
+    def attitude(self, t: float) -> np.ndarray:
+        tau = t - self.start
+        if tau >= self.duration:
+            return self.law.attitude(t)
+        tau = max(tau, 0.0)
+        return self.law.attitude(self.start + tau - tau * (1.0 - tau / self.duration) ** 2)
