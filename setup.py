@@ -17,6 +17,7 @@ setup(
         ("share/ament_index/resource_index/packages", ["resource/" + PACKAGE]),
         ("share/" + PACKAGE, ["package.xml"]),
         ("share/" + PACKAGE + "/config", glob("config/*.yaml")),
+        ("share/" + PACKAGE + "/campaigns", glob("campaigns/*.yaml")),
     ],
     install_requires=["numpy", "scipy", "pyyaml", "mcap", "mcap-ros2-support", "casadi"],
     zip_safe=True,
@@ -39,6 +40,7 @@ setup(
             "att-tune = att_planner.tools.tune:main",
             "att-keygen = att_planner.tools.keygen:main",
             "att-log = att_msgs_py.log.cli:main",
+            "att-mc = att_planner.tools.monte_carlo:main",
         ],
     },
 )

@@ -13,12 +13,13 @@ the torque limit): the command is quantised and given white noise once per contr
 motor delivers at most ``P_max/|ν|`` while it speeds the wheel up (the back-EMF envelope of a
 power-limited drive; braking is not limited), and friction opposes the spin::
 
-    u_net = env(Q(u) + ε, ν) − (c tanh(ν/ν_s) + b ν)
+    u_net = env(k Q(u) + ε, ν) − (c tanh(ν/ν_s) + b ν)
 
 (Coulomb ``c`` smoothed over ``ν_s`` so the integration stays smooth through zero speed, viscous
-``b``; Bialke 1998, "High fidelity mathematical modeling of reaction wheel performance"). The
-planner's model knows none of this: the controller compensates the friction it expects from
-measured wheel speeds. Magnetorquers: ``m_applied = (I + M) Q(m)`` with misalignment ``M`` drawn
+``b``; Bialke 1998, "High fidelity mathematical modeling of reaction wheel performance"; the scale
+factor ``k`` is 1 but in a Monte Carlo run's truth, :mod:`att_sim.dispersions`). The planner's
+model knows none of this: the controller compensates the friction it expects from measured wheel
+speeds. Magnetorquers: ``m_applied = (I + M) Q(m)`` with misalignment ``M`` drawn
 once (six small off-diagonal angles) and quantisation ``Q``.
 """
 from __future__ import annotations
@@ -42,6 +43,7 @@ class WheelDriveSpec:
     torque_quantization: float = 0.0    # N m per count; 0: none
     torque_noise: float = 0.0           # N m 1σ, per control step
     power_max: float = math.inf         # W: motor torque ≤ P_max/|ν| while speeding the wheel up
+    torque_scale: tuple = ()            # per wheel: delivered/commanded torque (a campaign's dispersion); (): 1
 
     def friction(self, speed: np.ndarray) -> np.ndarray:
         """Friction torque opposing relative wheel speeds ``speed`` (N m)."""
@@ -96,17 +98,18 @@ class WheelDrive:
         self.spec, self.rng = spec, rng
 
     def hold(self, u: np.ndarray) -> np.ndarray:
-        """The motor torques a command becomes for one step: quantised, with the drive's noise."""
+        """The motor torques a command becomes for one step: quantised, scaled, with the drive's noise."""
         u = quantize(u, self.spec.torque_quantization)
+        if self.spec.torque_scale:
+            u = u * np.asarray(self.spec.torque_scale)
         return u + self.rng.standard_normal(len(u)) * self.spec.torque_noise
 
     def motor(self, u: np.ndarray, speed: np.ndarray) -> np.ndarray:
         """Held torques ``u`` within the envelope at relative speeds ``speed``."""
         if math.isinf(self.spec.power_max):
             return u
-        accelerating = u * speed > 0
         limit = self.spec.power_max / np.maximum(np.abs(speed), 1e-12)
-        return np.where(accelerating, np.clip(u, -limit, limit), u)
+        return np.where(u * speed > 0, np.minimum(np.maximum(u, -limit), limit), u)
 
     def __call__(self, u: np.ndarray, speed: np.ndarray) -> np.ndarray:
         """Net torque on the wheels (motor minus friction): what :func:`att_sim.dynamics.derivative`

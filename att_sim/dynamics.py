@@ -116,10 +116,14 @@ def effective_wheel_torque(sc: Spacecraft, wheel_speed: np.ndarray, u: np.ndarra
     """Clip motor torques to their limit and cut those that would push a wheel beyond
     ``wheel_speed_max`` *relative to the body* (``Ω − Gᵀω``, ``Ω`` the state's inertial spin rate,
     ``ω`` the body rate) further."""
-    u = np.clip(np.asarray(u, float), -sc.wheel_torque_max, sc.wheel_torque_max)
-    relative = relative_wheel_speed(sc, wheel_speed, omega)
-    saturated = (np.abs(relative) >= sc.wheel_speed_max) & (np.sign(u) == np.sign(relative))
-    return np.where(saturated, 0.0, u)
+    return _speed_cut(sc, np.minimum(np.maximum(u, -sc.wheel_torque_max), sc.wheel_torque_max),
+                      relative_wheel_speed(sc, wheel_speed, omega))
+
+
+def _speed_cut(sc: Spacecraft, u: np.ndarray, relative: np.ndarray) -> np.ndarray:
+    """Torques ``u`` with those pushing a wheel at its limit speed ``relative`` further cut (u ν > 0:
+    the same sign, neither zero)."""
+    return np.where((np.abs(relative) >= sc.wheel_speed_max) & (u * relative > 0), 0.0, u)
 
 
 def external_torque(sc: Spacecraft, inputs: Inputs, q: np.ndarray, stage: tuple | None = None) -> np.ndarray:
@@ -144,9 +148,11 @@ def derivative(sc: Spacecraft, x: np.ndarray, inputs: Inputs, stage: tuple | Non
     if sc.n_wheels:
         h = h + sc.wheel_axes @ (sc.wheel_inertia * ws)
         if inputs.wheel_torque is not None:
-            u = effective_wheel_torque(sc, ws, inputs.wheel_torque, w)
+            relative = relative_wheel_speed(sc, ws, w)
+            u = _speed_cut(sc, np.minimum(np.maximum(inputs.wheel_torque, -sc.wheel_torque_max), sc.wheel_torque_max),
+                           relative)
             if inputs.wheel_drive is not None:
-                u = inputs.wheel_drive(u, relative_wheel_speed(sc, ws, w))
+                u = inputs.wheel_drive(u, relative)
             torque = torque - sc.wheel_axes @ u
             out[7:] = u / sc.wheel_inertia if sc.wheel_inertia > 0 else 0.0
         else:

@@ -84,6 +84,11 @@ def conjugate(q: np.ndarray) -> np.ndarray:
 def dcm(q: np.ndarray) -> np.ndarray:
     """Body-to-inertial rotation matrix ``R(q)`` (``v_i = R v_b``)."""
     q = np.asarray(q, dtype=float)
+    if q.shape == (4,):                 # one quaternion: the same formula on Python floats
+        x, y, z, w = q.tolist()
+        return np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+                         [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+                         [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)]])
     x, y, z, w = q[..., 0], q[..., 1], q[..., 2], q[..., 3]
     out = np.empty(q.shape[:-1] + (3, 3))
     out[..., 0, 0] = 1 - 2 * (y * y + z * z)
@@ -134,8 +139,8 @@ def to_axis_angle(q: np.ndarray) -> tuple[np.ndarray, float]:
     q = normalize(q)
     if q[3] < 0:
         q = -q
-    s = np.linalg.norm(q[:3])
-    angle = 2.0 * np.arctan2(s, q[3])
+    s = math.sqrt(q[:3] @ q[:3])
+    angle = 2.0 * math.atan2(s, q[3])
     axis = q[:3] / s if s > 1e-15 else np.array([1.0, 0.0, 0.0])
     return axis, float(angle)
 
@@ -164,6 +169,11 @@ def orthonormal_basis(v: np.ndarray, references=((1.0, 0.0, 0.0), (0.0, 1.0, 0.0
 def exp_map(phi: np.ndarray) -> np.ndarray:
     """Quaternion of the rotation vector ``phi`` (``exp(hat(phi))``), stable near zero."""
     phi = np.asarray(phi, dtype=float)
+    if phi.shape == (3,):               # one vector: the same formula on Python floats
+        angle = math.sqrt(phi @ phi)
+        k = math.sin(0.5 * angle) / angle if angle > 1e-8 else 0.5 - angle**2 / 48.0
+        x, y, z = phi.tolist()
+        return np.array([x * k, y * k, z * k, math.cos(0.5 * angle)])
     angle = np.linalg.norm(phi, axis=-1, keepdims=True)
     half = 0.5 * angle
     # sin(half)/angle with its Taylor series near 0

@@ -12,7 +12,10 @@ each at its own rate (:class:`att_sim.sensors.SensorSuite`): ``/sensors/imu`` (s
 (sensor_msgs/MagneticField), ``/sensors/sun_sensors`` (att_msgs/CoarseSunSensors),
 ``/sensors/wheel_speeds`` (sensor_msgs/JointState) and, for evaluation only,
 ``/simulator/sensor_truth`` (the gyro's actual bias); every noise source is drawn from the ``seed``
-parameter (default: the scenario's ``sensors.seed``). The world is the scenario's
+parameter (default: the scenario's ``sensors.seed``). With ``campaign`` (a Monte Carlo campaign file
+of this scenario) and ``run_seed`` it flies the dispersed truth of that run (:mod:`att_sim.dispersions`:
+mass properties, wheels, drives, initial attitude and rate, every noise from the run seed), so a
+campaign's run can be watched through the nodes. The world is the scenario's
 (:meth:`att_sim.simulation.Simulation.for_scenario`:
 orbit, field model, disturbances, epoch = sim time zero); the state's position is in the scenario's
 ``frame_id`` (GCRS with an epoch) and its field is the one at the published state. Runs at
@@ -49,6 +52,7 @@ from att_msgs.srv import ResetSimulator
 from att_msgs_py import convert, qos, topics, validation
 from att_msgs_py.errors import ConfigError, ErrorCode, RequestError, clip
 from att_msgs_py.node_runner import parameter_reader, publisher_of, run_node, spin_until_shutdown
+from att_sim import dispersions
 from att_sim import scenario as scen
 from att_sim.simulation import DEFAULT_STEP, Checks, Refusal, Simulation
 
@@ -68,12 +72,13 @@ class SimulatorNode(Node):
         self.last_command_time = -np.inf
         self.refused = {"command": 0, "reset": 0}
         try:
+            truth = param["truth"] or dispersions.Truth(self.scenario, param["initial_attitude"],
+                                                        param["initial_rate"], param["seed"])
             self.sim = Simulation.for_scenario(
-                self.scenario, q0=param["initial_attitude"], omega0=param["initial_rate"],
-                gravity_gradient=param["gravity_gradient"],
+                truth.scenario, q0=truth.q0, omega0=truth.omega0, gravity_gradient=param["gravity_gradient"],
                 checks=Checks(command_limit_factor=param["command_limit_factor"],
                               max_reset_rate=param["max_reset_rate"], body_frame_id=self.scenario.body_frame_id,
-                              stamp_ahead=self.step, stamp_age=self.command_timeout), seed=param["seed"])
+                              stamp_ahead=self.step, stamp_age=self.command_timeout), seed=truth.seed)
         except ValueError as err:        # the environment cannot start (e.g. a TLE that fails at t = 0)
             raise ConfigError(ErrorCode.INVALID_CONFIG, f"scenario '{self.scenario.name}': {clip(err, 300)}") from None
 
@@ -125,7 +130,9 @@ class SimulatorNode(Node):
             "gravity_gradient": param("gravity_gradient", bool(self.scenario.environment.get("gravity_gradient"))),
             "initial_attitude": param("initial_attitude", [0.0, 0.0, 0.0, 1.0], -inf, inf, length=4),
             "initial_rate": param("initial_rate", [0.0, 0.0, 0.0], -inf, inf, length=3),
-            "seed": param("seed", self.scenario.sensors.seed, 0, 2**63 - 1)}
+            "seed": param("seed", self.scenario.sensors.seed, 0, 2**63 - 1),
+            "campaign": param("campaign", ""),
+            "run_seed": param("run_seed", -1, -1, 2**32 - 1)}
         try:
             values["initial_attitude"] = validation.unit_quaternion(
                 values["initial_attitude"], "parameter 'initial_attitude'", ErrorCode.INVALID_PARAMETER)
@@ -136,7 +143,29 @@ class SimulatorNode(Node):
             raise ConfigError(ErrorCode.INVALID_PARAMETER, f"parameter 'initial_rate' has norm {rate:g} rad/s, above "
                                                            f"max_reset_rate = {values['max_reset_rate']:g} rad/s")
         read.refuse_unknown()
+        values["truth"] = self.dispersed_truth(values)
         return values
+
+    def dispersed_truth(self, values: dict) -> dispersions.Truth | None:
+        """The truth of run ``run_seed`` of the Monte Carlo ``campaign`` (a campaign file of this
+        scenario; the nominal start is ``initial_attitude``/``initial_rate``; the run seed is the
+        sensors' seed too), None without a campaign; ConfigError naming the parameter."""
+        path, seed = values["campaign"], values["run_seed"]
+        if not path and seed < 0:
+            return None
+        if not path or seed < 0:
+            raise ConfigError(ErrorCode.INVALID_PARAMETER, "parameters 'campaign' and 'run_seed' go together: a "
+                                                           "dispersed truth is the run of that seed of that campaign")
+        try:
+            campaign = dispersions.load_campaign(path)
+            if scen.find(campaign.scenario).resolve() != self.scenario.path.resolve():
+                raise ValueError(f"its scenario '{campaign.scenario}' is not this simulator's "
+                                 f"'{self.scenario.name}' ({self.scenario.path})")
+            truth, _ = dispersions.seed_truth(campaign, self.scenario, seed, values["initial_attitude"],
+                                              values["initial_rate"])
+        except (KeyError, ValueError) as err:
+            raise ConfigError(ErrorCode.INVALID_PARAMETER, f"parameter 'campaign': {clip(err, 300)}") from None
+        return truth
 
     def sensor_publishers(self) -> dict:
         """Publishers of the sensors the scenario has, by :class:`att_sim.sensors.Readings` field."""

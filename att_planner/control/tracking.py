@@ -17,6 +17,7 @@ to the limit when a wheel would exceed it.
 """
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -37,9 +38,10 @@ def rotation_vector_rate(phi, omega) -> np.ndarray:
     """dφ/dt of the rotation ``exp(φ)`` turning at body rate ``omega``: ``J_r⁻¹(φ) ω`` =
     ω + ½ φ × ω + (1/θ²)(1 − (θ/2) cot(θ/2)) φ × (φ × ω), θ = |φ| (< 2π)."""
     phi, omega = np.asarray(phi, float), np.asarray(omega, float)
-    theta = float(np.linalg.norm(phi))
-    c = (1.0 - 0.5 * theta / np.tan(0.5 * theta)) / theta**2 if theta > 1e-4 else 1.0 / 12.0 + theta**2 / 720.0
-    return omega + 0.5 * rot.cross(phi, omega) + c * rot.cross(phi, rot.cross(phi, omega))
+    theta = math.sqrt(phi @ phi)
+    c = (1.0 - 0.5 * theta / math.tan(0.5 * theta)) / theta**2 if theta > 1e-4 else 1.0 / 12.0 + theta**2 / 720.0
+    turn = rot.cross(phi, omega)
+    return omega + 0.5 * turn + c * rot.cross(phi, turn)
 
 
 def plan_reference(plan: Plan, t: float) -> Reference:
@@ -50,7 +52,7 @@ def plan_reference(plan: Plan, t: float) -> Reference:
     if t >= t_knots[-1]:
         return Reference(q[-1], np.zeros(3), np.zeros(3))
     t = max(t, t_knots[0])
-    k = int(np.clip(np.searchsorted(t_knots, t, side="right") - 1, 0, len(t_knots) - 2))
+    k = min(max(int(np.searchsorted(t_knots, t, side="right")) - 1, 0), len(t_knots) - 2)
     s = (t - t_knots[k]) / (t_knots[k + 1] - t_knots[k])
     h = t_knots[k + 1] - t_knots[k]
     axis, angle = rot.to_axis_angle(rot.multiply(rot.conjugate(q[k]), q[k + 1]))
@@ -82,4 +84,4 @@ def wheel_torques(sc: Spacecraft, body_torque, omega, wheel_speed, extra=None) -
         u = u * (sc.wheel_torque_max / peak)
     if extra is not None:
         u = u + extra
-    return np.clip(u, -sc.wheel_torque_max, sc.wheel_torque_max)
+    return np.minimum(np.maximum(u, -sc.wheel_torque_max), sc.wheel_torque_max)

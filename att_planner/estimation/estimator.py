@@ -119,6 +119,7 @@ class Estimator:
         the field and the Sun (:meth:`att_sim.world.Environment.bodies`), needed for vector updates."""
         self.specs, self.config, self.environment = specs, config, environment
         self.frame_id, self.body_frame_id = frame_id, body_frame_id
+        self._sigma3: tuple = (None, 0.0)        # (state, its attitude 3σ): health()'s cache
         self.checks = InputChecks(specs, frame_id, body_frame_id)
         self.trackers = {s.name: s for s in specs.star_trackers}
         variances = np.array([config.scale_factor_sigma**2] * 3 + [config.misalignment_sigma**2] * 6)
@@ -233,7 +234,9 @@ class Estimator:
         x = self.state
         if x is None:
             return Health.DIVERGED if self.diverged else Health.INITIALISING
-        sigma3 = 3.0 * math.sqrt(max(float(np.linalg.eigvalsh(x.P[:3, :3]).max()), 0.0))
+        if self._sigma3[0] is not x:          # asked several times per state: its largest eigenvalue once
+            self._sigma3 = (x, 3.0 * math.sqrt(max(float(np.linalg.eigvalsh(x.P[:3, :3]).max()), 0.0)))
+        sigma3 = self._sigma3[1]
         recent = t - self.last_fix <= self.config.propagate_timeout
         return Health.CONVERGED if recent and sigma3 <= self.config.converged_attitude_sigma else Health.PROPAGATING
 

@@ -31,6 +31,7 @@ R(q̂)ᵀ r`` and ``H = [[b̂×] 0]`` (from ``b = R(δq)ᵀ b̂ ≈ b̂ + b̂ ×
 """
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass, field
 
@@ -77,13 +78,16 @@ def transition(omega: np.ndarray, dt: float) -> np.ndarray:
     return out
 
 
+@functools.lru_cache(maxsize=64)
 def process_noise(arw: float, rrw: float, dt: float) -> np.ndarray:
-    """Discrete ``Q`` (6×6) of the gyro noise over ``dt`` (module docstring)."""
+    """Discrete ``Q`` (6×6) of the gyro noise over ``dt`` (module docstring); read-only, cached
+    (the gyro's interval is nearly always the same)."""
     Q = np.zeros((6, 6))
     i = np.arange(3)
     Q[i, i] = arw**2 * dt + rrw**2 * dt**3 / 3.0
     Q[i, i + 3] = Q[i + 3, i] = -rrw**2 * dt**2 / 2.0
     Q[i + 3, i + 3] = rrw**2 * dt
+    Q.flags.writeable = False
     return Q
 
 

@@ -21,7 +21,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from cryptography.hazmat.primitives.asymmetric.ed25519 import Ed25519PrivateKey
 
-from att_msgs_py import convert, signing
+from att_msgs_py import convert, signing, topics
 from att_msgs_py.errors import RequestError
 from att_msgs_py.parameters import SectionReader
 from att_msgs_py.types import Health, ManeuverResult, Plan, PointingMode
@@ -83,7 +83,7 @@ class ClosedLoop:
         self.refusals: list[RequestError] = []
         self.next_state = 0.0
         self.result: ManeuverResult | None = None
-        self.on_step = None     # called with (controller output, truth state) after each control step
+        self.tap = None     # optional (topic, t, mirror object) of everything the nodes would publish: a log
 
     # -- plans ------------------------------------------------------------------------------------
     def issue(self, plan: Plan, plan_id: str = "plan") -> tuple[Plan, bytes]:
@@ -107,6 +107,11 @@ class ClosedLoop:
         sim, ctl, est = self.sim, self.controller, self.estimator
         readings = sim.sense()
         t = sim.t
+        state_due = t >= self.next_state - 1e-9
+        if state_due:
+            self.next_state = t + self.publish_period
+        if self.tap is not None:
+            self._tap_readings(t, readings, state_due)
         outcome = None
         if est is not None:
             for m in readings.star_trackers:
@@ -121,9 +126,10 @@ class ClosedLoop:
                 self._guard(ctl.measured.on_wheel_speeds, readings.wheel_speeds)
             estimate = self._guard(est.on_gyro, readings.gyro) if readings.gyro is not None else None
             if estimate is not None:
+                if self.tap is not None:
+                    self.tap(topics.ESTIMATE, t, estimate)
                 outcome = ctl.accept_estimate(estimate)
-        elif t >= self.next_state - 1e-9:
-            self.next_state = t + self.publish_period
+        elif state_due:
             outcome = ctl.accept_state(sim.state(self.scenario.frame_id, self.scenario.body_frame_id))
         if outcome is not None:
             self._outcome(outcome)
@@ -131,14 +137,15 @@ class ClosedLoop:
                 out = ctl.step()
                 if out.result is not None:
                     self.result = out.result
+                if self.tap is not None:
+                    self.tap(topics.COMMAND, t, out.command)
+                    self.tap(topics.CONTROLLER_STATUS, t, out.status)
                 refused = sim.set_command(out.command)
                 if refused is not None:
                     self.refusals.append(RequestError(refused.code, refused.message))
                 if est is not None:
                     est.on_dipole_command(out.command.t, out.command.dipole)
                 self._record(out, readings)
-                if self.on_step is not None:
-                    self.on_step(out, sim.state(self.scenario.frame_id, self.scenario.body_frame_id))
         sim.advance(self.step)
 
     def run(self, duration: float) -> None:
@@ -171,6 +178,17 @@ class ClosedLoop:
             self.refusals.append(outcome.refused)
         if outcome.ended is not None:
             self.result = outcome.ended
+
+    def _tap_readings(self, t: float, readings, state_due: bool) -> None:
+        """Hand the tap what the simulator publishes now: the sensors' readings, then the state."""
+        for topic, m in ((topics.IMU, readings.gyro), (topics.MAGNETOMETER, readings.magnetometer),
+                         (topics.SUN_SENSORS, readings.sun_sensors), (topics.WHEEL_SPEEDS, readings.wheel_speeds),
+                         (topics.SENSOR_TRUTH, readings.truth), *((topics.STAR_TRACKER, m) for m in
+                                                                  readings.star_trackers)):
+            if m is not None:
+                self.tap(topic, t, m)
+        if state_due:
+            self.tap(topics.STATE, t, self.sim.state(self.scenario.frame_id, self.scenario.body_frame_id))
 
     def _record(self, out, readings) -> None:
         tr, sim, est, command = self.trace, self.sim, self.estimator, out.command

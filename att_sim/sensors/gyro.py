@@ -60,19 +60,22 @@ class Gyro:
 
     def _bias(self, n: int, dt: float) -> np.ndarray:
         """The bias at the end of each of ``n`` intervals (n, 3); advances the noise state. Each
-        flicker process is ``x_k = a x_(k-1) + w_k``: one step directly (the simulator's case), a
-        batch through ``scipy.signal.lfilter`` (imported then: it costs a node seconds at start)."""
+        flicker process is ``x_k = a x_(k-1) + w_k``: one step of the whole bank at once (the
+        simulator's case: the bank's draws in the order of the batch path), a batch through
+        ``scipy.signal.lfilter`` (imported then: it costs a node seconds at start)."""
         flicker = np.zeros((n, 3))
-        if self.flicker_sigma > 0:
+        if self.flicker_sigma > 0 and n == 1:       # the simulator's case: the bank in one step
+            a = np.exp(-dt / self.times)[:, None]
+            drive = self.rng.standard_normal((len(self.times), 3)) * (self.flicker_sigma * np.sqrt(1.0 - a * a))
+            self.flicker = a * self.flicker + drive
+            flicker[0] = self.flicker.sum(axis=0)
+        elif self.flicker_sigma > 0:
             for j, tau in enumerate(self.times):
                 a = math.exp(-dt / tau)
                 drive = self.rng.standard_normal((n, 3)) * (self.flicker_sigma * math.sqrt(1.0 - a * a))
-                if n == 1:
-                    path = (a * self.flicker[j] + drive[0])[None, :]
-                else:
-                    from scipy.signal import lfilter
+                from scipy.signal import lfilter
 
-                    path, _ = lfilter([1.0], [1.0, -a], drive, axis=0, zi=(a * self.flicker[j])[None, :])
+                path, _ = lfilter([1.0], [1.0, -a], drive, axis=0, zi=(a * self.flicker[j])[None, :])
                 flicker += path
                 self.flicker[j] = path[-1]
         walk = self.walk + np.cumsum(self.rng.standard_normal((n, 3)) * (self.spec.rrw * math.sqrt(dt)), axis=0)

@@ -38,7 +38,7 @@ def exclusion_margin(exclusion: Exclusion, boresight_N: np.ndarray, bodies: Bodi
         half = exclusion.half_angle
     if axis is None:
         raise ValueError(f"a {exclusion.body} exclusion needs the sky (a scenario epoch)")
-    return math.acos(float(np.clip(np.dot(boresight_N, axis), -1.0, 1.0))) - half
+    return math.acos(min(max(float(boresight_N @ axis), -1.0), 1.0)) - half
 
 
 class StarTracker:

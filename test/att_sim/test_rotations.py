@@ -47,3 +47,18 @@ def test_angle_between_is_sign_independent():
     r = rot.multiply(q, rot.from_axis_angle([1, 1, 0], 0.4))
     assert rot.angle_between(q, -r) == pytest.approx(0.4)
     assert np.allclose(rot.error_vector(-r, q), rot.error_vector(r, q))
+
+
+def test_one_quaternion_fast_paths_agree_with_the_stacked_forms():
+    """dcm, exp_map and to_axis_angle take Python-float paths for one quaternion or vector (the
+    loops' hot path); each row of a stack goes through numpy's: the same values to the last ulps."""
+    qs = random_quaternions(20)
+    stacked = rot.dcm(qs)
+    for q, R in zip(qs, stacked):
+        assert np.array_equal(rot.dcm(q), R)
+    phis = np.vstack([RNG.normal(size=(10, 3)), RNG.normal(size=(5, 3)) * 1e-9, np.zeros((1, 3))])
+    for phi, q in zip(phis, rot.exp_map(phis)):
+        assert np.allclose(rot.exp_map(phi), q, rtol=4e-16, atol=1e-300)
+    for q in qs:
+        axis, angle = rot.to_axis_angle(q)
+        assert np.allclose(rot.from_axis_angle(axis, angle), q if q[3] >= 0 else -q, rtol=0, atol=4e-16)

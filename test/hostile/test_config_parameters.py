@@ -220,6 +220,20 @@ NODE_CASES = {
     "controller estimate without tachometers": ("controller", ["-p", "scenario:=olivares_staffetti", "-p",
                                                                "state_source:=estimate"], P,
                                                 ["'state_source'", "wheel_tachometer"]),
+    # issue 16: a campaign's dispersed truth
+    "simulator campaign without run_seed": (SIM, ["-p", "campaign:={tmp}/campaign.yaml"], P,
+                                            ["'campaign'", "'run_seed'"]),
+    "simulator run_seed without campaign": (SIM, ["-p", "run_seed:=5"], P, ["'campaign'", "'run_seed'"]),
+    "simulator run_seed text": (SIM, ["-p", "run_seed:=lucky"], P, ["'run_seed'"]),
+    "simulator campaign missing": (SIM, ["-p", "campaign:={tmp}/no_campaign.yaml", "-p", "run_seed:=1"], P,
+                                   ["'campaign'", "cannot be read"]),
+    "simulator campaign of another scenario": (SIM, ["-p", "scenario:=leo_observatory", "-p",
+                                                     "campaign:={tmp}/campaign.yaml", "-p", "run_seed:=1"], P,
+                                               ["'campaign'", "swift_demo", "leo_observatory"]),
+    "simulator campaign with a typo": (SIM, ["-p", "campaign:={tmp}/campaign_typo.yaml", "-p", "run_seed:=1"], P,
+                                       ["'campaign'", "inertia_scal"]),
+    "simulator campaign run not physical": (SIM, ["-p", "campaign:={tmp}/campaign_wide.yaml", "-p", "run_seed:=0"],
+                                            P, ["'campaign'", "run seed 0", "triangle inequality"]),
     "estimator: a scenario without a gyro": ("estimator", ["-p", "scenario:=bruni_celani"], C, ["no gyro"]),
     "estimator: gate probability 1.5": ("estimator", ["-p", "gate_probability:=1.5"], P, ["'gate_probability'"]),
     "estimator: publish_rate above the gyro's": ("estimator", ["-p", "publish_rate:=100.0"], P, ["'publish_rate'"]),
@@ -241,6 +255,10 @@ def write_files(tmp: Path) -> None:
     (tmp / "typo.yaml").write_text("simulator:\n  ros__parameters:\n    real_time_facter: 2.0\n")
     (tmp / "rtf3.yaml").write_text("simulator:\n  ros__parameters:\n    real_time_factor: 3\n")
     (tmp / "mine.yaml").write_text(swift.replace("real_time_factor: 8.0", "real_time_factor: 5.0"))
+    scale = "{distribution: uniform, low: -0.9, high: 2.0}"
+    for name, dispersions in (("campaign", "{}"), ("campaign_typo", f"{{inertia_scal: {scale}}}"),
+                              ("campaign_wide", f"{{inertia_scale: {scale}}}")):
+        (tmp / f"{name}.yaml").write_text(f"campaign: {{scenario: swift_demo, seed: 1, dispersions: {dispersions}}}\n")
 
 
 def start(node: str, args: list, cwd: Path | None = None, output=subprocess.PIPE) -> subprocess.Popen:

@@ -24,12 +24,11 @@ from pathlib import Path
 
 import numpy as np
 import rclpy
-from rclpy.serialization import serialize_message
 
-from att_msgs.msg import ActuatorCommand, ControllerStatus, SpacecraftState
+from att_msgs.msg import SpacecraftState
 from att_msgs.srv import ResetSimulator
 from att_msgs_py import convert, qos, topics
-from att_msgs_py.log import LogWriter, read_log
+from att_msgs_py.log import read_log
 from att_msgs_py.types import ControlMode, PointingMode
 from att_planner.control.momentum import null_space
 from att_planner.guidance import reference
@@ -38,6 +37,7 @@ from att_planner.guidance.modes import law_of
 from att_planner.nodes.client import client_session
 from att_planner.tools.closed_loop import ClosedLoop
 from att_planner.tools.launch import isolated_env, join_env, start_suite
+from att_planner.tools.loop_log import open_loop_log
 from att_planner.tools.review.pointing import SATURATED, TOPICS, pointing_of, pointing_summary
 from att_sim import scenario as scen
 from att_sim import world
@@ -115,36 +115,30 @@ def fly(s: scen.Scenario, dumping: bool, seconds: float, out: Path) -> dict:
 
 def fly_in_process(s: scen.Scenario, dumping: bool, seconds: float, out: Path) -> dict:
     """:func:`fly` with the cores of the simulator and the controller in this process
-    (:class:`~att_planner.tools.closed_loop.ClosedLoop`, no DDS): the state, command and status each
-    control step written to the MCAP as the nodes publish them."""
+    (:class:`~att_planner.tools.closed_loop.ClosedLoop`, no DDS): what the nodes would publish written
+    to the MCAP (:mod:`att_planner.tools.loop_log`)."""
     run_dir = out / f"{s.name}_{'dumping' if dumping else 'no_dumping'}_in_process_{datetime.now(UTC):%Y%m%d_%H%M%S}"
     run_dir.mkdir(parents=True, exist_ok=True)
     mcap = run_dir / "run.mcap"
     q0, w0, wheels0 = start_state(s, 0.0)
     loop = ClosedLoop(s, q0=q0, omega0=w0, wheel_speed0=wheels0,
                       overrides={"controller": {"state_source": "truth", "momentum_dumping": dumping}})
-    log = LogWriter(mcap)
-    for topic, msg_type in ((topics.STATE, SpacecraftState), (topics.COMMAND, ActuatorCommand),
-                            (topics.CONTROLLER_STATUS, ControllerStatus)):
-        log.add_topic(topic, f"att_msgs/msg/{msg_type.__name__}")
+    log, write = open_loop_log(mcap)
     limit, saturated = s.spacecraft.wheel_speed_max, []
 
-    def record(step, state):
-        stamp = int(round(state.t * 1e9))
-        for topic, msg in ((topics.STATE, convert.state_msg(state)),
-                           (topics.COMMAND, convert.command_msg(step.command)),
-                           (topics.CONTROLLER_STATUS, convert.controller_status_msg(step.status))):
-            log.write(topic, serialize_message(msg), stamp)
-        ratio = np.max(np.abs(state.wheel_speeds - s.spacecraft.wheel_axes.T @ state.omega)) / limit
-        if not dumping and ratio >= SATURATED:
-            saturated.append(state.t)
+    def record(topic, t, message):
+        write(topic, t, message)
+        if topic == topics.STATE and not dumping:
+            relative = message.wheel_speeds - s.spacecraft.wheel_axes.T @ message.omega
+            if np.max(np.abs(relative)) / limit >= SATURATED:
+                saturated.append(t)
 
     wall0 = time.monotonic()
     loop.run(loop.step)
     code, why, _ = loop.controller.set_mode(ControlMode.POINTING, PointingMode("nadir"))
     if code:
         raise RuntimeError(f"the controller refused nadir pointing: {why}")
-    loop.on_step = record
+    loop.tap = record
     while loop.sim.t < seconds and not saturated and not loop.sim.halted:
         loop.run(60.0)
     wall = time.monotonic() - wall0

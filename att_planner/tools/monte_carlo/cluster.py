@@ -1,0 +1,68 @@
+"""Where a campaign's runs fly: a Dask cluster, local by default (``LocalCluster``, one
+single-threaded worker process per core: the runs are pure Python and numpy on small arrays, so
+threads would only share one interpreter lock) or an existing one reached by its scheduler address
+— one code path. The shared :class:`~att_planner.tools.monte_carlo.run.Setup` is scattered to every
+worker once; runs go out in chunks of ``chunk`` seeds and their rows come back as each chunk
+finishes (:func:`stream`); an interrupt (Ctrl-C) cancels what has not finished and keeps the rows
+that have.
+"""
+from __future__ import annotations
+
+import os
+from collections.abc import Iterator
+from contextlib import contextmanager
+
+from att_planner.tools.monte_carlo.run import Setup, fly
+
+
+class ClusterError(RuntimeError):
+    """A cluster that cannot be reached or started (one sentence)."""
+
+
+@contextmanager
+def client_for(scheduler: str | None, workers: int, timeout: float):
+    """A ``distributed.Client`` of the cluster at ``scheduler`` (reached within ``timeout`` s, else
+    :class:`ClusterError`) or of a local cluster of ``workers`` processes; closed on exit."""
+    import logging
+
+    from distributed import Client, LocalCluster
+
+    logging.getLogger("distributed").setLevel(logging.ERROR)      # its connection retries are our one line
+    if scheduler:
+        try:
+            client = Client(scheduler, timeout=timeout)
+        except (OSError, TimeoutError, ValueError) as exc:
+            raise ClusterError(f"--scheduler {scheduler}: no Dask scheduler reached within {timeout:g} s "
+                               f"({' '.join(str(exc).split())[:160]})") from None
+        try:
+            yield client
+        finally:
+            client.close()
+        return
+    with LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None,
+                      silence_logs=40, env={"OMP_NUM_THREADS": "1"}) as cluster, Client(cluster) as client:
+        yield client
+
+
+def fly_chunk(setup: Setup, seeds: list[tuple[int, int]]) -> list[dict]:
+    """The rows of ``(run, seed)`` pairs, flown one after the other in this worker."""
+    return [fly(setup, seed, run) for run, seed in seeds]
+
+
+def stream(client, setup: Setup, runs: list[tuple[int, int]], chunk: int) -> Iterator[list[dict]]:
+    """Rows of ``runs`` (``(run, seed)`` pairs) in chunks, each as soon as it finishes (in finishing
+    order). Closing the iterator (an interrupt) cancels the chunks still out."""
+    from distributed import as_completed
+
+    shared = client.scatter(setup, broadcast=True)
+    futures = [client.submit(fly_chunk, shared, runs[i:i + chunk], pure=False) for i in range(0, len(runs), chunk)]
+    try:
+        for future in as_completed(futures):
+            yield future.result()
+    finally:
+        client.cancel(futures)
+
+
+def local_workers() -> int:
+    """Worker processes of the default local cluster: the cores this process may use."""
+    return len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1

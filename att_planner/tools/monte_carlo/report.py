@@ -1,0 +1,149 @@
+"""A campaign's report: the per-run table (CSV: one row per run, the applied dispersions then the
+outcomes), the summary (JSON) and the figures (PNG, matplotlib's Agg backend): histograms of the
+final attitude error, the minimum zone margin, the peak wheel speed and torque against their
+limits and the settling time, and the outcome against the dispersion it ranks most with
+(Spearman's rank correlation, |ρ| largest).
+"""
+from __future__ import annotations
+
+import csv
+import math
+from pathlib import Path
+
+import numpy as np
+
+from att_planner.tools.monte_carlo.run import OUTCOMES
+
+STATISTICS = ("final_error_deg", "min_margin_deg", "peak_wheel_ratio", "peak_torque_ratio", "settling_time")
+WORST = 10
+
+
+def columns(rows: list[dict]) -> list[str]:
+    """``run``, ``seed``, the applied values (first-seen order), then the outcomes."""
+    names = ["run", "seed"]
+    for row in rows:
+        names += [k for k in row if k not in names and k not in OUTCOMES]
+    return names + list(OUTCOMES)
+
+
+def write_table(rows: list[dict], path: Path) -> Path:
+    """The rows, ordered by run, as CSV (floats with 17 significant digits: the table reads back exactly)."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    with open(path, "w", newline="") as fh:
+        writer = csv.DictWriter(fh, fieldnames=columns(rows))
+        writer.writeheader()
+        for row in sorted(rows, key=lambda r: r["run"]):
+            writer.writerow({k: repr(v) if isinstance(v, float) else v for k, v in row.items()})
+    return path
+
+
+def statistics(values) -> dict:
+    """Mean, median, 99th percentile, min and max of the finite values (NaN-free; None when none)."""
+    v = np.asarray(values, float)
+    v = v[np.isfinite(v)]
+    if v.size == 0:
+        return {"mean": None, "p50": None, "p99": None, "min": None, "max": None, "count": 0}
+    return {"mean": float(v.mean()), "p50": float(np.percentile(v, 50)), "p99": float(np.percentile(v, 99)),
+            "min": float(v.min()), "max": float(v.max()), "count": int(v.size)}
+
+
+def applied(rows: list[dict]) -> list[str]:
+    return [k for k in columns(rows) if k not in ("run", "seed") and k not in OUTCOMES]
+
+
+def ranks(x: np.ndarray) -> np.ndarray:
+    """Ranks 0..n−1 (average ranks are not needed: continuous draws do not tie)."""
+    r = np.empty(x.size)
+    r[np.argsort(x, kind="stable")] = np.arange(x.size)
+    return r
+
+
+def rank_correlations(rows: list[dict], outcome: str = "final_error_deg") -> dict[str, float]:
+    """Spearman's ρ of ``outcome`` with every applied dispersion (runs with a finite outcome)."""
+    y = np.array([r[outcome] for r in rows], float)
+    keep = np.isfinite(y)
+    out = {}
+    if keep.sum() < 3:
+        return out
+    ry = ranks(y[keep])
+    for name in applied(rows):
+        x = np.array([r.get(name, math.nan) for r in rows], float)[keep]
+        if np.all(np.isfinite(x)) and np.ptp(x) > 0:
+            out[name] = float(np.corrcoef(ranks(x), ry)[0, 1])
+    return out
+
+
+def plain(value):
+    """``value`` for strict JSON: a non-finite float becomes None (no margin without zones, a run
+    that never settled)."""
+    return value if not isinstance(value, float) or math.isfinite(value) else None
+
+
+def worst(rows: list[dict], count: int = WORST) -> list[dict]:
+    """The failed runs first, then the largest final errors: run, seed and outcomes."""
+    def badness(r):
+        return (bool(r["success"]), -np.nan_to_num(r["final_error_deg"], nan=np.inf))
+    return [{k: plain(r[k]) for k in ("run", "seed", *OUTCOMES) if k != "cpu_seconds"}
+            for r in sorted(rows, key=badness)[:count]]
+
+
+def summary(rows: list[dict], *, runs: int, wall: float, workers: int, table: Path, figures: list[str],
+            interrupted: bool, campaign: str, scenario: str, plan: dict) -> dict:
+    """The campaign's summary (the JSON ``att-mc --json`` writes)."""
+    n = len(rows)
+    correlations = rank_correlations(rows)
+    top = max(correlations, key=lambda k: abs(correlations[k])) if correlations else None
+    return {
+        "campaign": campaign, "scenario": scenario, "plan": plan,
+        "runs": n, "requested": runs, "interrupted": interrupted,
+        "wall_seconds": wall, "workers": workers, "runs_per_second": n / wall if wall > 0 else None,
+        "cpu_seconds_per_run": statistics([r["cpu_seconds"] for r in rows]),
+        "success_rate": sum(bool(r["success"]) for r in rows) / n if n else None,
+        **{name: statistics([r[name] for r in rows]) for name in STATISTICS},
+        "dispersions": {k: {"mean": float(np.mean(v)), "std": float(np.std(v, ddof=1)) if len(v) > 1 else None}
+                        for k in applied(rows) for v in [[r[k] for r in rows if k in r]]},
+        "rank_correlation_final_error": correlations, "most_influential": top,
+        "worst": worst(rows), "table": str(table), "figures": figures,
+    }
+
+
+def figures(rows: list[dict], out: Path, top: str | None) -> list[str]:
+    """The histograms and the scatter of the final error against ``top`` as PNG files in ``out``."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    out.mkdir(parents=True, exist_ok=True)
+    panels = (("final_error_deg", "final attitude error (deg)", None),
+              ("min_margin_deg", "minimum zone margin (deg)", 0.0),
+              ("peak_wheel_ratio", "peak wheel speed / limit", 1.0),
+              ("peak_torque_ratio", "peak wheel torque / limit", 1.0),
+              ("settling_time", "settling time after the plan (s)", None))
+    fig, axes = plt.subplots(1, len(panels), figsize=(4 * len(panels), 3.2))
+    for ax, (name, label, limit) in zip(axes, panels):
+        v = np.array([r[name] for r in rows], float)
+        ax.hist(v[np.isfinite(v)], bins=30, color="tab:blue")
+        if limit is not None:
+            ax.axvline(limit, color="tab:red", lw=1)
+        ax.set_xlabel(label)
+        ax.set_ylabel("runs")
+    fig.tight_layout()
+    paths = [out / "histograms.png"]
+    fig.savefig(paths[0], dpi=100)
+    plt.close(fig)
+    if top is not None:
+        fig, ax = plt.subplots(figsize=(5, 4))
+        ok = np.array([bool(r["success"]) for r in rows])
+        x = np.array([r[top] for r in rows], float)
+        y = np.array([r["final_error_deg"] for r in rows], float)
+        ax.scatter(x[ok], y[ok], s=6, label="success")
+        ax.scatter(x[~ok], y[~ok], s=12, color="tab:red", label="failure")
+        ax.set_xlabel(top)
+        ax.set_ylabel("final attitude error (deg)")
+        ax.legend()
+        fig.tight_layout()
+        paths.append(out / "influence.png")
+        fig.savefig(paths[-1], dpi=100)
+        plt.close(fig)
+    return [str(p) for p in paths]

@@ -1,0 +1,154 @@
+"""One run of a Monte Carlo campaign: the plan made once on the nominal model, flown on the run's
+dispersed truth (:mod:`att_sim.dispersions`) by :class:`~att_planner.tools.closed_loop.ClosedLoop`
+— the simulator, estimator and controller cores the nodes run — and judged as the planner judges
+its plans (:func:`att_planner.verification.rejection` with :data:`~att_planner.verification.TOLERANCES`)
+on the flown truth.
+
+A run: the simulation starts at the maneuver's initial attitude and rest, dispersed; the loop
+ticks until the estimate is CONVERGED (at most the campaign's ``converge_timeout``), as the demo
+waits before it sends a goal; then the controller flies the plan and holds its end for
+``settle_time``. The outcomes are taken at every control instant of the flown truth.
+"""
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from att_msgs_py.types import Health, Plan, Verification
+from att_planner.tools.closed_loop import ClosedLoop, plan_in_process
+from att_planner.tools.demo import maneuver_from_scenario, zone_margins
+from att_planner.verification import rejection
+from att_sim import dispersions as disp
+from att_sim import rotations as rot
+from att_sim import scenario as scen
+from att_sim.dispersions import DEG
+from att_sim.simulation import Checks, Simulation
+
+OUTCOMES = ("success", "code", "final_error_deg", "final_rate", "min_margin_deg", "peak_wheel_ratio",
+            "peak_torque_ratio", "settling_time", "start_time", "cpu_seconds", "reason")
+
+
+@dataclass(frozen=True)
+class Setup:
+    """What every run of a campaign shares (shipped once to each worker)."""
+
+    campaign: disp.Campaign
+    scenario: scen.Scenario
+    maneuver: dict
+    plan: Plan
+
+
+def checked(campaign: disp.Campaign, seeds=()) -> Setup:
+    """The campaign's scenario and its ``demo:`` maneuver, not yet planned, with the draw of every
+    seed of ``seeds`` checked (ValueError naming what is missing or the seed of a non-physical draw)."""
+    try:
+        scenario = scen.load(campaign.scenario)
+    except KeyError as exc:
+        raise ValueError(f"campaign {campaign.path}: campaign.scenario: {exc.args[0]}") from None
+    setup = Setup(campaign, scenario, maneuver_from_scenario(scenario), Plan())
+    for seed in seeds:
+        dispersed(setup, seed)
+    return setup
+
+
+def planned(setup: Setup) -> Setup:
+    """``setup`` with the plan for its maneuver, made once on the nominal model as the planner
+    service makes it (RequestError when there is none)."""
+    s, m = setup.scenario, setup.maneuver
+    plan = plan_in_process(s, m["q0"], m["qf"], m["sensor"], m["cones"], m["zones"], m["method"], m["time_budget"])
+    return replace(setup, plan=plan)
+
+
+def dispersed(setup: Setup, seed: int) -> tuple[disp.Truth, dict]:
+    """The truth of the run of seed ``seed`` and its applied values (ValueError when not physical)."""
+    return disp.seed_truth(setup.campaign, setup.scenario, seed, q0=setup.maneuver["q0"])
+
+
+def applied_columns(values: dict, loop: ClosedLoop) -> dict:
+    """The applied dispersions as table columns (``name[i]``), with the sensor biases the run's
+    seed drew from the datasheets (the gyro's turn-on bias, the magnetometer's bias)."""
+    out = {f"{name}[{i}]": float(x) for name, v in values.items() for i, x in enumerate(np.atleast_1d(v))}
+    sensors = loop.sim.sensors
+    if sensors is not None and sensors.gyro is not None:
+        out.update({f"gyro_bias_deg_per_h[{i}]": float(b) / DEG * 3600 for i, b in enumerate(sensors.gyro.turn_on)})
+    if sensors is not None and sensors.magnetometer is not None:
+        out.update({f"magnetometer_bias_nT[{i}]": float(b) * 1e9 for i, b in enumerate(sensors.magnetometer.bias)})
+    return out
+
+
+def loop_for(setup: Setup, truth: disp.Truth) -> ClosedLoop:
+    """The closed loop of the nominal scenario's flight software on the dispersed truth."""
+    s = truth.scenario
+    sim = Simulation.for_scenario(s, q0=truth.q0, omega0=truth.omega0, seed=truth.seed,
+                                  checks=Checks(body_frame_id=s.body_frame_id))
+    return ClosedLoop(setup.scenario, simulation=sim)
+
+
+def converge(loop: ClosedLoop, timeout: float) -> bool:
+    """Tick until the estimate is CONVERGED (immediately true without an estimator)."""
+    est, end = loop.estimator, loop.sim.t + timeout
+    while est is not None and est.health(loop.sim.t) != Health.CONVERGED:
+        if loop.sim.t >= end or loop.sim.halted:
+            return False
+        loop.tick()
+    return True
+
+
+def fly(setup: Setup, seed: int, run: int = -1, tap=None) -> dict:
+    """The row of the run of seed ``seed`` (``run``: its index in the campaign): applied values
+    and outcomes (:data:`OUTCOMES`). ``tap``: see :attr:`ClosedLoop.tap` (a full log)."""
+    cpu = time.process_time()
+    truth, values = dispersed(setup, seed)
+    loop = loop_for(setup, truth)
+    loop.tap = tap
+    row = {"run": run, "seed": seed, **applied_columns(values, loop)}
+    if not converge(loop, setup.campaign.converge_timeout):
+        result_code, message = 313, f"the estimate did not converge within {setup.campaign.converge_timeout:g} s"
+        start = loop.sim.t
+    else:
+        start = loop.sim.t
+        result = loop.fly(setup.plan)
+        result_code, message = result.error_code, result.message
+    row.update(outcomes(setup, loop, start, result_code, message))
+    row["cpu_seconds"] = time.process_time() - cpu
+    return row
+
+
+def settling_time(t: np.ndarray, error: np.ndarray, t_end: float, tolerance: float) -> float:
+    """Time after ``t_end`` from which ``error`` stays at or below ``tolerance`` (NaN: never)."""
+    after = t >= t_end - 1e-9
+    if not after.any() or error[after][-1] > tolerance:
+        return math.nan
+    outside = np.flatnonzero(error[after] > tolerance)
+    return 0.0 if outside.size == 0 else float(t[after][outside[-1] + 1] - t_end)
+
+
+def outcomes(setup: Setup, loop: ClosedLoop, start: float, code: int, message: str) -> dict:
+    """The flown truth measured as a plan's verification measures its integration."""
+    a = loop.trace.arrays()
+    sc, m = setup.scenario.spacecraft, setup.maneuver
+    if a["t"].size == 0:
+        return {"success": False, "code": int(code), "final_error_deg": math.nan, "final_rate": math.nan,
+                "min_margin_deg": math.nan, "peak_wheel_ratio": math.nan, "peak_torque_ratio": math.nan,
+                "settling_time": math.nan, "start_time": start, "reason": message}
+    error = rot.angle_between(a["q_true"], m["qf"])
+    names, margins = zone_margins(setup.scenario, m, a["t"], a["q_true"])
+    per_zone = margins.min(axis=0) if margins.size else np.zeros(0)
+    wheel = float(np.abs(a["wheel_speeds"]).max() / sc.wheel_speed_max) if sc.n_wheels else 0.0
+    torque = float(np.abs(a["wheel_torques"]).max() / sc.wheel_torque_max) if sc.n_wheels else 0.0
+    ver = Verification(final_attitude_error=float(error[-1]), final_rate=float(np.linalg.norm(a["omega_true"][-1])),
+                       min_cone_margin=float(per_zone.min()) if per_zone.size else math.inf,
+                       cone_margins=per_zone.tolist(), torque_ratio=torque, wheel_speed_ratio=wheel,
+                       rate_max=float(np.linalg.norm(a["omega_true"], axis=1).max()), dense_samples=int(a["t"].size),
+                       zone_names=names)
+    why = rejection(ver)
+    success = code == 0 and why is None
+    return {"success": success, "code": int(code), "final_error_deg": math.degrees(ver.final_attitude_error),
+            "final_rate": ver.final_rate, "min_margin_deg": math.degrees(ver.min_cone_margin),
+            "peak_wheel_ratio": wheel, "peak_torque_ratio": torque,
+            "settling_time": settling_time(a["t"], error, start + setup.plan.duration,
+                                           setup.campaign.settle_tolerance),
+            "start_time": start, "reason": "" if success else (why or message)}
