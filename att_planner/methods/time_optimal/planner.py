@@ -11,7 +11,13 @@ torque ``u = T/T̄``, rate ``ω̃ = ω τ``)::
                     or semi-free: R(q(t_f)) r ⟂ e₁, e₂ and R(q(t_f)) r · s ≥ 0 (sensor on target s),
                     optional |ω_j| ≤ ω̄ and per-wheel momentum |G⁺ J ω|_i ≤ h̄ (the momentum the
                     wheels would store producing the torque with zero total momentum), both
-                    tightened by BOUND_MARGIN at the collocation points.
+                    tightened by BOUND_MARGIN at the collocation points; with wheels, their speeds
+                    relative to the body within their limit (the momentum stored at the start turned
+                    with the body plus the slew's share: :func:`.model.wheel_speed_constraints`).
+
+A moving goal (issue 15: ``problem.goal_motion``, a pointing law) replaces the final attitude and
+the final rest by ``vec(q_g(t_f)ᶜ ⊗ q(t_f)) = 0`` and ``ω̃(t_f) = ω̃_g(t_f)``, the goal's Chebyshev
+series in t_f (:func:`.model.moving_goal_values`), so the slew ends on it at its rate.
 
 The zones are ``problem.zone_sky()`` (:mod:`att_planner.zones`: today's cones as inertial zones of
 the sensor ``r``, then Sun, Moon, Earth-limb and inertial zones, each of its own sensor). A zone
