@@ -106,11 +106,7 @@ def fly(s: scen.Scenario, dumping: bool, seconds: float, out: Path) -> dict:
             wall = time.monotonic() - wall0
     finally:
         suite.stop()
-    run = pointing_of(read_log(mcap, topics=TOPICS), s.spacecraft)
-    figures = pointing_summary(run, settle=SETTLE)
-    sim_seconds = float(run.state_t[-1] - run.state_t[0])
-    return {**figures, "mcap": str(mcap), "sim_seconds": sim_seconds, "wall_seconds": wall,
-            "rtf": sim_seconds / wall if wall > 0 else math.inf}
+    return figures_of(s, mcap, wall)
 
 
 def fly_in_process(s: scen.Scenario, dumping: bool, seconds: float, out: Path) -> dict:
@@ -143,11 +139,15 @@ def fly_in_process(s: scen.Scenario, dumping: bool, seconds: float, out: Path) -
         loop.run(60.0)
     wall = time.monotonic() - wall0
     log.close()
+    return {**figures_of(s, mcap, wall), "in_process": True}
+
+
+def figures_of(s: scen.Scenario, mcap: Path, wall: float) -> dict:
+    """A flight's figures from its MCAP alone (:func:`pointing_summary`), with its real-time factor."""
     run = pointing_of(read_log(mcap, topics=TOPICS), s.spacecraft)
-    figures = pointing_summary(run, settle=SETTLE)
     sim_seconds = float(run.state_t[-1] - run.state_t[0])
-    return {**figures, "mcap": str(mcap), "sim_seconds": sim_seconds, "wall_seconds": wall,
-            "rtf": sim_seconds / wall if wall > 0 else math.inf, "in_process": True}
+    return {**pointing_summary(run, settle=SETTLE), "mcap": str(mcap), "sim_seconds": sim_seconds,
+            "wall_seconds": wall, "rtf": sim_seconds / wall if wall > 0 else math.inf}
 
 
 def run(args) -> dict:
