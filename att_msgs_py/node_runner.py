@@ -26,6 +26,7 @@ from pathlib import Path
 import rclpy
 import yaml
 from rcl_interfaces.msg import ParameterDescriptor
+from rclpy.clock import Clock, ClockType
 from rclpy.executors import Executor, ExternalShutdownException, SingleThreadedExecutor
 
 from att_msgs_py.errors import ConfigError, ErrorCode, RequestError, clip
@@ -117,6 +118,29 @@ class RefusalLog:
             self.logged[what] = now
             self.logger.warning(clip(f"{what} refused ({self.counts[what]} so far) [{int(err.code)} "
                                      f"{err.code.name}]: {err.message}"))
+
+
+def subscribe_when_heard(node, publisher, count: int, timeout: float, subscribe: Callable[[], None]) -> None:
+    """Call ``subscribe()`` once ``count`` subscriptions are matched to ``publisher`` (at once when
+    they already are; after ``timeout`` s of wall time anyway, with a warning). A node whose answers
+    are recorded takes its inputs only when the recorder hears it: the simulator waits for those
+    inputs before sim time starts, so nothing the node says from t = 0 on is lost."""
+    if publisher.get_subscription_count() >= count:
+        subscribe()
+        return
+    give_up = time.monotonic() + timeout
+
+    def check():
+        heard = publisher.get_subscription_count()
+        if heard < count and time.monotonic() < give_up:
+            return
+        node.destroy_timer(timer)
+        if heard < count:
+            node.get_logger().warning(f"taking inputs with {heard} of {count} expected subscribers to "
+                                      f"{publisher.topic_name} after {timeout:g} s")
+        subscribe()
+
+    timer = node.create_timer(0.05, check, clock=Clock(clock_type=ClockType.STEADY_TIME))
 
 
 def parameter_reader(node, scenario_values: dict, source: str = "") -> ParameterReader:

@@ -46,7 +46,8 @@ from att_msgs.msg import ActuatorCommand, AttitudeEstimate, ControllerStatus, Ma
 from att_msgs.srv import SetControllerMode
 from att_msgs_py import convert, qos, signing, topics
 from att_msgs_py.errors import ErrorCode, RequestError
-from att_msgs_py.node_runner import RefusalLog, parameter_reader, participant_of, publisher_of, run_node
+from att_msgs_py.node_runner import (RefusalLog, parameter_reader, participant_of, publisher_of, run_node,
+                                     subscribe_when_heard)
 from att_msgs_py.types import ManeuverResult
 from att_planner.control.configure import controller_from_scenario, public_key
 from att_planner.estimation.inputs import Sources
@@ -60,6 +61,8 @@ class ControllerNode(Node):
         param = parameter_reader(self, self._scenario.node_params.get("controller", {}), str(self._scenario.path))
         self._core = controller_from_scenario(param, self._scenario)
         self._wall_timeout = param("wall_timeout", 2.0, 0.0, 3600.0, low_open=True)
+        wait_for_subscribers = param("wait_for_subscribers", 0, 0, 1000)
+        start_timeout = param("start_timeout", 60.0, 0.0, 3600.0, low_open=True)
         if param("require_signed_modes", False):
             self._core.mode_key = public_key(param, "mode_public_key")
         param.refuse_unknown()
@@ -74,12 +77,7 @@ class ControllerNode(Node):
 
         self._cmd_pub = self.create_publisher(ActuatorCommand, topics.COMMAND, qos.STREAM_QOS)
         self._status_pub = self.create_publisher(ControllerStatus, topics.CONTROLLER_STATUS, qos.STREAM_QOS)
-        if self._core.measured is None:
-            self.create_subscription(SpacecraftState, topics.STATE, self.on_state, qos.STREAM_QOS)
-        else:
-            self.create_subscription(AttitudeEstimate, topics.ESTIMATE, self.on_estimate, qos.STREAM_QOS)
-            self.create_subscription(JointState, topics.WHEEL_SPEEDS, self.on_wheel_speeds, qos.STREAM_QOS)
-            self.create_subscription(MagneticField, topics.MAGNETOMETER, self.on_magnetometer, qos.STREAM_QOS)
+        subscribe_when_heard(self, self._cmd_pub, wait_for_subscribers, start_timeout, self._subscribe_state)
         self.create_subscription(ManeuverPlan, topics.PLANS, self.on_plan, qos.LATCHED_QOS)
         self.create_subscription(ClockMsg, topics.CLOCK, self.on_clock, qos.CLOCK_QOS)
         self.create_service(SetControllerMode, topics.SET_CONTROLLER_MODE, self.on_set_mode)
@@ -94,6 +92,15 @@ class ControllerNode(Node):
                                f"kp={c.kp:.6g} kd={c.kd:.6g} m_max={self._core.m_max:g}")
 
     # -- inputs ---------------------------------------------------------------------------------
+    def _subscribe_state(self) -> None:
+        """The state (truth), or the estimate with the wheel speeds and the magnetometer."""
+        if self._core.measured is None:
+            self.create_subscription(SpacecraftState, topics.STATE, self.on_state, qos.STREAM_QOS)
+        else:
+            self.create_subscription(AttitudeEstimate, topics.ESTIMATE, self.on_estimate, qos.STREAM_QOS)
+            self.create_subscription(JointState, topics.WHEEL_SPEEDS, self.on_wheel_speeds, qos.STREAM_QOS)
+            self.create_subscription(MagneticField, topics.MAGNETOMETER, self.on_magnetometer, qos.STREAM_QOS)
+
     # (``info`` has no default: rclpy passes the message info only to two-argument callbacks)
     def on_clock(self, msg: ClockMsg, info: dict):
         sender = participant_of(publisher_of(info))

@@ -23,7 +23,7 @@ from sensor_msgs.msg import Imu, MagneticField
 from att_msgs.msg import ActuatorCommand, AttitudeEstimate, CoarseSunSensors, StarTracker
 from att_msgs_py import convert, qos, topics
 from att_msgs_py.errors import RequestError, clip
-from att_msgs_py.node_runner import RefusalLog, parameter_reader, publisher_of, run_node
+from att_msgs_py.node_runner import RefusalLog, parameter_reader, publisher_of, run_node, subscribe_when_heard
 from att_planner.estimation.configure import estimator_from_scenario
 from att_planner.estimation.inputs import Sources
 from att_sim import scenario as scen
@@ -36,21 +36,26 @@ class EstimatorNode(Node):
         s = scen.load_checked(parameter_reader(self, {})("scenario", "swift_demo"))
         param = parameter_reader(self, s.node_params.get("estimator", {}), str(s.path))
         self._core = estimator_from_scenario(param, s)
+        wait_for_subscribers = param("wait_for_subscribers", 0, 0, 1000)
+        start_timeout = param("start_timeout", 60.0, 0.0, 3600.0, low_open=True)
         param.refuse_unknown()
         self._refusals = RefusalLog(self.get_logger())
         self._sources = Sources(self._core.config.resync_timeout)
         self._pub = self.create_publisher(AttitudeEstimate, topics.ESTIMATE, qos.STREAM_QOS)
-        self.create_subscription(Imu, topics.IMU, self.on_imu, qos.STREAM_QOS)
-        self.create_subscription(StarTracker, topics.STAR_TRACKER, self.on_star_tracker, qos.STREAM_QOS)
-        self.create_subscription(MagneticField, topics.MAGNETOMETER, self.on_magnetometer, qos.STREAM_QOS)
-        self.create_subscription(CoarseSunSensors, topics.SUN_SENSORS, self.on_sun_sensors, qos.STREAM_QOS)
-        self.create_subscription(ActuatorCommand, topics.COMMAND, self.on_command, qos.STREAM_QOS)
+        subscribe_when_heard(self, self._pub, wait_for_subscribers, start_timeout, self._subscribe_sensors)
         c = self._core.config
         self.get_logger().info(
             f"scenario '{s.name}': MEKF on {len(s.sensors.star_trackers)} star tracker(s), "
             f"magnetometer {'yes' if s.sensors.magnetometer else 'no'}, sun sensors "
             f"{'yes' if s.sensors.sun_sensors else 'no'}; ARW {c.arw * math.sqrt(HOUR) / DEG:.4g} deg/sqrt(h), "
             f"bias walk {c.rrw * HOUR * math.sqrt(HOUR) / DEG:.4g} deg/h/sqrt(h), gate p = {c.gate_probability}")
+
+    def _subscribe_sensors(self) -> None:
+        self.create_subscription(Imu, topics.IMU, self.on_imu, qos.STREAM_QOS)
+        self.create_subscription(StarTracker, topics.STAR_TRACKER, self.on_star_tracker, qos.STREAM_QOS)
+        self.create_subscription(MagneticField, topics.MAGNETOMETER, self.on_magnetometer, qos.STREAM_QOS)
+        self.create_subscription(CoarseSunSensors, topics.SUN_SENSORS, self.on_sun_sensors, qos.STREAM_QOS)
+        self.create_subscription(ActuatorCommand, topics.COMMAND, self.on_command, qos.STREAM_QOS)
 
     def _guarded(self, what: str, info: dict, call, *args):
         """Run ``call(*args)`` (a core input) if its publisher is the one of ``what``, logging a

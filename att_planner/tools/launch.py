@@ -130,16 +130,21 @@ def start_suite(scenario: str, mcap_path: str | Path, log_dir: str | Path, *, en
     extra ROS parameters.
 
     The simulator holds sim time at zero until the recorder, the controller and the estimator
-    (those started) subscribe to its state or sensors, so every run is recorded and controlled from t = 0.
+    (those started) subscribe to its state or sensors; the controller and the estimator subscribe
+    only once their outputs are heard (commands by the simulator and the recorder, the estimate by
+    the recorder), so every run is recorded and controlled from t = 0.
     """
     nodes = default_nodes(scenario) if nodes is None else nodes
     suite = Suite(env or isolated_env(), Path(log_dir))
-    consumers = sum(n in nodes for n in ("recorder", "controller", "estimator"))
+    recorder = "recorder" in nodes
+    listeners = {"simulator": sum(n in nodes for n in ("recorder", "controller", "estimator")),
+                 "controller": ("simulator" in nodes) + int(recorder),
+                 "estimator": int(recorder)}
     for name in nodes:
         p = {"scenario": scenario}
         if name == "recorder":
             p = {"output": str(mcap_path)}
-        if name == "simulator":
-            p["wait_for_subscribers"] = consumers
+        if name in listeners:
+            p["wait_for_subscribers"] = listeners[name]
         suite.start(name, {**p, **(params or {}).get(name, {})})
     return suite

@@ -22,7 +22,7 @@ import pytest
 import rclpy
 import yaml
 
-from att_msgs.msg import SpacecraftState
+from att_msgs.msg import ActuatorCommand, SpacecraftState
 from att_msgs_py import convert, qos, topics
 from att_msgs_py.errors import ConfigError, ErrorCode, RequestError
 from att_planner.service.requests import load_spacecraft
@@ -238,6 +238,9 @@ NODE_CASES = {
     "estimator: gate probability 1.5": ("estimator", ["-p", "gate_probability:=1.5"], P, ["'gate_probability'"]),
     "estimator: publish_rate above the gyro's": ("estimator", ["-p", "publish_rate:=100.0"], P, ["'publish_rate'"]),
     "estimator: history zero": ("estimator", ["-p", "history:=0.0"], P, ["'history'"]),
+    "estimator: wait_for_subscribers negative": ("estimator", ["-p", "wait_for_subscribers:=-1"], P,
+                                                 ["'wait_for_subscribers'"]),
+    "controller: start_timeout zero": ("controller", ["-p", "start_timeout:=0.0"], P, ["'start_timeout'"]),
     "estimator: unknown parameter (typo)": ("estimator", ["-p", "gate_probabilty:=0.99"], P, ["gate_probabilty"]),
     "estimator: unknown scenario": ("estimator", ["-p", "scenario:=no_such_scenario"], C, ["no_such_scenario"]),
 }
@@ -352,3 +355,21 @@ def test_a_simulator_started_by_hand_waits_for_its_subscribers(ros_suite):
             rclpy.spin_once(s.client, timeout_sec=0.05)
         assert first and second, "no state after the second subscriber came"
         assert convert.from_time(first[0].header.stamp) == 0.0 and convert.from_time(second[0].header.stamp) == 0.0
+
+
+@pytest.mark.ros
+def test_a_controller_takes_its_inputs_once_its_commands_are_heard(ros_suite):
+    """``-p wait_for_subscribers:=2`` on the controller: no subscription to the state while fewer
+    than two subscriptions hear its commands; with the second it subscribes."""
+    with ros_suite("swift_demo", nodes=("controller",), name="wait_heard",
+                   params={"controller": {"wait_for_subscribers": 2, "state_source": "truth"}}) as s:
+        def state_subscribers(seconds):
+            end = time.monotonic() + seconds
+            while time.monotonic() < end and not s.client.count_subscribers(topics.STATE):
+                rclpy.spin_once(s.client, timeout_sec=0.05)
+            return s.client.count_subscribers(topics.STATE)
+
+        s.client.create_subscription(ActuatorCommand, topics.COMMAND, lambda _: None, qos.STREAM_QOS)
+        assert state_subscribers(4.0) == 0, "the controller took its inputs with one of two listeners"
+        s.client.create_subscription(ActuatorCommand, topics.COMMAND, lambda _: None, qos.STREAM_QOS)
+        assert state_subscribers(10.0) == 1, "the controller did not take its inputs after the second listener"

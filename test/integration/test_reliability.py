@@ -21,6 +21,7 @@ from att_msgs.srv import PlanManeuver
 from att_msgs_py import convert, qos, topics
 from att_msgs_py.errors import ErrorCode
 from att_msgs_py.log import read_log
+from att_msgs_py.log.repair import LogFileError, Scan, scan_records
 from att_msgs_py.types import ControlMode
 from att_planner.nodes.client import SuiteClient, maneuver_request
 from att_planner.tools.launch import Suite, isolated_env
@@ -199,6 +200,17 @@ def test_watchdogs_report_silence(suite):
     assert wait_for(client, lambda m: m.state_stale, statuses, 60), "controller did not report stale state"
 
 
+def messages_on_disk(path) -> int:
+    """Messages in the flushed chunks of a log still being written."""
+    scan = Scan(path, 0)
+    try:
+        for _ in scan_records(path, scan):
+            pass
+    except (LogFileError, FileNotFoundError):
+        pass
+    return scan.messages
+
+
 def test_recorder_killed_leaves_a_readable_log_and_clean_stop_writes_the_index(tmp_path):
     env = isolated_env()
     suite = Suite(env, tmp_path)
@@ -214,7 +226,12 @@ def test_recorder_killed_leaves_a_readable_log_and_clean_stop_writes_the_index(t
         assert len(state) > 20
         assert killed_at - state.log_time[-1] < 1.5, "more than about a second was lost"
         suite.start("recorder", {"output": str(tmp_path / "clean.mcap")})
-        time.sleep(5.0)
+        # on a loaded machine the new recorder takes seconds to start and match: wait for its messages
+        assert suite.wait_for_output("recorder", "recording", 60), suite.log_text("recorder")
+        deadline = time.monotonic() + 30.0
+        while messages_on_disk(tmp_path / "clean.mcap") <= 20 and time.monotonic() < deadline:
+            time.sleep(0.5)
+        assert suite.alive()["simulator"], suite.log_text("simulator")[-2000:]
     finally:
         codes = suite.stop()
     assert codes["recorder"] == 0

@@ -19,7 +19,8 @@ def run(args) -> dict:
     print(f"soak {r['scenario']}: {r['orbits']:g} orbits = {r['sim_time']:.0f} s of sim time in "
           f"{r['wall_seconds']:.1f} s wall -> real-time factor {r['real_time_factor']:.0f}")
     print(f"  state messages recorded {r['state_messages']} / expected {r['state_expected']} "
-          f"(dropped {r['dropped_state']}); commands {r['command_messages']}")
+          f"(dropped {r['dropped_state']}); commands {r['command_messages']}; "
+          f"lockstep suspended {r['lockstep_suspensions']} times")
     for name, m in r["memory"].items():
         print(f"  {name:10s} RSS {m['start_mib']:7.1f} -> {m['end_mib']:7.1f} MiB")
     settling = "not within the run" if r["settling_orbits"] is None else f"{r['settling_orbits']:.3f} orbits"

@@ -12,6 +12,7 @@ def test_half_orbit_as_fast_as_possible(tmp_path):
     r = run_soak("bruni_celani", 0.5, tmp_path)
     assert r["reached_end"] and r["real_time_factor"] > 5
     assert r["dropped_state"] == 0 and r["state_messages"] == r["state_expected"]
+    assert r["lockstep_suspensions"] == 0
     assert r["command_messages"] >= r["state_messages"] - 2       # one command answers each state
     assert all(code == 0 for code in r["exit_codes"].values()), r["exit_codes"]
     for name, m in r["memory"].items():
