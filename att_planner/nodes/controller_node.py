@@ -46,8 +46,14 @@ from att_msgs.msg import ActuatorCommand, AttitudeEstimate, ControllerStatus, Ma
 from att_msgs.srv import SetControllerMode
 from att_msgs_py import convert, qos, signing, topics
 from att_msgs_py.errors import ErrorCode, RequestError
-from att_msgs_py.node_runner import (RefusalLog, parameter_reader, participant_of, publisher_of, run_node,
-                                     subscribe_when_heard)
+from att_msgs_py.node_runner import (
+    RefusalLog,
+    parameter_reader,
+    participant_of,
+    publisher_of,
+    run_node,
+    subscribe_when_heard,
+)
 from att_msgs_py.types import ManeuverResult
 from att_planner.control.configure import controller_from_scenario, public_key
 from att_planner.estimation.inputs import Sources

@@ -20,7 +20,6 @@ from att_planner.tools.launch import isolated_env, start_suite
 from att_planner.tools.review.run import settling_time
 from att_sim import scenario as scen
 
-
 LOCKSTEP_TIMEOUT = 5.0
 LOCKSTEP_SUSPENDED = "free-running at RTF"     # the simulator's warning when no command answered a state
 
@@ -73,6 +72,7 @@ def run_soak(scenario: str, orbits: float, out_dir: str | Path, sample_period: f
     settling_orbits = None if settled_at is None else settled_at / s.orbit_model.period
     return {"scenario": scenario, "orbits": orbits, "sim_time": sim_time, "wall_seconds": wall,
             "real_time_factor": sim_time / wall, "state_messages": len(state), "state_expected": expected,
-            "command_messages": len(command), "lockstep_suspensions": suspensions, "dropped_state": expected - len(state),
+            "command_messages": len(command), "lockstep_suspensions": suspensions,
+            "dropped_state": expected - len(state),
             "memory": growth, "exit_codes": codes, "settling_orbits": settling_orbits,
             "reached_end": sim_time >= end_time - 1.0 / publish_rate}
