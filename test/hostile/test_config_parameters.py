@@ -28,6 +28,7 @@ from att_msgs_py.errors import ConfigError, ErrorCode, RequestError
 from att_planner.service.requests import load_spacecraft
 from att_planner.tools.launch import NODE_MODULES, isolated_env
 from att_sim import scenario
+from helpers import forked_nodes
 
 BASE = {
     "/**": {"ros__parameters": {
@@ -284,12 +285,20 @@ def run_case(node: str, args: list) -> tuple[int | None, str]:
 
 @pytest.fixture(scope="module")
 def node_results(tmp_path_factory):
-    """Every case of NODE_CASES, run three at a time."""
+    """Every case of NODE_CASES, three at a time: the first in its own interpreter (``python -m``,
+    as a user starts it), the others forked from one that imported the nodes once
+    (:mod:`forked_nodes`: the same ``main()``, argv, environment and file descriptors)."""
     tmp = tmp_path_factory.mktemp("hostile_config")
     write_files(tmp)
+    cases = {name: (node, [a.replace("{tmp}", str(tmp)) for a in args])
+             for name, (node, args, _, _) in NODE_CASES.items()}
+    first = next(iter(cases))
+    ctx = forked_nodes.context()
     with ThreadPoolExecutor(max_workers=3) as pool:
-        futures = {name: pool.submit(run_case, node, [a.replace("{tmp}", str(tmp)) for a in args])
-                   for name, (node, args, _, _) in NODE_CASES.items()}
+        futures = {name: pool.submit(run_case, node, args) if name == first else
+                   pool.submit(forked_nodes.run_case, ctx, NODE_MODULES[node], args, isolated_env(),
+                               str(tmp / f"case_{i}.log"))
+                   for i, (name, (node, args)) in enumerate(cases.items())}
         return {name: f.result() for name, f in futures.items()}
 
 
