@@ -1,4 +1,4 @@
-"""Messages of the 3D view (issue 17): ``/tf`` transforms and ``visualization_msgs/MarkerArray``
+"""Messages of the 3D view (issue 17): ``/tf`` transforms, the zones' margins and ``visualization_msgs/MarkerArray``
 from the plain :class:`att_msgs_py.types.Shape` (the conversions of :mod:`att_msgs_py.convert`,
 for Foxglove's 3D panel and RViz).
 
@@ -10,12 +10,15 @@ plan is gone) and nothing accumulates; the shapes keep their ``(ns, id)`` from a
 """
 from __future__ import annotations
 
+import math
+
 import numpy as np
 from geometry_msgs.msg import Point, Quaternion, Transform, TransformStamped, Vector3
 from std_msgs.msg import ColorRGBA, Header
 from tf2_msgs.msg import TFMessage
 from visualization_msgs.msg import Marker, MarkerArray
 
+from att_msgs.msg import ZoneMargins
 from att_msgs_py.convert import quaternion, time_msg, vector3
 from att_msgs_py.types import Shape, ShapeKind
 
@@ -33,6 +36,13 @@ def transform_msg(t: float, parent: str, child: str, q_BN, r_N=(0.0, 0.0, 0.0)) 
 
 def tf_msg(transforms: list[TransformStamped]) -> TFMessage:
     return TFMessage(transforms=list(transforms))
+
+
+def zone_margins_msg(t: float, frame_id: str, names, keep_in, margins) -> ZoneMargins:
+    """The zones' margins (rad) at sim time ``t``; ``min_margin`` inf without zones."""
+    values = [float(m) for m in margins]
+    return ZoneMargins(header=Header(stamp=time_msg(t), frame_id=frame_id), names=list(names),
+                       keep_in=[bool(k) for k in keep_in], margins=values, min_margin=min(values, default=math.inf))
 
 
 def marker_msg(shape: Shape, t: float) -> Marker:

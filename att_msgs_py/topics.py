@@ -18,6 +18,7 @@ SENSOR_TRUTH = "/simulator/sensor_truth"
 ESTIMATE = "/estimator/attitude"
 TF = "/tf"                                   # the 3D view (issue 17): the body frame under the inertial one
 SIM_MARKERS = "/simulator/markers"           # zones, boresights, Sun/Moon/Earth directions
+ZONE_MARGINS = "/simulator/zone_margins"     # the zones' truth margins, for plots
 PLAN_MARKERS = "/planner/plan_markers"       # the latest plan's boresight path
 
 PLAN_MANEUVER = "/planner/plan_maneuver"
@@ -42,6 +43,7 @@ RECORDED = {
     ESTIMATE: "att_msgs/msg/AttitudeEstimate",
     TF: "tf2_msgs/msg/TFMessage",
     SIM_MARKERS: "visualization_msgs/msg/MarkerArray",
+    ZONE_MARGINS: "att_msgs/msg/ZoneMargins",
     PLAN_MARKERS: "visualization_msgs/msg/MarkerArray",
 }
 

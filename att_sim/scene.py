@@ -53,6 +53,19 @@ def zone_views(zones: list[Zone], bodies: Bodies) -> list[ZoneView]:
     return out
 
 
+def zone_margins(zones: list[Zone], views: list[ZoneView], q_BN) -> np.ndarray:
+    """Margin of each zone (rad, >= 0 clear) at attitude ``q_BN``: ``γ − θ`` keep-out, ``θ − γ``
+    keep-in, ``γ`` the angle of the boresight ``R(q_BN) s_B`` from the zone's axis ``a_N``
+    (``views`` are :func:`zone_views` of ``zones``, in the same order)."""
+    R = rot.dcm(np.asarray(q_BN, float))
+    out = np.empty(len(views))
+    for k, (z, v) in enumerate(zip(zones, views, strict=True)):
+        b_N = R @ (z.sensor_axis / np.linalg.norm(z.sensor_axis))
+        gamma = math.atan2(np.linalg.norm(np.cross(b_N, v.axis_N)), float(b_N @ v.axis_N))
+        out[k] = v.half_angle - gamma if v.keep_in else gamma - v.half_angle
+    return out
+
+
 def cone_rim(axis_N, half_angle: float, length: float = LENGTH, n: int = RIM_POINTS) -> np.ndarray:
     """(n + 1, 3) closed circle of the points at ``half_angle`` from ``axis_N``, ``length`` from the apex."""
     a = np.asarray(axis_N, float) / np.linalg.norm(axis_N)

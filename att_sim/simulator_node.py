@@ -8,7 +8,8 @@ Subscribes ``/actuator/command`` (ActuatorCommand), publishes ``/spacecraft/stat
 (SpacecraftState) at ``publish_rate`` and ``/clock`` at ``clock_rate`` (Hz of sim time), serves
 ``/simulator/reset``. The 3D view (issue 17, :mod:`att_sim.scene`): ``/tf`` (tf2_msgs/TFMessage: the
 body frame ``body_frame_id`` under the inertial ``frame_id``, attitude only, the view centred on the
-spacecraft) at ``tf_rate`` and ``/simulator/markers`` (visualization_msgs/MarkerArray: the zones as
+spacecraft) and ``/simulator/zone_margins`` (att_msgs/ZoneMargins: each zone's truth margin) at
+``tf_rate``, and ``/simulator/markers`` (visualization_msgs/MarkerArray: the zones as
 cones where they are now, the sensor boresights, the Sun/Moon/Earth directions) at ``marker_rate``;
 a rate of 0 switches either off. With the scenario's sensors (issue 14) it also publishes what they measure,
 each at its own rate (:class:`att_sim.sensors.SensorSuite`): ``/sensors/imu`` (sensor_msgs/Imu),
@@ -53,7 +54,7 @@ from sensor_msgs.msg import Imu, JointState, MagneticField
 from tf2_msgs.msg import TFMessage
 from visualization_msgs.msg import MarkerArray
 
-from att_msgs.msg import ActuatorCommand, CoarseSunSensors, SensorTruth, SpacecraftState, StarTracker
+from att_msgs.msg import ActuatorCommand, CoarseSunSensors, SensorTruth, SpacecraftState, StarTracker, ZoneMargins
 from att_msgs.srv import ResetSimulator
 from att_msgs_py import convert, markers, qos, topics, validation
 from att_msgs_py.errors import ConfigError, ErrorCode, RequestError, clip
@@ -91,6 +92,8 @@ class SimulatorNode(Node):
         self.state_pub = self.create_publisher(SpacecraftState, topics.STATE, qos.STREAM_QOS)
         self.clock_pub = self.create_publisher(Clock, topics.CLOCK, qos.CLOCK_QOS)
         self.tf_pub = self.create_publisher(TFMessage, topics.TF, qos.STREAM_QOS) if self.tf_rate else None
+        self.margin_pub = (self.create_publisher(ZoneMargins, topics.ZONE_MARGINS, qos.STREAM_QOS)
+                           if self.tf_rate else None)
         self.marker_pub = (self.create_publisher(MarkerArray, topics.SIM_MARKERS, qos.STREAM_QOS)
                            if self.marker_rate else None)
         self.sensor_pubs = self.sensor_publishers()
@@ -334,13 +337,18 @@ class SimulatorNode(Node):
             self.sensor_pubs["star_trackers"].publish(convert.star_tracker_msg(m))
 
     def publish_view(self, k: int) -> None:
-        """The 3D view at step ``k``: /tf and the markers when their rates say so."""
+        """The 3D view at step ``k``: /tf and the zones' margins, and the markers, when their rates say so."""
         tf_every, marker_every = self.view_every
         t, frame_N, frame_B = self.sim.t, self.scenario.frame_id, self.scenario.body_frame_id
+        zones, q_BN = self.scenario.zones, self.sim.x[:4]
         if tf_every and k % tf_every == 0:
-            self.tf_pub.publish(markers.tf_msg([markers.transform_msg(t, frame_N, frame_B, self.sim.x[:4])]))
+            self.tf_pub.publish(markers.tf_msg([markers.transform_msg(t, frame_N, frame_B, q_BN)]))
+            views = scene.zone_views(zones, self.sim.environment.bodies(t))
+            self.margin_pub.publish(markers.zone_margins_msg(t, frame_N, [v.name for v in views],
+                                                             [v.keep_in for v in views],
+                                                             scene.zone_margins(zones, views, q_BN)))
         if marker_every and k % marker_every == 0:
-            shapes = scene.sky_shapes(self.scenario.zones, self.sim.environment.bodies(t), frame_N, frame_B)
+            shapes = scene.sky_shapes(zones, self.sim.environment.bodies(t), frame_N, frame_B)
             self.marker_pub.publish(markers.marker_array(shapes, t, frame_N))
 
     def state_message(self) -> SpacecraftState:

@@ -108,3 +108,17 @@ def test_without_a_sky_only_the_earth_is_drawn():
     shapes = scene.sky_shapes([Zone("c", "inertial", [1, 0, 0], 0.5, False, [0, 0, 1])], bodies, "eci", "body")
     assert [(s.ns, s.id) for s in shapes if s.ns == "bodies"] == [("bodies", 2)]      # the Earth keeps its id
     assert scene.zone_views([Zone("s", "sun", [1, 0, 0], 0.5)], bodies) == []
+
+
+def test_zone_margins_are_the_planners_truth_margins():
+    sc = scen.load("leo_observatory")
+    zones = sc.zones + [Zone("target", "inertial", [0, 0, 1], math.radians(20), True, [0.0, 0.6, 0.8])]
+    env = Environment.from_scenario(sc)
+    truth = ZoneSky(zones, Sky(sc.epoch, sc.orbit_model), window=4000.0)
+    for t, q in ((0.0, rot.IDENTITY), (2000.0, rot.from_axis_angle([1, 2, 3], 2.0))):
+        mine = scene.zone_margins(zones, scene.zone_views(zones, env.bodies(t)), q)
+        assert np.allclose(mine, truth.margins(np.array([t]), q[None], true=True).reshape(-1), atol=1e-9)
+    square = [Zone("out", "inertial", [1, 0, 0], math.radians(30), False, [0, 0, 1]),
+              Zone("in", "inertial", [1, 0, 0], math.radians(30), True, [0, 0, 1])]
+    views = scene.zone_views(square, None)
+    assert np.allclose(np.degrees(scene.zone_margins(square, views, rot.IDENTITY)), [60.0, -60.0])
