@@ -1,7 +1,7 @@
 """The 3D view through the nodes (issue 17): a real-sky run of the simulator and the planner,
 recorded; the log, decoded by rosbags from its own definitions, holds /tf with the body frame under
-the inertial one (the state's attitude), the zones' cones where the sky puts them, and the plan's
-boresight path."""
+the inertial one (the state's attitude), the zones' cones where the sky puts them, their margins,
+and the plan's boresight path."""
 import math
 
 import numpy as np
@@ -79,6 +79,17 @@ def test_a_recorded_real_sky_run_holds_tf_markers_and_the_plan_path(ros_suite):
             assert np.allclose(np.arccos(p @ axes[z.name] / np.linalg.norm(p, axis=1)), half, atol=1e-9), z.name
         (bore,) = [m for m in drawn if m.ns == "boresight"]
         assert bore.header.frame_id == "body" and bore.points[1].y > 0 and bore.points[1].x == bore.points[1].z == 0
+
+    margins = log[topics.ZONE_MARGINS]
+    assert len(margins) == len(log[topics.TF])
+    for m in margins[::10]:
+        assert list(m.names) == ["sun", "moon", "earth"] and m.min_margin == min(m.margins)
+        q = states[round(stamp(m), 6)].attitude
+        b_N = rot.dcm(np.array([q.x, q.y, q.z, q.w])) @ [0.0, 1.0, 0.0]        # the zones' sensor +y
+        bodies = env.bodies(stamp(m))
+        for value, z, axis in zip(m.margins, sc.zones, (bodies.sun, bodies.moon, bodies.nadir), strict=True):
+            half = z.half_angle + (bodies.earth_radius if z.body == "earth_limb" else 0.0)
+            assert abs(value - (math.acos(np.clip(b_N @ axis, -1, 1)) - half)) < 1e-9, z.name
 
     (path_array,) = log[topics.PLAN_MARKERS]
     (path,) = path_array.markers[1:]
