@@ -57,13 +57,14 @@ def zone_margins(zones: list[Zone], views: list[ZoneView], q_BN) -> np.ndarray:
     """Margin of each zone (rad, >= 0 clear) at attitude ``q_BN``: ``γ − θ`` keep-out, ``θ − γ``
     keep-in, ``γ`` the angle of the boresight ``R(q_BN) s_B`` from the zone's axis ``a_N``
     (``views`` are :func:`zone_views` of ``zones``, in the same order)."""
-    R = rot.dcm(np.asarray(q_BN, float))
-    out = np.empty(len(views))
-    for k, (z, v) in enumerate(zip(zones, views, strict=True)):
-        b_N = R @ (z.sensor_axis / np.linalg.norm(z.sensor_axis))
-        gamma = math.atan2(np.linalg.norm(np.cross(b_N, v.axis_N)), float(b_N @ v.axis_N))
-        out[k] = v.half_angle - gamma if v.keep_in else gamma - v.half_angle
-    return out
+    if not views:
+        return np.zeros(0)
+    s_B = np.array([z.sensor_axis / np.linalg.norm(z.sensor_axis) for z in zones])
+    b_N = s_B @ rot.dcm(np.asarray(q_BN, float)).T
+    a_N = np.array([v.axis_N for v in views])
+    gamma = np.arctan2(np.linalg.norm(np.cross(b_N, a_N), axis=1), np.einsum("ij,ij->i", b_N, a_N))
+    theta = np.array([v.half_angle for v in views])
+    return np.where([v.keep_in for v in views], theta - gamma, gamma - theta)
 
 
 def cone_rim(axis_N, half_angle: float, length: float = LENGTH, n: int = RIM_POINTS) -> np.ndarray:
