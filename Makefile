@@ -1,5 +1,5 @@
 # Two commands from a fresh clone: `make demo` and `make test`. Each bootstraps .venv on its own:
-# pinned wheels (requirements.txt), then the att_msgs interfaces built with rosidl into the venv
+# pinned wheels (requirements.txt), then the att_msgs and tf2_msgs interfaces built with rosidl into the venv
 # prefix, then this package (editable) and the demo's plan-signing key pair (att-keygen). Stamps make
 # a second run fast.
 SHELL := /bin/bash
@@ -27,15 +27,19 @@ $(VENV)/.stamp-deps: requirements.txt $(VENV)/.stamp-venv
 	$(PY) -m pip install --quiet --disable-pip-version-check -r requirements.txt
 	touch $@
 
+# tf2_msgs (the /tf type: its standard TFMessage definition, no wheel on PyPI) first, then att_msgs
 $(VENV)/.stamp-interfaces: $(INTERFACES) $(VENV)/.stamp-deps
-	rm -rf build/att_msgs && mkdir -p build
-	$(BUILD_ENV) cmake -S att_msgs_py/interfaces -B build/att_msgs -DCMAKE_INSTALL_PREFIX=$(PREFIX) \
-	  -DPython3_EXECUTABLE=$(PY) -DBUILD_TESTING=OFF > build/att_msgs.configure.log 2>&1 \
-	  || { tail -40 build/att_msgs.configure.log; exit 1; }
-	$(BUILD_ENV) cmake --build build/att_msgs -j2 > build/att_msgs.build.log 2>&1 \
-	  || { tail -40 build/att_msgs.build.log; exit 1; }
-	$(BUILD_ENV) cmake --install build/att_msgs > build/att_msgs.install.log 2>&1
-	$(PY) -c "import att_msgs.msg, att_msgs.srv, att_msgs.action"
+	mkdir -p build
+	set -e; for pkg in tf2_msgs:att_msgs_py/interfaces/tf2_msgs att_msgs:att_msgs_py/interfaces; do \
+	  name=$${pkg%%:*}; src=$${pkg#*:}; rm -rf build/$$name; \
+	  $(BUILD_ENV) cmake -S $$src -B build/$$name -DCMAKE_INSTALL_PREFIX=$(PREFIX) \
+	    -DPython3_EXECUTABLE=$(PY) -DBUILD_TESTING=OFF > build/$$name.configure.log 2>&1 \
+	    || { tail -40 build/$$name.configure.log; exit 1; }; \
+	  $(BUILD_ENV) cmake --build build/$$name -j2 > build/$$name.build.log 2>&1 \
+	    || { tail -40 build/$$name.build.log; exit 1; }; \
+	  $(BUILD_ENV) cmake --install build/$$name > build/$$name.install.log 2>&1; \
+	done
+	$(PY) -c "import att_msgs.msg, att_msgs.srv, att_msgs.action, tf2_msgs.msg"
 	touch $@
 
 $(VENV)/.stamp-package: setup.py package.xml pyproject.toml $(VENV)/.stamp-interfaces

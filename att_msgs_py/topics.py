@@ -16,6 +16,10 @@ SUN_SENSORS = "/sensors/sun_sensors"
 WHEEL_SPEEDS = "/sensors/wheel_speeds"
 SENSOR_TRUTH = "/simulator/sensor_truth"
 ESTIMATE = "/estimator/attitude"
+TF = "/tf"                                   # the 3D view (issue 17): the body frame under the inertial one
+SIM_MARKERS = "/simulator/markers"           # zones, boresights, Sun/Moon/Earth directions
+ZONE_MARGINS = "/simulator/zone_margins"     # the zones' truth margins, for plots
+PLAN_MARKERS = "/planner/plan_markers"       # the latest plan's boresight path
 
 PLAN_MANEUVER = "/planner/plan_maneuver"
 PLAN_SCHEDULE = "/planner/plan_schedule"
@@ -37,6 +41,10 @@ RECORDED = {
     WHEEL_SPEEDS: "sensor_msgs/msg/JointState",
     SENSOR_TRUTH: "att_msgs/msg/SensorTruth",
     ESTIMATE: "att_msgs/msg/AttitudeEstimate",
+    TF: "tf2_msgs/msg/TFMessage",
+    SIM_MARKERS: "visualization_msgs/msg/MarkerArray",
+    ZONE_MARGINS: "att_msgs/msg/ZoneMargins",
+    PLAN_MARKERS: "visualization_msgs/msg/MarkerArray",
 }
 
 

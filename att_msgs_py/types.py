@@ -422,3 +422,26 @@ class PointingMode:
     longitude: float = 0.0
     altitude: float = 0.0
     target_direction: np.ndarray = _empty(3)
+
+
+class ShapeKind(StrEnum):
+    """How a :class:`Shape` is drawn (``visualization_msgs/Marker`` TRIANGLE_LIST, LINE_STRIP, ARROW)."""
+
+    TRIANGLES = "triangles"
+    LINE = "line"
+    ARROW = "arrow"
+
+
+@dataclass(frozen=True)
+class Shape:
+    """One marker of the 3D view (issue 17): ``points`` (N, 3) m in frame ``frame_id`` (a
+    triangle list, a line strip, or an arrow's tail and head), colour ``rgba`` in [0, 1], line or
+    shaft ``width`` m. ``(ns, id)`` names it, so a newer shape with the same name replaces it."""
+
+    ns: str
+    id: int
+    frame_id: str
+    kind: ShapeKind
+    points: np.ndarray
+    rgba: tuple[float, float, float, float]
+    width: float = 0.02

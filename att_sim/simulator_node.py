@@ -6,7 +6,12 @@ no lock or cross-thread wake-up sits in the control loop.
 
 Subscribes ``/actuator/command`` (ActuatorCommand), publishes ``/spacecraft/state``
 (SpacecraftState) at ``publish_rate`` and ``/clock`` at ``clock_rate`` (Hz of sim time), serves
-``/simulator/reset``. With the scenario's sensors (issue 14) it also publishes what they measure,
+``/simulator/reset``. The 3D view (issue 17, :mod:`att_sim.scene`): ``/tf`` (tf2_msgs/TFMessage: the
+body frame ``body_frame_id`` under the inertial ``frame_id``, attitude only, the view centred on the
+spacecraft) and ``/simulator/zone_margins`` (att_msgs/ZoneMargins: each zone's truth margin) at
+``tf_rate``, and ``/simulator/markers`` (visualization_msgs/MarkerArray: the zones as
+cones where they are now, the sensor boresights, the Sun/Moon/Earth directions) at ``marker_rate``;
+a rate of 0 switches either off. With the scenario's sensors (issue 14) it also publishes what they measure,
 each at its own rate (:class:`att_sim.sensors.SensorSuite`): ``/sensors/imu`` (sensor_msgs/Imu),
 ``/sensors/star_tracker`` (att_msgs/StarTracker), ``/sensors/magnetometer``
 (sensor_msgs/MagneticField), ``/sensors/sun_sensors`` (att_msgs/CoarseSunSensors),
@@ -46,13 +51,15 @@ import rclpy
 from rclpy.node import Node
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import Imu, JointState, MagneticField
+from tf2_msgs.msg import TFMessage
+from visualization_msgs.msg import MarkerArray
 
-from att_msgs.msg import ActuatorCommand, CoarseSunSensors, SensorTruth, SpacecraftState, StarTracker
+from att_msgs.msg import ActuatorCommand, CoarseSunSensors, SensorTruth, SpacecraftState, StarTracker, ZoneMargins
 from att_msgs.srv import ResetSimulator
-from att_msgs_py import convert, qos, topics, validation
+from att_msgs_py import convert, markers, qos, topics, validation
 from att_msgs_py.errors import ConfigError, ErrorCode, RequestError, clip
 from att_msgs_py.node_runner import parameter_reader, publisher_of, run_node, spin_until_shutdown
-from att_sim import dispersions
+from att_sim import dispersions, scene
 from att_sim import scenario as scen
 from att_sim.simulation import DEFAULT_STEP, Checks, Refusal, Simulation
 
@@ -84,6 +91,11 @@ class SimulatorNode(Node):
 
         self.state_pub = self.create_publisher(SpacecraftState, topics.STATE, qos.STREAM_QOS)
         self.clock_pub = self.create_publisher(Clock, topics.CLOCK, qos.CLOCK_QOS)
+        self.tf_pub = self.create_publisher(TFMessage, topics.TF, qos.STREAM_QOS) if self.tf_rate else None
+        self.margin_pub = (self.create_publisher(ZoneMargins, topics.ZONE_MARGINS, qos.STREAM_QOS)
+                           if self.tf_rate else None)
+        self.marker_pub = (self.create_publisher(MarkerArray, topics.SIM_MARKERS, qos.STREAM_QOS)
+                           if self.marker_rate else None)
         self.sensor_pubs = self.sensor_publishers()
         self.create_subscription(ActuatorCommand, topics.COMMAND, self.on_command, qos.STREAM_QOS)
         self.create_service(ResetSimulator, topics.RESET_SIMULATOR, self.on_reset)
@@ -112,6 +124,10 @@ class SimulatorNode(Node):
         top = (1 + 1e-9) / self.step
         self.publish_period = 1.0 / param("publish_rate", min(10.0, 1.0 / self.step), 0.0, top, **per_step)
         self.clock_period = 1.0 / param("clock_rate", min(50.0, 1.0 / self.step), 0.0, top, **per_step)
+        # the 3D view: /tf (default: with every state) and the markers, in Hz of sim time; 0: off
+        off = dict(hint=" (at most 1/step: one per integration step; 0: off)")
+        self.tf_rate = param("tf_rate", 1.0 / self.publish_period, 0.0, top, **off)
+        self.marker_rate = param("marker_rate", min(1.0, 1.0 / self.step), 0.0, top, **off)
         self.real_time_factor = param("real_time_factor", 1.0, 0.0, inf)
         self.command_timeout = param("command_timeout", 1.0, 0.0, inf, low_open=True)
         self.end_time = param("end_time", 0.0, 0.0, inf)      # s of sim time; 0: run until stopped
@@ -231,6 +247,8 @@ class SimulatorNode(Node):
         real-time factor, and in lockstep wait for the command answering each state; callbacks
         run through ``executor.spin_once`` in between (``executor`` is also ``self.executor``,
         set when the node was added to it)."""
+        self.view_every = tuple(max(1, round(1.0 / (rate * self.step))) if rate else 0
+                                for rate in (self.tf_rate, self.marker_rate))
         state_every = max(1, round(self.publish_period / self.step))
         clock_every = max(1, round(self.clock_period / self.step))
         give_up = time.monotonic() + self.start_timeout
@@ -286,6 +304,7 @@ class SimulatorNode(Node):
         self.publish_readings()
         if k % clock_every == 0:
             self.clock_pub.publish(Clock(clock=convert.time_msg(t)))
+        self.publish_view(k)
         if k % state_every == 0:
             self.answered, self.awaited_stamp = False, t
             self.state_pub.publish(self.state_message())
@@ -316,6 +335,21 @@ class SimulatorNode(Node):
                 self.sensor_pubs[name].publish(make(reading))
         for m in r.star_trackers:
             self.sensor_pubs["star_trackers"].publish(convert.star_tracker_msg(m))
+
+    def publish_view(self, k: int) -> None:
+        """The 3D view at step ``k``: /tf and the zones' margins, and the markers, when their rates say so."""
+        tf_every, marker_every = self.view_every
+        t, frame_N, frame_B = self.sim.t, self.scenario.frame_id, self.scenario.body_frame_id
+        zones, q_BN = self.scenario.zones, self.sim.x[:4]
+        if tf_every and k % tf_every == 0:
+            self.tf_pub.publish(markers.tf_msg([markers.transform_msg(t, frame_N, frame_B, q_BN)]))
+            views = scene.zone_views(zones, self.sim.environment.bodies(t))
+            self.margin_pub.publish(markers.zone_margins_msg(t, frame_N, [v.name for v in views],
+                                                             [v.keep_in for v in views],
+                                                             scene.zone_margins(zones, views, q_BN)))
+        if marker_every and k % marker_every == 0:
+            shapes = scene.sky_shapes(zones, self.sim.environment.bodies(t), frame_N, frame_B)
+            self.marker_pub.publish(markers.marker_array(shapes, t, frame_N))
 
     def state_message(self) -> SpacecraftState:
         return convert.state_msg(self.sim.state(self.scenario.frame_id, self.scenario.body_frame_id))

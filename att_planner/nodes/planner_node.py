@@ -1,5 +1,8 @@
 """Planner node: serves ``/planner/plan_maneuver`` (PlanManeuver) and publishes every returned
-plan on the latched ``/planner/plans`` for the controller and the recorder.
+plan on the latched ``/planner/plans`` for the controller and the recorder; with ``plan_markers``
+(default true) it also publishes the latest plan's boresight path for the 3D view on the latched
+``/planner/plan_markers`` (visualization_msgs/MarkerArray, :func:`att_sim.scene.plan_shapes`): the
+planner shows its own plans, so the simulator stays on the truth side.
 
 Callbacks only translate: message -> :class:`ManeuverRequest` -> :func:`validate_maneuver` ->
 :func:`plan_maneuver` -> message (:mod:`att_planner.service` holds the logic); the response names
@@ -24,10 +27,11 @@ import uuid
 from rclpy.callback_groups import ReentrantCallbackGroup
 from rclpy.executors import MultiThreadedExecutor
 from rclpy.node import Node
+from visualization_msgs.msg import MarkerArray
 
 from att_msgs.msg import ManeuverPlan
 from att_msgs.srv import PlanManeuver, PlanSchedule
-from att_msgs_py import convert, qos, signing, topics
+from att_msgs_py import convert, markers, qos, signing, topics
 from att_msgs_py.errors import ConfigError, ErrorCode, RequestError, clip
 from att_msgs_py.node_runner import parameter_reader, run_node
 from att_msgs_py.types import Plan
@@ -38,6 +42,7 @@ from att_planner.service.requests import MAX_TIME_BUDGET, ManeuverRequest, valid
 from att_planner.service.worker import call_isolated, run_isolated, set_max_parallel, warm_up
 from att_planner.verification import TOLERANCES, Tolerances
 from att_sim import scenario as scen
+from att_sim import scene
 
 
 class PlannerNode(Node):
@@ -67,10 +72,13 @@ class PlannerNode(Node):
         key_path = param("signing_key", str(signing.default_key_dir() / signing.PRIVATE_NAME))
         self._signing_key = self._load_signing_key(key_path)
         set_max_parallel(param("max_parallel_solves", 2, 1, 64))
+        show_plans = param("plan_markers", True)
         warm_up()
         prepare(scenario.spacecraft)
         group = ReentrantCallbackGroup()
         self._plan_pub = self.create_publisher(ManeuverPlan, topics.PLANS, qos.LATCHED_QOS)
+        self._marker_pub = (self.create_publisher(MarkerArray, topics.PLAN_MARKERS, qos.LATCHED_QOS)
+                            if show_plans else None)
         self.create_service(PlanManeuver, topics.PLAN_MANEUVER, self.on_plan_maneuver, qos_profile=qos.SERVICE_QOS,
                             callback_group=group)
         self.create_service(PlanSchedule, topics.PLAN_SCHEDULE, self.on_plan_schedule, qos_profile=qos.SERVICE_QOS,
@@ -180,6 +188,12 @@ class PlannerNode(Node):
         if response.success:
             self.get_logger().info(clip(f"{what}: {outcome.message}"))
             self._plan_pub.publish(response.plan)
+            # a schedule has no sensor axis of its own: its zones' (none without zones)
+            s_B = context.get("sensor_axis", plan.zones[0].sensor_axis if plan.zones else None)
+            if self._marker_pub is not None and s_B is not None:
+                shapes = scene.plan_shapes(plan.q, s_B, self._frame_id)
+                t = convert.from_time(response.plan.header.stamp)
+                self._marker_pub.publish(markers.marker_array(shapes, t, self._frame_id))
         else:
             self.get_logger().warning(clip(f"{what} failed (code {response.error_code}): {outcome.message}"))
 
