@@ -302,8 +302,8 @@ def transcription(problem: ManeuverProblem, s: Scaling, mesh: np.ndarray, contro
     own, with :func:`weighted_path_function`'s constraints."""
     smooth = torque_accel is not None
     zones = problem.zone_sky()
-    options = dict(tol=tol, max_iter=max_iter, nlpsol_options={"expand": expand},
-                   ipopt_options=None if smooth else col.MUMPS_OPTIONS)
+    options = dict(tol=tol, max_iter=max_iter, nlpsol_options={"expand": expand},   # only the smooth plan is anytime
+                   ipopt_options=None if smooth else col.MUMPS_OPTIONS, incumbents=smooth)
     if boundary_case(problem, cone_margin):            # its path constraints are built for it alone
         path, weight = weighted_path_function(problem, s, cone_margin, 13 if smooth else 7,
                                               SMOOTH_END_RAMP if smooth else END_RAMP) or (None, None)
