@@ -4,9 +4,20 @@ Flight-software style isolation for the planner node: a solver that ignores its 
 or crashes (a segfault in a native solver) costs one worker process, never the node. Workers are
 forked from a ``forkserver`` that has already imported the numerics and serve one task after
 another, so what a method keeps between problems (its NLPs built for a shape, the compiled
-integrator) serves the next request too; a worker that overruns is killed and one that dies is
-replaced by a new one. At most ``max_parallel`` solve at once (the rest wait, within their own
-budget).
+integrator) serves the next request too. Building an NLP costs a cold worker most of a second or
+more (a solve then takes a fraction of that), so:
+
+* a worker is warm before it serves: :func:`start_pool` starts the workers and runs the warm-up
+  set with :func:`set_warm_up` (the planner's: its scenarios' maneuvers, which build the NLPs of
+  the shapes it serves) in each before the planner reports ready, and a worker retired later is
+  replaced by a warmed one in the background;
+* a worker that overruns its request is not killed at once: the request is answered without it,
+  and the worker is given :data:`REAP_SECONDS` more to finish (what it built stays built); only
+  then is it killed as hung. Its slot is freed for the next request; at most ``max_parallel``
+  workers finish so at once (beyond, an overrunning worker is killed at once).
+
+A worker that dies is replaced. At most ``max_parallel`` solve at once (the rest wait, within their
+own budget).
 
 A problem with a sky (issue 13) crosses to the child as it is: :class:`att_sim.ephemeris.Sky` and
 :class:`att_sim.orbit.TLEOrbit` pickle as their recipes (epoch and orbit, epoch and lines), since
@@ -28,12 +39,15 @@ _CONTEXT = multiprocessing.get_context("forkserver")
 _CONTEXT.set_forkserver_preload(["att_planner.service.planning", "numpy", "scipy.optimize", "att_sim.ephemeris",
                                  "skyfield.api", "sgp4.api", "casadi", "att_planner.methods.time_optimal.smooth"])
 _SLOTS = threading.BoundedSemaphore(max(1, os.cpu_count() or 1))
-KILL_GRACE = 0.5            # s after the wait before the child is terminated
+_REAPERS = threading.BoundedSemaphore(max(1, os.cpu_count() or 1))     # overrunning workers left to finish
+KILL_GRACE = 0.5            # s after the wait before an overrunning worker is handed to the reaper
+REAP_SECONDS = 30.0         # s an overrunning worker is given to finish before it is killed as hung
 
 
 def set_max_parallel(n: int) -> None:
-    global _SLOTS
+    global _SLOTS, _REAPERS
     _SLOTS = threading.BoundedSemaphore(max(1, int(n)))
+    _REAPERS = threading.BoundedSemaphore(max(1, int(n)))
 
 
 def warm_up() -> None:
@@ -45,6 +59,8 @@ def warm_up() -> None:
 
 _IDLE: list = []                # (process, connection) of the workers waiting for a task, the last used last
 _IDLE_LOCK = threading.Lock()
+_WARM_UP: tuple | None = None   # (function, args) every new worker of the pool runs before it serves
+_POOL_SIZE = 0                  # workers kept warm (start_pool)
 
 
 def _serve(conn) -> None:
@@ -58,6 +74,54 @@ def _serve(conn) -> None:
         conn.send(function(*args, **kwargs))
 
 
+def _spawn():
+    """A new worker process and its end of the pipe."""
+    conn, theirs = _CONTEXT.Pipe()
+    process = _CONTEXT.Process(target=_serve, args=(theirs,), daemon=True)
+    process.start()
+    theirs.close()
+    return process, conn
+
+
+def set_warm_up(function, args: tuple = ()) -> None:
+    """``function(*args)`` (importable by name) is run by every worker :func:`start_pool` starts
+    or replaces, before it takes a request."""
+    global _WARM_UP
+    _WARM_UP = (function, tuple(args))
+
+
+def _warm_worker() -> bool:
+    """Start a worker, run the warm-up in it and add it to the idle ones; False if it died."""
+    process, conn = _spawn()
+    if _WARM_UP is not None:
+        try:
+            conn.send((_WARM_UP[0], _WARM_UP[1], {}))
+            conn.recv()
+        except (EOFError, OSError):
+            _retire(process, conn)
+            return False
+    with _IDLE_LOCK:
+        _IDLE.insert(0, (process, conn))        # the least recently used end: requests prefer a worker that served
+    return True
+
+
+def start_pool(n: int) -> None:
+    """Start ``n`` workers and warm them (:func:`set_warm_up`) in parallel; return when all are ready."""
+    global _POOL_SIZE
+    _POOL_SIZE = max(0, int(n))
+    threads = [threading.Thread(target=_warm_worker, daemon=True) for _ in range(_POOL_SIZE)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+
+
+def idle_workers() -> int:
+    """Workers waiting for a task (alive or not yet found dead)."""
+    with _IDLE_LOCK:
+        return len(_IDLE)
+
+
 def _worker():
     """An idle worker (the one used last: its caches are the warmest), or a new one."""
     with _IDLE_LOCK:
@@ -66,15 +130,11 @@ def _worker():
             if process.is_alive():
                 return process, conn
             conn.close()
-    conn, theirs = _CONTEXT.Pipe()
-    process = _CONTEXT.Process(target=_serve, args=(theirs,), daemon=True)
-    process.start()
-    theirs.close()
-    return process, conn
+    return _spawn()
 
 
 def _retire(process, conn) -> None:
-    """Stop a worker (it overran or died): terminate, then kill."""
+    """Stop a worker (it hung or died): terminate, then kill."""
     if process.is_alive():
         process.terminate()
         process.join(1.0)
@@ -84,11 +144,35 @@ def _retire(process, conn) -> None:
     conn.close()
 
 
+def _replace() -> None:
+    """A warmed worker in the background for one retired, while the pool is short of its size."""
+    if idle_workers() < _POOL_SIZE:
+        threading.Thread(target=_warm_worker, daemon=True).start()
+
+
+def _reap(process, conn) -> None:
+    """Let an overrunning worker finish (its answer is dropped) within :data:`REAP_SECONDS`, then keep
+    it; kill it if it does not."""
+    try:
+        if conn.poll(REAP_SECONDS):
+            conn.recv()
+            with _IDLE_LOCK:
+                _IDLE.append((process, conn))
+            return
+        _retire(process, conn)
+        _replace()
+    except (EOFError, OSError):
+        _retire(process, conn)
+        _replace()
+    finally:
+        _REAPERS.release()
+
+
 def call_isolated(function, args: tuple, kwargs: dict, wait: float | None, *, on_death):
     """``function(*args, **kwargs)`` in a worker process (``function`` importable by name).
 
     Returns its result, ``None`` when it has not answered within ``wait`` s (+ grace; the worker
-    is then killed), or ``on_death(message)`` when the worker died without answering.
+    is then reaped: :func:`_reap`), or ``on_death(message)`` when the worker died without answering.
     """
     start = time.monotonic()
     if not _SLOTS.acquire(timeout=wait):
@@ -106,6 +190,9 @@ def call_isolated(function, args: tuple, kwargs: dict, wait: float | None, *, on
                 return result
             if not process.is_alive():
                 return on_death(f"solver process died (exit code {process.exitcode})")
+            if _REAPERS.acquire(blocking=False):
+                threading.Thread(target=_reap, args=(process, conn), daemon=True).start()
+                process = None
             return None
         except (EOFError, OSError):
             process.join(1.0)
@@ -113,6 +200,7 @@ def call_isolated(function, args: tuple, kwargs: dict, wait: float | None, *, on
         finally:
             if process is not None:
                 _retire(process, conn)
+                _replace()
     finally:
         _SLOTS.release()
 
