@@ -6,7 +6,7 @@ it; the build takes most of a second or more, a solve of a warm NLP a fraction o
 node therefore plans, in each worker process before it reports ready
 (:func:`att_planner.service.worker.start_pool`), the maneuver of the ``demo:`` section of each of
 its warm-up scenarios (:func:`maneuver_from_scenario`: the spacecraft, the attitudes and sensor,
-the section's cones and the scenario's zones at the maneuver's start) with its default method,
+the section's cones and the scenario's zones; :func:`warm_requests`) with its default method,
 through the service's own pipeline (:func:`.planning.plan_maneuver`, the node's padding), so that
 the NLPs a request of those shapes needs — the first mesh and its refinements — are built.
 """
@@ -50,9 +50,10 @@ def maneuver_from_scenario(s: scen.Scenario) -> dict:
 
 def warm_requests(names: list[str], *, frame_id: str, default_method: str) -> list[ValidRequest]:
     """The demo maneuver of each scenario of ``names`` that has one, as a validated request for
-    ``default_method`` of that scenario's spacecraft, its zones where they are at the maneuver's
-    start (the scenario's epoch plus ``start_time``, or ``start_lead`` without one: as ``att-demo``
-    asks)."""
+    ``default_method`` of that scenario's spacecraft. With a sky, twice: its zones where they are
+    at the scenario's epoch plus ``start_lead`` and at its ``start_time`` (as ``att-demo`` asks): a
+    demo may be set where the default method finds no way (the leo_observatory one grazes the
+    rising Earth limb), and the shape, not the geometry, is what the warm-up builds."""
     out = []
     for name in names:
         scenario = scen.load_checked(name)
@@ -60,18 +61,23 @@ def warm_requests(names: list[str], *, frame_id: str, default_method: str) -> li
             m = maneuver_from_scenario(scenario)
         except ValueError:
             continue
-        epoch = (0, 0)
+        epochs = [(0, 0)]
         if scenario.epoch is not None:
-            offset = m["start_lead"] if m["start_time"] is None else float(m["start_time"])
-            start = scenario.epoch + timedelta(seconds=offset)
-            sec = math.floor(start.timestamp())
-            epoch = (sec, round((start.timestamp() - sec) * 1e9))
-        request = ManeuverRequest(frame_id, m["q0"], m["qf"], m["sensor"],
-                                  [(c.direction, c.half_angle, c.name) for c in m["cones"]],
-                                  spacecraft=name, time_budget=WARM_BUDGET, epoch=epoch, zones=m["zones"])
-        out.append(validate_maneuver(request, frame_id=frame_id, default_spacecraft=name,
-                                     default_method=default_method, default_budget=WARM_BUDGET))
+            offsets = dict.fromkeys([m["start_lead"]] + ([] if m["start_time"] is None else [float(m["start_time"])]))
+            epochs = [_epoch_parts(scenario.epoch + timedelta(seconds=offset)) for offset in offsets]
+        for epoch in epochs:
+            request = ManeuverRequest(frame_id, m["q0"], m["qf"], m["sensor"],
+                                      [(c.direction, c.half_angle, c.name) for c in m["cones"]],
+                                      spacecraft=name, time_budget=WARM_BUDGET, epoch=epoch, zones=m["zones"])
+            out.append(validate_maneuver(request, frame_id=frame_id, default_spacecraft=name,
+                                         default_method=default_method, default_budget=WARM_BUDGET))
     return out
+
+
+def _epoch_parts(epoch) -> tuple[int, int]:
+    """``(sec, nanosec)`` of a UTC datetime, as a request carries it."""
+    sec = math.floor(epoch.timestamp())
+    return sec, round((epoch.timestamp() - sec) * 1e9)
 
 
 def warm(requests: list[ValidRequest], tol: Tolerances = TOLERANCES, cone_padding: float = 0.0) -> list[str]:
