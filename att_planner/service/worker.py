@@ -12,9 +12,9 @@ more (a solve then takes a fraction of that), so:
   the shapes it serves) in each before the planner reports ready, and a worker retired later is
   replaced by a warmed one in the background;
 * a worker that overruns its request is not killed at once: the request is answered without it,
-  and the worker is given :data:`REAP_SECONDS` more to finish (what it built stays built); only
-  then is it killed as hung. Its slot is freed for the next request; at most ``max_parallel``
-  workers finish so at once (beyond, an overrunning worker is killed at once).
+  and the worker is given :data:`REAP_SECONDS` more to finish (a method that honours its deadline
+  returns as soon as the NLP it was building is built, and that NLP stays built); only then is it
+  killed as hung. It keeps its slot meanwhile, so no more than ``max_parallel`` workers compute.
 
 A worker that dies is replaced. At most ``max_parallel`` solve at once (the rest wait, within their
 own budget).
@@ -39,15 +39,13 @@ _CONTEXT = multiprocessing.get_context("forkserver")
 _CONTEXT.set_forkserver_preload(["att_planner.service.planning", "numpy", "scipy.optimize", "att_sim.ephemeris",
                                  "skyfield.api", "sgp4.api", "casadi", "att_planner.methods.time_optimal.smooth"])
 _SLOTS = threading.BoundedSemaphore(max(1, os.cpu_count() or 1))
-_REAPERS = threading.BoundedSemaphore(max(1, os.cpu_count() or 1))     # overrunning workers left to finish
 KILL_GRACE = 0.5            # s after the wait before an overrunning worker is handed to the reaper
-REAP_SECONDS = 30.0         # s an overrunning worker is given to finish before it is killed as hung
+REAP_SECONDS = 5.0          # s an overrunning worker is given to finish (a cold NLP build: 0.2-2.5 s here)
 
 
 def set_max_parallel(n: int) -> None:
-    global _SLOTS, _REAPERS
+    global _SLOTS
     _SLOTS = threading.BoundedSemaphore(max(1, int(n)))
-    _REAPERS = threading.BoundedSemaphore(max(1, int(n)))
 
 
 def warm_up() -> None:
@@ -150,9 +148,9 @@ def _replace() -> None:
         threading.Thread(target=_warm_worker, daemon=True).start()
 
 
-def _reap(process, conn) -> None:
+def _reap(process, conn, slots) -> None:
     """Let an overrunning worker finish (its answer is dropped) within :data:`REAP_SECONDS`, then keep
-    it; kill it if it does not."""
+    it; kill it if it does not; then free its slot (``slots``: the semaphore it was taken from)."""
     try:
         if conn.poll(REAP_SECONDS):
             conn.recv()
@@ -165,7 +163,7 @@ def _reap(process, conn) -> None:
         _retire(process, conn)
         _replace()
     finally:
-        _REAPERS.release()
+        slots.release()
 
 
 def call_isolated(function, args: tuple, kwargs: dict, wait: float | None, *, on_death):
@@ -174,9 +172,10 @@ def call_isolated(function, args: tuple, kwargs: dict, wait: float | None, *, on
     Returns its result, ``None`` when it has not answered within ``wait`` s (+ grace; the worker
     is then reaped: :func:`_reap`), or ``on_death(message)`` when the worker died without answering.
     """
-    start = time.monotonic()
-    if not _SLOTS.acquire(timeout=wait):
+    start, slots = time.monotonic(), _SLOTS
+    if not slots.acquire(timeout=wait):
         return None
+    reaping = False
     try:
         remaining = None if wait is None else max(0.0, wait - (time.monotonic() - start))
         process, conn = _worker()
@@ -190,9 +189,8 @@ def call_isolated(function, args: tuple, kwargs: dict, wait: float | None, *, on
                 return result
             if not process.is_alive():
                 return on_death(f"solver process died (exit code {process.exitcode})")
-            if _REAPERS.acquire(blocking=False):
-                threading.Thread(target=_reap, args=(process, conn), daemon=True).start()
-                process = None
+            threading.Thread(target=_reap, args=(process, conn, slots), daemon=True).start()
+            process, reaping = None, True
             return None
         except (EOFError, OSError):
             process.join(1.0)
@@ -202,7 +200,8 @@ def call_isolated(function, args: tuple, kwargs: dict, wait: float | None, *, on
                 _retire(process, conn)
                 _replace()
     finally:
-        _SLOTS.release()
+        if not reaping:
+            slots.release()
 
 
 def run_isolated(method: Method, problem: ManeuverProblem, options: dict, wait: float | None) -> Plan | None:

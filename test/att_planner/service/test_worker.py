@@ -22,6 +22,7 @@ def own_pool(monkeypatch):
     monkeypatch.setattr(worker, "_IDLE", [])
     monkeypatch.setattr(worker, "_WARM_UP", None)
     monkeypatch.setattr(worker, "_POOL_SIZE", 0)
+    monkeypatch.setattr(worker, "_SLOTS", worker.threading.BoundedSemaphore(2))
     yield
     for process, conn in worker._IDLE:
         worker._retire(process, conn)
@@ -37,11 +38,18 @@ def test_a_pool_worker_runs_the_warm_up_before_its_first_request():
 
 
 def test_a_worker_that_overruns_and_then_finishes_is_kept_warm():
+    """Its slot is held while it finishes (no more workers compute than the slots), then freed."""
     assert worker.call_isolated(worker_tasks.sleep_then_pid, (1.5,), {}, 0.1, on_death=on_death) is None
+    assert [worker._SLOTS.acquire(blocking=False) for _ in range(2)] == [True, False]     # one held by it
+    worker._SLOTS.release()
     deadline = time.monotonic() + 20.0
     while not worker.idle_workers() and time.monotonic() < deadline:
         time.sleep(0.1)
     assert worker.idle_workers() == 1                  # back from the reaper, not killed
+    time.sleep(0.1)
+    assert [worker._SLOTS.acquire(blocking=False) for _ in range(2)] == [True, True]      # its slot freed
+    worker._SLOTS.release()
+    worker._SLOTS.release()
     (process, _), = worker._IDLE
     assert worker.call_isolated(worker_tasks.sleep_then_pid, (0.0,), {}, 10.0, on_death=on_death) == process.pid
 
