@@ -11,10 +11,11 @@ more (a solve then takes a fraction of that), so:
   set with :func:`set_warm_up` (the planner's: its scenarios' maneuvers, which build the NLPs of
   the shapes it serves) in each before the planner reports ready, and a worker retired later is
   replaced by a warmed one in the background;
-* a worker that overruns its request is not killed at once: the request is answered without it,
-  and the worker is given :data:`REAP_SECONDS` more to finish (a method that honours its deadline
-  returns as soon as the NLP it was building is built, and that NLP stays built); only then is it
-  killed as hung. It keeps its slot meanwhile, so no more than ``max_parallel`` workers compute.
+* a worker that overruns its request (a hung solver, or one building an NLP of a shape it was not
+  warmed for) is killed, and replaced by a warmed one in the background. (Letting it finish its
+  build instead, holding its slot for up to 5 s, starved the answers of concurrent requests on
+  this 2-core machine: the budget test's most expensive requests came 1.6-1.9 s after a 0.5 s
+  budget.)
 
 A worker that dies is replaced. At most ``max_parallel`` solve at once (the rest wait, within their
 own budget).
@@ -39,8 +40,7 @@ _CONTEXT = multiprocessing.get_context("forkserver")
 _CONTEXT.set_forkserver_preload(["att_planner.service.planning", "numpy", "scipy.optimize", "att_sim.ephemeris",
                                  "skyfield.api", "sgp4.api", "casadi", "att_planner.methods.time_optimal.smooth"])
 _SLOTS = threading.BoundedSemaphore(max(1, os.cpu_count() or 1))
-KILL_GRACE = 0.5            # s after the wait before an overrunning worker is handed to the reaper
-REAP_SECONDS = 5.0          # s an overrunning worker is given to finish (a cold NLP build: 0.2-2.5 s here)
+KILL_GRACE = 0.5            # s after the wait before the child is terminated
 
 
 def set_max_parallel(n: int) -> None:
@@ -132,7 +132,7 @@ def _worker():
 
 
 def _retire(process, conn) -> None:
-    """Stop a worker (it hung or died): terminate, then kill."""
+    """Stop a worker (it overran or died): terminate, then kill."""
     if process.is_alive():
         process.terminate()
         process.join(1.0)
@@ -148,34 +148,15 @@ def _replace() -> None:
         threading.Thread(target=_warm_worker, daemon=True).start()
 
 
-def _reap(process, conn, slots) -> None:
-    """Let an overrunning worker finish (its answer is dropped) within :data:`REAP_SECONDS`, then keep
-    it; kill it if it does not; then free its slot (``slots``: the semaphore it was taken from)."""
-    try:
-        if conn.poll(REAP_SECONDS):
-            conn.recv()
-            with _IDLE_LOCK:
-                _IDLE.append((process, conn))
-            return
-        _retire(process, conn)
-        _replace()
-    except (EOFError, OSError):
-        _retire(process, conn)
-        _replace()
-    finally:
-        slots.release()
-
-
 def call_isolated(function, args: tuple, kwargs: dict, wait: float | None, *, on_death):
     """``function(*args, **kwargs)`` in a worker process (``function`` importable by name).
 
     Returns its result, ``None`` when it has not answered within ``wait`` s (+ grace; the worker
-    is then reaped: :func:`_reap`), or ``on_death(message)`` when the worker died without answering.
+    is then killed and replaced), or ``on_death(message)`` when the worker died without answering.
     """
-    start, slots = time.monotonic(), _SLOTS
-    if not slots.acquire(timeout=wait):
+    start = time.monotonic()
+    if not _SLOTS.acquire(timeout=wait):
         return None
-    reaping = False
     try:
         remaining = None if wait is None else max(0.0, wait - (time.monotonic() - start))
         process, conn = _worker()
@@ -189,8 +170,6 @@ def call_isolated(function, args: tuple, kwargs: dict, wait: float | None, *, on
                 return result
             if not process.is_alive():
                 return on_death(f"solver process died (exit code {process.exitcode})")
-            threading.Thread(target=_reap, args=(process, conn, slots), daemon=True).start()
-            process, reaping = None, True
             return None
         except (EOFError, OSError):
             process.join(1.0)
@@ -200,8 +179,7 @@ def call_isolated(function, args: tuple, kwargs: dict, wait: float | None, *, on
                 _retire(process, conn)
                 _replace()
     finally:
-        if not reaping:
-            slots.release()
+        _SLOTS.release()
 
 
 def run_isolated(method: Method, problem: ManeuverProblem, options: dict, wait: float | None) -> Plan | None:
