@@ -126,7 +126,7 @@ def ros_times(name: str, problem: ManeuverProblem, repeats: int, best_repeats: i
                             params={"planner": {"warm_up_scenarios": warm}})
         try:
             with client_session("speed_bench") as client:
-                client.plan_client.wait_for_service(timeout_sec=60)
+                client.plan_client.wait_for_service(timeout_sec=180)     # the node warms its workers first
                 kwargs = dict(spacecraft=ROS_SPACECRAFT[name], frame_id="", zones=problem.zones, epoch=problem.epoch)
                 if problem.sky is not None:
                     kwargs["tle"] = tuple(sky.CASES[name].tle)
