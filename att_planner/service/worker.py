@@ -41,6 +41,7 @@ _CONTEXT.set_forkserver_preload(["att_planner.service.planning", "numpy", "scipy
                                  "skyfield.api", "sgp4.api", "casadi", "att_planner.methods.time_optimal.smooth"])
 _SLOTS = threading.BoundedSemaphore(max(1, os.cpu_count() or 1))
 KILL_GRACE = 0.5            # s after the wait before the child is terminated
+WARM_UP_TIMEOUT = 300.0     # s a worker's warm-up may take before the worker is given up (the node serves anyway)
 
 
 def set_max_parallel(n: int) -> None:
@@ -89,13 +90,16 @@ def set_warm_up(function, args: tuple = ()) -> None:
 
 
 def _warm_worker() -> bool:
-    """Start a worker, run the warm-up in it and add it to the idle ones; False if it died."""
+    """Start a worker, run the warm-up in it and add it to the idle ones; False if it died or its
+    warm-up overran :data:`WARM_UP_TIMEOUT`."""
     process, conn = _spawn()
     if _WARM_UP is not None:
         try:
             conn.send((_WARM_UP[0], _WARM_UP[1], {}))
+            if not conn.poll(WARM_UP_TIMEOUT):
+                raise TimeoutError
             conn.recv()
-        except (EOFError, OSError):
+        except (EOFError, OSError):       # TimeoutError is an OSError
             _retire(process, conn)
             return False
     with _IDLE_LOCK:

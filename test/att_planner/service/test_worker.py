@@ -51,6 +51,14 @@ def test_a_worker_that_overruns_is_killed_and_replaced_by_a_warmed_one():
     assert warmed and pid != pooled.pid
 
 
+def test_a_worker_whose_warm_up_hangs_is_given_up(monkeypatch):
+    monkeypatch.setattr(worker, "WARM_UP_TIMEOUT", 0.5)
+    worker.set_warm_up(worker_tasks.sleep_then_pid, (3600.0,))
+    start = time.monotonic()
+    worker.start_pool(1)
+    assert time.monotonic() - start < 10.0 and worker.idle_workers() == 0
+
+
 def test_the_planner_warm_up_builds_the_nlps_before_the_first_request():
     """A worker warmed on swift_demo's demo maneuver (the default method through the service's
     pipeline) holds that maneuver's NLPs before it serves a request."""
