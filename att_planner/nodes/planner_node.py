@@ -39,7 +39,8 @@ from att_planner import methods
 from att_planner.methods.schedule import plan_schedule
 from att_planner.service.planning import PlanOutcome, plan_maneuver, plan_schedule_request, prepare, run_method
 from att_planner.service.requests import MAX_TIME_BUDGET, ManeuverRequest, validate_maneuver, validate_schedule
-from att_planner.service.worker import call_isolated, run_isolated, set_max_parallel, warm_up
+from att_planner.service.warm import warm, warm_requests
+from att_planner.service.worker import call_isolated, run_isolated, set_max_parallel, set_warm_up, start_pool, warm_up
 from att_planner.verification import TOLERANCES, Tolerances
 from att_sim import scenario as scen
 from att_sim import scene
@@ -71,10 +72,17 @@ class PlannerNode(Node):
                                                            f"> 0 rad/s (.inf: none), got {self._schedule_rate_max!r}")
         key_path = param("signing_key", str(signing.default_key_dir() / signing.PRIVATE_NAME))
         self._signing_key = self._load_signing_key(key_path)
-        set_max_parallel(param("max_parallel_solves", 2, 1, 64))
+        parallel = param("max_parallel_solves", 2, 1, 64)
+        set_max_parallel(parallel)
         show_plans = param("plan_markers", True)
+        # every worker plans these scenarios' demo maneuvers before it serves (its NLPs built)
+        names = [n.strip() for n in param("warm_up_scenarios", scenario.name).split(",") if n.strip()]
+        param.refuse_unknown()
         warm_up()
         prepare(scenario.spacecraft)
+        set_warm_up(warm, (warm_requests(names, frame_id=self._frame_id, default_method=self._default_method),
+                           self._tolerances, self._cone_padding))
+        start_pool(parallel)
         group = ReentrantCallbackGroup()
         self._plan_pub = self.create_publisher(ManeuverPlan, topics.PLANS, qos.LATCHED_QOS)
         self._marker_pub = (self.create_publisher(MarkerArray, topics.PLAN_MARKERS, qos.LATCHED_QOS)

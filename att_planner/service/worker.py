@@ -4,9 +4,21 @@ Flight-software style isolation for the planner node: a solver that ignores its 
 or crashes (a segfault in a native solver) costs one worker process, never the node. Workers are
 forked from a ``forkserver`` that has already imported the numerics and serve one task after
 another, so what a method keeps between problems (its NLPs built for a shape, the compiled
-integrator) serves the next request too; a worker that overruns is killed and one that dies is
-replaced by a new one. At most ``max_parallel`` solve at once (the rest wait, within their own
-budget).
+integrator) serves the next request too. Building an NLP costs a cold worker most of a second or
+more (a solve then takes a fraction of that), so:
+
+* a worker is warm before it serves: :func:`start_pool` starts the workers and runs the warm-up
+  set with :func:`set_warm_up` (the planner's: its scenarios' maneuvers, which build the NLPs of
+  the shapes it serves) in each before the planner reports ready, and a worker retired later is
+  replaced by a warmed one in the background;
+* a worker that overruns its request (a hung solver, or one building an NLP of a shape it was not
+  warmed for) is killed, and replaced by a warmed one in the background. (Letting it finish its
+  build instead, holding its slot for up to 5 s, starved the answers of concurrent requests on
+  this 2-core machine: the budget test's most expensive requests came 1.6-1.9 s after a 0.5 s
+  budget.)
+
+A worker that dies is replaced. At most ``max_parallel`` solve at once (the rest wait, within their
+own budget).
 
 A problem with a sky (issue 13) crosses to the child as it is: :class:`att_sim.ephemeris.Sky` and
 :class:`att_sim.orbit.TLEOrbit` pickle as their recipes (epoch and orbit, epoch and lines), since
@@ -29,6 +41,7 @@ _CONTEXT.set_forkserver_preload(["att_planner.service.planning", "numpy", "scipy
                                  "skyfield.api", "sgp4.api", "casadi", "att_planner.methods.time_optimal.smooth"])
 _SLOTS = threading.BoundedSemaphore(max(1, os.cpu_count() or 1))
 KILL_GRACE = 0.5            # s after the wait before the child is terminated
+WARM_UP_TIMEOUT = 300.0     # s a worker's warm-up may take before the worker is given up (the node serves anyway)
 
 
 def set_max_parallel(n: int) -> None:
@@ -45,6 +58,8 @@ def warm_up() -> None:
 
 _IDLE: list = []                # (process, connection) of the workers waiting for a task, the last used last
 _IDLE_LOCK = threading.Lock()
+_WARM_UP: tuple | None = None   # (function, args) every new worker of the pool runs before it serves
+_POOL_SIZE = 0                  # workers kept warm (start_pool)
 
 
 def _serve(conn) -> None:
@@ -58,6 +73,57 @@ def _serve(conn) -> None:
         conn.send(function(*args, **kwargs))
 
 
+def _spawn():
+    """A new worker process and its end of the pipe."""
+    conn, theirs = _CONTEXT.Pipe()
+    process = _CONTEXT.Process(target=_serve, args=(theirs,), daemon=True)
+    process.start()
+    theirs.close()
+    return process, conn
+
+
+def set_warm_up(function, args: tuple = ()) -> None:
+    """``function(*args)`` (importable by name) is run by every worker :func:`start_pool` starts
+    or replaces, before it takes a request."""
+    global _WARM_UP
+    _WARM_UP = (function, tuple(args))
+
+
+def _warm_worker() -> bool:
+    """Start a worker, run the warm-up in it and add it to the idle ones; False if it died or its
+    warm-up overran :data:`WARM_UP_TIMEOUT`."""
+    process, conn = _spawn()
+    if _WARM_UP is not None:
+        try:
+            conn.send((_WARM_UP[0], _WARM_UP[1], {}))
+            if not conn.poll(WARM_UP_TIMEOUT):
+                raise TimeoutError
+            conn.recv()
+        except (EOFError, OSError):       # TimeoutError is an OSError
+            _retire(process, conn)
+            return False
+    with _IDLE_LOCK:
+        _IDLE.insert(0, (process, conn))        # the least recently used end: requests prefer a worker that served
+    return True
+
+
+def start_pool(n: int) -> None:
+    """Start ``n`` workers and warm them (:func:`set_warm_up`) in parallel; return when all are ready."""
+    global _POOL_SIZE
+    _POOL_SIZE = max(0, int(n))
+    threads = [threading.Thread(target=_warm_worker, daemon=True) for _ in range(_POOL_SIZE)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+
+
+def idle_workers() -> int:
+    """Workers waiting for a task (alive or not yet found dead)."""
+    with _IDLE_LOCK:
+        return len(_IDLE)
+
+
 def _worker():
     """An idle worker (the one used last: its caches are the warmest), or a new one."""
     with _IDLE_LOCK:
@@ -66,11 +132,7 @@ def _worker():
             if process.is_alive():
                 return process, conn
             conn.close()
-    conn, theirs = _CONTEXT.Pipe()
-    process = _CONTEXT.Process(target=_serve, args=(theirs,), daemon=True)
-    process.start()
-    theirs.close()
-    return process, conn
+    return _spawn()
 
 
 def _retire(process, conn) -> None:
@@ -84,11 +146,17 @@ def _retire(process, conn) -> None:
     conn.close()
 
 
+def _replace() -> None:
+    """A warmed worker in the background for one retired, while the pool is short of its size."""
+    if idle_workers() < _POOL_SIZE:
+        threading.Thread(target=_warm_worker, daemon=True).start()
+
+
 def call_isolated(function, args: tuple, kwargs: dict, wait: float | None, *, on_death):
     """``function(*args, **kwargs)`` in a worker process (``function`` importable by name).
 
     Returns its result, ``None`` when it has not answered within ``wait`` s (+ grace; the worker
-    is then killed), or ``on_death(message)`` when the worker died without answering.
+    is then killed and replaced), or ``on_death(message)`` when the worker died without answering.
     """
     start = time.monotonic()
     if not _SLOTS.acquire(timeout=wait):
@@ -113,6 +181,7 @@ def call_isolated(function, args: tuple, kwargs: dict, wait: float | None, *, on
         finally:
             if process is not None:
                 _retire(process, conn)
+                _replace()
     finally:
         _SLOTS.release()
 

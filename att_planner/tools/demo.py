@@ -36,35 +36,14 @@ from att_msgs.srv import ResetSimulator
 from att_msgs_py import convert, qos
 from att_msgs_py.log import read_log
 from att_msgs_py.topics import RESET_SIMULATOR, STATE
-from att_msgs_py.types import Cone
 from att_planner.nodes.client import client_session, maneuver_request
+from att_planner.service.warm import maneuver_from_scenario
 from att_planner.tools.launch import isolated_env, join_env, start_suite
 from att_planner.tools.review import review
 from att_planner.zones import ZoneSky, zones_from_cones
 from att_sim import rotations as rot
 from att_sim import scenario as scen
 from att_sim.ephemeris import Sky
-
-DEMO_KEYS = ("initial_attitude", "final_attitude", "sensor_axis")
-
-
-def maneuver_from_scenario(s: scen.Scenario) -> dict:
-    """The ``demo:`` section's maneuver with the scenario's zones; ValueError (one sentence) when
-    the scenario has no such section or it lacks a key."""
-    p = s.node_params.get("demo")
-    if not isinstance(p, dict):
-        raise ValueError(f"scenario '{s.name}' ({s.path}) has no 'demo:' section with the maneuver to fly "
-                         f"({', '.join(DEMO_KEYS)}, optional cones, method, time_budget, start_lead, start_time)")
-    missing = [k for k in DEMO_KEYS if k not in p]
-    if missing:
-        raise ValueError(f"scenario '{s.name}' ({s.path}): the 'demo:' section lacks {', '.join(missing)}")
-    dirs = np.asarray(p.get("cone_directions", []), float).reshape(-1, 3)
-    cones = [Cone(d, math.radians(a), n) for d, a, n in zip(dirs, p.get("cone_half_angles_deg", []),
-                                                             p.get("cone_names", []))]
-    return {"q0": np.asarray(p["initial_attitude"], float), "qf": np.asarray(p["final_attitude"], float),
-            "sensor": np.asarray(p["sensor_axis"], float), "cones": cones, "zones": list(s.zones),
-            "method": p.get("method", ""), "time_budget": float(p.get("time_budget", 30.0)),
-            "start_lead": float(p.get("start_lead", 0.0)), "start_time": p.get("start_time")}
 
 
 def zone_margins(scenario: scen.Scenario, maneuver: dict, t: np.ndarray, q: np.ndarray) -> tuple[list, np.ndarray]:

@@ -218,6 +218,9 @@ NODE_CASES = {
     "controller: not a scenario": ("controller", ["-p", "scenario:=controller_gains"], C, ["not a scenario"]),
     "planner: unknown scenario": ("planner", ["-p", "scenario:=no_such_scenario"], C, ["no_such_scenario"]),
     "planner: not a scenario": ("planner", ["-p", "scenario:=controller_gains"], C, ["not a scenario"]),
+    "planner: unknown parameter (typo)": ("planner", ["-p", "time_budgett:=5.0"], P, ["time_budgett"]),
+    "planner: unknown warm-up scenario": ("planner", ["-p", "warm_up_scenarios:=swift_demo,no_such_scenario"], C,
+                                          ["no_such_scenario"]),
     "planner: plan_markers integer": ("planner", ["-p", "plan_markers:=2"], P, ["'plan_markers'", "true or false"]),
     # issue 14: the simulator's seed, the controller's state source, the estimator's tuning
     "simulator seed negative": (SIM, ["-p", "seed:=-1"], P, ["'seed'"]),

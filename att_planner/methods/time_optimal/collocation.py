@@ -53,14 +53,16 @@ def uniform_mesh(intervals: int) -> np.ndarray:
     return np.linspace(0.0, 1.0, intervals + 1)
 
 
-def refine_mesh(mesh: np.ndarray, intervals, max_intervals: int | None = None) -> np.ndarray:
-    """Bisect the listed intervals of ``mesh`` (at most up to ``max_intervals`` intervals in all)."""
+def refine_mesh(mesh: np.ndarray, intervals, max_intervals: int | None = None, parts: int = 2) -> np.ndarray:
+    """Split the listed intervals of ``mesh`` into ``parts`` equal ones (bisect them by default), the
+    first listed first, up to ``max_intervals`` intervals in all."""
     mesh = np.asarray(mesh, float)
     chosen = sorted({int(k) for k in intervals})
     if max_intervals is not None:
-        chosen = chosen[: max(0, max_intervals - (len(mesh) - 1))]
-    mids = [(mesh[k] + mesh[k + 1]) / 2 for k in chosen]
-    return np.unique(np.concatenate([mesh, mids]))
+        chosen = chosen[: max(0, max_intervals - (len(mesh) - 1)) // (parts - 1)]
+    inner = np.arange(1, parts) / parts
+    cuts = [mesh[k] + (mesh[k + 1] - mesh[k]) * inner for k in chosen]
+    return np.unique(np.concatenate([mesh, *cuts]))
 
 
 class Phase:
@@ -365,16 +367,17 @@ class Transcription:
         self._objective = expr
 
     def build(self, *, tol: float = 1e-7, max_iter: int = 1000, ipopt_options: dict | None = None,
-              nlpsol_options: dict | None = None):
+              nlpsol_options: dict | None = None, incumbents: bool = True):
         """Create the IPOPT instance (once per mesh; every :meth:`solve` reuses it).
 
         ``ipopt_options`` are IPOPT's own (e.g. ``linear_solver``); ``nlpsol_options`` CasADi's
-        (e.g. ``expand``)."""
+        (e.g. ``expand``); ``incumbents``: keep the best feasible iterate of each solve (:meth:`solve`),
+        else only the deadline is watched."""
         if self._objective is None:
             raise ValueError("set an objective with minimize() before build()")
         g = ca.vertcat(*self._g)
         self.lbg, self.ubg = np.concatenate(self._lbg), np.concatenate(self._ubg)
-        self._callback = DeadlineCallback(self._w.shape[0], g.shape[0])
+        self._callback = DeadlineCallback(self._w.shape[0], g.shape[0], incumbents)
         opts = {"ipopt.print_level": 0, "ipopt.sb": "yes", "print_time": False,
                 "ipopt.tol": tol, "ipopt.acceptable_tol": 10 * tol, "ipopt.max_iter": max_iter,
                 "ipopt.constr_viol_tol": 1e-8, "ipopt.acceptable_constr_viol_tol": 1e-6,

@@ -302,14 +302,14 @@ def transcription(problem: ManeuverProblem, s: Scaling, mesh: np.ndarray, contro
     own, with :func:`weighted_path_function`'s constraints."""
     smooth = torque_accel is not None
     zones = problem.zone_sky()
-    options = dict(tol=tol, max_iter=max_iter, nlpsol_options={"expand": expand},
-                   ipopt_options=None if smooth else col.MUMPS_OPTIONS)
+    options = dict(tol=tol, max_iter=max_iter, nlpsol_options={"expand": expand},   # only the smooth plan is anytime
+                   ipopt_options=None if smooth else col.MUMPS_OPTIONS, incumbents=smooth)
     if boundary_case(problem, cone_margin):            # its path constraints are built for it alone
         path, weight = weighted_path_function(problem, s, cone_margin, 13 if smooth else 7,
                                               SMOOTH_END_RAMP if smooth else END_RAMP) or (None, None)
         tr = _build(problem, s, mesh, control, path, torque_accel, not zones.moving, weight).build(**options)
         return _start(tr.copy(mesh, extra_values=goal_values(problem, s)), problem, s, smooth, tf_bounds)
-    path, degree = path_function(problem, s, 13 if smooth else 7, cone_margin)
+    degree = motion_degree(zones)
     momentum = math.isfinite(problem.wheel_momentum_max)
     moving = sum(z.body != "inertial" for z in zones.zones)
     key = (smooth, torque_accel, s.Jn.tobytes(), len(mesh) - 1, control, sum(z.body == "inertial" for z in zones.zones),
@@ -319,6 +319,7 @@ def transcription(problem: ManeuverProblem, s: Scaling, mesh: np.ndarray, contro
     if key not in _NLPS:
         while len(_NLPS) >= CACHE_SIZE:
             _NLPS.pop(next(iter(_NLPS)))
+        path, _ = path_function(problem, s, 13 if smooth else 7, cone_margin)      # built only for a new shape
         _NLPS[key] = (_build(problem, s, mesh, control, path, torque_accel, not zones.moving,
                              path_parameters=path_values(problem, s, 0.0)).build(**options), zones)  # zones: kept alive
     tr = _NLPS[key][0].copy(mesh, path_values(problem, s, cone_margin), goal_values(problem, s))

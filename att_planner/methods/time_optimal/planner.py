@@ -37,9 +37,9 @@ routes — eigenaxis both ways round, tilted two-leg routes and the cone-riding 
 :mod:`att_planner.methods.constrained_axis`, optional plans of other methods (:mod:`.routes`) —
 each turned into a continuous bang-bang guess and solved on a coarse mesh; (2) the best converged
 solution is refined: intervals where the torque switches or a zone constraint fails between
-collocation points are bisected and the NLP re-solved from the interpolated solution; (3) the
-torque is integrated through the truth dynamics (:mod:`att_planner.verification`); a failure
-refines again.
+collocation points are split (in quarters, once by default) and the NLP re-solved from the
+interpolated solution; (3) the torque is integrated through the truth dynamics
+(:mod:`att_planner.verification`); a failure refines again.
 """
 from __future__ import annotations
 
@@ -150,9 +150,9 @@ class _Incumbent:
             return True
         return False
 
-    def refine(self, rounds: int) -> None:
-        """Stage 2: bisect the intervals where the torque switches or a path constraint fails
-        between collocation points, ``rounds`` times at most."""
+    def refine(self, rounds: int, parts: int) -> None:
+        """Stage 2: split the intervals where the torque switches or a path constraint fails
+        between collocation points into ``parts``, ``rounds`` times at most."""
         for _ in range(rounds):
             if self.run.expired():
                 return
@@ -161,7 +161,7 @@ class _Incumbent:
             split = np.union1d(bad, col.switch_intervals(sol, limit=max(4, sol.phase.intervals // 2)))
             if not len(split) or sol.phase.intervals >= self.run.max_intervals:
                 return
-            if not self.resolve(col.refine_mesh(sol.phase.mesh, split, self.run.max_intervals)):
+            if not self.resolve(col.refine_mesh(sol.phase.mesh, split, self.run.max_intervals, parts)):
                 return
 
     def check(self, sol: col.PhaseSolution):
@@ -288,7 +288,8 @@ def _verdict(plan: Plan, ok: bool, run: _Solve, incumbent: _Incumbent, best: str
 
 
 def plan_time_optimal(problem: ManeuverProblem, *, intervals: int = DEFAULT_INTERVALS, max_intervals: int | None = None,
-                      starts: int = 3, refine_rounds: int = 3, interpolation: str = Interpolation.ZOH,
+                      starts: int = 3, refine_rounds: int = 1, refine_split: int = 4,
+                      interpolation: str = Interpolation.ZOH,
                       cone_margin_deg: float = 0.05, warm_starts: tuple = (),
                       smooth_warm_start: bool = False, global_stage: bool = False, explore_tol: float = 1e-5,
                       tol: float = 1e-7,
@@ -297,8 +298,10 @@ def plan_time_optimal(problem: ManeuverProblem, *, intervals: int = DEFAULT_INTE
 
     Options: ``intervals`` coarse mesh for the multi-start stage; ``max_intervals`` cap on mesh
     refinement (default 120, or ``intervals`` when larger); ``starts`` number of cheap routes solved
-    (best kept, all reported in ``stats['starts']``); ``refine_rounds`` bisection rounds around
-    switches / between-node cone violations; ``interpolation`` 'zoh' (torque constant per interval)
+    (best kept, all reported in ``stats['starts']``); ``refine_rounds`` refinement rounds around
+    switches / between-node cone violations, each splitting those intervals into ``refine_split``
+    (one round into quarters: t_f within 0.06 % of three bisection rounds on the speed cases, two
+    NLP solves fewer); ``interpolation`` 'zoh' (torque constant per interval)
     or 'linear' (torque linear between nodes); ``cone_margin_deg`` tightening of every zone (keep-out
     and keep-in, moving or not) at the collocation points;
     ``warm_starts`` plans of other methods used as extra starting routes;
@@ -356,7 +359,7 @@ def plan_time_optimal(problem: ManeuverProblem, *, intervals: int = DEFAULT_INTE
     _, best_label, res = solved[0]
     stats["best_start"] = best_label
     incumbent = _Incumbent(run, tr, res)
-    incumbent.refine(refine_rounds)
+    incumbent.refine(refine_rounds, refine_split)
     seconds["refinement"], lap = time.monotonic() - lap, time.monotonic()
     extra: list = []
     ok, plan = incumbent.verified(extra)

@@ -20,7 +20,8 @@ and for the real sky its epoch, TLE and zones), so that the plans can be integra
 (test/att_planner/tools/test_bench_speed.py). ``--ros`` also times the quick and the best request
 through the ``PlanManeuver`` service of a planner node started for the purpose (the service pads
 the zones by the scenario's ``cone_padding_deg`` and validates the request; the round trip is
-reported).
+reported). The node warms its solver workers on the demo maneuvers of ``swift_demo`` and of the
+case's spacecraft's scenario (``warm_up_scenarios``) before it serves.
 
 Cases: ``swift`` and ``earth_obs`` (Celani & Bruni 2021, :mod:`att_planner.reference.celani_bruni`)
 and ``leo_observatory`` (the real sky, :mod:`.sky`).
@@ -120,10 +121,12 @@ def ros_times(name: str, problem: ManeuverProblem, repeats: int, best_repeats: i
     join_env(env)
     out: dict = {}
     with tempfile.TemporaryDirectory() as work:
-        suite = start_suite("swift_demo", os.path.join(work, "run.mcap"), work, env=env, nodes=("planner",))
+        warm = ",".join(dict.fromkeys(("swift_demo", ROS_SPACECRAFT[name])))    # warm for the case's spacecraft
+        suite = start_suite("swift_demo", os.path.join(work, "run.mcap"), work, env=env, nodes=("planner",),
+                            params={"planner": {"warm_up_scenarios": warm}})
         try:
             with client_session("speed_bench") as client:
-                client.plan_client.wait_for_service(timeout_sec=60)
+                client.plan_client.wait_for_service(timeout_sec=180)     # the node warms its workers first
                 kwargs = dict(spacecraft=ROS_SPACECRAFT[name], frame_id="", zones=problem.zones, epoch=problem.epoch)
                 if problem.sky is not None:
                     kwargs["tle"] = tuple(sky.CASES[name].tle)

@@ -97,3 +97,22 @@ def test_study_plumbing_on_one_quick_run(tmp_path):
     assert case["case"] == "swift" and case["first"]["verification"]["passes"]
     assert case["first"]["stage"] == "first" and len(case["first"]["solve_seconds_all"]) == 1
     assert case["best"]["verification"]["passes"] and case["time_optimal"]["verification"]["passes"]
+
+
+def test_benchmarks_speed_section_is_generated_from_the_json():
+    """BENCHMARKS.md's speed table, machine and targets are the committed JSON's (speed_report), and
+    a time-optimal method stage above its target reads as not met."""
+    from att_planner.tools.bench import speed_report
+
+    payload = json.loads((BENCHMARKS / "speed.json").read_text())
+    block = speed_report.section(payload)
+    markdown = (BENCHMARKS.parent / "BENCHMARKS.md").read_text()
+    assert block.split("\n\n")[0] in markdown                       # the table as generated
+    for row in payload["cases"]:
+        assert f"| {row['case']} | " in block
+    slow = json.loads(json.dumps(payload))
+    slow["cases"][0]["time_optimal_seconds"] = 2 * slow["targets"]["time_optimal_seconds"]
+    assert "time-optimal ≤ 0.3 s — **not met**" in speed_report.section(slow)
+    again = speed_report.replace_section(markdown, block)
+    assert again.count(speed_report.MARKER) == 1 and again.split(speed_report.MARKER)[0] == markdown.split(
+        speed_report.MARKER)[0]

@@ -1,0 +1,69 @@
+"""The planner's solver workers (issue 18): warm before they serve; one that overruns is killed and
+replaced by a warmed one."""
+import math
+import time
+
+import pytest
+
+from att_planner.service import worker
+from att_planner.service.warm import warm, warm_requests
+from att_planner.verification import TOLERANCES
+from helpers import worker_tasks
+
+
+def on_death(message):
+    return message
+
+
+@pytest.fixture(autouse=True)
+def own_pool(monkeypatch):
+    """Each test starts with no idle worker and its own warm-up; what it leaves is stopped."""
+    worker.warm_up()
+    monkeypatch.setattr(worker, "_IDLE", [])
+    monkeypatch.setattr(worker, "_WARM_UP", None)
+    monkeypatch.setattr(worker, "_POOL_SIZE", 0)
+    monkeypatch.setattr(worker, "_SLOTS", worker.threading.BoundedSemaphore(2))
+    yield
+    for process, conn in worker._IDLE:
+        worker._retire(process, conn)
+
+
+def test_a_pool_worker_runs_the_warm_up_before_its_first_request():
+    worker.set_warm_up(worker_tasks.warm_marker)
+    worker.start_pool(1)
+    assert worker.idle_workers() == 1
+    pid, warmed = worker.call_isolated(worker_tasks.pid_and_warmth, (), {}, 10.0, on_death=on_death)
+    assert warmed
+    assert worker.call_isolated(worker_tasks.pid_and_warmth, (), {}, 10.0, on_death=on_death) == (pid, True)
+
+
+def test_a_worker_that_overruns_is_killed_and_replaced_by_a_warmed_one():
+    worker.set_warm_up(worker_tasks.warm_marker)
+    worker.start_pool(1)
+    (pooled, _), = worker._IDLE
+    assert worker.call_isolated(worker_tasks.sleep_then_pid, (3600.0,), {}, 0.1, on_death=on_death) is None
+    pooled.join(10.0)
+    assert not pooled.is_alive()
+    deadline = time.monotonic() + 60.0
+    while not worker.idle_workers() and time.monotonic() < deadline:
+        time.sleep(0.1)
+    pid, warmed = worker.call_isolated(worker_tasks.pid_and_warmth, (), {}, 10.0, on_death=on_death)
+    assert warmed and pid != pooled.pid
+
+
+def test_a_worker_whose_warm_up_hangs_is_given_up(monkeypatch):
+    monkeypatch.setattr(worker, "WARM_UP_TIMEOUT", 0.5)
+    worker.set_warm_up(worker_tasks.sleep_then_pid, (3600.0,))
+    start = time.monotonic()
+    worker.start_pool(1)
+    assert time.monotonic() - start < 10.0 and worker.idle_workers() == 0
+
+
+def test_the_planner_warm_up_builds_the_nlps_before_the_first_request():
+    """A worker warmed on swift_demo's demo maneuver (the default method through the service's
+    pipeline) holds that maneuver's NLPs before it serves a request."""
+    requests = warm_requests(["swift_demo"], frame_id="eci", default_method="smooth_collocation")
+    assert [r.spacecraft for r in requests] == ["swift_demo"] and len(requests[0].problem.cones) == 3
+    worker.set_warm_up(warm, (requests, TOLERANCES, math.radians(2.0)))
+    worker.start_pool(1)
+    assert worker.call_isolated(worker_tasks.built_nlps, (), {}, 10.0, on_death=on_death) >= 1
