@@ -1,7 +1,8 @@
 """The live view: ``att-bridge`` beside a running simulator, a Foxglove WebSocket client connected to
 it (``websockets``, not the SDK: the protocol as Foxglove speaks it), every suite topic advertised
 with the log's schema, and the states received, decoded both from the advertised schema text (as
-Foxglove decodes them) and by rclpy. A second bridge on the same port stops with one line."""
+Foxglove decodes them) and by rclpy; a latched plan path published before the client connected is
+sent on subscription. A second bridge on the same port stops with one line."""
 from __future__ import annotations
 
 import json
@@ -13,14 +14,16 @@ import sys
 import time
 
 import pytest
+import rclpy
 from mcap.records import Schema
 from mcap_ros2.decoder import DecoderFactory
 from rclpy.serialization import deserialize_message
+from visualization_msgs.msg import Marker, MarkerArray
 from websockets.exceptions import InvalidStatus
 from websockets.sync.client import connect
 
 from att_msgs.msg import SpacecraftState
-from att_msgs_py import topics
+from att_msgs_py import qos, topics
 from att_msgs_py.log.definitions import message_definition
 from att_planner.tools.launch import NODE_MODULES, isolated_env
 
@@ -49,17 +52,27 @@ def advertised(ws, timeout: float = 10.0) -> tuple[dict, dict]:
     return info, channels
 
 
-def message_data(ws, subscription: int, count: int, timeout: float = 10.0) -> list[tuple[int, bytes]]:
-    """(timestamp, payload) of the first ``count`` message-data frames of ``subscription``."""
-    out = []
+def message_data(ws, counts: dict[int, int], timeout: float = 10.0) -> dict[int, list[tuple[int, bytes]]]:
+    """subscription id -> (timestamp, payload) of its first message-data frames, until each has ``counts``."""
+    out = {sub: [] for sub in counts}
     end = time.monotonic() + timeout
-    while len(out) < count and time.monotonic() < end:
+    while any(len(out[k]) < n for k, n in counts.items()) and time.monotonic() < end:
         frame = ws.recv(timeout=end - time.monotonic())
         if isinstance(frame, bytes) and frame[0] == MESSAGE_DATA:
             sub, stamp = struct.unpack_from("<IQ", frame, 1)
-            if sub == subscription:
-                out.append((stamp, frame[13:]))
+            out.setdefault(sub, []).append((stamp, frame[13:]))
     return out
+
+
+def publish_latched_path(client) -> None:
+    """A plan path on the latched topic, received by the bridge before any Foxglove client connects."""
+    pub = client.create_publisher(MarkerArray, topics.PLAN_MARKERS, qos.LATCHED_QOS)
+    pub.publish(MarkerArray(markers=[Marker(ns="live_test_path", id=3)]))
+    end = time.monotonic() + 10
+    while pub.get_subscription_count() < 1 and time.monotonic() < end:
+        rclpy.spin_once(client, timeout_sec=0.05)
+    assert pub.get_subscription_count() == 1, "the bridge did not subscribe to the plan path"
+    time.sleep(1.0)
 
 
 def test_a_foxglove_client_receives_the_suite_live(ros_suite):
@@ -67,6 +80,7 @@ def test_a_foxglove_client_receives_the_suite_live(ros_suite):
     with ros_suite("swift_demo", nodes=("simulator", "bridge"), params={"bridge": {"port": port}},
                    name="live_bridge") as s:
         assert s.suite.wait_for_output("bridge", f"ws://127.0.0.1:{port}", 20), s.suite.log_text("bridge")
+        publish_latched_path(s.client)
         url = f"ws://127.0.0.1:{port}"
         with pytest.raises(InvalidStatus):       # the old subprotocol alone is refused (HTTP 400)
             connect(url, subprotocols=["foxglove.websocket.v1"], open_timeout=5).close()
@@ -79,14 +93,17 @@ def test_a_foxglove_client_receives_the_suite_live(ros_suite):
                 c = channels[topic]
                 assert (c["encoding"], c["schemaEncoding"], c["schemaName"]) == ("cdr", "ros2msg", type_name)
                 assert c["schema"] == message_definition(type_name), topic
-            state = channels[topics.STATE]
-            ws.send(json.dumps({"op": "subscribe", "subscriptions": [{"id": 7, "channelId": state["id"]}]}))
-            frames = message_data(ws, 7, 5)
+            state, path = channels[topics.STATE], channels[topics.PLAN_MARKERS]
+            ws.send(json.dumps({"op": "subscribe", "subscriptions": [{"id": 7, "channelId": state["id"]},
+                                                                      {"id": 8, "channelId": path["id"]}]}))
+            received = message_data(ws, {7: 5, 8: 1})
+            frames = received[7]
         bridge_again = subprocess.run([sys.executable, "-m", NODE_MODULES["bridge"], "--ros-args", "-p",
                                        f"port:={port}"], env=isolated_env(), capture_output=True, text=True,
                                       timeout=30)
         codes = s.stop()
     assert len(frames) == 5, f"{len(frames)} states in 10 s"
+    assert [deserialize_message(p, MarkerArray).markers[0].ns for _, p in received[8]] == ["live_test_path"]
     decode = DecoderFactory().decoder_for("cdr", Schema(id=1, name=state["schemaName"], encoding="ros2msg",
                                                         data=state["schema"].encode()))
     stamps = []
