@@ -57,7 +57,10 @@ def message_data(ws, counts: dict[int, int], timeout: float = 10.0) -> dict[int,
     out = {sub: [] for sub in counts}
     end = time.monotonic() + timeout
     while any(len(out[k]) < n for k, n in counts.items()) and time.monotonic() < end:
-        frame = ws.recv(timeout=end - time.monotonic())
+        try:
+            frame = ws.recv(timeout=max(0.0, end - time.monotonic()))
+        except TimeoutError:
+            break
         if isinstance(frame, bytes) and frame[0] == MESSAGE_DATA:
             sub, stamp = struct.unpack_from("<IQ", frame, 1)
             out.setdefault(sub, []).append((stamp, frame[13:]))
@@ -103,7 +106,8 @@ def test_a_foxglove_client_receives_the_suite_live(ros_suite):
                                       timeout=30)
         codes = s.stop()
     assert len(frames) == 5, f"{len(frames)} states in 10 s"
-    assert [deserialize_message(p, MarkerArray).markers[0].ns for _, p in received[8]] == ["live_test_path"]
+    assert [deserialize_message(p, MarkerArray).markers[0].ns for _, p in received[8]] == ["live_test_path"], \
+        "the latched path was not sent on subscription"
     decode = DecoderFactory().decoder_for("cdr", Schema(id=1, name=state["schemaName"], encoding="ros2msg",
                                                         data=state["schema"].encode()))
     stamps = []
