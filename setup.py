@@ -33,6 +33,7 @@ setup(
             "att-controller = att_planner.nodes.controller_node:main",
             "att-estimator = att_planner.nodes.estimator_node:main",
             "att-recorder = att_msgs_py.log.recorder_node:main",
+            "att-bridge = att_msgs_py.log.bridge_node:main",
             "att-replay = att_msgs_py.log.replay:main",
             "att-review = att_planner.tools.review:main",
             "att-demo = att_planner.tools.demo:main",

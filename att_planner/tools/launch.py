@@ -24,6 +24,7 @@ NODE_MODULES = {
     "estimator": "att_planner.nodes.estimator_node",
     "planner": "att_planner.nodes.planner_node",
     "recorder": "att_msgs_py.log.recorder_node",
+    "bridge": "att_msgs_py.log.bridge_node",
 }
 
 

@@ -253,6 +253,15 @@ NODE_CASES = {
     "controller: start_timeout zero": ("controller", ["-p", "start_timeout:=0.0"], P, ["'start_timeout'"]),
     "estimator: unknown parameter (typo)": ("estimator", ["-p", "gate_probabilty:=0.99"], P, ["gate_probabilty"]),
     "estimator: unknown scenario": ("estimator", ["-p", "scenario:=no_such_scenario"], C, ["no_such_scenario"]),
+    # issue 17: the live bridge
+    "bridge: port text": ("bridge", ["-p", "port:=http"], P, ["'port'", "integer"]),
+    "bridge: port a float": ("bridge", ["-p", "port:=8765.0"], P, ["'port'", "integer"]),
+    "bridge: port negative": ("bridge", ["-p", "port:=-1"], P, ["'port'", "[0, 65535]"]),
+    "bridge: port above 65535": ("bridge", ["-p", "port:=70000"], P, ["'port'", "[0, 65535]"]),
+    "bridge: host a number": ("bridge", ["-p", "host:=5"], P, ["'host'", "a string"]),
+    "bridge: host not this machine's": ("bridge", ["-p", "host:=192.0.2.1", "-p", "port:=0"], P,
+                                        ["'host'", "192.0.2.1", "cannot serve", "Cannot assign"]),
+    "bridge: unknown parameter (typo)": ("bridge", ["-p", "prot:=8765"], P, ["prot"]),
 }
 RCL_PARSE_ERROR = re.compile(r"^\[ERROR\] \[[\d.]+\] \[rcl\]: Failed to parse global arguments$")
 REFUSAL = re.compile(r"^(\w+)\.py: \[(\d+) (\w+)\] (.+)$")
