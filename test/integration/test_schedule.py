@@ -10,7 +10,7 @@ from att_msgs.srv import PlanSchedule
 from att_msgs_py import convert
 from att_msgs_py.errors import ErrorCode
 from att_msgs_py.log import read_log
-from att_msgs_py.topics import STATE
+from att_msgs_py.topics import COMMAND, STATE
 from att_planner.reference.olivares_staffetti import olivares_targets
 from att_sim import rotations as rot
 
@@ -41,9 +41,11 @@ def test_schedule_is_planned_verified_and_executed(ros_suite):
         assert result.final_attitude_error < math.radians(0.5)
         codes = s.stop()
     assert all(c == 0 for c in codes.values()), codes
-    state = read_log(s.mcap, topics=[STATE])[STATE]
-    t, q = state["header.stamp"], state["attitude"]
-    t0 = t[-1] - (plan.duration + 10.0)          # the execution started settle_time + duration before the end
+    log = read_log(s.mcap, topics=[STATE, COMMAND])
+    t, q = log[STATE]["header.stamp"], log[STATE]["attitude"]
+    tracking = np.flatnonzero(log[COMMAND]["plan_id"] == plan.plan_id)
+    assert tracking.size, "no command tracked the plan"
+    t0 = log[COMMAND]["header.stamp"][tracking[0]]      # the first command of the plan: its t = 0
     for name, tp in zip(response.order, response.passage_times):
         k = int(np.argmin(np.abs(t - (t0 + tp))))
         assert rot.angle_between(q[k], targets[name]) < math.radians(2.0), name

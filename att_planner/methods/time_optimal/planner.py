@@ -287,6 +287,19 @@ def _verdict(plan: Plan, ok: bool, run: _Solve, incumbent: _Incumbent, best: str
     return status, f"{best}; {incumbent.sol.phase.intervals} intervals"
 
 
+def _swarm_start(run: _Solve, routes: list, intervals: int, explore_tol: float, stats: dict):
+    """Melton's first stage (:func:`.swarm.swarm_plan`) explored as the one start; its figures to
+    ``stats['global_stage']``, its seconds to ``stats['seconds']``."""
+    problem, s = run.problem, run.scaling
+    lap = time.monotonic()
+    swarm = swarm_plan(problem, s, routes[0].tf_estimate)
+    stats["seconds"]["global_stage"] = time.monotonic() - lap
+    stats["global_stage"] = {"iterations": swarm.nit, "evaluations": swarm.nfev, "cost": swarm.stats["cost"],
+                             "tf": swarm.stats["tf"]}
+    return _explore(run, [Route("swarm", plan=swarm, tf_estimate=swarm.duration / s.tu,
+                                min_margin=zone_margin(problem, swarm.t, swarm.q))], intervals, explore_tol)
+
+
 def plan_time_optimal(problem: ManeuverProblem, *, intervals: int = DEFAULT_INTERVALS, max_intervals: int | None = None,
                       starts: int = 3, refine_rounds: int = 1, refine_split: int = 4,
                       interpolation: str = Interpolation.ZOH,
@@ -330,14 +343,7 @@ def plan_time_optimal(problem: ManeuverProblem, *, intervals: int = DEFAULT_INTE
     stats = {"time_unit": s.tu, "seconds": seconds}
     solved = []
     if global_stage:         # Melton's two stages: the swarm's plan is the one start, the routes a fallback
-        lap = time.monotonic()
-        swarm = swarm_plan(problem, s, routes[0].tf_estimate)
-        seconds["global_stage"] = time.monotonic() - lap
-        stats["global_stage"] = {"iterations": swarm.nit, "evaluations": swarm.nfev, "cost": swarm.stats["cost"],
-                                 "tf": swarm.stats["tf"]}
-        tr, solved, start_log = _explore(run, [Route("swarm", plan=swarm, tf_estimate=swarm.duration / s.tu,
-                                                     min_margin=zone_margin(problem, swarm.t, swarm.q))],
-                                         intervals, explore_tol)
+        tr, solved, start_log = _swarm_start(run, routes, intervals, explore_tol, stats)
     clear = [rt.tf_estimate for rt in routes if rt.min_margin >= 0]
     if not solved or (clear and solved[0][0] > min(clear)):     # no swarm, or a start worse than a clear route
         tr_routes, more, more_log = _explore(run, routes, intervals, explore_tol)
