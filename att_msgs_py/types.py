@@ -154,12 +154,13 @@ class StageReport:
 
 @dataclass(frozen=True)
 class Passage:
-    """A target a plan passes through: its name, the passage time (s from the plan start) and
-    the target attitude."""
+    """A target a plan passes through: its name, the passage time (s from the plan start), the
+    target attitude and how long the plan holds it there (s; 0: a passage, not an observation)."""
 
     name: str
     time: float
     attitude: np.ndarray
+    dwell: float = 0.0
 
 
 def _empty(*shape):

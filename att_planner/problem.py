@@ -73,7 +73,10 @@ class ManeuverProblem:
       direction (rotation about it free); None: the full final attitude ``q_final`` is imposed.
     * ``targets``: name → attitude, every one to be passed through once, in any order, on the way
       from ``q_initial`` to ``q_final`` (a schedule; Olivares & Staffetti 2018: at a passage the
-      attitude is the target's and the body rate about body z is zero).
+      attitude is the target's and the body rate about body z is zero). ``target_dwell``: the
+      targets observed, held at rest for that many seconds (issue 17); ``target_windows``: the
+      span each observation must lie in (s from the start); a target is never observed while a
+      zone covers it.
     * ``rate_max`` (rad/s per body axis) and ``wheel_momentum_max`` (N m s per wheel, the momentum
       the wheels store producing a body-torque plan with zero total momentum): bounds a plan must
       keep, checked by the verification; infinite when not imposed.
@@ -101,6 +104,8 @@ class ManeuverProblem:
     deadline: float | None = None
     sensor_target: np.ndarray | None = None
     targets: dict = field(default_factory=dict)
+    target_dwell: dict = field(default_factory=dict)      # name -> s held at rest on the target (absent: a passage)
+    target_windows: dict = field(default_factory=dict)    # name -> (opens, closes) s: its observation within
     rate_max: float = math.inf
     wheel_momentum_max: float = math.inf
     zones: list[Zone] = field(default_factory=list)

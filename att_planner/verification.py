@@ -40,7 +40,7 @@ class Tolerances:
     """Acceptance of a plan after integration through the dynamics."""
 
     attitude: float = math.radians(0.5)    # rad: final (semi-free: boresight) and passage attitude error
-    rate: float = 1e-3                     # rad/s: final ‖ω‖ and |ω_z| at each passage
+    rate: float = 1e-3                     # rad/s: final ‖ω‖, |ω_z| at each passage, ‖ω‖ through an observation
     cone_penetration: float = 0.0          # rad a dense sample may lie below its clearance floor (clearances)
     limit_ratio: float = 1.0 + 1e-6        # control, wheel speed, body rate, wheel momentum / their limits
 
@@ -102,10 +102,13 @@ def measure(problem: ManeuverProblem, plan: Plan, traj: dyn.Trajectory) -> Verif
         target = np.asarray(problem.sensor_target, float)
         final_error = float(np.arccos(np.clip(reached @ target / np.linalg.norm(target), -1.0, 1.0)))
     passage_errors, passage_rates = [], []
-    for passage in plan.passages:
+    for passage in plan.passages:      # an observation: the worst sample of its dwell, at rest
         k = int(np.argmin(np.abs(traj.t - passage.time)))
-        passage_errors.append(float(rot.angle_between(traj.q[k], passage.attitude)))
-        passage_rates.append(float(abs(traj.omega[k, 2])))
+        held = np.flatnonzero((traj.t >= traj.t[k]) & (traj.t <= passage.time + passage.dwell)) \
+            if passage.dwell > 0 else np.array([k])
+        passage_errors.append(float(max(rot.angle_between(traj.q[i], passage.attitude) for i in held)))
+        rates = np.linalg.norm(traj.omega[held], axis=1) if passage.dwell > 0 else np.abs(traj.omega[held, 2])
+        passage_rates.append(float(rates.max()))
     return Verification(
         final_attitude_error=final_error,
         final_rate=final_rate,

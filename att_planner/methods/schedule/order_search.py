@@ -6,7 +6,7 @@ from __future__ import annotations
 import heapq
 import itertools
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -19,6 +19,8 @@ from att_planner.methods.schedule.transcription import (
 from att_planner.problem import ManeuverProblem
 from att_sim import dynamics as dyn
 from att_sim import rotations as rot
+
+MAX_ORDERS_EXAMINED = 200_000     # orders the search may look at (windows can rule out many in a row)
 
 
 def leg_bound_matrix(sc: dyn.Spacecraft, q_start, targets: list[np.ndarray], q_end, *, intervals: int = 12,
@@ -111,10 +113,60 @@ def orders_by_lower_bound(C: np.ndarray):
                 heapq.heappush(heap, (float(f2), float(g2), path + (j,)))
 
 
+VISIBILITY_STEP = 10.0      # s between the samples of a target's visibility among moving zones
+
+
+def visibility(zones, q: np.ndarray, window: tuple, margin: float = 0.0,
+               step: float = VISIBILITY_STEP) -> list[tuple]:
+    """The intervals ``(opens, closes)`` (s) within ``window`` in which attitude ``q`` keeps every
+    zone of ``zones`` (a ZoneSky or None) by ``margin`` rad: among moving zones, runs of clear
+    samples ``step`` s apart (within the zones' window, where their fit holds); [] if never."""
+    opens, closes = float(window[0]), float(window[1])
+    if zones is not None and zones.moving:
+        closes = min(closes, zones.window)
+    if closes < opens:
+        return []
+    if zones is None:
+        return [(opens, closes)]
+    if not zones.moving:
+        return [(opens, closes)] if zones.margins(0.0, q).min() >= margin else []
+    t = np.linspace(opens, closes, max(2, int(np.ceil((closes - opens) / step)) + 1))
+    clear = np.concatenate([[False], zones.margins(t, q).min(axis=1) >= margin, [False]])
+    edges = np.flatnonzero(np.diff(clear.astype(int)))
+    return [(float(t[a]), float(t[b - 1])) for a, b in zip(edges[::2], edges[1::2])]
+
+
+def earliest_observation(start: float, dwell: float, visible) -> float:
+    """The earliest time ≥ ``start`` from which a target can be held for ``dwell`` s inside one of
+    its ``visible`` intervals (sorted ``(opens, closes)``); inf if none."""
+    for opens, closes in visible:
+        at = max(start, opens)
+        if at + dwell <= closes:
+            return at
+    return np.inf
+
+
+def tour_bound(C: np.ndarray, order: list[int], dwell: np.ndarray, visible: list) -> tuple[float, np.ndarray]:
+    """Lower bound (s) on a tour of target indices ``order`` with its observations, and the
+    earliest arrivals it implies: each leg at least its bound ``C`` (nodes as in
+    :func:`leg_bound_matrix`), each target observed for ``dwell[j]`` s within one of its
+    ``visible[j]`` intervals, waiting where the next one has not opened. ``(inf, None)`` when a
+    target cannot be observed in time: no schedule of that order exists."""
+    n = C.shape[0] - 2
+    t, node, arrivals = 0.0, 0, []
+    for j in order:
+        t = earliest_observation(t + C[node, j + 1], dwell[j], visible[j])
+        if not np.isfinite(t):
+            return np.inf, None
+        arrivals.append(t)
+        t, node = t + dwell[j], j + 1
+    return t + C[node, n + 1], np.array(arrivals)
+
+
 @dataclass
 class Solved:
     order: tuple
-    tf: float
+    tf: float                 # s: the whole tour, observations included
     sol: ScheduleSolution
     transcription: MultiphaseTranscription
 
@@ -132,17 +184,24 @@ class OrderSolver:
     deadline: float | None = None
     zones: object = None              # att_planner.zones.ZoneSky or None
     zone_margin: float = 0.0          # rad, δ of every zone constraint
+    dwell: dict = field(default_factory=dict)       # name -> s held at the target (absent: a passage)
+    visible: dict = field(default_factory=dict)     # name -> sorted (opens, closes) s it may be observed in
 
     @classmethod
     def of(cls, problem: ManeuverProblem, substeps: int = SUBSTEPS, zone_margin: float = 0.0,
            zone_window: float | None = None) -> OrderSolver:
-        """The solver of ``problem``, its zones fitted over ``zone_window`` s (default: the problem's)."""
+        """The solver of ``problem``, its zones fitted over ``zone_window`` s (default: the problem's);
+        each target's visibility: its window (``problem.target_windows``) less the times a moving
+        zone covers it (:func:`visibility`)."""
         q_start = rot.normalize(np.asarray(problem.q_initial, float))
         q_end = rot.normalize(np.asarray(problem.q_final, float))
         quats = {k: rot.normalize(np.asarray(v, float)) for k, v in problem.targets.items()}
         zones = problem.zone_sky(zone_window)
+        zones = zones if zones.zones else None
+        visible = {k: visibility(zones, q, problem.target_windows.get(k, (0.0, np.inf)), zone_margin)
+                   for k, q in quats.items()}
         return cls(problem.spacecraft, q_start, q_end, quats, substeps, problem.rate_max, problem.deadline,
-                   zones if zones.zones else None, zone_margin)
+                   zones, zone_margin, dict(problem.target_dwell), visible)
 
     @property
     def moving(self) -> bool:
@@ -152,14 +211,23 @@ class OrderSolver:
     def expired(self) -> bool:
         return self.deadline is not None and time.monotonic() > self.deadline
 
-    def solve(self, order, intervals: int, guess: Solved | None = None, expand: bool | None = None) -> Solved:
+    def dwells(self, order) -> np.ndarray:
+        return np.array([self.dwell.get(k, 0.0) for k in order])
+
+    def solve(self, order, intervals: int, guess: Solved | None = None, expand: bool | None = None,
+              arrivals=None) -> Solved:
+        """The multiphase NLP of ``order`` (observations held, windows kept); ``arrivals`` (s) place
+        the initial guess's targets (:func:`tour_bound`'s waits)."""
         tr = cached_transcription(self.sc, len(order), intervals, self.substeps, self.rate_max, expand,
                                   self.zones, self.zone_margin)
         wall = None if self.deadline is None else self.deadline - time.monotonic()
         start_guess = tr.resample(guess.sol) if guess is not None else None
+        dwell = self.dwells(order)
+        windows = [(self.visible[k][0][0], self.visible[k][-1][1]) if self.visible.get(k) else (0.0, np.inf)
+                   for k in order]
         sol = tr.solve(self.q_start, [self.targets[k] for k in order], self.q_end, guess=start_guess,
-                       max_wall_time=wall)
-        tf = sol.tau_f * tr.scale.t_sat if sol.converged else np.inf
+                       max_wall_time=wall, dwell=dwell, windows=windows, arrivals=arrivals)
+        tf = sol.tau_f * tr.scale.t_sat + dwell.sum() if sol.converged else np.inf
         return Solved(tuple(order), tf, sol, tr)
 
     def leg_bounds(self, names: list, intervals: int) -> np.ndarray:
@@ -179,16 +247,32 @@ def search_orders(solver: OrderSolver, names: list, intervals: int, candidates: 
     stats["leg_bounds"] = C
     solved: list[Solved] = []
     incumbent = np.inf
-    unsolved_bound = np.inf   # smallest leg bound among the orders not solved
-    # time reversal maps a tour onto its reverse among zones that do not move, not among moving ones
-    reversible = rot.angle_between(solver.q_start, solver.q_end) < 1e-9 and not solver.moving
+    unsolved_bound = np.inf   # smallest bound among the orders not solved
+    dwell = solver.dwells(names)
+    visible = [solver.visible.get(k, [(0.0, np.inf)]) for k in names]
+    timed = any(v != [(0.0, np.inf)] for v in visible)
+    # time reversal maps a tour onto its reverse (observations held alike) among zones that do not
+    # move and without windows, not otherwise
+    reversible = rot.angle_between(solver.q_start, solver.q_end) < 1e-9 and not solver.moving and not timed
+    infeasible = examined = 0
     for bound, idx in orders_by_lower_bound(C):
-        if bound >= incumbent or len(solved) >= (max_order_solves if prove else candidates) or solver.expired():
-            unsolved_bound = bound
+        bound += dwell.sum()
+        if bound >= incumbent or len(solved) >= (max_order_solves if prove else candidates) or solver.expired() \
+                or examined >= MAX_ORDERS_EXAMINED:
+            unsolved_bound = min(unsolved_bound, bound)
             break
+        examined += 1
+        windowed, arrivals = tour_bound(C, idx, dwell, visible)
+        if not np.isfinite(windowed):
+            infeasible += 1        # a target could not be observed in time: no schedule of this order
+            continue
+        if windowed >= incumbent:
+            unsolved_bound = min(unsolved_bound, windowed)
+            continue
         if reversible and tuple(names[i] for i in reversed(idx)) in {s.order for s in solved}:
             continue  # time reversal: same schedule duration as an order already solved
-        s = solver.solve([names[i] for i in idx], intervals, expand=prove or None)
+        s = solver.solve([names[i] for i in idx], intervals, expand=prove or None,
+                         arrivals=arrivals if timed else None)
         solved.append(s)
         incumbent = min(incumbent, s.tf)
     if reversible and solved:
@@ -204,7 +288,8 @@ def search_orders(solver: OrderSolver, names: list, intervals: int, candidates: 
                 solved.append(solver.solve(s.order[::-1], intervals, expand=prove or None))
     # every order not solved costs at least unsolved_bound on the search grid
     incumbent = min(s.tf for s in solved) if solved else np.inf
-    stats.update(orders_solved=len(solved), lower_bound=min(unsolved_bound, incumbent),
+    stats.update(orders_solved=len(solved), orders_examined=examined, orders_infeasible=infeasible,
+                 lower_bound=min(unsolved_bound, incumbent),
                  unsolved_orders_bound=unsolved_bound,
                  order_proven=bool(unsolved_bound >= incumbent), search_seconds=time.perf_counter() - t0,
                  candidates=[{"order": list(s.order), "tf": s.tf} for s in solved])
@@ -212,22 +297,23 @@ def search_orders(solver: OrderSolver, names: list, intervals: int, candidates: 
 
 
 def exhaustive_order_search(problem: ManeuverProblem, *, intervals: int = 8, substeps: int = SUBSTEPS,
-                            progress=None) -> list[dict]:
+                            progress=None, zone_window: float | None = None) -> list[dict]:
     """Solve the multiphase problem of every order (all n! of them, reversals included, as an
-    independent check of the time-reversal symmetry — which moving zones break — and of the NLP's
-    local minima) and return
-    ``[{"order", "tf", "bound", "converged"}]`` sorted by ``tf``; ``bound`` is the leg lower bound
-    of :func:`leg_bound_matrix` on the same grid (so ``bound ≤ tf`` must hold for every order)."""
-    solver = OrderSolver.of(problem, substeps)
+    independent check of the time-reversal symmetry — which moving zones and windows break — and of
+    the NLP's local minima), observations and windows included, and return
+    ``[{"order", "tf", "bound", "converged"}]`` sorted by ``tf``; ``bound`` is :func:`tour_bound`
+    on the same grid's leg bounds (so ``bound ≤ tf`` must hold for every order; inf: no schedule)."""
+    solver = OrderSolver.of(problem, substeps, zone_window=zone_window)
     names = list(problem.targets)
     C = solver.leg_bounds(names, intervals)
-    index = {k: i + 1 for i, k in enumerate(names)}
+    dwell, visible = solver.dwells(names), [solver.visible[k] for k in names]
     rows = []
-    for perm in itertools.permutations(names):
-        s = solver.solve(perm, intervals, expand=True)
-        chain = [0] + [index[k] for k in perm] + [len(names) + 1]
-        bound = float(sum(C[a, b] for a, b in zip(chain[:-1], chain[1:])))
-        rows.append({"order": list(perm), "tf": float(s.tf), "bound": bound, "converged": s.sol.converged})
+    for perm in itertools.permutations(range(len(names))):
+        bound, arrivals = tour_bound(C, list(perm), dwell, visible)
+        s = solver.solve([names[i] for i in perm], intervals, expand=True,
+                         arrivals=arrivals if arrivals is not None else None)
+        rows.append({"order": [names[i] for i in perm], "tf": float(s.tf), "bound": float(bound),
+                     "converged": s.sol.converged})
         if progress is not None:
             progress(len(rows), rows[-1])
     return sorted(rows, key=lambda r: r["tf"])

@@ -7,7 +7,7 @@ import numpy as np
 
 from att_msgs_py.types import ControlKind, Passage, Plan, Status
 from att_planner.methods.schedule.order_search import OrderSolver, Solved, search_orders
-from att_planner.methods.schedule.transcription import SUBSTEPS, eigenaxis_rest_to_rest_time
+from att_planner.methods.schedule.transcription import SUBSTEPS, eigenaxis_rest_to_rest_time, node_times
 from att_planner.problem import ManeuverProblem
 from att_planner.verification import verify as verify_plan
 from att_sim import rotations as rot
@@ -17,15 +17,24 @@ METHOD = "schedule"
 
 def _plan(solver: OrderSolver, final: Solved) -> Plan:
     """The plan of a solved order in SI units: knot times, ZOH wheel torques (last row zero),
-    predicted q and ω at the knots, the passages; the predicted wheel speeds in ``stats``."""
+    predicted q and ω at the knots, the passages; the predicted wheel speeds in ``stats``. A target
+    with a dwell gets one more knot at the end of its observation: held, zero torque."""
     tr, sol = final.transcription, final.sol
     sc, scale, N = tr.sc, tr.scale, tr.intervals
-    t = np.concatenate([[0.0], np.cumsum(np.repeat(sol.durations / N, N) * scale.t_sat)])
-    passages = [Passage(name, float(tp), solver.targets[name])
-                for name, tp in zip(final.order, t[N::N][:tr.n_targets])]
-    return Plan(t=t, torque=np.vstack([sol.u * sc.wheel_torque_max, np.zeros((1, sc.n_wheels))]),
-                q=rot.normalize(sol.q), omega=sol.h @ scale.rate_per_h.T, control_kind=ControlKind.WHEEL_TORQUE,
-                method=METHOD, nit=sol.nit, passages=passages, stats={"wheel_speed": sol.h * sc.wheel_speed_max})
+    dwell = solver.dwells(final.order)
+    t = node_times(sol.durations * scale.t_sat, dwell, N)
+    torque = np.vstack([sol.u * sc.wheel_torque_max, np.zeros((1, sc.n_wheels))])
+    q, h = rot.normalize(sol.q), sol.h
+    passages = [Passage(name, float(tp), solver.targets[name], float(d))
+                for name, tp, d in zip(final.order, t[N::N][:tr.n_targets], dwell)]
+    held = [(p + 1) * N for p in range(tr.n_targets) if dwell[p] > 0]
+    if held:       # the observation: the node repeated at its end, a zero-torque interval before it
+        at = np.array(held)
+        t = np.insert(t, at + 1, t[at] + dwell[dwell > 0])
+        torque = np.insert(torque, at, 0.0, axis=0)
+        q, h = np.insert(q, at + 1, q[at], axis=0), np.insert(h, at + 1, h[at], axis=0)
+    return Plan(t=t, torque=torque, q=q, omega=h @ scale.rate_per_h.T, control_kind=ControlKind.WHEEL_TORQUE,
+                method=METHOD, nit=sol.nit, passages=passages, stats={"wheel_speed": h * sc.wheel_speed_max})
 
 
 def _finished(solver: OrderSolver, final: Solved, stats: dict, t_begin: float, cpu_begin: float) -> Plan:
@@ -75,7 +84,10 @@ def zone_window(problem: ManeuverProblem) -> float | None:
         return None
     nodes = [problem.q_initial, *problem.targets.values(), problem.q_final]
     longest = max(eigenaxis_rest_to_rest_time(problem.spacecraft, a, b) for a in nodes for b in nodes)
-    return max(problem.zone_sky().window, 2.0 * len(nodes[1:]) * longest)
+    observing = sum(problem.target_dwell.values())
+    closes = [w[1] for w in problem.target_windows.values() if np.isfinite(w[1])]
+    return max(problem.zone_sky().window, 2.0 * len(nodes[1:]) * longest + observing,
+               max(closes, default=0.0) + 2.0 * longest)
 
 
 def plan_schedule(problem: ManeuverProblem, *, order=None, search_intervals: int = 8, intervals: int = 24,
@@ -120,9 +132,13 @@ def plan_schedule(problem: ManeuverProblem, *, order=None, search_intervals: int
         raise ValueError("cone_margin_deg must be in [0, 5] and zone_refinements >= 0")
     solver = OrderSolver.of(problem, substeps, np.deg2rad(cone_margin_deg), zone_window(problem))
     stats: dict = {"orders_solved": 0, "search_intervals": search_intervals, "intervals": intervals,
-                   "substeps": substeps}
+                   "substeps": substeps, "visibility": solver.visible}
     empty = Plan(torque=np.zeros((0, problem.spacecraft.n_wheels)), control_kind=ControlKind.WHEEL_TORQUE,
                  method=METHOD)
+    never = [k for k in names if not any(b - a >= problem.target_dwell.get(k, 0.0) for a, b in solver.visible[k])]
+    if never:
+        return _finish(empty, Status.FAILED, f"target {never[0]!r} can never be observed: its window, less the "
+                       "times a zone covers it, holds no span as long as its dwell", t_begin, cpu_begin, stats)
     try:
         if order is not None:
             solved = [solver.solve(order, search_intervals)]
@@ -131,8 +147,9 @@ def plan_schedule(problem: ManeuverProblem, *, order=None, search_intervals: int
             solved = search_orders(solver, names, search_intervals, candidates, prove, max_order_solves,
                                    second_start_margin, stats)
         if not solved:
-            return _finish(empty, Status.FAILED, "deadline passed before any order was solved", t_begin, cpu_begin,
-                           stats)
+            why = ("no order observes every target within its window" if stats.get("orders_infeasible")
+                   and not solver.expired() else "deadline passed before any order was solved")
+            return _finish(empty, Status.FAILED, why, t_begin, cpu_begin, stats)
         best = min(solved, key=lambda s: s.tf)
         if not np.isfinite(best.tf):
             return _finish(empty, Status.FAILED, "no order converged: " + best.sol.return_status, t_begin,

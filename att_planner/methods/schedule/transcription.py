@@ -89,6 +89,15 @@ def eigenaxis_rest_to_rest_time(sc: dyn.Spacecraft, q_from: np.ndarray, q_to: np
     return float(2.0 * np.sqrt(angle / accel))
 
 
+def node_times(leg_durations: np.ndarray, dwell: np.ndarray, intervals: int) -> np.ndarray:
+    """Times (s) of the K+1 nodes of a tour of legs of ``leg_durations`` (s, ``intervals`` equal
+    intervals each), each target held for its ``dwell`` (s) before the next leg starts: a node at
+    a target is its arrival."""
+    held = np.concatenate([[0.0], np.cumsum(dwell)])[:len(leg_durations)]
+    return np.concatenate([[0.0], np.cumsum(np.repeat(np.asarray(leg_durations) / intervals, intervals))
+                           + np.repeat(held, intervals)])
+
+
 def _aligned(quats: list[np.ndarray]) -> list[np.ndarray]:
     """Flip signs so consecutive quaternions have a non-negative dot product (nearest sign)."""
     out = [rot.normalize(np.asarray(quats[0], float))]
@@ -143,18 +152,25 @@ class MultiphaseTranscription:
         U = ca.MX.sym("U", n_w, K)
         targets = ca.MX.sym("targets", 4, max(n_targets, 1))
         q_end = ca.MX.sym("q_end", 4)
+        dwell = ca.MX.sym("dwell", max(n_targets, 1))      # τ held at each target, in the order's sequence
         dtau = ca.repmat(T.T / N, N, 1).reshape((1, K))  # phase p's dτ on intervals p*N ... p*N+N-1
+        # τ of every node along the tour: the intervals before it and the dwells of the targets passed
+        held = ca.vertcat(0, ca.cumsum(dwell)[:n_targets]) if n_targets else ca.MX.zeros(1, 1)  # (P,) per phase
+        t_nodes = ca.horzcat(0, ca.cumsum(dtau, 1) + ca.repmat(held.T, N, 1).reshape((1, K)))
         step = _interval_map(self.scale, substeps).map(K)
         rows = [self._passage_rows(Q, V, U, dtau, step, targets, q_end),
+                self._observation_rows(V, t_nodes, dwell),
                 self._wheel_speed_rows(V, bound_margin), self._rate_rows(V, rate_max)]
         if self.zones is not None:
-            rows.append(self._zone_rows(T, Q, V, U, dtau, step, zone_margin))
+            rows.append(self._zone_rows(T, Q, V, U, dtau, step, zone_margin, t_nodes, dwell))
         g = [expr for block in rows for expr in block[0]]
+        start = len(rows[0][1])
+        self._observation_rows_at = slice(start, start + len(rows[1][1]))
         self._lbg = np.concatenate([block[1] for block in rows])
         self._ubg = np.concatenate([block[2] for block in rows])
         self._x = ca.vertcat(T, ca.vec(Q), ca.vec(V), ca.vec(U))
         self._split = ca.Function("split", [self._x], [T, Q, V, U])
-        nlp = {"x": self._x, "p": ca.vertcat(ca.vec(targets), q_end), "f": ca.sum1(T), "g": ca.vertcat(*g)}
+        nlp = {"x": self._x, "p": ca.vertcat(ca.vec(targets), q_end, dwell), "f": ca.sum1(T), "g": ca.vertcat(*g)}
         self.ipopt_options = {"ipopt.print_level": 0, "print_time": 0, "ipopt.tol": tol,
                               "ipopt.max_iter": max_iter, "ipopt.mu_strategy": "adaptive",
                               "ipopt.sb": "yes",
@@ -187,6 +203,20 @@ class MultiphaseTranscription:
         n_eq = sum(int(gi.numel()) for gi in g)
         return g, np.zeros(n_eq), np.zeros(n_eq)
 
+    def _observation_rows(self, V, t_nodes, dwell):
+        """Per target, in the order's sequence: its body rates about x and y at its node, then its
+        passage time τ along the tour (dwells included). Their bounds are set by each solve
+        (:meth:`solve`): rates free at a passage, zero where the target is held (a dwell, at rest);
+        the passage time within the target's observation window."""
+        if not self.n_targets:
+            return [], np.zeros(0), np.zeros(0)
+        N = self.intervals
+        rate_xy = ca.DM(self._per_nu(self.scale.rate_per_h[:2, :]))
+        nodes = [(p + 1) * N for p in range(self.n_targets)]
+        g = [rate_xy @ V[:, k] for k in nodes] + [t_nodes[:, nodes].T]
+        n = 3 * self.n_targets
+        return g, np.full(n, -np.inf), np.full(n, np.inf)
+
     def _wheel_speed_rows(self, V, bound_margin: float):
         """The inertial wheel speed h = M⁻¹ν within the limit too (as before the truth model limited
         the relative speed), only on the wheels where the box on ν does not already imply it (none
@@ -211,20 +241,26 @@ class MultiphaseTranscription:
         n = len(rate_rows) * self.n_nodes
         return [ca.vec(R @ V)], np.full(n, -1.0), np.full(n, 1.0)
 
-    def _zone_rows(self, T, Q, V, U, dtau, step, zone_margin: float):
+    def _zone_rows(self, T, Q, V, U, dtau, step, zone_margin: float, t_nodes, dwell):
         """Every zone at every node and interval midpoint (module docstring), at the point's time
-        along the tour when a zone moves; the tour then stays within the zones' window, where
-        their series hold."""
-        K = self.n_nodes - 1
+        along the tour (``t_nodes``, τ, dwells included) when a zone moves, and at each target held
+        through its dwell (its middle and end: a moving zone must stay off the observation); the
+        tour then stays within the zones' window, where their series hold."""
+        K, N = self.n_nodes - 1, self.intervals
         q_mid, _ = step(Q[:, :K], V[:, :K], U, dtau / 2)
-        t_nodes = ca.horzcat(0, ca.cumsum(dtau, 1))           # (1, K+1) τ from the start of the tour
         zone_g = self._zone_function(zone_margin)
         n_zone = len(self.zones.zones) * (2 * K + 1)
         lbg, ubg = np.full(n_zone, -np.inf), np.zeros(n_zone)
         if not self.zones.moving:
             return [ca.vec(zone_g.map(K + 1)(Q)), ca.vec(zone_g.map(K)(q_mid))], lbg, ubg
-        g = [ca.vec(zone_g.map(K + 1)(Q, t_nodes)), ca.vec(zone_g.map(K)(q_mid, t_nodes[:, :K] + dtau / 2)), ca.sum1(T)]
-        return g, np.append(lbg, 0.0), np.append(ubg, self.zones.window / self.scale.t_sat)
+        g = [ca.vec(zone_g.map(K + 1)(Q, t_nodes)), ca.vec(zone_g.map(K)(q_mid, t_nodes[:, :K] + dtau / 2))]
+        for p in range(self.n_targets):
+            node = (p + 1) * N
+            g += [zone_g(Q[:, node], t_nodes[:, node] + fraction * dwell[p]) for fraction in (0.5, 1.0)]
+        n_held = len(self.zones.zones) * 2 * self.n_targets
+        g.append(ca.sum1(T) + ca.sum1(dwell[:self.n_targets]) if self.n_targets else ca.sum1(T))
+        return (g, np.concatenate([lbg, np.full(n_held, -np.inf), [0.0]]),
+                np.concatenate([ubg, np.zeros(n_held), [self.zones.window / self.scale.t_sat]]))
 
     def _variable_bounds(self, bound_margin: float) -> None:
         """Box on the decision vector (T, Q, V, U): phase durations in [1e-3, 1e4] τ, quaternion
@@ -251,15 +287,20 @@ class MultiphaseTranscription:
         return ca.Function("zones", [q, tau] if moving else [q], [g])
 
     # -- guesses ----------------------------------------------------------------------------
-    def initial_guess(self, q_start, targets_in_order, q_end) -> ScheduleSolution:
-        """Slerp between consecutive (sign-aligned) attitudes with eigenaxis durations; wheel
-        momentum from the slerp rate by (1), clipped to the box; zero torque. With zones, the
+    def initial_guess(self, q_start, targets_in_order, q_end, dwell=None, arrivals=None) -> ScheduleSolution:
+        """Slerp between consecutive (sign-aligned) attitudes with eigenaxis durations (or the legs
+        that reach the targets at ``arrivals``, s, after their ``dwell``: waiting for a window);
+        wheel momentum from the slerp rate by (1), clipped to the box; zero torque. With zones, the
         nodes between the passages are pushed out of them (:meth:`_clear_zones`) and the momentum
         follows: each node's from the rotation of the interval before it (else the guess's rates
         cross the pushed attitudes)."""
         P, N, n_w = self.n_phases, self.intervals, self.sc.n_wheels
         chain = _aligned([q_start, *targets_in_order, q_end])
         dur = np.array([max(eigenaxis_rest_to_rest_time(self.sc, a, b), 1.0) for a, b in zip(chain[:-1], chain[1:])])
+        dwell = np.zeros(P - 1) if dwell is None else np.asarray(dwell, float)
+        if arrivals is not None and P > 1:     # each leg from the end of the previous observation to the arrival
+            arrivals = np.asarray(arrivals, float)
+            dur[:-1] = np.maximum(arrivals - np.concatenate([[0.0], arrivals[:-1] + dwell[:-1]]), dur[:-1])
         dur = dur / self.scale.t_sat
         qs, hs = [chain[0][None, :]], [np.zeros((1, n_w))]
         for p in range(P):
@@ -273,21 +314,22 @@ class MultiphaseTranscription:
         q = np.vstack(qs)
         h = np.vstack(hs)
         if self.zones is not None:
-            q = self._clear_zones(q, dur)
+            q = self._clear_zones(q, dur, dwell)
             for k in range(P * N - 1):      # the rates of the moved nodes: node k+1 gets interval k's
                 axis, angle = rot.to_axis_angle(rot.multiply(rot.conjugate(q[k]), q[k + 1]))
                 w_tau = axis * angle / (dur[k // N] / N)
                 h[k + 1] = np.clip(np.linalg.lstsq(self.scale.rate_matrix, w_tau, rcond=None)[0], -0.9, 0.9)
         return ScheduleSolution(dur, q, h, np.zeros((P * N, n_w)), False, "guess", 0, 0.0)
 
-    def _clear_zones(self, q: np.ndarray, durations: np.ndarray, beyond: float = np.deg2rad(2.0)) -> np.ndarray:
+    def _clear_zones(self, q: np.ndarray, durations: np.ndarray, dwell: np.ndarray,
+                     beyond: float = np.deg2rad(2.0)) -> np.ndarray:
         """The guess's attitudes ``q`` (K+1, 4) with each node between the passages that violates a
         zone (at its time) turned so that its boresight lies ``beyond`` outside the zone
         (keep-out: pushed off the guess's local plane of motion too, so the guess goes round the
         zone, not along its axis; keep-in: pulled in radially). A slerp through a zone's axis
         would give the NLP a zero constraint gradient to start from."""
         N, zs = self.intervals, self.zones
-        t = np.concatenate([[0.0], np.cumsum(np.repeat(durations / N, N))]) * self.scale.t_sat
+        t = node_times(durations * self.scale.t_sat, dwell, N)
         t = np.minimum(t, zs.window)
         out = q.copy()
         for k in range(1, len(q) - 1):
@@ -332,12 +374,18 @@ class MultiphaseTranscription:
     # -- solve ------------------------------------------------------------------------------
     def solve(self, q_start, targets_in_order, q_end, guess: ScheduleSolution | None = None,
               max_wall_time: float | None = None, start_at_rest: bool = True,
-              end_at_rest: bool = True) -> ScheduleSolution:
-        """Minimum-time trajectory through ``targets_in_order`` (quaternions, any sign)."""
+              end_at_rest: bool = True, dwell=None, windows=None, arrivals=None) -> ScheduleSolution:
+        """Minimum-time trajectory through ``targets_in_order`` (quaternions, any sign), holding each
+        at rest for its ``dwell`` (s, in the same order; none: a passage) and arriving within its
+        window (``windows``: (opens, closes) s from the start, the observation ending by ``closes``).
+        ``arrivals`` (s): the guess's arrival times (waiting for windows), else eigenaxis legs."""
         if len(targets_in_order) != self.n_targets:
             raise ValueError(f"expected {self.n_targets} targets, got {len(targets_in_order)}")
+        n = self.n_targets
+        dwell = np.zeros(n) if dwell is None else np.asarray(dwell, float)
+        windows = [(-np.inf, np.inf)] * n if windows is None else windows
         if guess is None:
-            guess = self.initial_guess(q_start, targets_in_order, q_end)
+            guess = self.initial_guess(q_start, targets_in_order, q_end, dwell, arrivals)
         solver = self._solver
         if max_wall_time is not None:
             solver = ca.nlpsol("schedule", "ipopt", self._nlp,
@@ -353,10 +401,18 @@ class MultiphaseTranscription:
             lbx[self._index_hf] = ubx[self._index_hf] = 0.0
         targets = ([rot.normalize(np.asarray(q, float)) for q in targets_in_order] if self.n_targets
                    else [np.zeros(4)])
-        params = np.concatenate([*targets, rot.normalize(np.asarray(q_end, float))])
+        t_sat = self.scale.t_sat
+        params = np.concatenate([*targets, rot.normalize(np.asarray(q_end, float)),
+                                 dwell / t_sat if n else np.zeros(1)])
+        lbg, ubg = self._lbg.copy(), self._ubg.copy()
+        rows = np.arange(self._observation_rows_at.start, self._observation_rows_at.stop)
+        held = np.repeat(dwell > 0, 2)
+        lbg[rows[:2 * n][held]] = ubg[rows[:2 * n][held]] = 0.0
+        lbg[rows[2 * n:]] = [w[0] / t_sat for w in windows]
+        ubg[rows[2 * n:]] = [(w[1] - d) / t_sat for w, d in zip(windows, dwell)]
         x0 = np.clip(x0, lbx, ubx)
         start = time.perf_counter()
-        out = solver(x0=x0, lbx=lbx, ubx=ubx, lbg=self._lbg, ubg=self._ubg, p=params)
+        out = solver(x0=x0, lbx=lbx, ubx=ubx, lbg=lbg, ubg=ubg, p=params)
         seconds = time.perf_counter() - start
         stats = solver.stats()
         T, Q, V, U = (np.array(v) for v in self._split(out["x"]))

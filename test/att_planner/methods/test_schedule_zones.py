@@ -11,31 +11,11 @@ from att_planner.methods import schedule as sch
 from att_planner.reference import olivares_staffetti as ref
 from att_planner.verification import integrate, rejection, verify
 from att_sim import rotations as rot
+from helpers.skies import DescendingSky
 
 GRID = 10
 X = np.array([1.0, 0.0, 0.0])
 C = np.sqrt(0.5)
-RATE = np.deg2rad(0.25)          # rad/s: the Sun descends along the 45° meridian
-
-
-class DescendingSky:
-    """A sky whose Sun starts at azimuth 45°, elevation 52° and turns down its meridian at RATE
-    (the zones' sky interface of :class:`att_planner.zones.ZoneSky`; Moon and Earth unused)."""
-
-    d0 = rot.dcm(rot.from_axis_angle([-C, C, 0.0], -np.deg2rad(52.0))) @ np.array([C, C, 0.0])
-
-    def sun_direction(self, t):
-        t = np.asarray(t, float)
-        turn = rot.from_axis_angle(np.broadcast_to([-C, C, 0.0], t.shape + (3,)), RATE * t)
-        return rot.dcm(turn) @ self.d0
-
-    moon_direction = sun_direction
-
-    def nadir(self, t):
-        return np.broadcast_to([0.0, 0.0, -1.0], np.shape(t) + (3,))
-
-    def earth_angular_radius(self, t):
-        return np.full(np.shape(t), 0.5)
 
 
 @pytest.fixture(scope="module")
