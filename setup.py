@@ -17,6 +17,7 @@ setup(
         ("share/ament_index/resource_index/packages", ["resource/" + PACKAGE]),
         ("share/" + PACKAGE, ["package.xml"]),
         ("share/" + PACKAGE + "/config", glob("config/*.yaml")),
+        ("share/" + PACKAGE + "/config/targets", glob("config/targets/*.yaml")),
         ("share/" + PACKAGE + "/campaigns", glob("campaigns/*.yaml")),
     ],
     install_requires=["numpy", "scipy", "pyyaml", "mcap", "mcap-ros2-support", "casadi"],

@@ -31,6 +31,7 @@ class ErrorCode(IntEnum):
     ZONE_AT_END = 154             # the start or goal violates a zone (keep-out entered / keep-in left)
     CONTRADICTORY_ZONES = 155     # zones no direction can satisfy together (e.g. keep-in inside keep-out)
     INVALID_WHEEL_SPEEDS = 160    # wheel_speeds of the wrong length, not finite, or beyond the wheels' limit
+    INVALID_OBSERVATION = 161     # a schedule's dwell or window: wrong length, not finite, negative, or too short
     # planner: solving
     SOLVER_FAILED = 200           # the method failed and no fallback plan was possible
     VERIFICATION_FAILED = 201     # the plan did not survive integration through the dynamics

@@ -149,7 +149,8 @@ class PlannerNode(Node):
                 frame_id=self._frame_id, request_frame=request.header.frame_id,
                 default_spacecraft=self._scenario_name, default_budget=self._default_budget,
                 rate_max=self._schedule_rate_max, epoch=convert.epoch_parts(request.epoch),
-                zones=[convert.zone_from_msg(z) for z in request.zones], tle=(request.tle_line1, request.tle_line2))
+                zones=[convert.zone_from_msg(z) for z in request.zones], tle=(request.tle_line1, request.tle_line2),
+                observations=(list(request.dwell_times), list(request.window_opens), list(request.window_closes)))
         except RequestError as err:
             return self.refuse(response, err, "schedule")
 
@@ -163,6 +164,7 @@ class PlannerNode(Node):
         if outcome.code == ErrorCode.OK:
             response.order = outcome.plan.order
             response.passage_times = [float(p.time) for p in outcome.plan.passages]
+            response.observation_ends = [float(p.time + p.dwell) for p in outcome.plan.passages]
         self.answer(response, outcome, valid.spacecraft, f"schedule of {len(valid.problem.targets)} targets",
                     zones=valid.problem.zones, epoch=valid.problem.epoch,
                     spacecraft_digest=valid.problem.spacecraft.digest)

@@ -39,6 +39,8 @@ MAX_CONES = 16
 MAX_OPTIONS = 16
 MAX_TIME_BUDGET = 600.0        # s
 MAX_TARGETS = 20               # schedule targets (the order search is exponential in their number)
+MAX_DWELL = 86_400.0           # s: a schedule target's observation, at most a day
+MAX_WINDOW = 7 * 86_400.0      # s: a schedule target's window opens within a week of the start
 SAME_TARGET = 1e-6             # rad: schedule targets closer than this are one attitude (q and -q too)
 END_POINTING_METHOD = "time_optimal"   # the method that ends a slew on a moving pointing mode
 
@@ -142,8 +144,10 @@ def check_cones(raw: list) -> list[Cone]:
 
 def zone_window(problem: ManeuverProblem, legs: int = 1) -> float:
     """The zone window (s) of ``problem`` (:meth:`ManeuverProblem.default_window`), times
-    ``legs`` for a schedule: the span its orbit must last."""
-    return problem.default_window() * legs
+    ``legs`` for a schedule, with its observations and its last window's close: the span its orbit
+    must last."""
+    closes = [b for _, b in problem.target_windows.values() if math.isfinite(b)]
+    return problem.default_window() * legs + sum(problem.target_dwell.values()) + max(closes, default=0.0)
 
 
 def check_sky(problem: ManeuverProblem, real: RequestSky, legs: int = 1) -> None:
@@ -334,17 +338,49 @@ def check_targets_clear(problem: ManeuverProblem) -> None:
                                f"{np.degrees(-m[k]):.2f} deg; it can never be passed")
 
 
+def check_observations(names: list, dwell: list, opens: list, closes: list) -> tuple[dict, dict]:
+    """A schedule's observations (``dwell_times``, ``window_opens``, ``window_closes``): each none or
+    one value per target; dwells finite in [0, MAX_DWELL]; windows both or neither, opens finite ≥ 0,
+    closes after opens by at least the dwell (.inf: never closes). ``(dwell, windows)`` by name."""
+    fields = {"dwell_times": dwell, "window_opens": opens, "window_closes": closes}
+    for field_name, values in fields.items():
+        if len(values) not in (0, len(names)):
+            raise RequestError(ErrorCode.INVALID_OBSERVATION,
+                               f"{field_name} has {len(values)} values for {len(names)} targets (give one per "
+                               "target, or none)")
+    if bool(opens) != bool(closes):
+        raise RequestError(ErrorCode.INVALID_OBSERVATION, "window_opens and window_closes go together: give both "
+                                                          "or neither")
+    for i, d in enumerate(dwell):
+        if not (math.isfinite(d) and 0.0 <= d <= MAX_DWELL):
+            raise RequestError(ErrorCode.INVALID_OBSERVATION,
+                               f"dwell_times[{i}] ('{names[i]}') = {d!r} s is outside [0, {MAX_DWELL:g}] s")
+    for i, (a, b) in enumerate(zip(opens, closes)):
+        if not (math.isfinite(a) and 0.0 <= a <= MAX_WINDOW):
+            raise RequestError(ErrorCode.INVALID_OBSERVATION,
+                               f"window_opens[{i}] ('{names[i]}') = {a!r} s is outside [0, {MAX_WINDOW:g}] s")
+        need = a + (dwell[i] if dwell else 0.0)
+        if math.isnan(b) or b < need or b == -math.inf:
+            raise RequestError(ErrorCode.INVALID_OBSERVATION,
+                               f"window_closes[{i}] ('{names[i]}') = {b!r} s leaves no time to observe it (it "
+                               f"opens at {a:g} s{f' and needs {dwell[i]:g} s' if dwell else ''})")
+    return ({n: float(d) for n, d in zip(names, dwell) if d > 0},
+            {n: (float(a), float(b)) for n, a, b in zip(names, opens, closes)})
+
+
 def validate_schedule(names: list, targets: list, q_start, q_end, spacecraft: str, time_budget: float, *,
                       frame_id: str, request_frame: str, default_spacecraft: str, default_budget: float,
                       rate_max: float = math.inf, epoch: tuple = (0, 0), zones: list = (),
-                      tle: tuple = ("", "")) -> ValidSchedule:
+                      tle: tuple = ("", ""), observations: tuple = ((), (), ())) -> ValidSchedule:
     """Check a PlanSchedule request: names match targets, unit quaternions, a wheeled spacecraft,
     the real sky as for a maneuver (``epoch`` (sec, nanosec), ``zones``, ``tle`` lines; the orbit
-    must last a window per leg). ``q_end`` None: end where the schedule started. ``rate_max``: the
+    must last a window per leg), the observations (``(dwell_times, window_opens, window_closes)``,
+    :func:`check_observations`). ``q_end`` None: end where the schedule started. ``rate_max``: the
     planner's body-rate bound."""
     check_frame(request_frame, frame_id)
     text(spacecraft, "spacecraft")
     checked = check_targets(list(names), list(targets))
+    dwell, windows = check_observations(list(names), *(list(v) for v in observations))
     q0 = unit_quaternion(q_start, "start_attitude")
     q1 = q0 if q_end is None else unit_quaternion(q_end, "end_attitude")
     name = spacecraft or default_spacecraft
@@ -357,7 +393,7 @@ def validate_schedule(names: list, targets: list, q_start, q_end, spacecraft: st
     budget = check_budget(float(time_budget), default_budget)
     real = resolve_sky(*epoch, list(zones), *tle, scenario)
     problem = ManeuverProblem(sc, q0, q1, targets=checked, rate_max=rate_max, zones=real.zones, epoch=real.epoch,
-                              sky=real.sky if real.moving else None)
+                              sky=real.sky if real.moving else None, target_dwell=dwell, target_windows=windows)
     if real.zones or real.sky is not None:
         check_sky(problem, real, legs=len(checked) + 1)
         check_targets_clear(problem)

@@ -204,6 +204,24 @@ SCHEDULE_CASES = {
     "schedule start zero": (dict(q_start=[0, 0, 0, 0]), ErrorCode.INVALID_ATTITUDE, "start_attitude is the zero"),
     "schedule end huge": (dict(q_end=[0, 0, 0, 1e200]), ErrorCode.INVALID_ATTITUDE, "end_attitude has norm"),
     "schedule budget nan": (dict(time_budget=NAN), ErrorCode.INVALID_TIME_BUDGET, "time_budget"),
+    "dwell for one of two": (dict(observations=([10.0], [], [])), ErrorCode.INVALID_OBSERVATION,
+                             "dwell_times has 1 values for 2 targets"),
+    "dwell negative": (dict(observations=([10.0, -1.0], [], [])), ErrorCode.INVALID_OBSERVATION,
+                       "dwell_times[1] ('b') = -1.0 s"),
+    "dwell nan": (dict(observations=([NAN, 1.0], [], [])), ErrorCode.INVALID_OBSERVATION, "dwell_times[0] ('a')"),
+    "dwell inf": (dict(observations=([1.0, INF], [], [])), ErrorCode.INVALID_OBSERVATION, "dwell_times[1] ('b')"),
+    "window opens only": (dict(observations=([], [0.0, 0.0], [])), ErrorCode.INVALID_OBSERVATION,
+                          "window_opens and window_closes go together"),
+    "window closes before it opens": (dict(observations=([], [100.0, 0.0], [50.0, INF])),
+                                      ErrorCode.INVALID_OBSERVATION, "window_closes[0] ('a') = 50.0 s"),
+    "window shorter than the dwell": (dict(observations=([60.0, 0.0], [100.0, 0.0], [130.0, INF])),
+                                      ErrorCode.INVALID_OBSERVATION, "needs 60 s"),
+    "window opens at -inf": (dict(observations=([], [-INF, 0.0], [10.0, 10.0])), ErrorCode.INVALID_OBSERVATION,
+                             "window_opens[0] ('a') = -inf"),
+    "window closes nan": (dict(observations=([], [0.0, 0.0], [NAN, 10.0])), ErrorCode.INVALID_OBSERVATION,
+                          "window_closes[0] ('a') = nan"),
+    "windows long": (dict(observations=([], [0.0] * 10_000, [1.0] * 10_000)), ErrorCode.INVALID_OBSERVATION,
+                     "window_opens has 10000 values"),
 }
 
 
@@ -221,6 +239,9 @@ def test_there_are_more_than_fifty_distinct_hostile_requests():
 
 def test_a_valid_schedule_passes_the_same_checks():
     assert sorted(schedule().problem.targets) == ["a", "b"]
+    observing = schedule(observations=([30.0, 0.0], [0.0, 100.0], [INF, 200.0])).problem
+    assert observing.target_dwell == {"a": 30.0}
+    assert observing.target_windows == {"a": (0.0, INF), "b": (100.0, 200.0)}
 
 
 def narrow_gap(gap_deg: float) -> list:

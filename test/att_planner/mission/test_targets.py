@@ -1,0 +1,104 @@
+"""Target lists (issue 17): the shipped observatory and Earth-observation lists, the attitude that
+points the sensor at a source, and hostile files refused with the file, target and field named."""
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from att_msgs_py.errors import ConfigError, ErrorCode
+from att_planner.methods.schedule.order_search import visibility
+from att_planner.mission import targets as tl
+from att_planner.tools.bench import sky
+from att_sim import rotations as rot
+
+
+def test_the_shipped_lists_load():
+    observatory = tl.load("observatory")
+    assert observatory.kind == "inertial" and observatory.scenario == "leo_observatory"
+    assert 10 <= len(observatory.targets) <= 20
+    for source in observatory.targets:
+        assert np.linalg.norm(source.direction) == pytest.approx(1.0) and source.dwell > 0
+    ground = tl.load("earth_observation")
+    assert ground.kind == "ground" and len(ground.targets) == 10
+    assert ground.min_elevation == pytest.approx(np.deg2rad(30.0))
+    toulouse = next(s for s in ground.targets if s.name == "toulouse")
+    assert (np.rad2deg(toulouse.latitude), np.rad2deg(toulouse.longitude)) == pytest.approx((43.604, 1.444))
+
+
+@pytest.mark.parametrize("sensor", [[0, 1, 0], [1, 0, 0], [0, 0, 1], [0.6, 0.8, 0]])
+def test_the_attitude_points_the_sensor_and_keeps_the_roll_axis_nearest_the_reference(sensor):
+    rng = np.random.default_rng(7)
+    sensor = np.asarray(sensor, float) / np.linalg.norm(sensor)
+    for d in rng.normal(size=(50, 3)):
+        d /= np.linalg.norm(d)
+        R = rot.dcm(tl.pointing_attitude(sensor, d))
+        assert R @ sensor == pytest.approx(d, abs=1e-12)
+        # the roll axis is the unit vector ⟂ d nearest north: its north component is |north ⟂ d|
+        r_body = np.roll(np.eye(3), 1, axis=0)[int(np.argmax(np.abs(sensor)))]
+        r_body = r_body - (r_body @ sensor) * sensor
+        roll = R @ (r_body / np.linalg.norm(r_body))
+        assert roll[2] == pytest.approx(np.sqrt(1.0 - d[2] ** 2), abs=1e-9)
+
+
+def test_sources_beside_the_sun_and_the_moon_are_never_visible_and_the_others_are():
+    _, problem = sky.case_problem("leo_observatory")
+    sources = {s.name: s for s in tl.load("observatory").targets}
+    problem = replace(problem, targets={k: tl.pointing_attitude(problem.sensor_axis, s.direction)
+                                        for k, s in sources.items()})
+    zones = problem.zone_sky(6 * 3600.0)
+    seen = {k: visibility(zones, q, (0.0, np.inf)) for k, q in problem.targets.items()}
+    # Sgr A* 6° from the Sun (zone 47°), the Pleiades 11-15° from the Moon (zone 23°) all day
+    assert {k for k, v in seen.items() if not v} == {"sgr_a_star", "pleiades"}
+    sun, moon = zones.true_axes(np.array([0.0]))[0][:2]
+    assert np.degrees(np.arccos(sun @ sources["sgr_a_star"].direction)) < 47.0
+    assert np.degrees(np.arccos(moon @ sources["pleiades"].direction)) < 23.0
+    # the Earth limb covers some sources for part of every orbit: their visible spans are broken
+    assert any(len(v) > 1 for v in seen.values())
+
+
+GOOD = {"kind": "inertial", "scenario": "leo_observatory",
+        "targets": [{"name": "a", "ra_deg": 10.0, "dec_deg": 20.0, "dwell_s": 60.0}]}
+HOSTILE = {
+    "kind unknown": ({"kind": "galactic"}, "kind = 'galactic'"),
+    "unknown file key": ({"colour": 1}, "unknown key(s) colour"),
+    "unknown scenario": ({"scenario": "nowhere"}, "scenario = 'nowhere' is not a known scenario"),
+    "no targets": ({"targets": []}, "targets must list 1 to 20"),
+    "21 targets": ({"targets": [{"name": f"t{i}", "ra_deg": i, "dec_deg": 0, "dwell_s": 1} for i in range(21)]},
+                   "got 21"),
+    "target not a mapping": ({"targets": [5]}, "targets[0] is not a mapping"),
+    "typo in a target": ({"targets": [{"name": "a", "ra_deg": 1, "dec": 2, "dwell_s": 1}]}, "unknown key(s) dec"),
+    "missing dwell": ({"targets": [{"name": "a", "ra_deg": 1, "dec_deg": 2}]}, "no key(s) dwell_s"),
+    "dec 95": ({"targets": [{"name": "a", "ra_deg": 1, "dec_deg": 95, "dwell_s": 1}]}, "targets[0] ('a').dec_deg = 95"),
+    "dwell nan": ({"targets": [{"name": "a", "ra_deg": 1, "dec_deg": 2, "dwell_s": float("nan")}]}, "dwell_s = nan"),
+    "dwell negative": ({"targets": [{"name": "a", "ra_deg": 1, "dec_deg": 2, "dwell_s": -5}]}, "dwell_s = -5"),
+    "ra as text": ({"targets": [{"name": "a", "ra_deg": "ten", "dec_deg": 2, "dwell_s": 1}]}, "ra_deg = 'ten'"),
+    "ra true": ({"targets": [{"name": "a", "ra_deg": True, "dec_deg": 2, "dwell_s": 1}]}, "ra_deg = True"),
+    "name with a control": ({"targets": [{"name": "a\x01", "ra_deg": 1, "dec_deg": 2, "dwell_s": 1}]}, "name ="),
+    "names repeat": ({"targets": [{"name": "a", "ra_deg": 1, "dec_deg": 2, "dwell_s": 1}] * 2}, "'a' appears twice"),
+    "roll reference zero": ({"roll_reference": [0, 0, 0]}, "roll_reference = [0, 0, 0]"),
+    "ground site at latitude 100": ({"kind": "ground", "targets": [{"name": "x", "lat_deg": 100, "lon_deg": 0,
+                                                                    "dwell_s": 1}]}, "lat_deg = 100"),
+    "ground elevation 90": ({"kind": "ground", "min_elevation_deg": 90, "targets": [
+        {"name": "x", "lat_deg": 0, "lon_deg": 0, "dwell_s": 1}]}, "min_elevation_deg = 90"),
+}
+
+
+@pytest.mark.parametrize("name", sorted(HOSTILE))
+def test_a_hostile_target_list_is_refused_naming_the_field(tmp_path, name):
+    import yaml
+    changes, words = HOSTILE[name]
+    path = tmp_path / "list.yaml"
+    path.write_text(yaml.safe_dump({**GOOD, **changes}))
+    with pytest.raises(ConfigError) as err:
+        tl.load(str(path))
+    assert err.value.code == ErrorCode.INVALID_CONFIG and words in err.value.message, err.value.message
+    assert str(path) in err.value.message
+
+
+def test_unknown_list_and_unreadable_file(tmp_path):
+    with pytest.raises(KeyError, match="unknown target list 'nowhere'.*observatory"):
+        tl.load("nowhere")
+    path = tmp_path / "broken.yaml"
+    path.write_text("kind: [inertial\n")
+    with pytest.raises(ConfigError, match="not valid YAML"):
+        tl.load(str(path))
