@@ -55,6 +55,7 @@ class WheelDriveSpec:
 class MagnetorquerSpec:
     quantization: float = 0.0           # A m² per count; 0: none
     misalignment: float = 0.0           # rad 1σ per off-diagonal element
+    scale: tuple = ()                   # per coil: produced/commanded dipole (a campaign's dispersion); (): 1
 
 
 @dataclass(frozen=True)
@@ -124,4 +125,5 @@ class Magnetorquers:
 
     def __call__(self, m: np.ndarray) -> np.ndarray:
         """The dipole the coils produce for the (saturated) command ``m``."""
-        return self.transfer @ quantize(m, self.spec.quantization)
+        m = quantize(m, self.spec.quantization)
+        return self.transfer @ (m * np.asarray(self.spec.scale) if self.spec.scale else m)

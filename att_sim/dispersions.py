@@ -37,6 +37,7 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass, replace
+from datetime import timedelta
 from pathlib import Path
 
 import numpy as np
@@ -45,7 +46,7 @@ from scipy.special import ndtr, ndtri
 
 from att_sim import rotations as rot
 from att_sim import scenario as scen
-from att_sim.actuators import WheelDriveSpec
+from att_sim.actuators import MagnetorquerSpec, WheelDriveSpec
 from att_sim.config_group import Group
 from att_sim.sensors import STREAMS
 
@@ -62,7 +63,9 @@ DISPERSIONS = {
     "wheel_misalignment_deg": (lambda sc: 2 * sc.n_wheels, "two perpendicular tilts of each wheel axis (deg)"),
     "wheel_inertia_scale": (lambda sc: 1, "relative error of the wheels' spin inertia"),
     "wheel_torque_scale": (lambda sc: sc.n_wheels, "relative error of each wheel drive's torque (scale factor)"),
+    "magnetorquer_scale": (lambda sc: 3, "relative error of each magnetorquer coil's dipole (scale factor)"),
     "com_offset_m": (lambda sc: 3, "centre of mass offset (m, body): facets' centres of pressure move by -offset"),
+    "epoch_offset_s": (lambda sc: 1, "the truth's epoch minus the flight software's (s): orbit, sky and field move"),
     "initial_attitude_error_deg": (lambda sc: 3, "rotation vector of the initial attitude error (deg, body)"),
     "initial_rate_error": (lambda sc: 3, "initial body rate error (rad/s)"),
 }
@@ -212,9 +215,14 @@ def truth(scenario: scen.Scenario, values: dict, seed: int, q0=rot.IDENTITY, ome
     """``scenario`` with the applied ``values`` (:func:`draw`) and the nominal start ``q0``,
     ``omega0`` dispersed; ValueError naming the seed when the draw is not physical or a dispersion
     has nothing to act on."""
-    sc, actuators, environment = scenario.spacecraft, scenario.actuators, scenario.environment
-    zero = {name: np.zeros(DISPERSIONS[name][0](sc)) for name in DISPERSIONS}
+    zero = {name: np.zeros(DISPERSIONS[name][0](scenario.spacecraft)) for name in DISPERSIONS}
     v = {**zero, **values}
+    if "epoch_offset_s" in values:
+        if scenario.epoch is None:
+            raise ValueError(f"epoch_offset_s: scenario '{scenario.name}' has no epoch, so an epoch offset would "
+                             f"change nothing")
+        scenario = scen.with_epoch(scenario, scenario.epoch + timedelta(seconds=float(v["epoch_offset_s"][0])))
+    sc, actuators, environment = scenario.spacecraft, scenario.actuators, scenario.environment
     moments, axes = np.linalg.eigh(sc.inertia)
     turn = rot.dcm(rot.exp_map(v["inertia_rotation_deg"] * DEG)) @ axes
     inertia = turn @ np.diag(moments * (1.0 + v["inertia_scale"])) @ turn.T
@@ -233,6 +241,14 @@ def truth(scenario: scen.Scenario, values: dict, seed: int, q0=rot.IDENTITY, ome
         if np.any(scale < 0):
             raise ValueError(f"run seed {seed}: a wheel torque scale factor is negative ({scale.min():.6g})")
         actuators = replace(actuators, wheels=replace(actuators.wheels or WheelDriveSpec(), torque_scale=tuple(scale)))
+    if "magnetorquer_scale" in values:
+        if not sc.dipole_max > 0:
+            raise ValueError(f"magnetorquer_scale: scenario '{scenario.name}' has no magnetorquers")
+        scale = 1.0 + v["magnetorquer_scale"]
+        if np.any(scale < 0):
+            raise ValueError(f"run seed {seed}: a magnetorquer scale factor is negative ({scale.min():.6g})")
+        actuators = replace(actuators, magnetorquers=replace(actuators.magnetorquers or MagnetorquerSpec(),
+                                                             scale=tuple(scale)))
     if "com_offset_m" in values:
         if not (environment.get("solar_pressure") or environment.get("drag")):
             raise ValueError(f"com_offset_m: scenario '{scenario.name}' has no solar pressure or drag, so a centre "

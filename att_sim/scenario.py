@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import math
 import os
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from datetime import datetime
 from pathlib import Path
 
@@ -406,6 +406,19 @@ def load(name: str) -> Scenario:
         frame_id=shared.get("frame_id", "eci"), body_frame_id=shared.get("body_frame_id", "body"),
         node_params=nodes, epoch=epoch, orbit_model=orbit_model, field_model=field_model, environment=environment,
         zones=zones, sensors=sensors, actuators=actuators)
+
+
+def with_epoch(scenario: Scenario, epoch: datetime) -> Scenario:
+    """``scenario`` with another epoch: everything its file builds from the epoch (orbit, field
+    model, environment, zones, sensors and actuators) rebuilt from that file for ``epoch``."""
+    doc = read_document(scenario.path)
+    shared = check_document(scenario.path, doc)
+    orbit_model = orbit_model_from_params(scenario.path, shared, epoch)
+    sensors, actuators = sensors_and_actuators(scenario.path, shared, epoch)
+    return replace(scenario, epoch=epoch, orbit_model=orbit_model,
+                   field_model=field_model_from_params(scenario.path, shared, epoch),
+                   environment=environment_from_params(scenario.path, shared, epoch),
+                   zones=zones_from_params(scenario.path, shared, epoch), sensors=sensors, actuators=actuators)
 
 
 def load_checked(name: str) -> Scenario:

@@ -149,6 +149,33 @@ def test_a_bad_campaign_is_refused_naming_the_field(name):
         disp.campaign_from(doc, Path("bad.yaml"))
 
 
+def test_the_coils_deliver_the_scaled_dipole():
+    c = campaign({"magnetorquer_scale": {"distribution": "uniform", "low": -0.3, "high": -0.2}})
+    ideal = replace(SWIFT, actuators=replace(SWIFT.actuators, magnetorquers=None))
+    truth, v = disp.seed_truth(c, ideal, 5)
+    coils = Simulation.for_scenario(truth.scenario).magnetorquers
+    m = np.array([2.0, -1.0, 0.5])
+    assert coils(m) == pytest.approx(m * (1 + v["magnetorquer_scale"]), rel=1e-12)
+
+
+def test_an_epoch_offset_moves_the_truths_orbit_and_sky():
+    """leo_observatory's epoch moved by the draw: the orbit's position at t = 0 is where the nominal
+    orbit is at the offset (the TLE is the same), and the Sun and the zones follow."""
+    leo = scen.load("leo_observatory")
+    c = replace(campaign({"epoch_offset_s": {"distribution": "uniform", "low": 100.0, "high": 200.0}}),
+                scenario="leo_observatory")
+    truth, v = disp.seed_truth(c, leo, 9)
+    offset = float(v["epoch_offset_s"][0])
+    assert 100.0 <= offset <= 200.0
+    assert (truth.scenario.epoch - leo.epoch).total_seconds() == pytest.approx(offset, abs=1e-6)
+    moved, nominal = truth.scenario.orbit_model, leo.orbit_model
+    assert moved.position(np.array([0.0, 60.0])) == pytest.approx(nominal.position(np.array([offset, offset + 60.0])),
+                                                                 abs=0.01)      # m
+    assert leo.epoch == scen.load("leo_observatory").epoch                # the nominal scenario is untouched
+    with pytest.raises(ValueError, match="'swift_demo' has no epoch"):
+        disp.seed_truth(campaign({"epoch_offset_s": {"distribution": "normal", "sigma": 1.0}}), SWIFT, 1)
+
+
 def test_bad_files_and_a_dispersion_with_nothing_to_act_on_are_refused(tmp_path):
     with pytest.raises(ValueError, match="cannot be read"):
         disp.load_campaign(tmp_path / "missing.yaml")
