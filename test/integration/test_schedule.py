@@ -1,4 +1,5 @@
-"""PlanSchedule over ROS: a 2-target tour planned by the planner node, verified, executed."""
+"""PlanSchedule over ROS: a 2-target tour planned by the planner node, verified, executed; the first
+target observed (held for a dwell, issue 17), the second flown through."""
 from __future__ import annotations
 
 import math
@@ -15,6 +16,7 @@ from att_planner.reference.olivares_staffetti import olivares_targets
 from att_sim import rotations as rot
 
 pytestmark = pytest.mark.ros
+DWELL = 20.0                  # s held on target a
 
 
 def schedule_request(names, targets, budget=120.0):
@@ -31,9 +33,17 @@ def test_schedule_is_planned_verified_and_executed(ros_suite):
         assert not bad.success and bad.error_code == ErrorCode.INVALID_ATTITUDE and "distinct" in bad.message
         targets = olivares_targets("A")
         names = ["a", "b"]
-        response = client.schedule(schedule_request(names, [targets[n] for n in names]))
+        short = schedule_request(names, [targets[n] for n in names])
+        short.dwell_times, short.window_opens, short.window_closes = [20.0, 0.0], [0.0, 0.0], [10.0, math.inf]
+        bad = client.schedule(short)
+        assert not bad.success and bad.error_code == ErrorCode.INVALID_OBSERVATION and "needs 20 s" in bad.message
+        request = schedule_request(names, [targets[n] for n in names])
+        request.dwell_times = [DWELL, 0.0]
+        response = client.schedule(request)
         assert response.success, response.message
         assert sorted(response.order) == names and len(response.passage_times) == 2
+        held = dict(zip(response.order, zip(response.passage_times, response.observation_ends)))
+        assert held["a"][1] - held["a"][0] == pytest.approx(DWELL) and held["b"][1] == held["b"][0]
         plan = response.plan
         assert plan.control_kind == "wheel_torque" and plan.verification.final_attitude_error < math.radians(0.5)
         result = client.execute(plan.plan_id)
@@ -49,3 +59,7 @@ def test_schedule_is_planned_verified_and_executed(ros_suite):
     for name, tp in zip(response.order, response.passage_times):
         k = int(np.argmin(np.abs(t - (t0 + tp))))
         assert rot.angle_between(q[k], targets[name]) < math.radians(2.0), name
+    start, end = held["a"]          # observed: on the target through the whole dwell
+    during = (t >= t0 + start + 1.0) & (t <= t0 + end)
+    assert during.sum() >= 10
+    assert max(rot.angle_between(qk, targets["a"]) for qk in q[during]) < math.radians(2.0)
