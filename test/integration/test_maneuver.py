@@ -2,7 +2,9 @@
 executed on the simulator, and the recorded MCAP checked by replay."""
 from __future__ import annotations
 
+import json
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -22,6 +24,7 @@ SENSOR = np.array([1.0, 0.0, 0.0])
 CONES = [Cone([0.5, 0.866, 0.0], math.radians(47), "sun"), Cone([0.0, 0.0, -1.0], math.radians(33), "earth"),
          Cone([0.1795, 0.3109, 0.9333], math.radians(23), "moon")]
 GOAL = rot.from_axis_angle([0, 0, 1], math.radians(135))
+LAYOUT = Path(__file__).parents[2] / "docs" / "foxglove_layout.json"
 
 
 @pytest.fixture(scope="module")
@@ -79,3 +82,14 @@ def test_maneuver_is_planned_executed_and_recorded(suite):
     assert m.min() >= 0.0, f"recorded path enters a cone by {np.degrees(-m.min()):.3f} deg"
     assert rot.angle_between(state["attitude"][-1], GOAL) < math.radians(0.5)
     assert np.linalg.norm(state["body_rate"][-1]) < 1e-3
+    # the shipped Foxglove layout opens this log: every topic it references holds messages in it
+    from mcap.reader import make_reader
+    with open(suite.mcap, "rb") as fh:
+        summary = make_reader(fh).get_summary()
+    counts = {summary.channels[c].topic: n for c, n in summary.statistics.channel_message_counts.items()}
+    config = json.loads(LAYOUT.read_text())["configById"]
+    referenced = {path.split(".")[0] for panel in config.values() for path in
+                  [*panel.get("topics", {}), *(p["value"] for p in panel.get("paths", [])), panel.get("topicPath", "")]
+                  if path}
+    assert len(referenced) >= 5
+    assert {t: counts.get(t, 0) for t in referenced if not counts.get(t)} == {}
