@@ -37,6 +37,17 @@ class ZoneView(NamedTuple):
     half_angle: float
 
 
+EARTH_FIXED_FRAME = "itrs"          # /tf child of the inertial frame in the scenarios with an epoch
+
+
+def earth_fixed(environment, t: float, r_N) -> tuple[np.ndarray, np.ndarray]:
+    """The Earth-fixed frame (ITRS) in the inertial frame of a view centred on the spacecraft at
+    ``r_N`` (m): ``(q_EN, origin_N)``, the rotation with ``p_N = R(q_EN) p_E`` (the transpose of
+    the field's GCRS → ITRS rotation, IAU 2006 by skyfield) and the Earth's centre at ``−r_N``."""
+    R_EN = environment.field.itrs_rotation(np.asarray(t, float))        # r_E = R r_N
+    return rot.from_dcm(R_EN.T), -np.asarray(r_N, float)
+
+
 def zone_views(zones: list[Zone], bodies: Bodies) -> list[ZoneView]:
     """Every zone where it is at the time of ``bodies`` (a Sun or Moon zone without a sky is left out)."""
     out = []

@@ -342,7 +342,11 @@ class SimulatorNode(Node):
         t, frame_N, frame_B = self.sim.t, self.scenario.frame_id, self.scenario.body_frame_id
         zones, q_BN = self.scenario.zones, self.sim.x[:4]
         if tf_every and k % tf_every == 0:
-            self.tf_pub.publish(markers.tf_msg([markers.transform_msg(t, frame_N, frame_B, q_BN)]))
+            frames = [markers.transform_msg(t, frame_N, frame_B, q_BN)]
+            if self.scenario.epoch is not None:         # the Earth-fixed frame, the Earth's centre at -r
+                q_EN, origin = scene.earth_fixed(self.sim.environment, t, self.sim.position())
+                frames.append(markers.transform_msg(t, frame_N, scene.EARTH_FIXED_FRAME, q_EN, origin))
+            self.tf_pub.publish(markers.tf_msg(frames))
             views = scene.zone_views(zones, self.sim.environment.bodies(t))
             self.margin_pub.publish(markers.zone_margins_msg(t, frame_N, [v.name for v in views],
                                                              [v.keep_in for v in views],

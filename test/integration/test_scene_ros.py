@@ -1,8 +1,9 @@
 """The 3D view through the nodes (issue 17): a real-sky run of the simulator and the planner,
 recorded; the log, decoded by rosbags from its own definitions, holds /tf with the body frame under
-the inertial one (the state's attitude), the zones' cones where the sky puts them, their margins,
-and the plan's boresight path."""
+the inertial one (the state's attitude) and the Earth-fixed frame (skyfield's ITRS, at -r), the
+zones' cones where the sky puts them, their margins, and the plan's boresight path."""
 import math
+from datetime import timedelta
 
 import numpy as np
 import pytest
@@ -52,9 +53,24 @@ def test_a_recorded_real_sky_run_holds_tf_markers_and_the_plan_path(ros_suite):
     assert types[topics.SIM_MARKERS] == types[topics.PLAN_MARKERS] == "visualization_msgs/msg/MarkerArray"
 
     states = {round(stamp(m), 6): m for m in log[topics.STATE]}
-    tfs = [t for m in log[topics.TF] for t in m.transforms]
-    assert len(tfs) >= 10 * END and {(t.header.frame_id, t.child_frame_id) for t in tfs} == {("gcrs", "body")}
-    assert max(stamp(t) for t in tfs) >= END - 1e-6
+    frames = [t for m in log[topics.TF] for t in m.transforms]
+    assert {(t.header.frame_id, t.child_frame_id) for t in frames} == {("gcrs", "body"), ("gcrs", "itrs")}
+    tfs = [t for t in frames if t.child_frame_id == "body"]
+    assert len(tfs) >= 10 * END and max(stamp(t) for t in tfs) >= END - 1e-6
+    # the Earth-fixed frame: skyfield's ITRS rotation at that instant, the Earth's centre at -r
+    from skyfield.api import load as sky_load
+    from skyfield.framelib import itrs
+    timescale = sky_load.timescale(builtin=True)
+    epoch = scen.load(SCENARIO).epoch
+    earth = [t for t in frames if t.child_frame_id == "itrs"]
+    assert len(earth) == len(tfs)
+    for t in earth[:: max(1, len(earth) // 5)]:
+        state = states[round(stamp(t), 6)]
+        utc = timescale.from_datetime(epoch + timedelta(seconds=stamp(t)))
+        r = t.transform.rotation
+        assert np.allclose(Rotation.from_quat([r.x, r.y, r.z, r.w]).as_matrix(), itrs.rotation_at(utc).T, atol=1e-6)
+        origin = t.transform.translation
+        assert np.allclose([origin.x, origin.y, origin.z], [-state.position.x, -state.position.y, -state.position.z])
     for t in tfs[:: max(1, len(tfs) // 10)]:
         q = states[round(stamp(t), 6)].attitude               # the state at the transform's time
         r = t.transform.rotation
