@@ -1,0 +1,139 @@
+"""A day's observation order (issue 17): which target next, when, and which cannot be observed.
+
+The mission flies one slew at a time (each planned and verified by the planner among the moving
+zones), so the order it follows is re-decided from where the spacecraft is, whenever a slew ends or
+a target is lost. :class:`MissionScheduler` does that without ROS:
+
+* each target's **visibility** over the mission's horizon: the spans in which its attitude keeps
+  every zone of the scenario (Sun, Moon, Earth limb at their true positions, sampled every
+  :data:`~att_planner.methods.schedule.order_search.VISIBILITY_STEP` s) by ``margin``;
+* each **leg**'s duration estimate: the rest-to-rest eigenaxis slew at the per-axis torque limit
+  (bang-bang, ``2 sqrt(θ / α)``, α of :func:`att_planner.methods.axis_rotations.axis_acceleration`)
+  times ``slew_factor`` (the smooth plans the planner returns take longer) plus ``lead`` (planning
+  and settling);
+* the **order**: the schedule planner's search (:func:`~att_planner.methods.schedule.order_search.
+  orders_by_lower_bound` on the leg estimates, every order checked by :func:`~att_planner.methods.
+  schedule.order_search.tour_bound` with the dwells and the waits for visibility); the first order
+  that observes every target before the horizon, else the longest observable prefix found (the rest
+  missed: no time left). A target with no visible span as long as its dwell before the horizon is
+  missed with the zone that covers it named.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from att_planner.methods.axis_rotations import axis_acceleration
+from att_planner.methods.schedule.order_search import (
+    earliest_observation,
+    orders_by_lower_bound,
+    tour_bound,
+    visibility,
+)
+from att_planner.zones import ZoneSky
+from att_sim import rotations as rot
+from att_sim import scenario as scen
+from att_sim.ephemeris import Sky
+
+MAX_ORDERS = 5_000            # orders examined per decision (the search is best-first: the good ones come early)
+
+
+@dataclass(frozen=True)
+class Decision:
+    """The order to fly from now: target names, their estimated arrivals (s of mission time), and
+    the targets that cannot be observed any more, with why."""
+
+    order: list
+    arrivals: list
+    missed: dict
+
+
+def slew_estimate(inertia: np.ndarray, torque_max: float, q_from, q_to) -> float:
+    """Rest-to-rest eigenaxis slew time (s) at the per-axis torque limit (bang-bang)."""
+    axis, angle = rot.to_axis_angle(rot.multiply(rot.conjugate(rot.normalize(np.asarray(q_from, float))),
+                                                 rot.normalize(np.asarray(q_to, float))))
+    if angle < 1e-12:
+        return 0.0
+    return 2.0 * math.sqrt(angle / axis_acceleration(inertia, axis, angle, torque_max))
+
+
+class MissionScheduler:
+    """Orders ``targets`` (name -> (attitude, dwell s)) for ``scenario`` over ``[0, horizon]`` s of
+    mission time (t = 0 at the scenario's epoch; module docstring)."""
+
+    def __init__(self, scenario: scen.Scenario, targets: dict, horizon: float, *, margin: float = 0.0,
+                 slew_factor: float = 1.5, lead: float = 60.0):
+        if scenario.epoch is None:
+            raise ValueError(f"scenario '{scenario.name}' has no epoch: a mission needs the real sky")
+        self.scenario, self.horizon = scenario, float(horizon)
+        self.targets = {k: (rot.normalize(np.asarray(q, float)), float(d)) for k, (q, d) in targets.items()}
+        self.slew_factor, self.lead = slew_factor, lead
+        sky = Sky(scenario.epoch, scenario.orbit_model)
+        self.zones = ZoneSky(list(scenario.zones), sky, window=self.horizon)
+        self.visible = {k: visibility(self.zones, q, (0.0, self.horizon), margin) for k, (q, _) in self.targets.items()}
+
+    def leg(self, q_from, q_to) -> float:
+        """Estimated duration (s) of a slew the mission flies: planning lead, then the plan."""
+        sc = self.scenario.spacecraft
+        return self.lead + self.slew_factor * slew_estimate(sc.inertia, sc.body_torque_max, q_from, q_to)
+
+    def covering_zone(self, name: str, t_now: float) -> str:
+        """The zone that most often covers target ``name`` between ``t_now`` and the horizon."""
+        t = np.linspace(t_now, self.horizon, 200)
+        m = self.zones.margins(t, self.targets[name][0], true=True)
+        worst = np.argmin(m, axis=1)[m.min(axis=1) < 0]
+        if not worst.size:
+            return ""
+        return self.zones.names[int(np.bincount(worst).argmax())]
+
+    def decide(self, t_now: float, q_now, remaining: list) -> Decision:
+        """The order to fly from attitude ``q_now`` at mission time ``t_now`` through ``remaining``."""
+        missed, names = {}, []
+        for k in remaining:
+            dwell = self.targets[k][1]
+            if not any(b - max(a, t_now) >= dwell for a, b in self.visible[k]):
+                zone = self.covering_zone(k, t_now)
+                missed[k] = (f"a {zone} zone covers it until the horizon" if zone else
+                             "no time left before the horizon") + f" (needs {dwell:g} s of visibility)"
+            else:
+                names.append(k)
+        if not names:
+            return Decision([], [], missed)
+        nodes = [np.asarray(q_now, float)] + [self.targets[k][0] for k in names]
+        n = len(names)
+        C = np.zeros((n + 2, n + 2))                  # the end node: anywhere, at no cost
+        for i in range(n + 1):
+            for j in range(1, n + 1):
+                if i != j:
+                    C[i, j] = self.leg(nodes[i], nodes[j])
+        dwell = np.array([self.targets[k][1] for k in names])
+        visible = [[(max(a, t_now) - t_now, b - t_now) for a, b in self.visible[k] if b > t_now] for k in names]
+        best_prefix: tuple = ()
+        for examined, (_, order) in enumerate(orders_by_lower_bound(C)):
+            if examined >= MAX_ORDERS:
+                break
+            bound, arrivals = tour_bound(C, order, dwell, visible)
+            if arrivals is not None:
+                return Decision([names[i] for i in order], list(t_now + arrivals), missed)
+            prefix = self._observable_prefix(C, order, dwell, visible)
+            if len(prefix[0]) > len(best_prefix[0] if best_prefix else ()):
+                best_prefix = prefix
+        order, arrivals = best_prefix or ((), ())
+        for i in set(range(n)) - set(order):
+            missed[names[i]] = "no time left before the horizon in the order flown"
+        return Decision([names[i] for i in order], [t_now + a for a in arrivals], missed)
+
+    @staticmethod
+    def _observable_prefix(C, order, dwell, visible) -> tuple:
+        """The start of ``order`` observed before a target cannot be (the recursion of
+        :func:`tour_bound`, its end leg free), and its arrivals."""
+        t, node, arrivals = 0.0, 0, []
+        for j in order:
+            t = earliest_observation(t + C[node, j + 1], dwell[j], visible[j])
+            if not np.isfinite(t):
+                break
+            arrivals.append(t)
+            t, node = t + dwell[j], j + 1
+        return tuple(order[:len(arrivals)]), tuple(arrivals)

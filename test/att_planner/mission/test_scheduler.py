@@ -1,0 +1,64 @@
+"""The mission's observation order (issue 17): on leo_observatory's day every observable source is
+ordered inside its visibility before the horizon; the two covered all day are missed with their
+zone named; a late decision drops what no longer fits."""
+import math
+
+import numpy as np
+import pytest
+
+from att_planner.mission import targets as tl
+from att_planner.mission.scheduler import MissionScheduler, slew_estimate
+from att_sim import rotations as rot
+from att_sim import scenario as scen
+
+HORIZON = 6 * 3600.0
+SENSOR = np.array([0.0, 1.0, 0.0])                 # leo_observatory's zones are of sensor +y
+
+
+@pytest.fixture(scope="module")
+def day():
+    sources = tl.load("observatory").targets
+    targets = {s.name: (tl.pointing_attitude(SENSOR, s.direction), s.dwell) for s in sources}
+    return MissionScheduler(scen.load("leo_observatory"), targets, HORIZON), targets
+
+
+def test_every_observable_source_is_ordered_inside_its_visibility(day):
+    scheduler, targets = day
+    decision = scheduler.decide(0.0, rot.IDENTITY, list(targets))
+    assert set(decision.missed) == {"sgr_a_star", "pleiades"}
+    assert "sun zone" in decision.missed["sgr_a_star"] and "moon zone" in decision.missed["pleiades"]
+    assert sorted(decision.order) == sorted(set(targets) - set(decision.missed))
+    end, q = 0.0, rot.IDENTITY
+    for name, arrival in zip(decision.order, decision.arrivals, strict=True):
+        q_target, dwell = targets[name]
+        assert arrival >= end + scheduler.leg(q, q_target) - 1e-9          # the slew fits before it
+        assert any(a <= arrival and arrival + dwell <= b for a, b in scheduler.visible[name]), name
+        held = np.linspace(arrival, arrival + dwell, 7)
+        assert scheduler.zones.margins(held, q_target, true=True).min() > -np.deg2rad(0.5), name
+        end, q = arrival + dwell, q_target
+    assert end <= HORIZON
+
+
+def test_a_late_decision_keeps_what_fits_and_says_why_the_rest_is_missed(day):
+    scheduler, targets = day
+    late = HORIZON - 2500.0
+    names = ["crab_nebula", "andromeda", "cas_a", "lmc", "m87"]
+    decision = scheduler.decide(late, rot.IDENTITY, names)
+    assert decision.order and decision.missed
+    assert set(decision.order) | set(decision.missed) == set(names)
+    assert all(a >= late for a in decision.arrivals)
+    last = decision.order[-1]
+    assert decision.arrivals[-1] + targets[last][1] <= HORIZON
+    assert all("horizon" in why for why in decision.missed.values())
+
+
+def test_the_slew_estimate_is_the_bang_bang_eigenaxis_time():
+    inertia = np.diag([3000.0, 4500.0, 6000.0])
+    q = rot.from_axis_angle([0.0, 0.0, 1.0], math.radians(90.0))
+    assert slew_estimate(inertia, 0.25, rot.IDENTITY, q) == pytest.approx(2 * math.sqrt(math.pi / 2 / (0.25 / 6000)))
+    assert slew_estimate(inertia, 0.25, q, -q) == 0.0
+
+
+def test_a_mission_needs_the_real_sky():
+    with pytest.raises(ValueError, match="'swift_demo' has no epoch"):
+        MissionScheduler(scen.load("swift_demo"), {}, HORIZON)
