@@ -133,6 +133,7 @@ REGISTRY = [
             "refine_rounds": Option(0, 6, True), "refine_split": Option(2, 8, True, doc="parts per refined interval"),
             "cone_margin_deg": Option(0.0, 5.0), "rate_max": _RATE_MAX, "wheel_momentum_max": _MOMENTUM_MAX,
             "smooth_warm_start": Option(0, 1, True), "global_stage": Option(0, 1, True, doc="particle swarm first"),
+            "parallel_starts": Option(0, 1, True, doc="the starts on two cores (a forked child)"),
             "boundary_cone": BOUNDARY_CONE}, check=_time_optimal_check,
            combined=("intervals", "max_intervals"), seeded=True),
     Method("constrained_axis", "att_planner.methods.constrained_axis", "plan_constrained_axis",

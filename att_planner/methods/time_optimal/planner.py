@@ -51,6 +51,7 @@ import numpy as np
 from att_msgs_py.types import Interpolation, Plan, Status
 from att_planner.cones import blocked_endpoint
 from att_planner.methods.axis_rotations import eigenaxis_leg, goal_attitude, no_torque_limit
+from att_planner.methods.lanes import map_in_lanes
 from att_planner.methods.time_optimal import collocation as col
 from att_planner.methods.time_optimal.model import Scaling, plan_arrays, scaling, transcription
 from att_planner.methods.time_optimal.routes import Route, candidate_routes, route_guess, select_routes, zone_margin
@@ -96,6 +97,7 @@ class _Solve:
     max_intervals: int
     deadline: float | None
     interpolation: str
+    lanes: bool = True                # the exploration's starts on two cores (methods.lanes)
     budget_hit: bool = False
     nit: int = 0
     nfev: int = 0
@@ -208,14 +210,24 @@ def _truth_violation_intervals(traj, sol: col.PhaseSolution, s: Scaling, problem
 
 
 def _explore(run: _Solve, routes: list[Route], intervals: int, explore_tol: float):
-    """Stage 1: every route solved on the coarse mesh; ``(transcription, solved, log)`` with
-    ``solved`` a list of (t_f, route label, result) of the converged ones."""
+    """Stage 1: every route solved on the coarse mesh (with ``run.lanes``, every other one by a
+    forked child: :func:`att_planner.methods.lanes.map_in_lanes`, the same answers on two cores);
+    ``(transcription, solved, log)`` with ``solved`` a list of (t_f, route label, result) of the
+    converged ones."""
     tr = run.transcription(col.uniform_mesh(intervals), explore_tol)
+
+    def start(rt: Route) -> col.NlpResult | None:
+        if run.deadline is not None and time.monotonic() > run.deadline:
+            return None
+        return tr.solve(tr.pack([route_guess(run.problem, run.scaling, rt, tr.phases[0])]), deadline=run.deadline)
+
     log, solved = [], []
-    for rt in routes:
-        if run.expired():
-            break
-        res = run.solve(tr, route_guess(run.problem, run.scaling, rt, tr.phases[0]))
+    for rt, res in zip(routes, map_in_lanes(start, routes) if run.lanes else map(start, routes)):
+        if res is None:
+            run.budget_hit = True
+            continue
+        run.nit += res.nit
+        run.nfev += res.nfev
         log.append({"route": rt.label, "tf_guess": rt.tf_estimate * run.scaling.tu,
                     "route_min_margin": rt.min_margin, "tf": res.objective * run.scaling.tu,
                     "status": res.status, "iterations": res.nit, "seconds": res.wall_time})
@@ -305,8 +317,8 @@ def plan_time_optimal(problem: ManeuverProblem, *, intervals: int = DEFAULT_INTE
                       interpolation: str = Interpolation.ZOH,
                       cone_margin_deg: float = 0.05, warm_starts: tuple = (),
                       smooth_warm_start: bool = False, global_stage: bool = False, explore_tol: float = 1e-5,
-                      tol: float = 1e-7,
-                      max_iter: int = 400, verify_reserve: float = 1.0) -> Plan:
+                      tol: float = 1e-7, max_iter: int = 400, verify_reserve: float = 1.0,
+                      parallel_starts: bool = True) -> Plan:
     """Minimum-time rest-to-rest slew with per-axis torque limits among the problem's zones.
 
     Options: ``intervals`` coarse mesh for the multi-start stage; ``max_intervals`` cap on mesh
@@ -325,7 +337,9 @@ def plan_time_optimal(problem: ManeuverProblem, *, intervals: int = DEFAULT_INTE
     start does not converge or ends slower than the bang-bang time of a route that clears every zone
     (``stats['global_stage']``: its iterations, cost, t_f; its seconds under ``seconds``);
     ``explore_tol``/``tol`` IPOPT tolerances of the two stages; ``max_iter`` per solve;
-    ``verify_reserve`` seconds kept before ``problem.deadline`` for the final verification.
+    ``verify_reserve`` seconds kept before ``problem.deadline`` for the final verification;
+    ``parallel_starts``: the starts solved on two cores, every other one by a forked child
+    (:mod:`att_planner.methods.lanes`: where this process can fork safely; the same answers).
     The bounds ``problem.rate_max`` and ``problem.wheel_momentum_max`` are imposed when finite.
     ``nit`` and ``nfev`` count IPOPT iterations and objective evaluations over every NLP solved.
     """
@@ -339,7 +353,8 @@ def plan_time_optimal(problem: ManeuverProblem, *, intervals: int = DEFAULT_INTE
     lap = time.monotonic()
     routes = _routes(problem, s, starts, warm_starts, smooth_warm_start, seconds)
     run = _Solve(problem, s, np.deg2rad(cone_margin_deg), _tf_bounds(problem, s, routes), tol, max_iter,
-                 max_intervals, None if problem.deadline is None else problem.deadline - verify_reserve, interpolation)
+                 max_intervals, None if problem.deadline is None else problem.deadline - verify_reserve, interpolation,
+                 bool(parallel_starts))
     stats = {"time_unit": s.tu, "seconds": seconds}
     solved = []
     if global_stage:         # Melton's two stages: the swarm's plan is the one start, the routes a fallback
