@@ -9,6 +9,7 @@ from att_msgs_py.types import ControlKind, Passage, Plan, Status
 from att_planner.methods.schedule.order_search import OrderSolver, Solved, search_orders
 from att_planner.methods.schedule.transcription import SUBSTEPS, eigenaxis_rest_to_rest_time, node_times
 from att_planner.problem import ManeuverProblem
+from att_planner.verification import rejection
 from att_planner.verification import verify as verify_plan
 from att_sim import rotations as rot
 
@@ -166,6 +167,9 @@ def plan_schedule(problem: ManeuverProblem, *, order=None, search_intervals: int
             plan.verification = verify_plan(problem, plan)
             if solver.zones is not None and plan.verification.min_cone_margin < 0 and zone_refinements:
                 plan = _refine_zones(problem, solver, final, plan, zone_refinements, stats, t_begin, cpu_begin)
+            why = rejection(plan.verification)
+            if why is not None:          # never a success the truth does not confirm
+                plan.status, plan.message = Status.FAILED, f"{plan.message}; fails truth verification: {why}"
         return plan
     except RuntimeError as exc:  # CasADi/IPOPT failures are reported, not raised
         return _finish(empty, Status.FAILED, f"solver error: {exc}", t_begin, cpu_begin, stats)

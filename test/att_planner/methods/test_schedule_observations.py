@@ -126,3 +126,13 @@ def test_a_moving_zone_defers_an_observation_until_the_target_is_clear():
     free = sch.plan_schedule(replace(problem, zones=[], sky=None), search_intervals=8, intervals=8)
     seen = free.passages[0]
     assert seen.time < covered[1] and seen.time + seen.dwell > covered[0]
+
+
+def test_a_schedule_the_truth_does_not_confirm_is_reported_failed():
+    """The schedule NLP keeps the wheels' speed box, not a momentum bound of the problem's; a
+    bound it does not model is still checked by the verification, and a plan that breaks it is
+    a failure, never an optimum."""
+    problem = replace(SMALL, wheel_momentum_max=1e-4)
+    plan = sch.plan_schedule(problem, search_intervals=GRID, intervals=GRID)
+    assert plan.status == Status.FAILED
+    assert "fails truth verification: wheel momentum" in plan.message
