@@ -14,6 +14,8 @@ from att_planner.verification import verify as verify_plan
 from att_sim import rotations as rot
 
 METHOD = "schedule"
+OBSERVATION_LOOKAHEAD = 7200.0    # s more of moving zones when targets are observed: a target covered now
+                                  # (by the Earth, most often) may be observable an orbit later
 
 
 def _plan(solver: OrderSolver, final: Solved) -> Plan:
@@ -80,14 +82,16 @@ def _finish(plan: Plan, status: Status, message: str, t_begin: float, cpu_begin:
 def zone_window(problem: ManeuverProblem) -> float | None:
     """The span (s) the zones are fitted over for a tour, or None (the problem's default) when no
     zone moves: twice (targets + 1) legs of the longest eigenaxis rest-to-rest transfer between
-    any two of the tour's attitudes, at least the problem's default window."""
+    any two of the tour's attitudes, with the observations' dwells and :data:`OBSERVATION_LOOKAHEAD`
+    when there are any, beyond the last window's close, at least the problem's default window."""
     if all(z.body == "inertial" for z in problem.zones):
         return None
     nodes = [problem.q_initial, *problem.targets.values(), problem.q_final]
     longest = max(eigenaxis_rest_to_rest_time(problem.spacecraft, a, b) for a in nodes for b in nodes)
     observing = sum(problem.target_dwell.values())
     closes = [w[1] for w in problem.target_windows.values() if np.isfinite(w[1])]
-    return max(problem.zone_sky().window, 2.0 * len(nodes[1:]) * longest + observing,
+    lookahead = OBSERVATION_LOOKAHEAD if problem.target_dwell else 0.0
+    return max(problem.zone_sky().window, 2.0 * len(nodes[1:]) * longest + observing + lookahead,
                max(closes, default=0.0) + 2.0 * longest)
 
 

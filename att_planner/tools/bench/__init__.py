@@ -20,6 +20,7 @@ STUDIES = {
     "speed": "att_planner.tools.bench.speed",
     "estimation": "att_planner.tools.bench.estimation",
     "momentum": "att_planner.tools.bench.momentum",
+    "observe": "att_planner.tools.bench.observe",
 }
 
 

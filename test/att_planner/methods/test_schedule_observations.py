@@ -111,7 +111,8 @@ def test_a_moving_zone_defers_an_observation_until_the_target_is_clear():
                       sky=DescendingSky(), target_dwell={"sun side": 120.0})
     zones = problem.zone_sky(zone_window(problem))
     visible = visibility(zones, target, (0.0, np.inf))
-    assert len(visible) == 2 and visible[0][0] == 0.0              # clear, covered, clear again
+    assert len(visible) >= 2 and visible[0][0] == 0.0              # clear, covered, clear again (and so on:
+    # the test Sun turns round every 1440 s)
     covered = (visible[0][1], visible[1][0])
     # the zone's edge reaches the plane at (52° - 15°) / 0.25 °/s = 148 s and leaves it at 268 s;
     # the visible spans end and begin on samples 10 s apart (VISIBILITY_STEP)
