@@ -95,6 +95,17 @@ def zone_window(problem: ManeuverProblem) -> float | None:
                max(closes, default=0.0) + 2.0 * longest)
 
 
+def _check_options(names: list, order, candidates: int, search_intervals: int, intervals: int,
+                   cone_margin_deg: float, zone_refinements: int) -> None:
+    """ValueError naming the first bad option of :func:`plan_schedule`."""
+    if order is not None and sorted(order) != sorted(names):
+        raise ValueError("order must list every target name exactly once")
+    if candidates < 1 or search_intervals < 1 or intervals < 1:
+        raise ValueError("candidates, search_intervals and intervals must be positive")
+    if not (np.isfinite(cone_margin_deg) and 0.0 <= cone_margin_deg <= 5.0) or zone_refinements < 0:
+        raise ValueError("cone_margin_deg must be in [0, 5] and zone_refinements >= 0")
+
+
 def plan_schedule(problem: ManeuverProblem, *, order=None, search_intervals: int = 8, intervals: int = 24,
                   substeps: int = SUBSTEPS, candidates: int = 2, prove: bool = False, max_order_solves: int = 1000,
                   second_start_margin: float = 0.01, cone_margin_deg: float = 0.05, zone_refinements: int = 2,
@@ -129,12 +140,7 @@ def plan_schedule(problem: ManeuverProblem, *, order=None, search_intervals: int
     """
     t_begin, cpu_begin = time.perf_counter(), time.process_time()
     names = list(problem.targets)
-    if order is not None and sorted(order) != sorted(names):
-        raise ValueError("order must list every target name exactly once")
-    if candidates < 1 or search_intervals < 1 or intervals < 1:
-        raise ValueError("candidates, search_intervals and intervals must be positive")
-    if not (np.isfinite(cone_margin_deg) and 0.0 <= cone_margin_deg <= 5.0) or zone_refinements < 0:
-        raise ValueError("cone_margin_deg must be in [0, 5] and zone_refinements >= 0")
+    _check_options(names, order, candidates, search_intervals, intervals, cone_margin_deg, zone_refinements)
     solver = OrderSolver.of(problem, substeps, np.deg2rad(cone_margin_deg), zone_window(problem))
     stats: dict = {"orders_solved": 0, "search_intervals": search_intervals, "intervals": intervals,
                    "substeps": substeps, "visibility": solver.visible}
