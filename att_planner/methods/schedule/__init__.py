@@ -44,6 +44,10 @@ or not, keep-out or keep-in, each of its own sensor, are kept at every node and 
 of every leg at its physical time along the tour (a leg starts at the sum of the earlier legs'
 durations), exactly in the phase durations; the leg bounds leave them out (still lower bounds).
 
+Observations (issue 17, ``problem.target_dwell`` and ``target_windows``): a target held at rest for
+its dwell, observed within its window and never while a zone covers it; the order search bounds each
+order with its waits (:func:`.order_search.tour_bound`) and drops orders that miss a window.
+
 Note on the paper's dynamics: ``|Ω| ≤ 710 rad/s`` with ``I_w = 1.69e-4`` gives h̄ = 0.12 N m s and
 t_sat = h̄ / T̄ = 11.9 s; the body-rate bound 0.04 rad/s is implied by the wheel box (|ω_i| ≤ h̄ /
 I_i ≤ 0.018 rad/s) and never binds.

@@ -9,7 +9,12 @@ keep-out ``a_z · R(q) s_z ≤ cos(θ_z + δ)``, keep-in ``≥ cos(θ_z − δ)`
 at the point's physical time over the whole tour, ``t = t_sat Σ dτ`` of the intervals before it
 (so a leg starts at the sum of the earlier legs' durations), through the ZoneSky's Chebyshev series
 of that CasADi expression: exact in the phase durations. The tour is then bounded by the zones'
-window. Without zones nothing is added: the NLP is the zone-free one."""
+window. Without zones nothing is added: the NLP is the zone-free one.
+
+Observations (issue 17): each target's dwell (τ) is a parameter, in the order's sequence; a target
+with one is reached at rest (its x and y rates zero too) and held, torque-free, before the next leg,
+so every later node's time moves by it; each arrival time is a constraint row whose bounds are the
+target's window (both set per solve); moving zones are kept on a held target through its dwell."""
 from __future__ import annotations
 
 import time
