@@ -26,12 +26,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from att_planner.methods.axis_rotations import axis_acceleration
-from att_planner.methods.schedule.order_search import (
-    earliest_observation,
-    orders_by_lower_bound,
-    tour_bound,
-    visibility,
-)
+from att_planner.methods.schedule.order_search import observed_prefix, orders_by_lower_bound, tour_bound, visibility
 from att_planner.zones import ZoneSky
 from att_sim import rotations as rot
 from att_sim import scenario as scen
@@ -117,23 +112,11 @@ class MissionScheduler:
             bound, arrivals = tour_bound(C, order, dwell, visible)
             if arrivals is not None:
                 return Decision([names[i] for i in order], list(t_now + arrivals), missed)
-            prefix = self._observable_prefix(C, order, dwell, visible)
-            if len(prefix[0]) > len(best_prefix[0] if best_prefix else ()):
-                best_prefix = prefix
+            arrivals, _ = observed_prefix(C, order, dwell, visible)
+            if len(arrivals) > len(best_prefix[1] if best_prefix else ()):
+                best_prefix = (tuple(order[:len(arrivals)]), tuple(arrivals))
         order, arrivals = best_prefix or ((), ())
         for i in set(range(n)) - set(order):
             missed[names[i]] = "no time left before the horizon in the order flown"
         return Decision([names[i] for i in order], [t_now + a for a in arrivals], missed)
 
-    @staticmethod
-    def _observable_prefix(C, order, dwell, visible) -> tuple:
-        """The start of ``order`` observed before a target cannot be (the recursion of
-        :func:`tour_bound`, its end leg free), and its arrivals."""
-        t, node, arrivals = 0.0, 0, []
-        for j in order:
-            t = earliest_observation(t + C[node, j + 1], dwell[j], visible[j])
-            if not np.isfinite(t):
-                break
-            arrivals.append(t)
-            t, node = t + dwell[j], j + 1
-        return tuple(order[:len(arrivals)]), tuple(arrivals)

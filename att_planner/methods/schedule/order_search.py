@@ -146,21 +146,30 @@ def earliest_observation(start: float, dwell: float, visible) -> float:
     return np.inf
 
 
-def tour_bound(C: np.ndarray, order: list[int], dwell: np.ndarray, visible: list) -> tuple[float, np.ndarray]:
-    """Lower bound (s) on a tour of target indices ``order`` with its observations, and the
-    earliest arrivals it implies: each leg at least its bound ``C`` (nodes as in
-    :func:`leg_bound_matrix`), each target observed for ``dwell[j]`` s within one of its
-    ``visible[j]`` intervals, waiting where the next one has not opened. ``(inf, None)`` when a
-    target cannot be observed in time: no schedule of that order exists."""
-    n = C.shape[0] - 2
+def observed_prefix(C: np.ndarray, order: list[int], dwell: np.ndarray, visible: list) -> tuple[np.ndarray, float]:
+    """The earliest arrivals (s) at the targets of ``order`` that can be observed one after the
+    other — each leg at least its bound ``C`` (nodes as in :func:`leg_bound_matrix`), each target
+    held ``dwell[j]`` s within one of its ``visible[j]`` intervals, waiting where the next one has
+    not opened — up to the first that cannot; and the end of the last observation (s)."""
     t, node, arrivals = 0.0, 0, []
     for j in order:
-        t = earliest_observation(t + C[node, j + 1], dwell[j], visible[j])
-        if not np.isfinite(t):
-            return np.inf, None
-        arrivals.append(t)
-        t, node = t + dwell[j], j + 1
-    return t + C[node, n + 1], np.array(arrivals)
+        at = earliest_observation(t + C[node, j + 1], dwell[j], visible[j])
+        if not np.isfinite(at):
+            break
+        arrivals.append(at)
+        t, node = at + dwell[j], j + 1
+    return np.array(arrivals), t
+
+
+def tour_bound(C: np.ndarray, order: list[int], dwell: np.ndarray, visible: list) -> tuple[float, np.ndarray]:
+    """Lower bound (s) on a tour of target indices ``order`` with its observations, and the
+    earliest arrivals it implies (:func:`observed_prefix`, then the leg to the end node).
+    ``(inf, None)`` when a target cannot be observed in time: no schedule of that order exists."""
+    arrivals, t = observed_prefix(C, order, dwell, visible)
+    if len(arrivals) < len(order):
+        return np.inf, None
+    last = order[-1] + 1 if len(order) else 0
+    return t + C[last, C.shape[0] - 1], arrivals
 
 
 @dataclass
