@@ -12,8 +12,8 @@ a target is lost. :class:`MissionScheduler` does that without ROS:
   times ``slew_factor`` (the smooth plans the planner returns take longer) plus ``lead`` (planning
   and settling);
 * the **order**: the schedule planner's search (:func:`~att_planner.methods.schedule.order_search.
-  orders_by_lower_bound` on the leg estimates, every order checked by :func:`~att_planner.methods.
-  schedule.order_search.tour_bound` with the dwells and the waits for visibility); the first order
+  orders_by_lower_bound` on the leg estimates, every order followed by :func:`~att_planner.methods.
+  schedule.order_search.observed_prefix` with the dwells and the waits for visibility); the first order
   that observes every target before the horizon, else the longest observable prefix found (the rest
   missed: no time left). A target with no visible span as long as its dwell before the horizon is
   missed with the zone that covers it named.
@@ -26,7 +26,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from att_planner.methods.axis_rotations import axis_acceleration
-from att_planner.methods.schedule.order_search import observed_prefix, orders_by_lower_bound, tour_bound, visibility
+from att_planner.methods.schedule.order_search import observed_prefix, orders_by_lower_bound, visibility
 from att_planner.zones import ZoneSky
 from att_sim import rotations as rot
 from att_sim import scenario as scen
@@ -109,10 +109,9 @@ class MissionScheduler:
         for examined, (_, order) in enumerate(orders_by_lower_bound(C)):
             if examined >= MAX_ORDERS:
                 break
-            bound, arrivals = tour_bound(C, order, dwell, visible)
-            if arrivals is not None:
+            arrivals, _ = observed_prefix(C, order, dwell, visible)       # the end node costs nothing
+            if len(arrivals) == n:
                 return Decision([names[i] for i in order], list(t_now + arrivals), missed)
-            arrivals, _ = observed_prefix(C, order, dwell, visible)
             if len(arrivals) > len(best_prefix[1] if best_prefix else ()):
                 best_prefix = (tuple(order[:len(arrivals)]), tuple(arrivals))
         order, arrivals = best_prefix or ((), ())
