@@ -83,7 +83,10 @@ def counts(received: dict) -> dict:
     return {t: len(v) for t, v in received.items()}
 
 
-def wait_for(received: dict, expected: dict, timeout: float = 10.0) -> None:
+def wait_for(received: dict, expected: dict, timeout: float = 60.0) -> None:
+    """Until the subscriber's callbacks have taken ``expected`` messages (at most ``timeout`` s: the
+    replay is acknowledged by DDS first, and one Python executor takes its ~10 000 messages one by
+    one; on a loaded 2-core machine that took more than 10 s and the count was read short)."""
     deadline = time.monotonic() + timeout
     while counts(received) != expected and time.monotonic() < deadline:
         time.sleep(0.1)
