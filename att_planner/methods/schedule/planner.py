@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import time
+from dataclasses import replace
 
 import numpy as np
 
@@ -14,6 +15,7 @@ from att_planner.verification import verify as verify_plan
 from att_sim import rotations as rot
 
 METHOD = "schedule"
+MAX_SUBSTEPS = 8                  # RK4 steps per ZOH interval a refinement may reach
 OBSERVATION_LOOKAHEAD = 7200.0    # s more of moving zones when targets are observed: a target covered now
                                   # (by the Earth, most often) may be observable an orbit later
 
@@ -55,19 +57,28 @@ def _finished(solver: OrderSolver, final: Solved, stats: dict, t_begin: float, c
 
 def _refine_zones(problem: ManeuverProblem, solver: OrderSolver, final: Solved, plan: Plan, rounds: int,
                   stats: dict, t_begin: float, cpu_begin: float) -> Plan:
-    """While the verified ``plan`` enters a zone between the NLP's points, double the intervals per
-    phase and re-solve its order from it (``rounds`` times at most, within the deadline); the
-    intervals tried go to ``stats['zone_refinements']``."""
+    """While the verified ``plan`` enters a zone between the NLP's points or the truth strays from
+    the NLP's own integration (a long leg's intervals: minutes), double the intervals per phase and
+    the RK4 substeps per interval (up to :data:`MAX_SUBSTEPS`) and re-solve its order from it
+    (``rounds`` times at most, within the deadline); the grids tried go to
+    ``stats['zone_refinements']``."""
     tried = stats["zone_refinements"] = []
-    while plan.verification.min_cone_margin < 0 and len(tried) < rounds and not solver.expired():
+    while _refinable(plan) and len(tried) < rounds and not solver.expired():
+        solver = replace(solver, substeps=min(2 * solver.substeps, MAX_SUBSTEPS))
         finer = solver.solve(final.order, 2 * final.transcription.intervals, guess=final)
-        tried.append(finer.transcription.intervals)
+        tried.append({"intervals": finer.transcription.intervals, "substeps": solver.substeps})
         if not np.isfinite(finer.tf):
             break
         final = finer
         plan = _finished(solver, final, stats, t_begin, cpu_begin)
         plan.verification = verify_plan(problem, plan)
     return plan
+
+
+def _refinable(plan: Plan) -> bool:
+    """A rejection a finer grid can mend: a zone entered, or the final or a passage attitude missed."""
+    why = rejection(plan.verification)
+    return why is not None and why.startswith(("enters", "leaves", "final attitude", "passage"))
 
 
 def _finish(plan: Plan, status: Status, message: str, t_begin: float, cpu_begin: float, stats: dict) -> Plan:
@@ -108,7 +119,7 @@ def _check_options(names: list, order, candidates: int, search_intervals: int, i
 
 def plan_schedule(problem: ManeuverProblem, *, order=None, search_intervals: int = 8, intervals: int = 24,
                   substeps: int = SUBSTEPS, candidates: int = 2, prove: bool = False, max_order_solves: int = 1000,
-                  second_start_margin: float = 0.01, cone_margin_deg: float = 0.05, zone_refinements: int = 2,
+                  second_start_margin: float = 0.01, cone_margin_deg: float = 0.05, zone_refinements: int = 3,
                   verify: bool = True) -> Plan:
     """Fastest rest-to-rest schedule through every target of ``problem.targets``, in the best order found.
 
@@ -135,8 +146,9 @@ def plan_schedule(problem: ManeuverProblem, *, order=None, search_intervals: int
     their physical time along the whole tour (:mod:`.transcription`), tightened by
     ``cone_margin_deg``; moving zones are fitted over :func:`zone_window` and break the time
     reversal (both directions of an order are then solved as distinct orders). When the verified
-    plan still enters a zone between those points, the intervals per phase are doubled and the
-    order re-solved from it, ``zone_refinements`` times at most.
+    plan still enters a zone between those points, or the truth strays from the NLP's integration (a
+    leg that waits for a window lasts minutes), the intervals per phase and the RK4 substeps per
+    interval are doubled and the order re-solved from it, ``zone_refinements`` times at most.
     """
     t_begin, cpu_begin = time.perf_counter(), time.process_time()
     names = list(problem.targets)
@@ -175,7 +187,7 @@ def plan_schedule(problem: ManeuverProblem, *, order=None, search_intervals: int
         plan = _finished(solver, final, stats, t_begin, cpu_begin)
         if verify:
             plan.verification = verify_plan(problem, plan)
-            if solver.zones is not None and plan.verification.min_cone_margin < 0 and zone_refinements:
+            if zone_refinements and _refinable(plan):
                 plan = _refine_zones(problem, solver, final, plan, zone_refinements, stats, t_begin, cpu_begin)
             why = rejection(plan.verification)
             if why is not None:          # never a success the truth does not confirm

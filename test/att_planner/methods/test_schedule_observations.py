@@ -137,3 +137,20 @@ def test_a_schedule_the_truth_does_not_confirm_is_reported_failed():
     plan = sch.plan_schedule(problem, search_intervals=GRID, intervals=GRID)
     assert plan.status == Status.FAILED
     assert "fails truth verification: wheel momentum" in plan.message
+
+
+def test_a_real_sky_tour_that_waits_is_refined_until_the_truth_confirms_it():
+    """vega then andromeda on leo_observatory's sky: the Earth limb covers andromeda for the first
+    23 minutes, so a leg waits ~20 minutes; with one RK4 step per ~100 s interval the truth leaves
+    the NLP's path. Unrefined, that is a failure said as such; refined (intervals and substeps
+    doubled), the same order verifies."""
+    from att_planner.tools.bench.observe import tour_problems
+
+    _, problem, _ = tour_problems(["vega", "andromeda"], 60.0)
+    raw = sch.plan_schedule(problem, search_intervals=6, intervals=12, zone_refinements=0)
+    assert raw.status == Status.FAILED and "fails truth verification" in raw.message
+    plan = sch.plan_schedule(problem, search_intervals=6, intervals=12)
+    assert plan.status in (Status.OPTIMAL, Status.FEASIBLE), plan.message
+    assert rejection(plan.verification) is None
+    assert plan.stats["zone_refinements"] and plan.stats["zone_refinements"][-1]["substeps"] >= 2
+    assert plan.order == raw.order
