@@ -18,6 +18,7 @@ setup(
         ("share/" + PACKAGE, ["package.xml"]),
         ("share/" + PACKAGE + "/config", glob("config/*.yaml")),
         ("share/" + PACKAGE + "/config/targets", glob("config/targets/*.yaml")),
+        ("share/" + PACKAGE + "/config/missions", glob("config/missions/*.yaml")),
         ("share/" + PACKAGE + "/campaigns", glob("campaigns/*.yaml")),
     ],
     install_requires=["numpy", "scipy", "pyyaml", "mcap", "mcap-ros2-support", "casadi"],
@@ -43,6 +44,7 @@ setup(
             "att-keygen = att_planner.tools.keygen:main",
             "att-log = att_msgs_py.log.cli:main",
             "att-mc = att_planner.tools.monte_carlo:main",
+            "att-mission = att_planner.tools.mission:main",
         ],
     },
 )

@@ -25,6 +25,7 @@ from att_msgs.msg import (
     ControllerStatus,
     KeepOutCone,
     ManeuverPlan,
+    MissionEvent,
     PlanStage,
     PlanVerification,
     PointingMode,
@@ -379,3 +380,19 @@ def estimate_from_msg(msg) -> types.AttitudeEstimate:
         bias_covariance=from_covariance9(msg.bias_covariance), health=int(msg.health),
         time_since_update=float(msg.time_since_update), rejected=int(msg.rejected_measurements),
         message=msg.message, frame_id=msg.header.frame_id, body_frame_id=msg.body_frame_id)
+
+
+def mission_event_msg(e: types.MissionEvent) -> MissionEvent:
+    msg = _header(MissionEvent(event=str(e.event), target=e.target, start=float(e.start), end=float(e.end),
+                               plan_id=e.plan_id, message=e.message), e.t, e.frame_id)
+    msg.attitude = quaternion(e.attitude)
+    msg.direction = vector3(e.direction)
+    return msg
+
+
+def mission_event_from_msg(msg) -> types.MissionEvent:
+    return types.MissionEvent(
+        t=from_time(msg.header.stamp), event=types.MissionEventKind(msg.event), target=msg.target,
+        start=float(msg.start), end=float(msg.end), attitude=from_quaternion(msg.attitude),
+        direction=from_vector3(msg.direction), plan_id=msg.plan_id, message=msg.message,
+        frame_id=msg.header.frame_id)

@@ -16,11 +16,15 @@ LATCHED_QOS = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=20, reliability=
 # not dropped (the ROS default keeps 10).
 SERVICE_QOS = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=500, reliability=ReliabilityPolicy.RELIABLE,
                          durability=DurabilityPolicy.VOLATILE)
+# Mission events: reliable and latched, deep enough for a day's events to reach a recorder that starts late.
+MISSION_QOS = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=1000, reliability=ReliabilityPolicy.RELIABLE,
+                         durability=DurabilityPolicy.TRANSIENT_LOCAL)
 CLOCK_QOS = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=1000, reliability=ReliabilityPolicy.RELIABLE,
                        durability=DurabilityPolicy.VOLATILE)
 
 
 def recorded_topics() -> dict[str, tuple[str, QoSProfile]]:
     """Topic -> (ROS type name, QoS) for everything the recorder writes."""
-    qos = {topics.CLOCK: CLOCK_QOS, topics.PLANS: LATCHED_QOS, topics.PLAN_MARKERS: LATCHED_QOS}
+    qos = {topics.CLOCK: CLOCK_QOS, topics.PLANS: LATCHED_QOS, topics.PLAN_MARKERS: LATCHED_QOS,
+           topics.MISSION_EVENTS: MISSION_QOS}
     return {topic: (type_name, qos.get(topic, STREAM_QOS)) for topic, type_name in topics.RECORDED.items()}

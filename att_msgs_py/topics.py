@@ -20,6 +20,7 @@ TF = "/tf"                                   # the 3D view (issue 17): the body 
 SIM_MARKERS = "/simulator/markers"           # zones, boresights, Sun/Moon/Earth directions
 ZONE_MARGINS = "/simulator/zone_margins"     # the zones' truth margins, for plots
 PLAN_MARKERS = "/planner/plan_markers"       # the latest plan's boresight path
+MISSION_EVENTS = "/mission/events"           # att-mission's decisions, slews, dwells and missed targets
 
 PLAN_MANEUVER = "/planner/plan_maneuver"
 PLAN_SCHEDULE = "/planner/plan_schedule"
@@ -45,6 +46,7 @@ RECORDED = {
     SIM_MARKERS: "visualization_msgs/msg/MarkerArray",
     ZONE_MARGINS: "att_msgs/msg/ZoneMargins",
     PLAN_MARKERS: "visualization_msgs/msg/MarkerArray",
+    MISSION_EVENTS: "att_msgs/msg/MissionEvent",
 }
 
 

@@ -446,3 +446,32 @@ class Shape:
     points: np.ndarray
     rgba: tuple[float, float, float, float]
     width: float = 0.02
+
+
+class MissionEventKind(StrEnum):
+    """What a mission event reports: ``att_msgs/MissionEvent``'s constants."""
+
+    SCHEDULED = "scheduled"
+    SLEW = "slew"
+    DWELL = "dwell"
+    PARK = "park"
+    MISSED = "missed"
+    REFUSED = "refused"
+    ENDED = "ended"
+
+
+@dataclass(frozen=True)
+class MissionEvent:
+    """One event of a mission (``att_msgs/MissionEvent``): at sim time ``t``, ``event`` about
+    ``target`` over ``[start, end]`` s of sim time, its attitude and direction when it has them."""
+
+    t: float
+    event: MissionEventKind
+    target: str = ""
+    start: float = 0.0
+    end: float = 0.0
+    attitude: np.ndarray = field(default_factory=lambda: np.array([0.0, 0.0, 0.0, 1.0]))
+    direction: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    plan_id: str = ""
+    message: str = ""
+    frame_id: str = ""

@@ -33,6 +33,7 @@ from att_sim import scenario as scen
 from att_sim.ephemeris import Sky
 
 MAX_ORDERS = 5_000            # orders examined per decision (the search is best-first: the good ones come early)
+HOLD_CHECK_STEP = 10.0        # s between the zone checks of an attitude held while waiting
 
 
 @dataclass(frozen=True)
@@ -119,3 +120,25 @@ class MissionScheduler:
             missed[names[i]] = "no time left before the horizon in the order flown"
         return Decision([names[i] for i in order], [t_now + a for a in arrivals], missed)
 
+
+    def observable_from(self, name: str, t: float) -> float | None:
+        """The earliest time ≥ ``t`` from which target ``name`` stays visible for its dwell (None: not
+        before the horizon)."""
+        dwell = self.targets[name][1]
+        return next((max(a, t) for a, b in self.visible[name] if b - max(a, t) >= dwell), None)
+
+    def clear(self, q, t0: float, t1: float) -> bool:
+        """Whether attitude ``q`` keeps every zone (at their true positions, no margin) over ``[t0, t1]``
+        (sampled every :data:`HOLD_CHECK_STEP` s and at both ends)."""
+        t = np.unique(np.append(np.arange(t0, t1, HOLD_CHECK_STEP), t1))
+        return bool(self.zones.margins(t, np.asarray(q, float), true=True).min() >= 0.0)
+
+    def park(self, q_from, t_now: float, until: float) -> str | None:
+        """A target (observed or not) to wait at from ``t_now`` until ``until``: reached by a leg from
+        ``q_from`` and visible from its arrival to ``until``, the nearest such; None when there is none."""
+        best = None
+        for name, (q, _) in self.targets.items():
+            arrive = t_now + self.leg(q_from, q)
+            if any(a <= arrive and until <= b for a, b in self.visible[name]) and (best is None or arrive < best[0]):
+                best = (arrive, name)
+        return best[1] if best else None

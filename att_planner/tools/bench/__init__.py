@@ -21,6 +21,7 @@ STUDIES = {
     "estimation": "att_planner.tools.bench.estimation",
     "momentum": "att_planner.tools.bench.momentum",
     "observe": "att_planner.tools.bench.observe",
+    "day": "att_planner.tools.bench.day",
 }
 
 

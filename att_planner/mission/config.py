@@ -1,0 +1,120 @@
+"""A mission file (issue 17): which targets to observe, from which scenario, for how long, and how
+the day is flown. One YAML file under ``config/missions/`` (read with ``yaml.safe_load`` only)::
+
+    targets: observatory           # a target list (config/targets/observatory.yaml); its scenario is flown
+    sensor_axis: [0, 1, 0]         # body axis put on each source
+    horizon_s: 21600               # s of sim time from the scenario's epoch
+    margin_deg: 1.0                # a target counts as visible this far outside every zone
+    rate_hz: 5.0                   # simulator step, state, control and estimate rate of the day
+    start_lead_s: 240              # s of sim time from a slew's request to its start (planning)
+    time_budget_s: 10              # planner wall-time budget per slew
+    method: ""                     # planning method ("": the planner's default)
+    pointing_tolerance_deg: 0.05   # a dwell counts as observed within this pointing error
+    momentum_dumping: true         # the controller's magnetorquer momentum dumping, all day
+
+Every key is checked; a bad file is refused with a :class:`~att_msgs_py.errors.ConfigError` naming
+the file and the key.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from att_msgs_py.errors import ConfigError, ErrorCode, clip
+from att_planner.mission import targets as target_lists
+from att_sim import scenario as scen
+
+# key -> (default, low, high); None default: required
+NUMBERS = {"horizon_s": (None, 60.0, 7 * 86_400.0), "margin_deg": (1.0, 0.0, 30.0), "rate_hz": (5.0, 0.5, 50.0),
+           "start_lead_s": (240.0, 1.0, 3600.0), "time_budget_s": (10.0, 0.05, 600.0),
+           "pointing_tolerance_deg": (0.05, 1e-4, 10.0)}
+KEYS = ("targets", "sensor_axis", "method", "momentum_dumping", *NUMBERS)
+
+
+@dataclass(frozen=True)
+class MissionConfig:
+    """A checked mission file: the target list, its scenario and how the day is flown (SI units)."""
+
+    path: Path
+    target_list: target_lists.TargetList
+    scenario: scen.Scenario
+    sensor_axis: np.ndarray
+    horizon: float
+    margin: float                 # rad
+    rate: float                   # Hz
+    start_lead: float             # s of sim time
+    time_budget: float            # s of wall time
+    method: str
+    pointing_tolerance: float     # rad
+    momentum_dumping: bool
+
+    def attitudes(self) -> dict:
+        """Target name -> (attitude body-to-inertial, dwell s, inertial direction)."""
+        tl = self.target_list
+        return {t.name: (target_lists.pointing_attitude(self.sensor_axis, t.direction, tl.roll_reference), t.dwell,
+                         t.direction) for t in tl.targets}
+
+
+def find(name: str) -> Path:
+    """A mission file: an explicit ``*.yaml`` path, or a stem under ``missions/`` of the config directories."""
+    if name.endswith(".yaml") and Path(name).is_file():
+        return Path(name)
+    for d in scen.config_dirs():
+        path = d / "missions" / f"{name}.yaml"
+        if path.is_file():
+            return path
+    known = sorted({p.stem for d in scen.config_dirs() for p in (d / "missions").glob("*.yaml")})
+    raise KeyError(f"unknown mission '{clip(name, 120)}' (known: {', '.join(known) or 'none'})")
+
+
+def _invalid(path, message: str) -> ConfigError:
+    return ConfigError(ErrorCode.INVALID_CONFIG, f"mission {clip(path, 200)}: {message}")
+
+
+def load(name: str) -> MissionConfig:
+    """The mission ``name`` (:func:`find`), every key checked (module docstring)."""
+    path = find(name)
+    doc = scen.read_document(path)
+    if not isinstance(doc, dict):
+        raise _invalid(path, f"the file is not a mapping of {', '.join(KEYS)}")
+    unknown = sorted(str(k) for k in set(doc) - set(KEYS))
+    if unknown:
+        raise _invalid(path, f"unknown key(s) {clip(', '.join(unknown), 120)} (known: {', '.join(KEYS)})")
+    numbers = {}
+    for key, (default, low, high) in NUMBERS.items():
+        value = doc.get(key, default)
+        ok = isinstance(value, (int, float)) and not isinstance(value, bool) and low <= value <= high
+        if not ok:
+            raise _invalid(path, f"{key} = {clip(repr(value), 60)} is not a number in [{low:g}, {high:g}]"
+                                 + (" (required)" if default is None and key not in doc else ""))
+        numbers[key] = float(value)
+    if not isinstance(doc.get("targets"), str):
+        raise _invalid(path, f"targets = {clip(repr(doc.get('targets')), 60)} is not the name of a target list")
+    try:
+        target_list = target_lists.load(doc["targets"])
+    except KeyError as err:
+        raise _invalid(path, f"targets: {err.args[0]}") from None
+    if target_list.kind != "inertial":
+        raise _invalid(path, f"targets '{doc['targets']}' is a {target_list.kind} list; att-mission flies inertial "
+                             "sources (ground sites are tracked with the pointing modes, not yet scheduled by "
+                             "a mission)")
+    axis = doc.get("sensor_axis")
+    vec = np.asarray(axis, float) if isinstance(axis, list) and len(axis) == 3 and all(
+        isinstance(v, (int, float)) and not isinstance(v, bool) for v in axis) else None
+    if vec is None or not np.isfinite(vec).all() or abs(np.linalg.norm(vec) - 1.0) > 1e-6:
+        raise _invalid(path, f"sensor_axis = {clip(repr(axis), 60)} is not a unit 3-vector (body axes)")
+    method = doc.get("method", "")
+    if not isinstance(method, str) or not method.isprintable() or len(method) > 64:
+        raise _invalid(path, f"method = {clip(repr(method), 60)} is not a method name")
+    dumping = doc.get("momentum_dumping", True)
+    if not isinstance(dumping, bool):
+        raise _invalid(path, f"momentum_dumping = {clip(repr(dumping), 60)} is not true or false")
+    scenario = scen.load_checked(target_list.scenario)
+    if scenario.epoch is None:
+        raise _invalid(path, f"scenario '{scenario.name}' has no epoch: a mission flies the real sky")
+    return MissionConfig(path, target_list, scenario, vec, numbers["horizon_s"], math.radians(numbers["margin_deg"]),
+                         numbers["rate_hz"], numbers["start_lead_s"], numbers["time_budget_s"], method,
+                         math.radians(numbers["pointing_tolerance_deg"]), dumping)

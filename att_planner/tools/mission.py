@@ -1,0 +1,250 @@
+"""``att-mission MISSION``: a day in orbit (issue 17) flown by the suite's nodes.
+
+Starts recorder, simulator, estimator, controller and planner (the mission file's rate for the
+simulator's step, its state, the control and the estimate; the simulator as fast as the loop goes;
+the controller's momentum dumping as the file says) and flies the target list of the mission file
+(:mod:`att_planner.mission.config`) from the scenario's epoch to its horizon:
+
+1. :class:`~att_planner.mission.scheduler.MissionScheduler` decides the order from where the
+   spacecraft holds now (targets no zone leaves visible for their dwell before the horizon are missed,
+   with the zone that covers them);
+2. the first target's slew is requested from the planner (the scenario's zones where they are when it
+   is flown: its start is ``start_lead`` s of sim time after the request, later when the target becomes
+   visible later), re-planned later once when it would arrive before the target is visible;
+3. while waiting for that start the spacecraft holds, or parks at another source when the zones reach
+   the held attitude first;
+4. the controller flies the plan and holds the target for its dwell; then back to 1. A slew the
+   planner or the controller refuses is tried again at the next decision, twice at most (the target is
+   then missed, with the refusal).
+
+Every decision, slew, dwell, park and miss is published on ``/mission/events``
+(``att_msgs/MissionEvent``) and recorded with everything else in one MCAP. At the end the day's
+figures are measured from that log (:func:`att_planner.mission.day.day_report`): the targets' dwells
+and pointing errors from the truth state, the zones' margins at their true positions, the wheels.
+The last line printed is ``MCAP: <path>``.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import sys
+import time
+from collections import Counter
+from datetime import UTC, datetime, timedelta
+from pathlib import Path
+
+import numpy as np
+import rclpy
+
+from att_msgs.msg import MissionEvent, SpacecraftState
+from att_msgs_py import convert, qos
+from att_msgs_py.errors import ConfigError
+from att_msgs_py.topics import MISSION_EVENTS, STATE
+from att_msgs_py.types import MissionEvent as Event
+from att_msgs_py.types import MissionEventKind as Kind
+from att_planner.mission import config as mission_config
+from att_planner.mission.day import day_report
+from att_planner.mission.scheduler import MissionScheduler, slew_estimate
+from att_planner.nodes.client import client_session, maneuver_request
+from att_planner.tools.demo import domain_line
+from att_planner.tools.launch import default_nodes, isolated_env, join_env, start_suite
+
+MAX_ATTEMPTS = 2               # slews refused per target before it is missed
+MIN_WALL_RTF = 0.5             # waits for sim time give up below this real-time factor
+
+
+class Telemetry:
+    """The spacecraft's latest state message (sim time, attitude, wheels), heard on the client's node."""
+
+    def __init__(self, node):
+        self.node, self.msg = node, None
+        node.create_subscription(SpacecraftState, STATE, self._on_state, qos.STREAM_QOS)
+
+    def _on_state(self, msg):
+        self.msg = msg
+
+    @property
+    def t(self) -> float:
+        return convert.from_time(self.msg.header.stamp)
+
+    def wait(self, until: float = -math.inf, timeout: float | None = None) -> float:
+        """Spin until a state at or after sim time ``until``; its time (TimeoutError past ``timeout``
+        s of wall time, by default the wait at :data:`MIN_WALL_RTF` plus a minute)."""
+        if timeout is None:
+            timeout = 60.0 + (max(0.0, until - self.t) / MIN_WALL_RTF if self.msg is not None and until > 0 else 60.0)
+        deadline = time.monotonic() + timeout
+        while self.msg is None or self.t < until:
+            if time.monotonic() > deadline:
+                raise TimeoutError(f"the simulator's state did not reach t = {until:.1f} s within {timeout:.0f} s")
+            rclpy.spin_once(self.node, timeout_sec=0.05)
+        return self.t
+
+
+class MissionRun:
+    """One mission flown through ``client`` (a :class:`~att_planner.nodes.client.SuiteClient`)."""
+
+    def __init__(self, client, mission: mission_config.MissionConfig, log=print):
+        self.client, self.mission, self.log = client, mission, log
+        self.scenario = mission.scenario
+        self.targets = mission.attitudes()
+        self.scheduler = MissionScheduler(self.scenario, {k: (q, d) for k, (q, d, _) in self.targets.items()},
+                                          mission.horizon, margin=mission.margin, lead=mission.start_lead)
+        self.telemetry = Telemetry(client)
+        self.events = client.create_publisher(MissionEvent, MISSION_EVENTS, qos.MISSION_QOS)
+        self.attempts: Counter = Counter()
+
+    def publish(self, kind: Kind, target: str = "", start: float = 0.0, end: float = 0.0, plan_id: str = "",
+                message: str = "") -> None:
+        q, _, d = self.targets.get(target, (np.array([0.0, 0.0, 0.0, 1.0]), 0.0, np.zeros(3)))
+        self.events.publish(convert.mission_event_msg(Event(
+            self.telemetry.t, kind, target, start, end, q, d, plan_id, message[:400], self.scenario.frame_id)))
+        self.log(f"[mission] t = {self.telemetry.t:8.1f} s  {kind.value:9s} {target:14s} {message}")
+
+    def fly(self, name: str, q_from, t_start: float, wait_for_visibility: bool):
+        """Plan the slew from ``q_from`` to target ``name`` starting at sim time ``t_start`` and fly it;
+        its end time, or None after a refusal (published). ``wait_for_visibility``: a plan that would
+        arrive before the target is visible for its dwell is planned again to arrive then (once)."""
+        q_to = self.targets[name][0]
+        sensor = self.mission.sensor_axis
+        for _ in range(2):
+            epoch = self.scenario.epoch + timedelta(seconds=t_start)
+            request = maneuver_request(q_from, q_to, sensor, [], method=self.mission.method,
+                                       time_budget=self.mission.time_budget, frame_id=self.scenario.frame_id,
+                                       epoch=epoch, zones=list(self.scenario.zones),
+                                       wheel_speeds=list(self.telemetry.msg.wheel_speeds))
+            response = self.client.plan(request)
+            if not response.success:
+                self.publish(Kind.REFUSED, name, message=f"planner: code {response.error_code}: {response.message}")
+                return None
+            plan = response.plan
+            visible = self.scheduler.observable_from(name, t_start + plan.duration) if wait_for_visibility else None
+            if visible is None or visible <= t_start + plan.duration + 1.0:
+                break
+            t_start = visible - plan.duration
+        self.publish(Kind.SLEW, name, t_start, t_start + plan.duration, plan.plan_id,
+                     f"{plan.method} {plan.duration:.1f} s, {math.degrees(plan.verification.min_cone_margin):.2f} deg "
+                     f"from the zones, planned in {plan.solve_seconds:.2f} s")
+        late = self.telemetry.wait() - t_start
+        if late > 0:
+            self.publish(Kind.REFUSED, name, plan_id=plan.plan_id,
+                         message=f"planning ended {late:.1f} s of sim time after the slew's start: start_lead "
+                                 "is too short")
+            return None
+        self.telemetry.wait(t_start)
+        result = self.client.execute(plan.plan_id, timeout=60.0 + plan.duration / MIN_WALL_RTF)
+        if not result.success:
+            self.publish(Kind.REFUSED, name, plan_id=plan.plan_id,
+                         message=f"controller: code {result.error_code}: {result.message}")
+            return None
+        return self.telemetry.t
+
+    def wait_at(self, q_hold, t_now: float, until: float) -> tuple[np.ndarray, float]:
+        """Hold ``q_hold`` until ``until`` − ``start_lead``, or park at a visible source when the
+        zones reach the held attitude first; the attitude held and the time after."""
+        t_request = until - self.mission.start_lead
+        if t_request <= t_now or self.scheduler.clear(q_hold, t_now, until):
+            return q_hold, (self.telemetry.wait(t_request) if t_request > t_now else t_now)
+        name = self.scheduler.park(q_hold, t_now, until)
+        if name is None:
+            self.log(f"[mission] no source to park at until t = {until:.0f} s: holding")
+            return q_hold, self.telemetry.wait(t_request)
+        end = self.fly(name, q_hold, t_now + self.mission.start_lead, wait_for_visibility=False)
+        if end is None:
+            return q_hold, self.telemetry.t
+        self.publish(Kind.PARK, name, end, until, message=f"waiting at {name} until t = {until:.0f} s")
+        return self.targets[name][0], self.telemetry.wait(max(end, t_request))
+
+    def run(self) -> None:
+        """Fly the mission to its horizon or its last target."""
+        t = self.telemetry.wait()
+        q_hold = convert.from_quaternion(self.telemetry.msg.attitude)
+        remaining, observed = list(self.targets), 0
+        while remaining and t < self.mission.horizon:
+            decision = self.scheduler.decide(t, q_hold, remaining)
+            for name, why in decision.missed.items():
+                self.publish(Kind.MISSED, name, message=why)
+                remaining.remove(name)
+            if not decision.order:
+                break
+            self.publish(Kind.SCHEDULED, message="order " + ", ".join(
+                f"{k} at {a:.0f} s" for k, a in zip(decision.order, decision.arrivals)))
+            name = decision.order[0]
+            sc = self.scenario.spacecraft
+            slew = self.scheduler.slew_factor * slew_estimate(sc.inertia, sc.body_torque_max, q_hold,
+                                                              self.targets[name][0])
+            t_start = max(t + self.mission.start_lead, decision.arrivals[0] - slew)
+            if t_start > t + self.mission.start_lead:
+                q_hold, t = self.wait_at(q_hold, t, t_start)
+                t_start = max(t_start, t + self.mission.start_lead)
+            end = self.fly(name, q_hold, t_start, wait_for_visibility=True)
+            if end is None:
+                self.attempts[name] += 1
+                if self.attempts[name] >= MAX_ATTEMPTS:
+                    remaining.remove(name)
+                    self.publish(Kind.MISSED, name, message=f"{MAX_ATTEMPTS} slews to it refused (above)")
+                q_hold, t = convert.from_quaternion(self.telemetry.msg.attitude), self.telemetry.t
+                continue
+            q_hold, dwell = self.targets[name][0], self.targets[name][1]
+            start = max(end, self.scheduler.observable_from(name, end) or end)
+            self.publish(Kind.DWELL, name, start, start + dwell, message=f"observing for {dwell:g} s")
+            t = self.telemetry.wait(start + dwell)
+            remaining.remove(name)
+            observed += 1
+        self.publish(Kind.ENDED, message=f"{observed} targets held for their dwell, {len(self.targets) - observed} "
+                                         f"missed or not reached at t = {self.telemetry.t:.0f} s")
+
+
+def fly_mission(mission: mission_config.MissionConfig, out: Path, log=print) -> tuple[Path, dict]:
+    """Start the nodes, fly ``mission``, stop them; the MCAP's path and the day's report."""
+    run_dir = out / f"{mission.path.stem}_{datetime.now(UTC).strftime('%Y%m%d_%H%M%S')}"
+    mcap_path = run_dir / "run.mcap"
+    env = isolated_env(inherit=True)
+    log(f"[mission] {domain_line(env)}")
+    join_env(env)
+    rate = mission.rate
+    params = {"simulator": {"step": 1.0 / rate, "publish_rate": rate, "clock_rate": rate, "real_time_factor": 0.0},
+              "controller": {"control_rate": rate, "momentum_dumping": mission.momentum_dumping},
+              "estimator": {"publish_rate": rate}}
+    name = mission.scenario.name
+    suite = start_suite(name, mcap_path, run_dir, env=env, nodes=default_nodes(name), params=params)
+    wall = time.monotonic()
+    try:
+        with client_session("mission") as client:
+            client.wait_for_servers(timeout=120)
+            MissionRun(client, mission, log).run()
+    finally:
+        codes = suite.stop()
+        log(f"[mission] nodes stopped: {codes}")
+    report = day_report(mcap_path, mission)
+    report["wall_seconds"] = time.monotonic() - wall
+    report["rtf"] = report["sim_seconds"] / report["wall_seconds"]
+    return mcap_path, report
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(prog="att-mission", description=__doc__.splitlines()[0])
+    parser.add_argument("mission", help="a mission file (config/missions/NAME.yaml, or a path)")
+    parser.add_argument("--out", default="runs", help="directory for the MCAP and the node logs")
+    parser.add_argument("--json", help="write the day's report here")
+    args = parser.parse_args(argv)
+    try:
+        mission = mission_config.load(args.mission)
+    except (KeyError, ConfigError) as err:
+        print(f"att-mission: {err.args[0] if isinstance(err, KeyError) else err}", file=sys.stderr)
+        return 2
+    mcap_path, report = fly_mission(mission, Path(args.out))
+    for target in report["targets"]:
+        print(f"[mission]   {target['name']:14s} {'observed' if target['observed'] else 'missed  '} "
+              f"{target.get('why', '')}")
+    print(f"[mission] observed {report['observed']}, missed {report['missed']}, minimum zone margin "
+          f"{report['min_margin_deg']:.2f} deg, peak wheel speed {report['peak_wheel_ratio']:.2f} of the limit, "
+          f"{report['sim_seconds']:.0f} s of sim time in {report['wall_seconds']:.0f} s (RTF {report['rtf']:.1f})")
+    if args.json:
+        Path(args.json).write_text(json.dumps(report, indent=1))
+    print(f"MCAP: {mcap_path}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
