@@ -387,6 +387,8 @@ def mission_event_msg(e: types.MissionEvent) -> MissionEvent:
                                plan_id=e.plan_id, message=e.message), e.t, e.frame_id)
     msg.attitude = quaternion(e.attitude)
     msg.direction = vector3(e.direction)
+    msg.sensor_axis = vector3(e.sensor_axis)
+    msg.tolerance = float(e.tolerance)
     return msg
 
 
@@ -394,5 +396,6 @@ def mission_event_from_msg(msg) -> types.MissionEvent:
     return types.MissionEvent(
         t=from_time(msg.header.stamp), event=types.MissionEventKind(msg.event), target=msg.target,
         start=float(msg.start), end=float(msg.end), attitude=from_quaternion(msg.attitude),
-        direction=from_vector3(msg.direction), plan_id=msg.plan_id, message=msg.message,
+        direction=from_vector3(msg.direction), sensor_axis=from_vector3(msg.sensor_axis),
+        tolerance=float(msg.tolerance), plan_id=msg.plan_id, message=msg.message,
         frame_id=msg.header.frame_id)

@@ -463,7 +463,8 @@ class MissionEventKind(StrEnum):
 @dataclass(frozen=True)
 class MissionEvent:
     """One event of a mission (``att_msgs/MissionEvent``): at sim time ``t``, ``event`` about
-    ``target`` over ``[start, end]`` s of sim time, its attitude and direction when it has them."""
+    ``target`` over ``[start, end]`` s of sim time, its attitude and direction when it has them, the
+    body ``sensor_axis`` put on it and the pointing ``tolerance`` (rad) a dwell is observed within."""
 
     t: float
     event: MissionEventKind
@@ -472,6 +473,8 @@ class MissionEvent:
     end: float = 0.0
     attitude: np.ndarray = field(default_factory=lambda: np.array([0.0, 0.0, 0.0, 1.0]))
     direction: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    sensor_axis: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    tolerance: float = 0.0
     plan_id: str = ""
     message: str = ""
     frame_id: str = ""

@@ -2,16 +2,17 @@
 
 The log's ``/mission/events`` say what was flown (dwells, slews, parks, misses, with why); the truth
 state says how: a target's pointing error is the largest angle, over its dwell, between the body
-sensor axis turned inertial by the recorded attitude and the source's direction; it counts as
-observed when that error stays within the mission's ``pointing_tolerance`` and no zone covers the
-boresight during the dwell. The zones' margins are taken at every recorded state's time with the
-Sun, Moon and Earth at their true positions (:class:`att_planner.zones.ZoneSky` on the scenario's
-sky); the wheels' peak speed against the scenario's limit.
+sensor axis (the event's) turned inertial by the recorded attitude and the source's direction; it
+counts as observed when that error stays within the event's tolerance (the mission's
+``pointing_tolerance``), no zone covers the boresight during the dwell and the log holds all of
+it. The zones' margins are taken at every recorded state's time with the Sun, Moon and Earth at
+their true positions (:class:`att_planner.zones.ZoneSky` on the scenario's sky); the wheels' peak
+speed relative to the body against the scenario's limit.
 """
 from __future__ import annotations
 
 import math
-from datetime import timedelta
+from datetime import datetime, timedelta
 from pathlib import Path
 
 import numpy as np
@@ -20,16 +21,10 @@ from att_msgs_py import convert
 from att_msgs_py.log import read_log
 from att_msgs_py.topics import MISSION_EVENTS, STATE
 from att_msgs_py.types import MissionEventKind as Kind
-from att_planner.mission.config import MissionConfig
 from att_planner.zones import ZoneSky
 from att_sim import rotations as rot
 from att_sim import scenario as scen
 from att_sim.ephemeris import Sky
-
-
-def utc(mission: MissionConfig, t: float) -> str:
-    """ISO 8601 UTC of sim time ``t``."""
-    return (mission.scenario.epoch + timedelta(seconds=float(t))).isoformat()
 
 
 def boresight_errors(q: np.ndarray, sensor_axis, direction) -> np.ndarray:
@@ -45,49 +40,59 @@ def events_of(log: dict) -> list:
     return [convert.mission_event_from_msg(m) for m in topic.messages] if topic is not None else []
 
 
-def day_report(mcap_path: str | Path, mission: MissionConfig) -> dict:
+def target_table(events: list, t: np.ndarray, q: np.ndarray, margins: np.ndarray, epoch: datetime) -> list[dict]:
+    """One row per target of the mission's ``events``: its dwell (sim time and UTC), whether it was
+    observed and the truth pointing error over it (from the states ``t``, ``q`` and the zones'
+    ``margins`` at them), or why it was missed."""
+    rows, seen = [], set()
+    step = float(np.median(np.diff(t))) if t.size > 1 else 0.0
+    for e in events:
+        if e.target in seen or e.event not in (Kind.DWELL, Kind.MISSED):
+            continue
+        seen.add(e.target)
+        if e.event == Kind.MISSED:
+            rows.append({"name": e.target, "start": None, "end": None, "observed": False,
+                         "pointing_error_deg": None, "why": e.message})
+            continue
+        inside = (t >= e.start) & (t <= e.end)
+        err = boresight_errors(q[inside], e.sensor_axis, e.direction)
+        covered = bool(inside.any() and margins[inside].min() < 0.0)
+        complete = bool(inside.any() and t[inside][-1] >= e.end - step)
+        observed = complete and not covered and float(err.max()) <= e.tolerance
+        why = ("" if observed else "the log ends before the dwell does" if not complete
+               else "a zone covered the boresight" if covered else
+               f"pointing error beyond the tolerance of {math.degrees(e.tolerance):g} deg")
+        rows.append({"name": e.target, "start": (epoch + timedelta(seconds=e.start)).isoformat(),
+                     "end": (epoch + timedelta(seconds=e.end)).isoformat(), "start_s": e.start, "end_s": e.end,
+                     "observed": observed, "pointing_error_deg": math.degrees(err.max()) if err.size else None,
+                     **({"why": why} if why else {})})
+    return rows
+
+
+def day_report(mcap_path: str | Path, scenario: scen.Scenario) -> dict:
     """The day's figures (module docstring) in the JSON layout of ``att-bench day``."""
     log = read_log(mcap_path, topics=[STATE, MISSION_EVENTS], keep_messages=[MISSION_EVENTS])
     state, events = log[STATE], events_of(log)
     t, q = np.asarray(state["header.stamp"], float), np.asarray(state["attitude"], float)
-    sc = mission.scenario
-    zone_sky = ZoneSky(list(sc.zones), Sky(sc.epoch, sc.orbit_model), window=max(1.0, float(t[-1] - t[0])))
+    zone_sky = ZoneSky(list(scenario.zones), Sky(scenario.epoch, scenario.orbit_model),
+                       window=max(1.0, float(t[-1] - t[0])))
     margins = zone_sky.margins(t, q, true=True)
-    targets, seen = [], set()
-    for e in events:
-        if e.event == Kind.DWELL:
-            inside = (t >= e.start) & (t <= e.end)
-            err = boresight_errors(q[inside], mission.sensor_axis, e.direction)
-            covered = bool(inside.any() and margins[inside].min() < 0.0)
-            observed = bool(inside.any() and t[inside][-1] >= e.end - 1.0 / mission.rate and not covered
-                            and err.max() <= mission.pointing_tolerance)
-            targets.append({"name": e.target, "start": utc(mission, e.start), "end": utc(mission, e.end),
-                            "start_s": e.start, "end_s": e.end, "observed": observed,
-                            "pointing_error_deg": math.degrees(err.max()) if err.size else math.inf,
-                            **({} if observed else {"why": "a zone covered the boresight" if covered else
-                                                    "pointing error beyond the tolerance" if err.size
-                                                    else "the log ends before the dwell"})})
-            seen.add(e.target)
-        elif e.event == Kind.MISSED and e.target not in seen:
-            targets.append({"name": e.target, "start": None, "end": None, "observed": False,
-                            "pointing_error_deg": None, "why": e.message})
-            seen.add(e.target)
-    for name in (n.name for n in mission.target_list.targets if n.name not in seen):
-        targets.append({"name": name, "start": None, "end": None, "observed": False, "pointing_error_deg": None,
-                        "why": "not reached before the mission ended"})
-    orbit = scen.shared_params(scen.read_document(sc.path)).get("orbit", {})
-    wheels = np.asarray(state["wheel_speeds"], float)
+    targets = target_table(events, t, q, margins, scenario.epoch)
+    orbit = scen.shared_params(scen.read_document(scenario.path)).get("orbit", {})
+    sc = scenario.spacecraft
+    relative = np.asarray(state["wheel_speeds"], float) - np.asarray(state["body_rate"], float) @ sc.wheel_axes
+    sensor_axis = next((e.sensor_axis for e in events if e.target), np.zeros(3))
     observed = sum(x["observed"] for x in targets)
     return {
-        "mcap": str(mcap_path), "epoch": utc(mission, t[0]), "sim_seconds": float(t[-1] - t[0]),
-        "tle": [orbit.get("line1", ""), orbit.get("line2", "")], "sensor_axis": list(mission.sensor_axis),
-        "targets": targets,
+        "mcap": str(mcap_path), "epoch": (scenario.epoch + timedelta(seconds=float(t[0]))).isoformat(),
+        "sim_seconds": float(t[-1] - t[0]), "tle": [orbit.get("line1", ""), orbit.get("line2", "")],
+        "sensor_axis": list(sensor_axis), "targets": targets,
         "zones": [{"name": z.name, "body": z.body, "half_angle_deg": math.degrees(z.half_angle), "keep_in": z.keep_in,
                    "sensor_axis": list(z.sensor_axis), "min_margin_deg": float(np.degrees(margins[:, i].min()))}
-                  for i, z in enumerate(sc.zones)],
+                  for i, z in enumerate(scenario.zones)],
         "observed": observed, "missed": len(targets) - observed,
         "min_margin_deg": float(np.degrees(margins.min())) if margins.size else math.inf,
-        "peak_wheel_ratio": float(np.abs(wheels).max() / sc.spacecraft.wheel_speed_max) if wheels.size else 0.0,
+        "peak_wheel_ratio": float(np.abs(relative).max() / sc.wheel_speed_max) if relative.size else 0.0,
         "events": [{"t": e.t, "event": e.event.value, "target": e.target, "start": e.start, "end": e.end,
                     "plan_id": e.plan_id, "message": e.message} for e in events],
     }

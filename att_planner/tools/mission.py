@@ -97,8 +97,10 @@ class MissionRun:
     def publish(self, kind: Kind, target: str = "", start: float = 0.0, end: float = 0.0, plan_id: str = "",
                 message: str = "") -> None:
         q, _, d = self.targets.get(target, (np.array([0.0, 0.0, 0.0, 1.0]), 0.0, np.zeros(3)))
+        m = self.mission
         self.events.publish(convert.mission_event_msg(Event(
-            self.telemetry.t, kind, target, start, end, q, d, plan_id, message[:400], self.scenario.frame_id)))
+            self.telemetry.t, kind, target, start, end, q, d, m.sensor_axis if target else np.zeros(3),
+            m.pointing_tolerance if target else 0.0, plan_id, message[:400], self.scenario.frame_id)))
         self.log(f"[mission] t = {self.telemetry.t:8.1f} s  {kind.value:9s} {target:14s} {message}")
 
     def fly(self, name: str, q_from, t_start: float, wait_for_visibility: bool):
@@ -191,6 +193,9 @@ class MissionRun:
             t = self.telemetry.wait(start + dwell)
             remaining.remove(name)
             observed += 1
+        for name in remaining:
+            self.publish(Kind.MISSED, name, message=f"not reached before the mission ended (horizon "
+                                                     f"{self.mission.horizon:g} s)")
         self.publish(Kind.ENDED, message=f"{observed} targets held for their dwell, {len(self.targets) - observed} "
                                          f"missed or not reached at t = {self.telemetry.t:.0f} s")
 
@@ -216,7 +221,7 @@ def fly_mission(mission: mission_config.MissionConfig, out: Path, log=print) -> 
     finally:
         codes = suite.stop()
         log(f"[mission] nodes stopped: {codes}")
-    report = day_report(mcap_path, mission)
+    report = day_report(mcap_path, mission.scenario)
     report["wall_seconds"] = time.monotonic() - wall
     report["rtf"] = report["sim_seconds"] / report["wall_seconds"]
     return mcap_path, report

@@ -22,6 +22,11 @@ executed plan, else the last magnetorquer-PD run, else the whole log), and write
 * ``pointing.png`` (a log with a pointing mode, issue 15) — the mode timeline with the guidance,
   the pointing error from the reference, each wheel's momentum against its limit, the dipoles
   (:mod:`.pointing`); the summary gains ``pointing``;
+* ``mission.png`` and ``mission_sky.png`` (a log of ``att-mission``, issue 17) — the day's
+  timeline (a Gantt row per target: slews, dwells observed or not, parks, misses; the controller's
+  mode), the zones' margins, wheel momentum and dipoles over the day, and the sky with the day's
+  boresight track, the targets and the Sun, Moon and nadir tracks (:mod:`.mission`); the summary
+  gains ``mission``: the table of targets observed (start, dwell, pointing error) and missed (why);
 * ``summary.txt``, ``summary.json`` and ``index.html`` (summary table, figures embedded).
 
 For a maneuver, "executed" is the whole reviewed segment: the maneuver (the plan, t = 0 to its
@@ -47,10 +52,12 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from att_msgs_py.log import read_log
-from att_msgs_py.topics import COMMAND, CONTROLLER_STATUS, PLANS, STATE
+from att_msgs_py.topics import COMMAND, CONTROLLER_STATUS, MISSION_EVENTS, PLANS, STATE
 from att_planner.tools.review.estimation import TOPICS as ESTIMATION_TOPICS
 from att_planner.tools.review.estimation import estimation_of, estimation_summary, figure_estimation
 from att_planner.tools.review.figures import figure_overview, figure_sky, figure_time_histories
+from att_planner.tools.review.mission import TOPICS as MISSION_TOPICS
+from att_planner.tools.review.mission import figure_mission, figure_mission_sky, mission_of, mission_summary
 from att_planner.tools.review.pointing import figure_pointing, pointing_of, pointing_summary
 from att_planner.tools.review.run import extract_run, settling_time
 from att_planner.tools.review.summary import format_summary, notes, scenario_for, summarize, summary_of, zone_sky_for
@@ -86,7 +93,8 @@ def review(log_path: str | Path, out_dir: str | Path | None = None, *, plan_id: 
     log_path = Path(log_path)
     out = Path(out_dir) if out_dir is not None else log_path.parent / "review"
     out.mkdir(parents=True, exist_ok=True)
-    log = read_log(log_path, topics=sorted({STATE, COMMAND, PLANS, CONTROLLER_STATUS, *ESTIMATION_TOPICS}))
+    log = read_log(log_path, topics=sorted({STATE, COMMAND, PLANS, CONTROLLER_STATUS, *ESTIMATION_TOPICS,
+                                            *MISSION_TOPICS}), keep_messages=(PLANS, MISSION_EVENTS))
     run = extract_run(log, plan_id)
     found = scenario_for(run, scenario)
     sc = found.spacecraft if found is not None else None
@@ -103,6 +111,11 @@ def review(log_path: str | Path, out_dir: str | Path | None = None, *, plan_id: 
     if pointing is not None:
         summary["pointing"] = pointing_summary(pointing)
         figures["pointing"] = figure_pointing(pointing, out / "pointing.png")
+    mission = mission_of(log, found)
+    if mission is not None:
+        summary["mission"] = mission_summary(mission)
+        figures["mission"] = figure_mission(mission, out / "mission.png")
+        figures["mission sky"] = figure_mission_sky(mission, out / "mission_sky.png")
     text = format_summary(summary)
     (out / "summary.txt").write_text(text + "\n")
     (out / "summary.json").write_text(json.dumps(summary, indent=2) + "\n")

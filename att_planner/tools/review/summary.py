@@ -282,6 +282,23 @@ def format_summary(s: dict, with_notes: bool = True) -> str:
         lines.append(f"pointing              {pt['pointing_seconds']:.0f} s, error rms {rms}; peak wheel speed "
                      f"{pt['peak_wheel_speed_ratio']:.3f} of its limit (saturated {sat}); dipole duty "
                      f"{pt['dipole_duty']:.2f}")
+    lines += mission_lines(s.get("mission"))
     if with_notes:
         lines += [f"note: {n}" for n in notes(s)]
     return "\n".join(lines)
+
+
+def mission_lines(m: dict | None) -> list[str]:
+    """The mission's table (issue 17): a line per target, observed (start, dwell, pointing error) or missed (why)."""
+    if not m:
+        return []
+    lines = [f"mission               {m['observed']} targets observed, {m['missed']} missed; smallest zone margin "
+             f"{m['min_zone_margin_deg']:.3f} deg; peak wheel momentum {m['peak_wheel_momentum_ratio']:.3f} "
+             "of its limit"]
+    for r in m["targets"]:
+        if r["observed"]:
+            lines.append(f"  {r['name']:14s} observed from {r['start']} for {r['end_s'] - r['start_s']:.0f} s, "
+                         f"pointing error {r['pointing_error_deg']:.4f} deg")
+        else:
+            lines.append(f"  {r['name']:14s} missed: {r['why']}")
+    return lines

@@ -62,3 +62,33 @@ def test_the_slew_estimate_is_the_bang_bang_eigenaxis_time():
 def test_a_mission_needs_the_real_sky():
     with pytest.raises(ValueError, match="'swift_demo' has no epoch"):
         MissionScheduler(scen.load("swift_demo"), {}, HORIZON)
+
+
+def test_observable_from_is_the_first_span_long_enough_for_the_dwell(day):
+    scheduler, targets = day
+    for name, (_, dwell) in targets.items():
+        start = scheduler.observable_from(name, 600.0)
+        spans = [(a, b) for a, b in scheduler.visible[name] if b - max(a, 600.0) >= dwell]
+        if not spans:
+            assert start is None, name
+            continue
+        assert start == pytest.approx(max(spans[0][0], 600.0)), name
+        assert scheduler.zones.margins(np.linspace(start, start + dwell, 9), targets[name][0], true=True).min() >= 0
+
+
+def test_a_held_attitude_is_clear_only_while_no_zone_covers_it(day):
+    scheduler, targets = day
+    q = targets["polaris"][0]
+    (a, b), *_ = [s for s in scheduler.visible["polaris"] if s[1] - s[0] > 600.0]
+    assert scheduler.clear(q, a + 10.0, b - 10.0)
+    assert not scheduler.clear(targets["sgr_a_star"][0], 0.0, 60.0)          # in the Sun zone all day
+
+
+def test_a_park_is_a_source_visible_from_its_arrival_until_the_wait_ends(day):
+    scheduler, targets = day
+    q_from, now, until = targets["sgr_a_star"][0], 1000.0, 2500.0
+    name = scheduler.park(q_from, now, until)
+    assert name is not None
+    arrive = now + scheduler.leg(q_from, targets[name][0])
+    assert scheduler.zones.margins(np.linspace(arrive, until, 50), targets[name][0], true=True).min() >= 0
+    assert scheduler.park(q_from, now, HORIZON + 7200.0) is None             # nothing is visible past the horizon

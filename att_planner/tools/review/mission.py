@@ -1,0 +1,174 @@
+"""The review of a mission's log (issue 17): numpy, and two figures.
+
+:func:`mission_of` gathers a log with ``/mission/events`` (``att-mission``): the events, the truth
+states (attitude, wheels relative to the body, applied dipole), the controller's modes and the
+zones' margins at every state (their true positions on the scenario's sky), and the per-target table
+of :func:`att_planner.mission.day.target_table` (dwell, observed, pointing error, or why missed).
+:func:`figure_mission` draws ``mission.png``: the timeline (a Gantt row per target: slews, dwells
+green when observed and red when not, parks; the controller's mode below), the zones' margins over
+the day, each wheel's momentum against its limit, the dipoles. :func:`figure_mission_sky` draws
+``mission_sky.png``: the day's boresight track in right ascension and declination, the targets
+(observed, missed), and the tracks of the Sun, the Moon and the nadir (the Earth zone's axis).
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from att_msgs_py.log import TopicLog
+from att_msgs_py.topics import CONTROLLER_STATUS, MISSION_EVENTS, STATE
+from att_msgs_py.types import MissionEventKind as Kind
+from att_planner.mission.day import events_of, target_table
+from att_planner.tools.review.run import MODE_NAMES
+from att_planner.zones import ZoneSky
+from att_sim import rotations as rot
+from att_sim import scenario as scen
+from att_sim.ephemeris import Sky
+
+TOPICS = [STATE, CONTROLLER_STATUS, MISSION_EVENTS]
+SKY_SAMPLES = 2000                 # points of each track on the sky plot
+
+
+@dataclass
+class MissionLog:
+    events: list                   # MissionEvent, in order
+    rows: list                     # target_table rows
+    t: np.ndarray                  # (n,) s of sim time, states
+    q: np.ndarray                  # (n, 4)
+    margins: np.ndarray            # (n, Z) rad
+    zone_names: list
+    wheel_momentum: np.ndarray     # (n, N) N m s, relative speeds × I_w
+    dipole: np.ndarray             # (n, 3) A m², applied
+    mode_t: np.ndarray             # (m,) controller status instants
+    mode: np.ndarray               # (m,)
+    limit: float                   # N m s per wheel
+    sky: Sky
+    sensor_axis: np.ndarray
+
+
+def mission_of(log: dict[str, TopicLog], scenario: scen.Scenario | None) -> MissionLog | None:
+    """The mission review's data of a log with mission events and a real-sky scenario (else None)."""
+    events = events_of(log)
+    if not events or scenario is None or scenario.epoch is None or STATE not in log:
+        return None
+    state, sc = log[STATE], scenario.spacecraft
+    t, q = np.asarray(state["header.stamp"], float), np.asarray(state["attitude"], float)
+    sky = Sky(scenario.epoch, scenario.orbit_model)
+    zones = ZoneSky(list(scenario.zones), sky, window=max(1.0, float(t[-1] - t[0])))
+    margins = zones.margins(t, q, true=True)
+    relative = np.asarray(state["wheel_speeds"], float) - np.asarray(state["body_rate"], float) @ sc.wheel_axes
+    status = log.get(CONTROLLER_STATUS)
+    mode_t = np.asarray(status["header.stamp"], float) if status is not None else np.zeros(0)
+    mode = np.asarray(status["mode"]) if status is not None else np.zeros(0)
+    sensor_axis = next((e.sensor_axis for e in events if e.target), np.array([0.0, 0.0, 1.0]))
+    return MissionLog(events, target_table(events, t, q, margins, scenario.epoch), t, q, margins, zones.names,
+                      relative * sc.wheel_inertia, np.asarray(state["dipole"], float), mode_t, mode,
+                      sc.wheel_inertia * sc.wheel_speed_max, sky, sensor_axis)
+
+
+def mission_summary(run: MissionLog) -> dict:
+    """Targets observed and missed (the table), the smallest zone margin, the peak wheel momentum."""
+    observed = sum(r["observed"] for r in run.rows)
+    return {"observed": observed, "missed": len(run.rows) - observed, "targets": run.rows,
+            "min_zone_margin_deg": float(np.degrees(run.margins.min())) if run.margins.size else math.inf,
+            "peak_wheel_momentum_ratio": float(np.abs(run.wheel_momentum).max() / run.limit)
+            if run.wheel_momentum.size else 0.0}
+
+
+def figure_mission(run: MissionLog, path: Path) -> Path:
+    """``mission.png``: timeline, zone margins, wheel momentum against its limit, dipoles."""
+    from att_planner.tools.review.figures import _figure
+
+    plt, fig = _figure(figsize=(12, 13))
+    axes = fig.subplots(4, 1, sharex=True, gridspec_kw={"height_ratios": [3, 1.3, 1.3, 1]})
+    h = 3600.0
+    names = list(dict.fromkeys(e.target for e in run.events if e.target))
+    observed = {r["name"]: r["observed"] for r in run.rows}
+    colours = {Kind.SLEW: "0.6", Kind.PARK: "tab:blue"}
+    for e in run.events:
+        if e.event in (Kind.SLEW, Kind.DWELL, Kind.PARK) and e.end > e.start:
+            colour = colours.get(e.event) or ("tab:green" if observed.get(e.target) else "tab:red")
+            axes[0].broken_barh([(e.start / h, (e.end - e.start) / h)], (names.index(e.target) - 0.35, 0.7),
+                                color=colour)
+        elif e.event == Kind.MISSED:
+            axes[0].plot(e.t / h, names.index(e.target), "rx", ms=6)
+    base = len(names) + 0.5
+    if run.mode.size:
+        axes[0].step(run.mode_t / h, base + run.mode / max(MODE_NAMES) * 1.5, where="post", color="k", lw=0.8)
+    axes[0].set_yticks(range(len(names)), [f"{n} ({'observed' if observed.get(n) else 'missed'})" for n in names],
+                       fontsize=7)
+    axes[0].set_ylim(-1, base + 2)
+    axes[0].invert_yaxis()
+    axes[0].set_title("slews (grey), dwells (green: observed, red: not), parks (blue), missed (x); "
+                      "top line: controller mode " + ", ".join(f"{k}={v}" for k, v in MODE_NAMES.items()), fontsize=8)
+    for i, name in enumerate(run.zone_names):
+        axes[1].plot(run.t / h, np.degrees(run.margins[:, i]), lw=0.7, label=name)
+    axes[1].axhline(0.0, color="r", lw=0.8)
+    axes[1].set_ylabel("zone margin\n(deg)")
+    axes[1].legend(ncol=len(run.zone_names), fontsize=7, loc="upper right")
+    for i in range(run.wheel_momentum.shape[1]):
+        axes[2].plot(run.t / h, run.wheel_momentum[:, i], lw=0.8, label=f"wheel {i}")
+    for sign in (1, -1):
+        axes[2].axhline(sign * run.limit, color="r", ls="--", lw=0.8)
+    axes[2].set_ylabel("wheel momentum\n(N m s; dashed: limit)")
+    axes[2].legend(ncol=4, fontsize=7, loc="upper right")
+    for i, axis in enumerate("xyz"):
+        axes[3].plot(run.t / h, run.dipole[:, i], lw=0.6, label=axis)
+    axes[3].set_ylabel("dipole applied\n(A m²)")
+    axes[3].legend(ncol=3, fontsize=7, loc="upper right")
+    axes[-1].set_xlabel("sim time (h from the epoch)")
+    for ax in axes:
+        ax.grid(alpha=0.3)
+    fig.tight_layout()
+    fig.savefig(path, dpi=90)
+    plt.close(fig)
+    return path
+
+
+def _ra_dec(v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    v = np.atleast_2d(v)
+    return np.degrees(np.arctan2(v[:, 1], v[:, 0])) % 360.0, np.degrees(np.arcsin(np.clip(v[:, 2], -1.0, 1.0)))
+
+
+def _track(ax, v: np.ndarray, **kwargs) -> None:
+    """A track in RA/Dec, broken where it wraps through RA 0/360."""
+    ra, dec = _ra_dec(v)
+    ra = np.where(np.abs(np.diff(ra, prepend=ra[0])) > 180.0, np.nan, ra)
+    ax.plot(ra, dec, **kwargs)
+
+
+def figure_mission_sky(run: MissionLog, path: Path) -> Path:
+    """``mission_sky.png``: boresight, targets, Sun, Moon and nadir over the day (RA, Dec)."""
+    from att_planner.tools.review.figures import _figure
+
+    plt, fig = _figure(figsize=(12, 6.5))
+    ax = fig.subplots()
+    pick = np.unique(np.linspace(0, len(run.t) - 1, SKY_SAMPLES).astype(int))
+    t = run.t[pick]
+    _track(ax, rot.dcm(run.q[pick]) @ run.sensor_axis, color="k", lw=0.6, label="boresight")
+    _track(ax, run.sky.sun_direction(t), color="orange", lw=3, label="Sun")
+    _track(ax, run.sky.moon_direction(t), color="0.5", lw=3, label="Moon")
+    _track(ax, run.sky.nadir(t), color="tab:blue", lw=0.5, ls=":", label="nadir (Earth zone axis)")
+    observed = {r["name"]: r["observed"] for r in run.rows}
+    seen = set()
+    for e in run.events:
+        if e.target and e.target not in seen and np.linalg.norm(e.direction) > 0.5:
+            seen.add(e.target)
+            ra, dec = _ra_dec(e.direction)
+            ok = observed.get(e.target, False)
+            ax.plot(ra, dec, "o" if ok else "x", color="tab:green" if ok else "tab:red", ms=7)
+            ax.annotate(e.target, (ra[0], dec[0]), fontsize=7, xytext=(4, 4), textcoords="offset points")
+    ax.set_xlim(360, 0)
+    ax.set_ylim(-90, 90)
+    ax.set_xlabel("right ascension (deg, GCRS)")
+    ax.set_ylabel("declination (deg)")
+    ax.set_title("the day's boresight track; targets observed (o) and missed (x)", fontsize=9)
+    ax.legend(fontsize=7, loc="lower left")
+    ax.grid(alpha=0.3)
+    fig.tight_layout()
+    fig.savefig(path, dpi=90)
+    plt.close(fig)
+    return path

@@ -1,0 +1,71 @@
+"""Mission files (issue 17): the shipped day loads; every key of a hostile file is refused with the
+file and the key named."""
+import math
+
+import numpy as np
+import pytest
+
+from att_msgs_py.errors import ConfigError, ErrorCode
+from att_planner.mission import config as mc
+from att_sim import rotations as rot
+
+GOOD = {"targets": "observatory", "sensor_axis": [0.0, 1.0, 0.0], "horizon_s": 3600}
+
+
+def write(tmp_path, text: str):
+    path = tmp_path / "mission.yaml"
+    path.write_text(text)
+    return str(path)
+
+
+def yaml_of(doc: dict) -> str:
+    import yaml
+    return yaml.safe_dump(doc)
+
+
+def test_the_shipped_day_loads_with_its_targets_pointed():
+    m = mc.load("observatory_day")
+    assert m.horizon == 6 * 3600.0 and m.scenario.name == "leo_observatory" and m.momentum_dumping
+    assert m.pointing_tolerance == pytest.approx(math.radians(0.05))
+    attitudes = m.attitudes()
+    assert len(attitudes) == 16
+    for q, dwell, direction in attitudes.values():
+        assert rot.dcm(q) @ m.sensor_axis == pytest.approx(direction, abs=1e-12) and dwell > 0
+
+
+def test_defaults_fill_what_a_file_leaves_out(tmp_path):
+    m = mc.load(write(tmp_path, yaml_of(GOOD)))
+    assert (m.rate, m.start_lead, m.method, m.margin) == (5.0, 240.0, "", pytest.approx(math.radians(1.0)))
+    assert np.array_equal(m.sensor_axis, [0.0, 1.0, 0.0])
+
+
+@pytest.mark.parametrize("change, field", [
+    ({"horizon_s": None}, "horizon_s"), ({"horizon_s": 10}, "horizon_s"), ({"horizon_s": True}, "horizon_s"),
+    ({"horizon_s": float("nan")}, "horizon_s"), ({"rate_hz": 0}, "rate_hz"), ({"rate_hz": "5"}, "rate_hz"),
+    ({"margin_deg": -1}, "margin_deg"), ({"start_lead_s": 1e9}, "start_lead_s"),
+    ({"time_budget_s": 0}, "time_budget_s"), ({"pointing_tolerance_deg": float("inf")}, "pointing_tolerance_deg"),
+    ({"sensor_axis": [0, 2, 0]}, "sensor_axis"), ({"sensor_axis": [0, 1]}, "sensor_axis"),
+    ({"sensor_axis": "y"}, "sensor_axis"), ({"sensor_axis": [0, True, 0]}, "sensor_axis"),
+    ({"targets": 3}, "targets"), ({"targets": "no_such_list"}, "unknown target list"),
+    ({"targets": "earth_observation"}, "ground list"), ({"method": "a\nb"}, "method"),
+    ({"momentum_dumping": "yes"}, "momentum_dumping"), ({"colour": "red"}, "unknown key(s) colour"),
+])
+def test_a_bad_key_is_refused_with_the_file_and_the_key_named(tmp_path, change, field):
+    doc = {**GOOD, **change}
+    doc = {k: v for k, v in doc.items() if v is not None}
+    path = write(tmp_path, yaml_of(doc))
+    with pytest.raises(ConfigError) as err:
+        mc.load(path)
+    assert err.value.code == ErrorCode.INVALID_CONFIG
+    assert path in str(err.value) and field in str(err.value)
+
+
+@pytest.mark.parametrize("text", ["", "[1, 2]", "just a string", "targets: [unclosed"])
+def test_a_file_that_is_not_a_mapping_is_refused(tmp_path, text):
+    with pytest.raises(ConfigError):
+        mc.load(write(tmp_path, text))
+
+
+def test_an_unknown_mission_names_the_known_ones():
+    with pytest.raises(KeyError, match="observatory_day"):
+        mc.find("no_such_mission")
