@@ -11,6 +11,7 @@ the day is flown. One YAML file under ``config/missions/`` (read with ``yaml.saf
     method: ""                     # planning method ("": the planner's default)
     pointing_tolerance_deg: 0.05   # a dwell counts as observed within this pointing error
     momentum_dumping: true         # the controller's magnetorquer momentum dumping, all day
+    rate_max_deg_per_s: 0.2        # per body axis, the slews' rate bound (default: :func:`gyroscopic_rate_limit`)
 
 Every key is checked; a bad file is refused with a :class:`~att_msgs_py.errors.ConfigError` naming
 the file and the key.
@@ -31,7 +32,8 @@ from att_sim import scenario as scen
 NUMBERS = {"horizon_s": (None, 60.0, 7 * 86_400.0), "margin_deg": (1.0, 0.0, 30.0), "rate_hz": (5.0, 0.5, 50.0),
            "start_lead_s": (240.0, 1.0, 3600.0), "time_budget_s": (10.0, 0.05, 600.0),
            "pointing_tolerance_deg": (0.05, 1e-4, 10.0)}
-KEYS = ("targets", "sensor_axis", "method", "momentum_dumping", *NUMBERS)
+KEYS = ("targets", "sensor_axis", "method", "momentum_dumping", "rate_max_deg_per_s", *NUMBERS)
+GYROSCOPIC_SHARE = 0.8        # of the wheels' torque margin over the planning limit the gyroscopic torque may take
 
 
 @dataclass(frozen=True)
@@ -50,12 +52,30 @@ class MissionConfig:
     method: str
     pointing_tolerance: float     # rad
     momentum_dumping: bool
+    rate_max: float               # rad/s per body axis, passed to the planner as option rate_max
 
     def attitudes(self) -> dict:
         """Target name -> (attitude body-to-inertial, dwell s, inertial direction)."""
         tl = self.target_list
         return {t.name: (target_lists.pointing_attitude(self.sensor_axis, t.direction, tl.roll_reference), t.dwell,
                          t.direction) for t in tl.targets}
+
+
+def gyroscopic_rate_limit(sc) -> float:
+    """The per-axis body rate (rad/s) that keeps the gyroscopic torque the plans leave to the wheels
+    within :data:`GYROSCOPIC_SHARE` of their margin over the planning limit.
+
+    The planners bound the body torque ``u = J ω̇ + ω × J ω`` by ``torque_max``; the wheels must
+    give ``J ω̇ + ω × H`` (``H`` the total momentum, near zero), which differs by ``ω × J ω``: at most
+    ``a² (J_max − J_min)`` per axis with every rate within ``a`` (principal axes). So
+    ``a = sqrt(share (T_w − T) / (J_max − J_min))``; inf (no bound) for a spherical inertia or
+    without a margin to share out (then the margin is what is missing, not a rate bound).
+    """
+    J = np.linalg.eigvalsh(np.asarray(sc.inertia, float))                # principal moments
+    spread, margin = float(J.max() - J.min()), float(sc.wheel_torque_max - sc.body_torque_max)
+    if spread <= 0.0 or not (margin > 0.0 and math.isfinite(margin)):
+        return math.inf
+    return math.sqrt(GYROSCOPIC_SHARE * margin / spread)
 
 
 def find(name: str) -> Path:
@@ -113,8 +133,15 @@ def load(name: str) -> MissionConfig:
     if not isinstance(dumping, bool):
         raise _invalid(path, f"momentum_dumping = {clip(repr(dumping), 60)} is not true or false")
     scenario = scen.load_checked(target_list.scenario)
+    rate = doc.get("rate_max_deg_per_s")
+    if rate is None:
+        rate_max = gyroscopic_rate_limit(scenario.spacecraft)
+    elif isinstance(rate, (int, float)) and not isinstance(rate, bool) and 1e-4 <= rate <= 10.0:
+        rate_max = math.radians(rate)
+    else:
+        raise _invalid(path, f"rate_max_deg_per_s = {clip(repr(rate), 60)} is not a number in [0.0001, 10]")
     if scenario.epoch is None:
         raise _invalid(path, f"scenario '{scenario.name}' has no epoch: a mission flies the real sky")
     return MissionConfig(path, target_list, scenario, vec, numbers["horizon_s"], math.radians(numbers["margin_deg"]),
                          numbers["rate_hz"], numbers["start_lead_s"], numbers["time_budget_s"], method,
-                         math.radians(numbers["pointing_tolerance_deg"]), dumping)
+                         math.radians(numbers["pointing_tolerance_deg"]), dumping, rate_max)

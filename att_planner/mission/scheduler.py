@@ -6,7 +6,9 @@ a target is lost. :class:`MissionScheduler` does that without ROS:
 
 * each target's **visibility** over the mission's horizon: the spans in which its attitude keeps
   every zone of the scenario (Sun, Moon, Earth limb at their true positions, sampled every
-  :data:`~att_planner.methods.schedule.order_search.VISIBILITY_STEP` s) by ``margin``;
+  :data:`~att_planner.methods.schedule.order_search.VISIBILITY_STEP` s) by ``margin`` while some
+  star tracker sees the sky clear of its exclusions (the slews start on a converged estimate, and the
+  estimate converges on the trackers);
 * each **leg**'s duration estimate: the rest-to-rest eigenaxis slew at the per-axis torque limit
   (bang-bang, ``2 sqrt(θ / α)``, α of :func:`att_planner.methods.axis_rotations.axis_acceleration`)
   times ``slew_factor`` (the smooth plans the planner returns take longer) plus ``lead`` (planning
@@ -25,8 +27,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from att_msgs_py.types import Zone
 from att_planner.methods.axis_rotations import axis_acceleration
-from att_planner.methods.schedule.order_search import observed_prefix, orders_by_lower_bound, visibility
+from att_planner.methods.schedule.order_search import observed_prefix, orders_by_lower_bound, spans, visibility_grid
 from att_planner.zones import ZoneSky
 from att_sim import rotations as rot
 from att_sim import scenario as scen
@@ -44,6 +47,18 @@ class Decision:
     order: list
     arrivals: list
     missed: dict
+
+
+def tracker_skies(scenario: scen.Scenario, sky: Sky, window: float) -> list[ZoneSky]:
+    """Each star tracker's exclusions as keep-out zones of its boresight (the sensor frame's +z in
+    the body), one :class:`ZoneSky` per tracker."""
+    out = []
+    for spec in scenario.sensors.star_trackers:
+        axis = rot.dcm(spec.mounting) @ np.array([0.0, 0.0, 1.0])
+        zones = [Zone(f"{spec.name}_{e.body}", e.body, axis, e.half_angle, False, e.direction) for e in spec.exclusions]
+        if zones:
+            out.append(ZoneSky(zones, sky, window=window))
+    return out
 
 
 def slew_estimate(inertia: np.ndarray, torque_max: float, q_from, q_to) -> float:
@@ -68,7 +83,18 @@ class MissionScheduler:
         self.slew_factor, self.lead = slew_factor, lead
         sky = Sky(scenario.epoch, scenario.orbit_model)
         self.zones = ZoneSky(list(scenario.zones), sky, window=self.horizon)
-        self.visible = {k: visibility(self.zones, q, (0.0, self.horizon), margin) for k, (q, _) in self.targets.items()}
+        self.trackers = tracker_skies(scenario, sky, self.horizon)
+        t = visibility_grid(0.0, self.horizon)
+        self.visible = {k: spans(t, (self.zones.margins(t, q, true=True).min(axis=1) >= margin) & self.tracked(q, t))
+                        for k, (q, _) in self.targets.items()}
+
+    def tracked(self, q, t) -> np.ndarray:
+        """Whether some star tracker sees the sky (clear of its exclusions) at attitude ``q`` at each
+        time of ``t`` (all True without trackers)."""
+        t = np.atleast_1d(np.asarray(t, float))
+        if not self.trackers:
+            return np.ones(t.shape, bool)
+        return np.max([z.margins(t, np.asarray(q, float), true=True).min(axis=1) for z in self.trackers], axis=0) >= 0
 
     def leg(self, q_from, q_to) -> float:
         """Estimated duration (s) of a slew the mission flies: planning lead, then the plan."""
@@ -129,9 +155,10 @@ class MissionScheduler:
 
     def clear(self, q, t0: float, t1: float) -> bool:
         """Whether attitude ``q`` keeps every zone (at their true positions, no margin) over ``[t0, t1]``
-        (sampled every :data:`HOLD_CHECK_STEP` s and at both ends)."""
+        (sampled every :data:`HOLD_CHECK_STEP` s and at both ends) and a star tracker sees the sky at
+        ``t1`` (a slew starts on a converged estimate)."""
         t = np.unique(np.append(np.arange(t0, t1, HOLD_CHECK_STEP), t1))
-        return bool(self.zones.margins(t, np.asarray(q, float), true=True).min() >= 0.0)
+        return bool(self.zones.margins(t, np.asarray(q, float), true=True).min() >= 0.0 and self.tracked(q, t1)[0])
 
     def park(self, q_from, t_now: float, until: float) -> str | None:
         """A target (observed or not) to wait at from ``t_now`` until ``until``: reached by a leg from

@@ -37,10 +37,11 @@ from pathlib import Path
 import numpy as np
 import rclpy
 
-from att_msgs.msg import MissionEvent, SpacecraftState
+from att_msgs.msg import AttitudeEstimate, MissionEvent, SpacecraftState
 from att_msgs_py import convert, qos
 from att_msgs_py.errors import ConfigError
-from att_msgs_py.topics import MISSION_EVENTS, STATE
+from att_msgs_py.topics import ESTIMATE, MISSION_EVENTS, STATE
+from att_msgs_py.types import Health
 from att_msgs_py.types import MissionEvent as Event
 from att_msgs_py.types import MissionEventKind as Kind
 from att_planner.mission import config as mission_config
@@ -52,17 +53,31 @@ from att_planner.tools.launch import default_nodes, isolated_env, join_env, star
 
 MAX_ATTEMPTS = 2               # slews refused per target before it is missed
 MIN_WALL_RTF = 0.5             # waits for sim time give up below this real-time factor
+RECOVERY_STEP = 10.0           # s of sim time between the checks of a held attitude that cannot start a slew
+RECOVERY_LIMIT = 1800.0        # s of sim time a mission waits for it at most
+CONVERGENCE = {int(h) for h in Health}
 
 
 class Telemetry:
-    """The spacecraft's latest state message (sim time, attitude, wheels), heard on the client's node."""
+    """The spacecraft's latest state message (sim time, attitude, wheels) and the estimate's health,
+    heard on the client's node."""
 
-    def __init__(self, node):
+    def __init__(self, node, estimator: bool):
         self.node, self.msg = node, None
+        self.health = None if estimator else Health.CONVERGED
         node.create_subscription(SpacecraftState, STATE, self._on_state, qos.STREAM_QOS)
+        if estimator:
+            node.create_subscription(AttitudeEstimate, ESTIMATE, self._on_estimate, qos.STREAM_QOS)
 
     def _on_state(self, msg):
         self.msg = msg
+
+    def _on_estimate(self, msg):
+        self.health = Health(msg.health) if msg.health in CONVERGENCE else Health.DIVERGED
+
+    @property
+    def converged(self) -> bool:
+        return self.health == Health.CONVERGED
 
     @property
     def t(self) -> float:
@@ -90,7 +105,7 @@ class MissionRun:
         self.targets = mission.attitudes()
         self.scheduler = MissionScheduler(self.scenario, {k: (q, d) for k, (q, d, _) in self.targets.items()},
                                           mission.horizon, margin=mission.margin, lead=mission.start_lead)
-        self.telemetry = Telemetry(client)
+        self.telemetry = Telemetry(client, mission.scenario.sensors.gyro is not None)
         self.events = client.create_publisher(MissionEvent, MISSION_EVENTS, qos.MISSION_QOS)
         self.attempts: Counter = Counter()
 
@@ -109,9 +124,12 @@ class MissionRun:
         arrive before the target is visible for its dwell is planned again to arrive then (once)."""
         q_to = self.targets[name][0]
         sensor = self.mission.sensor_axis
+        if not self.telemetry.converged:
+            return None
         for _ in range(2):
             epoch = self.scenario.epoch + timedelta(seconds=t_start)
-            request = maneuver_request(q_from, q_to, sensor, [], method=self.mission.method,
+            options = {"rate_max": self.mission.rate_max} if math.isfinite(self.mission.rate_max) else {}
+            request = maneuver_request(q_from, q_to, sensor, [], method=self.mission.method, options=options,
                                        time_budget=self.mission.time_budget, frame_id=self.scenario.frame_id,
                                        epoch=epoch, zones=list(self.scenario.zones),
                                        wheel_speeds=list(self.telemetry.msg.wheel_speeds))
@@ -157,6 +175,21 @@ class MissionRun:
         self.publish(Kind.PARK, name, end, until, message=f"waiting at {name} until t = {until:.0f} s")
         return self.targets[name][0], self.telemetry.wait(max(end, t_request))
 
+    def startable(self, q_hold, t: float) -> bool:
+        """Whether a slew can start from ``q_hold`` soon after ``t``: the attitude clear of every zone
+        until ``start_lead`` from now and the estimate converged."""
+        return self.telemetry.converged and self.scheduler.clear(q_hold, t, t + self.mission.start_lead)
+
+    def recover(self, q_hold, t: float) -> float:
+        """Hold until a slew can start again (:meth:`startable`; at most :data:`RECOVERY_LIMIT` s);
+        the time then."""
+        why = "the estimate is not converged" if not self.telemetry.converged else "a zone covers the held attitude"
+        self.log(f"[mission] t = {t:8.1f} s  holding: {why}")
+        end = t + RECOVERY_LIMIT
+        while t < end and not self.startable(q_hold, t):
+            t = self.telemetry.wait(t + RECOVERY_STEP)
+        return t
+
     def run(self) -> None:
         """Fly the mission to its horizon or its last target."""
         t = self.telemetry.wait()
@@ -181,11 +214,14 @@ class MissionRun:
                 t_start = max(t_start, t + self.mission.start_lead)
             end = self.fly(name, q_hold, t_start, wait_for_visibility=True)
             if end is None:
-                self.attempts[name] += 1
-                if self.attempts[name] >= MAX_ATTEMPTS:
-                    remaining.remove(name)
-                    self.publish(Kind.MISSED, name, message=f"{MAX_ATTEMPTS} slews to it refused (above)")
                 q_hold, t = convert.from_quaternion(self.telemetry.msg.attitude), self.telemetry.t
+                if self.startable(q_hold, t):
+                    self.attempts[name] += 1                # the slew itself was refused: the target's count
+                    if self.attempts[name] >= MAX_ATTEMPTS:
+                        remaining.remove(name)
+                        self.publish(Kind.MISSED, name, message=f"{MAX_ATTEMPTS} slews to it refused (above)")
+                else:
+                    t = self.recover(q_hold, t)
                 continue
             q_hold, dwell = self.targets[name][0], self.targets[name][1]
             start = max(end, self.scheduler.observable_from(name, end) or end)

@@ -130,9 +130,18 @@ def visibility(zones, q: np.ndarray, window: tuple, margin: float = 0.0,
         return [(opens, closes)]
     if not zones.moving:
         return [(opens, closes)] if zones.margins(0.0, q).min() >= margin else []
-    t = np.linspace(opens, closes, max(2, int(np.ceil((closes - opens) / step)) + 1))
-    clear = np.concatenate([[False], zones.margins(t, q).min(axis=1) >= margin, [False]])
-    edges = np.flatnonzero(np.diff(clear.astype(int)))
+    t = visibility_grid(opens, closes, step)
+    return spans(t, zones.margins(t, q).min(axis=1) >= margin)
+
+
+def visibility_grid(opens: float, closes: float, step: float = VISIBILITY_STEP) -> np.ndarray:
+    """Sample times from ``opens`` to ``closes`` (both included), at most ``step`` s apart."""
+    return np.linspace(opens, closes, max(2, int(np.ceil((closes - opens) / step)) + 1))
+
+
+def spans(t: np.ndarray, clear: np.ndarray) -> list[tuple]:
+    """The runs ``(first, last)`` of samples ``t`` where ``clear`` holds."""
+    edges = np.flatnonzero(np.diff(np.concatenate([[False], clear, [False]]).astype(int)))
     return [(float(t[a]), float(t[b - 1])) for a, b in zip(edges[::2], edges[1::2])]
 
 

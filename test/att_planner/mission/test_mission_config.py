@@ -49,6 +49,7 @@ def test_defaults_fill_what_a_file_leaves_out(tmp_path):
     ({"targets": 3}, "targets"), ({"targets": "no_such_list"}, "unknown target list"),
     ({"targets": "earth_observation"}, "ground list"), ({"method": "a\nb"}, "method"),
     ({"momentum_dumping": "yes"}, "momentum_dumping"), ({"colour": "red"}, "unknown key(s) colour"),
+    ({"rate_max_deg_per_s": 0}, "rate_max_deg_per_s"), ({"rate_max_deg_per_s": "fast"}, "rate_max_deg_per_s"),
 ])
 def test_a_bad_key_is_refused_with_the_file_and_the_key_named(tmp_path, change, field):
     doc = {**GOOD, **change}
@@ -69,3 +70,19 @@ def test_a_file_that_is_not_a_mapping_is_refused(tmp_path, text):
 def test_an_unknown_mission_names_the_known_ones():
     with pytest.raises(KeyError, match="observatory_day"):
         mc.find("no_such_mission")
+
+
+def test_the_default_rate_bound_keeps_the_gyroscopic_torque_within_the_wheels_margin():
+    m = mc.load("observatory_day")
+    sc = m.scenario.spacecraft
+    a = mc.gyroscopic_rate_limit(sc)
+    assert m.rate_max == a and 0.0 < a < 0.01
+    J = np.asarray(sc.inertia, float)
+    omega = np.random.default_rng(3).uniform(-a, a, (20_000, 3))
+    omega[:4] = [[a, a, a], [a, -a, a], [-a, a, a], [a, a, -a]]       # the corners bound it
+    gyroscopic = np.abs(np.cross(omega, omega @ J.T)).max()
+    margin = sc.wheel_torque_max - sc.body_torque_max
+    assert gyroscopic <= mc.GYROSCOPIC_SHARE * margin + 1e-12
+    assert gyroscopic >= 0.9 * mc.GYROSCOPIC_SHARE * margin               # and it is not needlessly slow
+    spherical = type("Sc", (), {"inertia": np.eye(3) * 10.0, "wheel_torque_max": 0.3, "body_torque_max": 0.25})
+    assert mc.gyroscopic_rate_limit(spherical) == math.inf
