@@ -120,13 +120,14 @@ class MissionRun:
 
     def fly(self, name: str, q_from, t_start: float, wait_for_visibility: bool):
         """Plan the slew from ``q_from`` to target ``name`` starting at sim time ``t_start`` and fly it;
-        its end time, or None after a refusal (published). ``wait_for_visibility``: a plan that would
-        arrive before the target is visible for its dwell is planned again to arrive then (once)."""
+        its end time, or None after a refusal (published; none while the estimate is not converged).
+        ``wait_for_visibility``: a plan that would arrive before the target is visible for its dwell is
+        planned again to arrive then (twice at most)."""
         q_to = self.targets[name][0]
         sensor = self.mission.sensor_axis
         if not self.telemetry.converged:
             return None
-        for _ in range(2):
+        for attempt in range(3):
             epoch = self.scenario.epoch + timedelta(seconds=t_start)
             options = {"rate_max": self.mission.rate_max} if math.isfinite(self.mission.rate_max) else {}
             request = maneuver_request(q_from, q_to, sensor, [], method=self.mission.method, options=options,
@@ -138,9 +139,18 @@ class MissionRun:
                 self.publish(Kind.REFUSED, name, message=f"planner: code {response.error_code}: {response.message}")
                 return None
             plan = response.plan
-            visible = self.scheduler.observable_from(name, t_start + plan.duration) if wait_for_visibility else None
-            if visible is None or visible <= t_start + plan.duration + 1.0:
+            arrival = t_start + plan.duration
+            visible = self.scheduler.observable_from(name, arrival) if wait_for_visibility else arrival
+            if visible is None:
+                self.publish(Kind.REFUSED, name, message=f"the slew would arrive at {arrival:.0f} s, after the "
+                                                         "target's last visibility before the horizon")
+                return None
+            if visible <= arrival + 1.0:
                 break
+            if attempt == 2:
+                self.publish(Kind.REFUSED, name, message=f"three slews arrived before the target is visible "
+                                                         f"at {visible:.0f} s")
+                return None
             t_start = visible - plan.duration
         self.publish(Kind.SLEW, name, t_start, t_start + plan.duration, plan.plan_id,
                      f"{plan.method} {plan.duration:.1f} s, {math.degrees(plan.verification.min_cone_margin):.2f} deg "
