@@ -61,13 +61,16 @@ def tracker_skies(scenario: scen.Scenario, sky: Sky, window: float) -> list[Zone
     return out
 
 
-def slew_estimate(inertia: np.ndarray, torque_max: float, q_from, q_to) -> float:
-    """Rest-to-rest eigenaxis slew time (s) at the per-axis torque limit (bang-bang)."""
+def slew_estimate(inertia: np.ndarray, torque_max: float, q_from, q_to, rate_max: float = math.inf) -> float:
+    """Rest-to-rest eigenaxis slew time (s) at the per-axis torque limit: bang-bang, or
+    bang-coast-bang when the eigenaxis rate reaches ``rate_max`` (per body axis, rad/s) first."""
     axis, angle = rot.to_axis_angle(rot.multiply(rot.conjugate(rot.normalize(np.asarray(q_from, float))),
                                                  rot.normalize(np.asarray(q_to, float))))
     if angle < 1e-12:
         return 0.0
-    return 2.0 * math.sqrt(angle / axis_acceleration(inertia, axis, angle, torque_max))
+    alpha = axis_acceleration(inertia, axis, angle, torque_max)
+    w = rate_max / float(np.max(np.abs(axis)))                  # the eigenaxis rate that reaches the bound
+    return 2.0 * math.sqrt(angle / alpha) if angle <= w * w / alpha else angle / w + w / alpha
 
 
 class MissionScheduler:
@@ -75,12 +78,12 @@ class MissionScheduler:
     mission time (t = 0 at the scenario's epoch; module docstring)."""
 
     def __init__(self, scenario: scen.Scenario, targets: dict, horizon: float, *, margin: float = 0.0,
-                 slew_factor: float = 1.5, lead: float = 60.0):
+                 slew_factor: float = 1.5, lead: float = 60.0, rate_max: float = math.inf):
         if scenario.epoch is None:
             raise ValueError(f"scenario '{scenario.name}' has no epoch: a mission needs the real sky")
         self.scenario, self.horizon = scenario, float(horizon)
         self.targets = {k: (rot.normalize(np.asarray(q, float)), float(d)) for k, (q, d) in targets.items()}
-        self.slew_factor, self.lead = slew_factor, lead
+        self.slew_factor, self.lead, self.rate_max = slew_factor, lead, rate_max
         sky = Sky(scenario.epoch, scenario.orbit_model)
         self.zones = ZoneSky(list(scenario.zones), sky, window=self.horizon)
         self.trackers = tracker_skies(scenario, sky, self.horizon)
@@ -96,10 +99,14 @@ class MissionScheduler:
             return np.ones(t.shape, bool)
         return np.max([z.margins(t, np.asarray(q, float), true=True).min(axis=1) for z in self.trackers], axis=0) >= 0
 
+    def slew(self, q_from, q_to) -> float:
+        """Estimated duration (s) of a planned slew: :func:`slew_estimate` × ``slew_factor``."""
+        sc = self.scenario.spacecraft
+        return self.slew_factor * slew_estimate(sc.inertia, sc.body_torque_max, q_from, q_to, self.rate_max)
+
     def leg(self, q_from, q_to) -> float:
         """Estimated duration (s) of a slew the mission flies: planning lead, then the plan."""
-        sc = self.scenario.spacecraft
-        return self.lead + self.slew_factor * slew_estimate(sc.inertia, sc.body_torque_max, q_from, q_to)
+        return self.lead + self.slew(q_from, q_to)
 
     def covering_zone(self, name: str, t_now: float) -> str:
         """The zone that most often covers target ``name`` between ``t_now`` and the horizon."""
@@ -160,12 +167,12 @@ class MissionScheduler:
         t = np.unique(np.append(np.arange(t0, t1, HOLD_CHECK_STEP), t1))
         return bool(self.zones.margins(t, np.asarray(q, float), true=True).min() >= 0.0 and self.tracked(q, t1)[0])
 
-    def park(self, q_from, t_now: float, until: float) -> str | None:
-        """A target (observed or not) to wait at from ``t_now`` until ``until``: reached by a leg from
-        ``q_from`` and visible from its arrival to ``until``, the nearest such; None when there is none."""
-        best = None
+    def parks(self, q_from, t_now: float, until: float) -> list[str]:
+        """Targets (observed or not) to wait at from ``t_now`` until ``until``: reached by a leg from
+        ``q_from`` and visible from their arrival to ``until``, the nearest first."""
+        found = []
         for name, (q, _) in self.targets.items():
             arrive = t_now + self.leg(q_from, q)
-            if any(a <= arrive and until <= b for a, b in self.visible[name]) and (best is None or arrive < best[0]):
-                best = (arrive, name)
-        return best[1] if best else None
+            if any(a <= arrive and until <= b for a, b in self.visible[name]):
+                found.append((arrive, name))
+        return [name for _, name in sorted(found)]

@@ -46,11 +46,12 @@ from att_msgs_py.types import MissionEvent as Event
 from att_msgs_py.types import MissionEventKind as Kind
 from att_planner.mission import config as mission_config
 from att_planner.mission.day import day_report
-from att_planner.mission.scheduler import MissionScheduler, slew_estimate
+from att_planner.mission.scheduler import MissionScheduler
 from att_planner.nodes.client import client_session, maneuver_request
 from att_planner.tools.demo import domain_line
 from att_planner.tools.launch import default_nodes, isolated_env, join_env, start_suite
 
+SLEW_FACTOR = 1.25             # planned slew / bang-coast-bang estimate (1.18 measured on the rate-bounded day)
 MAX_ATTEMPTS = 2               # slews refused per target before it is missed
 MIN_WALL_RTF = 0.5             # waits for sim time give up below this real-time factor
 RECOVERY_STEP = 10.0           # s of sim time between the checks of a held attitude that cannot start a slew
@@ -104,7 +105,8 @@ class MissionRun:
         self.scenario = mission.scenario
         self.targets = mission.attitudes()
         self.scheduler = MissionScheduler(self.scenario, {k: (q, d) for k, (q, d, _) in self.targets.items()},
-                                          mission.horizon, margin=mission.margin, lead=mission.start_lead)
+                                          mission.horizon, margin=mission.margin, lead=mission.start_lead,
+                                          rate_max=mission.rate_max, slew_factor=SLEW_FACTOR)
         self.telemetry = Telemetry(client, mission.scenario.sensors.gyro is not None)
         self.events = client.create_publisher(MissionEvent, MISSION_EVENTS, qos.MISSION_QOS)
         self.attempts: Counter = Counter()
@@ -169,21 +171,16 @@ class MissionRun:
             return None
         return self.telemetry.t
 
-    def wait_at(self, q_hold, t_now: float, until: float) -> tuple[np.ndarray, float]:
-        """Hold ``q_hold`` until ``until`` − ``start_lead``, or park at a visible source when the
-        zones reach the held attitude first; the attitude held and the time after."""
-        t_request = until - self.mission.start_lead
-        if t_request <= t_now or self.scheduler.clear(q_hold, t_now, until):
-            return q_hold, (self.telemetry.wait(t_request) if t_request > t_now else t_now)
-        name = self.scheduler.park(q_hold, t_now, until)
-        if name is None:
-            self.log(f"[mission] no source to park at until t = {until:.0f} s: holding")
-            return q_hold, self.telemetry.wait(t_request)
-        end = self.fly(name, q_hold, t_now + self.mission.start_lead, wait_for_visibility=False)
-        if end is None:
-            return q_hold, self.telemetry.t
-        self.publish(Kind.PARK, name, end, until, message=f"waiting at {name} until t = {until:.0f} s")
-        return self.targets[name][0], self.telemetry.wait(max(end, t_request))
+    def park(self, q_hold, t: float, until: float):
+        """Slew to a source that stays visible until ``until`` (:meth:`MissionScheduler.parks`, the
+        nearest three tried) and hold it; (its attitude, the time after) or None when none was flown."""
+        for name in self.scheduler.parks(q_hold, t, until)[:3]:
+            end = self.fly(name, q_hold, t + self.mission.start_lead, wait_for_visibility=False)
+            if end is not None:
+                self.publish(Kind.PARK, name, end, until, message=f"waiting at {name} until t = {until:.0f} s")
+                return self.targets[name][0], end
+            t = self.telemetry.t
+        return None
 
     def startable(self, q_hold, t: float) -> bool:
         """Whether a slew can start from ``q_hold`` soon after ``t``: the attitude clear of every zone
@@ -200,12 +197,25 @@ class MissionRun:
             t = self.telemetry.wait(t + RECOVERY_STEP)
         return t
 
+    def next_slew(self, decision, q_hold, t: float):
+        """The first of the decided order's first three targets whose slew can wait for its start at
+        ``q_hold`` clear of the zones: (name, start) or (None, the first target's start)."""
+        first = None
+        for name, arrival in list(zip(decision.order, decision.arrivals))[:3]:
+            start = max(t + self.mission.start_lead, arrival - self.scheduler.slew(q_hold, self.targets[name][0]))
+            first = start if first is None else first
+            if self.scheduler.clear(q_hold, t, start):
+                return name, start
+        return None, first
+
     def run(self) -> None:
         """Fly the mission to its horizon or its last target."""
         t = self.telemetry.wait()
         q_hold = convert.from_quaternion(self.telemetry.msg.attitude)
         remaining, observed = list(self.targets), 0
         while remaining and t < self.mission.horizon:
+            if not self.startable(q_hold, t):
+                t = self.recover(q_hold, t)
             decision = self.scheduler.decide(t, q_hold, remaining)
             for name, why in decision.missed.items():
                 self.publish(Kind.MISSED, name, message=why)
@@ -214,15 +224,17 @@ class MissionRun:
                 break
             self.publish(Kind.SCHEDULED, message="order " + ", ".join(
                 f"{k} at {a:.0f} s" for k, a in zip(decision.order, decision.arrivals)))
-            name = decision.order[0]
-            sc = self.scenario.spacecraft
-            slew = self.scheduler.slew_factor * slew_estimate(sc.inertia, sc.body_torque_max, q_hold,
-                                                              self.targets[name][0])
-            t_start = max(t + self.mission.start_lead, decision.arrivals[0] - slew)
-            if t_start > t + self.mission.start_lead:
-                q_hold, t = self.wait_at(q_hold, t, t_start)
-                t_start = max(t_start, t + self.mission.start_lead)
-            end = self.fly(name, q_hold, t_start, wait_for_visibility=True)
+            name, t_start = self.next_slew(decision, q_hold, t)
+            if name is None:                         # the held attitude cannot wait: park, then decide again
+                parked = self.park(q_hold, t, t_start)
+                if parked is None:
+                    self.log(f"[mission] t = {t:8.1f} s  no source to park at until t = {t_start:.0f} s: holding")
+                    t = self.telemetry.wait(t + RECOVERY_STEP)
+                else:
+                    q_hold, t = parked
+                continue
+            t = self.telemetry.wait(t_start - self.mission.start_lead)
+            end = self.fly(name, q_hold, max(t_start, t + self.mission.start_lead), wait_for_visibility=True)
             if end is None:
                 q_hold, t = convert.from_quaternion(self.telemetry.msg.attitude), self.telemetry.t
                 if self.startable(q_hold, t):
@@ -230,8 +242,6 @@ class MissionRun:
                     if self.attempts[name] >= MAX_ATTEMPTS:
                         remaining.remove(name)
                         self.publish(Kind.MISSED, name, message=f"{MAX_ATTEMPTS} slews to it refused (above)")
-                else:
-                    t = self.recover(q_hold, t)
                 continue
             q_hold, dwell = self.targets[name][0], self.targets[name][1]
             start = max(end, self.scheduler.observable_from(name, end) or end)

@@ -37,7 +37,7 @@ def flown(tmp_path_factory):
     (out / "two.yaml").write_text(yaml.safe_dump({"kind": "inertial", "scenario": "leo_observatory",
                                                   "targets": targets}))
     (out / "short.yaml").write_text(yaml.safe_dump({"targets": str(out / "two.yaml"), "sensor_axis": [0, 1, 0],
-                                                    "horizon_s": 2400, "start_lead_s": 120, "rate_hz": 2.5}))
+                                                    "horizon_s": 3000, "start_lead_s": 120, "rate_hz": 2.5}))
     mission = mission_config.load(str(out / "short.yaml"))
     mcap, report = fly_mission(mission, out, log=print)
     return mission, mcap, report

@@ -87,8 +87,22 @@ def test_a_held_attitude_is_clear_only_while_no_zone_covers_it(day):
 def test_a_park_is_a_source_visible_from_its_arrival_until_the_wait_ends(day):
     scheduler, targets = day
     q_from, now, until = targets["sgr_a_star"][0], 1000.0, 2500.0
-    name = scheduler.park(q_from, now, until)
-    assert name is not None
-    arrive = now + scheduler.leg(q_from, targets[name][0])
-    assert scheduler.zones.margins(np.linspace(arrive, until, 50), targets[name][0], true=True).min() >= 0
-    assert scheduler.park(q_from, now, HORIZON + 7200.0) is None             # nothing is visible past the horizon
+    names = scheduler.parks(q_from, now, until)
+    assert names
+    arrivals = [now + scheduler.leg(q_from, targets[name][0]) for name in names]
+    assert arrivals == sorted(arrivals)
+    for name, arrive in zip(names, arrivals):
+        assert scheduler.zones.margins(np.linspace(arrive, until, 50), targets[name][0], true=True).min() >= 0
+    assert scheduler.parks(q_from, now, HORIZON + 7200.0) == []              # nothing is visible past the horizon
+
+
+def test_a_rate_bound_lengthens_the_slew_to_a_coast_at_the_bound():
+    sc = scen.load("leo_observatory").spacecraft
+    q1 = rot.from_axis_angle([1.0, 0.0, 0.0], math.radians(120.0))
+    free = slew_estimate(sc.inertia, sc.body_torque_max, rot.IDENTITY, q1)
+    w = 0.002
+    bounded = slew_estimate(sc.inertia, sc.body_torque_max, rot.IDENTITY, q1, rate_max=w)
+    alpha = sc.body_torque_max / sc.inertia[0, 0]
+    assert free == pytest.approx(2 * math.sqrt(math.radians(120.0) / alpha))
+    assert bounded == pytest.approx(math.radians(120.0) / w + w / alpha) and bounded > free
+    assert slew_estimate(sc.inertia, sc.body_torque_max, rot.IDENTITY, q1, rate_max=1.0) == pytest.approx(free)
