@@ -117,15 +117,21 @@ class MissionScheduler:
             return ""
         return self.zones.names[int(np.bincount(worst).argmax())]
 
+    def held(self, name: str) -> float:
+        """How long target ``name`` must stay visible once reached (s): its dwell, then the lead of
+        the slew away from it (requested while the spacecraft still holds it)."""
+        return self.targets[name][1] + self.lead
+
     def decide(self, t_now: float, q_now, remaining: list) -> Decision:
-        """The order to fly from attitude ``q_now`` at mission time ``t_now`` through ``remaining``."""
+        """The order to fly from attitude ``q_now`` at mission time ``t_now`` through ``remaining``:
+        each leg a slew estimate, the first after the lead from now, each target held visible for
+        :meth:`held` (so the chain's arrivals are those of legs of :meth:`leg` after each dwell)."""
         missed, names = {}, []
         for k in remaining:
-            dwell = self.targets[k][1]
-            if not any(b - max(a, t_now) >= dwell for a, b in self.visible[k]):
+            if self.observable_from(k, t_now + self.lead) is None:
                 zone = self.covering_zone(k, t_now)
                 missed[k] = (f"a {zone} zone covers it until the horizon" if zone else
-                             "no time left before the horizon") + f" (needs {dwell:g} s of visibility)"
+                             "no time left before the horizon") + f" (needs {self.held(k):g} s of visibility)"
             else:
                 names.append(k)
         if not names:
@@ -136,29 +142,29 @@ class MissionScheduler:
         for i in range(n + 1):
             for j in range(1, n + 1):
                 if i != j:
-                    C[i, j] = self.leg(nodes[i], nodes[j])
-        dwell = np.array([self.targets[k][1] for k in names])
-        visible = [[(max(a, t_now) - t_now, b - t_now) for a, b in self.visible[k] if b > t_now] for k in names]
+                    C[i, j] = self.slew(nodes[i], nodes[j])
+        held = np.array([self.held(k) for k in names])
+        t0 = t_now + self.lead                        # the first slew starts after the lead
+        visible = [[(max(a, t0) - t0, b - t0) for a, b in self.visible[k] if b > t0] for k in names]
         best_prefix: tuple = ()
         for examined, (_, order) in enumerate(orders_by_lower_bound(C)):
             if examined >= MAX_ORDERS:
                 break
-            arrivals, _ = observed_prefix(C, order, dwell, visible)       # the end node costs nothing
+            arrivals, _ = observed_prefix(C, order, held, visible)        # the end node costs nothing
             if len(arrivals) == n:
-                return Decision([names[i] for i in order], list(t_now + arrivals), missed)
+                return Decision([names[i] for i in order], list(t0 + arrivals), missed)
             if len(arrivals) > len(best_prefix[1] if best_prefix else ()):
                 best_prefix = (tuple(order[:len(arrivals)]), tuple(arrivals))
         order, arrivals = best_prefix or ((), ())
         for i in set(range(n)) - set(order):
             missed[names[i]] = "no time left before the horizon in the order flown"
-        return Decision([names[i] for i in order], [t_now + a for a in arrivals], missed)
-
+        return Decision([names[i] for i in order], [t0 + a for a in arrivals], missed)
 
     def observable_from(self, name: str, t: float) -> float | None:
-        """The earliest time ≥ ``t`` from which target ``name`` stays visible for its dwell (None: not
-        before the horizon)."""
-        dwell = self.targets[name][1]
-        return next((max(a, t) for a, b in self.visible[name] if b - max(a, t) >= dwell), None)
+        """The earliest time ≥ ``t`` from which target ``name`` stays visible for :meth:`held` (None:
+        not before the horizon)."""
+        held = self.held(name)
+        return next((max(a, t) for a, b in self.visible[name] if b - max(a, t) >= held), None)
 
     def clear(self, q, t0: float, t1: float) -> bool:
         """Whether attitude ``q`` keeps every zone (at their true positions, no margin) over ``[t0, t1]``

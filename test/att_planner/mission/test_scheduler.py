@@ -64,16 +64,18 @@ def test_a_mission_needs_the_real_sky():
         MissionScheduler(scen.load("swift_demo"), {}, HORIZON)
 
 
-def test_observable_from_is_the_first_span_long_enough_for_the_dwell(day):
+def test_observable_from_is_the_first_span_long_enough_for_the_dwell_and_the_lead_away(day):
     scheduler, targets = day
     for name, (_, dwell) in targets.items():
+        assert scheduler.held(name) == dwell + scheduler.lead
         start = scheduler.observable_from(name, 600.0)
-        spans = [(a, b) for a, b in scheduler.visible[name] if b - max(a, 600.0) >= dwell]
+        spans = [(a, b) for a, b in scheduler.visible[name] if b - max(a, 600.0) >= dwell + scheduler.lead]
         if not spans:
             assert start is None, name
             continue
         assert start == pytest.approx(max(spans[0][0], 600.0)), name
-        assert scheduler.zones.margins(np.linspace(start, start + dwell, 9), targets[name][0], true=True).min() >= 0
+        held = np.linspace(start, start + dwell + scheduler.lead, 9)
+        assert scheduler.zones.margins(held, targets[name][0], true=True).min() >= 0
 
 
 def test_a_held_attitude_is_clear_only_while_no_zone_covers_it(day):
