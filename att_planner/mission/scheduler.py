@@ -17,7 +17,7 @@ a target is lost. :class:`MissionScheduler` does that without ROS:
   orders_by_lower_bound` on the leg estimates, every order followed by :func:`~att_planner.methods.
   schedule.order_search.observed_prefix` with the dwells and the waits for visibility); the first order
   that observes every target before the horizon, else the longest observable prefix found (the rest
-  missed: no time left). A target with no visible span as long as its dwell before the horizon is
+  left out of this order: a later decision, from elsewhere, may fit them). A target with no visible span as long as its dwell before the horizon is
   missed with the zone that covers it named.
 """
 from __future__ import annotations
@@ -41,12 +41,14 @@ HOLD_CHECK_STEP = 10.0        # s between the zone checks of an attitude held wh
 
 @dataclass(frozen=True)
 class Decision:
-    """The order to fly from now: target names, their estimated arrivals (s of mission time), and
-    the targets that cannot be observed any more, with why."""
+    """The order to fly from now: target names, their estimated arrivals (s of mission time), the
+    targets that cannot be observed any more, with why, and those left out of this order (observable,
+    but the order found could not fit them before the horizon; a later decision may)."""
 
     order: list
     arrivals: list
     missed: dict
+    left_out: list = ()
 
 
 def tracker_skies(scenario: scen.Scenario, sky: Sky, window: float) -> list[ZoneSky]:
@@ -156,9 +158,8 @@ class MissionScheduler:
             if len(arrivals) > len(best_prefix[1] if best_prefix else ()):
                 best_prefix = (tuple(order[:len(arrivals)]), tuple(arrivals))
         order, arrivals = best_prefix or ((), ())
-        for i in set(range(n)) - set(order):
-            missed[names[i]] = "no time left before the horizon in the order flown"
-        return Decision([names[i] for i in order], [t0 + a for a in arrivals], missed)
+        left_out = [names[i] for i in range(n) if i not in order]
+        return Decision([names[i] for i in order], [t0 + a for a in arrivals], missed, left_out)
 
     def observable_from(self, name: str, t: float) -> float | None:
         """The earliest time ≥ ``t`` from which target ``name`` stays visible for :meth:`held` (None:
