@@ -80,14 +80,7 @@ def gyroscopic_rate_limit(sc) -> float:
 
 def find(name: str) -> Path:
     """A mission file: an explicit ``*.yaml`` path, or a stem under ``missions/`` of the config directories."""
-    if name.endswith(".yaml") and Path(name).is_file():
-        return Path(name)
-    for d in scen.config_dirs():
-        path = d / "missions" / f"{name}.yaml"
-        if path.is_file():
-            return path
-    known = sorted({p.stem for d in scen.config_dirs() for p in (d / "missions").glob("*.yaml")})
-    raise KeyError(f"unknown mission '{clip(name, 120)}' (known: {', '.join(known) or 'none'})")
+    return target_lists.config_file("missions", name, "mission")
 
 
 def _invalid(path, message: str) -> ConfigError:

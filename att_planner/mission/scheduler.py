@@ -17,8 +17,9 @@ a target is lost. :class:`MissionScheduler` does that without ROS:
   orders_by_lower_bound` on the leg estimates, every order followed by :func:`~att_planner.methods.
   schedule.order_search.observed_prefix` with the dwells and the waits for visibility); the first order
   that observes every target before the horizon, else the longest observable prefix found (the rest
-  left out of this order: a later decision, from elsewhere, may fit them). A target with no visible span as long as its dwell before the horizon is
-  missed with the zone that covers it named.
+  left out of this order: a later decision, from elsewhere, may fit them). A target with no visible
+  span as long as its dwell and the next slew's lead before the horizon is missed with the zone that
+  covers it named.
 """
 from __future__ import annotations
 

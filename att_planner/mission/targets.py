@@ -113,16 +113,22 @@ def _target(path, kind: str, i: int, entry) -> Source | Site:
     return Site(name, lat, lon, alt, dwell)
 
 
-def find(name: str) -> Path:
-    """A target list: an explicit ``*.yaml`` path, or a stem under ``targets/`` of the config directories."""
+def config_file(folder: str, name: str, what: str) -> Path:
+    """An explicit ``*.yaml`` path, or the stem ``name`` under ``folder/`` of the config directories
+    (KeyError naming ``what`` and the known stems)."""
     if name.endswith(".yaml") and Path(name).is_file():
         return Path(name)
     for d in scen.config_dirs():
-        path = d / "targets" / f"{name}.yaml"
+        path = d / folder / f"{name}.yaml"
         if path.is_file():
             return path
-    known = sorted({p.stem for d in scen.config_dirs() for p in (d / "targets").glob("*.yaml")})
-    raise KeyError(f"unknown target list '{clip(name, 120)}' (known: {', '.join(known) or 'none'})")
+    known = sorted({p.stem for d in scen.config_dirs() for p in (d / folder).glob("*.yaml")})
+    raise KeyError(f"unknown {what} '{clip(name, 120)}' (known: {', '.join(known) or 'none'})")
+
+
+def find(name: str) -> Path:
+    """A target list: an explicit ``*.yaml`` path, or a stem under ``targets/`` of the config directories."""
+    return config_file("targets", name, "target list")
 
 
 def load(name: str) -> TargetList:

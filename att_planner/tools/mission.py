@@ -35,12 +35,11 @@ from datetime import UTC, datetime, timedelta
 from pathlib import Path
 
 import numpy as np
-import rclpy
 
-from att_msgs.msg import AttitudeEstimate, MissionEvent, SpacecraftState
+from att_msgs.msg import AttitudeEstimate, MissionEvent
 from att_msgs_py import convert, qos
 from att_msgs_py.errors import ConfigError
-from att_msgs_py.topics import ESTIMATE, MISSION_EVENTS, STATE
+from att_msgs_py.topics import ESTIMATE, MISSION_EVENTS
 from att_msgs_py.types import Health
 from att_msgs_py.types import MissionEvent as Event
 from att_msgs_py.types import MissionEventKind as Kind
@@ -48,7 +47,7 @@ from att_planner.mission import config as mission_config
 from att_planner.mission.day import day_report
 from att_planner.mission.scheduler import MissionScheduler
 from att_planner.nodes.client import client_session, maneuver_request
-from att_planner.tools.demo import domain_line
+from att_planner.tools.demo import SimClock, domain_line
 from att_planner.tools.launch import default_nodes, isolated_env, join_env, start_suite
 
 SLEW_FACTOR = 1.25             # planned slew / bang-coast-bang estimate (1.18 measured on the rate-bounded day)
@@ -59,18 +58,18 @@ RECOVERY_LIMIT = 1800.0        # s of sim time a mission waits for it at most
 CONVERGENCE = {int(h) for h in Health}
 
 
-class Telemetry:
+class Telemetry(SimClock):
     """The spacecraft's latest state message (sim time, attitude, wheels) and the estimate's health,
     heard on the client's node."""
 
     def __init__(self, node, estimator: bool):
-        self.node, self.msg = node, None
-        self.health = None if estimator else Health.CONVERGED
-        node.create_subscription(SpacecraftState, STATE, self._on_state, qos.STREAM_QOS)
+        super().__init__(node)
+        self.msg, self.health = None, None if estimator else Health.CONVERGED
         if estimator:
             node.create_subscription(AttitudeEstimate, ESTIMATE, self._on_estimate, qos.STREAM_QOS)
 
     def _on_state(self, msg):
+        super()._on_state(msg)
         self.msg = msg
 
     def _on_estimate(self, msg):
@@ -80,21 +79,11 @@ class Telemetry:
     def converged(self) -> bool:
         return self.health == Health.CONVERGED
 
-    @property
-    def t(self) -> float:
-        return convert.from_time(self.msg.header.stamp)
-
     def wait(self, until: float = -math.inf, timeout: float | None = None) -> float:
-        """Spin until a state at or after sim time ``until``; its time (TimeoutError past ``timeout``
-        s of wall time, by default the wait at :data:`MIN_WALL_RTF` plus a minute)."""
+        """:meth:`SimClock.wait`, by default as long as the wait takes at :data:`MIN_WALL_RTF`, plus a minute."""
         if timeout is None:
-            timeout = 60.0 + (max(0.0, until - self.t) / MIN_WALL_RTF if self.msg is not None and until > 0 else 60.0)
-        deadline = time.monotonic() + timeout
-        while self.msg is None or self.t < until:
-            if time.monotonic() > deadline:
-                raise TimeoutError(f"the simulator's state did not reach t = {until:.1f} s within {timeout:.0f} s")
-            rclpy.spin_once(self.node, timeout_sec=0.05)
-        return self.t
+            timeout = 60.0 + (max(0.0, until - self.t) / MIN_WALL_RTF if self.t is not None and until > 0 else 60.0)
+        return super().wait(until, timeout)
 
 
 class MissionRun:

@@ -139,7 +139,7 @@ def estimation_summary(run: EstimationRun) -> dict:
 
 def figure_estimation(run: EstimationRun, path: Path, t0: float = 0.0) -> Path:
     """``estimation.png``: error ±3σ per axis, bias, health and tracker validity, sensor residuals."""
-    from att_planner.tools.review.figures import _figure
+    from att_planner.tools.review.figures import _figure, _save
 
     plt, fig = _figure(figsize=(11, 13))
     axes = fig.subplots(5, 1, sharex=True)
@@ -176,7 +176,4 @@ def figure_estimation(run: EstimationRun, path: Path, t0: float = 0.0) -> Path:
     for ax in axes:
         ax.grid(alpha=0.3)
     fig.suptitle("Attitude estimate against the truth")
-    fig.tight_layout()
-    fig.savefig(path, dpi=90)
-    plt.close(fig)
-    return path
+    return _save(plt, fig, path)

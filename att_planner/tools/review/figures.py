@@ -297,6 +297,14 @@ def _figure(*args, **kwargs):
     return plt, plt.figure(*args, **kwargs)
 
 
+def _save(plt, fig, path: Path, dpi: int = 90) -> Path:
+    """Lay ``fig`` out, write it to ``path`` and close it."""
+    fig.tight_layout()
+    fig.savefig(path, dpi=dpi)
+    plt.close(fig)
+    return path
+
+
 def _time_label(run: Run) -> str:
     return f"t [s] from sim time {run.t0:.1f} s" + (" (dotted: plan end, then settle/hold)" if run.kind == "maneuver"
                                                     else "")
@@ -319,19 +327,13 @@ def figure_time_histories(run: Run, sc: Spacecraft | None, path: Path, zones: Zo
     for ax in axes[-1]:
         ax.set_xlabel(_time_label(run))
     fig.suptitle(_title(run))
-    fig.tight_layout()
-    fig.savefig(path, dpi=90)
-    plt.close(fig)
-    return path
+    return _save(plt, fig, path)
 
 
 def figure_sky(run: Run, path: Path, zones: ZoneSky | None = None) -> Path:
     plt, fig = _figure(figsize=(7.5, 7.5))
     plot_sky(fig.add_subplot(1, 1, 1), run, zones)
-    fig.tight_layout()
-    fig.savefig(path, dpi=100)
-    plt.close(fig)
-    return path
+    return _save(plt, fig, path, dpi=100)
 
 
 def figure_overview(run: Run, sc: Spacecraft | None, path: Path, zones: ZoneSky | None = None) -> Path:
@@ -349,10 +351,7 @@ def figure_overview(run: Run, sc: Spacecraft | None, path: Path, zones: ZoneSky 
         _maneuver_end(ax, run)
     right[2].set_xlabel(_time_label(run))
     fig.suptitle(_title(run), fontsize=11)
-    fig.tight_layout()
-    fig.savefig(path, dpi=100)
-    plt.close(fig)
-    return path
+    return _save(plt, fig, path, dpi=100)
 
 
 def _title(run: Run) -> str:

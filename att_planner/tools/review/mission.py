@@ -80,7 +80,7 @@ def mission_summary(run: MissionLog) -> dict:
 
 def figure_mission(run: MissionLog, path: Path) -> Path:
     """``mission.png``: timeline, zone margins, wheel momentum against its limit, dipoles."""
-    from att_planner.tools.review.figures import _figure
+    from att_planner.tools.review.figures import _figure, _save
 
     plt, fig = _figure(figsize=(12, 13))
     axes = fig.subplots(4, 1, sharex=True, gridspec_kw={"height_ratios": [3, 1.3, 1.3, 1]})
@@ -122,10 +122,7 @@ def figure_mission(run: MissionLog, path: Path) -> Path:
     axes[-1].set_xlabel("sim time (h from the epoch)")
     for ax in axes:
         ax.grid(alpha=0.3)
-    fig.tight_layout()
-    fig.savefig(path, dpi=90)
-    plt.close(fig)
-    return path
+    return _save(plt, fig, path)
 
 
 def _ra_dec(v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -142,7 +139,7 @@ def _track(ax, v: np.ndarray, **kwargs) -> None:
 
 def figure_mission_sky(run: MissionLog, path: Path) -> Path:
     """``mission_sky.png``: boresight, targets, Sun, Moon and nadir over the day (RA, Dec)."""
-    from att_planner.tools.review.figures import _figure
+    from att_planner.tools.review.figures import _figure, _save
 
     plt, fig = _figure(figsize=(12, 6.5))
     ax = fig.subplots()
@@ -168,7 +165,4 @@ def figure_mission_sky(run: MissionLog, path: Path) -> Path:
     ax.set_title("the day's boresight track; targets observed (o) and missed (x)", fontsize=9)
     ax.legend(fontsize=7, loc="lower left")
     ax.grid(alpha=0.3)
-    fig.tight_layout()
-    fig.savefig(path, dpi=90)
-    plt.close(fig)
-    return path
+    return _save(plt, fig, path)

@@ -73,7 +73,7 @@ def pointing_summary(run: PointingRun, settle: float = 0.0) -> dict:
 
 def figure_pointing(run: PointingRun, path: Path, t0: float = 0.0) -> Path:
     """``pointing.png``: mode timeline, pointing error, wheel momentum against its limit, dipoles."""
-    from att_planner.tools.review.figures import _figure
+    from att_planner.tools.review.figures import _figure, _save
 
     plt, fig = _figure(figsize=(11, 11))
     axes = fig.subplots(4, 1, sharex=True)
@@ -99,7 +99,4 @@ def figure_pointing(run: PointingRun, path: Path, t0: float = 0.0) -> Path:
     axes[-1].set_xlabel(f"time ({unit})")
     for ax in axes:
         ax.grid(alpha=0.3)
-    fig.tight_layout()
-    fig.savefig(path, dpi=90)
-    plt.close(fig)
-    return path
+    return _save(plt, fig, path)
