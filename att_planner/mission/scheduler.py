@@ -11,8 +11,8 @@ a target is lost. :class:`MissionScheduler` does that without ROS:
   estimate converges on the trackers);
 * each **leg**'s duration estimate: the rest-to-rest eigenaxis slew at the per-axis torque limit
   (bang-bang, ``2 sqrt(θ / α)``, α of :func:`att_planner.methods.axis_rotations.axis_acceleration`)
-  times ``slew_factor`` (the smooth plans the planner returns take longer) plus ``lead`` (planning
-  and settling);
+  times ``slew_factor`` (the smooth plans the planner returns take longer) plus ``lead`` (planning)
+  and ``settle`` (the controller's hold on the final attitude before it reports the slew done);
 * the **order**: the schedule planner's search (:func:`~att_planner.methods.schedule.order_search.
   orders_by_lower_bound` on the leg estimates, every order followed by :func:`~att_planner.methods.
   schedule.order_search.observed_prefix` with the dwells and the waits for visibility); the first order
@@ -81,12 +81,12 @@ class MissionScheduler:
     mission time (t = 0 at the scenario's epoch; module docstring)."""
 
     def __init__(self, scenario: scen.Scenario, targets: dict, horizon: float, *, margin: float = 0.0,
-                 slew_factor: float = 1.5, lead: float = 60.0, rate_max: float = math.inf):
+                 slew_factor: float = 1.5, lead: float = 60.0, rate_max: float = math.inf, settle: float = 0.0):
         if scenario.epoch is None:
             raise ValueError(f"scenario '{scenario.name}' has no epoch: a mission needs the real sky")
         self.scenario, self.horizon = scenario, float(horizon)
         self.targets = {k: (rot.normalize(np.asarray(q, float)), float(d)) for k, (q, d) in targets.items()}
-        self.slew_factor, self.lead, self.rate_max = slew_factor, lead, rate_max
+        self.slew_factor, self.lead, self.rate_max, self.settle = slew_factor, lead, rate_max, settle
         sky = Sky(scenario.epoch, scenario.orbit_model)
         self.zones = ZoneSky(list(scenario.zones), sky, window=self.horizon)
         self.trackers = tracker_skies(scenario, sky, self.horizon)
@@ -103,9 +103,11 @@ class MissionScheduler:
         return np.max([z.margins(t, np.asarray(q, float), true=True).min(axis=1) for z in self.trackers], axis=0) >= 0
 
     def slew(self, q_from, q_to) -> float:
-        """Estimated duration (s) of a planned slew: :func:`slew_estimate` × ``slew_factor``."""
+        """Estimated duration (s) of a planned slew until the controller reports it done:
+        :func:`slew_estimate` × ``slew_factor``, then ``settle`` on the final attitude."""
         sc = self.scenario.spacecraft
-        return self.slew_factor * slew_estimate(sc.inertia, sc.body_torque_max, q_from, q_to, self.rate_max)
+        return self.slew_factor * slew_estimate(sc.inertia, sc.body_torque_max, q_from, q_to, self.rate_max) \
+            + self.settle
 
     def leg(self, q_from, q_to) -> float:
         """Estimated duration (s) of a slew the mission flies: planning lead, then the plan."""

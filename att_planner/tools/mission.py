@@ -43,6 +43,7 @@ from att_msgs_py.topics import ESTIMATE, MISSION_EVENTS
 from att_msgs_py.types import Health
 from att_msgs_py.types import MissionEvent as Event
 from att_msgs_py.types import MissionEventKind as Kind
+from att_planner.control.controller import ControllerConfig
 from att_planner.mission import config as mission_config
 from att_planner.mission.day import day_report
 from att_planner.mission.scheduler import MissionScheduler
@@ -92,10 +93,12 @@ class MissionRun:
     def __init__(self, client, mission: mission_config.MissionConfig, log=print):
         self.client, self.mission, self.log = client, mission, log
         self.scenario = mission.scenario
+        controller = self.scenario.node_params.get("controller", {})
+        self.settle = float(controller.get("settle_time", ControllerConfig().settle_time))   # as the node reads it
         self.targets = mission.attitudes()
         self.scheduler = MissionScheduler(self.scenario, {k: (q, d) for k, (q, d, _) in self.targets.items()},
                                           mission.horizon, margin=mission.margin, lead=mission.start_lead,
-                                          rate_max=mission.rate_max, slew_factor=SLEW_FACTOR)
+                                          rate_max=mission.rate_max, slew_factor=SLEW_FACTOR, settle=self.settle)
         self.telemetry = Telemetry(client, mission.scenario.sensors.gyro is not None)
         self.events = client.create_publisher(MissionEvent, MISSION_EVENTS, qos.MISSION_QOS)
         self.attempts: Counter = Counter()
@@ -130,7 +133,7 @@ class MissionRun:
                 self.publish(Kind.REFUSED, name, message=f"planner: code {response.error_code}: {response.message}")
                 return None
             plan = response.plan
-            arrival = t_start + plan.duration
+            arrival = t_start + plan.duration + self.settle           # the controller reports it done then
             visible = self.scheduler.observable_from(name, arrival) if wait_for_visibility else arrival
             if visible is None:
                 self.publish(Kind.REFUSED, name, message=f"the slew would arrive at {arrival:.0f} s, after the "
@@ -142,7 +145,7 @@ class MissionRun:
                 self.publish(Kind.REFUSED, name, message=f"three slews arrived before the target is visible "
                                                          f"at {visible:.0f} s")
                 return None
-            t_start = visible - plan.duration
+            t_start = visible - plan.duration - self.settle
         self.publish(Kind.SLEW, name, t_start, t_start + plan.duration, plan.plan_id,
                      f"{plan.method} {plan.duration:.1f} s, {math.degrees(plan.verification.min_cone_margin):.2f} deg "
                      f"from the zones, planned in {plan.solve_seconds:.2f} s")
@@ -197,6 +200,13 @@ class MissionRun:
                 return name, start
         return None, first
 
+    def count_attempt(self, name: str, remaining: list) -> None:
+        """One more failed attempt at target ``name``: missed after :data:`MAX_ATTEMPTS`."""
+        self.attempts[name] += 1
+        if self.attempts[name] >= MAX_ATTEMPTS:
+            remaining.remove(name)
+            self.publish(Kind.MISSED, name, message=f"{MAX_ATTEMPTS} attempts at it failed (above)")
+
     def run(self) -> None:
         """Fly the mission to its horizon or its last target."""
         t = self.telemetry.wait()
@@ -226,14 +236,17 @@ class MissionRun:
             end = self.fly(name, q_hold, max(t_start, t + self.mission.start_lead), wait_for_visibility=True)
             if end is None:
                 q_hold, t = convert.from_quaternion(self.telemetry.msg.attitude), self.telemetry.t
-                if self.startable(q_hold, t):
-                    self.attempts[name] += 1                # the slew itself was refused: the target's count
-                    if self.attempts[name] >= MAX_ATTEMPTS:
-                        remaining.remove(name)
-                        self.publish(Kind.MISSED, name, message=f"{MAX_ATTEMPTS} slews to it refused (above)")
+                if self.startable(q_hold, t):               # the slew itself was refused: the target's count
+                    self.count_attempt(name, remaining)
                 continue
             q_hold, dwell = self.targets[name][0], self.targets[name][1]
-            start = max(end, self.scheduler.observable_from(name, end) or end)
+            start = self.scheduler.observable_from(name, end)
+            if start is None or not self.scheduler.clear(q_hold, end, start):
+                self.publish(Kind.REFUSED, name, message="arrived too late for this visibility window: "
+                                                         "deciding again")
+                self.count_attempt(name, remaining)
+                t = self.telemetry.t
+                continue
             self.publish(Kind.DWELL, name, start, start + dwell, message=f"observing for {dwell:g} s")
             t = self.telemetry.wait(start + dwell)
             remaining.remove(name)
