@@ -389,6 +389,9 @@ def mission_event_msg(e: types.MissionEvent) -> MissionEvent:
     msg.direction = vector3(e.direction)
     msg.sensor_axis = vector3(e.sensor_axis)
     msg.tolerance = float(e.tolerance)
+    if e.pointing is not None:
+        msg.pointing = pointing_msg(e.pointing)
+    msg.zones = [str(z) for z in e.zones]
     return msg
 
 
@@ -398,4 +401,5 @@ def mission_event_from_msg(msg) -> types.MissionEvent:
         start=float(msg.start), end=float(msg.end), attitude=from_quaternion(msg.attitude),
         direction=from_vector3(msg.direction), sensor_axis=from_vector3(msg.sensor_axis),
         tolerance=float(msg.tolerance), plan_id=msg.plan_id, message=msg.message,
-        frame_id=msg.header.frame_id)
+        frame_id=msg.header.frame_id, pointing=pointing_from_msg(msg.pointing) if msg.pointing.kind else None,
+        zones=tuple(msg.zones))

@@ -464,7 +464,8 @@ class MissionEventKind(StrEnum):
 class MissionEvent:
     """One event of a mission (``att_msgs/MissionEvent``): at sim time ``t``, ``event`` about
     ``target`` over ``[start, end]`` s of sim time, its attitude and direction when it has them, the
-    body ``sensor_axis`` put on it and the pointing ``tolerance`` (rad) a dwell is observed within."""
+    body ``sensor_axis`` put on it and the pointing ``tolerance`` (rad) a dwell is observed within;
+    a ground site's ``pointing`` mode; the names of the ``zones`` the mission keeps."""
 
     t: float
     event: MissionEventKind
@@ -478,3 +479,5 @@ class MissionEvent:
     plan_id: str = ""
     message: str = ""
     frame_id: str = ""
+    pointing: PointingMode | None = None
+    zones: tuple = ()

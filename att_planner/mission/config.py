@@ -12,6 +12,15 @@ the day is flown. One YAML file under ``config/missions/`` (read with ``yaml.saf
     pointing_tolerance_deg: 0.05   # a dwell counts as observed within this pointing error
     momentum_dumping: true         # the controller's magnetorquer momentum dumping, all day
     rate_max_deg_per_s: 0.2        # per body axis, the slews' rate bound (default: :func:`gyroscopic_rate_limit`)
+    zones: [sun, moon]             # the scenario's zones the mission keeps, by name (default: all of them)
+    secondary: velocity            # ground sites: the direction the secondary axis is kept nearest
+    secondary_axis: [0, 0, 1]      # ground sites: that body axis (default: ``targets.next_axis`` of the sensor)
+
+An inertial source is held at the attitude of :func:`~att_planner.mission.targets.pointing_attitude`;
+a ground site is tracked through its dwell with the controller's ``ground`` pointing mode
+(:mod:`att_planner.mission.ground`) while the spacecraft stands ``min_elevation_deg`` (the target
+list's) above it. An Earth-observation mission drops the scenario's Earth-limb zone of the payload
+(``zones``): its payload looks at the Earth.
 
 Every key is checked; a bad file is refused with a :class:`~att_msgs_py.errors.ConfigError` naming
 the file and the key.
@@ -25,14 +34,18 @@ from pathlib import Path
 import numpy as np
 
 from att_msgs_py.errors import ConfigError, ErrorCode, clip
+from att_msgs_py.types import SECONDARY_KINDS
 from att_planner.mission import targets as target_lists
+from att_planner.mission.ground import GroundTrack, site_mode
+from att_planner.mission.scheduler import MissionTarget
 from att_sim import scenario as scen
 
 # key -> (default, low, high); None default: required
 NUMBERS = {"horizon_s": (None, 60.0, 7 * 86_400.0), "margin_deg": (1.0, 0.0, 30.0), "rate_hz": (5.0, 0.5, 50.0),
            "start_lead_s": (240.0, 1.0, 3600.0), "time_budget_s": (10.0, 0.05, 600.0),
            "pointing_tolerance_deg": (0.05, 1e-4, 10.0)}
-KEYS = ("targets", "sensor_axis", "method", "momentum_dumping", "rate_max_deg_per_s", *NUMBERS)
+KEYS = ("targets", "sensor_axis", "method", "momentum_dumping", "rate_max_deg_per_s", "zones", "secondary",
+        "secondary_axis", *NUMBERS)
 GYROSCOPIC_SHARE = 0.8        # of the wheels' torque margin over the planning limit the gyroscopic torque may take
 
 
@@ -53,12 +66,19 @@ class MissionConfig:
     pointing_tolerance: float     # rad
     momentum_dumping: bool
     rate_max: float               # rad/s per body axis, passed to the planner as option rate_max
+    zones: list                   # att_msgs_py.types.Zone: those of the scenario the mission keeps
+    secondary: str                # ground sites: the pointing mode's secondary direction
+    secondary_axis: np.ndarray    # ground sites: its body axis
 
-    def attitudes(self) -> dict:
-        """Target name -> (attitude body-to-inertial, dwell s, inertial direction)."""
+    def targets(self) -> dict:
+        """Target name -> :class:`~att_planner.mission.scheduler.MissionTarget`, in the list's order."""
         tl = self.target_list
-        return {t.name: (target_lists.pointing_attitude(self.sensor_axis, t.direction, tl.roll_reference), t.dwell,
-                         t.direction) for t in tl.targets}
+        if tl.kind == "inertial":
+            return {t.name: MissionTarget(t.name, t.dwell, target_lists.pointing_attitude(
+                self.sensor_axis, t.direction, tl.roll_reference), t.direction) for t in tl.targets}
+        return {t.name: MissionTarget(t.name, t.dwell, track=GroundTrack(
+            self.scenario, t, site_mode(t, self.sensor_axis, self.secondary_axis, self.secondary), tl.min_elevation))
+            for t in tl.targets}
 
 
 def gyroscopic_rate_limit(sc) -> float:
@@ -110,15 +130,14 @@ def load(name: str) -> MissionConfig:
         target_list = target_lists.load(doc["targets"])
     except KeyError as err:
         raise _invalid(path, f"targets: {err.args[0]}") from None
-    if target_list.kind != "inertial":
-        raise _invalid(path, f"targets '{doc['targets']}' is a {target_list.kind} list; att-mission flies inertial "
-                             "sources (ground sites are tracked with the pointing modes, not yet scheduled by "
-                             "a mission)")
-    axis = doc.get("sensor_axis")
-    vec = np.asarray(axis, float) if isinstance(axis, list) and len(axis) == 3 and all(
-        isinstance(v, (int, float)) and not isinstance(v, bool) for v in axis) else None
-    if vec is None or not np.isfinite(vec).all() or abs(np.linalg.norm(vec) - 1.0) > 1e-6:
-        raise _invalid(path, f"sensor_axis = {clip(repr(axis), 60)} is not a unit 3-vector (body axes)")
+    vec = _unit_axis(path, doc, "sensor_axis", doc.get("sensor_axis"))
+    second = _unit_axis(path, doc, "secondary_axis", doc.get("secondary_axis", target_lists.next_axis(vec).tolist()))
+    if np.linalg.norm(np.cross(vec, second)) < 1e-3:
+        raise _invalid(path, f"secondary_axis = {clip(repr(doc.get('secondary_axis')), 60)} is parallel to sensor_axis")
+    secondary = doc.get("secondary", "velocity")
+    if secondary not in SECONDARY_KINDS or secondary == "inertial":
+        raise _invalid(path, f"secondary = {clip(repr(secondary), 60)} is not one of "
+                             f"{', '.join(k for k in SECONDARY_KINDS if k != 'inertial')}")
     method = doc.get("method", "")
     if not isinstance(method, str) or not method.isprintable() or len(method) > 64:
         raise _invalid(path, f"method = {clip(repr(method), 60)} is not a method name")
@@ -137,4 +156,26 @@ def load(name: str) -> MissionConfig:
         raise _invalid(path, f"scenario '{scenario.name}' has no epoch: a mission flies the real sky")
     return MissionConfig(path, target_list, scenario, vec, numbers["horizon_s"], math.radians(numbers["margin_deg"]),
                          numbers["rate_hz"], numbers["start_lead_s"], numbers["time_budget_s"], method,
-                         math.radians(numbers["pointing_tolerance_deg"]), dumping, rate_max)
+                         math.radians(numbers["pointing_tolerance_deg"]), dumping, rate_max,
+                         _zones(path, doc, scenario), secondary, second)
+
+
+def _unit_axis(path, doc: dict, key: str, axis) -> np.ndarray:
+    vec = np.asarray(axis, float) if isinstance(axis, list) and len(axis) == 3 and all(
+        isinstance(v, (int, float)) and not isinstance(v, bool) for v in axis) else None
+    if vec is None or not np.isfinite(vec).all() or abs(np.linalg.norm(vec) - 1.0) > 1e-6:
+        raise _invalid(path, f"{key} = {clip(repr(axis), 60)} is not a unit 3-vector (body axes)")
+    return vec
+
+
+def _zones(path, doc: dict, scenario) -> list:
+    """The scenario's zones named by ``zones`` (all of them without the key), each named once."""
+    names = doc.get("zones")
+    known = [z.name for z in scenario.zones]
+    if names is None:
+        return list(scenario.zones)
+    if not isinstance(names, list) or not all(isinstance(n, str) and n in known for n in names) \
+            or len(set(names)) != len(names):
+        raise _invalid(path, f"zones = {clip(repr(names), 80)} is not a list of distinct zone names of scenario "
+                             f"'{scenario.name}' ({', '.join(known) or 'none'})")
+    return [z for z in scenario.zones if z.name in names]

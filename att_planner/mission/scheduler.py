@@ -20,6 +20,14 @@ a target is lost. :class:`MissionScheduler` does that without ROS:
   left out of this order: a later decision, from elsewhere, may fit them). A target with no visible
   span as long as its dwell and the next slew's lead before the horizon is missed with the zone that
   covers it named.
+
+A ground site (:mod:`att_planner.mission.ground`) moves: its attitude is the tracking law's at each
+time, it is visible while the site is trackable (high enough, its tracking within the torque) and
+the law's attitude keeps the zones (not the trackers' sky: a pass lasts minutes, and the gyro
+carries the estimate through an outage; the next slew still starts on a converged estimate); a
+slew to it ends at rest on the law's attitude and the controller blends into the law for ``blend``
+s before its dwell (so it is held for blend + dwell, and its leg has no settle); its legs are
+estimated to where the law is when the site is next visible. The mission never parks at a site.
 """
 from __future__ import annotations
 
@@ -38,6 +46,36 @@ from att_sim.ephemeris import Sky
 
 MAX_ORDERS = 5_000            # orders examined per decision (the search is best-first: the good ones come early)
 HOLD_CHECK_STEP = 10.0        # s between the zone checks of an attitude held while waiting
+
+
+@dataclass(frozen=True)
+class MissionTarget:
+    """A target of the mission: an inertial source held at ``attitude`` (its ``direction`` inertial),
+    or a ground site followed along ``track`` (a :class:`~att_planner.mission.ground.GroundTrack`)."""
+
+    name: str
+    dwell: float
+    attitude: np.ndarray | None = None
+    direction: np.ndarray | None = None
+    track: object = None
+
+    @property
+    def moving(self) -> bool:
+        return self.track is not None
+
+    def attitudes(self, t) -> np.ndarray:
+        """The target's attitude at each time of ``t``, (K, 4)."""
+        t = np.atleast_1d(np.asarray(t, float))
+        return self.track.attitudes(t) if self.moving else np.broadcast_to(self.attitude, (t.size, 4))
+
+    def observable(self, t) -> np.ndarray:
+        """Whether the target's geometry allows observing it at each time of ``t`` (inertial: always)."""
+        t = np.atleast_1d(np.asarray(t, float))
+        return self.track.trackable(t) if self.moving else np.ones(t.size, bool)
+
+    def direction_at(self, t: float) -> np.ndarray:
+        """The inertial direction the sensor axis is put on at time ``t``."""
+        return self.track.line_of_sight(t)[0] if self.moving else self.direction
 
 
 @dataclass(frozen=True)
@@ -77,37 +115,62 @@ def slew_estimate(inertia: np.ndarray, torque_max: float, q_from, q_to, rate_max
 
 
 class MissionScheduler:
-    """Orders ``targets`` (name -> (attitude, dwell s)) for ``scenario`` over ``[0, horizon]`` s of
-    mission time (t = 0 at the scenario's epoch; module docstring)."""
+    """Orders ``targets`` (name -> :class:`MissionTarget`) for ``scenario`` over ``[0, horizon]`` s of
+    mission time (t = 0 at the scenario's epoch), keeping ``zones`` (default: the scenario's; module
+    docstring)."""
 
-    def __init__(self, scenario: scen.Scenario, targets: dict, horizon: float, *, margin: float = 0.0,
-                 slew_factor: float = 1.5, lead: float = 60.0, rate_max: float = math.inf, settle: float = 0.0):
+    def __init__(self, scenario: scen.Scenario, targets: dict, horizon: float, *, zones: list | None = None,
+                 margin: float = 0.0, slew_factor: float = 1.5, lead: float = 60.0, rate_max: float = math.inf,
+                 settle: float = 0.0, blend: float = 0.0):
         if scenario.epoch is None:
             raise ValueError(f"scenario '{scenario.name}' has no epoch: a mission needs the real sky")
-        self.scenario, self.horizon = scenario, float(horizon)
-        self.targets = {k: (rot.normalize(np.asarray(q, float)), float(d)) for k, (q, d) in targets.items()}
-        self.slew_factor, self.lead, self.rate_max, self.settle = slew_factor, lead, rate_max, settle
+        self.scenario, self.horizon, self.targets = scenario, float(horizon), dict(targets)
+        self.slew_factor, self.lead, self.rate_max = slew_factor, lead, rate_max
+        self.settle, self.blend = settle, blend
         sky = Sky(scenario.epoch, scenario.orbit_model)
-        self.zones = ZoneSky(list(scenario.zones), sky, window=self.horizon)
+        self.zones = ZoneSky(list(scenario.zones if zones is None else zones), sky, window=self.horizon)
         self.trackers = tracker_skies(scenario, sky, self.horizon)
-        t = visibility_grid(0.0, self.horizon)
-        self.visible = {k: spans(t, (self.zones.margins(t, q, true=True).min(axis=1) >= margin) & self.tracked(q, t))
-                        for k, (q, _) in self.targets.items()}
+        self.grid = visibility_grid(0.0, self.horizon)
+        self.visible = {k: spans(self.grid, self._clear_samples(target, margin)) for k, target in self.targets.items()}
+
+    def _clear_samples(self, target: MissionTarget, margin: float) -> np.ndarray:
+        """Whether ``target`` is visible at each time of the grid (module docstring)."""
+        t = self.grid
+        ok = target.observable(t)
+        if ok.any():
+            q = target.attitudes(t[ok])
+            clear = self.zones.margins(t[ok], q, true=True).min(axis=1) >= margin
+            ok[ok] = clear if target.moving else clear & self.tracked(q, t[ok])
+        return ok
 
     def tracked(self, q, t) -> np.ndarray:
-        """Whether some star tracker sees the sky (clear of its exclusions) at attitude ``q`` at each
-        time of ``t`` (all True without trackers)."""
+        """Whether some star tracker sees the sky (clear of its exclusions) at attitude ``q`` (one, or
+        one per time) at each time of ``t`` (all True without trackers)."""
         t = np.atleast_1d(np.asarray(t, float))
         if not self.trackers:
             return np.ones(t.shape, bool)
         return np.max([z.margins(t, np.asarray(q, float), true=True).min(axis=1) for z in self.trackers], axis=0) >= 0
 
-    def slew(self, q_from, q_to) -> float:
+    def slew(self, q_from, q_to, settle: bool = True) -> float:
         """Estimated duration (s) of a planned slew until the controller reports it done:
-        :func:`slew_estimate` × ``slew_factor``, then ``settle`` on the final attitude."""
+        :func:`slew_estimate` × ``slew_factor``, then (``settle``) ``settle`` on the final attitude."""
         sc = self.scenario.spacecraft
         return self.slew_factor * slew_estimate(sc.inertia, sc.body_torque_max, q_from, q_to, self.rate_max) \
-            + self.settle
+            + (self.settle if settle else 0.0)
+
+    def slew_to(self, name: str, q_from, t: float) -> float:
+        """Estimated slew (s) from ``q_from`` to target ``name`` (a site: where its law is when it is
+        next visible after ``t``; no settle, the controller blends into the law)."""
+        target = self.targets[name]
+        return self.slew(q_from, self.attitude_near(name, t), settle=not target.moving)
+
+    def attitude_near(self, name: str, t: float) -> np.ndarray:
+        """Target ``name``'s attitude: a site's at the start of its first visible span after ``t``
+        (at ``t`` when there is none)."""
+        target = self.targets[name]
+        if not target.moving:
+            return target.attitude
+        return target.attitudes(next((max(a, t) for a, b in self.visible[name] if b > t), t))[0]
 
     def leg(self, q_from, q_to) -> float:
         """Estimated duration (s) of a slew the mission flies: planning lead, then the plan."""
@@ -115,17 +178,38 @@ class MissionScheduler:
 
     def covering_zone(self, name: str, t_now: float) -> str:
         """The zone that most often covers target ``name`` between ``t_now`` and the horizon."""
+        target = self.targets[name]
         t = np.linspace(t_now, self.horizon, 200)
-        m = self.zones.margins(t, self.targets[name][0], true=True)
+        t = t[target.observable(t)]
+        if not t.size:
+            return ""
+        m = self.zones.margins(t, target.attitudes(t), true=True)
         worst = np.argmin(m, axis=1)[m.min(axis=1) < 0]
         if not worst.size:
             return ""
         return self.zones.names[int(np.bincount(worst).argmax())]
 
+    def why_missed(self, name: str, t_now: float) -> str:
+        """Why target ``name`` cannot be observed any more from ``t_now``."""
+        target, held = self.targets[name], f" (needs {self.held(name):g} s of visibility)"
+        if target.moving:
+            t = self.grid[self.grid >= t_now]
+            if not target.observable(t).any():
+                return (f"never {math.degrees(target.track.min_elevation):g} deg above its horizon with its "
+                        f"tracking within the torque before the horizon{held}")
+        zone = self.covering_zone(name, t_now)
+        if zone:
+            return f"a {zone} zone covers it until the horizon{held}"
+        longest = max((b - max(a, t_now) for a, b in self.visible[name] if b > t_now), default=0.0)
+        return (f"its visibility before the horizon lasts {longest:g} s at most" if longest > 0.0 else
+                "no time left before the horizon") + held
+
     def held(self, name: str) -> float:
-        """How long target ``name`` must stay visible once reached (s): its dwell, then the lead of
-        the slew away from it (requested while the spacecraft still holds it)."""
-        return self.targets[name][1] + self.lead
+        """How long target ``name`` must stay visible once reached (s): a source its dwell, then the
+        lead of the slew away from it (requested while the spacecraft still holds it); a site the
+        controller's blend into its law, then its dwell (the spacecraft then holds still)."""
+        target = self.targets[name]
+        return self.blend + target.dwell if target.moving else target.dwell + self.lead
 
     def decide(self, t_now: float, q_now, remaining: list) -> Decision:
         """The order to fly from attitude ``q_now`` at mission time ``t_now`` through ``remaining``:
@@ -134,20 +218,19 @@ class MissionScheduler:
         missed, names = {}, []
         for k in remaining:
             if self.observable_from(k, t_now + self.lead) is None:
-                zone = self.covering_zone(k, t_now)
-                missed[k] = (f"a {zone} zone covers it until the horizon" if zone else
-                             "no time left before the horizon") + f" (needs {self.held(k):g} s of visibility)"
+                missed[k] = self.why_missed(k, t_now)
             else:
                 names.append(k)
         if not names:
             return Decision([], [], missed)
-        nodes = [np.asarray(q_now, float)] + [self.targets[k][0] for k in names]
+        nodes = [np.asarray(q_now, float)] + [self.attitude_near(k, t_now + self.lead) for k in names]
+        settles = [not self.targets[k].moving for k in names]
         n = len(names)
         C = np.zeros((n + 2, n + 2))                  # the end node: anywhere, at no cost
         for i in range(n + 1):
             for j in range(1, n + 1):
                 if i != j:
-                    C[i, j] = self.slew(nodes[i], nodes[j])
+                    C[i, j] = self.slew(nodes[i], nodes[j], settle=settles[j - 1])
         held = np.array([self.held(k) for k in names])
         t0 = t_now + self.lead                        # the first slew starts after the lead
         visible = [[(max(a, t0) - t0, b - t0) for a, b in self.visible[k] if b > t0] for k in names]
@@ -178,11 +261,13 @@ class MissionScheduler:
         return bool(self.zones.margins(t, np.asarray(q, float), true=True).min() >= 0.0 and self.tracked(q, t1)[0])
 
     def parks(self, q_from, t_now: float, until: float) -> list[str]:
-        """Targets (observed or not) to wait at from ``t_now`` until ``until``: reached by a leg from
-        ``q_from`` and visible from their arrival to ``until``, the nearest first."""
+        """Sources (observed or not; never a site) to wait at from ``t_now`` until ``until``: reached by
+        a leg from ``q_from`` and visible from their arrival to ``until``, the nearest first."""
         found = []
-        for name, (q, _) in self.targets.items():
-            arrive = t_now + self.leg(q_from, q)
+        for name, target in self.targets.items():
+            if target.moving:
+                continue
+            arrive = t_now + self.leg(q_from, target.attitude)
             if any(a <= arrive and until <= b for a, b in self.visible[name]):
                 found.append((arrive, name))
         return [name for _, name in sorted(found)]

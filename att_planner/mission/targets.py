@@ -15,7 +15,7 @@ Two kinds, one file each (``config/targets/``; read with ``yaml.safe_load`` only
       - {name: toulouse, lat_deg: 43.60, lon_deg: 1.44, alt_m: 150, dwell_s: 60}
 
 An inertial source becomes a schedule target attitude (:func:`pointing_attitude`): the scenario's
-sensor axis on the source, the body axis after it (y → z → x → y) as near ``roll_reference`` as the
+sensor axis on the source, the body axis after it (x → z → y → x) as near ``roll_reference`` as the
 pointing allows (the vernal equinox where the source lies within a degree of the reference). A
 ground site stays a site: the pointing modes (issue 15) track it through its dwell. Every field is
 checked; a bad file is refused with a :class:`~att_msgs_py.errors.ConfigError` naming the file,
@@ -170,12 +170,11 @@ def load(name: str) -> TargetList:
 
 def pointing_attitude(sensor_axis, direction, roll_reference=CELESTIAL_NORTH) -> np.ndarray:
     """Body-to-inertial quaternion putting body ``sensor_axis`` on inertial ``direction``, the next
-    body axis (y → z → x → y after the sensor's largest component) nearest ``roll_reference``
+    body axis (x → z → y → x after the sensor's largest component) nearest ``roll_reference``
     (the vernal equinox when the direction lies within a degree of the reference)."""
     s = rot.normalize(np.asarray(sensor_axis, float))
     d = rot.normalize(np.asarray(direction, float))
-    r_body = np.roll(np.eye(3), 1, axis=0)[int(np.argmax(np.abs(s)))]
-    r_body = rot.normalize(r_body - (r_body @ s) * s)
+    r_body = next_axis(s)
     ref = np.asarray(roll_reference, float)
     if abs(ref @ d) > math.cos(math.radians(1.0)):
         ref = np.array([1.0, 0.0, 0.0]) if abs(d[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
@@ -183,3 +182,10 @@ def pointing_attitude(sensor_axis, direction, roll_reference=CELESTIAL_NORTH) ->
     body = np.column_stack([s, r_body, np.cross(s, r_body)])
     inertial = np.column_stack([d, r_inertial, np.cross(d, r_inertial)])
     return rot.from_dcm(inertial @ body.T)
+
+
+def next_axis(sensor_axis) -> np.ndarray:
+    """The body axis after the sensor's largest component (x → z → y → x), made normal to the sensor."""
+    s = rot.normalize(np.asarray(sensor_axis, float))
+    axis = np.roll(np.eye(3), 1, axis=0)[int(np.argmax(np.abs(s)))]
+    return rot.normalize(axis - (axis @ s) * s)

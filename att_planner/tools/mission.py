@@ -40,7 +40,7 @@ from att_msgs.msg import AttitudeEstimate, MissionEvent
 from att_msgs_py import convert, qos
 from att_msgs_py.errors import ConfigError
 from att_msgs_py.topics import ESTIMATE, MISSION_EVENTS
-from att_msgs_py.types import Health
+from att_msgs_py.types import ControlMode, Health, PointingMode
 from att_msgs_py.types import MissionEvent as Event
 from att_msgs_py.types import MissionEventKind as Kind
 from att_planner.control.controller import ControllerConfig
@@ -51,6 +51,8 @@ from att_planner.nodes.client import client_session, maneuver_request
 from att_planner.tools.demo import SimClock, domain_line
 from att_planner.tools.launch import default_nodes, isolated_env, join_env, start_suite
 
+SITE_DURATION_MATCH = 2.0      # s: a site's plan starts within this of the start its sky was planned for
+SITE_ARRIVAL_SLACK = 1.0       # s: a slew to a site must arrive within this of the site's visibility
 SLEW_FACTOR = 1.25             # planned slew / bang-coast-bang estimate (1.18 measured on the rate-bounded day)
 MAX_ATTEMPTS = 2               # slews refused per target before it is missed
 MIN_WALL_RTF = 0.5             # waits for sim time give up below this real-time factor
@@ -93,23 +95,29 @@ class MissionRun:
     def __init__(self, client, mission: mission_config.MissionConfig, log=print):
         self.client, self.mission, self.log = client, mission, log
         self.scenario = mission.scenario
-        controller = self.scenario.node_params.get("controller", {})
-        self.settle = float(controller.get("settle_time", ControllerConfig().settle_time))   # as the node reads it
-        self.targets = mission.attitudes()
-        self.scheduler = MissionScheduler(self.scenario, {k: (q, d) for k, (q, d, _) in self.targets.items()},
-                                          mission.horizon, margin=mission.margin, lead=mission.start_lead,
-                                          rate_max=mission.rate_max, slew_factor=SLEW_FACTOR, settle=self.settle)
+        controller, defaults = self.scenario.node_params.get("controller", {}), ControllerConfig()
+        self.settle = float(controller.get("settle_time", defaults.settle_time))        # as the node reads them
+        self.blend = float(controller.get("handover_blend", defaults.handover_blend))
+        self.targets = mission.targets()
+        self.scheduler = MissionScheduler(self.scenario, self.targets, mission.horizon, zones=mission.zones,
+                                          margin=mission.margin, lead=mission.start_lead, rate_max=mission.rate_max,
+                                          slew_factor=SLEW_FACTOR, settle=self.settle, blend=self.blend)
         self.telemetry = Telemetry(client, mission.scenario.sensors.gyro is not None)
         self.events = client.create_publisher(MissionEvent, MISSION_EVENTS, qos.MISSION_QOS)
         self.attempts: Counter = Counter()
 
     def publish(self, kind: Kind, target: str = "", start: float = 0.0, end: float = 0.0, plan_id: str = "",
                 message: str = "") -> None:
-        q, _, d = self.targets.get(target, (np.array([0.0, 0.0, 0.0, 1.0]), 0.0, np.zeros(3)))
+        q, d = np.array([0.0, 0.0, 0.0, 1.0]), np.zeros(3)
+        if target:
+            at = start or self.telemetry.t
+            q, d = self.targets[target].attitudes(at)[0], self.targets[target].direction_at(at)
         m = self.mission
+        site = self.targets[target].track if target else None
         self.events.publish(convert.mission_event_msg(Event(
             self.telemetry.t, kind, target, start, end, q, d, m.sensor_axis if target else np.zeros(3),
-            m.pointing_tolerance if target else 0.0, plan_id, message[:400], self.scenario.frame_id)))
+            m.pointing_tolerance if target else 0.0, plan_id, message[:400], self.scenario.frame_id,
+            site.mode if site is not None else None, tuple(z.name for z in m.zones))))
         self.log(f"[mission] t = {self.telemetry.t:8.1f} s  {kind.value:9s} {target:14s} {message}")
 
     def fly(self, name: str, q_from, t_start: float, wait_for_visibility: bool):
@@ -117,22 +125,13 @@ class MissionRun:
         its end time, or None after a refusal (published; none while the estimate is not converged).
         ``wait_for_visibility``: a plan that would arrive before the target is visible for its dwell is
         planned again to arrive then (twice at most)."""
-        q_to = self.targets[name][0]
-        sensor = self.mission.sensor_axis
+        q_to = self.targets[name].attitude
         if not self.telemetry.converged:
             return None
         for attempt in range(3):
-            epoch = self.scenario.epoch + timedelta(seconds=t_start)
-            options = {"rate_max": self.mission.rate_max} if math.isfinite(self.mission.rate_max) else {}
-            request = maneuver_request(q_from, q_to, sensor, [], method=self.mission.method, options=options,
-                                       time_budget=self.mission.time_budget, frame_id=self.scenario.frame_id,
-                                       epoch=epoch, zones=list(self.scenario.zones),
-                                       wheel_speeds=list(self.telemetry.msg.wheel_speeds))
-            response = self.client.plan(request)
-            if not response.success:
-                self.publish(Kind.REFUSED, name, message=f"planner: code {response.error_code}: {response.message}")
+            plan = self.plan(name, q_from, q_to, t_start)
+            if plan is None:
                 return None
-            plan = response.plan
             arrival = t_start + plan.duration + self.settle           # the controller reports it done then
             visible = self.scheduler.observable_from(name, arrival) if wait_for_visibility else arrival
             if visible is None:
@@ -146,6 +145,58 @@ class MissionRun:
                                                          f"at {visible:.0f} s")
                 return None
             t_start = visible - plan.duration - self.settle
+        return self.execute(name, plan, t_start)
+
+    def fly_to_site(self, name: str, q_from, t_start: float):
+        """Plan a slew from ``q_from``, starting at sim time ``t_start`` or later, that arrives at rest
+        on ground site ``name``'s tracking attitude when the site is visible for its blend and dwell,
+        and fly it, handing over to the site's pointing mode; the arrival time, or None after a
+        refusal (published). The arrival ``T`` is fixed first (the site's law at ``T`` is the plan's
+        goal), then the start ``T − duration`` (planned again, twice at most, while the plan's
+        duration moves its start's sky by more than :data:`SITE_DURATION_MATCH` s)."""
+        target = self.targets[name]
+        if not self.telemetry.converged:
+            return None
+        arrival = self.scheduler.observable_from(name, t_start + self.scheduler.slew_to(name, q_from, t_start))
+        duration = None
+        for _ in range(4):
+            if arrival is None:
+                self.publish(Kind.REFUSED, name, message="the slew cannot arrive before the site's last "
+                                                         "visibility before the horizon")
+                return None
+            guess = duration or self.scheduler.slew_to(name, q_from, t_start)
+            plan = self.plan(name, q_from, target.attitudes(arrival)[0], max(t_start, arrival - guess))
+            if plan is None:
+                return None
+            duration = plan.duration
+            if arrival - duration < t_start:               # longer than estimated: a later visibility
+                arrival = self.scheduler.observable_from(name, t_start + duration)
+                continue
+            if abs(duration - guess) <= SITE_DURATION_MATCH:
+                break
+        else:
+            self.publish(Kind.REFUSED, name, message="four plans did not fit the site's visibility")
+            return None
+        return self.execute(name, plan, arrival - duration, pointing_after=target.track.mode)
+
+    def plan(self, name: str, q_from, q_to, t_start: float):
+        """The planner's plan from ``q_from`` to ``q_to`` starting at sim time ``t_start`` among the
+        mission's zones where they are then, or None after a refusal (published)."""
+        epoch = self.scenario.epoch + timedelta(seconds=t_start)
+        options = {"rate_max": self.mission.rate_max} if math.isfinite(self.mission.rate_max) else {}
+        request = maneuver_request(q_from, q_to, self.mission.sensor_axis, [], method=self.mission.method,
+                                   options=options, time_budget=self.mission.time_budget,
+                                   frame_id=self.scenario.frame_id, epoch=epoch, zones=list(self.mission.zones),
+                                   wheel_speeds=list(self.telemetry.msg.wheel_speeds))
+        response = self.client.plan(request)
+        if not response.success:
+            self.publish(Kind.REFUSED, name, message=f"planner: code {response.error_code}: {response.message}")
+            return None
+        return response.plan
+
+    def execute(self, name: str, plan, t_start: float, pointing_after=None):
+        """Fly ``plan`` from sim time ``t_start`` (``pointing_after``: the mode the controller hands over
+        to at its end); the time the controller reports it done, or None after a refusal (published)."""
         self.publish(Kind.SLEW, name, t_start, t_start + plan.duration, plan.plan_id,
                      f"{plan.method} {plan.duration:.1f} s, {math.degrees(plan.verification.min_cone_margin):.2f} deg "
                      f"from the zones, planned in {plan.solve_seconds:.2f} s")
@@ -156,7 +207,8 @@ class MissionRun:
                                  "is too short")
             return None
         self.telemetry.wait(t_start)
-        result = self.client.execute(plan.plan_id, timeout=60.0 + plan.duration / MIN_WALL_RTF)
+        result = self.client.execute(plan.plan_id, timeout=60.0 + plan.duration / MIN_WALL_RTF,
+                                     pointing_after=pointing_after)
         if not result.success:
             self.publish(Kind.REFUSED, name, plan_id=plan.plan_id,
                          message=f"controller: code {result.error_code}: {result.message}")
@@ -170,9 +222,20 @@ class MissionRun:
             end = self.fly(name, q_hold, t + self.mission.start_lead, wait_for_visibility=False)
             if end is not None:
                 self.publish(Kind.PARK, name, end, until, message=f"waiting at {name} until t = {until:.0f} s")
-                return self.targets[name][0], end
+                return self.targets[name].attitude, end
             t = self.telemetry.t
         return None
+
+    def hold_still(self, target) -> np.ndarray:
+        """The attitude held after ``target``: a source's; after a site, the controller stops tracking
+        and holds the attitude of that moment (inertial pointing mode; braking takes the planning lead)."""
+        if not target.moving:
+            return target.attitude
+        answer = self.client.set_mode(ControlMode.POINTING, pointing=PointingMode("inertial"))
+        if not answer.success:
+            self.log(f"[mission] the controller refused the hold after {target.name}: code {answer.error_code}: "
+                     f"{answer.message}")
+        return convert.from_quaternion(self.telemetry.msg.attitude)
 
     def startable(self, q_hold, t: float) -> bool:
         """Whether a slew can start from ``q_hold`` soon after ``t``: the attitude clear of every zone
@@ -194,7 +257,7 @@ class MissionRun:
         ``q_hold`` clear of the zones: (name, start) or (None, the first target's start)."""
         first = None
         for name, arrival in list(zip(decision.order, decision.arrivals))[:3]:
-            start = max(t + self.mission.start_lead, arrival - self.scheduler.slew(q_hold, self.targets[name][0]))
+            start = max(t + self.mission.start_lead, arrival - self.scheduler.slew_to(name, q_hold, arrival))
             first = start if first is None else first
             if self.scheduler.clear(q_hold, t, start):
                 return name, start
@@ -233,22 +296,27 @@ class MissionRun:
                     q_hold, t = parked
                 continue
             t = self.telemetry.wait(t_start - self.mission.start_lead)
-            end = self.fly(name, q_hold, max(t_start, t + self.mission.start_lead), wait_for_visibility=True)
+            target, t_start = self.targets[name], max(t_start, t + self.mission.start_lead)
+            end = self.fly_to_site(name, q_hold, t_start) if target.moving else \
+                self.fly(name, q_hold, t_start, wait_for_visibility=True)
             if end is None:
                 q_hold, t = convert.from_quaternion(self.telemetry.msg.attitude), self.telemetry.t
                 if self.startable(q_hold, t):               # the slew itself was refused: the target's count
                     self.count_attempt(name, remaining)
                 continue
-            q_hold, dwell = self.targets[name][0], self.targets[name][1]
             start = self.scheduler.observable_from(name, end)
-            if start is None or not self.scheduler.clear(q_hold, end, start):
+            if start is None or (start > end + SITE_ARRIVAL_SLACK if target.moving
+                                 else not self.scheduler.clear(target.attitude, end, start)):
                 self.publish(Kind.REFUSED, name, message="arrived too late for this visibility window: "
                                                          "deciding again")
                 self.count_attempt(name, remaining)
-                t = self.telemetry.t
+                q_hold, t = self.hold_still(target), self.telemetry.t
                 continue
-            self.publish(Kind.DWELL, name, start, start + dwell, message=f"observing for {dwell:g} s")
-            t = self.telemetry.wait(start + dwell)
+            if target.moving:                               # the controller blends into the site's law first
+                start = end + self.blend
+            self.publish(Kind.DWELL, name, start, start + target.dwell, message=f"observing for {target.dwell:g} s")
+            t = self.telemetry.wait(start + target.dwell)
+            q_hold = self.hold_still(target)
             remaining.remove(name)
             observed += 1
         for name in remaining:

@@ -21,7 +21,7 @@ import numpy as np
 from att_msgs_py.log import TopicLog
 from att_msgs_py.topics import CONTROLLER_STATUS, MISSION_EVENTS, STATE
 from att_msgs_py.types import MissionEventKind as Kind
-from att_planner.mission.day import events_of, target_table
+from att_planner.mission.day import events_of, mission_zones, target_table
 from att_planner.tools.review.run import MODE_NAMES
 from att_planner.zones import ZoneSky
 from att_sim import rotations as rot
@@ -57,14 +57,14 @@ def mission_of(log: dict[str, TopicLog], scenario: scen.Scenario | None) -> Miss
     state, sc = log[STATE], scenario.spacecraft
     t, q = np.asarray(state["header.stamp"], float), np.asarray(state["attitude"], float)
     sky = Sky(scenario.epoch, scenario.orbit_model)
-    zones = ZoneSky(list(scenario.zones), sky, window=max(1.0, float(t[-1] - t[0])))
+    zones = ZoneSky(mission_zones(events, scenario), sky, window=max(1.0, float(t[-1] - t[0])))
     margins = zones.margins(t, q, true=True)
     relative = np.asarray(state["wheel_speeds"], float) - np.asarray(state["body_rate"], float) @ sc.wheel_axes
     status = log.get(CONTROLLER_STATUS)
     mode_t = np.asarray(status["header.stamp"], float) if status is not None else np.zeros(0)
     mode = np.asarray(status["mode"]) if status is not None else np.zeros(0)
     sensor_axis = next((e.sensor_axis for e in events if e.target), np.array([0.0, 0.0, 1.0]))
-    return MissionLog(events, target_table(events, t, q, margins, scenario.epoch), t, q, margins, zones.names,
+    return MissionLog(events, target_table(events, t, q, margins, scenario), t, q, margins, zones.names,
                       relative * sc.wheel_inertia, np.asarray(state["dipole"], float), mode_t, mode,
                       sc.wheel_inertia * sc.wheel_speed_max, sky, sensor_axis)
 

@@ -27,10 +27,24 @@ def test_the_shipped_day_loads_with_its_targets_pointed():
     m = mc.load("observatory_day")
     assert m.horizon == 6 * 3600.0 and m.scenario.name == "leo_observatory" and m.momentum_dumping
     assert m.pointing_tolerance == pytest.approx(math.radians(0.05))
-    attitudes = m.attitudes()
-    assert len(attitudes) == 16
-    for q, dwell, direction in attitudes.values():
-        assert rot.dcm(q) @ m.sensor_axis == pytest.approx(direction, abs=1e-12) and dwell > 0
+    targets = m.targets()
+    assert len(targets) == 16 and [z.name for z in m.zones] == ["sun", "moon", "earth"]
+    for target in targets.values():
+        assert not target.moving and target.dwell > 0
+        assert rot.dcm(target.attitude) @ m.sensor_axis == pytest.approx(target.direction, abs=1e-12)
+
+
+def test_the_shipped_earth_observation_day_tracks_its_sites_without_the_payload_earth_zone():
+    m = mc.load("earth_observation_day")
+    assert [z.name for z in m.zones] == ["sun", "moon"] and m.secondary == "velocity"
+    targets = m.targets()
+    assert len(targets) == 10 and all(t.moving for t in targets.values())
+    singapore = targets["singapore"]
+    t = np.array([6700.0, 6800.0])
+    q = singapore.attitudes(t)
+    for k in range(2):                           # the sensor on the line of sight, body +z nearest the velocity
+        assert rot.dcm(q[k]) @ m.sensor_axis == pytest.approx(singapore.direction_at(t[k]), abs=1e-9)
+    assert singapore.track.mode.kind == "ground" and singapore.track.mode.latitude == pytest.approx(math.radians(1.35))
 
 
 def test_defaults_fill_what_a_file_leaves_out(tmp_path):
@@ -47,7 +61,9 @@ def test_defaults_fill_what_a_file_leaves_out(tmp_path):
     ({"sensor_axis": [0, 2, 0]}, "sensor_axis"), ({"sensor_axis": [0, 1]}, "sensor_axis"),
     ({"sensor_axis": "y"}, "sensor_axis"), ({"sensor_axis": [0, True, 0]}, "sensor_axis"),
     ({"targets": 3}, "targets"), ({"targets": "no_such_list"}, "unknown target list"),
-    ({"targets": "earth_observation"}, "ground list"), ({"method": "a\nb"}, "method"),
+    ({"method": "a\nb"}, "method"), ({"zones": ["sun", "pluto"]}, "zones"), ({"zones": ["sun", "sun"]}, "zones"),
+    ({"zones": "sun"}, "zones"), ({"secondary": "up"}, "secondary"), ({"secondary": "inertial"}, "secondary"),
+    ({"secondary_axis": [0, 1, 0]}, "parallel to sensor_axis"), ({"secondary_axis": [1, 1, 0]}, "secondary_axis"),
     ({"momentum_dumping": "yes"}, "momentum_dumping"), ({"colour": "red"}, "unknown key(s) colour"),
     ({"rate_max_deg_per_s": 0}, "rate_max_deg_per_s"), ({"rate_max_deg_per_s": "fast"}, "rate_max_deg_per_s"),
 ])

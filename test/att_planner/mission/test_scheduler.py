@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from att_planner.mission import targets as tl
-from att_planner.mission.scheduler import MissionScheduler, slew_estimate
+from att_planner.mission.scheduler import MissionScheduler, MissionTarget, slew_estimate
 from att_sim import rotations as rot
 from att_sim import scenario as scen
 
@@ -19,7 +19,8 @@ SENSOR = np.array([0.0, 1.0, 0.0])                 # leo_observatory's zones are
 def day():
     sources = tl.load("observatory").targets
     targets = {s.name: (tl.pointing_attitude(SENSOR, s.direction), s.dwell) for s in sources}
-    return MissionScheduler(scen.load("leo_observatory"), targets, HORIZON), targets
+    held = {k: MissionTarget(k, d, q) for k, (q, d) in targets.items()}
+    return MissionScheduler(scen.load("leo_observatory"), held, HORIZON), targets
 
 
 def test_every_observable_source_is_ordered_inside_its_visibility(day):
@@ -110,3 +111,38 @@ def test_a_rate_bound_lengthens_the_slew_to_a_coast_at_the_bound():
     assert free == pytest.approx(2 * math.sqrt(math.radians(120.0) / alpha))
     assert bounded == pytest.approx(math.radians(120.0) / w + w / alpha) and bounded > free
     assert slew_estimate(sc.inertia, sc.body_torque_max, rot.IDENTITY, q1, rate_max=1.0) == pytest.approx(free)
+
+
+@pytest.fixture(scope="module")
+def sites():
+    from att_planner.mission import config as mc
+    mission = mc.load("earth_observation_day")
+    targets = mission.targets()
+    return MissionScheduler(mission.scenario, targets, HORIZON, zones=mission.zones, margin=mission.margin,
+                            lead=240.0, settle=60.0, blend=60.0), targets
+
+
+def test_a_site_is_visible_only_while_trackable_and_clear_of_the_zones(sites):
+    scheduler, targets = sites
+    for name, target in targets.items():
+        for a, b in scheduler.visible[name]:
+            t = np.arange(a, b + 1.0, 10.0)
+            assert target.track.elevation(t).min() >= target.track.min_elevation - 1e-12, name
+            assert target.track.torque(t).max() <= target.track.torque_limit, name
+            assert scheduler.zones.margins(t, target.attitudes(t), true=True).min() >= math.radians(1.0) - 1e-9
+    assert scheduler.visible["toulouse"] == []                 # 43.6 deg N: never 30 deg high from a 20.56 deg orbit
+    assert scheduler.held("singapore") == 60.0 + targets["singapore"].dwell          # the blend, then the dwell
+
+
+def test_sites_are_ordered_inside_their_passes_and_the_rest_missed_with_why(sites):
+    scheduler, targets = sites
+    decision = scheduler.decide(0.0, rot.IDENTITY, list(targets))
+    assert decision.order and sorted([*decision.order, *decision.missed, *decision.left_out]) == sorted(targets)
+    assert "never 30 deg above its horizon" in decision.missed["toulouse"]
+    assert "lasts 80 s at most" in decision.missed["kourou"]                # its passes are too short for 120 s
+    for name, arrival in zip(decision.order, decision.arrivals, strict=True):
+        assert any(a <= arrival and arrival + scheduler.held(name) <= b for a, b in scheduler.visible[name]), name
+    first = decision.order[0]
+    q_site = scheduler.attitude_near(first, 0.0)
+    assert decision.arrivals[0] >= scheduler.lead + scheduler.slew(rot.IDENTITY, q_site, settle=False) - 1e-6
+    assert scheduler.parks(rot.IDENTITY, 0.0, 600.0) == []     # a moving site is never a park

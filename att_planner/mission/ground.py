@@ -1,0 +1,93 @@
+"""Ground sites of a mission (issue 17): when a site can be observed and the attitude that tracks it.
+
+A site is observed with the controller's ``ground`` pointing mode (issue 15): the sensor axis on the
+line of sight to the site, carried by the Earth's rotation, a secondary body axis as close as
+possible to a named direction (:mod:`att_planner.guidance.laws`). :class:`GroundTrack` gives, over
+an array of times (s past the scenario's epoch):
+
+* the site's **elevation**: ``sin e = û · (r − s) / |r − s|`` with ``r`` the spacecraft's and ``s``
+  the site's position and ``û`` the site's geodetic up (GCRS, through the field's GCRS→ITRS table,
+  as the controller's law);
+* the **attitude** of the pointing law, exactly the one the controller flies;
+* the **torque** tracking it takes: the larger, per body axis, of the body torque ``J ω̇ + ω × J ω``
+  (what the planners bound) and ``J ω̇`` (what the wheels give with the total momentum near zero),
+  from the law's rate and acceleration (:func:`att_planner.guidance.reference`).
+
+A site is *trackable* at a time when it stands ``min_elevation`` above its horizon and that torque
+stays within ``torque_share`` of the planning limit (the rest is the feedback's): passes nearly
+overhead turn the line of sight faster than a large spacecraft can follow.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from att_msgs_py.types import PointingMode
+from att_planner.guidance import reference
+from att_planner.guidance.laws import Sky as GuidanceSky
+from att_planner.guidance.laws import geodetic_to_itrs
+from att_planner.guidance.modes import law_of
+from att_sim import world
+
+TORQUE_SHARE = 0.8             # of the planning torque limit a site's tracking may take
+
+
+def site_mode(site, sensor_axis, secondary_axis, secondary: str) -> PointingMode:
+    """The ``ground`` pointing mode that tracks ``site`` (a :class:`~att_planner.mission.targets.Site`)."""
+    return PointingMode("ground", primary_axis=np.asarray(sensor_axis, float),
+                        secondary_axis=np.asarray(secondary_axis, float), secondary=secondary,
+                        latitude=site.latitude, longitude=site.longitude, altitude=site.altitude)
+
+
+def geodetic_up(latitude: float, longitude: float) -> np.ndarray:
+    """The unit normal of the WGS-84 ellipsoid at a geodetic latitude and longitude (ITRS)."""
+    return np.array([math.cos(latitude) * math.cos(longitude), math.cos(latitude) * math.sin(longitude),
+                     math.sin(latitude)])
+
+
+class GroundTrack:
+    """Site ``site`` tracked with ``mode`` (:func:`site_mode`) from ``scenario``'s spacecraft and orbit."""
+
+    def __init__(self, scenario, site, mode: PointingMode, min_elevation: float, torque_share: float = TORQUE_SHARE):
+        self.site, self.mode, self.min_elevation = site, mode, float(min_elevation)
+        self.environment = world.Environment.from_scenario(scenario)
+        self.law = law_of(mode, GuidanceSky.of(self.environment), 0.0, np.array([0.0, 0.0, 0.0, 1.0]))
+        self.spacecraft = scenario.spacecraft
+        self.torque_limit = torque_share * self.spacecraft.body_torque_max
+        self.r_itrs = geodetic_to_itrs(site.latitude, site.longitude, site.altitude)
+        self.up_itrs = geodetic_up(site.latitude, site.longitude)
+
+    def elevation(self, t) -> np.ndarray:
+        """The spacecraft's elevation (rad) above the site's horizon at each time of ``t``."""
+        t = np.atleast_1d(np.asarray(t, float))
+        R = self.environment.field.itrs_rotation(t)                       # GCRS -> ITRS, (K, 3, 3)
+        r = np.asarray(self.environment.orbit.position(t), float).reshape(-1, 3)    # GCRS, as the law's
+        up_to_sc = np.einsum("kij,kj->ki", R, r) - self.r_itrs             # ITRS, site to spacecraft
+        return np.arcsin(np.clip(up_to_sc @ self.up_itrs / np.linalg.norm(up_to_sc, axis=1), -1.0, 1.0))
+
+    def attitudes(self, t) -> np.ndarray:
+        """The law's attitude (body-to-inertial) at each time of ``t``, (K, 4)."""
+        return np.array([self.law.attitude(float(x)) for x in np.atleast_1d(t)])
+
+    def line_of_sight(self, t) -> np.ndarray:
+        """The unit line of sight from the spacecraft to the site at each time of ``t``, (K, 3)."""
+        return np.array([self.law.primary(float(x)) for x in np.atleast_1d(t)])
+
+    def torque(self, t) -> np.ndarray:
+        """The largest per-axis torque (N m) tracking the site takes at each time of ``t`` (module docstring)."""
+        J = self.spacecraft.inertia
+        out = []
+        for x in np.atleast_1d(t):
+            ref = reference(self.law.attitude, float(x))
+            wheel = J @ ref.omega_dot
+            out.append(max(np.abs(wheel).max(), np.abs(wheel + np.cross(ref.omega, J @ ref.omega)).max()))
+        return np.array(out)
+
+    def trackable(self, t) -> np.ndarray:
+        """Whether the site is above ``min_elevation`` and its tracking within the torque share, at each time."""
+        t = np.atleast_1d(np.asarray(t, float))
+        ok = self.elevation(t) >= self.min_elevation
+        if ok.any():
+            ok[ok] = self.torque(t[ok]) <= self.torque_limit
+        return ok
