@@ -401,5 +401,10 @@ def mission_event_from_msg(msg) -> types.MissionEvent:
         start=float(msg.start), end=float(msg.end), attitude=from_quaternion(msg.attitude),
         direction=from_vector3(msg.direction), sensor_axis=from_vector3(msg.sensor_axis),
         tolerance=float(msg.tolerance), plan_id=msg.plan_id, message=msg.message,
-        frame_id=msg.header.frame_id, pointing=pointing_from_msg(msg.pointing) if msg.pointing.kind else None,
-        zones=tuple(msg.zones))
+        frame_id=msg.header.frame_id, pointing=_site_pointing(msg), zones=tuple(getattr(msg, "zones", ())))
+
+
+def _site_pointing(msg) -> types.PointingMode | None:
+    """A mission event's pointing mode: None for a source, and in logs recorded before events had one."""
+    pointing = getattr(msg, "pointing", None)
+    return pointing_from_msg(pointing) if pointing is not None and pointing.kind else None

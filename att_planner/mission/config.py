@@ -15,6 +15,7 @@ the day is flown. One YAML file under ``config/missions/`` (read with ``yaml.saf
     zones: [sun, moon]             # the scenario's zones the mission keeps, by name (default: all of them)
     secondary: velocity            # ground sites: the direction the secondary axis is kept nearest
     secondary_axis: [0, 0, 1]      # ground sites: that body axis (default: ``targets.next_axis`` of the sensor)
+    handover_blend_s: 180          # ground sites: the controller's blend from rest into the site's law (s)
 
 An inertial source is held at the attitude of :func:`~att_planner.mission.targets.pointing_attitude`;
 a ground site is tracked through its dwell with the controller's ``ground`` pointing mode
@@ -43,7 +44,7 @@ from att_sim import scenario as scen
 # key -> (default, low, high); None default: required
 NUMBERS = {"horizon_s": (None, 60.0, 7 * 86_400.0), "margin_deg": (1.0, 0.0, 30.0), "rate_hz": (5.0, 0.5, 50.0),
            "start_lead_s": (240.0, 1.0, 3600.0), "time_budget_s": (10.0, 0.05, 600.0),
-           "pointing_tolerance_deg": (0.05, 1e-4, 10.0)}
+           "pointing_tolerance_deg": (0.05, 1e-4, 10.0), "handover_blend_s": (60.0, 0.0, 3600.0)}
 KEYS = ("targets", "sensor_axis", "method", "momentum_dumping", "rate_max_deg_per_s", "zones", "secondary",
         "secondary_axis", *NUMBERS)
 GYROSCOPIC_SHARE = 0.8        # of the wheels' torque margin over the planning limit the gyroscopic torque may take
@@ -69,6 +70,7 @@ class MissionConfig:
     zones: list                   # att_msgs_py.types.Zone: those of the scenario the mission keeps
     secondary: str                # ground sites: the pointing mode's secondary direction
     secondary_axis: np.ndarray    # ground sites: its body axis
+    handover_blend: float         # s: the controller's blend into a site's law (its parameter handover_blend)
 
     def targets(self) -> dict:
         """Target name -> :class:`~att_planner.mission.scheduler.MissionTarget`, in the list's order."""
@@ -157,7 +159,7 @@ def load(name: str) -> MissionConfig:
     return MissionConfig(path, target_list, scenario, vec, numbers["horizon_s"], math.radians(numbers["margin_deg"]),
                          numbers["rate_hz"], numbers["start_lead_s"], numbers["time_budget_s"], method,
                          math.radians(numbers["pointing_tolerance_deg"]), dumping, rate_max,
-                         _zones(path, doc, scenario), secondary, second)
+                         _zones(path, doc, scenario), secondary, second, numbers["handover_blend_s"])
 
 
 def _unit_axis(path, doc: dict, key: str, axis) -> np.ndarray:

@@ -22,12 +22,16 @@ a target is lost. :class:`MissionScheduler` does that without ROS:
   covers it named.
 
 A ground site (:mod:`att_planner.mission.ground`) moves: its attitude is the tracking law's at each
-time, it is visible while the site is trackable (high enough, its tracking within the torque) and
-the law's attitude keeps the zones (not the trackers' sky: a pass lasts minutes, and the gyro
-carries the estimate through an outage; the next slew still starts on a converged estimate); a
-slew to it ends at rest on the law's attitude and the controller blends into the law for ``blend``
-s before its dwell (so it is held for blend + dwell, and its leg has no settle); its legs are
-estimated to where the law is when the site is next visible. The mission never parks at a site.
+time. A slew to it ends at rest on the law's attitude and the controller blends into the law for
+``blend`` s (:class:`att_planner.guidance.laws.BlendedLaw`) before the dwell: a large spacecraft
+cannot reach a pass's line-of-sight rate (5-10 mrad/s) from rest in a minute, so the blend is long
+and starts low, where the line of sight turns slowly. The site counts as visible for an arrival when
+the law's attitude keeps the zones from the arrival to the dwell's end and the site is trackable (high
+enough, its tracking within the torque) through the dwell (not the trackers' sky: a pass lasts
+minutes, and the gyro carries the estimate through an outage; the next slew still starts on a
+converged estimate). It is held for blend + dwell, its leg has no settle, the leg away from it starts
+after the lead, held still; its legs are estimated to where the law is when the site is next
+visible. The mission never parks at a site.
 """
 from __future__ import annotations
 
@@ -131,17 +135,29 @@ class MissionScheduler:
         self.zones = ZoneSky(list(scenario.zones if zones is None else zones), sky, window=self.horizon)
         self.trackers = tracker_skies(scenario, sky, self.horizon)
         self.grid = visibility_grid(0.0, self.horizon)
-        self.visible = {k: spans(self.grid, self._clear_samples(target, margin)) for k, target in self.targets.items()}
+        self.visible = {k: self._site_spans(target, margin) if target.moving else
+                        spans(self.grid, self._clear_samples(target, margin)) for k, target in self.targets.items()}
 
     def _clear_samples(self, target: MissionTarget, margin: float) -> np.ndarray:
-        """Whether ``target`` is visible at each time of the grid (module docstring)."""
-        t = self.grid
-        ok = target.observable(t)
-        if ok.any():
-            q = target.attitudes(t[ok])
-            clear = self.zones.margins(t[ok], q, true=True).min(axis=1) >= margin
-            ok[ok] = clear if target.moving else clear & self.tracked(q, t[ok])
-        return ok
+        """Whether source ``target`` keeps the zones and a tracker sees the sky, at each time of the grid."""
+        q = target.attitude
+        return (self.zones.margins(self.grid, q, true=True).min(axis=1) >= margin) & self.tracked(q, self.grid)
+
+    def _site_spans(self, target: MissionTarget, margin: float) -> list[tuple]:
+        """A site's spans ``(a, b)``: a slew arriving at ``A`` in ``[a, b − blend − dwell]`` is followed
+        by the blend into the site's law and the dwell, with the law's attitude clear of the zones from
+        ``A`` to the dwell's end and the site trackable through the dwell (the blend starts where the
+        site rises, its line of sight slow; so ``held`` = blend + dwell as for a source's dwell)."""
+        t, held = self.grid, self.blend + target.dwell
+        clear = self.zones.margins(t, target.attitudes(t), true=True).min(axis=1) >= margin
+        trackable = target.observable(t) & clear
+        out = []
+        for za, zb in spans(t, clear):
+            for ka, kb in spans(t, trackable):
+                lo, hi = max(za, ka - self.blend), min(zb - held, kb - held)
+                if lo <= hi:
+                    out.append((lo, hi + held))
+        return sorted(out)
 
     def tracked(self, q, t) -> np.ndarray:
         """Whether some star tracker sees the sky (clear of its exclusions) at attitude ``q`` (one, or
@@ -224,13 +240,13 @@ class MissionScheduler:
         if not names:
             return Decision([], [], missed)
         nodes = [np.asarray(q_now, float)] + [self.attitude_near(k, t_now + self.lead) for k in names]
-        settles = [not self.targets[k].moving for k in names]
+        moving = [False] + [self.targets[k].moving for k in names]
         n = len(names)
         C = np.zeros((n + 2, n + 2))                  # the end node: anywhere, at no cost
         for i in range(n + 1):
             for j in range(1, n + 1):
-                if i != j:
-                    C[i, j] = self.slew(nodes[i], nodes[j], settle=settles[j - 1])
+                if i != j:                            # away from a site: held still for the lead first
+                    C[i, j] = self.slew(nodes[i], nodes[j], settle=not moving[j]) + (self.lead if moving[i] else 0.0)
         held = np.array([self.held(k) for k in names])
         t0 = t_now + self.lead                        # the first slew starts after the lead
         visible = [[(max(a, t0) - t0, b - t0) for a, b in self.visible[k] if b > t0] for k in names]

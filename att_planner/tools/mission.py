@@ -58,6 +58,8 @@ MAX_ATTEMPTS = 2               # slews refused per target before it is missed
 MIN_WALL_RTF = 0.5             # waits for sim time give up below this real-time factor
 RECOVERY_STEP = 10.0           # s of sim time between the checks of a held attitude that cannot start a slew
 RECOVERY_LIMIT = 1800.0        # s of sim time a mission waits for it at most
+ESCAPE_LEAD = 60.0             # s of sim time from the request to the start of a slew away from a zone's path
+ESCAPE_BUDGET = 2.0            # s of wall time the planner gets for it
 CONVERGENCE = {int(h) for h in Health}
 
 
@@ -95,9 +97,9 @@ class MissionRun:
     def __init__(self, client, mission: mission_config.MissionConfig, log=print):
         self.client, self.mission, self.log = client, mission, log
         self.scenario = mission.scenario
-        controller, defaults = self.scenario.node_params.get("controller", {}), ControllerConfig()
-        self.settle = float(controller.get("settle_time", defaults.settle_time))        # as the node reads them
-        self.blend = float(controller.get("handover_blend", defaults.handover_blend))
+        controller = self.scenario.node_params.get("controller", {})
+        self.settle = float(controller.get("settle_time", ControllerConfig().settle_time))   # as the node reads it
+        self.blend = mission.handover_blend                                                  # set by fly_mission
         self.targets = mission.targets()
         self.scheduler = MissionScheduler(self.scenario, self.targets, mission.horizon, zones=mission.zones,
                                           margin=mission.margin, lead=mission.start_lead, rate_max=mission.rate_max,
@@ -120,16 +122,16 @@ class MissionRun:
             site.mode if site is not None else None, tuple(z.name for z in m.zones))))
         self.log(f"[mission] t = {self.telemetry.t:8.1f} s  {kind.value:9s} {target:14s} {message}")
 
-    def fly(self, name: str, q_from, t_start: float, wait_for_visibility: bool):
+    def fly(self, name: str, q_from, t_start: float, wait_for_visibility: bool, budget: float | None = None):
         """Plan the slew from ``q_from`` to target ``name`` starting at sim time ``t_start`` and fly it;
         its end time, or None after a refusal (published; none while the estimate is not converged).
         ``wait_for_visibility``: a plan that would arrive before the target is visible for its dwell is
-        planned again to arrive then (twice at most)."""
+        planned again to arrive then (twice at most). ``budget``: the planner's wall time (default the mission's)."""
         q_to = self.targets[name].attitude
         if not self.telemetry.converged:
             return None
         for attempt in range(3):
-            plan = self.plan(name, q_from, q_to, t_start)
+            plan = self.plan(name, q_from, q_to, t_start, budget)
             if plan is None:
                 return None
             arrival = t_start + plan.duration + self.settle           # the controller reports it done then
@@ -179,13 +181,14 @@ class MissionRun:
             return None
         return self.execute(name, plan, arrival - duration, pointing_after=target.track.mode)
 
-    def plan(self, name: str, q_from, q_to, t_start: float):
+    def plan(self, name: str, q_from, q_to, t_start: float, budget: float | None = None):
         """The planner's plan from ``q_from`` to ``q_to`` starting at sim time ``t_start`` among the
-        mission's zones where they are then, or None after a refusal (published)."""
+        mission's zones where they are then (``budget`` s of wall time, default the mission's), or None
+        after a refusal (published)."""
         epoch = self.scenario.epoch + timedelta(seconds=t_start)
         options = {"rate_max": self.mission.rate_max} if math.isfinite(self.mission.rate_max) else {}
         request = maneuver_request(q_from, q_to, self.mission.sensor_axis, [], method=self.mission.method,
-                                   options=options, time_budget=self.mission.time_budget,
+                                   options=options, time_budget=budget or self.mission.time_budget,
                                    frame_id=self.scenario.frame_id, epoch=epoch, zones=list(self.mission.zones),
                                    wheel_speeds=list(self.telemetry.msg.wheel_speeds))
         response = self.client.plan(request)
@@ -215,11 +218,13 @@ class MissionRun:
             return None
         return self.telemetry.t
 
-    def park(self, q_hold, t: float, until: float):
+    def park(self, q_hold, t: float, until: float, lead: float | None = None, budget: float | None = None):
         """Slew to a source that stays visible until ``until`` (:meth:`MissionScheduler.parks`, the
-        nearest three tried) and hold it; (its attitude, the time after) or None when none was flown."""
+        nearest three tried), starting ``lead`` s from now (default the mission's ``start_lead``) and
+        planned in ``budget``, and hold it; (its attitude, the time after) or None when none was flown."""
         for name in self.scheduler.parks(q_hold, t, until)[:3]:
-            end = self.fly(name, q_hold, t + self.mission.start_lead, wait_for_visibility=False)
+            end = self.fly(name, q_hold, t + (lead or self.mission.start_lead), wait_for_visibility=False,
+                           budget=budget)
             if end is not None:
                 self.publish(Kind.PARK, name, end, until, message=f"waiting at {name} until t = {until:.0f} s")
                 return self.targets[name].attitude, end
@@ -228,13 +233,19 @@ class MissionRun:
 
     def hold_still(self, target) -> np.ndarray:
         """The attitude held after ``target``: a source's; after a site, the controller stops tracking
-        and holds the attitude of that moment (inertial pointing mode; braking takes the planning lead)."""
+        and holds the attitude of that moment (inertial pointing mode; braking takes the planning lead),
+        asked again every :data:`RECOVERY_STEP` s while it refuses (a mode starts on a converged
+        estimate: a pass can blind both trackers), :data:`RECOVERY_LIMIT` s at most."""
         if not target.moving:
             return target.attitude
+        t, end = self.telemetry.t, self.telemetry.t + RECOVERY_LIMIT
         answer = self.client.set_mode(ControlMode.POINTING, pointing=PointingMode("inertial"))
         if not answer.success:
-            self.log(f"[mission] the controller refused the hold after {target.name}: code {answer.error_code}: "
-                     f"{answer.message}")
+            self.log(f"[mission] t = {t:8.1f} s  the controller refused the hold after {target.name} (code "
+                     f"{answer.error_code}: {answer.message}): still tracking it, asking every {RECOVERY_STEP:g} s")
+        while not answer.success and t < end:
+            t = self.telemetry.wait(t + RECOVERY_STEP)
+            answer = self.client.set_mode(ControlMode.POINTING, pointing=PointingMode("inertial"))
         return convert.from_quaternion(self.telemetry.msg.attitude)
 
     def startable(self, q_hold, t: float) -> bool:
@@ -242,15 +253,22 @@ class MissionRun:
         until ``start_lead`` from now and the estimate converged."""
         return self.telemetry.converged and self.scheduler.clear(q_hold, t, t + self.mission.start_lead)
 
-    def recover(self, q_hold, t: float) -> float:
-        """Hold until a slew can start again (:meth:`startable`; at most :data:`RECOVERY_LIMIT` s);
-        the time then."""
+    def recover(self, q_hold, t: float) -> tuple:
+        """Get back to where a slew can start (:meth:`startable`): with a converged estimate a zone is
+        about to cover the held attitude, so leave it while it is clear for :data:`ESCAPE_LEAD` s (a
+        park planned in :data:`ESCAPE_BUDGET` s); else (or when no park was flown) hold until a slew
+        can start, at most :data:`RECOVERY_LIMIT` s. The attitude held and the time then."""
+        if self.telemetry.converged and self.scheduler.clear(q_hold, t, t + ESCAPE_LEAD):
+            self.log(f"[mission] t = {t:8.1f} s  a zone is about to cover the held attitude: leaving it")
+            parked = self.park(q_hold, t, t + ESCAPE_LEAD + 2.0 * self.mission.start_lead, ESCAPE_LEAD, ESCAPE_BUDGET)
+            if parked is not None:
+                return parked
         why = "the estimate is not converged" if not self.telemetry.converged else "a zone covers the held attitude"
         self.log(f"[mission] t = {t:8.1f} s  holding: {why}")
         end = t + RECOVERY_LIMIT
         while t < end and not self.startable(q_hold, t):
             t = self.telemetry.wait(t + RECOVERY_STEP)
-        return t
+        return q_hold, t
 
     def next_slew(self, decision, q_hold, t: float):
         """The first of the decided order's first three targets whose slew can wait for its start at
@@ -277,7 +295,7 @@ class MissionRun:
         remaining, observed = list(self.targets), 0
         while remaining and t < self.mission.horizon:
             if not self.startable(q_hold, t):
-                t = self.recover(q_hold, t)
+                q_hold, t = self.recover(q_hold, t)
             decision = self.scheduler.decide(t, q_hold, remaining)
             for name, why in decision.missed.items():
                 self.publish(Kind.MISSED, name, message=why)
@@ -335,7 +353,8 @@ def fly_mission(mission: mission_config.MissionConfig, out: Path, log=print) -> 
     join_env(env)
     rate = mission.rate
     params = {"simulator": {"step": 1.0 / rate, "publish_rate": rate, "clock_rate": rate, "real_time_factor": 0.0},
-              "controller": {"control_rate": rate, "momentum_dumping": mission.momentum_dumping},
+              "controller": {"control_rate": rate, "momentum_dumping": mission.momentum_dumping,
+                             "handover_blend": mission.handover_blend},
               "estimator": {"publish_rate": rate}}
     name = mission.scenario.name
     suite = start_suite(name, mcap_path, run_dir, env=env, nodes=default_nodes(name), params=params)

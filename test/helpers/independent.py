@@ -72,3 +72,17 @@ def margins(payload, t, q):
         gamma = np.arccos(np.clip(np.sum(a * b, axis=1) / np.linalg.norm(b, axis=1), -1.0, 1.0))
         out[z["name"]] = half - gamma if z["keep_in"] else gamma - half
     return out
+
+
+def site_sight(epoch: str, tle, latitude_deg: float, longitude_deg: float, altitude_m: float, t):
+    """Unit lines of sight (K, 3, GCRS) from the spacecraft of ``tle`` to a WGS-84 ground site at
+    times ``t`` (s past the UTC ``epoch``): skyfield's ``wgs84.latlon`` and ``EarthSatellite``."""
+    from skyfield.api import EarthSatellite, wgs84
+
+    ts, _ = _skyfield()
+    e = datetime.fromisoformat(epoch.replace("Z", "+00:00"))
+    tt = ts.utc(e.year, e.month, e.day, e.hour, e.minute, e.second + e.microsecond * 1e-6 + np.asarray(t))
+    r = EarthSatellite(*tle, ts=ts).at(tt).position.m.T
+    site = wgs84.latlon(latitude_deg, longitude_deg, elevation_m=altitude_m).at(tt).position.m.T
+    v = site - r
+    return v / np.linalg.norm(v, axis=1, keepdims=True)
