@@ -64,6 +64,7 @@ def test_defaults_fill_what_a_file_leaves_out(tmp_path):
     ({"method": "a\nb"}, "method"), ({"zones": ["sun", "pluto"]}, "zones"), ({"zones": ["sun", "sun"]}, "zones"),
     ({"zones": "sun"}, "zones"), ({"secondary": "up"}, "secondary"), ({"secondary": "inertial"}, "secondary"),
     ({"secondary_axis": [0, 1, 0]}, "parallel to sensor_axis"), ({"secondary_axis": [1, 1, 0]}, "secondary_axis"),
+    ({"handover_blend_s": -1}, "handover_blend_s"), ({"handover_blend_s": "long"}, "handover_blend_s"),
     ({"momentum_dumping": "yes"}, "momentum_dumping"), ({"colour": "red"}, "unknown key(s) colour"),
     ({"rate_max_deg_per_s": 0}, "rate_max_deg_per_s"), ({"rate_max_deg_per_s": "fast"}, "rate_max_deg_per_s"),
 ])
