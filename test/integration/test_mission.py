@@ -9,19 +9,17 @@ import math
 
 import numpy as np
 import pytest
-import yaml
 
 from att_msgs_py import convert
 from att_msgs_py.log import read_log
 from att_msgs_py.topics import MISSION_EVENTS, PLANS, STATE
 from att_msgs_py.types import MissionEventKind as Kind
-from att_planner.mission import config as mission_config
 from att_planner.mission.targets import load as load_targets
-from att_planner.tools.mission import fly_mission
 from att_planner.tools.review import review
 from att_sim import rotations as rot
 from att_sim import scenario as scen
 from att_sim.ephemeris import Sky
+from helpers.missions import fly_written
 
 pytestmark = pytest.mark.ros
 SOURCES = {"polaris": 60.0, "cas_a": 60.0}         # visible at the epoch for 1870 s, from 1070 s on (1 deg margin)
@@ -34,13 +32,8 @@ def flown(tmp_path_factory):
     targets = [{"name": n, "ra_deg": math.degrees(math.atan2(d[1], d[0])) % 360.0,
                 "dec_deg": math.degrees(math.asin(d[2])), "dwell_s": dwell}
                for n, dwell in SOURCES.items() for d in [observatory[n].direction]]
-    (out / "two.yaml").write_text(yaml.safe_dump({"kind": "inertial", "scenario": "leo_observatory",
-                                                  "targets": targets}))
-    (out / "short.yaml").write_text(yaml.safe_dump({"targets": str(out / "two.yaml"), "sensor_axis": [0, 1, 0],
-                                                    "horizon_s": 3000, "start_lead_s": 120, "rate_hz": 2.5}))
-    mission = mission_config.load(str(out / "short.yaml"))
-    mcap, report = fly_mission(mission, out, log=print)
-    return mission, mcap, report
+    return fly_written(out, {"kind": "inertial", "scenario": "leo_observatory", "targets": targets},
+                       {"sensor_axis": [0, 1, 0], "horizon_s": 3000, "start_lead_s": 120, "rate_hz": 2.5})
 
 
 def test_both_sources_are_observed_within_the_tolerance(flown):

@@ -8,16 +8,14 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-import yaml
 
 from att_msgs_py import convert
 from att_msgs_py.log import read_log
 from att_msgs_py.topics import MISSION_EVENTS, STATE
 from att_msgs_py.types import MissionEventKind as Kind
-from att_planner.mission import config as mission_config
-from att_planner.tools.mission import fly_mission
 from att_sim import rotations as rot
 from helpers.independent import site_sight
+from helpers.missions import fly_written
 
 pytestmark = pytest.mark.ros
 SITE = {"name": "new_guinea", "lat_deg": -4.0, "lon_deg": 145.0, "alt_m": 0.0, "dwell_s": 30.0}
@@ -26,15 +24,11 @@ SITE = {"name": "new_guinea", "lat_deg": -4.0, "lon_deg": 145.0, "alt_m": 0.0, "
 @pytest.fixture(scope="module")
 def flown(tmp_path_factory):
     out = tmp_path_factory.mktemp("mission_ground")
-    (out / "site.yaml").write_text(yaml.safe_dump({"kind": "ground", "scenario": "leo_observatory",
-                                                   "min_elevation_deg": 30.0, "targets": [SITE]}))
-    (out / "pass.yaml").write_text(yaml.safe_dump({
-        "targets": str(out / "site.yaml"), "sensor_axis": [0, 1, 0], "secondary": "velocity",
-        "secondary_axis": [0, 0, 1], "zones": ["sun", "moon"], "horizon_s": 1700, "start_lead_s": 120,
-        "rate_hz": 2.5, "pointing_tolerance_deg": 0.1, "handover_blend_s": 180}))
-    mission = mission_config.load(str(out / "pass.yaml"))
-    mcap, report = fly_mission(mission, out, log=print)
-    return mission, mcap, report
+    return fly_written(out, {"kind": "ground", "scenario": "leo_observatory", "min_elevation_deg": 30.0,
+                             "targets": [SITE]},
+                       {"sensor_axis": [0, 1, 0], "secondary": "velocity", "secondary_axis": [0, 0, 1],
+                        "zones": ["sun", "moon"], "horizon_s": 1700, "start_lead_s": 120, "rate_hz": 2.5,
+                        "pointing_tolerance_deg": 0.1, "handover_blend_s": 180})
 
 
 def test_the_site_is_observed_within_the_tolerance_in_the_report(flown):

@@ -1,0 +1,17 @@
+"""A mission written to files and flown through the nodes (the ROS mission tests)."""
+from __future__ import annotations
+
+import yaml
+
+from att_planner.mission import config as mission_config
+from att_planner.tools.mission import fly_mission
+
+
+def fly_written(out, target_list: dict, mission: dict):
+    """Write ``target_list`` and ``mission`` (its ``targets`` key set to that list) under ``out`` and
+    fly it: (the loaded mission, the MCAP's path, the day's report)."""
+    (out / "targets.yaml").write_text(yaml.safe_dump(target_list))
+    (out / "mission.yaml").write_text(yaml.safe_dump({**mission, "targets": str(out / "targets.yaml")}))
+    loaded = mission_config.load(str(out / "mission.yaml"))
+    mcap, report = fly_mission(loaded, out, log=print)
+    return loaded, mcap, report
