@@ -206,7 +206,7 @@ class MissionScheduler:
         return self.zones.names[int(np.bincount(worst).argmax())]
 
     def why_missed(self, name: str, t_now: float) -> str:
-        """Why target ``name`` cannot be observed any more from ``t_now``."""
+        """Why target ``name`` cannot be observed any more from ``t_now`` (its first slew after the lead)."""
         target, held = self.targets[name], f" (needs {self.held(name):g} s of visibility)"
         if target.moving:
             t = self.grid[self.grid >= t_now]
@@ -216,7 +216,8 @@ class MissionScheduler:
         zone = self.covering_zone(name, t_now)
         if zone:
             return f"a {zone} zone covers it until the horizon{held}"
-        longest = max((b - max(a, t_now) for a, b in self.visible[name] if b > t_now), default=0.0)
+        t_first = t_now + self.lead
+        longest = max((b - max(a, t_first) for a, b in self.visible[name] if b > t_first), default=0.0)
         return (f"its visibility before the horizon lasts {longest:g} s at most" if longest > 0.0 else
                 "no time left before the horizon") + held
 

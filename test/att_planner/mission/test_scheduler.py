@@ -148,3 +148,15 @@ def test_sites_are_ordered_inside_their_passes_and_the_rest_missed_with_why(site
     q_site = scheduler.attitude_near(first, 0.0)
     assert decision.arrivals[0] >= scheduler.lead + scheduler.slew(rot.IDENTITY, q_site, settle=False) - 1e-6
     assert scheduler.parks(rot.IDENTITY, 0.0, 600.0) == []     # a moving site is never a park
+
+
+def test_a_visibility_too_short_after_the_lead_is_named_with_its_length(day):
+    """A source visible until the horizon, decided 30 s too late for its dwell after the lead: the
+    length named is what is left after the lead (the day's LMC was told 1065 s, measured from the
+    decision, when 825 s were left)."""
+    scheduler, targets = day
+    name, (a, b) = next((k, v[-1]) for k, v in scheduler.visible.items()
+                        if v and v[-1][1] >= HORIZON - 10.0 and v[-1][1] - v[-1][0] > scheduler.held(k) + 600.0)
+    now = b - scheduler.held(name) - scheduler.lead + 30.0
+    assert scheduler.observable_from(name, now + scheduler.lead) is None
+    assert f"lasts {scheduler.held(name) - 30.0:g} s at most" in scheduler.why_missed(name, now), name
