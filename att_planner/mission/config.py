@@ -10,7 +10,7 @@ the day is flown. One YAML file under ``config/missions/`` (read with ``yaml.saf
     time_budget_s: 10              # planner wall-time budget per slew
     method: ""                     # planning method ("": the planner's default)
     pointing_tolerance_deg: 0.05   # a dwell counts as observed within this pointing error
-    momentum_dumping: true         # the controller's magnetorquer momentum dumping, all day
+    momentum_dumping: true         # the controller's magnetorquer dumping while it holds (pointing mode)
     rate_max_deg_per_s: 0.2        # per body axis, the slews' rate bound (default: :func:`gyroscopic_rate_limit`)
     zones: [sun, moon]             # the scenario's zones the mission keeps, by name (default: all of them)
     secondary: velocity            # ground sites: the direction the secondary axis is kept nearest

@@ -227,26 +227,31 @@ class MissionRun:
                            budget=budget)
             if end is not None:
                 self.publish(Kind.PARK, name, end, until, message=f"waiting at {name} until t = {until:.0f} s")
-                return self.targets[name].attitude, end
+                return self.hold(self.targets[name]), end
             t = self.telemetry.t
         return None
 
-    def hold_still(self, target) -> np.ndarray:
-        """The attitude held after ``target``: a source's; after a site, the controller stops tracking
-        and holds the attitude of that moment (inertial pointing mode; braking takes the planning lead),
-        asked again every :data:`RECOVERY_STEP` s while it refuses (a mode starts on a converged
-        estimate: a pass can blind both trackers), :data:`RECOVERY_LIMIT` s at most."""
-        if not target.moving:
-            return target.attitude
-        t, end = self.telemetry.t, self.telemetry.t + RECOVERY_LIMIT
-        answer = self.client.set_mode(ControlMode.POINTING, pointing=PointingMode("inertial"))
+    def hold(self, target=None) -> np.ndarray:
+        """Hold still after reaching or leaving ``target`` (None: where the mission starts, the
+        attitude of that moment) in the controller's inertial pointing mode
+        (the mode that dumps momentum with the magnetorquers; the hold that ends a plan does not): a
+        source's attitude, or after a site the attitude of that moment (the controller stops tracking
+        it; braking takes the planning lead). A mode starts on a converged estimate: after a site,
+        whose pass can blind both trackers, it is asked again every :data:`RECOVERY_STEP` s (at most
+        :data:`RECOVERY_LIMIT` s) while the site is still tracked; a source stays held by the plan's
+        end. The attitude held."""
+        fixed = target is not None and not target.moving
+        hold = PointingMode("inertial", attitude=target.attitude) if fixed else PointingMode("inertial")
+        t, end = self.telemetry.t, self.telemetry.t + (RECOVERY_LIMIT if target is not None and target.moving else 0.0)
+        answer = self.client.set_mode(ControlMode.POINTING, pointing=hold)
         if not answer.success:
-            self.log(f"[mission] t = {t:8.1f} s  the controller refused the hold after {target.name} (code "
-                     f"{answer.error_code}: {answer.message}): still tracking it, asking every {RECOVERY_STEP:g} s")
+            self.log(f"[mission] t = {t:8.1f} s  the controller refused the hold {target.name if target else 'here'} "
+                     f"(code {answer.error_code}: {answer.message})" + (f": still tracking it, asking every "
+                                                                       f"{RECOVERY_STEP:g} s" if end > t else ""))
         while not answer.success and t < end:
             t = self.telemetry.wait(t + RECOVERY_STEP)
-            answer = self.client.set_mode(ControlMode.POINTING, pointing=PointingMode("inertial"))
-        return convert.from_quaternion(self.telemetry.msg.attitude)
+            answer = self.client.set_mode(ControlMode.POINTING, pointing=hold)
+        return target.attitude if fixed else convert.from_quaternion(self.telemetry.msg.attitude)
 
     def startable(self, q_hold, t: float) -> bool:
         """Whether a slew can start from ``q_hold`` soon after ``t``: the attitude clear of every zone
@@ -292,10 +297,12 @@ class MissionRun:
         """Fly the mission to its horizon or its last target."""
         t = self.telemetry.wait()
         q_hold = convert.from_quaternion(self.telemetry.msg.attitude)
-        remaining, observed = list(self.targets), 0
+        remaining, observed, holding = list(self.targets), 0, False
         while remaining and t < self.mission.horizon:
             if not self.startable(q_hold, t):
                 q_hold, t = self.recover(q_hold, t)
+            if not holding:                 # the attitude the scenario starts at, held (not left to drift)
+                q_hold, holding = self.hold(), True
             decision = self.scheduler.decide(t, q_hold, remaining)
             for name, why in decision.missed.items():
                 self.publish(Kind.MISSED, name, message=why)
@@ -328,13 +335,15 @@ class MissionRun:
                 self.publish(Kind.REFUSED, name, message="arrived too late for this visibility window: "
                                                          "deciding again")
                 self.count_attempt(name, remaining)
-                q_hold, t = self.hold_still(target), self.telemetry.t
+                q_hold, t = self.hold(target), self.telemetry.t
                 continue
             if target.moving:                               # the controller blends into the site's law first
                 start = end + self.blend
+            else:
+                self.hold(target)
             self.publish(Kind.DWELL, name, start, start + target.dwell, message=f"observing for {target.dwell:g} s")
             t = self.telemetry.wait(start + target.dwell)
-            q_hold = self.hold_still(target)
+            q_hold = self.hold(target) if target.moving else target.attitude
             remaining.remove(name)
             observed += 1
         for name in remaining:

@@ -57,9 +57,11 @@ def test_the_log_holds_the_events_plans_and_the_dwells_on_target(flown):
     t, q = np.asarray(log[STATE]["header.stamp"]), np.asarray(log[STATE]["attitude"])
     sky = Sky(mission.scenario.epoch, mission.scenario.orbit_model)
     zones = {z.body: z for z in mission.scenario.zones}
+    dipole = np.asarray(log[STATE]["dipole"])
     for e in (e for e in events if e.event == Kind.DWELL):
         held = (t >= e.start) & (t <= e.end)
         assert held.sum() >= mission.rate * (e.end - e.start) - 1
+        assert np.abs(dipole[held]).max() > 0.0                   # held in pointing mode: momentum dumped
         boresight = np.einsum("nij,j->ni", rot.dcm(q[held]), mission.sensor_axis)
         assert np.degrees(np.arccos(np.clip(boresight @ e.direction, -1, 1))).max() <= 0.05
         for body, direction in (("sun", sky.sun_direction(t[held])), ("moon", sky.moon_direction(t[held]))):
