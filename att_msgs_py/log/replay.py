@@ -3,9 +3,11 @@
 Like ``ros2 bag play`` (not available from PyPI): every recorded message is republished as its
 raw CDR bytes (rclpy ``Publisher.publish`` takes serialized bytes), with its original type
 (``topics.message_class`` of the channel's schema name) and the recorded QoS
-(reliability and durability; the history depth is raised to at least 1000 so that a burst at
-``--rate 0`` is not overwritten before reliable delivery). Messages keep their recorded order and
-spacing (log time) divided by ``--rate``; ``--rate 0`` publishes as fast as possible.
+(reliability and durability; the history depth is raised to the topic's message count, at least
+1000: a keep-last writer overwrites what a slow reliable reader has not acknowledged, and at
+``--rate 0`` on a loaded machine a depth of 1000 lost 19 of 1547 wheel-speed messages).
+Messages keep their recorded order and spacing (log time) divided by ``--rate``; ``--rate 0``
+publishes as fast as possible.
 
 Topics are published under the ``/replay`` namespace by default (``/spacecraft/state`` ->
 ``/replay/spacecraft/state``, ``/clock`` -> ``/replay/clock``), so a replay onto a domain where
@@ -25,6 +27,7 @@ import os
 import re
 import sys
 import time
+from collections import Counter
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -68,9 +71,10 @@ def read_records(path: str | Path) -> tuple[list[Record], dict[str, tuple[str, s
     return records, channels
 
 
-def qos_from_metadata(topic: str, metadata: str):
+def qos_from_metadata(topic: str, metadata: str, messages: int = 0):
     """The recorded publisher QoS (rosbag2 ``offered_qos_profiles`` YAML), the suite's own for its
-    topics when the metadata is empty; depth at least :data:`MIN_DEPTH`."""
+    topics when the metadata is empty; depth ``messages`` (the topic's whole replay), at least
+    :data:`MIN_DEPTH`."""
     from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
 
     from att_msgs_py import qos
@@ -84,7 +88,7 @@ def qos_from_metadata(topic: str, metadata: str):
                       else DurabilityPolicy.VOLATILE)
         reliability = (ReliabilityPolicy.BEST_EFFORT if re.search(r"reliability:\s*best_effort", metadata)
                        else ReliabilityPolicy.RELIABLE)
-    return QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=MIN_DEPTH, reliability=reliability,
+    return QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=max(MIN_DEPTH, messages), reliability=reliability,
                       durability=durability)
 
 
@@ -136,10 +140,11 @@ def play(path: str | Path, *, rate: float = 1.0, topics: list[str] | None = None
     types = {t: channels[t] for t in selected if t in channels}
     if CLOCK in selected and CLOCK not in types:
         types[CLOCK] = (CLOCK_TYPE, "")
+    per_topic = Counter(r.topic for r in records)
     node = Node(node_name)
     try:
         pubs = {t: node.create_publisher(suite_topics.message_class(type_name), replayed_name(t, namespace),
-                                         qos_from_metadata(t, meta))
+                                         qos_from_metadata(t, meta, per_topic[t]))
                 for t, (type_name, meta) in types.items()}
         deadline = time.monotonic() + wait
         while time.monotonic() < deadline and any(p.get_subscription_count() == 0 for p in pubs.values()):
