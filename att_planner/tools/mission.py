@@ -226,7 +226,9 @@ class MissionRun:
             end = self.fly(name, q_hold, t + (lead or self.mission.start_lead), wait_for_visibility=False,
                            budget=budget)
             if end is not None:
-                self.publish(Kind.PARK, name, end, until, message=f"waiting at {name} until t = {until:.0f} s")
+                self.publish(Kind.PARK, name, end, max(end, until),
+                             message=f"waiting at {name} until t = {until:.0f} s" if end < until else
+                             f"parked at {name} after the t = {until:.0f} s it was to wait until: deciding again")
                 return self.hold(self.targets[name]), end
             t = self.telemetry.t
         return None
