@@ -15,7 +15,8 @@ the controller's momentum dumping as the file says) and flies the target list of
    the held attitude first;
 4. the controller flies the plan and holds the target for its dwell; then back to 1. A slew the
    planner or the controller refuses is tried again at the next decision, twice at most (the target is
-   then missed, with the refusal).
+   then missed, with the refusal);
+5. with no target left, the spacecraft holds (leaving a zone's path) until the horizon.
 
 Every decision, slew, dwell, park and miss is published on ``/mission/events``
 (``att_msgs/MissionEvent``) and recorded with everything else in one MCAP. At the end the day's
@@ -260,11 +261,12 @@ class MissionRun:
         until ``start_lead`` from now and the estimate converged."""
         return self.telemetry.converged and self.scheduler.clear(q_hold, t, t + self.mission.start_lead)
 
-    def recover(self, q_hold, t: float) -> tuple:
+    def recover(self, q_hold, t: float, until: float = math.inf) -> tuple:
         """Get back to where a slew can start (:meth:`startable`): with a converged estimate a zone is
         about to cover the held attitude, so leave it while it is clear for :data:`ESCAPE_LEAD` s (a
         park planned in :data:`ESCAPE_BUDGET` s); else (or when no park was flown) hold until a slew
-        can start, at most :data:`RECOVERY_LIMIT` s. The attitude held and the time then."""
+        can start, at most :data:`RECOVERY_LIMIT` s and not past ``until``. The attitude held and the
+        time then."""
         if self.telemetry.converged and self.scheduler.clear(q_hold, t, t + ESCAPE_LEAD):
             self.log(f"[mission] t = {t:8.1f} s  a zone is about to cover the held attitude: leaving it")
             parked = self.park(q_hold, t, t + ESCAPE_LEAD + 2.0 * self.mission.start_lead, ESCAPE_LEAD, ESCAPE_BUDGET)
@@ -272,10 +274,24 @@ class MissionRun:
                 return parked
         why = "the estimate is not converged" if not self.telemetry.converged else "a zone covers the held attitude"
         self.log(f"[mission] t = {t:8.1f} s  holding: {why}")
-        end = t + RECOVERY_LIMIT
+        end = min(t + RECOVERY_LIMIT, until)
         while t < end and not self.startable(q_hold, t):
             t = self.telemetry.wait(t + RECOVERY_STEP)
         return q_hold, t
+
+    def hold_until(self, q_hold, t: float, until: float) -> None:
+        """With nothing left to observe, hold (dumping) until ``until`` (the horizon: the day is flown
+        whole); a zone due at the held attitude within two leads is left for a park at a source clear
+        for :data:`RECOVERY_LIMIT` s (or until ``until``), else as :meth:`recover` does."""
+        while t < until:
+            if not self.scheduler.clear(q_hold, t, min(until, t + 2.0 * self.mission.start_lead)):
+                parked = self.park(q_hold, t, min(until, t + RECOVERY_LIMIT))
+                if parked is not None:
+                    q_hold, t = parked
+                    continue
+            if not self.startable(q_hold, t):
+                q_hold, t = self.recover(q_hold, t, until)
+            t = self.telemetry.wait(min(until, t + RECOVERY_STEP))
 
     def next_slew(self, decision, q_hold, t: float):
         """The first of the decided order's first three targets whose slew can wait for its start at
@@ -351,6 +367,7 @@ class MissionRun:
         for name in remaining:
             self.publish(Kind.MISSED, name, message=f"not reached before the mission ended (horizon "
                                                      f"{self.mission.horizon:g} s)")
+        self.hold_until(q_hold, t, self.mission.horizon)
         self.publish(Kind.ENDED, message=f"{observed} targets held for their dwell, {len(self.targets) - observed} "
                                          f"missed or not reached at t = {self.telemetry.t:.0f} s")
 

@@ -33,7 +33,7 @@ def flown(tmp_path_factory):
                 "dec_deg": math.degrees(math.asin(d[2])), "dwell_s": dwell}
                for n, dwell in SOURCES.items() for d in [observatory[n].direction]]
     return fly_written(out, {"kind": "inertial", "scenario": "leo_observatory", "targets": targets},
-                       {"sensor_axis": [0, 1, 0], "horizon_s": 3000, "start_lead_s": 120, "rate_hz": 2.5})
+                       {"sensor_axis": [0, 1, 0], "horizon_s": 2400, "start_lead_s": 120, "rate_hz": 2.5})
 
 
 def test_both_sources_are_observed_within_the_tolerance(flown):
@@ -42,7 +42,7 @@ def test_both_sources_are_observed_within_the_tolerance(flown):
     for row in report["targets"]:
         assert row["pointing_error_deg"] <= 0.05 and row["end_s"] - row["start_s"] == SOURCES[row["name"]]
     assert report["min_margin_deg"] > 0.0 and 0.0 < report["peak_wheel_ratio"] < 1.0
-    assert report["sim_seconds"] > 600.0 and report["rtf"] > 1.0
+    assert report["sim_seconds"] >= mission.horizon - 1.0 and report["rtf"] > 1.0     # the day flown whole
 
 
 def test_the_log_holds_the_events_plans_and_the_dwells_on_target(flown):
