@@ -274,8 +274,13 @@ class MissionScheduler:
         """Whether attitude ``q`` keeps every zone (at their true positions, no margin) over ``[t0, t1]``
         (sampled every :data:`HOLD_CHECK_STEP` s and at both ends) and a star tracker sees the sky at
         ``t1`` (a slew starts on a converged estimate)."""
+        return self.keeps_zones(q, t0, t1) and bool(self.tracked(q, t1)[0])
+
+    def keeps_zones(self, q, t0: float, t1: float) -> bool:
+        """Whether attitude ``q`` keeps every zone (true positions, no margin) over ``[t0, t1]``,
+        sampled every :data:`HOLD_CHECK_STEP` s and at both ends."""
         t = np.unique(np.append(np.arange(t0, t1, HOLD_CHECK_STEP), t1))
-        return bool(self.zones.margins(t, np.asarray(q, float), true=True).min() >= 0.0 and self.tracked(q, t1)[0])
+        return bool(self.zones.margins(t, np.asarray(q, float), true=True).min() >= 0.0)
 
     def parks(self, q_from, t_now: float, until: float) -> list[str]:
         """Sources (observed or not; never a site) to wait at from ``t_now`` until ``until``: reached by

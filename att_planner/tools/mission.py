@@ -272,7 +272,8 @@ class MissionRun:
             parked = self.park(q_hold, t, t + ESCAPE_LEAD + 2.0 * self.mission.start_lead, ESCAPE_LEAD, ESCAPE_BUDGET)
             if parked is not None:
                 return parked
-        why = "the estimate is not converged" if not self.telemetry.converged else "a zone covers the held attitude"
+        why = ("the estimate is not converged" if not self.telemetry.converged else
+               "a zone reaches the held attitude, or no tracker sees the sky, within the lead")
         self.log(f"[mission] t = {t:8.1f} s  holding: {why}")
         end = min(t + RECOVERY_LIMIT, until)
         while t < end and not self.startable(q_hold, t):
@@ -282,15 +283,17 @@ class MissionRun:
     def hold_until(self, q_hold, t: float, until: float) -> None:
         """With nothing left to observe, hold (dumping) until ``until`` (the horizon: the day is flown
         whole); a zone due at the held attitude within two leads is left for a park at a source clear
-        for :data:`RECOVERY_LIMIT` s (or until ``until``), else as :meth:`recover` does."""
+        for :data:`RECOVERY_LIMIT` s (or until ``until``), within one lead as :meth:`recover` does
+        (no slew follows: the trackers' view of the sky does not matter here)."""
+        lead = self.mission.start_lead
         while t < until:
-            if not self.scheduler.clear(q_hold, t, min(until, t + 2.0 * self.mission.start_lead)):
+            if not self.scheduler.keeps_zones(q_hold, t, min(until, t + 2.0 * lead)):
                 parked = self.park(q_hold, t, min(until, t + RECOVERY_LIMIT))
                 if parked is not None:
                     q_hold, t = parked
                     continue
-            if not self.startable(q_hold, t):
-                q_hold, t = self.recover(q_hold, t, until)
+                if not self.scheduler.keeps_zones(q_hold, t, min(until, t + lead)):
+                    q_hold, t = self.recover(q_hold, t, until)
             t = self.telemetry.wait(min(until, t + RECOVERY_STEP))
 
     def next_slew(self, decision, q_hold, t: float):
