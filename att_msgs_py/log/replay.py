@@ -18,7 +18,8 @@ publishes on the recorded names (with a warning: the nodes then act on the repla
 ``/clock`` messages when the log has them, otherwise a clock built from each message's log time,
 published just before it. Before playing, the tool waits up to ``--wait`` s until every topic has
 a subscriber; after the last message it waits up to ``--linger`` s until reliable subscribers
-have acknowledged everything.
+have acknowledged everything, and exits 1 naming the topics when they have not (the replay was
+published, but a slow subscriber misses what it had not received when the tool exits).
 """
 from __future__ import annotations
 
@@ -57,6 +58,10 @@ class Record:
     log_time_ns: int
     topic: str
     data: bytes
+
+
+class NotDelivered(RuntimeError):
+    """Reliable subscribers had not acknowledged every replayed message when the linger ran out."""
 
 
 def read_records(path: str | Path) -> tuple[list[Record], dict[str, tuple[str, str]]]:
@@ -165,8 +170,13 @@ def play(path: str | Path, *, rate: float = 1.0, topics: list[str] | None = None
             pubs[r.topic].publish(r.data)
             counts[r.topic] += 1
         acked_by = time.monotonic() + linger
-        for pub in pubs.values():      # reliable subscribers: wait until they have everything
-            pub.wait_for_all_acked(Duration(nanoseconds=int(max(0.0, acked_by - time.monotonic()) * 1e9)))
+        unacknowledged = [pub.topic_name for pub in pubs.values()   # reliable subscribers: until they have everything
+                          if not pub.wait_for_all_acked(
+                              Duration(nanoseconds=int(max(0.0, acked_by - time.monotonic()) * 1e9)))]
+        if unacknowledged:
+            raise NotDelivered(f"not acknowledged by every reliable subscriber within --linger {linger:g} s: "
+                               f"{', '.join(unacknowledged)} (a slow subscriber misses what it had not "
+                               f"received; a longer --linger waits for it)")
         return {p.topic_name: n for p, n in zip(pubs.values(), counts.values())}
     finally:
         node.destroy_node()
@@ -209,6 +219,9 @@ def main(argv=None) -> int:
     except ValueError as err:
         print(f"att-replay: {err}", file=sys.stderr)
         return 2
+    except NotDelivered as err:
+        print(f"att-replay: {err}", file=sys.stderr)
+        return 1
     except (KeyboardInterrupt, Exception) as err:
         # Ctrl-C: KeyboardInterrupt, or any error once rclpy's handler has shut the context down
         if not isinstance(err, (KeyboardInterrupt, ExternalShutdownException)) and rclpy.ok():

@@ -71,7 +71,7 @@ def replay(domain: int, *args: str) -> tuple[int, str]:
     proc = subprocess.Popen([sys.executable, "-m", "att_msgs_py.log.replay", str(FIXTURE), "--rate", "0", *args],
                             env=isolated_env(domain), stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
     try:
-        out, _ = proc.communicate(timeout=40)
+        out, _ = proc.communicate(timeout=120)
     finally:
         if proc.poll() is None:
             proc.kill()
@@ -98,7 +98,9 @@ def test_replay_republishes_the_fixture_under_replay_and_nothing_on_the_live_nam
     from att_msgs_py.topics import message_class
 
     with listening(("/replay", "")) as (domain, received):
-        code, out = replay(domain, "--clock", "--wait", "30")
+        # --linger 60: one Python executor takes the ~10 000 messages one by one; with the default 5 s
+        # the tool exited before it had them all (CI: 522 of 774 /clock) and now says so with exit 1
+        code, out = replay(domain, "--clock", "--wait", "30", "--linger", "60")
         expected = {t: len(v) for t, v in log.items()}
         wait_for(received["/replay"], expected)
         time.sleep(0.5)                          # anything sent to the live names would be in by now
@@ -161,3 +163,19 @@ def test_replay_builds_a_clock_from_log_times_when_the_log_has_none():
     assert [r.topic for r in out] == [CLOCK, "/a", "/b", CLOCK, "/a"]
     stamps = [deserialize_message(r.data, Clock).clock for r in out if r.topic == CLOCK]
     assert [(s.sec, s.nanosec) for s in stamps] == [(1, 500_000_000), (2, 999_999_999)]
+
+
+def test_replay_exits_1_naming_the_topics_a_reliable_subscriber_has_not_acknowledged(monkeypatch, capsys):
+    """When the linger runs out before every reliable subscriber has acknowledged (DDS's answer
+    stood in for), the replay is not reported as delivered."""
+    from rclpy.publisher import Publisher
+
+    from att_msgs_py.log.replay import main
+
+    monkeypatch.setattr(Publisher, "wait_for_all_acked",
+                        lambda self, timeout: self.topic_name != "/replay/planner/plans")
+    code = main([str(FIXTURE), "--rate", "0", "--topics", "/planner/plans", "/controller/status",
+                 "--wait", "0", "--linger", "0"])
+    err = capsys.readouterr().err
+    assert code == 1, err
+    assert "within --linger 0 s: /replay/planner/plans (" in err, err
