@@ -78,6 +78,14 @@ def mission_summary(run: MissionLog) -> dict:
             if run.wheel_momentum.size else 0.0}
 
 
+def timeline_bars(events) -> list[tuple]:
+    """(event, start, end) of every slew, dwell and park; a park ends when the next of them starts,
+    which may come before the time it waited until (the mission decided again and left early)."""
+    flown = [e for e in events if e.event in (Kind.SLEW, Kind.DWELL, Kind.PARK) and e.end > e.start]
+    return [(e, e.start, min([e.end] + [n.start for n in flown if e.event == Kind.PARK and n.start > e.start]))
+            for e in flown]
+
+
 def figure_mission(run: MissionLog, path: Path) -> Path:
     """``mission.png``: timeline, zone margins, wheel momentum against its limit, dipoles."""
     from att_planner.tools.review.figures import _figure, _save
@@ -88,12 +96,11 @@ def figure_mission(run: MissionLog, path: Path) -> Path:
     names = list(dict.fromkeys(e.target for e in run.events if e.target))
     observed = {r["name"]: r["observed"] for r in run.rows}
     colours = {Kind.SLEW: "0.6", Kind.PARK: "tab:blue"}
+    for e, start, end in timeline_bars(run.events):
+        colour = colours.get(e.event) or ("tab:green" if observed.get(e.target) else "tab:red")
+        axes[0].broken_barh([(start / h, (end - start) / h)], (names.index(e.target) - 0.35, 0.7), color=colour)
     for e in run.events:
-        if e.event in (Kind.SLEW, Kind.DWELL, Kind.PARK) and e.end > e.start:
-            colour = colours.get(e.event) or ("tab:green" if observed.get(e.target) else "tab:red")
-            axes[0].broken_barh([(e.start / h, (e.end - e.start) / h)], (names.index(e.target) - 0.35, 0.7),
-                                color=colour)
-        elif e.event == Kind.MISSED:
+        if e.event == Kind.MISSED:
             axes[0].plot(e.t / h, names.index(e.target), "rx", ms=6)
     base = len(names) + 0.5
     if run.mode.size:

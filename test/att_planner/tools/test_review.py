@@ -174,3 +174,22 @@ def test_review_picks_the_executed_plan_segment(log):
     cmd = log["/actuator/command"]
     first = np.flatnonzero(cmd["plan_id"] == run.plan.plan_id)[0]
     assert run.t0 == cmd["header.stamp"][first] and run.t[0] >= 0 and run.t[-1] > run.plan.duration
+
+
+def test_the_timeline_ends_a_park_when_the_next_slew_leaves_it():
+    """The day's park at eta_carinae waited until 16 735 s but the slew to vega left at 16 317 s;
+    a park the mission stays in keeps its own end."""
+    from att_msgs_py.types import MissionEvent
+    from att_msgs_py.types import MissionEventKind as Kind
+    from att_planner.tools.review.mission import timeline_bars
+
+    events = [MissionEvent(912.2, Kind.PARK, "3c273", 912.2, 1027.3),
+              MissionEvent(935.8, Kind.SLEW, "3c273", 1152.4, 1156.4),
+              MissionEvent(13652.4, Kind.PARK, "eta_carinae", 13652.4, 16734.9),
+              MissionEvent(16155.8, Kind.SLEW, "vega", 16317.0, 17196.1),
+              MissionEvent(17256.4, Kind.DWELL, "vega", 17256.2, 17556.2),
+              MissionEvent(17300.0, Kind.MISSED, "pleiades")]
+    bars = [(e.target, e.event, start, end) for e, start, end in timeline_bars(events)]
+    assert bars == [("3c273", Kind.PARK, 912.2, 1027.3), ("3c273", Kind.SLEW, 1152.4, 1156.4),
+                    ("eta_carinae", Kind.PARK, 13652.4, 16317.0), ("vega", Kind.SLEW, 16317.0, 17196.1),
+                    ("vega", Kind.DWELL, 17256.2, 17556.2)]
