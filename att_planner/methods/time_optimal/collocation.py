@@ -18,9 +18,8 @@ Two control representations, chosen so that a simulator reproduces the plan exac
 Path constraints ``g(x, u)`` or ``g(x, u, t)`` are imposed at nodes and midpoints, a time-dependent one
 at the point's physical time ``t = t0 + T τ`` (``t0``: the sum of the earlier phases' durations),
 an expression of the duration variables, so its derivatives with respect to them are exact (moving
-keep-out zones); :func:`path_violations` checks them
-between those points on the Hermite cubic interpolant and :func:`refine_mesh` bisects the intervals
-where they fail (or where a bang-bang control switches, :func:`switch_intervals`). A phase may give
+keep-out zones); :mod:`~att_planner.methods.time_optimal.mesh` checks them between those points and
+refines the mesh where they fail. A phase may give
 the path constraints a last input ``w(τ)``, a known function of the mesh fraction (the ramp of a
 tightening near the ends, issue 19), evaluated at each point.
 
@@ -44,25 +43,6 @@ CONTROL_KINDS = ("constant", "linear")
 # solves: 0.10 s, the defaults 0.12-0.17 s); not on the smooth ones, whose iterations they changed
 # (earth_obs 28 -> 70, swift 25 -> 22)
 MUMPS_OPTIONS = {"mumps_pivot_order": 0, "mumps_scaling": 0, "mumps_permuting_scaling": 0}
-
-
-def uniform_mesh(intervals: int) -> np.ndarray:
-    """Mesh fractions ``τ_k = k/N`` for ``N`` equal intervals."""
-    if intervals < 1:
-        raise ValueError("intervals must be a positive integer")
-    return np.linspace(0.0, 1.0, intervals + 1)
-
-
-def refine_mesh(mesh: np.ndarray, intervals, max_intervals: int | None = None, parts: int = 2) -> np.ndarray:
-    """Split the listed intervals of ``mesh`` into ``parts`` equal ones (bisect them by default), the
-    first listed first, up to ``max_intervals`` intervals in all."""
-    mesh = np.asarray(mesh, float)
-    chosen = sorted({int(k) for k in intervals})
-    if max_intervals is not None:
-        chosen = chosen[: max(0, max_intervals - (len(mesh) - 1)) // (parts - 1)]
-    inner = np.arange(1, parts) / parts
-    cuts = [mesh[k] + (mesh[k + 1] - mesh[k]) * inner for k in chosen]
-    return np.unique(np.concatenate([mesh, *cuts]))
 
 
 class Phase:
@@ -191,7 +171,7 @@ class PhaseSolution:
         return h00 * self.x[k] + h10 * h * fk + h01 * self.x[k + 1] + h11 * h * fk1
 
     def resample(self, phase: Phase) -> PhaseGuess:
-        """This solution as a warm start on another mesh (e.g. after :func:`refine_mesh`)."""
+        """This solution as a warm start on another mesh (e.g. after ``mesh.refine_mesh``)."""
         mesh = phase.mesh
         mids = (mesh[:-1] + mesh[1:]) / 2
         u = self.control_at(mids if phase.control == "constant" else mesh)
@@ -465,48 +445,3 @@ class Transcription:
         N, nx, nu = ph.intervals, ph.n_state, ph.n_control
         return PhaseSolution(ph, float(w[sl["T"]][0]), w[sl["X"]].reshape(N + 1, nx),
                              w[sl["Xm"]].reshape(N, nx), w[sl["U"]].reshape(ph.n_control_samples, nu))
-
-
-def path_violations(solution: PhaseSolution, samples_per_interval: int = 8, tol: float = 0.0,
-                    t_start: float = 0.0):
-    """Check the path constraints between collocation points on the Hermite interpolant
-    (a time-dependent one at ``t_start + duration τ``).
-
-    Returns ``(intervals, worst)``: the indices of intervals where some ``g`` leaves its bounds by
-    more than ``tol`` and the largest excess found (≤ 0 when everything holds).
-    """
-    ph = solution.phase
-    if ph.path is None:
-        return np.array([], int), -np.inf
-    s = (np.arange(1, samples_per_interval + 1) / (samples_per_interval + 1))
-    tau = (ph.mesh[:-1, None] + np.diff(ph.mesh)[:, None] * s[None, :]).ravel()
-    x = solution.state_at(tau)
-    u = solution.control_at(tau)
-    gval = np.array(ph.path(*ph.path_args(x.T, u.T, (t_start + solution.duration * tau)[None, :], tau))).T
-    lb, ub = ph.path_bounds
-    excess = np.maximum(lb - gval, gval - ub).max(axis=1).reshape(ph.intervals, samples_per_interval).max(axis=1)
-    return np.flatnonzero(excess > tol), float(excess.max())
-
-
-def switch_intervals(solution: PhaseSolution, rel_tol: float = 0.02, limit: int | None = None) -> np.ndarray:
-    """Intervals of a bang-bang control where a component switches: not saturated there while
-    saturated in a neighbouring interval. Bisecting them localises the switching instants.
-
-    Sorted by decreasing jump of the control across the interval's neighbours (relative to the
-    bound span); ``limit`` keeps the strongest ones only (singular or state-constrained arcs, where
-    the control is interior, would otherwise flag interval after interval)."""
-    ph = solution.phase
-    lb, ub = ph.control_bounds
-    span = np.where(np.isfinite(ub - lb), ub - lb, np.inf)
-    u = solution.u
-    saturated = (u <= lb + rel_tol * span) | (u >= ub - rel_tol * span)      # (K, nu)
-    if ph.control == "linear":
-        saturated = saturated[:-1] & saturated[1:]
-    nb = np.zeros_like(saturated)
-    nb[1:] |= saturated[:-1]
-    nb[:-1] |= saturated[1:]
-    flagged = np.flatnonzero(np.any(~saturated & nb, axis=1))
-    padded = np.vstack([u[:1], u, u[-1:]])
-    jump = np.max(np.abs(padded[2:] - padded[:-2]) / np.where(np.isfinite(span), span, 1.0), axis=1)
-    order = flagged[np.argsort(-jump[flagged], kind="stable")]
-    return order if limit is None else order[:limit]

@@ -53,6 +53,7 @@ from att_planner.cones import blocked_endpoint
 from att_planner.methods.axis_rotations import eigenaxis_leg, goal_attitude, no_torque_limit
 from att_planner.methods.lanes import map_in_lanes
 from att_planner.methods.time_optimal import collocation as col
+from att_planner.methods.time_optimal import mesh as meshes
 from att_planner.methods.time_optimal.model import Scaling, plan_arrays, scaling, transcription
 from att_planner.methods.time_optimal.routes import Route, candidate_routes, route_guess, select_routes, zone_margin
 from att_planner.methods.time_optimal.swarm import swarm_plan
@@ -159,11 +160,11 @@ class _Incumbent:
             if self.run.expired():
                 return
             sol = self.sol
-            bad, _ = col.path_violations(sol, tol=1e-4)
-            split = np.union1d(bad, col.switch_intervals(sol, limit=max(4, sol.phase.intervals // 2)))
+            bad, _ = meshes.path_violations(sol, tol=1e-4)
+            split = np.union1d(bad, meshes.switch_intervals(sol, limit=max(4, sol.phase.intervals // 2)))
             if not len(split) or sol.phase.intervals >= self.run.max_intervals:
                 return
-            if not self.resolve(col.refine_mesh(sol.phase.mesh, split, self.run.max_intervals, parts)):
+            if not self.resolve(meshes.refine_mesh(sol.phase.mesh, split, self.run.max_intervals, parts)):
                 return
 
     def check(self, sol: col.PhaseSolution):
@@ -183,7 +184,7 @@ class _Incumbent:
             if not len(bad):
                 bad = np.arange(self.sol.phase.intervals)
             extra.append(len(bad))
-            if not self.resolve(col.refine_mesh(self.sol.phase.mesh, bad, run.max_intervals)):
+            if not self.resolve(meshes.refine_mesh(self.sol.phase.mesh, bad, run.max_intervals)):
                 break
             ok, plan, traj = self.check(self.sol)
         run.expired()
@@ -214,7 +215,7 @@ def _explore(run: _Solve, routes: list[Route], intervals: int, explore_tol: floa
     forked child: :func:`att_planner.methods.lanes.map_in_lanes`, the same answers on two cores);
     ``(transcription, solved, log)`` with ``solved`` a list of (t_f, route label, result) of the
     converged ones."""
-    tr = run.transcription(col.uniform_mesh(intervals), explore_tol)
+    tr = run.transcription(meshes.uniform_mesh(intervals), explore_tol)
 
     def start(rt: Route) -> col.NlpResult | None:
         if run.deadline is not None and time.monotonic() > run.deadline:

@@ -34,6 +34,7 @@ from att_planner.cones import blocked_endpoint
 from att_planner.methods.axis_rotations import no_torque_limit
 from att_planner.methods.graph_smooth import plan_graph_smooth
 from att_planner.methods.time_optimal import collocation as col
+from att_planner.methods.time_optimal import mesh as meshes
 from att_planner.methods.time_optimal.model import Scaling, rigid_body_dynamics, scaling, transcription
 from att_planner.methods.time_optimal.planner import CONVERGED_VIOLATION, _truth_violation_intervals
 from att_planner.problem import ManeuverProblem
@@ -114,7 +115,7 @@ def plan_smooth_collocation(problem: ManeuverProblem, *, intervals: int = DEFAUL
     tf_seed = max(p.duration for p in seeds) / s.tu
     tf_max = 10.0 * tf_seed if not problem.zone_sky().moving else min(10.0 * tf_seed, problem.zone_sky().window / s.tu)
     bounds = (min(1e-2 * tf_seed, 0.5 * tf_max), tf_max)
-    mesh, stats, best = col.uniform_mesh(intervals), {"meshes": []}, None
+    mesh, stats, best = meshes.uniform_mesh(intervals), {"meshes": []}, None
     initial = [guess(p, s, col.Phase(rigid_body_dynamics(s.Jn, smooth=True), mesh)) for p in seeds]
     nit = nfev = 0
     for _ in range(REFINE_ROUNDS + 1):
@@ -142,7 +143,7 @@ def plan_smooth_collocation(problem: ManeuverProblem, *, intervals: int = DEFAUL
         bad = _truth_violation_intervals(replace(traj, t=traj.t / plan.stats["slowed_by"]), sol, s, problem)
         if w is None or rejection(plan.verification) is None or not len(bad) or len(mesh) - 1 >= 4 * intervals:
             break
-        mesh = col.refine_mesh(mesh, bad, 4 * intervals)
+        mesh = meshes.refine_mesh(mesh, bad, 4 * intervals)
         initial = [sol.resample(tr.phases[0].with_mesh(mesh))]
     elapsed = time.monotonic() - start
     expired = expired_at(problem)

@@ -4,12 +4,13 @@ import numpy as np
 import pytest
 
 from att_planner.methods.time_optimal import collocation as col
+from att_planner.methods.time_optimal import mesh as meshes
 
 
 def _double_integrator(control, intervals=10, max_iter=1000):
     x, u = ca.SX.sym("x", 2), ca.SX.sym("u", 1)
     f = ca.Function("f", [x, u], [ca.vertcat(x[1], u)])
-    phase = col.Phase(f, col.uniform_mesh(intervals), control=control, control_bounds=(-1, 1),
+    phase = col.Phase(f, meshes.uniform_mesh(intervals), control=control, control_bounds=(-1, 1),
                       duration_bounds=(0.1, 10))
     tr = col.Transcription([phase])
     tr.bound_state(0, 0, [0, 0])
@@ -52,16 +53,3 @@ def test_an_unconverged_solve_keeps_its_feasible_iterate_of_least_time():
         assert x == pytest.approx(1.0, abs=1e-3) and v == pytest.approx(0.0, abs=1e-9)
         assert 2.0 - 1e-6 <= sol.duration < 2.001
     assert _double_integrator("constant")[1].incumbent is None        # converged: the answer itself
-
-
-def test_refine_mesh_bisects_only_the_listed_intervals_within_the_cap():
-    mesh = col.uniform_mesh(4)
-    assert np.allclose(col.refine_mesh(mesh, [1, 3]), [0, 0.25, 0.375, 0.5, 0.75, 0.875, 1])
-    assert len(col.refine_mesh(mesh, [0, 1, 2, 3], max_intervals=6)) == 7
-
-
-def test_refine_mesh_splits_into_parts_within_the_cap():
-    mesh = col.uniform_mesh(4)
-    assert np.allclose(col.refine_mesh(mesh, [1], parts=4), [0, 0.25, 0.3125, 0.375, 0.4375, 0.5, 0.75, 1])
-    # each split interval adds three: room for two of the four within 10
-    assert len(col.refine_mesh(mesh, [0, 1, 2, 3], max_intervals=10, parts=4)) == 11

@@ -13,6 +13,7 @@ from att_planner import methods
 from att_planner.methods.constrained_axis import plan_constrained_axis
 from att_planner.methods.eigenaxis import plan_eigenaxis
 from att_planner.methods.time_optimal import collocation as col
+from att_planner.methods.time_optimal import mesh as meshes
 from att_planner.methods.time_optimal import model, plan_time_optimal
 from att_planner.reference.time_optimal_cases import case_problem
 from att_sim import rotations as rot
@@ -72,7 +73,7 @@ def test_an_nlp_is_built_once_per_shape_and_shared(monkeypatch):
     monkeypatch.setattr(col.Transcription, "build", lambda self, **kw: built.append(kw) or build(self, **kw))
     problem = case_problem("swift")
     other = replace(problem, cones=[Cone(-c.direction, c.half_angle, c.name) for c in problem.cones])
-    s, mesh = model.scaling(problem), col.uniform_mesh(8)
+    s, mesh = model.scaling(problem), meshes.uniform_mesh(8)
     first, second = (model.transcription(p, s, mesh, "constant", 1e-3, (0.1, 10.0)) for p in (problem, other))
     assert len(built) == 1 and first._solver is second._solver
     assert not np.allclose(first.phases[0].path_parameters, second.phases[0].path_parameters)
