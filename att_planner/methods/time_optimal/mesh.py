@@ -1,7 +1,8 @@
 """The collocation mesh and its refinement: a uniform mesh, the path constraints checked between the
 collocation points on the Hermite cubic interpolant (:func:`path_violations`), the intervals where a
 bang-bang control switches (:func:`switch_intervals`), and :func:`refine_mesh` splitting the
-intervals they name (Betts, *Practical Methods for Optimal Control*, 2nd ed., §4.7)."""
+intervals they name (the mesh refinement of Betts, *Practical Methods for Optimal Control*, 2nd ed.,
+whose Hermite–Simpson transcription :mod:`.collocation` implements)."""
 from __future__ import annotations
 
 from typing import TYPE_CHECKING

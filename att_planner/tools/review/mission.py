@@ -82,8 +82,13 @@ def timeline_bars(events) -> list[tuple]:
     """(event, start, end) of every slew, dwell and park; a park ends when the next of them starts,
     which may come before the time it waited until (the mission decided again and left early)."""
     flown = [e for e in events if e.event in (Kind.SLEW, Kind.DWELL, Kind.PARK) and e.end > e.start]
-    return [(e, e.start, min([e.end] + [n.start for n in flown if e.event == Kind.PARK and n.start > e.start]))
-            for e in flown]
+
+    def end(e) -> float:
+        if e.event != Kind.PARK:
+            return e.end
+        return min([e.end] + [n.start for n in flown if n.start > e.start])
+
+    return [(e, e.start, end(e)) for e in flown]
 
 
 def figure_mission(run: MissionLog, path: Path) -> Path:
