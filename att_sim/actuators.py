@@ -46,9 +46,13 @@ class WheelDriveSpec:
     torque_scale: tuple = ()            # per wheel: delivered/commanded torque (a campaign's dispersion); (): 1
 
     def friction(self, speed: np.ndarray) -> np.ndarray:
-        """Friction torque opposing relative wheel speeds ``speed`` (N m)."""
+        """Friction torques opposing relative wheel speeds ``speed`` (N m)."""
         speed = np.asarray(speed, float)
-        return self.coulomb_friction * np.tanh(speed / self.friction_speed) + self.viscous_friction * speed
+        return np.array([self.friction_at(v) for v in speed.ravel().tolist()]).reshape(speed.shape)
+
+    def friction_at(self, speed: float) -> float:
+        """Friction torque opposing one relative wheel speed (N m): ``c tanh(ν/ν_s) + b ν``."""
+        return self.coulomb_friction * math.tanh(speed / self.friction_speed) + self.viscous_friction * speed
 
 
 @dataclass(frozen=True)
@@ -92,6 +96,10 @@ def quantize(value: np.ndarray, lsb: float) -> np.ndarray:
     return lsb * np.round(np.asarray(value, float) / lsb) if lsb > 0 else np.asarray(value, float)
 
 
+def _clip(value: float, limit: float) -> float:
+    return min(max(value, -limit), limit)
+
+
 class WheelDrive:
     """The wheel drives of one spacecraft (see module docstring)."""
 
@@ -105,17 +113,19 @@ class WheelDrive:
             u = u * np.asarray(self.spec.torque_scale)
         return u + self.rng.standard_normal(len(u)) * self.spec.torque_noise
 
-    def motor(self, u: np.ndarray, speed: np.ndarray) -> np.ndarray:
-        """Held torques ``u`` within the envelope at relative speeds ``speed``."""
-        if math.isinf(self.spec.power_max):
+    def motor(self, u, speed) -> list:
+        """Held torques ``u`` within the envelope at relative speeds ``speed`` (sequences of floats;
+        a list: :func:`att_sim.dynamics.derivative` works on Python floats)."""
+        u, speed, power = np.asarray(u, float).tolist(), np.asarray(speed, float).tolist(), self.spec.power_max
+        if math.isinf(power):
             return u
-        limit = self.spec.power_max / np.maximum(np.abs(speed), 1e-12)
-        return np.where(u * speed > 0, np.minimum(np.maximum(u, -limit), limit), u)
+        return [_clip(u_k, power / max(abs(v), 1e-12)) if u_k * v > 0 else u_k for u_k, v in zip(u, speed)]
 
-    def __call__(self, u: np.ndarray, speed: np.ndarray) -> np.ndarray:
-        """Net torque on the wheels (motor minus friction): what :func:`att_sim.dynamics.derivative`
+    def __call__(self, u, speed) -> list:
+        """Net torques on the wheels (motor minus friction): what :func:`att_sim.dynamics.derivative`
         applies at each stage."""
-        return self.motor(u, speed) - self.spec.friction(speed)
+        speed = np.asarray(speed, float).tolist()
+        return [m - self.spec.friction_at(v) for m, v in zip(self.motor(u, speed), speed)]
 
 
 class Magnetorquers:

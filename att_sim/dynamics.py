@@ -34,6 +34,7 @@ import hashlib
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from functools import cached_property
+from operator import mul
 
 import numpy as np
 
@@ -65,6 +66,11 @@ class Spacecraft:
     @cached_property
     def inertia_inv(self) -> np.ndarray:
         return np.linalg.inv(self.inertia)
+
+    @cached_property
+    def rows(self) -> tuple[list, list, list]:
+        """``(J, J⁻¹, G)`` as nested lists of Python floats (:func:`derivative`'s arithmetic)."""
+        return self.inertia.tolist(), self.inertia_inv.tolist(), self.wheel_axes.tolist()
 
     @cached_property
     def wheel_axes_pinv(self) -> np.ndarray:
@@ -116,50 +122,60 @@ def effective_wheel_torque(sc: Spacecraft, wheel_speed: np.ndarray, u: np.ndarra
     """Clip motor torques to their limit and cut those that would push a wheel beyond
     ``wheel_speed_max`` *relative to the body* (``Ω − Gᵀω``, ``Ω`` the state's inertial spin rate,
     ``ω`` the body rate) further."""
-    return _speed_cut(sc, np.minimum(np.maximum(u, -sc.wheel_torque_max), sc.wheel_torque_max),
-                      relative_wheel_speed(sc, wheel_speed, omega))
+    relative = relative_wheel_speed(sc, wheel_speed, omega)
+    return np.array(_limited(sc, np.asarray(u, float).tolist(), relative.tolist()))
 
 
-def _speed_cut(sc: Spacecraft, u: np.ndarray, relative: np.ndarray) -> np.ndarray:
-    """Torques ``u`` with those pushing a wheel at its limit speed ``relative`` further cut (u ν > 0:
-    the same sign, neither zero)."""
-    return np.where((np.abs(relative) >= sc.wheel_speed_max) & (u * relative > 0), 0.0, u)
+def _limited(sc: Spacecraft, u: list, relative: list) -> list:
+    """Torques ``u`` clipped to the limit, those pushing a wheel at its limit speed ``relative``
+    further cut (u ν > 0: the same sign, neither zero); Python floats."""
+    limit, speed_max = sc.wheel_torque_max, sc.wheel_speed_max
+    return [0.0 if abs(v) >= speed_max and u_k * v > 0 else u_k
+            for u_k, v in zip((min(max(u_k, -limit), limit) for u_k in u), relative)]
 
 
 def external_torque(sc: Spacecraft, inputs: Inputs, q: np.ndarray, stage: tuple | None = None) -> np.ndarray:
     """Body torque ``τ_body + m × B_b + τ_env`` (N m, body axes); ``stage`` = ``(B_b, τ_env)`` of a
     :data:`StageEnvironment`, else the held ``inputs.field_body`` and ``inputs.gravity_gradient``."""
+    return np.array(_external_torque(inputs, stage))
+
+
+def _external_torque(inputs: Inputs, stage: tuple | None) -> list:
+    """:func:`external_torque` as three Python floats."""
     field_b, tau_env = (inputs.field_body, inputs.gravity_gradient) if stage is None else stage
-    tau = np.zeros(3) if inputs.body_torque is None else np.array(inputs.body_torque, float)
+    tau = [0.0, 0.0, 0.0] if inputs.body_torque is None else np.asarray(inputs.body_torque, float).tolist()
     if inputs.dipole is not None and field_b is not None:
-        tau = tau + rot.cross(inputs.dipole, field_b)
+        (m0, m1, m2), (b0, b1, b2) = np.asarray(inputs.dipole, float).tolist(), np.asarray(field_b, float).tolist()
+        tau = [tau[0] + (m1 * b2 - m2 * b1), tau[1] + (m2 * b0 - m0 * b2), tau[2] + (m0 * b1 - m1 * b0)]
     if tau_env is not None:
-        tau = tau + tau_env
+        tau = [a + b for a, b in zip(tau, np.asarray(tau_env, float).tolist())]
     return tau
 
 
 def derivative(sc: Spacecraft, x: np.ndarray, inputs: Inputs, stage: tuple | None = None) -> np.ndarray:
-    """Time derivative of the state for actuator inputs held constant (see module docstring);
-    ``stage``: the environment ``(B_b, τ_env)`` at this state (:func:`external_torque`)."""
-    q, w, ws = x[:4], x[4:7], x[7:]
-    out = np.empty_like(x)
-    h = sc.inertia @ w
-    torque = external_torque(sc, inputs, q, stage)
-    if sc.n_wheels:
-        h = h + sc.wheel_axes @ (sc.wheel_inertia * ws)
+    """Time derivative of one state for actuator inputs held constant (see module docstring);
+    ``stage``: the environment ``(B_b, τ_env)`` at this state (:func:`external_torque`). Evaluated
+    on Python floats: on 3-vectors numpy's cost is its per-call overhead (the simulator's hot path)."""
+    J, J_inv, G = sc.rows
+    q, (w0, w1, w2), ws = x[:4].tolist(), x[4:7].tolist(), x[7:].tolist()
+    h = [r[0] * w0 + r[1] * w1 + r[2] * w2 for r in J]
+    torque = _external_torque(inputs, stage)
+    wheel_rates = [0.0] * len(ws)
+    if ws:
+        spin = [sc.wheel_inertia * s for s in ws]
+        h = [h_i + sum(map(mul, row, spin)) for h_i, row in zip(h, G)]
         if inputs.wheel_torque is not None:
-            relative = relative_wheel_speed(sc, ws, w)
-            u = _speed_cut(sc, np.minimum(np.maximum(inputs.wheel_torque, -sc.wheel_torque_max), sc.wheel_torque_max),
-                           relative)
+            relative = [s - (a * w0 + b * w1 + c * w2) for s, a, b, c in zip(ws, *G)]
+            u = _limited(sc, np.asarray(inputs.wheel_torque, float).tolist(), relative)
             if inputs.wheel_drive is not None:
                 u = inputs.wheel_drive(u, relative)
-            torque = torque - sc.wheel_axes @ u
-            out[7:] = u / sc.wheel_inertia if sc.wheel_inertia > 0 else 0.0
-        else:
-            out[7:] = 0.0
-    out[4:7] = sc.inertia_inv @ (torque - rot.cross(w, h))
-    out[:4] = quaternion_rate(q.tolist(), w.tolist())     # on Python floats: a fraction of numpy scalars' cost
-    return out
+            torque = [t - sum(map(mul, row, u)) for t, row in zip(torque, G)]
+            if sc.wheel_inertia > 0:
+                wheel_rates = [u_k / sc.wheel_inertia for u_k in u]
+    hx, hy, hz = h
+    net = (torque[0] - (w1 * hz - w2 * hy), torque[1] - (w2 * hx - w0 * hz), torque[2] - (w0 * hy - w1 * hx))
+    w_dot = [r[0] * net[0] + r[1] * net[1] + r[2] * net[2] for r in J_inv]
+    return np.array([*quaternion_rate(q, (w0, w1, w2)), *w_dot, *wheel_rates])
 
 
 def quaternion_rate(q, w) -> tuple:

@@ -30,6 +30,7 @@ a lower bound of the geodetic altitude, sampled every ≤ 30 s.
 """
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import fields
 from datetime import UTC, datetime, timedelta
@@ -81,10 +82,11 @@ class CircularOrbit(Orbit):
         """``r`` is computed as :func:`att_sim.environment.position` does (equal to it); ``v = ṙ``."""
         p = self.params
         u = env.argument_of_latitude(p, t)
-        cu, su = np.cos(u), np.sin(u)
-        r = p.radius * np.stack(env.direction(p, cu, su, self._plane), -1)
-        v = (p.radius * p.mean_motion) * np.stack(env.direction(p, -su, cu, self._plane), -1)
-        return r, v
+        one = u.ndim == 0                       # one time (the simulator's): on Python floats
+        cu, su = (math.cos(u), math.sin(u)) if one else (np.cos(u), np.sin(u))
+        stack = np.array if one else functools.partial(np.stack, axis=-1)
+        return (p.radius * stack(env.direction(p, cu, su, self._plane)),
+                (p.radius * p.mean_motion) * stack(env.direction(p, -su, cu, self._plane)))
 
 
 def _rotation(raan, i, argp):

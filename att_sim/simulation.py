@@ -300,8 +300,8 @@ class Simulation:
         motor = net = inp.wheel_torque          # at the step's start: motor torque, and less friction
         if self.wheel_drive is not None:
             speed = dyn.relative_wheel_speed(self.sc, self.x[7:], self.x[4:7])
-            motor = self.wheel_drive.motor(inp.wheel_torque, speed)
-            net = self.wheel_drive(inp.wheel_torque, speed)
+            motor = np.array(self.wheel_drive.motor(inp.wheel_torque, speed))
+            net = np.array(self.wheel_drive(inp.wheel_torque, speed))
         self.applied = Applied(motor, inp.dipole, mean - self.sc.wheel_axes @ net)
         self.x, self.now = x_new, now
         self.t += dt

@@ -63,19 +63,28 @@ class Update:
 
 
 def transition(omega: np.ndarray, dt: float) -> np.ndarray:
-    """``Φ`` (6×6) of the error state over ``dt`` at the estimated rate ``omega`` (module docstring)."""
-    w = float(np.linalg.norm(omega))
-    W = rot.hat(omega)
-    theta = w * dt
+    """``Φ`` (6×6) of the error state over ``dt`` at the estimated rate ``omega`` (module docstring).
+    With ``W = [ω̂×]`` and ``W² = ω̂ω̂ᵀ − |ω̂|² I``: ``Φ₁₁ = I − a W + b W²``, ``Φ₁₂ = −dt I + b W − c W²``,
+    ``a = sin θ/|ω̂|``, ``b = (1 − cos θ)/|ω̂|²``, ``c = (θ − sin θ)/|ω̂|³`` (their series to O(θ³) below
+    θ = 1e-6); on Python floats (the estimator calls it at every gyro sample)."""
+    w = np.asarray(omega, float).tolist()
+    n2 = w[0] * w[0] + w[1] * w[1] + w[2] * w[2]
+    norm = math.sqrt(n2)
+    theta = norm * dt
     if theta > 1e-6:
-        phi11 = I3 - W * math.sin(theta) / w + W @ W * (1.0 - math.cos(theta)) / w**2
-        phi12 = -(I3 * dt - W * (1.0 - math.cos(theta)) / w**2 + W @ W * (theta - math.sin(theta)) / w**3)
-    else:                         # series: the same to O(θ³)
-        phi11 = I3 - W * dt + W @ W * dt**2 / 2.0
-        phi12 = -(I3 * dt - W * dt**2 / 2.0 + W @ W * dt**3 / 6.0)
-    out = np.eye(6)
-    out[:3, :3], out[:3, 3:] = phi11, phi12
-    return out
+        a, b, c = math.sin(theta) / norm, (1.0 - math.cos(theta)) / n2, (theta - math.sin(theta)) / (n2 * norm)
+    else:
+        a, b, c = dt, dt * dt / 2.0, dt**3 / 6.0
+    W = ((0.0, -w[2], w[1]), (w[2], 0.0, -w[0]), (-w[1], w[0], 0.0))
+    rows = []
+    for i in range(3):
+        W2 = [w[i] * w[j] - (n2 if i == j else 0.0) for j in range(3)]
+        rows.append([(1.0 if i == j else 0.0) - a * W[i][j] + b * W2[j] for j in range(3)]
+                    + [(-dt if i == j else 0.0) + b * W[i][j] - c * W2[j] for j in range(3)])
+    return np.array(rows + _LOWER_IDENTITY)
+
+
+_LOWER_IDENTITY = np.eye(6)[3:].tolist()
 
 
 @functools.lru_cache(maxsize=64)
@@ -97,10 +106,12 @@ OFF_DIAGONAL = ((0, 1), (0, 2), (1, 0), (1, 2), (2, 0), (2, 1))   # as att_sim.r
 def scale_misalignment_sensitivity(omega: np.ndarray) -> np.ndarray:
     """``G(ω)`` (3×9) with ``E(p) ω = G(ω) p``, ``p = [s_x, s_y, s_z, m_01, m_02, m_10, m_12, m_20, m_21]``."""
     G = np.zeros((3, 9))
-    G[[0, 1, 2], [0, 1, 2]] = omega
-    for k, (i, j) in enumerate(OFF_DIAGONAL):
-        G[i, 3 + k] = omega[j]
+    G.flat[_SENSITIVITY_AT] = np.asarray(omega, float)[_SENSITIVITY_OF]
     return G
+
+
+_SENSITIVITY_AT = [0, 10, 20] + [9 * i + 3 + k for k, (i, _) in enumerate(OFF_DIAGONAL)]   # flat indices in G
+_SENSITIVITY_OF = [0, 1, 2] + [j for _, j in OFF_DIAGONAL]                                # the rate's axis
 
 
 def propagate(x: FilterState, omega_measured: np.ndarray, dt: float, arw: float, rrw: float,
@@ -115,9 +126,10 @@ def propagate(x: FilterState, omega_measured: np.ndarray, dt: float, arw: float,
     if consider is not None:
         psi = np.zeros((6, 9))
         psi[:3] = phi[:3, 3:] @ scale_misalignment_sensitivity(omega)
-        cross = phi @ x.C @ psi.T
-        P += cross + cross.T + (psi * consider) @ psi.T
-        C = phi @ x.C + psi * consider
+        phi_C, psi_consider = phi @ x.C, psi * consider
+        cross = phi_C @ psi.T
+        P += cross + cross.T + psi_consider @ psi.T
+        C = phi_C + psi_consider
     P[:3, :3] += extra_attitude_noise * I3
     return FilterState(x.t + dt, rot.normalize(rot.propagate_constant_rate(x.q, omega, dt)), x.bias,
                        0.5 * (P + P.T), C)
