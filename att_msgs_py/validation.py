@@ -77,7 +77,8 @@ def finite_array(value, name: str, code: ErrorCode, shape: tuple | None = None) 
     if shape is not None and (a.ndim != len(shape) or any(s not in (-1, n) for s, n in zip(shape, a.shape))):
         want = "x".join("K" if s == -1 else str(s) for s in shape)
         raise RequestError(code, f"{name} has shape {'x'.join(map(str, a.shape)) or 'scalar'}; expected {want}")
-    if not np.isfinite(a).all():
+    finite = all(map(math.isfinite, a.ravel().tolist())) if a.size <= 64 else np.isfinite(a).all()   # small: floats
+    if not finite:
         raise RequestError(code, f"{name} has NaN or Inf entries")
     return a
 

@@ -134,14 +134,10 @@ def _limited(sc: Spacecraft, u: list, relative: list) -> list:
             for u_k, v in zip((min(max(u_k, -limit), limit) for u_k in u), relative)]
 
 
-def external_torque(sc: Spacecraft, inputs: Inputs, q: np.ndarray, stage: tuple | None = None) -> np.ndarray:
-    """Body torque ``τ_body + m × B_b + τ_env`` (N m, body axes); ``stage`` = ``(B_b, τ_env)`` of a
-    :data:`StageEnvironment`, else the held ``inputs.field_body`` and ``inputs.gravity_gradient``."""
-    return np.array(_external_torque(inputs, stage))
-
-
-def _external_torque(inputs: Inputs, stage: tuple | None) -> list:
-    """:func:`external_torque` as three Python floats."""
+def external_torque(inputs: Inputs, stage: tuple | None = None) -> list:
+    """Body torque ``τ_body + m × B_b + τ_env`` (N m, body axes; three Python floats): ``stage`` =
+    ``(B_b, τ_env)`` of a :data:`StageEnvironment`, else the held ``inputs.field_body`` and
+    ``inputs.gravity_gradient``."""
     field_b, tau_env = (inputs.field_body, inputs.gravity_gradient) if stage is None else stage
     tau = [0.0, 0.0, 0.0] if inputs.body_torque is None else np.asarray(inputs.body_torque, float).tolist()
     if inputs.dipole is not None and field_b is not None:
@@ -152,6 +148,13 @@ def _external_torque(inputs: Inputs, stage: tuple | None) -> list:
     return tau
 
 
+def mean_external_torque(inputs: Inputs, stages: list) -> np.ndarray:
+    """The RK4-weighted mean ``(τ₁ + 2τ₂ + 2τ₃ + τ₄)/6`` of :func:`external_torque` over a step's four
+    ``stages`` (N m, body axes): the body torque a step applied."""
+    t1, t2, t3, t4 = (external_torque(inputs, s) for s in stages)
+    return np.array([(a + 2 * b + 2 * c + d) / 6.0 for a, b, c, d in zip(t1, t2, t3, t4)])
+
+
 def derivative(sc: Spacecraft, x: np.ndarray, inputs: Inputs, stage: tuple | None = None) -> np.ndarray:
     """Time derivative of one state for actuator inputs held constant (see module docstring);
     ``stage``: the environment ``(B_b, τ_env)`` at this state (:func:`external_torque`). Evaluated
@@ -159,7 +162,7 @@ def derivative(sc: Spacecraft, x: np.ndarray, inputs: Inputs, stage: tuple | Non
     J, J_inv, G = sc.rows
     q, (w0, w1, w2), ws = x[:4].tolist(), x[4:7].tolist(), x[7:].tolist()
     h = [r[0] * w0 + r[1] * w1 + r[2] * w2 for r in J]
-    torque = _external_torque(inputs, stage)
+    torque = external_torque(inputs, stage)
     wheel_rates = [0.0] * len(ws)
     if ws:
         spin = [sc.wheel_inertia * s for s in ws]

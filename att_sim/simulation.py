@@ -296,7 +296,7 @@ class Simulation:
             self.halted = True
             self.halt_reason = f"state became non-finite at t = {self.t:.3f} s; propagation stopped"
             return
-        mean = sum(w * dyn.external_torque(self.sc, inp, None, s) for w, s in zip((1, 2, 2, 1), stages)) / 6.0
+        mean = dyn.mean_external_torque(inp, stages)
         motor = net = inp.wheel_torque          # at the step's start: motor torque, and less friction
         if self.wheel_drive is not None:
             speed = dyn.relative_wheel_speed(self.sc, self.x[7:], self.x[4:7])
