@@ -83,6 +83,11 @@ def finite_array(value, name: str, code: ErrorCode, shape: tuple | None = None) 
     return a
 
 
+def peak(a: np.ndarray) -> float:
+    """The largest magnitude of a 1-D array's entries (0 for none), on Python floats."""
+    return max(map(abs, a.tolist()), default=0.0)
+
+
 def number(value, name: str, code: ErrorCode, low: float = -math.inf, high: float = math.inf,
            *, low_open: bool = False) -> float:
     """A finite float in [low, high] (``(low, high]`` with ``low_open``)."""
@@ -96,10 +101,10 @@ def number(value, name: str, code: ErrorCode, low: float = -math.inf, high: floa
 def _unit(v, size: int, name: str, code: ErrorCode, what: str) -> np.ndarray:
     """A ``size``-vector within :data:`UNIT_TOLERANCE` of unit norm, normalised."""
     v = np.asarray(v, float)
-    if v.shape != (size,) or not np.all(np.isfinite(v)):
+    components = v.tolist() if v.shape == (size,) else ()
+    if not components or not all(map(math.isfinite, components)):
         raise RequestError(code, f"{name} has NaN or Inf components")
-    with np.errstate(over="ignore"):
-        n = np.linalg.norm(v)
+    n = math.hypot(*components)
     if n == 0.0:
         raise RequestError(code, f"{name} is the zero {what}")
     if abs(n - 1.0) > UNIT_TOLERANCE:

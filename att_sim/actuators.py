@@ -113,18 +113,17 @@ class WheelDrive:
             u = u * np.asarray(self.spec.torque_scale)
         return u + self.rng.standard_normal(len(u)) * self.spec.torque_noise
 
-    def motor(self, u, speed) -> list:
-        """Held torques ``u`` within the envelope at relative speeds ``speed`` (sequences of floats;
-        a list: :func:`att_sim.dynamics.derivative` works on Python floats)."""
-        u, speed, power = np.asarray(u, float).tolist(), np.asarray(speed, float).tolist(), self.spec.power_max
+    def motor(self, u: list, speed: list) -> list:
+        """Held torques ``u`` within the envelope at relative speeds ``speed`` (lists of floats:
+        :func:`att_sim.dynamics.derivative` works on Python floats)."""
+        power = self.spec.power_max
         if math.isinf(power):
-            return u
+            return list(u)
         return [_clip(u_k, power / max(abs(v), 1e-12)) if u_k * v > 0 else u_k for u_k, v in zip(u, speed)]
 
-    def __call__(self, u, speed) -> list:
-        """Net torques on the wheels (motor minus friction): what :func:`att_sim.dynamics.derivative`
-        applies at each stage."""
-        speed = np.asarray(speed, float).tolist()
+    def __call__(self, u: list, speed: list) -> list:
+        """Net torques on the wheels (motor minus friction) at relative speeds ``speed``: what
+        :func:`att_sim.dynamics.derivative` applies at each stage."""
         return [m - self.spec.friction_at(v) for m, v in zip(self.motor(u, speed), speed)]
 
 

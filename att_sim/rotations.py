@@ -17,6 +17,7 @@ All functions accept a single quaternion ``(4,)`` or a stack ``(..., 4)``.
 from __future__ import annotations
 
 import math
+from operator import mul
 
 import numpy as np
 
@@ -136,13 +137,13 @@ def from_axis_angle(axis: np.ndarray, angle) -> np.ndarray:
 
 def to_axis_angle(q: np.ndarray) -> tuple[np.ndarray, float]:
     """Axis and angle in [0, π] of a single quaternion (shortest rotation)."""
-    q = normalize(q)
-    if q[3] < 0:
-        q = -q
-    s = math.sqrt(q[:3] @ q[:3])
-    angle = 2.0 * math.atan2(s, q[3])
-    axis = q[:3] / s if s > 1e-15 else np.array([1.0, 0.0, 0.0])
-    return axis, float(angle)
+    x, y, z, w = normalize(q).tolist()
+    if w < 0:
+        x, y, z, w = -x, -y, -z, -w
+    s = math.sqrt(x * x + y * y + z * z)
+    angle = 2.0 * math.atan2(s, w)
+    axis = np.array([x / s, y / s, z / s]) if s > 1e-15 else np.array([1.0, 0.0, 0.0])
+    return axis, angle
 
 
 def slerp(q0: np.ndarray, q1: np.ndarray, s) -> np.ndarray:
@@ -187,7 +188,13 @@ def expm_so3(phi: np.ndarray) -> np.ndarray:
 
 
 def angle_between(q1: np.ndarray, q2: np.ndarray) -> np.ndarray:
-    """Rotation angle (rad, in [0, π]) taking attitude q1 to q2; sign-independent."""
+    """Rotation angle (rad, in [0, π]) taking attitude q1 to q2; sign-independent (two single
+    quaternions: a float, on Python floats)."""
+    q1, q2 = np.asarray(q1, float), np.asarray(q2, float)
+    if q1.shape == (4,) and q2.shape == (4,):
+        a, b = q1.tolist(), q2.tolist()
+        d = abs(sum(map(mul, a, b))) / math.sqrt(sum(map(mul, a, a)) * sum(map(mul, b, b)))
+        return 2.0 * math.acos(min(d, 1.0))
     d = np.abs(np.sum(normalize(q1) * normalize(q2), axis=-1))
     return 2.0 * np.arccos(np.clip(d, -1.0, 1.0))
 
@@ -195,6 +202,8 @@ def angle_between(q1: np.ndarray, q2: np.ndarray) -> np.ndarray:
 def error_vector(q: np.ndarray, q_ref: np.ndarray) -> np.ndarray:
     """Attitude error ``q_ref^* ⊗ q`` vector part, sign chosen with w >= 0 (body frame)."""
     e = multiply(conjugate(q_ref), q)
+    if e.shape == (4,):                 # one quaternion
+        return -e[:3] if e[3] < 0 else e[:3]
     sign = np.where(e[..., 3:] < 0, -1.0, 1.0)
     return (e * sign)[..., :3]
 

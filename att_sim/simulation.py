@@ -164,7 +164,7 @@ class Simulation:
                 ("wheel_torques", wheel_torque, self.sc.wheel_torque_max, "wheel_torque_max"),
                 ("dipole", dipole, self.sc.dipole_max, "dipole_max"),
                 ("body_torque", body_torque, self.sc.body_torque_max, "torque_max")):
-            peak = float(np.max(np.abs(value))) if value.size else 0.0
+            peak = validation.peak(value)
             if peak > c.command_limit_factor * limit:
                 ratio = f"{peak / limit:.3g} x" if limit > 0 else "above"
                 raise RequestError(ErrorCode.COMMAND_LIMIT,
@@ -260,10 +260,11 @@ class Simulation:
         if self.wheel_drive is not None and active:      # the watchdog disables the drives: no torque at all
             u = self.wheel_drive.hold(u)
         u = dyn.effective_wheel_torque(self.sc, ws, u, w)
-        m = np.clip(self.dipole_cmd, -self.sc.dipole_max, self.sc.dipole_max) if active else np.zeros(3)
+        m = np.minimum(np.maximum(self.dipole_cmd, -self.sc.dipole_max), self.sc.dipole_max) if active else np.zeros(3)
         if self.magnetorquers is not None:
             m = self.magnetorquers(m)
-        tau = np.clip(self.body_cmd, -self.sc.body_torque_max, self.sc.body_torque_max) if active else np.zeros(3)
+        tau = (np.minimum(np.maximum(self.body_cmd, -self.sc.body_torque_max), self.sc.body_torque_max) if active
+               else np.zeros(3))
         return dyn.Inputs(wheel_torque=u, body_torque=tau, dipole=m, wheel_drive=self.wheel_drive)
 
     def sense(self) -> Readings:
@@ -299,9 +300,9 @@ class Simulation:
         mean = dyn.mean_external_torque(inp, stages)
         motor = net = inp.wheel_torque          # at the step's start: motor torque, and less friction
         if self.wheel_drive is not None:
-            speed = dyn.relative_wheel_speed(self.sc, self.x[7:], self.x[4:7])
-            motor = np.array(self.wheel_drive.motor(inp.wheel_torque, speed))
-            net = np.array(self.wheel_drive(inp.wheel_torque, speed))
+            speed = dyn.relative_wheel_speed(self.sc, self.x[7:], self.x[4:7]).tolist()
+            motor = np.array(self.wheel_drive.motor(inp.wheel_torque.tolist(), speed))
+            net = np.array(self.wheel_drive(inp.wheel_torque.tolist(), speed))
         self.applied = Applied(motor, inp.dipole, mean - self.sc.wheel_axes @ net)
         self.x, self.now = x_new, now
         self.t += dt

@@ -59,18 +59,18 @@ class StateGate:
             raise RequestError(code, f"state stamp {s.t!r} is not a finite time >= 0")
         q = validation.unit_quaternion(s.q, "state.attitude", code)
         omega = validation.finite_array(s.omega, "state.body_rate", code, (3,))
-        if np.max(np.abs(omega)) > MAX_BODY_RATE:
-            raise RequestError(code, f"state.body_rate reaches {np.max(np.abs(omega)):.6g} rad/s; at most "
+        if validation.peak(omega) > MAX_BODY_RATE:
+            raise RequestError(code, f"state.body_rate reaches {validation.peak(omega):.6g} rad/s; at most "
                                      f"{MAX_BODY_RATE}")
         wheels = validation.finite_array(s.wheel_speeds, "state.wheel_speeds", code, (-1,))
         if wheels.size != sc.n_wheels:
             raise RequestError(code, f"state.wheel_speeds has {wheels.size} entries; the spacecraft has "
                                      f"{sc.n_wheels} wheels")
-        if wheels.size and np.max(np.abs(wheels)) > 2 * sc.wheel_speed_max:
-            raise RequestError(code, f"state.wheel_speeds reach {np.max(np.abs(wheels)):.6g} rad/s, twice above "
+        if validation.peak(wheels) > 2 * sc.wheel_speed_max:
+            raise RequestError(code, f"state.wheel_speeds reach {validation.peak(wheels):.6g} rad/s, twice above "
                                      f"the limit {sc.wheel_speed_max:g}")
         b = validation.finite_array(s.field_body, "state.magnetic_field_body", code, (3,))
-        if np.linalg.norm(b) > MAX_FIELD:
+        if math.hypot(*b.tolist()) > MAX_FIELD:
             raise RequestError(code, f"state.magnetic_field_body is {np.linalg.norm(b):.3g} T; at most {MAX_FIELD} T")
         s.q, s.omega, s.wheel_speeds, s.field_body = q, omega, wheels, b
         return s

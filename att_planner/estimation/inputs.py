@@ -43,14 +43,14 @@ class InputChecks:
         t = _time(m.t, "gyro")
         self._frame(m.frame_id, self.body_frame_id, "gyro")
         omega = validation.finite_array(m.omega, "gyro angular_velocity", BAD, (3,))
-        if np.max(np.abs(omega)) > MAX_RATE:
-            raise RequestError(BAD, f"gyro angular_velocity reaches {np.max(np.abs(omega)):.6g} rad/s; at most "
-                                    f"{MAX_RATE:g}")
+        peak = validation.peak(omega)
+        if peak > MAX_RATE:
+            raise RequestError(BAD, f"gyro angular_velocity reaches {peak:.6g} rad/s; at most {MAX_RATE:g}")
         if last_t is not None and t <= last_t:
             raise RequestError(ErrorCode.STALE_MEASUREMENT, f"gyro stamp {t:.6g} s does not follow the last one "
                                                             f"({last_t:.6g} s)")
         limit = self.specs.gyro.range if self.specs.gyro is not None else math.inf
-        return omega, bool(np.any(np.abs(omega) >= SATURATION * limit))
+        return omega, peak >= SATURATION * limit
 
     def star_tracker(self, m: StarTrackerMeasurement) -> np.ndarray | None:
         """The sensor attitude of a valid measurement (None for an invalid one)."""

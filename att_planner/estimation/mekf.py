@@ -130,7 +130,8 @@ def propagate(x: FilterState, omega_measured: np.ndarray, dt: float, arw: float,
         cross = phi_C @ psi.T
         P += cross + cross.T + psi_consider @ psi.T
         C = phi_C + psi_consider
-    P[:3, :3] += extra_attitude_noise * I3
+    if extra_attitude_noise:
+        P[:3, :3] += extra_attitude_noise * I3
     return FilterState(x.t + dt, rot.normalize(rot.propagate_constant_rate(x.q, omega, dt)), x.bias,
                        0.5 * (P + P.T), C)
 

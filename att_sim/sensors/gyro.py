@@ -91,11 +91,11 @@ class Gyro:
         n = len(increments)
         rate = increments @ self.transfer.T / dt + self._bias(n, dt)
         rate += self.rng.standard_normal((n, 3)) * self.noise_sigma(dt)
-        rate = np.clip(rate, -self.spec.range, self.spec.range)
+        rate = np.minimum(np.maximum(rate, -self.spec.range), self.spec.range)
         lsb = self.spec.quantization
         if lsb > 0:
             total = self.carry + np.cumsum(rate * dt, axis=0)
             counted = lsb * np.round(total / lsb)
             self.carry = total[-1] - counted[-1]
-            rate = np.diff(np.vstack([np.zeros(3), counted]), axis=0) / dt
+            rate = (counted if n == 1 else np.diff(counted, axis=0, prepend=0.0)) / dt     # the counts of each sample
         return rate[0] if np.ndim(rotation) == 1 else rate
