@@ -10,6 +10,7 @@ from __future__ import annotations
 import math
 import unicodedata
 from datetime import UTC, datetime, timedelta
+from operator import mul
 
 import numpy as np
 
@@ -104,7 +105,7 @@ def _unit(v, size: int, name: str, code: ErrorCode, what: str) -> np.ndarray:
     components = v.tolist() if v.shape == (size,) else ()
     if not components or not all(map(math.isfinite, components)):
         raise RequestError(code, f"{name} has NaN or Inf components")
-    n = math.hypot(*components)
+    n = math.sqrt(sum(map(mul, components, components)))   # as a dot product: a denormal's square is zero
     if n == 0.0:
         raise RequestError(code, f"{name} is the zero {what}")
     if abs(n - 1.0) > UNIT_TOLERANCE:

@@ -193,8 +193,8 @@ def angle_between(q1: np.ndarray, q2: np.ndarray) -> np.ndarray:
     q1, q2 = np.asarray(q1, float), np.asarray(q2, float)
     if q1.shape == (4,) and q2.shape == (4,):
         a, b = q1.tolist(), q2.tolist()
-        d = abs(sum(map(mul, a, b))) / math.sqrt(sum(map(mul, a, a)) * sum(map(mul, b, b)))
-        return 2.0 * math.acos(min(d, 1.0))
+        norms = math.sqrt(sum(map(mul, a, a)) * sum(map(mul, b, b)))
+        return 2.0 * math.acos(min(abs(sum(map(mul, a, b))) / norms, 1.0)) if norms > 0 else math.nan
     d = np.abs(np.sum(normalize(q1) * normalize(q2), axis=-1))
     return 2.0 * np.arccos(np.clip(d, -1.0, 1.0))
 

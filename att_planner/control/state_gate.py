@@ -70,7 +70,7 @@ class StateGate:
             raise RequestError(code, f"state.wheel_speeds reach {validation.peak(wheels):.6g} rad/s, twice above "
                                      f"the limit {sc.wheel_speed_max:g}")
         b = validation.finite_array(s.field_body, "state.magnetic_field_body", code, (3,))
-        if math.hypot(*b.tolist()) > MAX_FIELD:
+        if math.sqrt(sum(c * c for c in b.tolist())) > MAX_FIELD:
             raise RequestError(code, f"state.magnetic_field_body is {np.linalg.norm(b):.3g} T; at most {MAX_FIELD} T")
         s.q, s.omega, s.wheel_speeds, s.field_body = q, omega, wheels, b
         return s
