@@ -141,8 +141,8 @@ def external_torque(inputs: Inputs, stage: tuple | None = None) -> list:
     field_b, tau_env = (inputs.field_body, inputs.gravity_gradient) if stage is None else stage
     tau = [0.0, 0.0, 0.0] if inputs.body_torque is None else np.asarray(inputs.body_torque, float).tolist()
     if inputs.dipole is not None and field_b is not None:
-        (m0, m1, m2), (b0, b1, b2) = np.asarray(inputs.dipole, float).tolist(), np.asarray(field_b, float).tolist()
-        tau = [tau[0] + (m1 * b2 - m2 * b1), tau[1] + (m2 * b0 - m0 * b2), tau[2] + (m0 * b1 - m1 * b0)]
+        magnetic = rot.cross_floats(np.asarray(inputs.dipole, float).tolist(), np.asarray(field_b, float).tolist())
+        tau = [a + b for a, b in zip(tau, magnetic)]
     if tau_env is not None:
         tau = [a + b for a, b in zip(tau, np.asarray(tau_env, float).tolist())]
     return tau
@@ -175,8 +175,7 @@ def derivative(sc: Spacecraft, x: np.ndarray, inputs: Inputs, stage: tuple | Non
             torque = [t - sum(map(mul, row, u)) for t, row in zip(torque, G)]
             if sc.wheel_inertia > 0:
                 wheel_rates = [u_k / sc.wheel_inertia for u_k in u]
-    hx, hy, hz = h
-    net = (torque[0] - (w1 * hz - w2 * hy), torque[1] - (w2 * hx - w0 * hz), torque[2] - (w0 * hy - w1 * hx))
+    net = [t - c for t, c in zip(torque, rot.cross_floats((w0, w1, w2), h))]
     w_dot = [r[0] * net[0] + r[1] * net[1] + r[2] * net[2] for r in J_inv]
     return np.array([*quaternion_rate(q, (w0, w1, w2)), *w_dot, *wheel_rates])
 

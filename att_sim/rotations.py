@@ -32,11 +32,16 @@ def cross(a: np.ndarray, b: np.ndarray, axis: int = -1) -> np.ndarray:
     """``a × b`` along ``axis``, broadcasting (cheaper than ``np.cross`` on small stacks and on
     component-first batches; two single vectors take the scalar formula, the dynamics' hot path)."""
     if len(np.shape(a)) == 1 and len(np.shape(b)) == 1:
-        (a0, a1, a2), (b0, b1, b2) = np.asarray(a, float).tolist(), np.asarray(b, float).tolist()
-        return np.array([a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0])
+        return np.array(cross_floats(np.asarray(a, float).tolist(), np.asarray(b, float).tolist()))
     a1, a2 = np.take(a, _NEXT_AXIS, axis), np.take(a, _PREV_AXIS, axis)
     b1, b2 = np.take(b, _NEXT_AXIS, axis), np.take(b, _PREV_AXIS, axis)
     return a1 * b2 - a2 * b1
+
+
+def cross_floats(a, b) -> tuple[float, float, float]:
+    """``a × b`` of two 3-sequences of Python floats (the formula of :func:`cross` for one pair)."""
+    (a0, a1, a2), (b0, b1, b2) = a, b
+    return a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0
 
 
 def hat(v: np.ndarray) -> np.ndarray:
