@@ -201,15 +201,15 @@ class MissionRun:
     def execute(self, name: str, plan, t_start: float, pointing_after=None):
         """Fly ``plan`` from sim time ``t_start`` (``pointing_after``: the mode the controller hands over
         to at its end); the time the controller reports it done, or None after a refusal (published)."""
+        late = self.telemetry.wait() - t_start
+        if late > 0:            # never flown: no slew event (a slew event is a slew started)
+            self.publish(Kind.REFUSED, name, plan_id=plan.plan_id,
+                         message=f"planning ended {late:.1f} s of sim time after the slew's start ({plan.method}, "
+                                 f"planned in {plan.solve_seconds:.2f} s): start_lead is too short")
+            return None
         self.publish(Kind.SLEW, name, t_start, t_start + plan.duration, plan.plan_id,
                      f"{plan.method} {plan.duration:.1f} s, {math.degrees(plan.verification.min_cone_margin):.2f} deg "
                      f"from the zones, planned in {plan.solve_seconds:.2f} s")
-        late = self.telemetry.wait() - t_start
-        if late > 0:
-            self.publish(Kind.REFUSED, name, plan_id=plan.plan_id,
-                         message=f"planning ended {late:.1f} s of sim time after the slew's start: start_lead "
-                                 "is too short")
-            return None
         self.telemetry.wait(t_start)
         result = self.client.execute(plan.plan_id, timeout=60.0 + plan.duration / MIN_WALL_RTF,
                                      pointing_after=pointing_after)

@@ -79,13 +79,20 @@ def mission_summary(run: MissionLog) -> dict:
 
 
 def timeline_bars(events) -> list[tuple]:
-    """(event, start, end) of every slew, dwell and park; a park ends when the next of them starts,
-    which may come before the time it waited until (the mission decided again and left early)."""
-    flown = [e for e in events if e.event in (Kind.SLEW, Kind.DWELL, Kind.PARK) and e.end > e.start]
+    """(event, start, end) of every slew, dwell and park flown. A slew the controller refused or
+    aborted ends at the refusal (not drawn when that came at its start); a park ends when the next
+    of them starts, which may come before the time it waited until (the mission decided again and
+    left early)."""
+    refused_at = {e.plan_id: e.t for e in events if e.event == Kind.REFUSED and e.plan_id}
+
+    def slew_end(e) -> float:
+        return min(e.end, refused_at.get(e.plan_id, math.inf)) if e.event == Kind.SLEW and e.plan_id else e.end
+
+    flown = [e for e in events if e.event in (Kind.SLEW, Kind.DWELL, Kind.PARK) and slew_end(e) > e.start]
 
     def end(e) -> float:
         if e.event != Kind.PARK:
-            return e.end
+            return slew_end(e)
         return min([e.end] + [n.start for n in flown if n.start > e.start])
 
     return [(e, e.start, end(e)) for e in flown]

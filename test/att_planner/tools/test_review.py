@@ -193,3 +193,22 @@ def test_the_timeline_ends_a_park_when_the_next_slew_leaves_it():
     assert bars == [("3c273", Kind.PARK, 912.2, 1027.3), ("3c273", Kind.SLEW, 1152.4, 1156.4),
                     ("eta_carinae", Kind.PARK, 13652.4, 16317.0), ("vega", Kind.SLEW, 16317.0, 17196.1),
                     ("vega", Kind.DWELL, 17256.2, 17556.2)]
+
+
+def test_the_timeline_ends_a_refused_slew_at_its_refusal():
+    """A slew the controller refused at its start is not drawn and does not end the park before
+    it; one aborted in flight ends at its refusal."""
+    from att_msgs_py.types import MissionEvent
+    from att_msgs_py.types import MissionEventKind as Kind
+    from att_planner.tools.review.mission import timeline_bars
+
+    events = [MissionEvent(40.0, Kind.PARK, "vega", 40.0, 300.0),
+              MissionEvent(162.0, Kind.SLEW, "polaris", 162.0, 623.3, plan_id="aa"),
+              MissionEvent(162.0, Kind.REFUSED, "polaris", plan_id="aa"),
+              MissionEvent(196.4, Kind.SLEW, "polaris", 285.6, 747.8, plan_id="bb"),
+              MissionEvent(808.4, Kind.DWELL, "polaris", 808.0, 868.0),
+              MissionEvent(902.4, Kind.SLEW, "cas_a", 988.0, 1708.0, plan_id="cc"),
+              MissionEvent(1200.0, Kind.REFUSED, "cas_a", plan_id="cc")]
+    bars = [(e.target, e.event, start, end) for e, start, end in timeline_bars(events)]
+    assert bars == [("vega", Kind.PARK, 40.0, 285.6), ("polaris", Kind.SLEW, 285.6, 747.8),
+                    ("polaris", Kind.DWELL, 808.0, 868.0), ("cas_a", Kind.SLEW, 988.0, 1200.0)]
