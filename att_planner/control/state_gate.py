@@ -13,8 +13,6 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-import numpy as np
-
 from att_msgs_py import validation
 from att_msgs_py.errors import ErrorCode, RequestError
 from att_msgs_py.types import State
@@ -70,8 +68,9 @@ class StateGate:
             raise RequestError(code, f"state.wheel_speeds reach {validation.peak(wheels):.6g} rad/s, twice above "
                                      f"the limit {sc.wheel_speed_max:g}")
         b = validation.finite_array(s.field_body, "state.magnetic_field_body", code, (3,))
-        if math.sqrt(sum(c * c for c in b.tolist())) > MAX_FIELD:
-            raise RequestError(code, f"state.magnetic_field_body is {np.linalg.norm(b):.3g} T; at most {MAX_FIELD} T")
+        field = math.sqrt(sum(c * c for c in b.tolist()))
+        if field > MAX_FIELD:
+            raise RequestError(code, f"state.magnetic_field_body is {field:.3g} T; at most {MAX_FIELD} T")
         s.q, s.omega, s.wheel_speeds, s.field_body = q, omega, wheels, b
         return s
 
