@@ -7,7 +7,8 @@ the day is flown. One YAML file under ``config/missions/`` (read with ``yaml.saf
     margin_deg: 1.0                # a target counts as visible this far outside every zone
     rate_hz: 5.0                   # simulator step, state, control and estimate rate of the day
     start_lead_s: 240              # s of sim time from a slew's request to its start (planning)
-    time_budget_s: 10              # planner wall-time budget per slew
+    time_budget_s: 10              # planner wall-time budget per slew (the day runs at most
+                                   # start_lead_s / time_budget_s times real time: a plan is back in time)
     method: ""                     # planning method ("": the planner's default)
     pointing_tolerance_deg: 0.05   # a dwell counts as observed within this pointing error
     momentum_dumping: true         # the controller's magnetorquer dumping while it holds (pointing mode)

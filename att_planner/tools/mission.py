@@ -383,7 +383,10 @@ def fly_mission(mission: mission_config.MissionConfig, out: Path, log=print) -> 
     log(f"[mission] {domain_line(env)}")
     join_env(env)
     rate = mission.rate
-    params = {"simulator": {"step": 1.0 / rate, "publish_rate": rate, "clock_rate": rate, "real_time_factor": 0.0},
+    # the simulator does not wait for the planner: at most start_lead / time_budget × real time, a plan
+    # that takes its whole wall-time budget still comes back before its slew's start
+    pace = mission.start_lead / mission.time_budget
+    params = {"simulator": {"step": 1.0 / rate, "publish_rate": rate, "clock_rate": rate, "real_time_factor": pace},
               "controller": {"control_rate": rate, "momentum_dumping": mission.momentum_dumping,
                              "handover_blend": mission.handover_blend},
               "estimator": {"publish_rate": rate}}
