@@ -136,3 +136,30 @@ class Magnetorquers:
         """The dipole the coils produce for the (saturated) command ``m``."""
         m = quantize(m, self.spec.quantization)
         return self.transfer @ (m * np.asarray(self.spec.scale) if self.spec.scale else m)
+
+
+class DrivesOfRuns:
+    """The wheel drives of several runs acting at once (:class:`att_sim.lockstep.Lockstep`): the
+    torques of :class:`WheelDrive` on arrays of runs, one array per wheel, by the same operations
+    element by element (the friction's ``tanh`` is ``math.tanh``, as one run's), so every run gets
+    the bits its own drive gives it."""
+
+    def __init__(self, specs: list[WheelDriveSpec]):
+        self.power = np.array([s.power_max for s in specs])
+        self.coulomb = np.array([s.coulomb_friction for s in specs])
+        self.viscous = np.array([s.viscous_friction for s in specs])
+        self.friction_speed = np.array([s.friction_speed for s in specs])
+
+    def motor(self, u: list, speed: list) -> list:
+        """:meth:`WheelDrive.motor`: held torques within each run's envelope (an infinite power limit
+        clips nothing)."""
+        out = []
+        for u_k, v in zip(u, speed):
+            limit = self.power / np.maximum(np.abs(v), 1e-12)
+            out.append(np.where(u_k * v > 0, np.minimum(np.maximum(u_k, -limit), limit), u_k))
+        return out
+
+    def __call__(self, u: list, speed: list) -> list:
+        """:meth:`WheelDrive.__call__`: net torques on the wheels, motor minus friction."""
+        return [m - (self.coulomb * np.array([math.tanh(a) for a in (v / self.friction_speed).tolist()])
+                     + self.viscous * v) for m, v in zip(self.motor(u, speed), speed)]

@@ -118,6 +118,18 @@ def relative_wheel_speed(sc: Spacecraft, wheel_speed: np.ndarray, omega: np.ndar
     return np.asarray(wheel_speed, float) - sc.wheel_axes.T @ np.asarray(omega, float)
 
 
+def relative_speeds(G, w, ws) -> list:
+    """``Ω − Gᵀω`` component by component (:func:`rates`' arithmetic): ``G`` rows of components,
+    ``w`` the body rate's, ``ws`` the wheels'."""
+    w0, w1, w2 = w
+    return [s - (a * w0 + b * w1 + c * w2) for s, a, b, c in zip(ws, *G)]
+
+
+def through_wheels(G, u) -> list:
+    """``G u``, the body vector of wheel quantities ``u``, component by component."""
+    return [sum(map(mul, row, u)) for row in G]
+
+
 def effective_wheel_torque(sc: Spacecraft, wheel_speed: np.ndarray, u: np.ndarray, omega: np.ndarray) -> np.ndarray:
     """Clip motor torques to their limit and cut those that would push a wheel beyond
     ``wheel_speed_max`` *relative to the body* (``Ω − Gᵀω``, ``Ω`` the state's inertial spin rate,
@@ -134,50 +146,81 @@ def _limited(sc: Spacecraft, u: list, relative: list) -> list:
             for u_k, v in zip((min(max(u_k, -limit), limit) for u_k in u), relative)]
 
 
+def limited_runs(limit, speed_max, u: list, relative: list) -> list:
+    """:func:`_limited` of several runs at once: ``u`` and ``relative`` one array of runs per wheel
+    (the same operations, so the same bits run by run)."""
+    clipped = (np.minimum(np.maximum(u_k, -limit), limit) for u_k in u)
+    return [np.where((np.abs(v) >= speed_max) & (u_k * v > 0), 0.0, u_k) for u_k, v in zip(clipped, relative)]
+
+
+def torque_sum(tau_body, dipole, field_b, tau_env) -> list:
+    """``τ_body + m × B_b + τ_env`` component by component (each a Python float, or an array of
+    runs); ``dipole`` / ``field_b`` / ``tau_env`` None: absent."""
+    tau = [0.0, 0.0, 0.0] if tau_body is None else list(tau_body)
+    if dipole is not None and field_b is not None:
+        tau = [a + b for a, b in zip(tau, rot.cross_floats(dipole, field_b))]
+    if tau_env is not None:
+        tau = [a + b for a, b in zip(tau, tau_env)]
+    return tau
+
+
+def _floats(v):
+    return None if v is None else np.asarray(v, float).tolist()
+
+
 def external_torque(inputs: Inputs, stage: tuple | None = None) -> list:
     """Body torque ``τ_body + m × B_b + τ_env`` (N m, body axes; three Python floats): ``stage`` =
     ``(B_b, τ_env)`` of a :data:`StageEnvironment`, else the held ``inputs.field_body`` and
     ``inputs.gravity_gradient``."""
     field_b, tau_env = (inputs.field_body, inputs.gravity_gradient) if stage is None else stage
-    tau = [0.0, 0.0, 0.0] if inputs.body_torque is None else np.asarray(inputs.body_torque, float).tolist()
-    if inputs.dipole is not None and field_b is not None:
-        magnetic = rot.cross_floats(np.asarray(inputs.dipole, float).tolist(), np.asarray(field_b, float).tolist())
-        tau = [a + b for a, b in zip(tau, magnetic)]
-    if tau_env is not None:
-        tau = [a + b for a, b in zip(tau, np.asarray(tau_env, float).tolist())]
-    return tau
+    return torque_sum(_floats(inputs.body_torque), _floats(inputs.dipole), _floats(field_b), _floats(tau_env))
+
+
+def rk4_mean(t1, t2, t3, t4) -> list:
+    """The RK4-weighted mean ``(a + 2b + 2c + d)/6`` of four stages' values, component by component."""
+    return [(a + 2 * b + 2 * c + d) / 6.0 for a, b, c, d in zip(t1, t2, t3, t4)]
 
 
 def mean_external_torque(inputs: Inputs, stages: list) -> np.ndarray:
-    """The RK4-weighted mean ``(τ₁ + 2τ₂ + 2τ₃ + τ₄)/6`` of :func:`external_torque` over a step's four
-    ``stages`` (N m, body axes): the body torque a step applied."""
-    t1, t2, t3, t4 = (external_torque(inputs, s) for s in stages)
-    return np.array([(a + 2 * b + 2 * c + d) / 6.0 for a, b, c, d in zip(t1, t2, t3, t4)])
+    """The RK4-weighted mean of :func:`external_torque` over a step's four ``stages`` (N m, body
+    axes): the body torque a step applied."""
+    return np.array(rk4_mean(*(external_torque(inputs, s) for s in stages)))
 
 
 def derivative(sc: Spacecraft, x: np.ndarray, inputs: Inputs, stage: tuple | None = None) -> np.ndarray:
     """Time derivative of one state for actuator inputs held constant (see module docstring);
     ``stage``: the environment ``(B_b, τ_env)`` at this state (:func:`external_torque`). Evaluated
     on Python floats: on 3-vectors numpy's cost is its per-call overhead (the simulator's hot path)."""
-    J, J_inv, G = sc.rows
-    q, (w0, w1, w2), ws = x[:4].tolist(), x[4:7].tolist(), x[7:].tolist()
+    u = inputs.wheel_torque
+    return np.array(rates(sc.rows, sc.wheel_inertia, x[:4].tolist(), x[4:7].tolist(), x[7:].tolist(),
+                          external_torque(inputs, stage), None if u is None else _floats(u),
+                          lambda v, nu: _limited(sc, v, nu), inputs.wheel_drive, sc.wheel_inertia > 0))
+
+
+def rates(rows: tuple, wheel_inertia, q, w, ws, torque, u, limited, drive, spinning: bool) -> list:
+    """The state derivative component by component — each component a Python float (one run) or an
+    array of runs, with the same operations either way: ``rows`` = (J, J⁻¹, G) nested sequences of
+    such components, ``torque`` the external body torque, ``u`` the held motor torques (None: no
+    motor input), ``limited(u, ν)`` the speed-limit cut (:func:`_limited`), ``drive(u, ν)`` the
+    imperfect drives' net torques (None: ideal), ``spinning``: the wheels have inertia."""
+    J, J_inv, G = rows
+    w0, w1, w2 = w
     h = [r[0] * w0 + r[1] * w1 + r[2] * w2 for r in J]
-    torque = external_torque(inputs, stage)
     wheel_rates = [0.0] * len(ws)
     if ws:
-        spin = [sc.wheel_inertia * s for s in ws]
-        h = [h_i + sum(map(mul, row, spin)) for h_i, row in zip(h, G)]
-        if inputs.wheel_torque is not None:
-            relative = [s - (a * w0 + b * w1 + c * w2) for s, a, b, c in zip(ws, *G)]
-            u = _limited(sc, np.asarray(inputs.wheel_torque, float).tolist(), relative)
-            if inputs.wheel_drive is not None:
-                u = inputs.wheel_drive(u, relative)
-            torque = [t - sum(map(mul, row, u)) for t, row in zip(torque, G)]
-            if sc.wheel_inertia > 0:
-                wheel_rates = [u_k / sc.wheel_inertia for u_k in u]
-    net = [t - c for t, c in zip(torque, rot.cross_floats((w0, w1, w2), h))]
+        spin = [wheel_inertia * s for s in ws]
+        h = [h_i + s for h_i, s in zip(h, through_wheels(G, spin))]
+        if u is not None:
+            relative = relative_speeds(G, w, ws)
+            u = limited(u, relative)
+            if drive is not None:
+                u = drive(u, relative)
+            torque = [t - g for t, g in zip(torque, through_wheels(G, u))]
+            if spinning:
+                wheel_rates = [u_k / wheel_inertia for u_k in u]
+    net = [t - c for t, c in zip(torque, rot.cross_floats(w, h))]
     w_dot = [r[0] * net[0] + r[1] * net[1] + r[2] * net[2] for r in J_inv]
-    return np.array([*quaternion_rate(q, (w0, w1, w2)), *w_dot, *wheel_rates])
+    return [*quaternion_rate(q, w), *w_dot, *wheel_rates]
 
 
 def quaternion_rate(q, w) -> tuple:

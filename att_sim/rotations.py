@@ -109,6 +109,17 @@ def dcm(q: np.ndarray) -> np.ndarray:
     return out
 
 
+def to_body(q, v) -> list:
+    """``dcm(q)ᵀ v``, an inertial vector in body axes, component by component: ``q`` and ``v`` are
+    sequences of Python floats (one vector) or of arrays (a batch, one array per component); the same
+    operations either way."""
+    x, y, z, w = q
+    v0, v1, v2 = v
+    return [(1 - 2 * (y * y + z * z)) * v0 + 2 * (x * y + z * w) * v1 + 2 * (x * z - y * w) * v2,
+            2 * (x * y - z * w) * v0 + (1 - 2 * (x * x + z * z)) * v1 + 2 * (y * z + x * w) * v2,
+            2 * (x * z + y * w) * v0 + 2 * (y * z - x * w) * v1 + (1 - 2 * (x * x + y * y)) * v2]
+
+
 def from_dcm(R: np.ndarray) -> np.ndarray:
     """Quaternion of a body-to-inertial matrix (Shepperd's method, w >= 0)."""
     R = np.asarray(R, dtype=float)

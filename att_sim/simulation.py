@@ -279,7 +279,10 @@ class Simulation:
         """One RK4 step, the actuator inputs held and the environment evaluated at every stage; a
         non-finite result or an environment that cannot be evaluated (e.g. a decayed TLE) halts the
         simulation. The applied body torque reported is the step's RK4-weighted mean."""
-        inp = self.inputs()
+        self.advance_with(self.inputs(), dt)
+
+    def advance_with(self, inp: dyn.Inputs, dt: float) -> None:
+        """:meth:`advance` with the step's inputs already taken (:meth:`inputs`)."""
         stages = []
 
         def stage(t, x):
@@ -288,21 +291,33 @@ class Simulation:
             return got
         try:
             x_new = dyn.step(self.sc, self.x, inp, dt, stage, self.t)
+        except ValueError as err:
+            self.halt_environment(err)
+            return
+        u, G = inp.wheel_torque.tolist(), self.sc.rows[2]
+        motor = net = u
+        if self.wheel_drive is not None:        # at the step's start: motor torque, and less friction
+            speed = dyn.relative_speeds(G, self.x[4:7].tolist(), self.x[7:].tolist())
+            motor, net = self.wheel_drive.motor(u, speed), self.wheel_drive(u, speed)
+        body = [m - g for m, g in zip(dyn.mean_external_torque(inp, stages).tolist(), dyn.through_wheels(G, net))]
+        self.finish_step(x_new, dt, Applied(np.array(motor, float), inp.dipole, np.array(body)))
+
+    def finish_step(self, x_new: np.ndarray, dt: float, applied: Applied) -> None:
+        """Take the state ``x_new`` a step of ``dt`` reached and what acted over it, or halt: a
+        non-finite state, an environment that cannot be evaluated there."""
+        try:
             now = self.environment.sample(self.t + dt, x_new[:4]) if np.all(np.isfinite(x_new)) else None
         except ValueError as err:
-            self.halted = True
-            self.halt_reason = f"environment failed at t = {self.t:.3f} s: {err}; propagation stopped"
+            self.halt_environment(err)
             return
         if now is None:
             self.halted = True
             self.halt_reason = f"state became non-finite at t = {self.t:.3f} s; propagation stopped"
             return
-        mean = dyn.mean_external_torque(inp, stages)
-        motor = net = inp.wheel_torque          # at the step's start: motor torque, and less friction
-        if self.wheel_drive is not None:
-            speed = dyn.relative_wheel_speed(self.sc, self.x[7:], self.x[4:7]).tolist()
-            motor = np.array(self.wheel_drive.motor(inp.wheel_torque.tolist(), speed))
-            net = np.array(self.wheel_drive(inp.wheel_torque.tolist(), speed))
-        self.applied = Applied(motor, inp.dipole, mean - self.sc.wheel_axes @ net)
+        self.applied = applied
         self.x, self.now = x_new, now
         self.t += dt
+
+    def halt_environment(self, err: ValueError) -> None:
+        self.halted = True
+        self.halt_reason = f"environment failed at t = {self.t:.3f} s: {err}; propagation stopped"

@@ -204,11 +204,34 @@ class Environment:
     def stage(self, t: float, x: np.ndarray) -> tuple[np.ndarray, np.ndarray | None]:
         """``(B_b, τ_env)`` at one RK4 stage (:data:`att_sim.dynamics.StageEnvironment`); ``τ_env``
         is None when no disturbance is active."""
-        now = self._now(t)
         q = x[:4]
-        field_b = rot.dcm(q).T @ now.field_N
-        torques = self._torques(now, q, field_b)
-        return field_b, (sum(torques.values()) if torques else None)
+        field_b = np.array(rot.to_body(q.tolist(), self.field_inertial(t).tolist()))
+        return field_b, self.disturbance(t, q, field_b)
+
+    def share_time_part(self, other: Environment) -> None:
+        """Keep the time-only part (:class:`_Now`, field tracks) in one cache with ``other``'s, when
+        both have the same orbit object, epoch, field model, sky and drag (the runs of a campaign:
+        each run's environment would compute the same values); otherwise nothing changes."""
+        def key(e):
+            return id(e.orbit), e.epoch, e.field.model, e.field.epoch, e.field.dipole, e.sky is None, e.flags.drag
+        if other is not self and key(other) == key(self):
+            self._cache, self._tracks = other._cache, other._tracks
+
+    def field_inertial(self, t: float) -> np.ndarray:
+        """The geomagnetic field at the spacecraft at time ``t`` (T, inertial axes)."""
+        return self._now(t).field_N
+
+    @property
+    def disturbed(self) -> bool:
+        """Whether any disturbance torque acts (else :meth:`disturbance` is always None)."""
+        f = self.flags
+        return f.gravity_gradient or f.solar_pressure or f.drag or self.residual_dipole is not None
+
+    def disturbance(self, t: float, q: np.ndarray, field_b: np.ndarray) -> np.ndarray | None:
+        """The sum of the active disturbance torques (N m, body axes) at time ``t``, attitude ``q``
+        and body field ``field_b`` (None when none is active)."""
+        torques = self._torques(self._now(t), q, field_b)
+        return sum(torques.values()) if torques else None
 
     def sample(self, t: float, q: np.ndarray) -> Sample:
         """Field, total disturbance torque, position and shadow at time ``t`` and attitude ``q``."""

@@ -104,6 +104,12 @@ class ClosedLoop:
     # -- the loop ---------------------------------------------------------------------------------
     def tick(self) -> None:
         """One simulator step: readings and state out, the controller's command (when due) in, advance."""
+        self.exchange()
+        self.sim.advance(self.step)
+
+    def exchange(self) -> None:
+        """A step's messages without the advance: readings and state out, the command (when due) in
+        (:func:`fly_together` advances many loops' simulations at once)."""
         sim, ctl, est = self.sim, self.controller, self.estimator
         readings = sim.sense()
         t = sim.t
@@ -146,7 +152,6 @@ class ClosedLoop:
                 if est is not None:
                     est.on_dipole_command(out.command.t, out.command.dipole)
                 self._record(out, readings)
-        sim.advance(self.step)
 
     def run(self, duration: float) -> None:
         """Tick for ``duration`` s of sim time (stops early if the simulation halts)."""

@@ -12,7 +12,7 @@ import os
 from collections.abc import Iterator
 from contextlib import contextmanager
 
-from att_planner.tools.monte_carlo.run import Setup, fly
+from att_planner.tools.monte_carlo.run import Setup, fly_together
 
 
 class ClusterError(RuntimeError):
@@ -45,8 +45,8 @@ def client_for(scheduler: str | None, workers: int, timeout: float):
 
 
 def fly_chunk(setup: Setup, seeds: list[tuple[int, int]]) -> list[dict]:
-    """The rows of ``(run, seed)`` pairs, flown one after the other in this worker."""
-    return [fly(setup, seed, run) for run, seed in seeds]
+    """The rows of ``(run, seed)`` pairs, flown together in this worker (:func:`fly_together`)."""
+    return fly_together(setup, seeds)
 
 
 def stream(client, setup: Setup, runs: list[tuple[int, int]], chunk: int) -> Iterator[list[dict]]:

@@ -17,7 +17,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from att_msgs_py.types import Health, Plan, Verification
+from att_msgs_py.types import Health, ManeuverResult, Plan, Verification
 from att_planner.tools.closed_loop import ClosedLoop, plan_in_process
 from att_planner.tools.demo import maneuver_from_scenario, zone_margins
 from att_planner.verification import rejection
@@ -25,6 +25,7 @@ from att_sim import dispersions as disp
 from att_sim import rotations as rot
 from att_sim import scenario as scen
 from att_sim.dispersions import DEG
+from att_sim.lockstep import Lockstep
 from att_sim.simulation import Checks, Simulation
 
 OUTCOMES = ("success", "code", "final_error_deg", "final_rate", "min_margin_deg", "peak_wheel_ratio",
@@ -87,34 +88,78 @@ def loop_for(setup: Setup, truth: disp.Truth) -> ClosedLoop:
     return ClosedLoop(setup.scenario, simulation=sim)
 
 
-def converge(loop: ClosedLoop, timeout: float) -> bool:
-    """Tick until the estimate is CONVERGED (immediately true without an estimator)."""
-    est, end = loop.estimator, loop.sim.t + timeout
-    while est is not None and est.health(loop.sim.t) != Health.CONVERGED:
-        if loop.sim.t >= end or loop.sim.halted:
-            return False
-        loop.tick()
-    return True
+@dataclass
+class _Flight:
+    """One run of :func:`fly_together`: converging, then flying its plan (``deadline``: of the phase)."""
+
+    setup: Setup
+    loop: ClosedLoop
+    row: dict
+    deadline: float
+    flying: bool = False
+    start: float = math.nan
+
+    def going(self) -> bool:
+        """Whether the run takes another step — the checks of converging (until CONVERGED or
+        ``converge_timeout``) and of :meth:`ClosedLoop.fly` (until the controller ends the maneuver),
+        in their order; an ended run gets its outcomes."""
+        setup, loop = self.setup, self.loop
+        sim, est = loop.sim, loop.estimator
+        if not self.flying:
+            if est is not None and est.health(sim.t) != Health.CONVERGED:
+                if sim.t < self.deadline and not sim.halted:
+                    return True
+                return self.end(313, f"the estimate did not converge within {setup.campaign.converge_timeout:g} s")
+            self.start, self.flying = sim.t, True
+            refused = loop.execute(setup.plan)
+            if refused is not None:
+                return self.end(int(refused.code), refused.message)
+            loop.result = None
+            self.deadline = sim.t + setup.plan.duration + loop.controller.config.settle_time + 10
+        if loop.result is None and sim.t < self.deadline and not sim.halted:
+            return True
+        result = loop.result or ManeuverResult(False, 305, "the maneuver did not end in time")
+        return self.end(result.error_code, result.message)
+
+    def end(self, code: int, message: str) -> bool:
+        start = self.start if self.flying else self.loop.sim.t
+        self.row.update(outcomes(self.setup, self.loop, start, code, message))
+        return False
+
+
+def fly_together(setup: Setup, runs: list[tuple[int, int]], tap=None) -> list[dict]:
+    """The rows of ``(run, seed)`` pairs (applied values and outcomes, :data:`OUTCOMES`), flown in
+    lockstep: each run converges, then flies the plan, as it would alone, and the simulations of the
+    runs still going advance together (:class:`att_sim.lockstep.Lockstep`: the bits of each run
+    alone, for about the cost of one run's step). ``cpu_seconds``: the group's CPU time shared
+    equally. ``tap``: see :attr:`ClosedLoop.tap` (a full log; one run)."""
+    cpu = time.process_time()
+    flights = []
+    for run, seed in runs:
+        truth, values = dispersed(setup, seed)
+        loop = loop_for(setup, truth)
+        loop.tap = tap
+        flights.append(_Flight(setup, loop, {"run": run, "seed": seed, **applied_columns(values, loop)},
+                               loop.sim.t + setup.campaign.converge_timeout))
+    going, lockstep = flights, None
+    while going:
+        still = [f for f in going if f.going()]
+        if len(still) != len(going) or lockstep is None:
+            lockstep = Lockstep([f.loop.sim for f in still]) if len(still) > 1 else None
+        going = still
+        for f in going:
+            f.loop.exchange()
+        if lockstep is not None:
+            lockstep.advance(going[0].loop.step)
+        elif going:
+            going[0].loop.sim.advance(going[0].loop.step)
+    share = (time.process_time() - cpu) / max(len(flights), 1)
+    return [{**f.row, "cpu_seconds": share} for f in flights]
 
 
 def fly(setup: Setup, seed: int, run: int = -1, tap=None) -> dict:
-    """The row of the run of seed ``seed`` (``run``: its index in the campaign): applied values
-    and outcomes (:data:`OUTCOMES`). ``tap``: see :attr:`ClosedLoop.tap` (a full log)."""
-    cpu = time.process_time()
-    truth, values = dispersed(setup, seed)
-    loop = loop_for(setup, truth)
-    loop.tap = tap
-    row = {"run": run, "seed": seed, **applied_columns(values, loop)}
-    if not converge(loop, setup.campaign.converge_timeout):
-        result_code, message = 313, f"the estimate did not converge within {setup.campaign.converge_timeout:g} s"
-        start = loop.sim.t
-    else:
-        start = loop.sim.t
-        result = loop.fly(setup.plan)
-        result_code, message = result.error_code, result.message
-    row.update(outcomes(setup, loop, start, result_code, message))
-    row["cpu_seconds"] = time.process_time() - cpu
-    return row
+    """The row of the run of seed ``seed`` (``run``: its index in the campaign), alone: :func:`fly_together`."""
+    return fly_together(setup, [(run, seed)], tap)[0]
 
 
 def settling_time(t: np.ndarray, error: np.ndarray, t_end: float, tolerance: float) -> float:

@@ -9,6 +9,7 @@ import json
 import math
 import socket
 import time
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -18,7 +19,8 @@ import att_planner.tools.monte_carlo as mc
 from att_msgs_py.log import read_log
 from att_msgs_py.topics import COMMAND, ESTIMATE, IMU, PLANS, STAR_TRACKER, STATE
 from att_planner.tools.monte_carlo import report
-from att_planner.tools.monte_carlo.run import checked, fly, planned
+from att_planner.tools.monte_carlo import run as run_module
+from att_planner.tools.monte_carlo.run import checked, fly, fly_together, planned
 from att_sim import dispersions as disp
 
 DATA = Path(__file__).resolve().parents[2] / "data"
@@ -72,6 +74,26 @@ def test_a_20_run_campaign_on_a_local_dask_cluster_is_reproduced_from_its_seeds(
             if key not in ("cpu_seconds",):
                 expected = again[key]
                 assert (repr(expected) if isinstance(expected, float) else str(expected)) == value, key
+
+
+def test_runs_flown_together_give_the_rows_they_give_alone(setup, monkeypatch):
+    """Lockstep flight (the campaign's) is the runs' own flights, bit for bit — also when a run ends
+    early and the group goes on without it (here a run tumbling at 0.3 rad/s, beyond the star
+    tracker's rate limit, whose estimate never converges)."""
+    runs = [(i, disp.run_seed(7, i)) for i in (1, 2, 5)]
+    tumbling = runs[1][1]
+    dispersed = run_module.dispersed
+
+    def with_a_tumbling_run(setup_, seed):
+        truth, values = dispersed(setup_, seed)
+        return (replace(truth, omega0=np.array([0.3, 0.0, 0.0])) if seed == tumbling else truth), values
+    monkeypatch.setattr(run_module, "dispersed", with_a_tumbling_run)
+    together = fly_together(setup, runs)
+    assert [row["code"] for row in together] == [0, 313, 0]
+    for (run, seed), row in zip(runs, together):
+        alone = fly(setup, seed, run)
+        assert {k: repr(v) for k, v in alone.items() if k != "cpu_seconds"} == \
+               {k: repr(v) for k, v in row.items() if k != "cpu_seconds"}
 
 
 def test_an_interrupted_campaign_keeps_its_finished_runs_and_writes_a_partial_report(tmp_path, setup, monkeypatch):

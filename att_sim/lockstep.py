@@ -1,0 +1,97 @@
+"""Simulations advanced together: one RK4 step of many runs at once (the runs of a Monte Carlo campaign).
+
+:class:`Lockstep` holds simulations at the same time, each with its own spacecraft, drives,
+environment and random streams, and advances them as :meth:`Simulation.advance
+<att_sim.simulation.Simulation.advance>` advances each: every run's inputs (its watchdog, its
+drives' held torques and noise), then one RK4 step of all the states together — the derivative is
+:func:`att_sim.dynamics.rates` on arrays of runs, the field of each run's environment in body axes
+(:func:`att_sim.rotations.to_body`) at every stage — then every run's applied torques, its sample of
+the environment and its time. The arithmetic is the single run's, element by element, so each run
+reaches the bits it reaches alone (test/att_sim/test_lockstep.py), for about the cost of one run's step.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from att_sim import dynamics as dyn
+from att_sim import rotations as rot
+from att_sim.actuators import DrivesOfRuns
+from att_sim.simulation import Applied, Simulation
+
+
+def _by_run(matrices: list) -> list:
+    """Equally shaped matrices (nested lists of floats), one per run, as rows of arrays of runs."""
+    return [list(row) for row in np.moveaxis(np.array(matrices, float), 0, -1)]
+
+
+class Lockstep:
+    """Simulations at one time, of spacecraft with the same number of wheels, advanced together."""
+
+    def __init__(self, sims: list[Simulation]):
+        if not sims:
+            raise ValueError("a lockstep needs at least one simulation")
+        first = sims[0]
+        for s in sims[1:]:
+            if s.t != first.t or s.sc.n_wheels != first.sc.n_wheels:
+                raise ValueError("the simulations of a lockstep share their time and their number of wheels")
+            if (s.wheel_drive is None) != (first.wheel_drive is None) \
+                    or (s.sc.wheel_inertia > 0) != (first.sc.wheel_inertia > 0):
+                raise ValueError("the simulations of a lockstep all have wheel drives (and spinning wheels) or none")
+        self.sims = list(sims)
+        for s in sims[1:]:
+            s.environment.share_time_part(first.environment)
+        self.rows = tuple(_by_run([s.sc.rows[k] for s in sims]) for k in range(3))
+        self.wheel_inertia = np.array([s.sc.wheel_inertia for s in sims])
+        self.spinning = first.sc.wheel_inertia > 0
+        self.torque_max = np.array([s.sc.wheel_torque_max for s in sims])
+        self.speed_max = np.array([s.sc.wheel_speed_max for s in sims])
+        self.drives = None if first.wheel_drive is None else DrivesOfRuns([s.wheel_drive.spec for s in sims])
+        self.disturbed = any(s.environment.disturbed for s in sims)
+
+    def _limited(self, u: list, relative: list) -> list:
+        return dyn.limited_runs(self.torque_max, self.speed_max, u, relative)
+
+    def _stage(self, t: float, x: np.ndarray) -> tuple[list, list | None]:
+        """Each run's ``(B_b, τ_env)`` at one stage (one array of runs per component)."""
+        envs = [s.environment for s in self.sims]
+        field_b = rot.to_body(list(x[:4]), list(np.array([e.field_inertial(t) for e in envs]).T))
+        if not self.disturbed:
+            return field_b, None
+        columns = np.array(field_b).T
+        torques = [e.disturbance(t, x[:4, i], columns[i]) for i, e in enumerate(envs)]
+        return field_b, list(np.array([np.zeros(3) if tau is None else tau for tau in torques]).T)
+
+    def advance(self, dt: float) -> None:
+        """One step of ``dt`` of every simulation (a run whose step fails halts alone, as it would alone)."""
+        sims = self.sims
+        inputs = [s.inputs() for s in sims]
+        x = np.array([s.x for s in sims]).T
+        u = list(np.array([i.wheel_torque for i in inputs]).T)
+        tau_body, dipole = (list(np.array([getattr(i, k) for i in inputs]).T) for k in ("body_torque", "dipole"))
+        stages = []
+
+        def f(t, state):
+            field_b, tau_env = self._stage(t, state)
+            stages.append((field_b, tau_env))
+            torque = dyn.torque_sum(tau_body, dipole, field_b, tau_env)
+            out = np.empty_like(state)
+            for k, c in enumerate(dyn.rates(self.rows, self.wheel_inertia, list(state[:4]), list(state[4:7]),
+                                            list(state[7:]), torque, u, self._limited, self.drives, self.spinning)):
+                out[k] = c
+            return out
+        try:
+            x_new = dyn.renormalised(dyn.rk4(f, sims[0].t, x, dt))
+        except ValueError:              # some run's environment failed: each run alone, as it would be
+            for s, inp in zip(sims, inputs):
+                s.advance_with(inp, dt)
+            return
+        G = self.rows[2]
+        motor = net = u
+        if self.drives is not None:
+            speed = dyn.relative_speeds(G, list(x[4:7]), list(x[7:]))
+            motor, net = self.drives.motor(u, speed), self.drives(u, speed)
+        mean = dyn.rk4_mean(*(dyn.torque_sum(tau_body, dipole, fb, te) for fb, te in stages))
+        body = np.array([m - g for m, g in zip(mean, dyn.through_wheels(G, net))]).T
+        motor = np.array(motor, float).reshape(len(u), len(sims)).T
+        for i, (s, inp) in enumerate(zip(sims, inputs)):
+            s.finish_step(x_new[:, i].copy(), dt, Applied(motor[i].copy(), inp.dipole, body[i].copy()))
