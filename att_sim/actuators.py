@@ -146,6 +146,7 @@ class DrivesOfRuns:
 
     def __init__(self, specs: list[WheelDriveSpec]):
         self.power = np.array([s.power_max for s in specs])
+        self.unlimited = bool(np.all(np.isinf(self.power)))
         self.coulomb = np.array([s.coulomb_friction for s in specs])
         self.viscous = np.array([s.viscous_friction for s in specs])
         self.friction_speed = np.array([s.friction_speed for s in specs])
@@ -153,6 +154,8 @@ class DrivesOfRuns:
     def motor(self, u: list, speed: list) -> list:
         """:meth:`WheelDrive.motor`: held torques within each run's envelope (an infinite power limit
         clips nothing)."""
+        if self.unlimited:
+            return list(u)
         out = []
         for u_k, v in zip(u, speed):
             limit = self.power / np.maximum(np.abs(v), 1e-12)

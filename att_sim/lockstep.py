@@ -47,6 +47,8 @@ class Lockstep:
         self.speed_max = np.array([s.sc.wheel_speed_max for s in sims])
         self.drives = None if first.wheel_drive is None else DrivesOfRuns([s.wheel_drive.spec for s in sims])
         self.disturbed = any(s.environment.disturbed for s in sims)
+        envs = [s.environment for s in sims]
+        self.one_sky = all(e.shares_time_part(first.environment) for e in envs)   # one time-only part for all
 
     def _limited(self, u: list, relative: list) -> list:
         return dyn.limited_runs(self.torque_max, self.speed_max, u, relative)
@@ -54,7 +56,9 @@ class Lockstep:
     def _stage(self, t: float, x: np.ndarray) -> tuple[list, list | None]:
         """Each run's ``(B_b, τ_env)`` at one stage (one array of runs per component)."""
         envs = [s.environment for s in self.sims]
-        field_b = rot.to_body(list(x[:4]), list(np.array([e.field_inertial(t) for e in envs]).T))
+        field_N = envs[0].field_inertial(t).tolist() if self.one_sky else \
+            list(np.array([e.field_inertial(t) for e in envs]).T)
+        field_b = rot.to_body(list(x[:4]), field_N)
         if not self.disturbed:
             return field_b, None
         columns = np.array(field_b).T

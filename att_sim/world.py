@@ -212,10 +212,16 @@ class Environment:
         """Keep the time-only part (:class:`_Now`, field tracks) in one cache with ``other``'s, when
         both have the same orbit object, epoch, field model, sky and drag (the runs of a campaign:
         each run's environment would compute the same values); otherwise nothing changes."""
-        def key(e):
-            return id(e.orbit), e.epoch, e.field.model, e.field.epoch, e.field.dipole, e.sky is None, e.flags.drag
-        if other is not self and key(other) == key(self):
+        if other is not self and self._time_key() == other._time_key():
             self._cache, self._tracks = other._cache, other._tracks
+
+    def shares_time_part(self, other: Environment) -> bool:
+        """Whether this environment's time-only part is ``other``'s (:meth:`share_time_part`)."""
+        return self._cache is other._cache
+
+    def _time_key(self) -> tuple:
+        return (id(self.orbit), self.epoch, self.field.model, self.field.epoch, self.field.dipole, self.sky is None,
+                self.flags.drag)
 
     def field_inertial(self, t: float) -> np.ndarray:
         """The geomagnetic field at the spacecraft at time ``t`` (T, inertial axes)."""

@@ -95,3 +95,28 @@ def test_simulations_of_different_times_or_wheels_are_refused():
         Lockstep([a, b])
     with pytest.raises(ValueError, match="at least one"):
         Lockstep([])
+
+
+def test_a_run_whose_environment_fails_halts_as_it_would_alone_and_the_others_go_on(monkeypatch):
+    """One run's orbit stops propagating (as a decayed TLE does) at 0.12 s: that run halts with the
+    reason it gets alone; the other run's states stay its own."""
+    failing, healthy = disturbed_pair(1), disturbed_pair(2)
+    orbit = failing[0].environment.orbit
+    assert failing[1].environment.orbit is orbit and healthy[0].environment.orbit is not orbit
+    state = orbit.state
+
+    def decayed(t):
+        if t > 0.12:
+            raise ValueError("the orbit decayed")
+        return state(t)
+    monkeypatch.setattr(orbit, "state", decayed)
+    lockstep = Lockstep([failing[1], healthy[1]])
+    for _ in range(4):
+        for a in (failing[0], healthy[0]):
+            if not a.halted:
+                a.advance(0.05)
+        lockstep.advance(0.05)
+    alone, together = [failing[0], healthy[0]], [failing[1], healthy[1]]
+    assert alone[0].halted and together[0].halted and "the orbit decayed" in together[0].halt_reason
+    assert together[0].halt_reason == alone[0].halt_reason and not together[1].halted
+    assert_same(alone, together)

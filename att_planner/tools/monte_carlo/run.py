@@ -8,6 +8,11 @@ A run: the simulation starts at the maneuver's initial attitude and rest, disper
 ticks until the estimate is CONVERGED (at most the campaign's ``converge_timeout``), as the demo
 waits before it sends a goal; then the controller flies the plan and holds its end for
 ``settle_time``. The outcomes are taken at every control instant of the flown truth.
+
+The runs of a task fly in lockstep (:func:`fly_together`): each run's flight software steps on its
+own, and the simulations of the runs still going advance in one RK4 step on arrays of runs
+(:class:`att_sim.lockstep.Lockstep`), which gives each run the bits it gets alone — a run's row does
+not depend on the runs it flew with, so a run is reproduced alone from its seed.
 """
 from __future__ import annotations
 
