@@ -39,7 +39,8 @@ def cross(a: np.ndarray, b: np.ndarray, axis: int = -1) -> np.ndarray:
 
 
 def cross_floats(a, b) -> tuple[float, float, float]:
-    """``a × b`` of two 3-sequences of Python floats (the formula of :func:`cross` for one pair)."""
+    """``a × b`` of two 3-sequences of Python floats (the formula of :func:`cross` for one pair), or
+    of arrays of runs, component by component (:mod:`att_sim.lockstep`)."""
     (a0, a1, a2), (b0, b1, b2) = a, b
     return a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0
 

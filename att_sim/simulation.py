@@ -4,7 +4,8 @@
 command and the environment of :mod:`att_sim.world` (orbit, field, Sun, disturbances), which is
 evaluated at every RK4 stage; the actuator command is held over a step. The published state carries
 the field and position *at the published state* (its time and attitude). The simulator node is a
-thin adapter around it; tests drive it directly.
+thin adapter around it; tests drive it directly; :class:`att_sim.lockstep.Lockstep` advances the
+simulations of many Monte Carlo runs in one step, each to the bits :meth:`Simulation.advance` gives it.
 
 Every command and reset is checked field by field first (:class:`Checks`); a refused one changes
 nothing and comes back as a :class:`Refusal` (an :class:`~att_msgs_py.errors.ErrorCode` and a
@@ -319,5 +320,6 @@ class Simulation:
         self.t += dt
 
     def halt_environment(self, err: ValueError) -> None:
+        """Stop: the environment could not be evaluated (``err`` says why)."""
         self.halted = True
         self.halt_reason = f"environment failed at t = {self.t:.3f} s: {err}; propagation stopped"
