@@ -167,7 +167,14 @@ class Estimator:
         """Propagate to the sample's stamp (and apply what arrived meanwhile); the estimate when
         one is due (every ``publish_period``). ``wall``: the monotonic time it arrived: a sample more
         than ``max_gyro_gap`` after the last is refused unless none came for ``resync_timeout`` s, in
-        which case it starts a new timeline (a restarted simulator): the filter starts afresh."""
+        which case it starts a new timeline (a restarted simulator): the filter starts afresh. In
+        three parts (:meth:`take_gyro`, :meth:`catch_up`, :meth:`publish`) for :func:`catch_up_together`."""
+        omega = self.take_gyro(m, wall)
+        self.catch_up()
+        return self.publish(m.t, omega)
+
+    def take_gyro(self, m: GyroMeasurement, wall: float = 0.0) -> np.ndarray:
+        """Check and keep a gyro sample (see :meth:`on_gyro`); its measured rate."""
         last = self.gyro[-1][0] if self.gyro else None
         silent = wall - self.last_wall > self.config.resync_timeout
         omega, saturated = self.checks.gyro(m, None if silent else last)
@@ -182,12 +189,20 @@ class Estimator:
         if saturated:
             self.report.notes.append(f"gyro saturated at t = {m.t:.3f} s: attitude covariance grown")
         self.gyro.append((m.t, omega, saturated))
+        return omega
+
+    def catch_up(self) -> None:
+        """The filter brought to the newest gyro sample (the measurements since applied at their
+        instants); what is older than ``history`` forgotten."""
         self._reprocess(len(self.snapshots) - 1)
-        self._trim(m.t)
-        if m.t < self.next_publish - 1e-9:
+        self._trim(self.gyro[-1][0])
+
+    def publish(self, t: float, omega_measured: np.ndarray) -> AttitudeEstimate | None:
+        """The estimate at gyro time ``t`` when one is due (every ``publish_period``), else None."""
+        if t < self.next_publish - 1e-9:
             return None
-        self.next_publish = m.t + self.config.publish_period
-        return self.estimate(m.t, omega)
+        self.next_publish = t + self.config.publish_period
+        return self.estimate(t, omega_measured)
 
     def _restart(self) -> None:
         """Forget every state, sample and measurement (a new timeline): initialising again."""
@@ -290,6 +305,9 @@ class Estimator:
                 k += 1
             self.snapshots.append((t_j, self._propagate(x, omega, t_j, saturated)))
             x = self.snapshots[-1][1]
+        self._forget_before_loss()
+
+    def _forget_before_loss(self) -> None:
         if self.lost_at > self.snapshots[0][0]:       # nothing before a loss is replayed: drop it
             while len(self.snapshots) > 1 and self.snapshots[0][0] < self.lost_at:
                 self.snapshots.popleft()
@@ -299,12 +317,33 @@ class Estimator:
                    saturated: bool) -> mekf.FilterState | None:
         if x is None or t <= x.t:
             return x
-        dt = t - x.t
-        extra = (self.specs.gyro.range * dt) ** 2 if saturated and self.specs.gyro else 0.0
+        dt, extra = self._interval(x, t, saturated)
         x = mekf.propagate(x, omega, dt, self.config.arw, self.config.rrw, self.consider, extra)
-        if not mekf.healthy(x.P):
-            return self._lose(t, f"covariance not positive definite at t = {t:.3f} s")
-        return x
+        return self._checked(t, x, mekf.healthy(x.P))
+
+    def _interval(self, x: mekf.FilterState, t: float, saturated: bool) -> tuple[float, float]:
+        """``dt`` from ``x`` to ``t`` and the attitude variance a saturated sample adds over it."""
+        dt = t - x.t
+        return dt, (self.specs.gyro.range * dt) ** 2 if saturated and self.specs.gyro else 0.0
+
+    def _checked(self, t: float, x: mekf.FilterState, healthy: bool) -> mekf.FilterState | None:
+        return x if healthy else self._lose(t, f"covariance not positive definite at t = {t:.3f} s")
+
+    def _plain_step(self) -> tuple | None:
+        """``(x, ω_m, t, saturated)`` when :meth:`catch_up` is one propagation — the newest gyro
+        interval after the newest state, no measurement in it — else None."""
+        t0, x = self.snapshots[-1]
+        t, omega, saturated = self.gyro[-1]
+        if x is None or t <= x.t or (len(self.gyro) > 1 and self.gyro[-2][0] > t0) \
+                or (self.records and self.records[-1].t > t0):
+            return None
+        return x, omega, t, saturated
+
+    def _after_plain_step(self, t: float, x: mekf.FilterState | None) -> None:
+        """:meth:`catch_up` finished with the state ``x`` its one propagation reached."""
+        self.snapshots.append((t, x))
+        self._forget_before_loss()
+        self._trim(t)
 
     def _lose(self, t: float, why: str) -> None:
         """Drop the estimate at ``t``: DIVERGED until the next initialisation."""
@@ -414,3 +453,34 @@ class Estimator:
             self.gyro.popleft()
         self.records = [r for r in self.records if r.t > self.snapshots[0][0]]
 
+
+
+def catch_up_together(estimators: list[Estimator]) -> None:
+    """:meth:`Estimator.catch_up` of several estimators of one tuning (lockstep Monte Carlo runs):
+    those whose catching up is one propagation propagate as one stack
+    (:func:`~att_planner.estimation.mekf.propagate_runs`: each to the bits it reaches alone), the
+    others alone."""
+    plain = []
+    for e in estimators:
+        step = e._plain_step()
+        if step is None or not _same_tuning(e, estimators[0]):
+            e.catch_up()
+        else:
+            plain.append((e, step))
+    if not plain:
+        return
+    intervals = [e._interval(x, t, saturated) for e, (x, _, t, saturated) in plain]
+    config, consider = plain[0][0].config, plain[0][0].consider
+    states = mekf.propagate_runs([x for _, (x, *_) in plain], np.array([omega for _, (_, omega, *_) in plain]),
+                                 [dt for dt, _ in intervals], config.arw, config.rrw, consider,
+                                 [extra for _, extra in intervals])
+    healthy = mekf.healthy_runs(np.array([x.P for x in states]))
+    for (e, (_, _, t, _)), x, ok in zip(plain, states, healthy):
+        e._after_plain_step(t, e._checked(t, x, ok))
+
+
+def _same_tuning(a: Estimator, b: Estimator) -> bool:
+    """Whether ``a`` and ``b`` propagate with the same noise figures and considered variances."""
+    same_consider = (a.consider is None and b.consider is None) or (
+        a.consider is not None and b.consider is not None and np.array_equal(a.consider, b.consider))
+    return a.config.arw == b.config.arw and a.config.rrw == b.config.rrw and same_consider

@@ -63,28 +63,41 @@ class Update:
 
 
 def transition(omega: np.ndarray, dt: float) -> np.ndarray:
-    """``Φ`` (6×6) of the error state over ``dt`` at the estimated rate ``omega`` (module docstring).
-    With ``W = [ω̂×]`` and ``W² = ω̂ω̂ᵀ − |ω̂|² I``: ``Φ₁₁ = I − a W + b W²``, ``Φ₁₂ = −dt I + b W − c W²``,
+    """``Φ`` (6×6) of the error state over ``dt`` at the estimated rate ``omega`` (module docstring):
+    :func:`transitions` of one run."""
+    return transitions(np.asarray(omega, float)[None], [dt])[0]
+
+
+def transitions(omega: np.ndarray, dt) -> np.ndarray:
+    """``Φ`` (R×6×6) of R filters at their estimated rates ``omega`` (R×3) over ``dt`` (R). With
+    ``W = [ω̂×]`` and ``W² = ω̂ω̂ᵀ − |ω̂|² I``: ``Φ₁₁ = I − a W + b W²``, ``Φ₁₂ = −dt I + b W − c W²``,
     ``a = sin θ/|ω̂|``, ``b = (1 − cos θ)/|ω̂|²``, ``c = (θ − sin θ)/|ω̂|³`` (their series to O(θ³) below
-    θ = 1e-6); on Python floats (the estimator calls it at every gyro sample)."""
-    w = np.asarray(omega, float).tolist()
-    n2 = w[0] * w[0] + w[1] * w[1] + w[2] * w[2]
-    norm = math.sqrt(n2)
-    theta = norm * dt
-    if theta > 1e-6:
-        a, b, c = math.sin(theta) / norm, (1.0 - math.cos(theta)) / n2, (theta - math.sin(theta)) / (n2 * norm)
-    else:
-        a, b, c = dt, dt * dt / 2.0, dt**3 / 6.0
-    W = ((0.0, -w[2], w[1]), (w[2], 0.0, -w[0]), (-w[1], w[0], 0.0))
-    rows = []
-    for i in range(3):
-        W2 = [w[i] * w[j] - (n2 if i == j else 0.0) for j in range(3)]
-        rows.append([(1.0 if i == j else 0.0) - a * W[i][j] + b * W2[j] for j in range(3)]
-                    + [(-dt if i == j else 0.0) + b * W[i][j] - c * W2[j] for j in range(3)])
-    return np.array(rows + _LOWER_IDENTITY)
+    θ = 1e-6): the coefficients on Python floats run by run, the entries on arrays of runs."""
+    w = np.asarray(omega, float).reshape(-1, 3)
+    dts = [float(d) for d in dt]
+    coefficients = []
+    for (w0, w1, w2), h in zip(w.tolist(), dts):
+        n2 = w0 * w0 + w1 * w1 + w2 * w2
+        norm = math.sqrt(n2)
+        theta = norm * h
+        if theta > 1e-6:
+            sin = math.sin(theta)
+            coefficients.append((sin / norm, (1.0 - math.cos(theta)) / n2, (theta - sin) / (n2 * norm), n2))
+        else:
+            coefficients.append((h, h * h / 2.0, h**3 / 6.0, n2))
+    a, b, c, n2 = (v[:, None, None] for v in np.array(coefficients).T)
+    W = rot.hat(w)
+    W2 = w[:, :, None] * w[:, None, :] - n2 * I3        # ω̂ω̂ᵀ − |ω̂|² I (off the diagonal: minus 0.0)
+    diagonal = np.zeros_like(W)
+    diagonal[:, _DIAGONAL, _DIAGONAL] = -np.array(dts)[:, None]
+    out = np.zeros((len(dts), 6, 6))
+    out[:, :3, :3] = I3 - a * W + b * W2
+    out[:, :3, 3:] = diagonal + b * W - c * W2
+    out[:, 3:, 3:] = I3
+    return out
 
 
-_LOWER_IDENTITY = np.eye(6)[3:].tolist()
+_DIAGONAL = [0, 1, 2]
 
 
 @functools.lru_cache(maxsize=64)
@@ -104,10 +117,12 @@ OFF_DIAGONAL = ((0, 1), (0, 2), (1, 0), (1, 2), (2, 0), (2, 1))   # as att_sim.r
 
 
 def scale_misalignment_sensitivity(omega: np.ndarray) -> np.ndarray:
-    """``G(ω)`` (3×9) with ``E(p) ω = G(ω) p``, ``p = [s_x, s_y, s_z, m_01, m_02, m_10, m_12, m_20, m_21]``."""
-    G = np.zeros((3, 9))
-    G.flat[_SENSITIVITY_AT] = np.asarray(omega, float)[_SENSITIVITY_OF]
-    return G
+    """``G(ω)`` (3×9) with ``E(p) ω = G(ω) p``, ``p = [s_x, s_y, s_z, m_01, m_02, m_10, m_12, m_20, m_21]``
+    (of each row of ``omega`` (R×3): R×3×9)."""
+    omega = np.asarray(omega, float)
+    G = np.zeros(omega.shape[:-1] + (27,))
+    G[..., _SENSITIVITY_AT] = omega[..., _SENSITIVITY_OF]
+    return G.reshape(omega.shape[:-1] + (3, 9))
 
 
 _SENSITIVITY_AT = [0, 10, 20] + [9 * i + 3 + k for k, (i, _) in enumerate(OFF_DIAGONAL)]   # flat indices in G
@@ -118,22 +133,37 @@ def propagate(x: FilterState, omega_measured: np.ndarray, dt: float, arw: float,
               consider: np.ndarray | None = None, extra_attitude_noise: float = 0.0) -> FilterState:
     """``x`` advanced by ``dt`` with the measured mean rate ``omega_measured`` over the interval;
     ``consider``: the variances (9,) of the gyro's scale factors and misalignments (None: none);
-    ``extra_attitude_noise`` (rad², per axis) is added to the attitude block (a saturated gyro)."""
-    omega = np.asarray(omega_measured, float) - x.bias
-    phi = transition(omega, dt)
-    P = phi @ x.P @ phi.T + process_noise(arw, rrw, dt)
-    C = x.C
+    ``extra_attitude_noise`` (rad², per axis) is added to the attitude block (a saturated gyro).
+    :func:`propagate_runs` of one filter."""
+    return propagate_runs([x], np.asarray(omega_measured, float)[None], [dt], arw, rrw, consider,
+                          [extra_attitude_noise])[0]
+
+
+def propagate_runs(states: list[FilterState], omega_measured: np.ndarray, dt, arw: float, rrw: float,
+                   consider: np.ndarray | None = None, extra_attitude_noise=None) -> list[FilterState]:
+    """:func:`propagate` of R filters at once (lockstep Monte Carlo runs of one tuning): ``omega_measured``
+    (R×3), ``dt`` and ``extra_attitude_noise`` one per filter. The matrices of all the filters are
+    multiplied as one stack (per filter the same products, so the same bits); the attitude run by run."""
+    dt = [float(d) for d in dt]
+    omega = np.asarray(omega_measured, float) - np.array([x.bias for x in states])
+    phi = transitions(omega, dt)
+    phi_T = phi.transpose(0, 2, 1)
+    P = phi @ np.array([x.P for x in states]) @ phi_T + np.array([process_noise(arw, rrw, d) for d in dt])
+    C = np.array([x.C for x in states])
     if consider is not None:
-        psi = np.zeros((6, 9))
-        psi[:3] = phi[:3, 3:] @ scale_misalignment_sensitivity(omega)
-        phi_C, psi_consider = phi @ x.C, psi * consider
-        cross = phi_C @ psi.T
-        P += cross + cross.T + psi_consider @ psi.T
+        psi = np.zeros((len(states), 6, 9))
+        psi[:, :3] = phi[:, :3, 3:] @ scale_misalignment_sensitivity(omega)
+        phi_C, psi_consider = phi @ C, psi * consider
+        psi_T = psi.transpose(0, 2, 1)
+        cross = phi_C @ psi_T
+        P += cross + cross.transpose(0, 2, 1) + psi_consider @ psi_T
         C = phi_C + psi_consider
-    if extra_attitude_noise:
-        P[:3, :3] += extra_attitude_noise * I3
-    return FilterState(x.t + dt, rot.normalize(rot.propagate_constant_rate(x.q, omega, dt)), x.bias,
-                       0.5 * (P + P.T), C)
+    for i, extra in enumerate(extra_attitude_noise or ()):
+        if extra:
+            P[i, :3, :3] += extra * I3
+    P = 0.5 * (P + P.transpose(0, 2, 1))
+    return [FilterState(x.t + d, rot.normalize(rot.propagate_constant_rate(x.q, w, d)), x.bias, P[i].copy(),
+                        C[i].copy()) for i, (x, w, d) in enumerate(zip(states, omega, dt))]
 
 
 def attitude_residual(q_estimate: np.ndarray, q_measured: np.ndarray) -> np.ndarray:
@@ -169,6 +199,18 @@ def update(x: FilterState, y: np.ndarray, H: np.ndarray, R: np.ndarray, gate: fl
     P = A @ x.P @ A.T + K @ R @ K.T               # Joseph form
     q = rot.normalize(rot.multiply(x.q, rot.exp_map(dx[:3])))
     return Update(FilterState(x.t, q, x.bias + dx[3:], 0.5 * (P + P.T), A @ x.C), True, d2)
+
+
+def healthy_runs(P: np.ndarray) -> list[bool]:
+    """:func:`healthy` of each covariance of the stack ``P`` (R×6×6): one factorisation of the stack
+    when every one is usable, else one by one."""
+    if np.all(np.isfinite(P)):
+        try:
+            np.linalg.cholesky(P)
+            return [True] * len(P)
+        except np.linalg.LinAlgError:
+            pass
+    return [healthy(p) for p in P]
 
 
 def healthy(P: np.ndarray) -> bool:

@@ -82,6 +82,7 @@ class ClosedLoop:
         self.tracker_status = 0                 # of the latest tracker measurement (TrackerStatus)
         self.refusals: list[RequestError] = []
         self.next_state = 0.0
+        self._readings, self._state_due = None, False     # of the step being exchanged (measure, respond)
         self.result: ManeuverResult | None = None
         self.tap = None     # optional (topic, t, mirror object) of everything the nodes would publish: a log
 
@@ -108,34 +109,52 @@ class ClosedLoop:
         self.sim.advance(self.step)
 
     def exchange(self) -> None:
-        """A step's messages without the advance: readings and state out, the command (when due) in
-        (:func:`fly_together` advances many loops' simulations at once)."""
+        """A step's messages without the advance: readings and state out, the command (when due) in.
+        In two halves around the estimator's catching up (:meth:`measure`, :meth:`respond`), which
+        :func:`~att_planner.tools.monte_carlo.run.fly_together` does for many loops at once."""
+        omega = self.measure()
+        if omega is not None:
+            self.estimator.catch_up()
+        self.respond(omega)
+
+    def measure(self) -> np.ndarray | None:
+        """The readings out: to the estimator (its gyro sample taken, not yet propagated to: the
+        measured rate is returned, None without one) and to the controller's measured state."""
         sim, ctl, est = self.sim, self.controller, self.estimator
-        readings = sim.sense()
+        self._readings = readings = sim.sense()
         t = sim.t
-        state_due = t >= self.next_state - 1e-9
-        if state_due:
+        self._state_due = t >= self.next_state - 1e-9
+        if self._state_due:
             self.next_state = t + self.publish_period
         if self.tap is not None:
-            self._tap_readings(t, readings, state_due)
+            self._tap_readings(t, readings, self._state_due)
+        if est is None:
+            return None
+        for m in readings.star_trackers:
+            self.tracker_status = int(m.status)
+            self._guard(est.on_star_tracker, m)
+        if readings.magnetometer is not None:
+            self._guard(est.on_magnetometer, readings.magnetometer)
+            self._guard(ctl.measured.on_magnetometer, readings.magnetometer)
+        if readings.sun_sensors is not None:
+            self._guard(est.on_sun_sensors, readings.sun_sensors)
+        if readings.wheel_speeds is not None:
+            self._guard(ctl.measured.on_wheel_speeds, readings.wheel_speeds)
+        return self._guard(est.take_gyro, readings.gyro) if readings.gyro is not None else None
+
+    def respond(self, omega: np.ndarray | None) -> None:
+        """The estimate (when due; ``omega``: the gyro rate :meth:`measure` returned) or the state to
+        the controller; its command, when due, to the simulator."""
+        sim, ctl, est, readings = self.sim, self.controller, self.estimator, self._readings
+        t = sim.t
         outcome = None
         if est is not None:
-            for m in readings.star_trackers:
-                self.tracker_status = int(m.status)
-                self._guard(est.on_star_tracker, m)
-            if readings.magnetometer is not None:
-                self._guard(est.on_magnetometer, readings.magnetometer)
-                self._guard(ctl.measured.on_magnetometer, readings.magnetometer)
-            if readings.sun_sensors is not None:
-                self._guard(est.on_sun_sensors, readings.sun_sensors)
-            if readings.wheel_speeds is not None:
-                self._guard(ctl.measured.on_wheel_speeds, readings.wheel_speeds)
-            estimate = self._guard(est.on_gyro, readings.gyro) if readings.gyro is not None else None
+            estimate = est.publish(readings.gyro.t, omega) if omega is not None else None
             if estimate is not None:
                 if self.tap is not None:
                     self.tap(topics.ESTIMATE, t, estimate)
                 outcome = ctl.accept_estimate(estimate)
-        elif state_due:
+        elif self._state_due:
             outcome = ctl.accept_state(sim.state(self.scenario.frame_id, self.scenario.body_frame_id))
         if outcome is not None:
             self._outcome(outcome)

@@ -23,6 +23,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from att_msgs_py.types import Health, ManeuverResult, Plan, Verification
+from att_planner.estimation.estimator import catch_up_together
 from att_planner.tools.closed_loop import ClosedLoop, plan_in_process
 from att_planner.tools.demo import maneuver_from_scenario, zone_margins
 from att_planner.verification import rejection
@@ -152,8 +153,10 @@ def fly_together(setup: Setup, runs: list[tuple[int, int]], tap=None) -> list[di
         if len(still) != len(going) or lockstep is None:
             lockstep = Lockstep([f.loop.sim for f in still]) if len(still) > 1 else None
         going = still
-        for f in going:
-            f.loop.exchange()
+        rates = [f.loop.measure() for f in going]
+        catch_up_together([f.loop.estimator for f, omega in zip(going, rates) if omega is not None])
+        for f, omega in zip(going, rates):
+            f.loop.respond(omega)
         if lockstep is not None:
             lockstep.advance(going[0].loop.step)
         elif going:

@@ -36,6 +36,31 @@ def test_transition_matches_the_matrix_exponential_of_the_error_dynamics():
         assert np.allclose(mekf.transition(omega, 0.1), expm(F * 0.1), atol=1e-12)
 
 
+def test_filters_propagated_as_one_stack_reach_the_bits_they_reach_alone():
+    """propagate_runs (lockstep Monte Carlo runs) is propagate filter by filter: the same products of
+    each, whatever the stack; and healthy_runs says which covariances are usable."""
+    rng = np.random.default_rng(11)
+    consider = np.array([50e-6**2] * 3 + [1e-4**2] * 6)
+    states, rates = [], []
+    for k in range(6):
+        A = rng.normal(size=(6, 6))
+        q = rng.normal(size=4)
+        states.append(mekf.FilterState(1.0, q / np.linalg.norm(q), rng.normal(0, 1e-5, 3), A @ A.T * 1e-8))
+        rates.append(rng.normal(0, 10.0 ** -k, 3))        # down to 1e-5 rad/s: the series branch
+    dts, extras = rng.uniform(0.02, 0.2, 6), [0.0, 1e-9, 0.0, 0.0, 0.0, 2e-10]
+    together = mekf.propagate_runs(states, np.array(rates), dts, 1e-6, 1e-9, consider, extras)
+    together = mekf.propagate_runs(together, np.array(rates), dts, 1e-6, 1e-9, consider, extras)   # C ≠ 0 now
+    for x, w, dt, extra, got in zip(states, rates, dts, extras, together):
+        alone = mekf.propagate(mekf.propagate(x, w, dt, 1e-6, 1e-9, consider, extra), w, dt, 1e-6, 1e-9, consider,
+                               extra)
+        for name in ("t", "q", "bias", "P", "C"):
+            np.testing.assert_array_equal(getattr(got, name), getattr(alone, name))
+    stack = np.array([x.P for x in together])
+    assert mekf.healthy_runs(stack) == [True] * 6
+    stack[2, 0, 0], stack[4, 1, 1] = -1.0, np.nan
+    assert mekf.healthy_runs(stack) == [True, True, False, True, False, True]
+
+
 def test_process_noise_matches_van_loans_discretisation():
     arw, rrw, dt = 1e-5, 1e-7, 0.5
     F = np.zeros((6, 6))
