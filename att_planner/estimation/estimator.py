@@ -168,9 +168,10 @@ class Estimator:
         one is due (every ``publish_period``). ``wall``: the monotonic time it arrived: a sample more
         than ``max_gyro_gap`` after the last is refused unless none came for ``resync_timeout`` s, in
         which case it starts a new timeline (a restarted simulator): the filter starts afresh. In
-        three parts (:meth:`take_gyro`, :meth:`catch_up`, :meth:`publish`) for :func:`catch_up_together`."""
+        three parts (:meth:`take_gyro`, :meth:`reprocess` from :attr:`newest`, :meth:`publish`) for
+        :func:`reprocess_together`."""
         omega = self.take_gyro(m, wall)
-        self.catch_up()
+        self.reprocess(self.newest)
         return self.publish(m.t, omega)
 
     def take_gyro(self, m: GyroMeasurement, wall: float = 0.0) -> np.ndarray:
@@ -191,14 +192,15 @@ class Estimator:
         self.gyro.append((m.t, omega, saturated))
         return omega
 
-    def catch_up(self) -> None:
-        """The filter brought to the newest gyro sample (the measurements since applied at their
-        instants); what is older than ``history`` forgotten."""
-        self._reprocess(len(self.snapshots) - 1)
-        self._trim(self.gyro[-1][0])
+    @property
+    def newest(self) -> int:
+        """Index of the newest state: :meth:`reprocess` from it catches up with a new gyro sample."""
+        return len(self.snapshots) - 1
 
     def publish(self, t: float, omega_measured: np.ndarray) -> AttitudeEstimate | None:
-        """The estimate at gyro time ``t`` when one is due (every ``publish_period``), else None."""
+        """After a gyro sample of time ``t`` was caught up with: what is older than ``history``
+        forgotten; the estimate when one is due (every ``publish_period``), else None."""
+        self._trim(t)
         if t < self.next_publish - 1e-9:
             return None
         self.next_publish = t + self.config.publish_period
@@ -214,22 +216,24 @@ class Estimator:
         self.rejected_in_a_row = 0
 
     def on_star_tracker(self, m: StarTrackerMeasurement) -> None:
-        """Keep a valid tracker measurement for its instant (an invalid one says only that)."""
+        """Apply a valid tracker measurement at its instant (an invalid one says only that)."""
+        self.reprocess(self.take_star_tracker(m))
+
+    def take_star_tracker(self, m: StarTrackerMeasurement) -> int | None:
+        """Check and keep a tracker measurement; the state to :meth:`reprocess` from (None: none)."""
         q = self.checks.star_tracker(m)
-        if q is not None:
-            self._insert(_Record(m.t, "tracker", (m.name, q)))
+        return None if q is None else self._insert(_Record(m.t, "tracker", (m.name, q)))
 
     def on_magnetometer(self, m: MagnetometerMeasurement) -> None:
         field_B = self.checks.magnetometer(m)
-        if not self.dipoles.clean(m.t):
-            return
-        self._insert(_Record(m.t, "magnetometer", field_B))
+        if self.dipoles.clean(m.t):
+            self.reprocess(self._insert(_Record(m.t, "magnetometer", field_B)))
 
     def on_sun_sensors(self, m: SunSensorMeasurement) -> None:
         values = self.checks.sun_sensors(m)
         s = sun_vector(values, self.specs.sun_sensors.normals, self.config.sun_threshold)
         if s is not None:
-            self._insert(_Record(m.t, "sun", s))
+            self.reprocess(self._insert(_Record(m.t, "sun", s)))
 
     def on_dipole_command(self, t: float, dipole: np.ndarray) -> None:
         """The controller's magnetorquer command stamped ``t`` (for the magnetometer's blanking)."""
@@ -273,8 +277,9 @@ class Estimator:
                                 frame_id=self.frame_id, body_frame_id=self.body_frame_id)
 
     # -- the filter over its history ---------------------------------------------------------------
-    def _insert(self, record: _Record) -> None:
-        """Keep ``record`` and reprocess from the last state before its instant."""
+    def _insert(self, record: _Record) -> int | None:
+        """Keep ``record``; the last state before its instant when that is not the newest (the
+        state to reprocess from; None: the next gyro sample applies it)."""
         if record.t <= self.snapshots[0][0]:
             oldest = self.snapshots[0][0]
             raise RequestError(ErrorCode.STALE_MEASUREMENT,
@@ -288,22 +293,32 @@ class Estimator:
         self.records.append(record)
         self.records.sort(key=lambda r: r.t)          # stable: equal instants keep their arrival order
         if record.t <= self.snapshots[-1][0]:
-            start = max(i for i, (t, _) in enumerate(self.snapshots) if t < record.t)
-            self._reprocess(start)
+            return max(i for i, (t, _) in enumerate(self.snapshots) if t < record.t)
+        return None
 
-    def _reprocess(self, start: int) -> None:
-        """Rebuild every state after snapshot ``start`` from it: propagate through each gyro
-        interval, stopping at measurement instants to apply them."""
+    def reprocess(self, start: int | None) -> None:
+        """Rebuild every state after snapshot ``start`` from it (None: nothing to do): propagate
+        through each gyro interval, stopping at measurement instants to apply them."""
+        if start is None:
+            return
+        steps = self._reprocess_steps(start)
+        request = next(steps, None)
+        while request is not None:
+            request = _resume(steps, self._propagate(*request))
+
+    def _reprocess_steps(self, start: int):
+        """:meth:`reprocess` as a generator: yields each propagation ``(x, ω_m, t, saturated)`` and
+        goes on with the state sent back (:meth:`_propagate`'s, or :func:`reprocess_together`'s)."""
         t0, x = self.snapshots[start]
         while len(self.snapshots) > start + 1:
             self.snapshots.pop()
         records = [r for r in self.records if r.t > t0]
         k = 0
-        for t_j, omega, saturated in (g for g in self.gyro if g[0] > t0):
+        for t_j, omega, saturated in [g for g in self.gyro if g[0] > t0]:
             while k < len(records) and records[k].t <= t_j:
-                x = self._apply(self._propagate(x, omega, records[k].t, saturated), records[k])
+                x = self._apply((yield x, omega, records[k].t, saturated), records[k])
                 k += 1
-            self.snapshots.append((t_j, self._propagate(x, omega, t_j, saturated)))
+            self.snapshots.append((t_j, (yield x, omega, t_j, saturated)))
             x = self.snapshots[-1][1]
         self._forget_before_loss()
 
@@ -328,22 +343,6 @@ class Estimator:
 
     def _checked(self, t: float, x: mekf.FilterState, healthy: bool) -> mekf.FilterState | None:
         return x if healthy else self._lose(t, f"covariance not positive definite at t = {t:.3f} s")
-
-    def _plain_step(self) -> tuple | None:
-        """``(x, ω_m, t, saturated)`` when :meth:`catch_up` is one propagation — the newest gyro
-        interval after the newest state, no measurement in it — else None."""
-        t0, x = self.snapshots[-1]
-        t, omega, saturated = self.gyro[-1]
-        if x is None or t <= x.t or (len(self.gyro) > 1 and self.gyro[-2][0] > t0) \
-                or (self.records and self.records[-1].t > t0):
-            return None
-        return x, omega, t, saturated
-
-    def _after_plain_step(self, t: float, x: mekf.FilterState | None) -> None:
-        """:meth:`catch_up` finished with the state ``x`` its one propagation reached."""
-        self.snapshots.append((t, x))
-        self._forget_before_loss()
-        self._trim(t)
 
     def _lose(self, t: float, why: str) -> None:
         """Drop the estimate at ``t``: DIVERGED until the next initialisation."""
@@ -455,28 +454,56 @@ class Estimator:
 
 
 
-def catch_up_together(estimators: list[Estimator]) -> None:
-    """:meth:`Estimator.catch_up` of several estimators of one tuning (lockstep Monte Carlo runs):
-    those whose catching up is one propagation propagate as one stack
-    (:func:`~att_planner.estimation.mekf.propagate_runs`: each to the bits it reaches alone), the
-    others alone."""
-    plain = []
-    for e in estimators:
-        step = e._plain_step()
-        if step is None or not _same_tuning(e, estimators[0]):
-            e.catch_up()
+def reprocess_together(jobs: list[tuple[Estimator, int | None]]) -> None:
+    """:meth:`Estimator.reprocess` of several estimators at once (lockstep Monte Carlo runs): their
+    reprocessings advance side by side, and the propagations they need at each turn that share one
+    tuning go as one stack (:func:`~att_planner.estimation.mekf.propagate_runs`: each to the bits it
+    reaches alone); each estimator's own operations keep their order."""
+    live = []
+    for e, start in jobs:
+        if start is not None:
+            steps = e._reprocess_steps(start)
+            request = next(steps, None)
+            if request is not None:
+                live.append((e, steps, request))
+    while live:
+        states = _propagate_together([(e, request) for e, _, request in live])
+        live = [(e, steps, request) for (e, steps, _), x in zip(live, states)
+                if (request := _resume(steps, x)) is not None]
+
+
+def _propagate_together(requests: list[tuple[Estimator, tuple]]) -> list:
+    """:meth:`Estimator._propagate` of each ``(estimator, (x, ω_m, t, saturated))``: the real
+    propagations of the first one's tuning as one stack, the others one by one."""
+    out = [None] * len(requests)
+    stack = []
+    for i, (e, (x, omega, t, saturated)) in enumerate(requests):
+        if x is None or t <= x.t or not _same_tuning(e, requests[0][0]):
+            out[i] = e._propagate(x, omega, t, saturated)
         else:
-            plain.append((e, step))
-    if not plain:
-        return
-    intervals = [e._interval(x, t, saturated) for e, (x, _, t, saturated) in plain]
-    config, consider = plain[0][0].config, plain[0][0].consider
-    states = mekf.propagate_runs([x for _, (x, *_) in plain], np.array([omega for _, (_, omega, *_) in plain]),
-                                 [dt for dt, _ in intervals], config.arw, config.rrw, consider,
-                                 [extra for _, extra in intervals])
-    healthy = mekf.healthy_runs(np.array([x.P for x in states]))
-    for (e, (_, _, t, _)), x, ok in zip(plain, states, healthy):
-        e._after_plain_step(t, e._checked(t, x, ok))
+            stack.append(i)
+    if stack:
+        first = requests[stack[0]][0]
+        states, omegas, intervals = [], [], []
+        for i in stack:
+            e, (x, omega, t, saturated) = requests[i]
+            states.append(x)
+            omegas.append(omega)
+            intervals.append(e._interval(x, t, saturated))
+        propagated = mekf.propagate_runs(states, np.array(omegas), [dt for dt, _ in intervals], first.config.arw,
+                                         first.config.rrw, first.consider, [extra for _, extra in intervals])
+        for i, x, ok in zip(stack, propagated, mekf.healthy_runs(np.array([x.P for x in propagated]))):
+            e, (_, _, t, _) = requests[i]
+            out[i] = e._checked(t, x, ok)
+    return out
+
+
+def _resume(steps, value):
+    """The generator ``steps`` sent ``value``: its next request, None when it has finished."""
+    try:
+        return steps.send(value)
+    except StopIteration:
+        return None
 
 
 def _same_tuning(a: Estimator, b: Estimator) -> bool:

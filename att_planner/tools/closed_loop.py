@@ -82,7 +82,6 @@ class ClosedLoop:
         self.tracker_status = 0                 # of the latest tracker measurement (TrackerStatus)
         self.refusals: list[RequestError] = []
         self.next_state = 0.0
-        self._readings, self._state_due = None, False     # of the step being exchanged (measure, respond)
         self.result: ManeuverResult | None = None
         self.tap = None     # optional (topic, t, mirror object) of everything the nodes would publish: a log
 
@@ -109,52 +108,46 @@ class ClosedLoop:
         self.sim.advance(self.step)
 
     def exchange(self) -> None:
-        """A step's messages without the advance: readings and state out, the command (when due) in.
-        In two halves around the estimator's catching up (:meth:`measure`, :meth:`respond`), which
-        :func:`~att_planner.tools.monte_carlo.run.fly_together` does for many loops at once."""
-        omega = self.measure()
-        if omega is not None:
-            self.estimator.catch_up()
-        self.respond(omega)
+        """A step's messages without the advance: readings and state out, the command (when due) in."""
+        for estimator, start in self.exchange_steps():
+            estimator.reprocess(start)
 
-    def measure(self) -> np.ndarray | None:
-        """The readings out: to the estimator (its gyro sample taken, not yet propagated to: the
-        measured rate is returned, None without one) and to the controller's measured state."""
+    def exchange_steps(self):
+        """:meth:`exchange` as a generator: it yields each reprocessing ``(estimator, start)`` the
+        estimator needs before the exchange goes on (:meth:`Estimator.reprocess
+        <att_planner.estimation.estimator.Estimator.reprocess>`), which the caller does — at once,
+        or for many loops together (:func:`~att_planner.tools.monte_carlo.run.fly_together`)."""
         sim, ctl, est = self.sim, self.controller, self.estimator
-        self._readings = readings = sim.sense()
+        readings = sim.sense()
         t = sim.t
-        self._state_due = t >= self.next_state - 1e-9
-        if self._state_due:
+        state_due = t >= self.next_state - 1e-9
+        if state_due:
             self.next_state = t + self.publish_period
         if self.tap is not None:
-            self._tap_readings(t, readings, self._state_due)
-        if est is None:
-            return None
-        for m in readings.star_trackers:
-            self.tracker_status = int(m.status)
-            self._guard(est.on_star_tracker, m)
-        if readings.magnetometer is not None:
-            self._guard(est.on_magnetometer, readings.magnetometer)
-            self._guard(ctl.measured.on_magnetometer, readings.magnetometer)
-        if readings.sun_sensors is not None:
-            self._guard(est.on_sun_sensors, readings.sun_sensors)
-        if readings.wheel_speeds is not None:
-            self._guard(ctl.measured.on_wheel_speeds, readings.wheel_speeds)
-        return self._guard(est.take_gyro, readings.gyro) if readings.gyro is not None else None
-
-    def respond(self, omega: np.ndarray | None) -> None:
-        """The estimate (when due; ``omega``: the gyro rate :meth:`measure` returned) or the state to
-        the controller; its command, when due, to the simulator."""
-        sim, ctl, est, readings = self.sim, self.controller, self.estimator, self._readings
-        t = sim.t
+            self._tap_readings(t, readings, state_due)
         outcome = None
         if est is not None:
-            estimate = est.publish(readings.gyro.t, omega) if omega is not None else None
-            if estimate is not None:
-                if self.tap is not None:
-                    self.tap(topics.ESTIMATE, t, estimate)
-                outcome = ctl.accept_estimate(estimate)
-        elif self._state_due:
+            for m in readings.star_trackers:
+                self.tracker_status = int(m.status)
+                start = self._guard(est.take_star_tracker, m)
+                if start is not None:
+                    yield est, start
+            if readings.magnetometer is not None:
+                self._guard(est.on_magnetometer, readings.magnetometer)
+                self._guard(ctl.measured.on_magnetometer, readings.magnetometer)
+            if readings.sun_sensors is not None:
+                self._guard(est.on_sun_sensors, readings.sun_sensors)
+            if readings.wheel_speeds is not None:
+                self._guard(ctl.measured.on_wheel_speeds, readings.wheel_speeds)
+            omega = self._guard(est.take_gyro, readings.gyro) if readings.gyro is not None else None
+            if omega is not None:
+                yield est, est.newest
+                estimate = est.publish(readings.gyro.t, omega)
+                if estimate is not None:
+                    if self.tap is not None:
+                        self.tap(topics.ESTIMATE, t, estimate)
+                    outcome = ctl.accept_estimate(estimate)
+        elif state_due:
             outcome = ctl.accept_state(sim.state(self.scenario.frame_id, self.scenario.body_frame_id))
         if outcome is not None:
             self._outcome(outcome)

@@ -23,7 +23,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from att_msgs_py.types import Health, ManeuverResult, Plan, Verification
-from att_planner.estimation.estimator import catch_up_together
+from att_planner.estimation.estimator import reprocess_together
 from att_planner.tools.closed_loop import ClosedLoop, plan_in_process
 from att_planner.tools.demo import maneuver_from_scenario, zone_margins
 from att_planner.verification import rejection
@@ -153,10 +153,11 @@ def fly_together(setup: Setup, runs: list[tuple[int, int]], tap=None) -> list[di
         if len(still) != len(going) or lockstep is None:
             lockstep = Lockstep([f.loop.sim for f in still]) if len(still) > 1 else None
         going = still
-        rates = [f.loop.measure() for f in going]
-        catch_up_together([f.loop.estimator for f, omega in zip(going, rates) if omega is not None])
-        for f, omega in zip(going, rates):
-            f.loop.respond(omega)
+        exchanges = [f.loop.exchange_steps() for f in going]
+        while exchanges:                # each turn: every exchange to its next reprocessing, done together
+            turn = [(steps, next(steps, None)) for steps in exchanges]
+            reprocess_together([job for _, job in turn if job is not None])
+            exchanges = [steps for steps, job in turn if job is not None]
         if lockstep is not None:
             lockstep.advance(going[0].loop.step)
         elif going:

@@ -17,7 +17,7 @@ from att_msgs_py.types import (
     StarTrackerMeasurement,
     SunSensorMeasurement,
 )
-from att_planner.estimation.estimator import Estimator, EstimatorConfig
+from att_planner.estimation.estimator import Estimator, EstimatorConfig, reprocess_together
 from att_planner.estimation.inputs import Sources
 from att_sim import rotations as rot
 from att_sim.sensors.specs import (
@@ -271,3 +271,35 @@ def test_a_covariance_that_stops_being_positive_definite_loses_the_estimate_whic
     assert np.allclose(e.attitude_covariance, np.eye(3) * math.pi**2)   # published as lost, not as known
     est.on_star_tracker(tracker(0.1, Q))
     assert est.on_gyro(gyro(0.1)).health == Health.CONVERGED
+
+
+def test_estimators_reprocessed_together_reach_the_states_they_reach_alone():
+    """reprocess_together (the lockstep Monte Carlo's) is each estimator's own reprocessing: late
+    trackers, a run whose trackers are wrong until it loses its estimate and reinitialises, a blind
+    run, and one of another tuning (propagated on its own) end bit for bit where they end alone."""
+    wrong = rot.multiply(Q, rot.from_axis_angle([1, 0, 0], 0.2))
+
+    def streams():
+        return [(estimator(), lambda t: truth(t), True), (estimator(lost_after=3), lambda t: wrong, True),
+                (estimator(), lambda t: truth(t), False), (estimator(arw=2 * GYRO.arw), lambda t: truth(t), True)]
+
+    alone, together = streams(), streams()
+    for k in range(60):
+        t = 0.05 * k
+        late = [tracker(t - 0.1, q(t - 0.1), valid=valid) for _, q, valid in alone] if k >= 2 and k % 4 == 2 else None
+        for i, (est, _, _) in enumerate(alone):
+            if late:
+                est.on_star_tracker(late[i])
+            est.on_gyro(gyro(t, OMEGA))
+        if late:
+            reprocess_together([(est, est.take_star_tracker(m)) for (est, _, _), m in zip(together, late)])
+        rates = [est.take_gyro(gyro(t, OMEGA)) for est, _, _ in together]
+        reprocess_together([(est, est.newest) for est, _, _ in together])
+        for (est, _, _), omega in zip(together, rates):
+            est.publish(t, omega)
+    assert alone[1][0].rejected >= 3 and alone[2][0].state is None
+    for (a, _, _), (b, _, _) in zip(alone, together):
+        assert (a.state is None) == (b.state is None) and a.rejected == b.rejected and a.lost_at == b.lost_at
+        if a.state is not None:
+            for name in ("t", "q", "bias", "P", "C"):
+                np.testing.assert_array_equal(getattr(a.state, name), getattr(b.state, name))
