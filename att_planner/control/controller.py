@@ -155,6 +155,7 @@ class Controller:
         self.maneuver: Maneuver | None = None
         self.hold_q: np.ndarray | None = None          # final attitude held after a maneuver
         self.cache = PlanCache(context, config.max_cached_plans, config.max_cache_bytes)
+        self.references = tracking.ReferenceMemo()     # the plan's reference (shared by lockstep runs)
         self.guidance_sky = guidance_sky
         self.pointing = None                           # the pointing law of MODE_POINTING (guidance.laws)
         self.safe_law = None                           # the safe mode's Sun pointing, built when first used
@@ -437,7 +438,7 @@ class Controller:
         s, m, sc = self.state, self.maneuver, self.spacecraft
         plan = m.plan
         elapsed = s.t - m.t0
-        ref = tracking.plan_reference(plan, elapsed)
+        ref = self.references(plan, elapsed)
         if plan.control_kind == ControlKind.WHEEL_TORQUE:
             # the plan's wheel torques as feedforward, PD feedback about its reference states
             fb = tracking.tracking_torque(s.q, s.omega, tracking.Reference(ref.q, ref.omega, np.zeros(3)),

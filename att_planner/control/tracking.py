@@ -65,6 +65,19 @@ def plan_reference(plan: Plan, t: float) -> Reference:
     return Reference(q_ref, w_ref, tau)
 
 
+class ReferenceMemo:
+    """:func:`plan_reference` remembering its latest answer: controllers flying one plan object
+    from one start (lockstep Monte Carlo runs) share one and compute each instant's reference once."""
+
+    def __init__(self):
+        self.plan, self.t, self.reference = None, math.nan, None
+
+    def __call__(self, plan: Plan, t: float) -> Reference:
+        if plan is not self.plan or t != self.t:
+            self.plan, self.t, self.reference = plan, t, plan_reference(plan, t)
+        return self.reference
+
+
 def tracking_torque(q, omega, ref: Reference, kp: float, kd: float) -> np.ndarray:
     e = rot.error_vector(q, ref.q)     # sign chosen so that e_w >= 0 (shortest way back)
     return ref.torque - kp * 2.0 * e - kd * (np.asarray(omega) - ref.omega)

@@ -57,17 +57,19 @@ class Trace:
 
 class ClosedLoop:
     def __init__(self, scenario: Scenario, *, overrides: dict | None = None, seed: int | None = None,
-                 q0=rot.IDENTITY, omega0=(0.0, 0.0, 0.0), wheel_speed0=None, simulation: Simulation | None = None):
+                 q0=rot.IDENTITY, omega0=(0.0, 0.0, 0.0), wheel_speed0=None, simulation: Simulation | None = None,
+                 key: Ed25519PrivateKey | None = None):
         """``overrides``: ``{node: {parameter: value}}`` over the scenario's sections (simulator
         ``step``/``publish_rate``, every controller and estimator parameter); ``seed``: the noise
-        seed (default the scenario's); ``simulation``: a prepared one (e.g. a dispersed truth)."""
+        seed (default the scenario's); ``simulation``: a prepared one (e.g. a dispersed truth);
+        ``key``: the plan-signing key (default a new one; loops sharing one can share issued plans)."""
         overrides = overrides or {}
         sections = scenario.node_params
         sim_param = SectionReader(sections.get("simulator", {}), str(scenario.path), overrides.get("simulator"))
         self.step = sim_param("step", DEFAULT_STEP, 0.0, 1.0, low_open=True)
         self.publish_period = 1.0 / sim_param("publish_rate", min(10.0, 1.0 / self.step), 0.0,
                                               (1 + 1e-9) / self.step, low_open=True)
-        self.key = Ed25519PrivateKey.generate()
+        self.key = key or Ed25519PrivateKey.generate()
         ctl_param = SectionReader(sections.get("controller", {}), str(scenario.path), overrides.get("controller"))
         self.controller = controller_from_scenario(ctl_param, scenario, key=self.key.public_key())
         self.estimator = None
@@ -94,10 +96,12 @@ class ClosedLoop:
         signing.sign(msg, self.key)
         return convert.plan_from_msg(msg), signing.payload(msg)
 
-    def execute(self, plan: Plan, plan_id: str = "plan", after: PointingMode | None = None) -> RequestError | None:
+    def execute(self, plan: Plan, plan_id: str = "plan", after: PointingMode | None = None,
+                issued: tuple[Plan, bytes] | None = None) -> RequestError | None:
         """Start flying ``plan`` now, handing over to the pointing mode ``after`` at its end (why
-        not, when it cannot start)."""
-        received, payload = self.issue(plan, plan_id)
+        not, when it cannot start); ``issued``: what :meth:`issue` made of it already (loops of one
+        key flying one plan share it)."""
+        received, payload = issued or self.issue(plan, plan_id)
         resolved, refused = self.controller.resolve(received.plan_id, received, payload)
         return refused or self.controller.start(resolved, after)
 

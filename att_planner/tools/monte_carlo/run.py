@@ -10,9 +10,9 @@ waits before it sends a goal; then the controller flies the plan and holds its e
 ``settle_time``. The outcomes are taken at every control instant of the flown truth.
 
 The runs of a task fly in lockstep (:func:`fly_together`): each run's flight software steps on its
-own, and the simulations of the runs still going advance in one RK4 step on arrays of runs
-(:class:`att_sim.lockstep.Lockstep`), which gives each run the bits it gets alone — a run's row does
-not depend on the runs it flew with, so a run is reproduced alone from its seed.
+own, the heavy numerics of a step are done for all the runs at once — the estimators' propagations,
+the plan's reference, one RK4 step of every simulation — and each run gets the bits it gets alone:
+a run's row does not depend on the runs it flew with, so a run is reproduced alone from its seed.
 """
 from __future__ import annotations
 
@@ -21,8 +21,10 @@ import time
 from dataclasses import dataclass, replace
 
 import numpy as np
+from cryptography.hazmat.primitives.asymmetric.ed25519 import Ed25519PrivateKey
 
 from att_msgs_py.types import Health, ManeuverResult, Plan, Verification
+from att_planner.control.tracking import ReferenceMemo
 from att_planner.estimation.estimator import reprocess_together
 from att_planner.tools.closed_loop import ClosedLoop, plan_in_process
 from att_planner.tools.demo import maneuver_from_scenario, zone_margins
@@ -86,12 +88,13 @@ def applied_columns(values: dict, loop: ClosedLoop) -> dict:
     return out
 
 
-def loop_for(setup: Setup, truth: disp.Truth) -> ClosedLoop:
-    """The closed loop of the nominal scenario's flight software on the dispersed truth."""
+def loop_for(setup: Setup, truth: disp.Truth, key: Ed25519PrivateKey | None = None) -> ClosedLoop:
+    """The closed loop of the nominal scenario's flight software on the dispersed truth (``key``:
+    its plan-signing key, default a new one)."""
     s = truth.scenario
     sim = Simulation.for_scenario(s, q0=truth.q0, omega0=truth.omega0, seed=truth.seed,
                                   checks=Checks(body_frame_id=s.body_frame_id))
-    return ClosedLoop(setup.scenario, simulation=sim)
+    return ClosedLoop(setup.scenario, simulation=sim, key=key)
 
 
 @dataclass
@@ -102,6 +105,7 @@ class _Flight:
     loop: ClosedLoop
     row: dict
     deadline: float
+    issued: tuple                   # the plan as the loops' one key issued it
     flying: bool = False
     start: float = math.nan
 
@@ -117,7 +121,7 @@ class _Flight:
                     return True
                 return self.end(313, f"the estimate did not converge within {setup.campaign.converge_timeout:g} s")
             self.start, self.flying = sim.t, True
-            refused = loop.execute(setup.plan)
+            refused = loop.execute(setup.plan, issued=self.issued)
             if refused is not None:
                 return self.end(int(refused.code), refused.message)
             loop.result = None
@@ -135,18 +139,22 @@ class _Flight:
 
 def fly_together(setup: Setup, runs: list[tuple[int, int]], tap=None) -> list[dict]:
     """The rows of ``(run, seed)`` pairs (applied values and outcomes, :data:`OUTCOMES`), flown in
-    lockstep: each run converges, then flies the plan, as it would alone, and the simulations of the
-    runs still going advance together (:class:`att_sim.lockstep.Lockstep`: the bits of each run
-    alone, for about the cost of one run's step). ``cpu_seconds``: the group's CPU time shared
-    equally. ``tap``: see :attr:`ClosedLoop.tap` (a full log; one run)."""
+    lockstep: each run converges, then flies the plan, as it would alone; at each step the runs'
+    estimators reprocess together (:func:`~att_planner.estimation.estimator.reprocess_together`:
+    their propagations as one stack), their controllers share the plan's reference (one plan object,
+    issued once with the loops' one key: :class:`~att_planner.control.tracking.ReferenceMemo`), and
+    the simulations of the runs still going advance together (:class:`att_sim.lockstep.Lockstep`) —
+    every run to the bits it reaches alone. ``cpu_seconds``: the group's CPU time shared equally.
+    ``tap``: see :attr:`ClosedLoop.tap` (a full log; one run)."""
     cpu = time.process_time()
-    flights = []
+    flights, key, references, issued = [], Ed25519PrivateKey.generate(), ReferenceMemo(), None
     for run, seed in runs:
         truth, values = dispersed(setup, seed)
-        loop = loop_for(setup, truth)
-        loop.tap = tap
+        loop = loop_for(setup, truth, key)
+        loop.tap, loop.controller.references = tap, references
+        issued = issued or loop.issue(setup.plan)
         flights.append(_Flight(setup, loop, {"run": run, "seed": seed, **applied_columns(values, loop)},
-                               loop.sim.t + setup.campaign.converge_timeout))
+                               loop.sim.t + setup.campaign.converge_timeout, issued))
     going, lockstep = flights, None
     while going:
         still = [f for f in going if f.going()]
