@@ -453,7 +453,6 @@ class Estimator:
         self.records = [r for r in self.records if r.t > self.snapshots[0][0]]
 
 
-
 def reprocess_together(jobs: list[tuple[Estimator, int | None]]) -> None:
     """:meth:`Estimator.reprocess` of several estimators at once (lockstep Monte Carlo runs): their
     reprocessings advance side by side, and the propagations they need at each turn that share one
@@ -476,14 +475,14 @@ def _propagate_together(requests: list[tuple[Estimator, tuple]]) -> list:
     """:meth:`Estimator._propagate` of each ``(estimator, (x, ω_m, t, saturated))``: the real
     propagations of the first one's tuning as one stack, the others one by one."""
     out = [None] * len(requests)
-    stack = []
+    stack, first = [], None
     for i, (e, (x, omega, t, saturated)) in enumerate(requests):
-        if x is None or t <= x.t or not _same_tuning(e, requests[0][0]):
-            out[i] = e._propagate(x, omega, t, saturated)
-        else:
+        if x is not None and t > x.t and (first is None or _same_tuning(e, first)):
+            first = first or e
             stack.append(i)
+        else:
+            out[i] = e._propagate(x, omega, t, saturated)
     if stack:
-        first = requests[stack[0]][0]
         states, omegas, intervals = [], [], []
         for i in stack:
             e, (x, omega, t, saturated) = requests[i]
