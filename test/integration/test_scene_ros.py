@@ -3,6 +3,7 @@ recorded; the log, decoded by rosbags from its own definitions, holds /tf with t
 the inertial one (the state's attitude) and the Earth-fixed frame (skyfield's ITRS, at -r), the
 zones' cones where the sky puts them, their margins, and the plan's boresight path."""
 import math
+import time
 from datetime import timedelta
 
 import numpy as np
@@ -10,6 +11,7 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 from att_msgs_py import topics
+from att_msgs_py.log import read_log
 from att_planner.nodes.client import maneuver_request
 from att_sim import rotations as rot
 from att_sim import scenario as scen
@@ -34,6 +36,21 @@ def decode(path):
     return out, types
 
 
+def recorded(path, topic: str, timeout: float) -> bool:
+    """Whether the recorder has written a message of ``topic`` to ``path`` (it flushes every 0.5 s;
+    read while it writes) within ``timeout`` s: the planner's latched markers reach it whenever its
+    executor gets to them, which under load can be after a fast simulator's end."""
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        try:
+            if len(read_log(path, topics=[topic]).get(topic, ())):
+                return True
+        except (OSError, ValueError):
+            pass                    # not written yet, or a chunk half written: try again
+        time.sleep(0.2)
+    return False
+
+
 def stamp(msg) -> float:
     return msg.header.stamp.sec + msg.header.stamp.nanosec * 1e-9
 
@@ -47,6 +64,7 @@ def test_a_recorded_real_sky_run_holds_tf_markers_and_the_plan_path(ros_suite):
                                                   time_budget=10.0, frame_id="gcrs"))
         assert response.success, response.message
         assert s.suite.wait_for_output("simulator", "end_time reached", timeout=120)
+        assert recorded(s.mcap, topics.PLAN_MARKERS, timeout=60)     # the simulator may end before it arrives
         s.stop()
     log, types = decode(s.mcap)
     assert types[topics.TF] == "tf2_msgs/msg/TFMessage"
