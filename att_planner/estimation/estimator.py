@@ -60,6 +60,7 @@ from att_msgs_py.types import (
 from att_planner.estimation import mekf
 from att_planner.estimation.attitude_determination import quest, sun_vector
 from att_planner.estimation.inputs import DipoleLog, InputChecks
+from att_planner.estimation.lockstep import resume
 from att_sim import rotations as rot
 from att_sim.sensors.specs import SensorSpecs
 
@@ -169,7 +170,7 @@ class Estimator:
         than ``max_gyro_gap`` after the last is refused unless none came for ``resync_timeout`` s, in
         which case it starts a new timeline (a restarted simulator): the filter starts afresh. In
         three parts (:meth:`take_gyro`, :meth:`reprocess` from :attr:`newest`, :meth:`publish`) for
-        :func:`reprocess_together`."""
+        :func:`att_planner.estimation.lockstep.reprocess_together`."""
         omega = self.take_gyro(m, wall)
         self.reprocess(self.newest)
         return self.publish(m.t, omega)
@@ -301,14 +302,15 @@ class Estimator:
         through each gyro interval, stopping at measurement instants to apply them."""
         if start is None:
             return
-        steps = self._reprocess_steps(start)
+        steps = self.reprocess_steps(start)
         request = next(steps, None)
         while request is not None:
-            request = _resume(steps, self._propagate(*request))
+            request = resume(steps, self.propagate_to(*request))
 
-    def _reprocess_steps(self, start: int):
+    def reprocess_steps(self, start: int):
         """:meth:`reprocess` as a generator: yields each propagation ``(x, ω_m, t, saturated)`` and
-        goes on with the state sent back (:meth:`_propagate`'s, or :func:`reprocess_together`'s)."""
+        goes on with the state sent back (:meth:`propagate_to`'s, or
+        :func:`~att_planner.estimation.lockstep.reprocess_together`'s)."""
         t0, x = self.snapshots[start]
         while len(self.snapshots) > start + 1:
             self.snapshots.pop()
@@ -328,20 +330,23 @@ class Estimator:
                 self.snapshots.popleft()
             self.records = [r for r in self.records if r.t > self.snapshots[0][0]]
 
-    def _propagate(self, x: mekf.FilterState | None, omega: np.ndarray, t: float,
-                   saturated: bool) -> mekf.FilterState | None:
+    def propagate_to(self, x: mekf.FilterState | None, omega: np.ndarray, t: float,
+                     saturated: bool) -> mekf.FilterState | None:
+        """``x`` propagated to ``t`` on the gyro rate ``omega`` (unchanged when there is nothing to do;
+        None when the covariance goes bad: the estimate is lost)."""
         if x is None or t <= x.t:
             return x
-        dt, extra = self._interval(x, t, saturated)
+        dt, extra = self.interval(x, t, saturated)
         x = mekf.propagate(x, omega, dt, self.config.arw, self.config.rrw, self.consider, extra)
-        return self._checked(t, x, mekf.healthy(x.P))
+        return self.checked(t, x, mekf.healthy(x.P))
 
-    def _interval(self, x: mekf.FilterState, t: float, saturated: bool) -> tuple[float, float]:
+    def interval(self, x: mekf.FilterState, t: float, saturated: bool) -> tuple[float, float]:
         """``dt`` from ``x`` to ``t`` and the attitude variance a saturated sample adds over it."""
         dt = t - x.t
         return dt, (self.specs.gyro.range * dt) ** 2 if saturated and self.specs.gyro else 0.0
 
-    def _checked(self, t: float, x: mekf.FilterState, healthy: bool) -> mekf.FilterState | None:
+    def checked(self, t: float, x: mekf.FilterState, healthy: bool) -> mekf.FilterState | None:
+        """``x`` propagated to ``t``, or None (the estimate lost) when its covariance is not ``healthy``."""
         return x if healthy else self._lose(t, f"covariance not positive definite at t = {t:.3f} s")
 
     def _lose(self, t: float, why: str) -> None:
@@ -451,62 +456,3 @@ class Estimator:
         while self.gyro and self.gyro[0][0] <= self.snapshots[0][0]:
             self.gyro.popleft()
         self.records = [r for r in self.records if r.t > self.snapshots[0][0]]
-
-
-def reprocess_together(jobs: list[tuple[Estimator, int | None]]) -> None:
-    """:meth:`Estimator.reprocess` of several estimators at once (lockstep Monte Carlo runs): their
-    reprocessings advance side by side, and the propagations they need at each turn that share one
-    tuning go as one stack (:func:`~att_planner.estimation.mekf.propagate_runs`: each to the bits it
-    reaches alone); each estimator's own operations keep their order."""
-    live = []
-    for e, start in jobs:
-        if start is not None:
-            steps = e._reprocess_steps(start)
-            request = next(steps, None)
-            if request is not None:
-                live.append((e, steps, request))
-    while live:
-        states = _propagate_together([(e, request) for e, _, request in live])
-        live = [(e, steps, request) for (e, steps, _), x in zip(live, states)
-                if (request := _resume(steps, x)) is not None]
-
-
-def _propagate_together(requests: list[tuple[Estimator, tuple]]) -> list:
-    """:meth:`Estimator._propagate` of each ``(estimator, (x, ω_m, t, saturated))``: the real
-    propagations of the first one's tuning as one stack, the others one by one."""
-    out = [None] * len(requests)
-    stack, first = [], None
-    for i, (e, (x, omega, t, saturated)) in enumerate(requests):
-        if x is not None and t > x.t and (first is None or _same_tuning(e, first)):
-            first = first or e
-            stack.append(i)
-        else:
-            out[i] = e._propagate(x, omega, t, saturated)
-    if stack:
-        states, omegas, intervals = [], [], []
-        for i in stack:
-            e, (x, omega, t, saturated) = requests[i]
-            states.append(x)
-            omegas.append(omega)
-            intervals.append(e._interval(x, t, saturated))
-        propagated = mekf.propagate_runs(states, np.array(omegas), [dt for dt, _ in intervals], first.config.arw,
-                                         first.config.rrw, first.consider, [extra for _, extra in intervals])
-        for i, x, ok in zip(stack, propagated, mekf.healthy_runs(np.array([x.P for x in propagated]))):
-            e, (_, _, t, _) = requests[i]
-            out[i] = e._checked(t, x, ok)
-    return out
-
-
-def _resume(steps, value):
-    """The generator ``steps`` sent ``value``: its next request, None when it has finished."""
-    try:
-        return steps.send(value)
-    except StopIteration:
-        return None
-
-
-def _same_tuning(a: Estimator, b: Estimator) -> bool:
-    """Whether ``a`` and ``b`` propagate with the same noise figures and considered variances."""
-    same_consider = (a.consider is None and b.consider is None) or (
-        a.consider is not None and b.consider is not None and np.array_equal(a.consider, b.consider))
-    return a.config.arw == b.config.arw and a.config.rrw == b.config.rrw and same_consider

@@ -25,7 +25,7 @@ from cryptography.hazmat.primitives.asymmetric.ed25519 import Ed25519PrivateKey
 
 from att_msgs_py.types import Health, ManeuverResult, Plan, Verification
 from att_planner.control.tracking import ReferenceMemo
-from att_planner.estimation.estimator import reprocess_together
+from att_planner.estimation.lockstep import reprocess_together
 from att_planner.tools.closed_loop import ClosedLoop, plan_in_process
 from att_planner.tools.demo import maneuver_from_scenario, zone_margins
 from att_planner.verification import rejection

@@ -17,8 +17,9 @@ from att_msgs_py.types import (
     StarTrackerMeasurement,
     SunSensorMeasurement,
 )
-from att_planner.estimation.estimator import Estimator, EstimatorConfig, reprocess_together
+from att_planner.estimation.estimator import Estimator, EstimatorConfig
 from att_planner.estimation.inputs import Sources
+from att_planner.estimation.lockstep import reprocess_together
 from att_sim import rotations as rot
 from att_sim.sensors.specs import (
     ARCSEC,

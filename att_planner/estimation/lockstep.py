@@ -1,0 +1,75 @@
+"""Estimators of lockstep Monte Carlo runs reprocessed together (no ROS).
+
+The runs of a Monte Carlo task step in lockstep: at each step every run's estimator reprocesses
+(catches up with its gyro sample, replays a late tracker sample). :func:`reprocess_together` runs
+their :meth:`Estimator.reprocess_steps <att_planner.estimation.estimator.Estimator.reprocess_steps>`
+side by side and propagates, at each turn, the filters of one tuning as one stack
+(:func:`att_planner.estimation.mekf.propagate_runs`), each to the bits it reaches alone; each
+estimator's own operations keep their order.
+"""
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from att_planner.estimation import mekf
+
+if TYPE_CHECKING:
+    from att_planner.estimation.estimator import Estimator
+
+
+def reprocess_together(jobs: list[tuple[Estimator, int | None]]) -> None:
+    """:meth:`Estimator.reprocess` of each ``(estimator, start)`` (start None: nothing to do), all at once."""
+    live = []
+    for e, start in jobs:
+        if start is not None:
+            steps = e.reprocess_steps(start)
+            request = next(steps, None)
+            if request is not None:
+                live.append((e, steps, request))
+    while live:
+        states = _propagate_together([(e, request) for e, _, request in live])
+        live = [(e, steps, request) for (e, steps, _), x in zip(live, states)
+                if (request := resume(steps, x)) is not None]
+
+
+def _propagate_together(requests: list[tuple[Estimator, tuple]]) -> list:
+    """:meth:`Estimator.propagate_to` of each ``(estimator, (x, ω_m, t, saturated))``: the real
+    propagations of the first one's tuning as one stack, the others one by one."""
+    out = [None] * len(requests)
+    stack, first = [], None
+    for i, (e, (x, omega, t, saturated)) in enumerate(requests):
+        if x is not None and t > x.t and (first is None or _same_tuning(e, first)):
+            first = first or e
+            stack.append(i)
+        else:
+            out[i] = e.propagate_to(x, omega, t, saturated)
+    if stack:
+        states, omegas, intervals = [], [], []
+        for i in stack:
+            e, (x, omega, t, saturated) = requests[i]
+            states.append(x)
+            omegas.append(omega)
+            intervals.append(e.interval(x, t, saturated))
+        propagated = mekf.propagate_runs(states, np.array(omegas), [dt for dt, _ in intervals], first.config.arw,
+                                         first.config.rrw, first.consider, [extra for _, extra in intervals])
+        for i, x, ok in zip(stack, propagated, mekf.healthy_runs(np.array([x.P for x in propagated]))):
+            e, (_, _, t, _) = requests[i]
+            out[i] = e.checked(t, x, ok)
+    return out
+
+
+def resume(steps, value):
+    """The generator ``steps`` sent ``value``: its next request, None when it has finished."""
+    try:
+        return steps.send(value)
+    except StopIteration:
+        return None
+
+
+def _same_tuning(a: Estimator, b: Estimator) -> bool:
+    """Whether ``a`` and ``b`` propagate with the same noise figures and considered variances."""
+    same_consider = (a.consider is None and b.consider is None) or (
+        a.consider is not None and b.consider is not None and np.array_equal(a.consider, b.consider))
+    return a.config.arw == b.config.arw and a.config.rrw == b.config.rrw and same_consider
