@@ -43,8 +43,10 @@ covariance grown by ``(range Δt)²`` per axis: the true rate is unknown beyond 
 from __future__ import annotations
 
 import math
+from bisect import bisect_right
 from collections import deque
 from dataclasses import dataclass, field
+from operator import attrgetter
 
 import numpy as np
 
@@ -103,6 +105,9 @@ class _Record:
     kind: str                              # "tracker", "magnetometer", "sun"
     data: object
     accepted: bool | None = None           # None until it is first processed
+
+
+_instant = attrgetter("t")                 # a record's instant: the records' sort key
 
 
 @dataclass
@@ -292,7 +297,7 @@ class Estimator:
                                f"{record.kind} measurement of t = {record.t:.6g} s is ahead of the gyro (t = "
                                f"{newest:.6g} s) by more than max_gyro_gap = {self.config.max_gyro_gap:g} s")
         self.records.append(record)
-        self.records.sort(key=lambda r: r.t)          # stable: equal instants keep their arrival order
+        self.records.sort(key=_instant)               # stable: equal instants keep their arrival order
         if record.t <= self.snapshots[-1][0]:
             return max(i for i, (t, _) in enumerate(self.snapshots) if t < record.t)
         return None
@@ -314,9 +319,9 @@ class Estimator:
         t0, x = self.snapshots[start]
         while len(self.snapshots) > start + 1:
             self.snapshots.pop()
-        records = [r for r in self.records if r.t > t0]
+        records = self._records_after(t0)
         k = 0
-        for t_j, omega, saturated in [g for g in self.gyro if g[0] > t0]:
+        for t_j, omega, saturated in self._gyro_after(t0):
             while k < len(records) and records[k].t <= t_j:
                 x = self._apply((yield x, omega, records[k].t, saturated), records[k])
                 k += 1
@@ -328,7 +333,20 @@ class Estimator:
         if self.lost_at > self.snapshots[0][0]:       # nothing before a loss is replayed: drop it
             while len(self.snapshots) > 1 and self.snapshots[0][0] < self.lost_at:
                 self.snapshots.popleft()
-            self.records = [r for r in self.records if r.t > self.snapshots[0][0]]
+            self.records = self._records_after(self.snapshots[0][0])
+
+    def _records_after(self, t: float) -> list[_Record]:
+        """The records later than ``t`` (kept sorted by time)."""
+        return self.records[bisect_right(self.records, t, key=_instant):]
+
+    def _gyro_after(self, t: float) -> list[tuple[float, np.ndarray, bool]]:
+        """The gyro samples later than ``t``, oldest first (their stamps increase)."""
+        after = []
+        for sample in reversed(self.gyro):
+            if sample[0] <= t:
+                break
+            after.append(sample)
+        return after[::-1]
 
     def propagate_to(self, x: mekf.FilterState | None, omega: np.ndarray, t: float,
                      saturated: bool) -> mekf.FilterState | None:
@@ -455,4 +473,4 @@ class Estimator:
             self.snapshots.popleft()
         while self.gyro and self.gyro[0][0] <= self.snapshots[0][0]:
             self.gyro.popleft()
-        self.records = [r for r in self.records if r.t > self.snapshots[0][0]]
+        self.records = self._records_after(self.snapshots[0][0])

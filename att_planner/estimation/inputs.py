@@ -104,8 +104,8 @@ class DipoleLog:
         self.commands.append((float(t), bool(np.any(np.asarray(dipole, float) != 0.0))))
 
     def clean(self, t: float) -> bool:
-        before = [on for stamp, on in self.commands if stamp < t - 1e-9]
-        return not (before and before[-1])
+        on = next((on for stamp, on in reversed(self.commands) if stamp < t - 1e-9), False)   # the last before t
+        return not on
 
 
 class Sources:
