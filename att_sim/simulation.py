@@ -274,7 +274,7 @@ class Simulation:
             return Readings()
         x = self.x
         return self.sensors.sample(self.t, x[:4], x[4:7], dyn.relative_wheel_speed(self.sc, x[7:], x[4:7]),
-                                   self.now.field_B, self.applied.dipole, self.environment.bodies(self.t))
+                                   self.now.field_B, self.applied.dipole, lambda: self.environment.bodies(self.t))
 
     def advance(self, dt: float) -> None:
         """One RK4 step, the actuator inputs held and the environment evaluated at every stage; a

@@ -51,8 +51,9 @@ class Trace:
     mode: list = field(default_factory=list)
     attitude_error: list = field(default_factory=list)    # rad, from the controller's reference (status)
 
-    def arrays(self) -> dict[str, np.ndarray]:
-        return {k: np.asarray(v) for k, v in self.__dict__.items()}
+    def arrays(self, *names: str) -> dict[str, np.ndarray]:
+        """The fields ``names`` (default every one) as arrays."""
+        return {k: np.asarray(getattr(self, k)) for k in names or self.__dict__}
 
 
 class ClosedLoop:

@@ -10,6 +10,7 @@ source added later does not change the others' streams.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -83,12 +84,13 @@ class SensorSuite:
         self.gyro_last: tuple[float, np.ndarray] | None = None               # (t, q) of the last gyro sample
 
     def sample(self, t: float, q: np.ndarray, omega: np.ndarray, relative_wheel_speed: np.ndarray,
-               field_B: np.ndarray, dipole_applied: np.ndarray, bodies: Bodies) -> Readings:
+               field_B: np.ndarray, dipole_applied: np.ndarray, bodies: Callable[[], Bodies]) -> Readings:
         """What the sensors output at time ``t`` for the truth state (attitude ``q``, body rate
         ``omega``, wheel speeds relative to the body) and the environment (``field_B`` in body axes,
-        the applied dipole, ``bodies``). The gyro measures the rotation since its previous sample
-        (at its first sample: ``omega`` over one period); a tracker's measurement of ``t`` comes out
-        at the first call at or after ``t`` + its latency."""
+        the applied dipole, ``bodies()``: called when a sensor that sees them is due). The gyro
+        measures the rotation since its previous sample (at its first sample: ``omega`` over one
+        period); a tracker's measurement of ``t`` comes out at the first call at or after ``t`` + its
+        latency."""
         out = Readings()
         body = self.body_frame_id
         if self.gyro is not None and self.schedules["gyro"].due(t):
@@ -102,17 +104,20 @@ class SensorSuite:
             sigma = self.gyro.noise_sigma(dt)
             out.gyro = GyroMeasurement(t, self.gyro.measure(rotation, dt), np.eye(3) * sigma**2, body)
             out.truth = SensorTruth(t, self.gyro.bias.copy(), self._magnetometer_bias(), body)
+        sky = None
         for tracker, schedule in zip(self.trackers, self.tracker_schedules):
             if schedule.due(t):
-                self.pending.append((t + tracker.spec.latency, tracker.measure(t, q, omega, bodies, self.frame_id)))
-        out.star_trackers = [m for release, m in self.pending if release <= t + 1e-9]
-        self.pending = [(release, m) for release, m in self.pending if release > t + 1e-9]
+                sky = bodies() if sky is None else sky
+                self.pending.append((t + tracker.spec.latency, tracker.measure(t, q, omega, sky, self.frame_id)))
+        if self.pending:
+            out.star_trackers = [m for release, m in self.pending if release <= t + 1e-9]
+            self.pending = [(release, m) for release, m in self.pending if release > t + 1e-9]
         if self.tachometer is not None and self.schedules["tachometer"].due(t):
             out.wheel_speeds = self.tachometer.measure(t, relative_wheel_speed, body)
         if self.magnetometer is not None and self.schedules["magnetometer"].due(t):
             out.magnetometer = self.magnetometer.measure(t, field_B, dipole_applied, body)
         if self.sun_sensors is not None and self.schedules["sun_sensors"].due(t):
-            out.sun_sensors = self.sun_sensors.measure(t, q, bodies, body)
+            out.sun_sensors = self.sun_sensors.measure(t, q, bodies() if sky is None else sky, body)
         return out
 
     def _magnetometer_bias(self) -> np.ndarray:

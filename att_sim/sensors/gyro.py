@@ -53,23 +53,29 @@ class Gyro:
         self.walk = np.zeros(3)
         self.carry = np.zeros(3)          # rad: angle not yet output by the quantiser
         self.bias = self.turn_on + self.flicker.sum(axis=0)
+        self._banks: dict[float, tuple[np.ndarray, np.ndarray]] = {}    # dt -> (a, σ√(1 − a²)) of each process
 
     def noise_sigma(self, dt: float) -> float:
         """1σ of the white rate noise of one sample (rad/s)."""
         return self.spec.arw / math.sqrt(dt)
 
+    def _bank(self, dt: float) -> tuple[np.ndarray, np.ndarray]:
+        """Each flicker process's step over ``dt``: its factor ``a = exp(−Δt/τ)`` and the drive's 1σ
+        (columns), kept for the few intervals a simulator's clock makes."""
+        bank = self._banks.get(dt)
+        if bank is None:
+            if len(self._banks) >= 64:
+                self._banks.clear()
+            a = np.exp(-dt / self.times)[:, None]
+            bank = self._banks[dt] = (a, self.flicker_sigma * np.sqrt(1.0 - a * a))
+        return bank
+
     def _bias(self, n: int, dt: float) -> np.ndarray:
         """The bias at the end of each of ``n`` intervals (n, 3); advances the noise state. Each
-        flicker process is ``x_k = a x_(k-1) + w_k``: one step of the whole bank at once (the
-        simulator's case: the bank's draws in the order of the batch path), a batch through
-        ``scipy.signal.lfilter`` (imported then: it costs a node seconds at start)."""
+        flicker process is ``x_k = a x_(k-1) + w_k``: a batch (n > 1) through ``scipy.signal.lfilter``
+        (imported then: it costs a node seconds at start); one interval is :meth:`_measure_one`'s."""
         flicker = np.zeros((n, 3))
-        if self.flicker_sigma > 0 and n == 1:       # the simulator's case: the bank in one step
-            a = np.exp(-dt / self.times)[:, None]
-            drive = self.rng.standard_normal((len(self.times), 3)) * (self.flicker_sigma * np.sqrt(1.0 - a * a))
-            self.flicker = a * self.flicker + drive
-            flicker[0] = self.flicker.sum(axis=0)
-        elif self.flicker_sigma > 0:
+        if self.flicker_sigma > 0:
             for j, tau in enumerate(self.times):
                 a = math.exp(-dt / tau)
                 drive = self.rng.standard_normal((n, 3)) * (self.flicker_sigma * math.sqrt(1.0 - a * a))
@@ -89,6 +95,9 @@ class Gyro:
         rows of ``rotation`` ((n, 3), or (3,) for one sample: then the result is (3,))."""
         increments = np.atleast_2d(np.asarray(rotation, float))
         n = len(increments)
+        if n == 1:
+            rate = self._measure_one(increments[0], dt)
+            return rate if np.ndim(rotation) == 1 else rate[None, :]
         rate = increments @ self.transfer.T / dt + self._bias(n, dt)
         rate += self.rng.standard_normal((n, 3)) * self.noise_sigma(dt)
         rate = np.minimum(np.maximum(rate, -self.spec.range), self.spec.range)
@@ -97,5 +106,26 @@ class Gyro:
             total = self.carry + np.cumsum(rate * dt, axis=0)
             counted = lsb * np.round(total / lsb)
             self.carry = total[-1] - counted[-1]
-            rate = (counted if n == 1 else np.diff(counted, axis=0, prepend=0.0)) / dt     # the counts of each sample
-        return rate[0] if np.ndim(rotation) == 1 else rate
+            rate = np.diff(counted, axis=0, prepend=0.0) / dt     # the counts of each sample
+        return rate
+
+    def _measure_one(self, rotation: np.ndarray, dt: float) -> np.ndarray:
+        """:meth:`measure` of one interval (the simulator's case): the whole flicker bank in one step
+        (its draws first), then the rate random walk, the white noise."""
+        rng, spec = self.rng, self.spec
+        flicker = np.zeros(3)
+        if self.flicker_sigma > 0:
+            a, drive_sigma = self._bank(dt)
+            self.flicker = a * self.flicker + rng.standard_normal(self.flicker.shape) * drive_sigma
+            flicker = self.flicker.sum(axis=0)
+        self.walk = self.walk + rng.standard_normal(3) * (spec.rrw * math.sqrt(dt))
+        self.bias = self.turn_on + flicker + self.walk
+        rate = rotation @ self.transfer.T / dt + self.bias
+        rate = rate + rng.standard_normal(3) * self.noise_sigma(dt)
+        rate = np.minimum(np.maximum(rate, -spec.range), spec.range)
+        if spec.quantization > 0:
+            total = self.carry + rate * dt
+            counted = spec.quantization * np.round(total / spec.quantization)
+            self.carry = total - counted
+            rate = counted / dt
+        return rate

@@ -174,7 +174,7 @@ def _drive(suite: SensorSuite, duration: float, step: float = 0.05):
     out, q, omega = [], rot.IDENTITY, np.array([0.0, 0.01, 0.0])
     for k in range(int(round(duration / step)) + 1):
         t = k * step
-        out.append((t, suite.sample(t, q, omega, np.zeros(3), np.array([2e-5, 0, 0]), np.zeros(3), bodies())))
+        out.append((t, suite.sample(t, q, omega, np.zeros(3), np.array([2e-5, 0, 0]), np.zeros(3), bodies)))
         q = rot.propagate_constant_rate(q, omega, step)
     return out
 

@@ -190,7 +190,7 @@ def settling_time(t: np.ndarray, error: np.ndarray, t_end: float, tolerance: flo
 
 def outcomes(setup: Setup, loop: ClosedLoop, start: float, code: int, message: str) -> dict:
     """The flown truth measured as a plan's verification measures its integration."""
-    a = loop.trace.arrays()
+    a = loop.trace.arrays("t", "q_true", "omega_true", "wheel_speeds", "wheel_torques")
     sc, m = setup.scenario.spacecraft, setup.maneuver
     if a["t"].size == 0:
         return {"success": False, "code": int(code), "final_error_deg": math.nan, "final_rate": math.nan,
