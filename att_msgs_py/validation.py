@@ -37,6 +37,8 @@ def text(value, name: str, code: ErrorCode = ErrorCode.INVALID_TEXT, max_length:
         raise RequestError(code, f"{name} must be a string, got {type(value).__name__}")
     if len(value) > max_length:
         raise RequestError(ErrorCode.SIZE_LIMIT, f"{name} has {len(value)} characters; at most {max_length}")
+    if value.isascii() and value.isprintable():      # printable ASCII has none of them (the common case)
+        return value
     bad = next((ch for ch in value if unicodedata.category(ch) in ("Cc", "Cf", "Cs", "Cn")), None)
     if bad is not None:
         raise RequestError(ErrorCode.INVALID_TEXT,
@@ -75,7 +77,8 @@ def sendable_epoch(epoch: datetime, name: str, code: ErrorCode = ErrorCode.INVAL
 def finite_array(value, name: str, code: ErrorCode, shape: tuple | None = None) -> np.ndarray:
     """A float array of ``shape`` (``-1`` for any length) with only finite entries."""
     a = np.asarray(value, dtype=float)
-    if shape is not None and (a.ndim != len(shape) or any(s not in (-1, n) for s, n in zip(shape, a.shape))):
+    if shape is not None and a.shape != shape and (a.ndim != len(shape) or
+                                                   any(s not in (-1, n) for s, n in zip(shape, a.shape))):
         want = "x".join("K" if s == -1 else str(s) for s in shape)
         raise RequestError(code, f"{name} has shape {'x'.join(map(str, a.shape)) or 'scalar'}; expected {want}")
     finite = all(map(math.isfinite, a.ravel().tolist())) if a.size <= 64 else np.isfinite(a).all()   # small: floats

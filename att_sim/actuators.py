@@ -93,7 +93,7 @@ def actuators_from_params(values, label: str = "actuators") -> ActuatorSpecs:
 
 
 def quantize(value: np.ndarray, lsb: float) -> np.ndarray:
-    return lsb * np.round(np.asarray(value, float) / lsb) if lsb > 0 else np.asarray(value, float)
+    return lsb * np.rint(np.asarray(value, float) / lsb) if lsb > 0 else np.asarray(value, float)
 
 
 def _clip(value: float, limit: float) -> float:

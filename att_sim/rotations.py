@@ -218,9 +218,14 @@ def angle_between(q1: np.ndarray, q2: np.ndarray) -> np.ndarray:
 
 def error_vector(q: np.ndarray, q_ref: np.ndarray) -> np.ndarray:
     """Attitude error ``q_ref^* ⊗ q`` vector part, sign chosen with w >= 0 (body frame)."""
+    q, q_ref = np.asarray(q, float), np.asarray(q_ref, float)
+    if q.shape == (4,) and q_ref.shape == (4,):         # one pair: multiply's scalar formula, p = q_ref*
+        (rx, ry, rz, pw), (qx, qy, qz, qw) = q_ref.tolist(), q.tolist()
+        px, py, pz = -rx, -ry, -rz
+        e = [pw * qx + qw * px + (py * qz - pz * qy), pw * qy + qw * py + (pz * qx - px * qz),
+             pw * qz + qw * pz + (px * qy - py * qx)]
+        return np.array([-c for c in e] if pw * qw - (px * qx + py * qy + pz * qz) < 0 else e)
     e = multiply(conjugate(q_ref), q)
-    if e.shape == (4,):                 # one quaternion
-        return -e[:3] if e[3] < 0 else e[:3]
     sign = np.where(e[..., 3:] < 0, -1.0, 1.0)
     return (e * sign)[..., :3]
 

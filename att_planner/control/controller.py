@@ -209,11 +209,12 @@ class Controller:
             if self.maneuver is not None:
                 out.ended = self.abort(f"aborted: {out.note}")
             self.next_control = -math.inf
-        rate = float(np.linalg.norm(admission.state.omega))
-        if first and self.mode == ControlMode.IDLE and rate > self.config.safe_rate_threshold:
-            self.mode = ControlMode.SAFE
-            out.note = (f"the spacecraft rotates at {rate:.4g} rad/s (above safe_rate_threshold "
-                        f"{self.config.safe_rate_threshold:g} rad/s): rate damping (safe mode)")
+        if first and self.mode == ControlMode.IDLE:
+            rate = float(np.linalg.norm(admission.state.omega))
+            if rate > self.config.safe_rate_threshold:
+                self.mode = ControlMode.SAFE
+                out.note = (f"the spacecraft rotates at {rate:.4g} rad/s (above safe_rate_threshold "
+                            f"{self.config.safe_rate_threshold:g} rad/s): rate damping (safe mode)")
         return out
 
     def accept_estimate(self, estimate: AttitudeEstimate, wall: float = 0.0,

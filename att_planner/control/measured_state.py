@@ -22,6 +22,7 @@ from att_sim.dynamics import Spacecraft
 from att_sim.sensors.specs import SensorSpecs
 
 BAD = ErrorCode.INVALID_MEASUREMENT
+HEALTHS = tuple(Health)
 
 
 class MeasuredState:
@@ -62,7 +63,7 @@ class MeasuredState:
     def compose(self, estimate: AttitudeEstimate) -> State:
         """The state of ``estimate`` with the measured wheel speeds (made inertial) and field; an
         estimate of a health the message does not define is refused (310)."""
-        if estimate.health not in tuple(Health):
+        if estimate.health not in HEALTHS:
             raise RequestError(ErrorCode.INVALID_STATE, f"estimate health {estimate.health!r} is not one of "
                                                         f"{[int(h) for h in Health]}")
         n = self.spacecraft.n_wheels

@@ -92,7 +92,7 @@ def wheel_torques(sc: Spacecraft, body_torque, omega, wheel_speed, extra=None) -
     h_w = sc.wheel_axes @ (sc.wheel_inertia * np.asarray(wheel_speed, float))
     demand = np.asarray(body_torque, float) + rot.cross(omega, h_w)
     u = -sc.wheel_axes_pinv @ demand
-    peak = float(np.max(np.abs(u))) if u.size else 0.0
+    peak = float(np.abs(u).max()) if u.size else 0.0
     if peak > sc.wheel_torque_max:
         u = u * (sc.wheel_torque_max / peak)
     if extra is not None:

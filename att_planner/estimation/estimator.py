@@ -260,10 +260,15 @@ class Estimator:
         if x is None:
             return Health.DIVERGED if self.diverged else Health.INITIALISING
         if self._sigma3[0] is not x:          # asked several times per state: its largest eigenvalue once
-            self._sigma3 = (x, 3.0 * math.sqrt(max(float(np.linalg.eigvalsh(x.P[:3, :3]).max()), 0.0)))
+            self.keep_largest_attitude_variance(float(np.linalg.eigvalsh(x.P[:3, :3]).max()))
         sigma3 = self._sigma3[1]
         recent = t - self.last_fix <= self.config.propagate_timeout
         return Health.CONVERGED if recent and sigma3 <= self.config.converged_attitude_sigma else Health.PROPAGATING
+
+    def keep_largest_attitude_variance(self, largest: float) -> None:
+        """The largest eigenvalue of the newest state's attitude covariance, which :meth:`health`
+        needs (computed for many estimators at once by :func:`~att_planner.estimation.lockstep.reprocess_together`)."""
+        self._sigma3 = (self.state, 3.0 * math.sqrt(max(largest, 0.0)))
 
     def estimate(self, t: float, omega_measured: np.ndarray) -> AttitudeEstimate:
         """The estimate at gyro time ``t`` (the filter's newest state)."""

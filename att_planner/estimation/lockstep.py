@@ -20,7 +20,8 @@ if TYPE_CHECKING:
 
 
 def reprocess_together(jobs: list[tuple[Estimator, int | None]]) -> None:
-    """:meth:`Estimator.reprocess` of each ``(estimator, start)`` (start None: nothing to do), all at once."""
+    """:meth:`Estimator.reprocess` of each ``(estimator, start)`` (start None: nothing to do), all at once;
+    then the largest attitude variance of each one's newest state, which its health needs, as one stack."""
     live = []
     for e, start in jobs:
         if start is not None:
@@ -32,6 +33,18 @@ def reprocess_together(jobs: list[tuple[Estimator, int | None]]) -> None:
         states = _propagate_together([(e, request) for e, _, request in live])
         live = [(e, steps, request) for (e, steps, _), x in zip(live, states)
                 if (request := resume(steps, x)) is not None]
+    _largest_variances([e for e, start in jobs if start is not None])
+
+
+def _largest_variances(estimators: list[Estimator]) -> None:
+    """:meth:`Estimator.keep_largest_attitude_variance` of each estimator's newest state (stacked
+    ``eigvalsh`` gives each matrix the bits it gets alone)."""
+    states = [e.state for e in estimators]
+    stack = [(e, x) for e, x in zip(estimators, states) if x is not None]
+    if len(stack) > 1:
+        largest = np.linalg.eigvalsh(np.array([x.P[:3, :3] for _, x in stack])).max(axis=-1)
+        for (e, _), value in zip(stack, largest.tolist()):
+            e.keep_largest_attitude_variance(value)
 
 
 def _propagate_together(requests: list[tuple[Estimator, tuple]]) -> list:

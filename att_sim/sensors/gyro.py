@@ -104,7 +104,7 @@ class Gyro:
         lsb = self.spec.quantization
         if lsb > 0:
             total = self.carry + np.cumsum(rate * dt, axis=0)
-            counted = lsb * np.round(total / lsb)
+            counted = lsb * np.rint(total / lsb)
             self.carry = total[-1] - counted[-1]
             rate = np.diff(counted, axis=0, prepend=0.0) / dt     # the counts of each sample
         return rate
@@ -125,7 +125,7 @@ class Gyro:
         rate = np.minimum(np.maximum(rate, -spec.range), spec.range)
         if spec.quantization > 0:
             total = self.carry + rate * dt
-            counted = spec.quantization * np.round(total / spec.quantization)
+            counted = spec.quantization * np.rint(total / spec.quantization)
             self.carry = total - counted
             rate = counted / dt
         return rate

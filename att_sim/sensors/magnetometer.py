@@ -27,5 +27,5 @@ class Magnetometer:
         b = self.transfer @ field_B + self.bias + s.dipole_coupling * np.asarray(dipole_applied, float)
         b = b + self.rng.standard_normal(3) * s.noise
         if s.quantization > 0:
-            b = s.quantization * np.round(b / s.quantization)
+            b = s.quantization * np.rint(b / s.quantization)
         return MagnetometerMeasurement(t=t, field=b, covariance=self.covariance, frame_id=frame_id)

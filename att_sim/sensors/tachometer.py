@@ -16,5 +16,5 @@ class Tachometer:
         s = self.spec
         speeds = np.asarray(relative_speed, float) + self.rng.standard_normal(len(relative_speed)) * s.noise
         if s.quantization > 0:
-            speeds = s.quantization * np.round(speeds / s.quantization)
+            speeds = s.quantization * np.rint(speeds / s.quantization)
         return WheelSpeedMeasurement(t=t, speeds=speeds, frame_id=frame_id)
