@@ -97,5 +97,19 @@ class Lockstep:
         mean = dyn.rk4_mean(*(dyn.torque_sum(tau_body, dipole, fb, te) for fb, te in stages))
         body = np.array([m - g for m, g in zip(mean, dyn.through_wheels(G, net))]).T
         motor = np.array(motor, float).reshape(len(u), len(sims)).T
+        samples = self._samples(sims[0].t + dt, x_new)
         for i, (s, inp) in enumerate(zip(sims, inputs)):
-            s.finish_step(x_new[:, i].copy(), dt, Applied(motor[i].copy(), inp.dipole, body[i].copy()))
+            s.finish_step(x_new[:, i].copy(), dt, Applied(motor[i].copy(), inp.dipole, body[i].copy()), samples[i])
+
+    def _samples(self, t: float, x: np.ndarray) -> list:
+        """Each run's :meth:`Environment.sample <att_sim.world.Environment.sample>` at ``t`` and its
+        state (a column of ``x``), the field in body axes of all at once; Nones (each run samples
+        alone) when an environment cannot be evaluated."""
+        try:
+            field_b, tau_env = self._stage(t, x)
+        except ValueError:
+            return [None] * len(self.sims)
+        field_b = np.array(field_b).T
+        tau_env = [None] * len(self.sims) if tau_env is None else np.array(tau_env).T
+        return [s.environment.sample_of(t, b.copy(), None if tau is None else tau.copy())
+                for s, b, tau in zip(self.sims, field_b, tau_env)]

@@ -303,11 +303,13 @@ class Simulation:
         body = [m - g for m, g in zip(dyn.mean_external_torque(inp, stages).tolist(), dyn.through_wheels(G, net))]
         self.finish_step(x_new, dt, Applied(np.array(motor, float), inp.dipole, np.array(body)))
 
-    def finish_step(self, x_new: np.ndarray, dt: float, applied: Applied) -> None:
+    def finish_step(self, x_new: np.ndarray, dt: float, applied: Applied, sample: world.Sample | None = None) -> None:
         """Take the state ``x_new`` a step of ``dt`` reached and what acted over it, or halt: a
-        non-finite state, an environment that cannot be evaluated there."""
+        non-finite state, an environment that cannot be evaluated there. ``sample``: the
+        environment's sample there, when it is known already."""
         try:
-            now = self.environment.sample(self.t + dt, x_new[:4]) if np.all(np.isfinite(x_new)) else None
+            finite = np.all(np.isfinite(x_new))
+            now = None if not finite else self.environment.sample(self.t + dt, x_new[:4]) if sample is None else sample
         except ValueError as err:
             self.halt_environment(err)
             return

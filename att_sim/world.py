@@ -241,6 +241,9 @@ class Environment:
 
     def sample(self, t: float, q: np.ndarray) -> Sample:
         """Field, total disturbance torque, position and shadow at time ``t`` and attitude ``q``."""
+        return self.sample_of(t, *self.stage(t, np.asarray(q, float)))
+
+    def sample_of(self, t: float, field_b: np.ndarray, torque: np.ndarray | None) -> Sample:
+        """:meth:`sample` of the attitude whose :meth:`stage` values at ``t`` are ``field_b``, ``torque``."""
         now = self._now(t)
-        field_b, torque = self.stage(t, np.asarray(q, float))
         return Sample(field_b, np.zeros(3) if torque is None else torque, now.r.copy(), now.shadow)

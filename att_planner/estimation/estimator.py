@@ -107,6 +107,9 @@ class _Record:
     accepted: bool | None = None           # None until it is first processed
 
 
+MESSAGES = {Health.INITIALISING: "waiting for a star tracker or a sun vector and a field measurement",
+            Health.DIVERGED: "estimate lost: reinitialising from the next measurements",
+            Health.PROPAGATING: "propagating on the gyro", Health.CONVERGED: "converged"}   # an estimate's, by health
 _instant = attrgetter("t")                 # a record's instant: the records' sort key
 
 
@@ -279,12 +282,9 @@ class Estimator:
         else:
             P_att, P_bias, q, bias = x.P[:3, :3].copy(), x.P[3:, 3:].copy(), x.q, x.bias
             self.last_q, self.last_bias = q, bias
-        message = {Health.INITIALISING: "waiting for a star tracker or a sun vector and a field measurement",
-                   Health.DIVERGED: "estimate lost: reinitialising from the next measurements",
-                   Health.PROPAGATING: "propagating on the gyro", Health.CONVERGED: "converged"}[health]
         return AttitudeEstimate(t=t, q=q.copy(), omega=omega_measured - bias, gyro_bias=bias.copy(),
                                 attitude_covariance=P_att, bias_covariance=P_bias, health=int(health),
-                                time_since_update=t - self.last_fix, rejected=self.rejected, message=message,
+                                time_since_update=t - self.last_fix, rejected=self.rejected, message=MESSAGES[health],
                                 frame_id=self.frame_id, body_frame_id=self.body_frame_id)
 
     # -- the filter over its history ---------------------------------------------------------------
