@@ -231,7 +231,8 @@ def error_vector(q: np.ndarray, q_ref: np.ndarray) -> np.ndarray:
 
 
 def propagate_constant_rate(q: np.ndarray, omega: np.ndarray, dt: float) -> np.ndarray:
-    """Exact attitude after ``dt`` at constant body rate: ``q ⊗ exp(omega dt)``."""
+    """Exact attitude after ``dt`` at constant body rate: ``q ⊗ exp(omega dt)`` (rows of ``q`` and
+    ``omega`` with a column of ``dt``: each row's)."""
     return multiply(q, exp_map(np.asarray(omega) * dt))
 
 

@@ -143,7 +143,8 @@ def propagate_runs(states: list[FilterState], omega_measured: np.ndarray, dt, ar
                    consider: np.ndarray | None = None, extra_attitude_noise=None) -> list[FilterState]:
     """:func:`propagate` of R filters at once (lockstep Monte Carlo runs of one tuning): ``omega_measured``
     (R×3), ``dt`` and ``extra_attitude_noise`` one per filter. The matrices of all the filters are
-    multiplied as one stack (per filter the same products, so the same bits); the attitude run by run."""
+    multiplied as one stack (per filter the same products, so the same bits), the attitudes too
+    (``q ⊗ exp(ω̂ Δt)``, elementwise)."""
     dt = [float(d) for d in dt]
     omega = np.asarray(omega_measured, float) - np.array([x.bias for x in states])
     phi = transitions(omega, dt)
@@ -162,8 +163,8 @@ def propagate_runs(states: list[FilterState], omega_measured: np.ndarray, dt, ar
         if extra:
             P[i, :3, :3] += extra * I3
     P = 0.5 * (P + P.transpose(0, 2, 1))
-    return [FilterState(x.t + d, rot.normalize(rot.propagate_constant_rate(x.q, w, d)), x.bias, P[i].copy(),
-                        C[i].copy()) for i, (x, w, d) in enumerate(zip(states, omega, dt))]
+    q = rot.normalize(rot.propagate_constant_rate(np.array([x.q for x in states]), omega, np.array(dt)[:, None]))
+    return [FilterState(x.t + d, q[i], x.bias, P[i].copy(), C[i].copy()) for i, (x, d) in enumerate(zip(states, dt))]
 
 
 def attitude_residual(q_estimate: np.ndarray, q_measured: np.ndarray) -> np.ndarray:
