@@ -133,6 +133,8 @@ class Estimator:
         self.trackers = {s.name: s for s in specs.star_trackers}
         variances = np.array([config.scale_factor_sigma**2] * 3 + [config.misalignment_sigma**2] * 6)
         self.consider = variances if np.any(variances > 0) else None
+        # what a propagation takes besides the state: equal tunings propagate as one stack (lockstep)
+        self.tuning = (config.arw, config.rrw, None if self.consider is None else self.consider.tobytes())
         from scipy.special import gammaincinv  # the chi-square quantile; scipy.stats costs seconds to import
 
         self.gates = {k: 2.0 * float(gammaincinv(k / 2.0, config.gate_probability)) for k in (3,)}

@@ -53,7 +53,7 @@ def _propagate_together(requests: list[tuple[Estimator, tuple]]) -> list:
     out = [None] * len(requests)
     stack, first = [], None
     for i, (e, (x, omega, t, saturated)) in enumerate(requests):
-        if x is not None and t > x.t and (first is None or _same_tuning(e, first)):
+        if x is not None and t > x.t and (first is None or e.tuning == first.tuning):
             first = first or e
             stack.append(i)
         else:
@@ -80,9 +80,3 @@ def resume(steps, value):
     except StopIteration:
         return None
 
-
-def _same_tuning(a: Estimator, b: Estimator) -> bool:
-    """Whether ``a`` and ``b`` propagate with the same noise figures and considered variances."""
-    same_consider = (a.consider is None and b.consider is None) or (
-        a.consider is not None and b.consider is not None and np.array_equal(a.consider, b.consider))
-    return a.config.arw == b.config.arw and a.config.rrw == b.config.rrw and same_consider
