@@ -77,7 +77,7 @@ def multiply(p: np.ndarray, q: np.ndarray) -> np.ndarray:
                          pw * qz + qw * pz + (px * qy - py * qx), pw * qw - (px * qx + py * qy + pz * qz)])
     pv, pw = p[..., :3], p[..., 3:]
     qv, qw = q[..., :3], q[..., 3:]
-    v = pw * qv + qw * pv + np.cross(pv, qv)
+    v = pw * qv + qw * pv + cross(pv, qv)
     w = pw * qw - np.sum(pv * qv, axis=-1, keepdims=True)
     return np.concatenate([v, w], axis=-1)
 

@@ -164,7 +164,7 @@ def propagate_runs(states: list[FilterState], omega_measured: np.ndarray, dt, ar
             P[i, :3, :3] += extra * I3
     P = 0.5 * (P + P.transpose(0, 2, 1))
     q = rot.normalize(rot.propagate_constant_rate(np.array([x.q for x in states]), omega, np.array(dt)[:, None]))
-    return [FilterState(x.t + d, q[i], x.bias, P[i].copy(), C[i].copy()) for i, (x, d) in enumerate(zip(states, dt))]
+    return [FilterState(x.t + d, q[i], x.bias, P[i], C[i]) for i, (x, d) in enumerate(zip(states, dt))]
 
 
 def attitude_residual(q_estimate: np.ndarray, q_measured: np.ndarray) -> np.ndarray:
