@@ -26,13 +26,18 @@ def columns(rows: list[dict]) -> list[str]:
     return names + list(OUTCOMES)
 
 
+def by_run(row: dict) -> int:
+    """The sort key of rows: their run's index in the campaign."""
+    return row["run"]
+
+
 def write_table(rows: list[dict], path: Path) -> Path:
     """The rows, ordered by run, as CSV (floats with 17 significant digits: the table reads back exactly)."""
     path.parent.mkdir(parents=True, exist_ok=True)
     with open(path, "w", newline="") as fh:
         writer = csv.DictWriter(fh, fieldnames=columns(rows))
         writer.writeheader()
-        for row in sorted(rows, key=lambda r: r["run"]):
+        for row in sorted(rows, key=by_run):
             writer.writerow({k: repr(v) if isinstance(v, float) else v for k, v in row.items()})
     return path
 
@@ -59,7 +64,9 @@ def ranks(x: np.ndarray) -> np.ndarray:
 
 
 def rank_correlations(rows: list[dict], outcome: str = "final_error_deg") -> dict[str, float]:
-    """Spearman's ρ of ``outcome`` with every applied dispersion (runs with a finite outcome)."""
+    """Spearman's ρ of ``outcome`` with every applied dispersion (runs with a finite outcome; in run
+    order, whatever order the rows came back in)."""
+    rows = sorted(rows, key=by_run)
     y = np.array([r[outcome] for r in rows], float)
     keep = np.isfinite(y)
     out = {}
@@ -89,7 +96,9 @@ def worst(rows: list[dict], count: int = WORST) -> list[dict]:
 
 def summary(rows: list[dict], *, runs: int, wall: float, workers: int, table: Path, figures: list[str],
             interrupted: bool, campaign: str, scenario: str, plan: dict) -> dict:
-    """The campaign's summary (the JSON ``att-mc --json`` writes)."""
+    """The campaign's summary (the JSON ``att-mc --json`` writes): of the rows in run order, so the
+    same runs give the same figures whatever order they finished in."""
+    rows = sorted(rows, key=by_run)
     n = len(rows)
     correlations = rank_correlations(rows)
     top = max(correlations, key=lambda k: abs(correlations[k])) if correlations else None

@@ -168,3 +168,20 @@ def test_rank_correlation_finds_the_dispersion_the_outcome_follows():
             for i in range(200)]
     rho = report.rank_correlations(rows)
     assert rho["a[0]"] == pytest.approx(1.0) and abs(rho["b[0]"]) < 0.2
+
+
+def test_the_summary_is_the_same_whatever_order_the_runs_finished_in():
+    """Rows come back in finishing order; every figure of the summary is of the rows in run order
+    (a mean's float sum and the order of equally bad runs depend on it)."""
+    rng = np.random.default_rng(1)
+    rows = [{"run": i, "seed": 100 + i, "a[0]": float(rng.normal()), "success": i % 7 != 3,
+             "code": 0 if i % 7 != 3 else 305,
+             "final_error_deg": float(rng.lognormal(-4, 1)) if i % 7 != 3 else math.nan, "final_rate": 1e-5,
+             "min_margin_deg": float(rng.normal(2, 0.1)), "peak_wheel_ratio": float(rng.uniform()),
+             "peak_torque_ratio": float(rng.uniform()), "settling_time": float(rng.uniform(0, 5)), "start_time": 3.0,
+             "cpu_seconds": 1.0, "reason": ""} for i in range(300)]
+    shuffled = [rows[i] for i in rng.permutation(len(rows))]
+    common = {"runs": 300, "wall": 10.0, "workers": 2, "table": Path("t.csv"), "figures": [], "interrupted": False,
+              "campaign": "c.yaml", "scenario": "s", "plan": {}}
+    assert json.dumps(report.summary(shuffled, **common)) == json.dumps(report.summary(rows, **common))
+    assert report.summary(shuffled, **common)["worst"][0]["run"] == 3      # of the failed runs, the first by run
