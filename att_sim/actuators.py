@@ -138,18 +138,51 @@ class Magnetorquers:
         return self.transfer @ (m * np.asarray(self.spec.scale) if self.spec.scale else m)
 
 
+class MagnetorquersOfRuns:
+    """:class:`Magnetorquers` of several runs on rows of runs (R × 3), the same operations per run
+    (the transfer matrices as one stack: each run's product has its own bits)."""
+
+    def __init__(self, coils: list[Magnetorquers]):
+        self.lsb = np.array([[c.spec.quantization] for c in coils])
+        self.scale = _per_run([c.spec.scale for c in coils], 1.0, 3)
+        self.transfer = np.array([c.transfer for c in coils])
+
+    def __call__(self, m: np.ndarray) -> np.ndarray:
+        m = np.where(self.lsb > 0, self.lsb * np.rint(m / np.where(self.lsb > 0, self.lsb, 1.0)), m)
+        return (self.transfer @ (m * self.scale)[:, :, None])[:, :, 0]
+
+
+def _per_run(values: list, default: float, width: int) -> np.ndarray:
+    """Rows of runs (R × width) of per-run tuples, ``default`` for an empty one."""
+    return np.array([v if v else (default,) * width for v in values], float)
+
+
 class DrivesOfRuns:
     """The wheel drives of several runs acting at once (:class:`att_sim.lockstep.Lockstep`): the
-    torques of :class:`WheelDrive` on arrays of runs, one array per wheel, by the same operations
-    element by element (the friction's ``tanh`` is ``math.tanh``, as one run's), so every run gets
+    torques of :class:`WheelDrive` on arrays of runs — :meth:`hold` on rows of runs (R × wheels),
+    the others one array per wheel — by the same operations element by element (the friction's
+    ``tanh`` is ``math.tanh``, as one run's; a missing scale is a product by 1), so every run gets
     the bits its own drive gives it."""
 
-    def __init__(self, specs: list[WheelDriveSpec]):
+    def __init__(self, drives: list[WheelDrive], n_wheels: int):
+        specs = [d.spec for d in drives]
+        self.rngs = [d.rng for d in drives]
+        self.lsb = np.array([[s.torque_quantization] for s in specs])
+        self.scale = _per_run([s.torque_scale for s in specs], 1.0, n_wheels)
+        self.noise = np.array([[s.torque_noise] for s in specs])
         self.power = np.array([s.power_max for s in specs])
         self.unlimited = bool(np.all(np.isinf(self.power)))
         self.coulomb = np.array([s.coulomb_friction for s in specs])
         self.viscous = np.array([s.viscous_friction for s in specs])
         self.friction_speed = np.array([s.friction_speed for s in specs])
+
+    def hold(self, u: np.ndarray, active: list[bool]) -> np.ndarray:
+        """:meth:`WheelDrive.hold` of the runs whose watchdog is not tripped (``active``; the others'
+        ``u`` unchanged, nothing drawn from their streams): quantised, scaled, plus each drive's noise."""
+        noise = np.array([rng.standard_normal(u.shape[1]) if on else np.zeros(u.shape[1])
+                          for rng, on in zip(self.rngs, active)])
+        quantized = np.where(self.lsb > 0, self.lsb * np.rint(u / np.where(self.lsb > 0, self.lsb, 1.0)), u)
+        return np.where(np.array(active)[:, None], quantized * self.scale + noise * self.noise, u)
 
     def motor(self, u: list, speed: list) -> list:
         """:meth:`WheelDrive.motor`: held torques within each run's envelope (an infinite power limit

@@ -15,7 +15,7 @@ import numpy as np
 
 from att_sim import dynamics as dyn
 from att_sim import rotations as rot
-from att_sim.actuators import DrivesOfRuns
+from att_sim.actuators import DrivesOfRuns, MagnetorquersOfRuns
 from att_sim.simulation import Applied, Simulation
 
 
@@ -45,7 +45,13 @@ class Lockstep:
         self.spinning = first.sc.wheel_inertia > 0
         self.torque_max = np.array([s.sc.wheel_torque_max for s in sims])
         self.speed_max = np.array([s.sc.wheel_speed_max for s in sims])
-        self.drives = None if first.wheel_drive is None else DrivesOfRuns([s.wheel_drive.spec for s in sims])
+        n = first.sc.n_wheels
+        self.drives = None if first.wheel_drive is None else DrivesOfRuns([s.wheel_drive for s in sims], n)
+        coils = [s.magnetorquers for s in sims]
+        self.coils = MagnetorquersOfRuns(coils) if all(c is not None for c in coils) else None
+        self.stacked_inputs = n > 0 and (self.coils is not None or all(c is None for c in coils))
+        self.axes_T = np.array([s.sc.wheel_axes.T for s in sims])           # R × wheels × 3
+        self.limits = {k: np.array([[getattr(s.sc, k)] for s in sims]) for k in ("dipole_max", "body_torque_max")}
         self.disturbed = any(s.environment.disturbed for s in sims)
         envs = [s.environment for s in sims]
         self.one_sky = all(e.shares_time_part(first.environment) for e in envs)   # one time-only part for all
@@ -68,8 +74,9 @@ class Lockstep:
     def advance(self, dt: float) -> None:
         """One step of ``dt`` of every simulation (a run whose step fails halts alone, as it would alone)."""
         sims = self.sims
-        inputs = [s.inputs() for s in sims]
-        x = np.array([s.x for s in sims]).T
+        x = np.array([s.x for s in sims])
+        inputs = self._inputs(x)
+        x = x.T
         u = list(np.array([i.wheel_torque for i in inputs]).T)
         tau_body, dipole = (list(np.array([getattr(i, k) for i in inputs]).T) for k in ("body_torque", "dipole"))
         stages = []
@@ -100,6 +107,30 @@ class Lockstep:
         samples = self._samples(sims[0].t + dt, x_new)
         for i, (s, inp) in enumerate(zip(sims, inputs)):
             s.finish_step(x_new[:, i].copy(), dt, Applied(motor[i].copy(), inp.dipole, body[i].copy()), samples[i])
+
+    def _inputs(self, x: np.ndarray) -> list[dyn.Inputs]:
+        """Every run's :meth:`Simulation.inputs <att_sim.simulation.Simulation.inputs>` at its state
+        (a row of ``x``), on rows of runs: commands zeroed where the watchdog is tripped, the drives'
+        hold, the torque and speed limits (:func:`att_sim.dynamics.limited_runs`), the dipole's and
+        body torque's limits, the coils; run by run when some runs have coils and others not."""
+        sims = self.sims
+        if not self.stacked_inputs:
+            return [s.inputs() for s in sims]
+        active = [not s.command_timeout for s in sims]
+        on = np.array(active)[:, None]
+        u = np.where(on, np.array([s.wheel_cmd for s in sims]), 0.0)
+        if self.drives is not None:
+            u = self.drives.hold(u, active)
+        relative = x[:, 7:] - (self.axes_T @ x[:, 4:7, None])[:, :, 0]
+        u = np.array(self._limited(list(u.T), list(relative.T))).T
+        limit = self.limits["dipole_max"]
+        m = np.where(on, np.minimum(np.maximum(np.array([s.dipole_cmd for s in sims]), -limit), limit), 0.0)
+        if self.coils is not None:
+            m = self.coils(m)
+        limit = self.limits["body_torque_max"]
+        tau = np.where(on, np.minimum(np.maximum(np.array([s.body_cmd for s in sims]), -limit), limit), 0.0)
+        return [dyn.Inputs(wheel_torque=u[i], body_torque=tau[i], dipole=m[i], wheel_drive=s.wheel_drive)
+                for i, s in enumerate(sims)]
 
     def _samples(self, t: float, x: np.ndarray) -> list:
         """Each run's :meth:`Environment.sample <att_sim.world.Environment.sample>` at ``t`` and its

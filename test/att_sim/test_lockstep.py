@@ -43,13 +43,16 @@ def commands(sim: Simulation, rng: np.random.Generator) -> Command:
                    dipole=rng.uniform(-1.2, 1.2, 3) * min(sc.dipole_max, 10.0))
 
 
-def fly(pairs, steps: int, dt: float = 0.05):
-    """Advance the first of each pair alone and the second ones in one lockstep, commanding both alike."""
+def fly(pairs, steps: int, dt: float = 0.05, before_step=None):
+    """Advance the first of each pair alone and the second ones in one lockstep, commanding both alike
+    (``before_step(k, pairs)`` before step k)."""
     alone = [a for a, _ in pairs]
     together = [b for _, b in pairs]
     lockstep = Lockstep(together)
     rng_a, rng_b = np.random.default_rng(7), np.random.default_rng(7)
     for k in range(steps):
+        if before_step is not None:
+            before_step(k, pairs)
         if k % 3 == 0:
             for a, b in pairs:
                 assert a.set_command(commands(a, rng_a)) is None
@@ -81,6 +84,22 @@ def test_runs_in_the_real_sky_with_every_disturbance_reach_the_bits_they_reach_a
     alone, together = fly([disturbed_pair(seed) for seed in (1, 2)], steps=30)
     assert_same(alone, together)
     assert all(np.any(a.now.torque_B != 0) for a in alone)
+
+
+def test_runs_whose_watchdog_trips_or_that_have_no_coils_reach_the_bits_they_reach_alone():
+    """The inputs of a lockstep are taken on rows of runs: a tripped watchdog zeroes one run's
+    commands (and draws no drive noise); runs with and without coils are taken run by run."""
+    def watchdog(k, pairs):                 # run i's watchdog trips over steps 10(i + 1) .. 10(i + 1) + 6
+        for i, pair in enumerate(pairs):
+            for s in pair:
+                s.command_timeout = 10 * (i + 1) <= k < 10 * (i + 1) + 7
+    pairs = [dispersed_pair(seed) for seed in (4, 8, 15)]
+    alone, together = fly(pairs, steps=50, before_step=watchdog)
+    assert_same(alone, together)
+    assert len({a.x.tobytes() for a in alone}) == 3
+    for a, b in pairs[1:]:
+        a.magnetorquers = b.magnetorquers = None
+    assert_same(*fly(pairs, steps=20))
 
 
 def test_one_run_is_a_lockstep_of_one():
