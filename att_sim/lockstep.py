@@ -6,7 +6,8 @@ environment and random streams, and advances them as :meth:`Simulation.advance
 drives' held torques and noise), then one RK4 step of all the states together — the derivative is
 :func:`att_sim.dynamics.rates` on arrays of runs, the field of each run's environment in body axes
 (:func:`att_sim.rotations.to_body`) at every stage — then every run's applied torques, its sample of
-the environment and its time. The arithmetic is the single run's, element by element, so each run
+the environment and its time; :meth:`Lockstep.sense` takes every run's sensor readings, the gyros
+measuring together. The arithmetic is the single run's, element by element, so each run
 reaches the bits it reaches alone (test/att_sim/test_lockstep.py), for about the cost of one run's step.
 """
 from __future__ import annotations
@@ -16,6 +17,8 @@ import numpy as np
 from att_sim import dynamics as dyn
 from att_sim import rotations as rot
 from att_sim.actuators import DrivesOfRuns, MagnetorquersOfRuns
+from att_sim.sensors import Readings
+from att_sim.sensors.gyro import measure_together
 from att_sim.simulation import Applied, Simulation
 
 
@@ -107,6 +110,17 @@ class Lockstep:
         samples = self._samples(sims[0].t + dt, x_new)
         for i, (s, inp) in enumerate(zip(sims, inputs)):
             s.finish_step(x_new[:, i].copy(), dt, Applied(motor[i].copy(), inp.dipole, body[i].copy()), samples[i])
+
+    def sense(self) -> list[Readings]:
+        """Every run's :meth:`Simulation.sense <att_sim.simulation.Simulation.sense>`, the gyros due
+        measuring together (:func:`att_sim.sensors.gyro.measure_together`)."""
+        intervals = [s.gyro_interval() for s in self.sims]
+        due = [i for i, interval in enumerate(intervals) if interval is not None]
+        rates = [None] * len(self.sims)
+        measured = measure_together([self.sims[i].sensors.gyro for i in due], [intervals[i] for i in due])
+        for i, rate in zip(due, measured):
+            rates[i] = rate
+        return [s.sense((interval, rate)) for s, interval, rate in zip(self.sims, intervals, rates)]
 
     def _inputs(self, x: np.ndarray) -> list[dyn.Inputs]:
         """Every run's :meth:`Simulation.inputs <att_sim.simulation.Simulation.inputs>` at its state

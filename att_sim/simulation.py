@@ -268,13 +268,21 @@ class Simulation:
                else np.zeros(3))
         return dyn.Inputs(wheel_torque=u, body_torque=tau, dipole=m, wheel_drive=self.wheel_drive)
 
-    def sense(self) -> Readings:
-        """What the sensors output now (nothing without sensors): see :class:`att_sim.sensors.SensorSuite`."""
+    def sense(self, gyro: tuple | None = None) -> Readings:
+        """What the sensors output now (nothing without sensors): see :class:`att_sim.sensors.SensorSuite`
+        (``gyro``: its :meth:`~att_sim.sensors.SensorSuite.sample`'s, the gyro's interval and rate
+        taken already)."""
         if self.sensors is None:
             return Readings()
         x = self.x
         return self.sensors.sample(self.t, x[:4], x[4:7], dyn.relative_wheel_speed(self.sc, x[7:], x[4:7]),
-                                   self.now.field_B, self.applied.dipole, lambda: self.environment.bodies(self.t))
+                                   self.now.field_B, self.applied.dipole, lambda: self.environment.bodies(self.t),
+                                   gyro)
+
+    def gyro_interval(self) -> tuple[np.ndarray, float] | None:
+        """The gyro's interval now (:meth:`SensorSuite.gyro_interval <att_sim.sensors.SensorSuite.gyro_interval>`;
+        None without sensors)."""
+        return None if self.sensors is None else self.sensors.gyro_interval(self.t, self.x[:4], self.x[4:7])
 
     def advance(self, dt: float) -> None:
         """One RK4 step, the actuator inputs held and the environment evaluated at every stage; a

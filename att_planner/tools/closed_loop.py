@@ -29,6 +29,7 @@ from att_planner.control.configure import controller_from_scenario
 from att_planner.estimation.configure import estimator_from_scenario
 from att_sim import rotations as rot
 from att_sim.scenario import Scenario
+from att_sim.sensors import Readings
 from att_sim.simulation import DEFAULT_STEP, Checks, Simulation
 
 
@@ -117,13 +118,14 @@ class ClosedLoop:
         for estimator, start in self.exchange_steps():
             estimator.reprocess(start)
 
-    def exchange_steps(self):
+    def exchange_steps(self, readings: Readings | None = None):
         """:meth:`exchange` as a generator: it yields each reprocessing ``(estimator, start)`` the
         estimator needs before the exchange goes on (:meth:`Estimator.reprocess
         <att_planner.estimation.estimator.Estimator.reprocess>`), which the caller does — at once,
-        or for many loops together (:func:`~att_planner.tools.monte_carlo.run.fly_together`)."""
+        or for many loops together (:func:`~att_planner.tools.monte_carlo.run.fly_together`, which
+        also senses for them: ``readings``, the simulation's now)."""
         sim, ctl, est = self.sim, self.controller, self.estimator
-        readings = sim.sense()
+        readings = sim.sense() if readings is None else readings
         t = sim.t
         state_due = t >= self.next_state - 1e-9
         if state_due:

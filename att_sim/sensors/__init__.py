@@ -83,26 +83,39 @@ class SensorSuite:
         self.pending: list[tuple[float, StarTrackerMeasurement]] = []        # (release time, measurement)
         self.gyro_last: tuple[float, np.ndarray] | None = None               # (t, q) of the last gyro sample
 
+    def gyro_interval(self, t: float, q: np.ndarray, omega: np.ndarray) -> tuple[np.ndarray, float] | None:
+        """When the gyro is due at ``t``: the rotation vector it measures (since its previous sample;
+        at its first, ``omega`` over one period) and the interval; None when it is not (or there is
+        none). Asking starts the gyro's next interval."""
+        if self.gyro is None or not self.schedules["gyro"].due(t):
+            return None
+        if self.gyro_last is None:
+            dt = self.schedules["gyro"].period
+            rotation = np.asarray(omega, float) * dt
+        else:
+            dt = t - self.gyro_last[0]
+            rotation = rot.log_map(rot.multiply(rot.conjugate(self.gyro_last[1]), q))
+        self.gyro_last = (t, np.array(q, float))
+        return rotation, dt
+
     def sample(self, t: float, q: np.ndarray, omega: np.ndarray, relative_wheel_speed: np.ndarray,
-               field_B: np.ndarray, dipole_applied: np.ndarray, bodies: Callable[[], Bodies]) -> Readings:
+               field_B: np.ndarray, dipole_applied: np.ndarray, bodies: Callable[[], Bodies],
+               gyro: tuple | None = None) -> Readings:
         """What the sensors output at time ``t`` for the truth state (attitude ``q``, body rate
         ``omega``, wheel speeds relative to the body) and the environment (``field_B`` in body axes,
         the applied dipole, ``bodies()``: called when a sensor that sees them is due). The gyro
         measures the rotation since its previous sample (at its first sample: ``omega`` over one
         period); a tracker's measurement of ``t`` comes out at the first call at or after ``t`` + its
-        latency."""
+        latency. ``gyro``: ``(interval, rate)`` when :meth:`gyro_interval` was asked and the rate
+        measured already (:class:`att_sim.lockstep.Lockstep`'s gyros measure together)."""
         out = Readings()
         body = self.body_frame_id
-        if self.gyro is not None and self.schedules["gyro"].due(t):
-            if self.gyro_last is None:
-                dt = self.schedules["gyro"].period
-                rotation = np.asarray(omega, float) * dt
-            else:
-                dt = t - self.gyro_last[0]
-                rotation = rot.log_map(rot.multiply(rot.conjugate(self.gyro_last[1]), q))
-            self.gyro_last = (t, np.array(q, float))
+        interval, rate = (self.gyro_interval(t, q, omega), None) if gyro is None else gyro
+        if interval is not None:
+            dt = interval[1]
             sigma = self.gyro.noise_sigma(dt)
-            out.gyro = GyroMeasurement(t, self.gyro.measure(rotation, dt), np.eye(3) * sigma**2, body)
+            out.gyro = GyroMeasurement(t, self.gyro.measure(*interval) if rate is None else rate,
+                                       np.eye(3) * sigma**2, body)
             out.truth = SensorTruth(t, self.gyro.bias.copy(), self._magnetometer_bias(), body)
         sky = None
         for tracker, schedule in zip(self.trackers, self.tracker_schedules):

@@ -129,3 +129,45 @@ class Gyro:
             self.carry = total - counted
             rate = counted / dt
         return rate
+
+
+def _column(values) -> np.ndarray:
+    """One value per gyro, as a column (R × 1)."""
+    return np.array([[v] for v in values], float)
+
+
+def measure_together(gyros: list[Gyro], intervals: list[tuple[np.ndarray, float]]) -> list[np.ndarray]:
+    """:meth:`Gyro.measure` of one interval ``(rotation, dt)`` for each gyro (the runs of a lockstep):
+    each gyro's draws from its own stream in its own order, the arithmetic on rows of gyros (element
+    by element; the stacked bank sums and products give each row its own bits). Gyros unlike in
+    their noise's form (a bank or none, a quantiser or none) measure one by one."""
+    quantized = {g.spec.quantization > 0 for g in gyros}
+    if len(gyros) < 2 or len(quantized) > 1 or len({g.flicker.shape for g in gyros}) > 1 \
+            or not all(g.flicker_sigma > 0 for g in gyros):
+        return [g.measure(rotation, dt) for g, (rotation, dt) in zip(gyros, intervals)]
+    banks = [g._bank(dt) for g, (_, dt) in zip(gyros, intervals)]
+    draws = [(g.rng.standard_normal(g.flicker.shape), g.rng.standard_normal(3), g.rng.standard_normal(3))
+             for g in gyros]
+    dt = _column([dt for _, dt in intervals])
+    flicker = np.array([a for a, _ in banks]) * np.array([g.flicker for g in gyros]) \
+        + np.array([d[0] for d in draws]) * np.array([sigma for _, sigma in banks])
+    walk = np.array([g.walk for g in gyros]) + np.array([d[1] for d in draws]) * _column(
+        [g.spec.rrw * math.sqrt(h) for g, (_, h) in zip(gyros, intervals)])
+    bias = np.array([g.turn_on for g in gyros]) + flicker.sum(axis=1) + walk
+    rotation = np.array([r for r, _ in intervals])[:, None, :]
+    rate = (rotation @ np.array([g.transfer.T for g in gyros]))[:, 0, :] / dt + bias
+    rate = rate + np.array([d[2] for d in draws]) * _column([g.noise_sigma(h) for g, (_, h) in zip(gyros, intervals)])
+    limit = _column([g.spec.range for g in gyros])
+    rate = np.minimum(np.maximum(rate, -limit), limit)
+    carry = [None] * len(gyros)
+    if quantized == {True}:
+        lsb = _column([g.spec.quantization for g in gyros])
+        total = np.array([g.carry for g in gyros]) + rate * dt
+        counted = lsb * np.rint(total / lsb)
+        carry = total - counted
+        rate = counted / dt
+    for i, g in enumerate(gyros):
+        g.flicker, g.walk, g.bias = flicker[i], walk[i], bias[i]
+        if carry[i] is not None:
+            g.carry = carry[i]
+    return list(rate)

@@ -57,10 +57,24 @@ def fly(pairs, steps: int, dt: float = 0.05, before_step=None):
             for a, b in pairs:
                 assert a.set_command(commands(a, rng_a)) is None
                 assert b.set_command(commands(b, rng_b)) is None
+        assert_same_readings([a.sense() for a in alone], lockstep.sense())
         for a in alone:
             a.advance(dt)
         lockstep.advance(dt)
     return alone, together
+
+
+def assert_same_readings(alone, together):
+    """The sensors' outputs of one instant, alone and in a lockstep (the gyros measure together)."""
+    for a, b in zip(alone, together):
+        assert (a.gyro is None) == (b.gyro is None) and len(a.star_trackers) == len(b.star_trackers)
+        if a.gyro is not None:
+            np.testing.assert_array_equal(a.gyro.omega, b.gyro.omega)
+            np.testing.assert_array_equal(a.truth.gyro_bias, b.truth.gyro_bias)
+        for m, n in zip(a.star_trackers, b.star_trackers):
+            np.testing.assert_array_equal(m.q, n.q)
+        if a.wheel_speeds is not None:
+            np.testing.assert_array_equal(a.wheel_speeds.speeds, b.wheel_speeds.speeds)
 
 
 def assert_same(alone, together):

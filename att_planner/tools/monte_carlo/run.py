@@ -140,7 +140,8 @@ class _Flight:
 def fly_together(setup: Setup, runs: list[tuple[int, int]], tap=None) -> list[dict]:
     """The rows of ``(run, seed)`` pairs (applied values and outcomes, :data:`OUTCOMES`), flown in
     lockstep: each run converges, then flies the plan, as it would alone; at each step the runs'
-    estimators reprocess together (:func:`~att_planner.estimation.estimator.reprocess_together`:
+    gyros measure together (:meth:`Lockstep.sense <att_sim.lockstep.Lockstep.sense>`), their
+    estimators reprocess together (:func:`~att_planner.estimation.lockstep.reprocess_together`:
     their propagations as one stack), their controllers share the plan's reference (one plan object,
     issued once with the loops' one key: :class:`~att_planner.control.tracking.ReferenceMemo`), and
     the simulations of the runs still going advance together (:class:`att_sim.lockstep.Lockstep`) —
@@ -161,7 +162,8 @@ def fly_together(setup: Setup, runs: list[tuple[int, int]], tap=None) -> list[di
         if len(still) != len(going) or lockstep is None:
             lockstep = Lockstep([f.loop.sim for f in still]) if len(still) > 1 else None
         going = still
-        exchanges = [f.loop.exchange_steps() for f in going]
+        readings = lockstep.sense() if lockstep is not None else [None] * len(going)
+        exchanges = [f.loop.exchange_steps(r) for f, r in zip(going, readings)]
         while exchanges:                # each turn: every exchange to its next reprocessing, done together
             turn = [(steps, next(steps, None)) for steps in exchanges]
             reprocess_together([job for _, job in turn if job is not None])
