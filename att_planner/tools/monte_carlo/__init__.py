@@ -57,7 +57,7 @@ def campaign_parser() -> argparse.ArgumentParser:
     p.add_argument("--timeout", type=positive(float, 3600), default=10.0,
                    help="s to reach the scheduler (default 10)")
     p.add_argument("--chunk", type=positive(int, 10_000), default=None,
-                   help="runs per task (default: about 4 tasks per worker, at most 25 runs)")
+                   help="runs per task (default: about 4 tasks per worker, at most 50 runs)")
     p.add_argument("--no-figures", action="store_true")
     p.add_argument("--no-progress", action="store_true")
     return p
@@ -83,7 +83,7 @@ def run_campaign(args) -> int:
         setup = planned(setup)
         workers = len(client.scheduler_info().get("workers", {})) or workers
         bar = None if args.no_progress else ProgressBar()
-        chunk = args.chunk or max(1, min(25, count // (4 * workers)))
+        chunk = args.chunk or max(1, min(50, count // (4 * workers)))
         start = time.monotonic()
         chunks = stream(client, setup, runs, chunk)
         try:
