@@ -92,8 +92,13 @@ def actuators_from_params(values, label: str = "actuators") -> ActuatorSpecs:
     return ActuatorSpecs(wheels, magnetorquers)
 
 
-def quantize(value: np.ndarray, lsb: float) -> np.ndarray:
-    return lsb * np.rint(np.asarray(value, float) / lsb) if lsb > 0 else np.asarray(value, float)
+def quantize(value: np.ndarray, lsb) -> np.ndarray:
+    """``value`` in whole multiples of ``lsb`` (0: unchanged); ``lsb`` a number, or a column of one
+    per row (rows of runs)."""
+    value = np.asarray(value, float)
+    if np.ndim(lsb) == 0:
+        return lsb * np.rint(value / lsb) if lsb > 0 else value
+    return np.where(lsb > 0, lsb * np.rint(value / np.where(lsb > 0, lsb, 1.0)), value)
 
 
 def _clip(value: float, limit: float) -> float:
@@ -148,8 +153,7 @@ class MagnetorquersOfRuns:
         self.transfer = np.array([c.transfer for c in coils])
 
     def __call__(self, m: np.ndarray) -> np.ndarray:
-        m = np.where(self.lsb > 0, self.lsb * np.rint(m / np.where(self.lsb > 0, self.lsb, 1.0)), m)
-        return (self.transfer @ (m * self.scale)[:, :, None])[:, :, 0]
+        return (self.transfer @ (quantize(m, self.lsb) * self.scale)[:, :, None])[:, :, 0]
 
 
 def _per_run(values: list, default: float, width: int) -> np.ndarray:
@@ -181,8 +185,7 @@ class DrivesOfRuns:
         ``u`` unchanged, nothing drawn from their streams): quantised, scaled, plus each drive's noise."""
         noise = np.array([rng.standard_normal(u.shape[1]) if on else np.zeros(u.shape[1])
                           for rng, on in zip(self.rngs, active)])
-        quantized = np.where(self.lsb > 0, self.lsb * np.rint(u / np.where(self.lsb > 0, self.lsb, 1.0)), u)
-        return np.where(np.array(active)[:, None], quantized * self.scale + noise * self.noise, u)
+        return np.where(np.array(active)[:, None], quantize(u, self.lsb) * self.scale + noise * self.noise, u)
 
     def motor(self, u: list, speed: list) -> list:
         """:meth:`WheelDrive.motor`: held torques within each run's envelope (an infinite power limit

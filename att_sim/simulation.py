@@ -316,8 +316,10 @@ class Simulation:
         non-finite state, an environment that cannot be evaluated there. ``sample``: the
         environment's sample there, when it is known already."""
         try:
-            finite = np.all(np.isfinite(x_new))
-            now = None if not finite else self.environment.sample(self.t + dt, x_new[:4]) if sample is None else sample
+            finite = bool(np.all(np.isfinite(x_new)))
+            if finite and sample is None:
+                sample = self.environment.sample(self.t + dt, x_new[:4])
+            now = sample if finite else None
         except ValueError as err:
             self.halt_environment(err)
             return

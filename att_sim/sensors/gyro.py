@@ -73,7 +73,7 @@ class Gyro:
     def _bias(self, n: int, dt: float) -> np.ndarray:
         """The bias at the end of each of ``n`` intervals (n, 3); advances the noise state. Each
         flicker process is ``x_k = a x_(k-1) + w_k``: a batch (n > 1) through ``scipy.signal.lfilter``
-        (imported then: it costs a node seconds at start); one interval is :meth:`_measure_one`'s."""
+        (imported then: it costs a node seconds at start); one interval is :func:`measure_together`'s."""
         flicker = np.zeros((n, 3))
         if self.flicker_sigma > 0:
             for j, tau in enumerate(self.times):
@@ -95,8 +95,8 @@ class Gyro:
         rows of ``rotation`` ((n, 3), or (3,) for one sample: then the result is (3,))."""
         increments = np.atleast_2d(np.asarray(rotation, float))
         n = len(increments)
-        if n == 1:
-            rate = self._measure_one(increments[0], dt)
+        if n == 1:                        # the simulator's case
+            rate = measure_together([self], [(increments[0], dt)])[0]
             return rate if np.ndim(rotation) == 1 else rate[None, :]
         rate = increments @ self.transfer.T / dt + self._bias(n, dt)
         rate += self.rng.standard_normal((n, 3)) * self.noise_sigma(dt)
@@ -109,27 +109,6 @@ class Gyro:
             rate = np.diff(counted, axis=0, prepend=0.0) / dt     # the counts of each sample
         return rate
 
-    def _measure_one(self, rotation: np.ndarray, dt: float) -> np.ndarray:
-        """:meth:`measure` of one interval (the simulator's case): the whole flicker bank in one step
-        (its draws first), then the rate random walk, the white noise."""
-        rng, spec = self.rng, self.spec
-        flicker = np.zeros(3)
-        if self.flicker_sigma > 0:
-            a, drive_sigma = self._bank(dt)
-            self.flicker = a * self.flicker + rng.standard_normal(self.flicker.shape) * drive_sigma
-            flicker = self.flicker.sum(axis=0)
-        self.walk = self.walk + rng.standard_normal(3) * (spec.rrw * math.sqrt(dt))
-        self.bias = self.turn_on + flicker + self.walk
-        rate = rotation @ self.transfer.T / dt + self.bias
-        rate = rate + rng.standard_normal(3) * self.noise_sigma(dt)
-        rate = np.minimum(np.maximum(rate, -spec.range), spec.range)
-        if spec.quantization > 0:
-            total = self.carry + rate * dt
-            counted = spec.quantization * np.rint(total / spec.quantization)
-            self.carry = total - counted
-            rate = counted / dt
-        return rate
-
 
 def _column(values) -> np.ndarray:
     """One value per gyro, as a column (R × 1)."""
@@ -137,37 +116,43 @@ def _column(values) -> np.ndarray:
 
 
 def measure_together(gyros: list[Gyro], intervals: list[tuple[np.ndarray, float]]) -> list[np.ndarray]:
-    """:meth:`Gyro.measure` of one interval ``(rotation, dt)`` for each gyro (the runs of a lockstep):
-    each gyro's draws from its own stream in its own order, the arithmetic on rows of gyros (element
-    by element; the stacked bank sums and products give each row its own bits). Gyros unlike in
-    their noise's form (a bank or none, a quantiser or none) measure one by one."""
-    quantized = {g.spec.quantization > 0 for g in gyros}
-    if len(gyros) < 2 or len(quantized) > 1 or len({g.flicker.shape for g in gyros}) > 1 \
-            or not all(g.flicker_sigma > 0 for g in gyros):
-        return [g.measure(rotation, dt) for g, (rotation, dt) in zip(gyros, intervals)]
-    banks = [g._bank(dt) for g, (_, dt) in zip(gyros, intervals)]
-    draws = [(g.rng.standard_normal(g.flicker.shape), g.rng.standard_normal(3), g.rng.standard_normal(3))
-             for g in gyros]
-    dt = _column([dt for _, dt in intervals])
-    flicker = np.array([a for a, _ in banks]) * np.array([g.flicker for g in gyros]) \
-        + np.array([d[0] for d in draws]) * np.array([sigma for _, sigma in banks])
-    walk = np.array([g.walk for g in gyros]) + np.array([d[1] for d in draws]) * _column(
+    """:meth:`Gyro.measure` of one interval ``(rotation, dt)`` for each gyro — one gyro's sample in the
+    simulator, or the gyros of a lockstep's runs at once: the whole flicker bank in one step, then the
+    rate random walk, the white noise (each gyro's draws from its own stream, in that order), the
+    arithmetic on rows of gyros (element by element; the stacked bank sums and products give each
+    row the bits it gets alone). Gyros unlike in their noise's form (a bank or none, a quantiser or
+    none) measure one by one."""
+    if not gyros:
+        return []
+    banked, quantized = gyros[0].flicker_sigma > 0, gyros[0].spec.quantization > 0
+    if any((g.flicker_sigma > 0) != banked or (g.spec.quantization > 0) != quantized
+           or g.flicker.shape != gyros[0].flicker.shape for g in gyros):
+        return [measure_together([g], [interval])[0] for g, interval in zip(gyros, intervals)]
+    dt = _column([h for _, h in intervals])
+    flicker_sum = np.zeros((len(gyros), 3))
+    if banked:
+        banks = [g._bank(h) for g, (_, h) in zip(gyros, intervals)]
+        flicker = np.array([a for a, _ in banks]) * np.array([g.flicker for g in gyros]) \
+            + np.array([g.rng.standard_normal(g.flicker.shape) for g in gyros]) * np.array([s for _, s in banks])
+        flicker_sum = flicker.sum(axis=1)
+        for g, row in zip(gyros, flicker):
+            g.flicker = row
+    walk = np.array([g.walk for g in gyros]) + np.array([g.rng.standard_normal(3) for g in gyros]) * _column(
         [g.spec.rrw * math.sqrt(h) for g, (_, h) in zip(gyros, intervals)])
-    bias = np.array([g.turn_on for g in gyros]) + flicker.sum(axis=1) + walk
+    bias = np.array([g.turn_on for g in gyros]) + flicker_sum + walk
     rotation = np.array([r for r, _ in intervals])[:, None, :]
     rate = (rotation @ np.array([g.transfer.T for g in gyros]))[:, 0, :] / dt + bias
-    rate = rate + np.array([d[2] for d in draws]) * _column([g.noise_sigma(h) for g, (_, h) in zip(gyros, intervals)])
+    rate = rate + np.array([g.rng.standard_normal(3) for g in gyros]) * _column(
+        [g.noise_sigma(h) for g, (_, h) in zip(gyros, intervals)])
     limit = _column([g.spec.range for g in gyros])
     rate = np.minimum(np.maximum(rate, -limit), limit)
-    carry = [None] * len(gyros)
-    if quantized == {True}:
+    if quantized:
         lsb = _column([g.spec.quantization for g in gyros])
         total = np.array([g.carry for g in gyros]) + rate * dt
         counted = lsb * np.rint(total / lsb)
-        carry = total - counted
         rate = counted / dt
-    for i, g in enumerate(gyros):
-        g.flicker, g.walk, g.bias = flicker[i], walk[i], bias[i]
-        if carry[i] is not None:
-            g.carry = carry[i]
+        for g, row in zip(gyros, total - counted):
+            g.carry = row
+    for g, w, b in zip(gyros, walk, bias):
+        g.walk, g.bias = w, b
     return list(rate)
