@@ -26,6 +26,7 @@ import math
 
 import numpy as np
 
+from att_sim.actuators import quantize
 from att_sim.rotations import small_error_matrix
 from att_sim.sensors.specs import GyroSpec
 
@@ -104,7 +105,7 @@ class Gyro:
         lsb = self.spec.quantization
         if lsb > 0:
             total = self.carry + np.cumsum(rate * dt, axis=0)
-            counted = lsb * np.rint(total / lsb)
+            counted = quantize(total, lsb)
             self.carry = total[-1] - counted[-1]
             rate = np.diff(counted, axis=0, prepend=0.0) / dt     # the counts of each sample
         return rate
@@ -149,7 +150,7 @@ def measure_together(gyros: list[Gyro], intervals: list[tuple[np.ndarray, float]
     if quantized:
         lsb = _column([g.spec.quantization for g in gyros])
         total = np.array([g.carry for g in gyros]) + rate * dt
-        counted = lsb * np.rint(total / lsb)
+        counted = quantize(total, lsb)
         rate = counted / dt
         for g, row in zip(gyros, total - counted):
             g.carry = row

@@ -10,6 +10,7 @@ from __future__ import annotations
 import numpy as np
 
 from att_msgs_py.types import MagnetometerMeasurement
+from att_sim.actuators import quantize
 from att_sim.rotations import small_error_matrix
 from att_sim.sensors.specs import MagnetometerSpec
 
@@ -25,7 +26,5 @@ class Magnetometer:
                 frame_id: str = "") -> MagnetometerMeasurement:
         s = self.spec
         b = self.transfer @ field_B + self.bias + s.dipole_coupling * np.asarray(dipole_applied, float)
-        b = b + self.rng.standard_normal(3) * s.noise
-        if s.quantization > 0:
-            b = s.quantization * np.rint(b / s.quantization)
+        b = quantize(b + self.rng.standard_normal(3) * s.noise, s.quantization)
         return MagnetometerMeasurement(t=t, field=b, covariance=self.covariance, frame_id=frame_id)

@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from att_msgs_py.types import WheelSpeedMeasurement
+from att_sim.actuators import quantize
 from att_sim.sensors.specs import TachometerSpec
 
 
@@ -15,6 +16,5 @@ class Tachometer:
     def measure(self, t: float, relative_speed: np.ndarray, frame_id: str = "") -> WheelSpeedMeasurement:
         s = self.spec
         speeds = np.asarray(relative_speed, float) + self.rng.standard_normal(len(relative_speed)) * s.noise
-        if s.quantization > 0:
-            speeds = s.quantization * np.rint(speeds / s.quantization)
+        speeds = quantize(speeds, s.quantization)
         return WheelSpeedMeasurement(t=t, speeds=speeds, frame_id=frame_id)
