@@ -77,14 +77,20 @@ def sendable_epoch(epoch: datetime, name: str, code: ErrorCode = ErrorCode.INVAL
 def finite_array(value, name: str, code: ErrorCode, shape: tuple | None = None) -> np.ndarray:
     """A float array of ``shape`` (``-1`` for any length) with only finite entries."""
     a = np.asarray(value, dtype=float)
-    if shape is not None and a.shape != shape and (a.ndim != len(shape) or
-                                                   any(s not in (-1, n) for s, n in zip(shape, a.shape))):
+    if shape is not None and not _fits(a.shape, shape):
         want = "x".join("K" if s == -1 else str(s) for s in shape)
         raise RequestError(code, f"{name} has shape {'x'.join(map(str, a.shape)) or 'scalar'}; expected {want}")
     finite = all(map(math.isfinite, a.ravel().tolist())) if a.size <= 64 else np.isfinite(a).all()   # small: floats
     if not finite:
         raise RequestError(code, f"{name} has NaN or Inf entries")
     return a
+
+
+def _fits(found: tuple, shape: tuple) -> bool:
+    """Whether an array of shape ``found`` has ``shape`` (``-1``: any length)."""
+    if found == shape or shape == (-1,) and len(found) == 1:       # the common cases first
+        return True
+    return len(found) == len(shape) and all(s in (-1, n) for s, n in zip(shape, found))
 
 
 def peak(a: np.ndarray) -> float:

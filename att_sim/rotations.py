@@ -84,6 +84,9 @@ def multiply(p: np.ndarray, q: np.ndarray) -> np.ndarray:
 
 def conjugate(q: np.ndarray) -> np.ndarray:
     q = np.array(q, dtype=float)
+    if q.shape == (4,):                 # one quaternion: the same negation on Python floats
+        x, y, z, w = q.tolist()
+        return np.array([-x, -y, -z, w])
     q[..., :3] *= -1.0
     return q
 
@@ -154,13 +157,20 @@ def from_axis_angle(axis: np.ndarray, angle) -> np.ndarray:
 
 def to_axis_angle(q: np.ndarray) -> tuple[np.ndarray, float]:
     """Axis and angle in [0, π] of a single quaternion (shortest rotation)."""
-    x, y, z, w = normalize(q).tolist()
+    axis, angle = _axis_angle(q)
+    return np.array(axis), angle
+
+
+def _axis_angle(q) -> tuple[tuple[float, float, float], float]:
+    """:func:`to_axis_angle` on Python floats (``q`` normalised as :func:`normalize` does: the same bits)."""
+    x, y, z, w = np.asarray(q, float).tolist()
+    n = math.sqrt(x * x + y * y + z * z + w * w)
+    x, y, z, w = (x / n, y / n, z / n, w / n) if n > 0 else (math.nan,) * 4     # numpy's 0/0
     if w < 0:
         x, y, z, w = -x, -y, -z, -w
     s = math.sqrt(x * x + y * y + z * z)
     angle = 2.0 * math.atan2(s, w)
-    axis = np.array([x / s, y / s, z / s]) if s > 1e-15 else np.array([1.0, 0.0, 0.0])
-    return axis, angle
+    return ((x / s, y / s, z / s) if s > 1e-15 else (1.0, 0.0, 0.0)), angle
 
 
 def slerp(q0: np.ndarray, q1: np.ndarray, s) -> np.ndarray:
@@ -238,8 +248,8 @@ def propagate_constant_rate(q: np.ndarray, omega: np.ndarray, dt: float) -> np.n
 
 def log_map(q: np.ndarray) -> np.ndarray:
     """Rotation vector (axis × angle, angle in [0, π]) of a single quaternion: the inverse of :func:`exp_map`."""
-    axis, angle = to_axis_angle(q)
-    return axis * angle
+    (x, y, z), angle = _axis_angle(q)
+    return np.array([x * angle, y * angle, z * angle])
 
 
 OFF_DIAGONAL = ((0, 1), (0, 2), (1, 0), (1, 2), (2, 0), (2, 1))

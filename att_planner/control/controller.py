@@ -156,6 +156,7 @@ class Controller:
         self.hold_q: np.ndarray | None = None          # final attitude held after a maneuver
         self.cache = PlanCache(context, config.max_cached_plans, config.max_cache_bytes)
         self.references = tracking.ReferenceMemo()     # the plan's reference (shared by lockstep runs)
+        self.prepared: tuple | None = None             # (state, reference, wheel torques) of the law, done ahead
         self.guidance_sky = guidance_sky
         self.pointing = None                           # the pointing law of MODE_POINTING (guidance.laws)
         self.safe_law = None                           # the safe mode's Sun pointing, built when first used
@@ -430,9 +431,34 @@ class Controller:
         self._point(out, self.safe_law)
 
     def _wheel_command(self, ref: tracking.Reference) -> np.ndarray:
-        """Wheel torques of the tracking law about a body-torque reference."""
+        """Wheel torques of the tracking law about a body-torque reference (the ones :meth:`prepare`
+        was given for this state and reference, when it was)."""
+        prepared, self.prepared = self.prepared, None
         s, c = self.state, self.config
+        if prepared is not None and prepared[0] is s and prepared[1] is ref:
+            return prepared[2]
         return self._wheels(tracking.tracking_torque(s.q, s.omega, ref, c.tracking_kp, c.tracking_kd))
+
+    def tracked_reference(self) -> tracking.Reference | None:
+        """The reference the next :meth:`step` feeds to the tracking law of :meth:`_wheel_command`
+        (a plan of body torques being flown), None when it does not."""
+        m = self.maneuver
+        if self.mode != ControlMode.PLAN_TRACKING or m is None or m.plan.control_kind == ControlKind.WHEEL_TORQUE:
+            return None
+        return self.references(m.plan, self.state.t - m.t0)
+
+    @property
+    def law(self) -> tuple:
+        """What the tracking law's wheel torques depend on besides the state and the reference:
+        controllers of one law compute them as rows (:mod:`att_planner.control.lockstep`)."""
+        c = self.config
+        return (id(self.spacecraft), c.tracking_kp, c.tracking_kd, c.null_space_speed, c.null_space_gain,
+                self.friction)
+
+    def prepare(self, reference: tracking.Reference, wheel_torques: np.ndarray) -> None:
+        """Give the next :meth:`step` the tracking law's wheel torques about ``reference`` for the
+        latest state, computed elsewhere (:func:`att_planner.control.lockstep.track_together`)."""
+        self.prepared = (self.state, reference, wheel_torques)
 
     def _track(self, out: StepOutput, cancel_requested: bool) -> None:
         """One plan-tracking step: command, feedback every ``feedback_period``, the end."""

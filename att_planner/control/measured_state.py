@@ -42,8 +42,8 @@ class MeasuredState:
             raise RequestError(BAD, f"wheel speed header.frame_id '{str(m.frame_id)[:64]}' is not "
                                     f"'{self.body_frame_id}'")
         speeds = validation.finite_array(m.speeds, "wheel speed velocity", BAD, (sc.n_wheels,))
-        if speeds.size and np.max(np.abs(speeds)) > 2 * sc.wheel_speed_max:
-            raise RequestError(BAD, f"wheel speed velocity reaches {np.max(np.abs(speeds)):.6g} rad/s, more than "
+        if validation.peak(speeds) > 2 * sc.wheel_speed_max:
+            raise RequestError(BAD, f"wheel speed velocity reaches {validation.peak(speeds):.6g} rad/s, more than "
                                     f"twice the limit {sc.wheel_speed_max:g}")
         self.wheel_speeds = speeds
 

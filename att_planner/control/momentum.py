@@ -49,8 +49,11 @@ def null_space(sc: Spacecraft) -> np.ndarray:
 
 def null_space_torques(sc: Spacecraft, wheel_speed, bias_speed: float, gain: float) -> np.ndarray:
     """``u_n = −k_n I_w N (Nᵀ Ω − c_b)`` (N m per wheel): drives each null-space speed component to
-    ``bias_speed`` and puts no torque on the body."""
+    ``bias_speed`` and puts no torque on the body (rows of runs' speeds: each row's, to its bits alone)."""
+    w = np.asarray(wheel_speed, float)
     N = null_space(sc)
     if not N.size:
-        return np.zeros(sc.n_wheels)
-    return -gain * sc.wheel_inertia * N @ (N.T @ np.asarray(wheel_speed, float) - bias_speed)
+        return np.zeros(w.shape[:-1] + (sc.n_wheels,))
+    if w.ndim == 2:
+        return np.matmul(-gain * sc.wheel_inertia * N, np.matmul(N.T, w[:, :, None]) - bias_speed)[:, :, 0]
+    return -gain * sc.wheel_inertia * N @ (N.T @ w - bias_speed)

@@ -98,3 +98,25 @@ def wheel_torques(sc: Spacecraft, body_torque, omega, wheel_speed, extra=None) -
     if extra is not None:
         u = u + extra
     return np.minimum(np.maximum(u, -sc.wheel_torque_max), sc.wheel_torque_max)
+
+
+def matvec_rows(A: np.ndarray, rows: np.ndarray) -> np.ndarray:
+    """``A @ v`` of each row ``v`` (stacked: each row gets the bits of ``A @ v`` alone)."""
+    return np.matmul(A, rows[:, :, None])[:, :, 0]
+
+
+def tracking_torques_of_runs(q, omega, ref_q, ref_omega, ref_torque, kp: float, kd: float) -> np.ndarray:
+    """:func:`tracking_torque` of each row (runs × 4 attitudes, runs × 3 rates and references)."""
+    e = rot.error_vector(q, ref_q)
+    return ref_torque - kp * 2.0 * e - kd * (omega - ref_omega)
+
+
+def wheel_torques_of_runs(sc: Spacecraft, body_torque, omega, wheel_speed, extra) -> np.ndarray:
+    """:func:`wheel_torques` of each row (runs × 3 torques and rates, runs × wheels speeds and
+    extras), row by row the same operations: each row gets the bits it gets alone."""
+    h_w = matvec_rows(sc.wheel_axes, sc.wheel_inertia * wheel_speed)
+    u = matvec_rows(-sc.wheel_axes_pinv, body_torque + rot.cross(omega, h_w))
+    peak = np.abs(u).max(axis=1)
+    for i in np.flatnonzero(peak > sc.wheel_torque_max).tolist():
+        u[i] = u[i] * (sc.wheel_torque_max / peak[i])
+    return np.minimum(np.maximum(u + extra, -sc.wheel_torque_max), sc.wheel_torque_max)

@@ -16,7 +16,7 @@ loop's own key, as the planner would sign them.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from typing import NamedTuple
 
 import numpy as np
 from cryptography.hazmat.primitives.asymmetric.ed25519 import Ed25519PrivateKey
@@ -27,34 +27,54 @@ from att_msgs_py.parameters import SectionReader
 from att_msgs_py.types import Health, ManeuverResult, Plan, PointingMode
 from att_planner.control.configure import controller_from_scenario
 from att_planner.estimation.configure import estimator_from_scenario
+from att_planner.estimation.estimator import Estimator
 from att_sim import rotations as rot
 from att_sim.scenario import Scenario
 from att_sim.sensors import Readings
 from att_sim.simulation import DEFAULT_STEP, Checks, Simulation
 
 
-@dataclass
-class Trace:
-    """What happened at each control instant (lists while running; :meth:`arrays` to analyse)."""
+class Reprocessing(NamedTuple):
+    """An estimator's reprocessing from snapshot ``start`` (:meth:`ClosedLoop.exchange_steps`)."""
 
-    t: list = field(default_factory=list)
-    q_true: list = field(default_factory=list)
-    omega_true: list = field(default_factory=list)
-    q_est: list = field(default_factory=list)             # the controller's attitude (estimate or truth)
-    attitude_covariance: list = field(default_factory=list)
-    bias_true: list = field(default_factory=list)
-    bias_est: list = field(default_factory=list)
-    health: list = field(default_factory=list)
-    tracker_status: list = field(default_factory=list)    # TrackerStatus of the latest tracker sample
-    wheel_speeds: list = field(default_factory=list)      # rad/s, relative to the body (truth)
-    wheel_torques: list = field(default_factory=list)     # N m, commanded
-    dipole: list = field(default_factory=list)            # A m², commanded
-    mode: list = field(default_factory=list)
-    attitude_error: list = field(default_factory=list)    # rad, from the controller's reference (status)
+    estimator: Estimator
+    start: int
+
+
+class Trace:
+    """What happened at each control instant: one row per instant while running (:meth:`append`),
+    columns by :meth:`arrays` — the truth (attitude, rate, wheel speeds relative to the body from
+    the state vector and the wheel axes), the controller's attitude (estimate or truth), the
+    estimate's attitude covariance and gyro bias (NaN without one), the truth's gyro bias, the
+    health, the latest tracker sample's status, the commanded wheel torques, dipole and mode, and
+    the attitude error to the controller's reference (its status)."""
+
+    FIELDS = ("t", "q_true", "omega_true", "q_est", "attitude_covariance", "bias_true", "bias_est", "health",
+              "tracker_status", "wheel_speeds", "wheel_torques", "dipole", "mode", "attitude_error")
+    _ROW = ("t", "x", "q_est", "attitude_covariance", "bias_est", "bias_true", "health", "tracker_status",
+            "wheel_torques", "dipole", "mode", "attitude_error")
+
+    def __init__(self, wheel_axes: np.ndarray):
+        self.axes_T = np.asarray(wheel_axes, float).T      # wheels x 3: relative speeds ν = Ω − Gᵀω
+        self.rows: list[tuple] = []
+
+    def append(self, t: float, x: np.ndarray, q_est: np.ndarray, attitude_covariance: np.ndarray,
+               bias_est: np.ndarray, bias_true: np.ndarray, health: int, tracker_status: int,
+               wheel_torques: np.ndarray, dipole: np.ndarray, mode: int, attitude_error: float) -> None:
+        """One instant (``x``: the simulation's state vector [q, ω, Ω]); the arrays are kept as given."""
+        self.rows.append((t, x, q_est, attitude_covariance, bias_est, bias_true, health, tracker_status,
+                          wheel_torques, dipole, mode, attitude_error))
+
+    def __len__(self) -> int:
+        return len(self.rows)
 
     def arrays(self, *names: str) -> dict[str, np.ndarray]:
-        """The fields ``names`` (default every one) as arrays."""
-        return {k: np.asarray(getattr(self, k)) for k in names or self.__dict__}
+        """The fields ``names`` (default every one of :data:`FIELDS`) as arrays, one row per instant."""
+        columns = dict(zip(self._ROW, zip(*self.rows))) if self.rows else {}
+        x = np.array(columns.get("x", ()), float).reshape(-1, 7 + len(self.axes_T))
+        derived = {"q_true": lambda: x[:, :4], "omega_true": lambda: x[:, 4:7],
+                   "wheel_speeds": lambda: x[:, 7:] - np.matmul(self.axes_T, x[:, 4:7, None])[..., 0]}
+        return {k: derived[k]() if k in derived else np.asarray(columns.get(k, ())) for k in names or self.FIELDS}
 
 
 class ClosedLoop:
@@ -82,7 +102,7 @@ class ClosedLoop:
         self.sim = simulation or Simulation.for_scenario(
             scenario, q0=q0, omega0=omega0, wheel_speed0=wheel_speed0, seed=seed,
             checks=Checks(body_frame_id=scenario.body_frame_id))
-        self.trace = Trace()
+        self.trace = Trace(self.sim.sc.wheel_axes)
         self.tracker_status = 0                 # of the latest tracker measurement (TrackerStatus)
         self.refusals: list[RequestError] = []
         self.next_state = 0.0
@@ -115,15 +135,17 @@ class ClosedLoop:
 
     def exchange(self) -> None:
         """A step's messages without the advance: readings and state out, the command (when due) in."""
-        for estimator, start in self.exchange_steps():
-            estimator.reprocess(start)
+        for job in self.exchange_steps():
+            if isinstance(job, Reprocessing):
+                job.estimator.reprocess(job.start)
 
     def exchange_steps(self, readings: Readings | None = None):
-        """:meth:`exchange` as a generator: it yields each reprocessing ``(estimator, start)`` the
-        estimator needs before the exchange goes on (:meth:`Estimator.reprocess
+        """:meth:`exchange` as a generator: it yields each :class:`Reprocessing` the estimator needs
+        before the exchange goes on (:meth:`Estimator.reprocess
         <att_planner.estimation.estimator.Estimator.reprocess>`), which the caller does — at once,
         or for many loops together (:func:`~att_planner.tools.monte_carlo.run.fly_together`, which
-        also senses for them: ``readings``, the simulation's now)."""
+        also senses for them: ``readings``, the simulation's now) — and the controller when it is
+        about to step (its tracking law may be prepared then: :mod:`att_planner.control.lockstep`)."""
         sim, ctl, est = self.sim, self.controller, self.estimator
         readings = sim.sense() if readings is None else readings
         t = sim.t
@@ -138,7 +160,7 @@ class ClosedLoop:
                 self.tracker_status = int(m.status)
                 start = self._guard(est.take_star_tracker, m)
                 if start is not None:
-                    yield est, start
+                    yield Reprocessing(est, start)
             if readings.magnetometer is not None:
                 self._guard(est.on_magnetometer, readings.magnetometer)
                 self._guard(ctl.measured.on_magnetometer, readings.magnetometer)
@@ -148,7 +170,7 @@ class ClosedLoop:
                 self._guard(ctl.measured.on_wheel_speeds, readings.wheel_speeds)
             omega = self._guard(est.take_gyro, readings.gyro) if readings.gyro is not None else None
             if omega is not None:
-                yield est, est.newest
+                yield Reprocessing(est, est.newest)
                 estimate = est.publish(readings.gyro.t, omega)
                 if estimate is not None:
                     if self.tap is not None:
@@ -159,6 +181,7 @@ class ClosedLoop:
         if outcome is not None:
             self._outcome(outcome)
             if ctl.due():
+                yield ctl
                 out = ctl.step()
                 if out.result is not None:
                     self.result = out.result
@@ -170,7 +193,7 @@ class ClosedLoop:
                     self.refusals.append(RequestError(refused.code, refused.message))
                 if est is not None:
                     est.on_dipole_command(out.command.t, out.command.dipole)
-                self._record(out, readings)
+                self._record(out)
 
     def run(self, duration: float) -> None:
         """Tick for ``duration`` s of sim time (stops early if the simulation halts)."""
@@ -214,28 +237,17 @@ class ClosedLoop:
         if state_due:
             self.tap(topics.STATE, t, self.sim.state(self.scenario.frame_id, self.scenario.body_frame_id))
 
-    def _record(self, out, readings) -> None:
-        tr, sim, est, command = self.trace, self.sim, self.estimator, out.command
-        x = sim.x
-        state = self.controller.state
-        tr.t.append(sim.t)
-        tr.q_true.append(x[:4].copy())
-        tr.omega_true.append(x[4:7].copy())
-        tr.q_est.append(state.q.copy())
-        tr.wheel_speeds.append(x[7:] - sim.sc.wheel_axes.T @ x[4:7])
-        tr.wheel_torques.append(np.asarray(command.wheel_torques, float).copy())
-        tr.dipole.append(np.asarray(command.dipole, float).copy())
-        tr.mode.append(int(command.mode))
-        tr.attitude_error.append(float(out.status.attitude_error))
-        if est is not None and est.state is not None:
-            tr.attitude_covariance.append(est.state.P[:3, :3].copy())
-            tr.bias_est.append(est.state.bias.copy())
-        else:
-            tr.attitude_covariance.append(np.full((3, 3), math.nan))
-            tr.bias_est.append(np.full(3, math.nan))
-        tr.bias_true.append(sim.sensors.gyro.bias.copy() if sim.sensors and sim.sensors.gyro else np.zeros(3))
-        tr.health.append(int(est.health(sim.t)) if est is not None else int(Health.CONVERGED))
-        tr.tracker_status.append(self.tracker_status)
+    def _record(self, out) -> None:
+        sim, est, command = self.sim, self.estimator, out.command
+        filtered = est is not None and est.state is not None
+        self.trace.append(
+            sim.t, sim.x.copy(), self.controller.state.q.copy(),
+            est.state.P[:3, :3].copy() if filtered else np.full((3, 3), math.nan),
+            est.state.bias.copy() if filtered else np.full(3, math.nan),
+            sim.sensors.gyro.bias.copy() if sim.sensors and sim.sensors.gyro else np.zeros(3),
+            int(est.health(sim.t)) if est is not None else int(Health.CONVERGED), self.tracker_status,
+            np.array(command.wheel_torques, float), np.array(command.dipole, float), int(command.mode),
+            float(out.status.attitude_error))
 
 
 def plan_in_process(scenario: Scenario, q0, qf, sensor_axis, cones=(), zones=(), method: str = "",

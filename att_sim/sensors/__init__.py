@@ -112,10 +112,8 @@ class SensorSuite:
         body = self.body_frame_id
         interval, rate = (self.gyro_interval(t, q, omega), None) if gyro is None else gyro
         if interval is not None:
-            dt = interval[1]
-            sigma = self.gyro.noise_sigma(dt)
             out.gyro = GyroMeasurement(t, self.gyro.measure(*interval) if rate is None else rate,
-                                       np.eye(3) * sigma**2, body)
+                                       self.gyro.noise_covariance(interval[1]), body)
             out.truth = SensorTruth(t, self.gyro.bias.copy(), self._magnetometer_bias(), body)
         sky = None
         for tracker, schedule in zip(self.trackers, self.tracker_schedules):

@@ -55,10 +55,22 @@ class Gyro:
         self.carry = np.zeros(3)          # rad: angle not yet output by the quantiser
         self.bias = self.turn_on + self.flicker.sum(axis=0)
         self._banks: dict[float, tuple[np.ndarray, np.ndarray]] = {}    # dt -> (a, σ√(1 − a²)) of each process
+        self._covariances: dict[float, np.ndarray] = {}                 # dt -> the sample's noise covariance
 
     def noise_sigma(self, dt: float) -> float:
         """1σ of the white rate noise of one sample (rad/s)."""
         return self.spec.arw / math.sqrt(dt)
+
+    def noise_covariance(self, dt: float) -> np.ndarray:
+        """``σ² I`` of one sample's white rate noise over ``dt`` ((rad/s)²): read-only, shared by the
+        samples of one interval (kept for the few intervals a simulator's clock makes)."""
+        covariance = self._covariances.get(dt)
+        if covariance is None:
+            if len(self._covariances) >= 64:
+                self._covariances.clear()
+            covariance = self._covariances[dt] = np.eye(3) * self.noise_sigma(dt) ** 2
+            covariance.flags.writeable = False
+        return covariance
 
     def _bank(self, dt: float) -> tuple[np.ndarray, np.ndarray]:
         """Each flicker process's step over ``dt``: its factor ``a = exp(−Δt/τ)`` and the drive's 1σ

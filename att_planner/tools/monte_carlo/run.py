@@ -11,7 +11,7 @@ waits before it sends a goal; then the controller flies the plan and holds its e
 
 The runs of a task fly in lockstep (:func:`fly_together`): each run's flight software steps on its
 own, the heavy numerics of a step are done for all the runs at once — the estimators' propagations,
-the plan's reference, one RK4 step of every simulation — and each run gets the bits it gets alone:
+the plan's reference and the tracking law, one RK4 step of every simulation — and each run gets the bits it gets alone:
 a run's row does not depend on the runs it flew with, so a run is reproduced alone from its seed.
 """
 from __future__ import annotations
@@ -24,9 +24,11 @@ import numpy as np
 from cryptography.hazmat.primitives.asymmetric.ed25519 import Ed25519PrivateKey
 
 from att_msgs_py.types import Health, ManeuverResult, Plan, Verification
+from att_planner.control.controller import Controller
+from att_planner.control.lockstep import track_together
 from att_planner.control.tracking import ReferenceMemo
 from att_planner.estimation.lockstep import reprocess_together
-from att_planner.tools.closed_loop import ClosedLoop, plan_in_process
+from att_planner.tools.closed_loop import ClosedLoop, Reprocessing, plan_in_process
 from att_planner.tools.demo import maneuver_from_scenario, zone_margins
 from att_planner.verification import rejection
 from att_sim import dispersions as disp
@@ -143,7 +145,8 @@ def fly_together(setup: Setup, runs: list[tuple[int, int]], tap=None) -> list[di
     gyros measure together (:meth:`Lockstep.sense <att_sim.lockstep.Lockstep.sense>`), their
     estimators reprocess together (:func:`~att_planner.estimation.lockstep.reprocess_together`:
     their propagations as one stack), their controllers share the plan's reference (one plan object,
-    issued once with the loops' one key: :class:`~att_planner.control.tracking.ReferenceMemo`), and
+    issued once with the loops' one key: :class:`~att_planner.control.tracking.ReferenceMemo`) and
+    compute its tracking law as rows (:func:`~att_planner.control.lockstep.track_together`), and
     the simulations of the runs still going advance together (:class:`att_sim.lockstep.Lockstep`) —
     every run to the bits it reaches alone. ``cpu_seconds``: the group's CPU time shared equally.
     ``tap``: see :attr:`ClosedLoop.tap` (a full log; one run)."""
@@ -164,9 +167,10 @@ def fly_together(setup: Setup, runs: list[tuple[int, int]], tap=None) -> list[di
         going = still
         readings = lockstep.sense() if lockstep is not None else [None] * len(going)
         exchanges = [f.loop.exchange_steps(r) for f, r in zip(going, readings)]
-        while exchanges:                # each turn: every exchange to its next reprocessing, done together
+        while exchanges:                # each turn: every exchange to its next job, those of a kind done together
             turn = [(steps, next(steps, None)) for steps in exchanges]
-            reprocess_together([job for _, job in turn if job is not None])
+            reprocess_together([job for _, job in turn if isinstance(job, Reprocessing)])
+            track_together([job for _, job in turn if isinstance(job, Controller)])
             exchanges = [steps for steps, job in turn if job is not None]
         if lockstep is not None:
             lockstep.advance(going[0].loop.step)
