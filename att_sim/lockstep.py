@@ -18,7 +18,7 @@ from att_sim import dynamics as dyn
 from att_sim import rotations as rot
 from att_sim.actuators import DrivesOfRuns, MagnetorquersOfRuns
 from att_sim.sensors import Readings
-from att_sim.sensors.gyro import measure_together
+from att_sim.sensors.gyro import GyrosOfRuns
 from att_sim.simulation import Applied, Simulation
 
 
@@ -58,6 +58,7 @@ class Lockstep:
         self.disturbed = any(s.environment.disturbed for s in sims)
         envs = [s.environment for s in sims]
         self.one_sky = all(e.shares_time_part(first.environment) for e in envs)   # one time-only part for all
+        self.gyros: tuple[list, GyrosOfRuns] | None = None   # the runs whose gyros were due, and theirs
 
     def _limited(self, u: list, relative: list) -> list:
         return dyn.limited_runs(self.torque_max, self.speed_max, u, relative)
@@ -113,11 +114,13 @@ class Lockstep:
 
     def sense(self) -> list[Readings]:
         """Every run's :meth:`Simulation.sense <att_sim.simulation.Simulation.sense>`, the gyros due
-        measuring together (:func:`att_sim.sensors.gyro.measure_together`)."""
+        measuring together (:class:`att_sim.sensors.gyro.GyrosOfRuns`)."""
         intervals = [s.gyro_interval() for s in self.sims]
         due = [i for i, interval in enumerate(intervals) if interval is not None]
         rates = [None] * len(self.sims)
-        measured = measure_together([self.sims[i].sensors.gyro for i in due], [intervals[i] for i in due])
+        if due and (self.gyros is None or self.gyros[0] != due):
+            self.gyros = (due, GyrosOfRuns([self.sims[i].sensors.gyro for i in due]))
+        measured = self.gyros[1].measure([intervals[i] for i in due]) if due else []
         for i, rate in zip(due, measured):
             rates[i] = rate
         return [s.sense((interval, rate)) for s, interval, rate in zip(self.sims, intervals, rates)]

@@ -56,6 +56,7 @@ class Gyro:
         self.bias = self.turn_on + self.flicker.sum(axis=0)
         self._banks: dict[float, tuple[np.ndarray, np.ndarray]] = {}    # dt -> (a, σ√(1 − a²)) of each process
         self._covariances: dict[float, np.ndarray] = {}                 # dt -> the sample's noise covariance
+        self._alone: GyrosOfRuns | None = None                         # this gyro's one-sample path
 
     def noise_sigma(self, dt: float) -> float:
         """1σ of the white rate noise of one sample (rad/s)."""
@@ -86,7 +87,7 @@ class Gyro:
     def _bias(self, n: int, dt: float) -> np.ndarray:
         """The bias at the end of each of ``n`` intervals (n, 3); advances the noise state. Each
         flicker process is ``x_k = a x_(k-1) + w_k``: a batch (n > 1) through ``scipy.signal.lfilter``
-        (imported then: it costs a node seconds at start); one interval is :func:`measure_together`'s."""
+        (imported then: it costs a node seconds at start); one interval is :class:`GyrosOfRuns`'s."""
         flicker = np.zeros((n, 3))
         if self.flicker_sigma > 0:
             for j, tau in enumerate(self.times):
@@ -109,7 +110,8 @@ class Gyro:
         increments = np.atleast_2d(np.asarray(rotation, float))
         n = len(increments)
         if n == 1:                        # the simulator's case
-            rate = measure_together([self], [(increments[0], dt)])[0]
+            self._alone = self._alone or GyrosOfRuns([self])
+            rate = self._alone.measure([(increments[0], dt)])[0]
             return rate if np.ndim(rotation) == 1 else rate[None, :]
         rate = increments @ self.transfer.T / dt + self._bias(n, dt)
         rate += self.rng.standard_normal((n, 3)) * self.noise_sigma(dt)
@@ -128,44 +130,66 @@ def _column(values) -> np.ndarray:
     return np.array([[v] for v in values], float)
 
 
-def measure_together(gyros: list[Gyro], intervals: list[tuple[np.ndarray, float]]) -> list[np.ndarray]:
-    """:meth:`Gyro.measure` of one interval ``(rotation, dt)`` for each gyro — one gyro's sample in the
-    simulator, or the gyros of a lockstep's runs at once: the whole flicker bank in one step, then the
-    rate random walk, the white noise (each gyro's draws from its own stream, in that order), the
-    arithmetic on rows of gyros (element by element; the stacked bank sums and products give each
-    row the bits it gets alone). Gyros unlike in their noise's form (a bank or none, a quantiser or
-    none) measure one by one."""
-    if not gyros:
-        return []
-    banked, quantized = gyros[0].flicker_sigma > 0, gyros[0].spec.quantization > 0
-    if any((g.flicker_sigma > 0) != banked or (g.spec.quantization > 0) != quantized
-           or g.flicker.shape != gyros[0].flicker.shape for g in gyros):
-        return [measure_together([g], [interval])[0] for g, interval in zip(gyros, intervals)]
-    dt = _column([h for _, h in intervals])
-    flicker_sum = np.zeros((len(gyros), 3))
-    if banked:
-        banks = [g._bank(h) for g, (_, h) in zip(gyros, intervals)]
-        flicker = np.array([a for a, _ in banks]) * np.array([g.flicker for g in gyros]) \
-            + np.array([g.rng.standard_normal(g.flicker.shape) for g in gyros]) * np.array([s for _, s in banks])
-        flicker_sum = flicker.sum(axis=1)
-        for g, row in zip(gyros, flicker):
-            g.flicker = row
-    walk = np.array([g.walk for g in gyros]) + np.array([g.rng.standard_normal(3) for g in gyros]) * _column(
-        [g.spec.rrw * math.sqrt(h) for g, (_, h) in zip(gyros, intervals)])
-    bias = np.array([g.turn_on for g in gyros]) + flicker_sum + walk
-    rotation = np.array([r for r, _ in intervals])[:, None, :]
-    rate = (rotation @ np.array([g.transfer.T for g in gyros]))[:, 0, :] / dt + bias
-    rate = rate + np.array([g.rng.standard_normal(3) for g in gyros]) * _column(
-        [g.noise_sigma(h) for g, (_, h) in zip(gyros, intervals)])
-    limit = _column([g.spec.range for g in gyros])
-    rate = np.minimum(np.maximum(rate, -limit), limit)
-    if quantized:
-        lsb = _column([g.spec.quantization for g in gyros])
-        total = np.array([g.carry for g in gyros]) + rate * dt
-        counted = quantize(total, lsb)
-        rate = counted / dt
-        for g, row in zip(gyros, total - counted):
-            g.carry = row
-    for g, w, b in zip(gyros, walk, bias):
-        g.walk, g.bias = w, b
-    return list(rate)
+class GyrosOfRuns:
+    """Gyros sampled together — one gyro's sample in the simulator, or the gyros of a lockstep's runs
+    at once: the whole flicker bank in one step, then the rate random walk, the white noise (each
+    gyro's draws from its own stream, in that order), the arithmetic on rows of gyros (element by
+    element; the stacked bank sums and products give each row the bits it gets alone). The gyros'
+    constants are stacked once, their factors for an interval kept for the few intervals a clock
+    makes. Gyros unlike in their noise's form (a bank or none, a quantiser or none) measure one by one."""
+
+    def __init__(self, gyros: list[Gyro]):
+        self.gyros, first = gyros, gyros[0]
+        self.banked, self.quantized = first.flicker_sigma > 0, first.spec.quantization > 0
+        self.alike = all((g.flicker_sigma > 0) == self.banked and (g.spec.quantization > 0) == self.quantized
+                         and g.flicker.shape == first.flicker.shape for g in gyros)
+        if self.alike:
+            self.transfer_T = np.array([g.transfer.T for g in gyros])
+            self.turn_on = np.array([g.turn_on for g in gyros])
+            self.limit = _column([g.spec.range for g in gyros])
+            self.lsb = _column([g.spec.quantization for g in gyros])
+        self._factors: dict[tuple, tuple] = {}
+
+    def _of_intervals(self, dts: tuple) -> tuple:
+        """For the intervals ``dts`` (one per gyro): their column, the bank's factors and drives' 1σ,
+        the rate walk's and the white noise's 1σ (columns)."""
+        factors = self._factors.get(dts)
+        if factors is None:
+            if len(self._factors) >= 64:
+                self._factors.clear()
+            gyros = self.gyros
+            banks = [g._bank(h) for g, h in zip(gyros, dts)] if self.banked else []
+            factors = self._factors[dts] = (
+                _column(dts), np.array([a for a, _ in banks]), np.array([s for _, s in banks]),
+                _column([g.spec.rrw * math.sqrt(h) for g, h in zip(gyros, dts)]),
+                _column([g.noise_sigma(h) for g, h in zip(gyros, dts)]))
+        return factors
+
+    def measure(self, intervals: list[tuple[np.ndarray, float]]) -> list[np.ndarray]:
+        """The rate each gyro measures over its interval ``(rotation, dt)`` (the gyros' order)."""
+        gyros = self.gyros
+        if not self.alike:
+            return [GyrosOfRuns([g]).measure([interval])[0] for g, interval in zip(gyros, intervals)]
+        dt, a, sigma, walk_sigma, noise_sigma = self._of_intervals(tuple(h for _, h in intervals))
+        flicker_sum = np.zeros((len(gyros), 3))
+        if self.banked:
+            flicker = a * np.array([g.flicker for g in gyros]) \
+                + np.array([g.rng.standard_normal(g.flicker.shape) for g in gyros]) * sigma
+            flicker_sum = flicker.sum(axis=1)
+            for g, row in zip(gyros, flicker):
+                g.flicker = row
+        walk = np.array([g.walk for g in gyros]) + np.array([g.rng.standard_normal(3) for g in gyros]) * walk_sigma
+        bias = self.turn_on + flicker_sum + walk
+        rotation = np.array([r for r, _ in intervals])[:, None, :]
+        rate = (rotation @ self.transfer_T)[:, 0, :] / dt + bias
+        rate = rate + np.array([g.rng.standard_normal(3) for g in gyros]) * noise_sigma
+        rate = np.minimum(np.maximum(rate, -self.limit), self.limit)
+        if self.quantized:
+            total = np.array([g.carry for g in gyros]) + rate * dt
+            counted = quantize(total, self.lsb)
+            rate = counted / dt
+            for g, row in zip(gyros, total - counted):
+                g.carry = row
+        for g, w, b in zip(gyros, walk, bias):
+            g.walk, g.bias = w, b
+        return list(rate)
