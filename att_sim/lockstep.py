@@ -14,11 +14,13 @@ from __future__ import annotations
 
 import numpy as np
 
+from att_msgs_py.types import WheelSpeedMeasurement
 from att_sim import dynamics as dyn
 from att_sim import rotations as rot
 from att_sim.actuators import DrivesOfRuns, MagnetorquersOfRuns
-from att_sim.sensors import Readings
+from att_sim.sensors import Readings, Taken
 from att_sim.sensors.gyro import GyrosOfRuns
+from att_sim.sensors.tachometer import measure_together as measure_tachometers
 from att_sim.simulation import Applied, Simulation
 
 
@@ -114,16 +116,25 @@ class Lockstep:
 
     def sense(self) -> list[Readings]:
         """Every run's :meth:`Simulation.sense <att_sim.simulation.Simulation.sense>`, the gyros due
-        measuring together (:class:`att_sim.sensors.gyro.GyrosOfRuns`)."""
-        intervals = [s.gyro_interval() for s in self.sims]
-        due = [i for i, interval in enumerate(intervals) if interval is not None]
-        rates = [None] * len(self.sims)
+        measuring together (:class:`att_sim.sensors.gyro.GyrosOfRuns`), the tachometers due too
+        (:func:`att_sim.sensors.tachometer.measure_together`)."""
+        sims = self.sims
+        if any(s.sensors is None for s in sims):
+            return [s.sense() for s in sims]
+        taken = [Taken(s.gyro_interval()) for s in sims]
+        due = [i for i, got in enumerate(taken) if got.gyro_interval is not None]
         if due and (self.gyros is None or self.gyros[0] != due):
-            self.gyros = (due, GyrosOfRuns([self.sims[i].sensors.gyro for i in due]))
-        measured = self.gyros[1].measure([intervals[i] for i in due]) if due else []
-        for i, rate in zip(due, measured):
-            rates[i] = rate
-        return [s.sense((interval, rate)) for s, interval, rate in zip(self.sims, intervals, rates)]
+            self.gyros = (due, GyrosOfRuns([sims[i].sensors.gyro for i in due]))
+        for i, rate in zip(due, self.gyros[1].measure([taken[i].gyro_interval for i in due]) if due else ()):
+            taken[i].gyro_rate = rate
+        due = [i for i, s in enumerate(sims) if s.sensors.tachometer_due(s.t)]
+        if due:
+            x = np.array([sims[i].x for i in due])
+            relative = x[:, 7:] - (self.axes_T[due] @ x[:, 4:7, None])[:, :, 0]
+            measured = measure_tachometers([sims[i].sensors.tachometer for i in due], relative)
+            for i, speeds in zip(due, measured):
+                taken[i].wheel_speeds = WheelSpeedMeasurement(sims[i].t, speeds, sims[i].sensors.body_frame_id)
+        return [s.sense(got) for s, got in zip(sims, taken)]
 
     def _inputs(self, x: np.ndarray) -> list[dyn.Inputs]:
         """Every run's :meth:`Simulation.inputs <att_sim.simulation.Simulation.inputs>` at its state

@@ -29,7 +29,7 @@ from att_sim import rotations as rot
 from att_sim import world
 from att_sim.actuators import ActuatorSpecs, Magnetorquers, WheelDrive
 from att_sim.orbit import CircularOrbit
-from att_sim.sensors import Readings, SensorSuite, rng
+from att_sim.sensors import Readings, SensorSuite, Taken, rng
 from att_sim.sensors.specs import SensorSpecs
 
 DEFAULT_STEP = 0.05             # s: the simulator's RK4 step unless its parameter says otherwise
@@ -268,16 +268,16 @@ class Simulation:
                else np.zeros(3))
         return dyn.Inputs(wheel_torque=u, body_torque=tau, dipole=m, wheel_drive=self.wheel_drive)
 
-    def sense(self, gyro: tuple | None = None) -> Readings:
+    def sense(self, taken: Taken | None = None) -> Readings:
         """What the sensors output now (nothing without sensors): see :class:`att_sim.sensors.SensorSuite`
-        (``gyro``: its :meth:`~att_sim.sensors.SensorSuite.sample`'s, the gyro's interval and rate
-        taken already)."""
+        (``taken``: its :meth:`~att_sim.sensors.SensorSuite.sample`'s, the gyro's and tachometer's
+        measurements taken already)."""
         if self.sensors is None:
             return Readings()
         x = self.x
-        return self.sensors.sample(self.t, x[:4], x[4:7], dyn.relative_wheel_speed(self.sc, x[7:], x[4:7]),
-                                   self.now.field_B, self.applied.dipole, lambda: self.environment.bodies(self.t),
-                                   gyro)
+        relative = None if taken is not None else dyn.relative_wheel_speed(self.sc, x[7:], x[4:7])
+        return self.sensors.sample(self.t, x[:4], x[4:7], relative, self.now.field_B, self.applied.dipole,
+                                   lambda: self.environment.bodies(self.t), taken)
 
     def gyro_interval(self) -> tuple[np.ndarray, float] | None:
         """The gyro's interval now (:meth:`SensorSuite.gyro_interval <att_sim.sensors.SensorSuite.gyro_interval>`;

@@ -53,6 +53,17 @@ class Readings:
     truth: SensorTruth | None = None
 
 
+@dataclass
+class Taken:
+    """What was measured for a suite already, its schedules asked (:class:`att_sim.lockstep.Lockstep`
+    measures the runs' gyros and tachometers together): the gyro's interval (None: not due) and
+    rate, the tachometer's sample (None: not due)."""
+
+    gyro_interval: tuple[np.ndarray, float] | None = None
+    gyro_rate: np.ndarray | None = None
+    wheel_speeds: WheelSpeedMeasurement | None = None
+
+
 class _Schedule:
     """Due times of a sensor of ``rate`` Hz: t = 0, 1/rate, 2/rate, ... (counted, never drifting)."""
 
@@ -98,19 +109,24 @@ class SensorSuite:
         self.gyro_last = (t, np.array(q, float))
         return rotation, dt
 
+    def tachometer_due(self, t: float) -> bool:
+        """Whether the tachometer samples at ``t`` (asking starts its next period)."""
+        return self.tachometer is not None and self.schedules["tachometer"].due(t)
+
     def sample(self, t: float, q: np.ndarray, omega: np.ndarray, relative_wheel_speed: np.ndarray,
                field_B: np.ndarray, dipole_applied: np.ndarray, bodies: Callable[[], Bodies],
-               gyro: tuple | None = None) -> Readings:
+               taken: Taken | None = None) -> Readings:
         """What the sensors output at time ``t`` for the truth state (attitude ``q``, body rate
         ``omega``, wheel speeds relative to the body) and the environment (``field_B`` in body axes,
         the applied dipole, ``bodies()``: called when a sensor that sees them is due). The gyro
         measures the rotation since its previous sample (at its first sample: ``omega`` over one
         period); a tracker's measurement of ``t`` comes out at the first call at or after ``t`` + its
-        latency. ``gyro``: ``(interval, rate)`` when :meth:`gyro_interval` was asked and the rate
-        measured already (:class:`att_sim.lockstep.Lockstep`'s gyros measure together)."""
+        latency. ``taken``: the gyro's and the tachometer's measurements when they were taken already
+        (:meth:`gyro_interval` and :meth:`tachometer_due` asked: :class:`Taken`)."""
         out = Readings()
         body = self.body_frame_id
-        interval, rate = (self.gyro_interval(t, q, omega), None) if gyro is None else gyro
+        interval, rate = (self.gyro_interval(t, q, omega), None) if taken is None else \
+            (taken.gyro_interval, taken.gyro_rate)
         if interval is not None:
             out.gyro = GyroMeasurement(t, self.gyro.measure(*interval) if rate is None else rate,
                                        self.gyro.noise_covariance(interval[1]), body)
@@ -123,7 +139,9 @@ class SensorSuite:
         if self.pending:
             out.star_trackers = [m for release, m in self.pending if release <= t + 1e-9]
             self.pending = [(release, m) for release, m in self.pending if release > t + 1e-9]
-        if self.tachometer is not None and self.schedules["tachometer"].due(t):
+        if taken is not None:
+            out.wheel_speeds = taken.wheel_speeds
+        elif self.tachometer_due(t):
             out.wheel_speeds = self.tachometer.measure(t, relative_wheel_speed, body)
         if self.magnetometer is not None and self.schedules["magnetometer"].due(t):
             out.magnetometer = self.magnetometer.measure(t, field_B, dipole_applied, body)

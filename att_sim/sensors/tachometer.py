@@ -14,7 +14,16 @@ class Tachometer:
         self.spec, self.rng = spec, rng
 
     def measure(self, t: float, relative_speed: np.ndarray, frame_id: str = "") -> WheelSpeedMeasurement:
-        s = self.spec
-        speeds = np.asarray(relative_speed, float) + self.rng.standard_normal(len(relative_speed)) * s.noise
-        speeds = quantize(speeds, s.quantization)
+        speeds = measure_together([self], np.asarray(relative_speed, float)[None])[0]
         return WheelSpeedMeasurement(t=t, speeds=speeds, frame_id=frame_id)
+
+
+def measure_together(tachometers: list[Tachometer], relative_speeds: np.ndarray) -> np.ndarray:
+    """The speeds each tachometer measures (a row of ``relative_speeds`` each: the runs of a
+    lockstep), each one's noise from its own stream, the arithmetic on rows (element by element:
+    each row's bits alone)."""
+    noise = np.array([[tach.spec.noise] for tach in tachometers])
+    lsb = np.array([[tach.spec.quantization] for tach in tachometers])
+    n = relative_speeds.shape[1]
+    draws = np.array([tach.rng.standard_normal(n) for tach in tachometers]).reshape(len(tachometers), n)
+    return quantize(relative_speeds + draws * noise, lsb)
