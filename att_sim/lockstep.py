@@ -121,7 +121,7 @@ class Lockstep:
         sims = self.sims
         if any(s.sensors is None for s in sims):
             return [s.sense() for s in sims]
-        taken = [Taken(s.gyro_interval()) for s in sims]
+        taken = [Taken(s.gyro_interval(rotation)) for s, rotation in zip(sims, self._gyro_rotations())]
         due = [i for i, got in enumerate(taken) if got.gyro_interval is not None]
         if due and (self.gyros is None or self.gyros[0] != due):
             self.gyros = (due, GyrosOfRuns([sims[i].sensors.gyro for i in due]))
@@ -135,6 +135,20 @@ class Lockstep:
             for i, speeds in zip(due, measured):
                 taken[i].wheel_speeds = WheelSpeedMeasurement(sims[i].t, speeds, sims[i].sensors.body_frame_id)
         return [s.sense(got) for s, got in zip(sims, taken)]
+
+    def _gyro_rotations(self) -> list:
+        """Each run's rotation since its gyro's last sample, ``log(q_last* ⊗ q)``, on rows (None: no
+        sample yet); used where the gyro is due (:meth:`SensorSuite.gyro_interval
+        <att_sim.sensors.SensorSuite.gyro_interval>`)."""
+        sims = self.sims
+        out = [None] * len(sims)
+        since = [i for i, s in enumerate(sims) if s.sensors.gyro_last is not None]
+        if since:
+            last = np.array([sims[i].sensors.gyro_last[1] for i in since])
+            rotations = rot.log_map(rot.multiply(rot.conjugate(last), np.array([sims[i].x[:4] for i in since])))
+            for i, rotation in zip(since, rotations):
+                out[i] = rotation
+        return out
 
     def _inputs(self, x: np.ndarray) -> list[dyn.Inputs]:
         """Every run's :meth:`Simulation.inputs <att_sim.simulation.Simulation.inputs>` at its state

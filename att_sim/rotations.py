@@ -247,9 +247,21 @@ def propagate_constant_rate(q: np.ndarray, omega: np.ndarray, dt: float) -> np.n
 
 
 def log_map(q: np.ndarray) -> np.ndarray:
-    """Rotation vector (axis × angle, angle in [0, π]) of a single quaternion: the inverse of :func:`exp_map`."""
-    (x, y, z), angle = _axis_angle(q)
-    return np.array([x * angle, y * angle, z * angle])
+    """Rotation vector (axis × angle, angle in [0, π]) of a quaternion, or of each row: the inverse
+    of :func:`exp_map` (rows: :func:`to_axis_angle`'s operations element by element, the same bits)."""
+    q = np.asarray(q, float)
+    if q.ndim == 1:
+        (x, y, z), angle = _axis_angle(q)
+        return np.array([x * angle, y * angle, z * angle])
+    with np.errstate(invalid="ignore", divide="ignore"):
+        x, y, z, w = q.T
+        n = np.sqrt(x * x + y * y + z * z + w * w)
+        sign = np.where(w / n < 0, -1.0, 1.0)
+        x, y, z, w = x / n * sign, y / n * sign, z / n * sign, w / n * sign
+        s = np.sqrt(x * x + y * y + z * z)
+        angle = 2.0 * np.array([math.atan2(a, b) for a, b in zip(s.tolist(), w.tolist())])   # numpy's differs
+        axis = np.where((s > 1e-15)[:, None], np.array([x / s, y / s, z / s]).T, np.array([1.0, 0.0, 0.0]))
+    return axis * angle[:, None]
 
 
 OFF_DIAGONAL = ((0, 1), (0, 2), (1, 0), (1, 2), (2, 0), (2, 1))

@@ -279,10 +279,10 @@ class Simulation:
         return self.sensors.sample(self.t, x[:4], x[4:7], relative, self.now.field_B, self.applied.dipole,
                                    lambda: self.environment.bodies(self.t), taken)
 
-    def gyro_interval(self) -> tuple[np.ndarray, float] | None:
-        """The gyro's interval now (:meth:`SensorSuite.gyro_interval <att_sim.sensors.SensorSuite.gyro_interval>`;
-        None without sensors)."""
-        return None if self.sensors is None else self.sensors.gyro_interval(self.t, self.x[:4], self.x[4:7])
+    def gyro_interval(self, rotation: np.ndarray | None = None) -> tuple[np.ndarray, float] | None:
+        """The gyro's interval now (:meth:`SensorSuite.gyro_interval <att_sim.sensors.SensorSuite.gyro_interval>`,
+        ``rotation`` its; None without sensors)."""
+        return None if self.sensors is None else self.sensors.gyro_interval(self.t, self.x[:4], self.x[4:7], rotation)
 
     def advance(self, dt: float) -> None:
         """One RK4 step, the actuator inputs held and the environment evaluated at every stage; a

@@ -94,10 +94,12 @@ class SensorSuite:
         self.pending: list[tuple[float, StarTrackerMeasurement]] = []        # (release time, measurement)
         self.gyro_last: tuple[float, np.ndarray] | None = None               # (t, q) of the last gyro sample
 
-    def gyro_interval(self, t: float, q: np.ndarray, omega: np.ndarray) -> tuple[np.ndarray, float] | None:
-        """When the gyro is due at ``t``: the rotation vector it measures (since its previous sample;
-        at its first, ``omega`` over one period) and the interval; None when it is not (or there is
-        none). Asking starts the gyro's next interval."""
+    def gyro_interval(self, t: float, q: np.ndarray, omega: np.ndarray,
+                      rotation: np.ndarray | None = None) -> tuple[np.ndarray, float] | None:
+        """When the gyro is due at ``t``: the rotation vector it measures (since its previous sample,
+        ``log(q_last* ⊗ q)``: ``rotation`` when computed already; at its first, ``omega`` over one
+        period) and the interval; None when it is not (or there is none). Asking starts the gyro's
+        next interval."""
         if self.gyro is None or not self.schedules["gyro"].due(t):
             return None
         if self.gyro_last is None:
@@ -105,7 +107,7 @@ class SensorSuite:
             rotation = np.asarray(omega, float) * dt
         else:
             dt = t - self.gyro_last[0]
-            rotation = rot.log_map(rot.multiply(rot.conjugate(self.gyro_last[1]), q))
+            rotation = rot.log_map(rot.multiply(rot.conjugate(self.gyro_last[1]), q)) if rotation is None else rotation
         self.gyro_last = (t, np.array(q, float))
         return rotation, dt
 
