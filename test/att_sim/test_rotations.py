@@ -62,3 +62,15 @@ def test_one_quaternion_fast_paths_agree_with_the_stacked_forms():
     for q in qs:
         axis, angle = rot.to_axis_angle(q)
         assert np.allclose(rot.from_axis_angle(axis, angle), q if q[3] >= 0 else -q, rtol=0, atol=4e-16)
+
+
+def test_log_map_of_rows_gives_each_row_its_bits_alone():
+    """The lockstep's gyros take the rotations of all runs as rows: each row is the one quaternion's
+    log map bit for bit — small and zero rotations, w < 0, unnormalised, zero and non-finite rows."""
+    qs = np.vstack([random_quaternions(200) * RNG.uniform(1e-3, 1e3, (200, 1)),
+                    [[1e-12, -2e-13, 3e-14, -1.0], [0.0, 0.0, 0.0, 1.0], [0.0, 0.0, 0.0, 0.0],
+                     [np.nan, 0.0, 0.0, 1.0], [0.6, 0.8, 0.0, 0.0]]])
+    rows = rot.log_map(qs)
+    for q, row in zip(qs, rows):
+        assert rot.log_map(q).tobytes() == row.tobytes()
+    assert np.allclose(rot.exp_map(rows[:200]), rot.normalize(qs[:200]) * np.sign(qs[:200, 3:]), atol=1e-12)
