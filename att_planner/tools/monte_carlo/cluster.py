@@ -14,6 +14,13 @@ from contextlib import contextmanager
 
 from att_planner.tools.monte_carlo.run import Setup, fly_together
 
+# The local cluster's housekeeping, slowed: the runs keep every core busy, and Dask's defaults wake
+# its processes every 10-500 ms (the event-loop watchdog's tick, the system monitor, the nannies'
+# memory checks, the workers' statistical profiler sampling the running task every 10 ms). An idle
+# 2-worker cluster took 1.06 s of CPU in 20 s with them, 0.24 s with these (measured; BENCHMARKS.md).
+QUIET = {"distributed.admin.tick.interval": "1s", "distributed.admin.system-monitor.interval": "5s",
+         "distributed.worker.memory.monitor-interval": "1s", "distributed.worker.profile.enabled": False}
+
 
 class ClusterError(RuntimeError):
     """A cluster that cannot be reached or started (one sentence)."""
@@ -39,8 +46,11 @@ def client_for(scheduler: str | None, workers: int, timeout: float):
         finally:
             client.close()
         return
-    with LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None,
-                      silence_logs=40, env={"OMP_NUM_THREADS": "1"}) as cluster, Client(cluster) as client:
+    import dask
+
+    with dask.config.set(QUIET), LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
+                                              dashboard_address=None, silence_logs=40,
+                                              env={"OMP_NUM_THREADS": "1"}) as cluster, Client(cluster) as client:
         yield client
 
 
