@@ -101,7 +101,7 @@ class DipoleLog:
         self.commands: deque[tuple[float, bool]] = deque(maxlen=size)
 
     def record(self, t: float, dipole) -> None:
-        self.commands.append((float(t), bool(np.asarray(dipole, float).any())))
+        self.commands.append((float(t), any(np.asarray(dipole, float).tolist())))     # NaN counts as on, as numpy's
 
     def clean(self, t: float) -> bool:
         on = next((on for stamp, on in reversed(self.commands) if stamp < t - 1e-9), False)   # the last before t
