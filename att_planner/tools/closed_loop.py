@@ -65,9 +65,6 @@ class Trace:
         self.rows.append((t, x, q_est, attitude_covariance, bias_est, bias_true, health, tracker_status,
                           wheel_torques, dipole, mode, attitude_error))
 
-    def __len__(self) -> int:
-        return len(self.rows)
-
     def arrays(self, *names: str) -> dict[str, np.ndarray]:
         """The fields ``names`` (default every one of :data:`FIELDS`) as arrays, one row per instant."""
         columns = dict(zip(self._ROW, zip(*self.rows))) if self.rows else {}

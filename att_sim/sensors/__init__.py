@@ -115,7 +115,7 @@ class SensorSuite:
         """Whether the tachometer samples at ``t`` (asking starts its next period)."""
         return self.tachometer is not None and self.schedules["tachometer"].due(t)
 
-    def sample(self, t: float, q: np.ndarray, omega: np.ndarray, relative_wheel_speed: np.ndarray,
+    def sample(self, t: float, q: np.ndarray, omega: np.ndarray, relative_wheel_speed: np.ndarray | None,
                field_B: np.ndarray, dipole_applied: np.ndarray, bodies: Callable[[], Bodies],
                taken: Taken | None = None) -> Readings:
         """What the sensors output at time ``t`` for the truth state (attitude ``q``, body rate
@@ -124,7 +124,8 @@ class SensorSuite:
         measures the rotation since its previous sample (at its first sample: ``omega`` over one
         period); a tracker's measurement of ``t`` comes out at the first call at or after ``t`` + its
         latency. ``taken``: the gyro's and the tachometer's measurements when they were taken already
-        (:meth:`gyro_interval` and :meth:`tachometer_due` asked: :class:`Taken`)."""
+        (:meth:`gyro_interval` and :meth:`tachometer_due` asked: :class:`Taken`; then
+        ``relative_wheel_speed`` is not used)."""
         out = Readings()
         body = self.body_frame_id
         interval, rate = (self.gyro_interval(t, q, omega), None) if taken is None else \

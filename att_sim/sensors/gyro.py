@@ -169,7 +169,7 @@ class GyrosOfRuns:
         """The rate each gyro measures over its interval ``(rotation, dt)`` (the gyros' order)."""
         gyros = self.gyros
         if not self.alike:
-            return [GyrosOfRuns([g]).measure([interval])[0] for g, interval in zip(gyros, intervals)]
+            return [g.measure(*interval) for g, interval in zip(gyros, intervals)]
         dt, a, sigma, walk_sigma, noise_sigma = self._of_intervals(tuple(h for _, h in intervals))
         flicker_sum = np.zeros((len(gyros), 3))
         if self.banked:

@@ -1,12 +1,20 @@
 """The tracking law on rows of runs (att_planner.control.lockstep): each row gets the bits the
 controller computes alone — the PD about the reference, the null-space torques, the drive friction
-compensated, the wheels' distribution and its scaling to the torque limit."""
+compensated, the wheels' distribution and its scaling to the torque limit — and controllers stepping
+together command what each commands alone."""
 import numpy as np
 import pytest
 
+from att_msgs_py.types import ControlMode
 from att_planner.control import momentum, tracking
+from att_planner.control.controller import Controller, ControllerConfig
+from att_planner.control.lockstep import track_together
+from att_planner.methods.eigenaxis import plan_eigenaxis_smooth
+from att_planner.problem import ManeuverProblem
 from att_sim import rotations as rot
 from att_sim import scenario
+from att_sim.simulation import Simulation
+from helpers.signed_plans import context, issue
 
 
 @pytest.mark.parametrize("name", ["swift_demo", "leo_momentum"])     # 3 wheels; 4 (a null space)
@@ -38,3 +46,46 @@ def test_the_law_on_rows_gives_each_run_the_bits_it_gets_alone(name):
         demand = tau + rot.cross(omega[i], sc.wheel_axes @ (sc.wheel_inertia * speeds[i]))
         scaled += bool(np.abs(sc.wheel_axes_pinv @ demand).max() > sc.wheel_torque_max)
     assert 0 < scaled < runs
+
+
+def _tracking(start_error_deg: float, ctx):
+    """A swift_demo controller (of the plan context ``ctx``: controllers of one model share theirs)
+    flying an eigenaxis plan, on a simulation started off its start."""
+    s = scenario.load("swift_demo")
+    q0 = rot.from_axis_angle([1.0, 0.2, -0.3], np.radians(start_error_deg))
+    sim = Simulation(s.spacecraft, s.orbit, q0=q0, omega0=np.array([1e-3, -2e-3, 5e-4]))
+    plan, payload = issue(plan_eigenaxis_smooth(ManeuverProblem(s.spacecraft, rot.IDENTITY,
+                                                                rot.from_axis_angle([0, 0, 1], 1.0))), ctx)
+    config = ControllerConfig(control_period=0.05, tracking_kp=1.0, tracking_kd=16.0)
+    core = Controller(ctx, config, body_frame_id="body")
+    assert core.receive_plan(plan, payload) is None and core.accept_state(sim.state("eci", "body")).refused is None
+    assert core.start(core.resolve("p1")[0]) is None and core.mode == ControlMode.PLAN_TRACKING
+    sim.advance(0.05)
+    return sim, core
+
+
+def test_controllers_stepping_together_command_what_each_commands_alone():
+    """track_together hands each controller the wheel torques its own law gives (bit for bit: the
+    step alone, with nothing prepared, commands the same bytes); a prepared command is used only for
+    the state and reference it was made for."""
+    ctx = context()
+    flights = [_tracking(e, ctx) for e in (0.0, 0.05, 0.2)]
+    for _ in range(40):
+        for sim, core in flights:
+            assert core.accept_state(sim.state("eci", "body"), wall=sim.t).refused is None and core.due()
+        track_together([core for _, core in flights])
+        for sim, core in flights:
+            prepared = core.prepared[2].copy()
+            core.prepared = None
+            command = core.step().command
+            assert command.wheel_torques.tobytes() == prepared.tobytes()
+            assert sim.set_command(command) is None
+            sim.advance(0.05)
+    sim, core = flights[0]
+    core.accept_state(sim.state("eci", "body"), wall=sim.t)
+    core.prepare(core.tracked_reference(), np.full(sim.sc.n_wheels, 0.5))
+    assert np.all(core.step().command.wheel_torques == 0.5)               # made for this state: used
+    core.prepare(core.tracked_reference(), np.full(sim.sc.n_wheels, 0.5))
+    sim.advance(0.05)
+    core.accept_state(sim.state("eci", "body"), wall=sim.t)
+    assert not np.any(core.step().command.wheel_torques == 0.5)           # a newer state: computed again
