@@ -317,12 +317,14 @@ class Estimator:
         steps = self.reprocess_steps(start)
         request = next(steps, None)
         while request is not None:
-            request = resume(steps, self.propagate_to(*request))
+            request = resume(steps, mekf.update(*request) if isinstance(request, mekf.Correction)
+                             else self.propagate_to(*request))
 
     def reprocess_steps(self, start: int):
         """:meth:`reprocess` as a generator: yields each propagation ``(x, ω_m, t, saturated)`` and
         goes on with the state sent back (:meth:`propagate_to`'s, or
-        :func:`~att_planner.estimation.lockstep.reprocess_together`'s)."""
+        :func:`~att_planner.estimation.lockstep.reprocess_together`'s), and each Kalman update
+        (:class:`~.mekf.Correction`), going on with its :class:`~.mekf.Update`."""
         t0, x = self.snapshots[start]
         while len(self.snapshots) > start + 1:
             self.snapshots.pop()
@@ -330,7 +332,7 @@ class Estimator:
         k = 0
         for t_j, omega, saturated in self._gyro_after(t0):
             while k < len(records) and records[k].t <= t_j:
-                x = self._apply((yield x, omega, records[k].t, saturated), records[k])
+                x = yield from self._apply((yield x, omega, records[k].t, saturated), records[k])
                 k += 1
             self.snapshots.append((t_j, (yield x, omega, t_j, saturated)))
             x = self.snapshots[-1][1]
@@ -379,8 +381,10 @@ class Estimator:
         self.diverged, self.lost_at = True, max(self.lost_at, t)
         self.report.notes.append(f"estimate diverged ({why}): reinitialising")
 
-    def _apply(self, x: mekf.FilterState | None, r: _Record) -> mekf.FilterState | None:
-        """``x`` after the measurement ``r`` (gated the first time; replayed as decided then)."""
+    def _apply(self, x: mekf.FilterState | None, r: _Record):
+        """``x`` after the measurement ``r`` (gated the first time; replayed as decided then), as a
+        generator (``yield from``): it yields its Kalman update (:class:`~.mekf.Correction`) and goes
+        on with the :class:`~.mekf.Update` sent back."""
         if x is None:
             return self._initialise(r)
         if r.kind == "tracker":
@@ -395,7 +399,7 @@ class Estimator:
             reference, measured, R = self._vector(r)
             y, H = mekf.vector_residual(x.q, measured, reference)
         first = r.accepted is None
-        result = mekf.update(x, y, H, R, self.gates[3] if first else math.inf)
+        result = yield mekf.Correction(x, y, H, R, self.gates[3] if first else math.inf)
         if first and self._decided(r, result):
             return self._lose(r.t, f"{self.config.lost_after} star tracker measurements in a row rejected")
         if not (r.accepted and result.accepted):

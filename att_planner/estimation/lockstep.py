@@ -3,8 +3,9 @@
 The runs of a Monte Carlo task step in lockstep: at each step every run's estimator reprocesses
 (catches up with its gyro sample, replays a late tracker sample). :func:`reprocess_together` runs
 their :meth:`Estimator.reprocess_steps <att_planner.estimation.estimator.Estimator.reprocess_steps>`
-side by side and propagates, at each turn, the filters of one tuning as one stack
-(:func:`att_planner.estimation.mekf.propagate_runs`), each to the bits it reaches alone; each
+side by side and, at each turn, propagates the filters of one tuning as one stack
+(:func:`att_planner.estimation.mekf.propagate_runs`) and makes the Kalman updates asked as stacks
+(:func:`att_planner.estimation.mekf.update_runs`), each to the bits it reaches alone; each
 estimator's own operations keep their order.
 """
 from __future__ import annotations
@@ -30,9 +31,9 @@ def reprocess_together(jobs: list[tuple[Estimator, int | None]]) -> None:
             if request is not None:
                 live.append((e, steps, request))
     while live:
-        states = _propagate_together([(e, request) for e, _, request in live])
-        live = [(e, steps, request) for (e, steps, _), x in zip(live, states)
-                if (request := resume(steps, x)) is not None]
+        answers = _answer_together([(e, request) for e, _, request in live])
+        live = [(e, steps, request) for (e, steps, _), answer in zip(live, answers)
+                if (request := resume(steps, answer)) is not None]
     _largest_variances([e for e, start in jobs if start is not None])
 
 
@@ -45,6 +46,20 @@ def _largest_variances(estimators: list[Estimator]) -> None:
         largest = np.linalg.eigvalsh(np.array([x.P[:3, :3] for _, x in stack])).max(axis=-1)
         for (e, _), value in zip(stack, largest.tolist()):
             e.keep_largest_attitude_variance(value)
+
+
+def _answer_together(requests: list[tuple[Estimator, tuple]]) -> list:
+    """The answer to each estimator's request: its Kalman updates (:class:`~.mekf.Correction`)
+    as stacks (:func:`~.mekf.update_runs`), its propagations by :func:`_propagate_together`."""
+    out = [None] * len(requests)
+    corrections = [i for i, (_, request) in enumerate(requests) if isinstance(request, mekf.Correction)]
+    if corrections:
+        for i, answer in zip(corrections, mekf.update_runs([requests[i][1] for i in corrections])):
+            out[i] = answer
+    propagations = [i for i, (_, request) in enumerate(requests) if not isinstance(request, mekf.Correction)]
+    for i, answer in zip(propagations, _propagate_together([requests[i] for i in propagations])):
+        out[i] = answer
+    return out
 
 
 def _propagate_together(requests: list[tuple[Estimator, tuple]]) -> list:

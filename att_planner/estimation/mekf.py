@@ -34,6 +34,7 @@ from __future__ import annotations
 import functools
 import math
 from dataclasses import dataclass, field
+from typing import NamedTuple
 
 import numpy as np
 
@@ -200,6 +201,57 @@ def update(x: FilterState, y: np.ndarray, H: np.ndarray, R: np.ndarray, gate: fl
     P = A @ x.P @ A.T + K @ R @ K.T               # Joseph form
     q = rot.normalize(rot.multiply(x.q, rot.exp_map(dx[:3])))
     return Update(FilterState(x.t, q, x.bias + dx[3:], 0.5 * (P + P.T), A @ x.C), True, d2)
+
+
+class Correction(NamedTuple):
+    """A Kalman update to make (:func:`update`'s arguments)."""
+
+    x: FilterState
+    y: np.ndarray
+    H: np.ndarray
+    R: np.ndarray
+    gate: float = math.inf
+
+
+def update_runs(corrections: list[Correction]) -> list[Update]:
+    """:func:`update` of each correction — filters of lockstep runs at one instant: the matrices of
+    those with measurements of one size as stacks (per filter the same products and solves, so the
+    same bits), the attitude reset per filter."""
+    out: list[Update | None] = [None] * len(corrections)
+    size = len(corrections[0].y) if corrections else 0
+    stack = [i for i, c in enumerate(corrections) if len(c.y) == size and c.H.shape == corrections[0].H.shape]
+    if len(stack) < 2:
+        return [update(*c) for c in corrections]
+    for i, c in enumerate(corrections):
+        if i not in stack:
+            out[i] = update(*c)
+    cs = [corrections[i] for i in stack]
+    P, H, R = np.array([c.x.P for c in cs]), np.array([c.H for c in cs]), np.array([c.R for c in cs])
+    y = np.array([c.y for c in cs])
+    S = H @ P @ H.transpose(0, 2, 1) + R
+    try:
+        S_inv_y = np.linalg.solve(S, y[:, :, None])[:, :, 0]
+    except np.linalg.LinAlgError:           # a singular one: each alone
+        for i in stack:
+            out[i] = update(*corrections[i])
+        return out
+    d2 = [float(a @ b) for a, b in zip(y, S_inv_y)]
+    passed = [k for k, (c, d) in enumerate(zip(cs, d2)) if d <= c.gate]
+    for k, (c, d) in enumerate(zip(cs, d2)):
+        out[stack[k]] = Update(c.x, False, d)
+    if passed:
+        P, H, R, y, S = P[passed], H[passed], R[passed], y[passed], S[passed]
+        K = np.linalg.solve(S, H @ P).transpose(0, 2, 1)
+        dx = (K @ y[:, :, None])[:, :, 0]
+        A = np.eye(P.shape[1]) - K @ H
+        P = A @ P @ A.transpose(0, 2, 1) + K @ R @ K.transpose(0, 2, 1)
+        P = 0.5 * (P + P.transpose(0, 2, 1))
+        C = A @ np.array([cs[k].x.C for k in passed])
+        for j, k in enumerate(passed):
+            x = cs[k].x
+            q = rot.normalize(rot.multiply(x.q, rot.exp_map(dx[j, :3])))
+            out[stack[k]] = Update(FilterState(x.t, q, x.bias + dx[j, 3:], P[j], C[j]), True, d2[k])
+    return out
 
 
 def healthy_runs(P: np.ndarray) -> list[bool]:

@@ -61,6 +61,31 @@ def test_filters_propagated_as_one_stack_reach_the_bits_they_reach_alone():
     assert mekf.healthy_runs(stack) == [True, True, False, True, False, True]
 
 
+def test_kalman_updates_as_stacks_reach_the_bits_they_reach_alone():
+    """update_runs (lockstep runs' tracker updates at one instant) is update filter by filter, the gate's
+    rejections included; a stack with a singular innovation covariance is made update by update."""
+    rng = np.random.default_rng(12)
+    corrections = []
+    for k in range(30):
+        A = rng.normal(size=(6, 6))
+        P = A @ A.T * 1e-6 + 1e-8 * np.eye(6)
+        q, bias, C = rot.normalize(rng.normal(size=4)), rng.normal(0, 1e-5, 3), rng.normal(0, 1e-6, (6, 9))
+        x = mekf.FilterState(2.0, q, bias, P, C)
+        y, H = rng.normal(0, 1e-4 * (1 + 30 * (k % 3 == 0)), 3), mekf.attitude_sensitivity()
+        if k % 7 == 6:
+            y, H = mekf.vector_residual(x.q, np.array([1.0, 0.01, 0.0]), np.array([0.0, 1.0, 0.0]))
+        corrections.append(mekf.Correction(x, y, H, np.eye(3) * 1e-8 * (1 + k % 4), 30.0 if k % 2 else math.inf))
+    singular = mekf.Correction(corrections[0].x, np.ones(3), np.zeros((3, 6)), np.zeros((3, 3)))     # S = 0
+    for cs in (corrections, corrections + [singular]):
+        together = mekf.update_runs(cs)
+        for c, got in zip(cs, together):
+            alone = mekf.update(*c)
+            assert (got.accepted, repr(got.d2)) == (alone.accepted, repr(alone.d2))
+            for name in ("t", "q", "bias", "P", "C"):
+                np.testing.assert_array_equal(getattr(got.state, name), getattr(alone.state, name))
+    assert 0 < sum(u.accepted for u in together) < len(corrections)
+
+
 def test_process_noise_matches_van_loans_discretisation():
     arw, rrw, dt = 1e-5, 1e-7, 0.5
     F = np.zeros((6, 6))
