@@ -316,7 +316,8 @@ class Simulation:
         non-finite state, an environment that cannot be evaluated there. ``sample``: the
         environment's sample there, when it is known already."""
         try:
-            finite = bool(np.all(np.isfinite(x_new)))
+            values = x_new.tolist()
+            finite = math.isfinite(sum(values)) or all(map(math.isfinite, values))   # a finite sum: all are
             if finite and sample is None:
                 sample = self.environment.sample(self.t + dt, x_new[:4])
             now = sample if finite else None
