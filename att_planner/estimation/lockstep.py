@@ -53,9 +53,8 @@ def _answer_together(requests: list[tuple[Estimator, tuple]]) -> list:
     as stacks (:func:`~.mekf.update_runs`), its propagations by :func:`_propagate_together`."""
     out = [None] * len(requests)
     corrections = [i for i, (_, request) in enumerate(requests) if isinstance(request, mekf.Correction)]
-    if corrections:
-        for i, answer in zip(corrections, mekf.update_runs([requests[i][1] for i in corrections])):
-            out[i] = answer
+    for i, answer in zip(corrections, mekf.update_runs([requests[i][1] for i in corrections])):
+        out[i] = answer
     propagations = [i for i, (_, request) in enumerate(requests) if not isinstance(request, mekf.Correction)]
     for i, answer in zip(propagations, _propagate_together([requests[i] for i in propagations])):
         out[i] = answer

@@ -222,9 +222,8 @@ def update_runs(corrections: list[Correction]) -> list[Update]:
     stack = [i for i, c in enumerate(corrections) if len(c.y) == size and c.H.shape == corrections[0].H.shape]
     if len(stack) < 2:
         return [update(*c) for c in corrections]
-    for i, c in enumerate(corrections):
-        if i not in stack:
-            out[i] = update(*c)
+    for i in set(range(len(corrections))) - set(stack):
+        out[i] = update(*corrections[i])
     cs = [corrections[i] for i in stack]
     P, H, R = np.array([c.x.P for c in cs]), np.array([c.H for c in cs]), np.array([c.R for c in cs])
     y = np.array([c.y for c in cs])
