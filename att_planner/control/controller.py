@@ -55,10 +55,9 @@ from att_planner.control.magnetorquer import dipole_command
 from att_planner.control.measured_state import MeasuredState
 from att_planner.control.plan_cache import PlanCache
 from att_planner.control.plan_checks import PlanContext, check_start
-from att_planner.control.pointing import pointing_torque
+from att_planner.control.pointing import handover_law, pointing_torque
 from att_planner.control.state_gate import GateConfig, StateGate
 from att_planner.guidance import reference as guidance_reference
-from att_planner.guidance.laws import BlendedLaw
 from att_planner.guidance.laws import Sky as GuidanceSky
 from att_planner.guidance.modes import law_of
 from att_planner.zones import ZoneSky, zones_from_cones
@@ -132,8 +131,6 @@ ZONE_FIT_WINDOW = 1.0                          # s: a ZoneSky needs a window; th
 
 
 USABLE = (Health.CONVERGED, Health.PROPAGATING)   # estimates the attitude laws may fly on
-HANDOVER_RATE_MATCH = 1e-4     # rad/s: a plan ending this close to the law's rate hands over directly
-HANDOVER_ATTITUDE_MATCH = 1e-3  # rad: ... and this close to its attitude (else: through the blend)
 
 
 class Controller:
@@ -439,22 +436,6 @@ class Controller:
             return prepared[2]
         return self._wheels(tracking.tracking_torque(s.q, s.omega, ref, c.tracking_kp, c.tracking_kd))
 
-    def tracked_reference(self) -> tracking.Reference | None:
-        """The reference the next :meth:`step` feeds to the tracking law of :meth:`_wheel_command`
-        (a plan of body torques being flown), None when it does not."""
-        m = self.maneuver
-        if self.mode != ControlMode.PLAN_TRACKING or m is None or m.plan.control_kind == ControlKind.WHEEL_TORQUE:
-            return None
-        return self.references(m.plan, self.state.t - m.t0)
-
-    @property
-    def law(self) -> tuple:
-        """What the tracking law's wheel torques depend on besides the state and the reference:
-        controllers of one law compute them as rows (:mod:`att_planner.control.lockstep`)."""
-        c = self.config
-        return (id(self.spacecraft), c.tracking_kp, c.tracking_kd, c.null_space_speed, c.null_space_gain,
-                self.friction)
-
     def prepare(self, reference: tracking.Reference, wheel_torques: np.ndarray) -> None:
         """Give the next :meth:`step` the tracking law's wheel torques about ``reference`` for the
         latest state, computed elsewhere (:func:`att_planner.control.lockstep.track_together`)."""
@@ -490,7 +471,7 @@ class Controller:
         out.status.reference_q, out.status.reference_rate = ref.q, ref.omega
         out.status.attitude_error = float(rot.angle_between(s.q, ref.q))
         if m.after is not None and elapsed >= plan.duration:
-            law = self._handover(m.after, plan, s.t)
+            law = handover_law(m.after, plan, s.t, self.config.handover_blend)
             out.result = self._end(True, ErrorCode.OK, f"maneuver complete; pointing {law.name}")
             self.mode, self.pointing, self.hold_q = ControlMode.POINTING, law, None
             out.status.message = f"maneuver complete; pointing {law.name}"
@@ -498,16 +479,6 @@ class Controller:
         if elapsed >= plan.duration + self.config.settle_time:
             out.result = self._end(True, ErrorCode.OK, "maneuver complete")
             out.status.message = "maneuver complete; holding the final attitude"
-
-    def _handover(self, law, plan: Plan, t: float):
-        """The pointing law a plan hands over to at its end: the law itself when the plan ends on
-        the law's attitude at its rate (a slew planned to end on the moving target, flown when
-        planned), else the law entered through
-        :class:`~att_planner.guidance.laws.BlendedLaw` over ``handover_blend`` s (a plan ending at rest)."""
-        ref = guidance_reference(law.attitude, t)
-        matched = (float(np.linalg.norm(plan.omega[-1] - ref.omega)) <= HANDOVER_RATE_MATCH
-                   and rot.angle_between(plan.q[-1], ref.q) <= HANDOVER_ATTITUDE_MATCH)
-        return law if matched or self.config.handover_blend <= 0 else BlendedLaw(law, t, self.config.handover_blend)
 
     def _end(self, success: bool, code: ErrorCode, message: str) -> ManeuverResult:
         """Close the running maneuver; its figures are those of the latest state (there is one:

@@ -15,9 +15,15 @@ from __future__ import annotations
 
 import numpy as np
 
+from att_msgs_py.types import Plan
 from att_planner.guidance import Reference
+from att_planner.guidance import reference as guidance_reference
+from att_planner.guidance.laws import BlendedLaw
 from att_sim import rotations as rot
 from att_sim.dynamics import Spacecraft
+
+HANDOVER_RATE_MATCH = 1e-4     # rad/s: a plan ending this close to the law's rate hands over directly
+HANDOVER_ATTITUDE_MATCH = 1e-3  # rad: ... and this close to its attitude (else: through the blend)
 
 
 def body_reference(q, ref: Reference) -> tuple[np.ndarray, np.ndarray]:
@@ -33,3 +39,14 @@ def pointing_torque(sc: Spacecraft, q, omega, ref: Reference, kp: float, kd: flo
     J = sc.inertia
     feedforward = J @ (w_r_dot - rot.cross(omega, w_r)) + rot.cross(omega, J @ omega)
     return feedforward - kp * 2.0 * rot.error_vector(q, ref.q) - kd * (omega - w_r)
+
+
+def handover_law(law, plan: Plan, t: float, blend: float):
+    """The pointing law a plan hands over to at its end (at ``t``): the law itself when the plan ends
+    on the law's attitude at its rate (a slew planned to end on the moving target, flown when
+    planned), else the law entered through :class:`~att_planner.guidance.laws.BlendedLaw` over
+    ``blend`` s (a plan ending at rest)."""
+    ref = guidance_reference(law.attitude, t)
+    matched = (float(np.linalg.norm(plan.omega[-1] - ref.omega)) <= HANDOVER_RATE_MATCH
+               and rot.angle_between(plan.q[-1], ref.q) <= HANDOVER_ATTITUDE_MATCH)
+    return law if matched or blend <= 0 else BlendedLaw(law, t, blend)

@@ -8,7 +8,7 @@ import pytest
 from att_msgs_py.types import ControlMode
 from att_planner.control import momentum, tracking
 from att_planner.control.controller import Controller, ControllerConfig
-from att_planner.control.lockstep import track_together
+from att_planner.control.lockstep import track_together, tracked_reference
 from att_planner.methods.eigenaxis import plan_eigenaxis_smooth
 from att_planner.problem import ManeuverProblem
 from att_sim import rotations as rot
@@ -83,9 +83,9 @@ def test_controllers_stepping_together_command_what_each_commands_alone():
             sim.advance(0.05)
     sim, core = flights[0]
     core.accept_state(sim.state("eci", "body"), wall=sim.t)
-    core.prepare(core.tracked_reference(), np.full(sim.sc.n_wheels, 0.5))
+    core.prepare(tracked_reference(core), np.full(sim.sc.n_wheels, 0.5))
     assert np.all(core.step().command.wheel_torques == 0.5)               # made for this state: used
-    core.prepare(core.tracked_reference(), np.full(sim.sc.n_wheels, 0.5))
+    core.prepare(tracked_reference(core), np.full(sim.sc.n_wheels, 0.5))
     sim.advance(0.05)
     core.accept_state(sim.state("eci", "body"), wall=sim.t)
     assert not np.any(core.step().command.wheel_torques == 0.5)           # a newer state: computed again
