@@ -6,9 +6,8 @@ realisation by the wheels (:meth:`Controller._wheel_command
 <att_planner.control.controller.Controller._wheel_command>`) — on their own state.
 :func:`track_together` computes it for the controllers of one law (one nominal model, the same
 gains: :func:`law`) as rows of runs, each row to the bits the controller computes alone, and hands
-each its wheel torques
-(:meth:`Controller.prepare <att_planner.control.controller.Controller.prepare>`); the controllers
-then step as they would alone.
+each its wheel torques (:meth:`Controller.prepare
+<att_planner.control.controller.Controller.prepare>`); the controllers then step as they would alone.
 """
 from __future__ import annotations
 
