@@ -23,9 +23,18 @@ def _run(module: str, args: list, env: dict, output_path: str) -> None:
     os.environ.update(env)
     mod = importlib.import_module(module)
     sys.argv = [mod.__file__, "--ros-args", *args]
-    mod.main()
-    sys.stdout.flush()
-    sys.stderr.flush()
+    code = 1                            # an exception escaping main(): the interpreter's exit status
+    try:
+        mod.main()
+        code = 0
+    except SystemExit as exc:
+        code = exc.code if isinstance(exc.code, int) else 0 if exc.code is None else 1
+        raise
+    finally:
+        sys.stdout.flush()
+        sys.stderr.flush()
+        with open(output_path + ".exit", "w", encoding="utf-8") as fh:
+            fh.write(str(code))
 
 
 def context() -> multiprocessing.context.BaseContext:
@@ -36,7 +45,10 @@ def context() -> multiprocessing.context.BaseContext:
 
 def run_case(ctx, module: str, args: list, env: dict, output_path: str,
              timeout: float = 30.0) -> tuple[int | None, str]:
-    """Exit code (None: still running after ``timeout`` s, then killed) and the output."""
+    """Exit code (None: still running after ``timeout`` s, then killed) and the output. The exit
+    code is the forkserver's report; where it reports 255, its "status lost" (CPython's
+    ``popen_forkserver.poll`` when the status pipe gives EOF: seen once under load, the node's one
+    line printed), the code the child recorded as ``main()`` ended is taken."""
     proc = ctx.Process(target=_run, args=(module, args, env, output_path))
     proc.start()
     proc.join(timeout)
@@ -44,5 +56,8 @@ def run_case(ctx, module: str, args: list, env: dict, output_path: str,
     if code is None:
         proc.kill()
         proc.join()
+    elif code == 255 and os.path.exists(output_path + ".exit"):
+        with open(output_path + ".exit", encoding="utf-8") as fh:
+            code = int(fh.read())
     with open(output_path, encoding="utf-8", errors="replace") as fh:
         return code, fh.read()
