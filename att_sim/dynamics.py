@@ -118,6 +118,12 @@ def relative_wheel_speed(sc: Spacecraft, wheel_speed: np.ndarray, omega: np.ndar
     return np.asarray(wheel_speed, float) - sc.wheel_axes.T @ np.asarray(omega, float)
 
 
+def relative_wheel_speeds(axes_T: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """:func:`relative_wheel_speed` of each row of states ``x`` (rows of [q, ω, Ω]); ``axes_T``: the
+    wheels × 3 matrix ``Gᵀ`` of all rows, or one per row (stacked products: each row's bits alone)."""
+    return x[:, 7:] - np.matmul(axes_T, x[:, 4:7, None])[:, :, 0]
+
+
 def relative_speeds(G, w, ws) -> list:
     """``Ω − Gᵀω`` component by component (:func:`rates`' arithmetic): ``G`` rows of components,
     ``w`` the body rate's, ``ws`` the wheels'."""

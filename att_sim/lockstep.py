@@ -130,8 +130,8 @@ class Lockstep:
         due = [i for i, s in enumerate(sims) if s.sensors.tachometer_due(s.t)]
         if due:
             x = np.array([sims[i].x for i in due])
-            relative = x[:, 7:] - (self.axes_T[due] @ x[:, 4:7, None])[:, :, 0]
-            measured = measure_tachometers([sims[i].sensors.tachometer for i in due], relative)
+            measured = measure_tachometers([sims[i].sensors.tachometer for i in due],
+                                           dyn.relative_wheel_speeds(self.axes_T[due], x))
             for i, speeds in zip(due, measured):
                 taken[i].wheel_speeds = WheelSpeedMeasurement(sims[i].t, speeds, sims[i].sensors.body_frame_id)
         return [s.sense(got) for s, got in zip(sims, taken)]
@@ -163,7 +163,7 @@ class Lockstep:
         u = np.where(on, np.array([s.wheel_cmd for s in sims]), 0.0)
         if self.drives is not None:
             u = self.drives.hold(u, active)
-        relative = x[:, 7:] - (self.axes_T @ x[:, 4:7, None])[:, :, 0]
+        relative = dyn.relative_wheel_speeds(self.axes_T, x)
         u = np.array(self._limited(list(u.T), list(relative.T))).T
         limit = self.limits["dipole_max"]
         m = np.where(on, np.minimum(np.maximum(np.array([s.dipole_cmd for s in sims]), -limit), limit), 0.0)

@@ -54,9 +54,10 @@ def track_together(controllers: list[Controller]) -> None:
     omega = np.array([s.omega for s in states])
     speeds = np.array([s.wheel_speeds for s in states])
     refs = [ref for _, ref in group]
-    body = tracking.tracking_torques_of_runs(np.array([s.q for s in states]), omega, np.array([r.q for r in refs]),
-                                             np.array([r.omega for r in refs]), np.array([r.torque for r in refs]),
-                                             config.tracking_kp, config.tracking_kd)
+    stacked = tracking.Reference(np.array([r.q for r in refs]), np.array([r.omega for r in refs]),
+                                 np.array([r.torque for r in refs]))
+    body = tracking.tracking_torque(np.array([s.q for s in states]), omega, stacked, config.tracking_kp,
+                                    config.tracking_kd)
     extra = momentum.null_space_torques(sc, speeds, config.null_space_speed, config.null_space_gain)
     if first.friction is not None:
         extra = extra + first.friction(speeds - tracking.matvec_rows(sc.wheel_axes.T, omega))

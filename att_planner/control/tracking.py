@@ -79,6 +79,7 @@ class ReferenceMemo:
 
 
 def tracking_torque(q, omega, ref: Reference, kp: float, kd: float) -> np.ndarray:
+    """The PD demand of the module docstring (rows of attitudes, rates and references: each row's)."""
     e = rot.error_vector(q, ref.q)     # sign chosen so that e_w >= 0 (shortest way back)
     return ref.torque - kp * 2.0 * e - kd * (np.asarray(omega) - ref.omega)
 
@@ -103,12 +104,6 @@ def wheel_torques(sc: Spacecraft, body_torque, omega, wheel_speed, extra=None) -
 def matvec_rows(A: np.ndarray, rows: np.ndarray) -> np.ndarray:
     """``A @ v`` of each row ``v`` (stacked: each row gets the bits of ``A @ v`` alone)."""
     return np.matmul(A, rows[:, :, None])[:, :, 0]
-
-
-def tracking_torques_of_runs(q, omega, ref_q, ref_omega, ref_torque, kp: float, kd: float) -> np.ndarray:
-    """:func:`tracking_torque` of each row (runs × 4 attitudes, runs × 3 rates and references)."""
-    e = rot.error_vector(q, ref_q)
-    return ref_torque - kp * 2.0 * e - kd * (omega - ref_omega)
 
 
 def wheel_torques_of_runs(sc: Spacecraft, body_torque, omega, wheel_speed, extra) -> np.ndarray:

@@ -28,6 +28,7 @@ from att_msgs_py.types import Health, ManeuverResult, Plan, PointingMode
 from att_planner.control.configure import controller_from_scenario
 from att_planner.estimation.configure import estimator_from_scenario
 from att_planner.estimation.estimator import Estimator
+from att_sim import dynamics as dyn
 from att_sim import rotations as rot
 from att_sim.scenario import Scenario
 from att_sim.sensors import Readings
@@ -70,7 +71,7 @@ class Trace:
         columns = dict(zip(self._ROW, zip(*self.rows))) if self.rows else {}
         x = np.array(columns.get("x", ()), float).reshape(-1, 7 + len(self.axes_T))
         derived = {"q_true": lambda: x[:, :4], "omega_true": lambda: x[:, 4:7],
-                   "wheel_speeds": lambda: x[:, 7:] - np.matmul(self.axes_T, x[:, 4:7, None])[..., 0]}
+                   "wheel_speeds": lambda: dyn.relative_wheel_speeds(self.axes_T, x)}
         return {k: derived[k]() if k in derived else np.asarray(columns.get(k, ())) for k in names or self.FIELDS}
 
 

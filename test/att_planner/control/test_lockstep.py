@@ -30,7 +30,7 @@ def test_the_law_on_rows_gives_each_run_the_bits_it_gets_alone(name):
     ref_torque = size * 0.05 * rng.standard_normal((runs, 3))
     speeds = 0.5 * sc.wheel_speed_max * rng.standard_normal((runs, sc.n_wheels))
     gains = (1.0, 16.0)
-    body = tracking.tracking_torques_of_runs(q, omega, ref_q, ref_omega, ref_torque, *gains)
+    body = tracking.tracking_torque(q, omega, tracking.Reference(ref_q, ref_omega, ref_torque), *gains)
     extra = momentum.null_space_torques(sc, speeds, 3.0, 0.05) + \
         friction(speeds - tracking.matvec_rows(sc.wheel_axes.T, omega))
     rows = tracking.wheel_torques_of_runs(sc, body, omega, speeds, extra)
