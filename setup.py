@@ -30,7 +30,7 @@ setup(
     python_requires=">=3.11",
     entry_points={
         "console_scripts": [
-            "att-sim = att_sim.simulator_node:main",
+            "att-sim = att_sim.truth.simulator_node:main",
             "att-planner = att_planner.nodes.planner_node:main",
             "att-controller = att_planner.nodes.controller_node:main",
             "att-estimator = att_planner.nodes.estimator_node:main",

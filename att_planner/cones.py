@@ -25,7 +25,7 @@ from att_msgs_py import validation
 from att_msgs_py.errors import ErrorCode, RequestError
 from att_msgs_py.types import Cone, Zone
 from att_planner.zones import ZoneSky, same_axis
-from att_sim import rotations as rot
+from att_sim.models import rotations as rot
 
 BOUNDARY_TOLERANCE = 1e-6   # rad: an end direction this far inside a boundary is on it
 END_RADIUS = 0.01           # rad: the neighbourhood of an end direction where margin ≥ −tol suffices

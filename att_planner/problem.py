@@ -20,11 +20,11 @@ import numpy as np
 
 from att_msgs_py.types import Cone, Zone
 from att_planner.zones import ZoneSky, clenshaw, zones_from_cones
-from att_sim import rotations as rot
-from att_sim.dynamics import Spacecraft
+from att_sim.models import rotations as rot
+from att_sim.models.dynamics import Spacecraft
 
-if TYPE_CHECKING:          # the annotations only: att_sim.ephemeris loads skyfield
-    from att_sim.ephemeris import Sky
+if TYPE_CHECKING:          # the annotations only: att_sim.models.ephemeris loads skyfield
+    from att_sim.models.ephemeris import Sky
 
 GOAL_DEGREE = 16         # of a moving goal's series of the attitude (sign-continuous) and the rate
 
@@ -83,7 +83,7 @@ class ManeuverProblem:
     * ``cones``: inertial keep-out cones of ``sensor_axis`` (as before issue 13); ``zones``: further
       zones, each with its own sensor axis, moving or not (:class:`att_msgs_py.types.Zone`);
       ``epoch``: the UTC instant of t = 0; ``sky``: the sky seen from the spacecraft
-      (:class:`att_sim.ephemeris.Sky`, needed by sun, moon and earth_limb zones).
+      (:class:`att_sim.models.ephemeris.Sky`, needed by sun, moon and earth_limb zones).
       :meth:`zone_sky` joins them: what every method and the verification use.
     * ``goal_motion``: a goal that moves (a pointing law, issue 15:
       :class:`MovingGoal`, made by :mod:`att_planner.service.moving_goal`): ``t ↦ (q, ω)``, the attitude and

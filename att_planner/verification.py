@@ -3,7 +3,7 @@ it against its problem, with one named set of tolerances (:data:`TOLERANCES`).
 
 Every plan the planner returns carries these figures, and the methods and the benchmarks judge
 plans by them; nothing is taken from a planner's own model. The integration is
-:func:`att_sim.dynamics.simulate_profile` (RK4 with inputs switched exactly at the knots for
+:func:`att_sim.models.dynamics.simulate_profile` (RK4 with inputs switched exactly at the knots for
 zero-order hold, :data:`VERIFY_STEPS` steps over the plan at least), from the problem's initial
 attitude at rest with the wheels stopped. Checked: the final attitude (semi-free: the boresight
 on its target; a moving goal: its attitude at the final time) and rate (a moving goal: relative to
@@ -29,8 +29,8 @@ import numpy as np
 from att_msgs_py.types import ControlKind, Interpolation, Plan, Verification
 from att_planner.cones import ARC_TOLERANCE, BOUNDARY_TOLERANCE, END_RADIUS
 from att_planner.problem import ManeuverProblem
-from att_sim import dynamics as dyn
-from att_sim import rotations as rot
+from att_sim.models import dynamics as dyn
+from att_sim.models import rotations as rot
 
 VERIFY_STEPS = 2000         # RK4 steps over the plan (at least one per control interval)
 
@@ -186,7 +186,7 @@ def _wheel_momentum(sc: dyn.Spacecraft, traj: dyn.Trajectory, wheels: bool) -> n
 
 def wheel_speeds_along(problem: ManeuverProblem, plan: Plan, traj: dyn.Trajectory) -> np.ndarray:
     """The wheels' speeds relative to the body along the trajectory, ``Ω − Gᵀω`` (K, N): what the
-    truth model limits (:func:`att_sim.dynamics.relative_wheel_speed`). A wheel-torque plan
+    truth model limits (:func:`att_sim.models.dynamics.relative_wheel_speed`). A wheel-torque plan
     integrates its wheels; a body-torque plan's are :func:`body_plan_wheel_speeds` (the two parts summed)."""
     sc = problem.spacecraft
     if plan.control_kind == ControlKind.WHEEL_TORQUE:

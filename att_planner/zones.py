@@ -2,7 +2,7 @@
 
 Zone ``z`` (:class:`att_msgs_py.types.Zone`) has a body sensor axis ``s_z``, a unit inertial axis
 ``a_z(t)`` and a half-angle ``θ_z(t)``: ``inertial`` a fixed direction and half-angle (today's
-cones), ``sun`` / ``moon`` the direction from the spacecraft (:class:`att_sim.ephemeris.Sky`),
+cones), ``sun`` / ``moon`` the direction from the spacecraft (:class:`att_sim.models.ephemeris.Sky`),
 ``earth_limb`` the nadir −r̂(t) with ``asin(R_E/|r(t)|) + half_angle``. Its margin at attitude ``q``
 is, with the boresight ``b = R(q) s_z / |s_z|`` and ``γ = angle(b, a_z)``::
 
@@ -29,7 +29,7 @@ from __future__ import annotations
 import numpy as np
 
 from att_msgs_py.types import ZONE_BODIES, Cone, Zone
-from att_sim import rotations as rot
+from att_sim.models import rotations as rot
 
 FIT_TOLERANCE = 1e-8          # rad: largest error of the fitted axes and half-angles against the sky
 DEGREES = (4, 8, 12, 16, 24, 32, 40)   # degrees tried on a piece, in order

@@ -1,1 +1,1 @@
-"""Truth side: attitude dynamics, environment and the simulator node."""
+"""Truth and shared models: the simulated spacecraft, its environment and the models flight software shares."""

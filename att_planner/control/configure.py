@@ -20,9 +20,9 @@ from att_planner.control.measured_state import MeasuredState
 from att_planner.control.plan_checks import PlanContext
 from att_planner.control.state_gate import GateConfig
 from att_planner.guidance.laws import Sky as GuidanceSky
-from att_sim import world
-from att_sim.ephemeris import Sky
-from att_sim.scenario import Scenario
+from att_sim.models import world
+from att_sim.models.ephemeris import Sky
+from att_sim.models.scenario import Scenario
 
 STATE_SOURCES = ("truth", "estimate")
 

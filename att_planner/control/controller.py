@@ -5,7 +5,7 @@ the mode, the received plans, the :class:`Maneuver` being executed and the attit
 Its inputs are plain types (:mod:`att_msgs_py.types`), its outputs a :class:`StepOutput` per
 control instant (actuator command, status, action feedback, the result of a maneuver that ended).
 The node (:mod:`att_planner.nodes.controller_node`) only translates messages; tests drive the
-core directly, like :class:`att_sim.simulation.Simulation`.
+core directly, like :class:`att_sim.truth.simulation.Simulation`.
 
 Inputs are hostile until checked: a state passes :class:`~.state_gate.StateGate` (fields, time,
 source) or changes nothing; a plan passes :func:`~.plan_checks.check_plan` (fields, spacecraft,
@@ -21,7 +21,7 @@ time, then a hold of its final attitude.
 
 The feedback's ``min_cone_margin`` covers the plan's cones and zones at their true positions now:
 a :class:`~att_planner.zones.ZoneSky` of the plan, built once when it starts, on the controller's
-``sky`` (:class:`att_sim.ephemeris.Sky` at the scenario epoch, whose time is sim time), evaluated
+``sky`` (:class:`att_sim.models.ephemeris.Sky` at the scenario epoch, whose time is sim time), evaluated
 straight from the ephemeris at the current state's time (one evaluation per feedback). The truth
 does not depend on the plan's epoch: a plan made for another start instant shows the margins it
 really has. Without a ``sky`` (a scenario with no epoch) the moving zones are left out: the margin
@@ -61,9 +61,9 @@ from att_planner.guidance import reference as guidance_reference
 from att_planner.guidance.laws import Sky as GuidanceSky
 from att_planner.guidance.modes import law_of
 from att_planner.zones import ZoneSky, zones_from_cones
-from att_sim import rotations as rot
-from att_sim.dynamics import Spacecraft
-from att_sim.ephemeris import Sky
+from att_sim.models import rotations as rot
+from att_sim.models.dynamics import Spacecraft
+from att_sim.models.ephemeris import Sky
 
 
 @dataclass(frozen=True)
@@ -141,7 +141,7 @@ class Controller:
         """``measured``: fly on attitude estimates (:meth:`accept_estimate`) with measured wheel
         speeds and field, blanking the magnetometer; None: on truth states (:meth:`accept_state`).
         ``friction``: the wheel drives' expected friction torque at relative speeds ν (a callable,
-        :meth:`att_sim.actuators.WheelDriveSpec.friction`), compensated in every wheel command.
+        :meth:`att_sim.models.actuator_specs.WheelDriveSpec.friction`), compensated in every wheel command.
         ``guidance_sky``: the onboard orbit, Sun and Earth the pointing laws look at (issue 15)."""
         self.context, self.config, self.mode, self.body_frame_id = context, config, mode, body_frame_id
         self.measured, self.friction = measured, friction

@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from att_sim.rotations import cross
+from att_sim.models.rotations import cross
 
 
 def _gain(k, axis: int):

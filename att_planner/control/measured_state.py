@@ -18,8 +18,8 @@ from att_msgs_py import validation
 from att_msgs_py.errors import ErrorCode, RequestError
 from att_msgs_py.types import AttitudeEstimate, Health, MagnetometerMeasurement, State, WheelSpeedMeasurement
 from att_planner.estimation.inputs import DipoleLog, InputChecks
-from att_sim.dynamics import Spacecraft
-from att_sim.sensors.specs import SensorSpecs
+from att_sim.models.dynamics import Spacecraft
+from att_sim.models.sensor_specs import SensorSpecs
 
 BAD = ErrorCode.INVALID_MEASUREMENT
 HEALTHS = tuple(Health)

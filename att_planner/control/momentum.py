@@ -18,8 +18,8 @@ from functools import lru_cache
 
 import numpy as np
 
-from att_sim import rotations as rot
-from att_sim.dynamics import Spacecraft
+from att_sim.models import rotations as rot
+from att_sim.models.dynamics import Spacecraft
 
 
 def desaturation_dipole(wheel_momentum, target, field_body, gain: float, dipole_max: float) -> np.ndarray:

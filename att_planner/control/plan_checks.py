@@ -5,8 +5,8 @@ inline in an ``ExecuteManeuver`` goal): sizes and lengths against each other, fi
 quaternions, times from 0 strictly increasing and bounded, controls within the spacecraft's
 limits, known vocabularies, bounded strings, its zones (:func:`att_msgs_py.validation.zone`: known
 body, unit axes, half-angle range, an inertial zone's direction) and its epoch (within
-:mod:`att_sim.epoch`'s span; needed by a zone that moves); then its context: made for this spacecraft
-configuration (name and :attr:`~att_sim.dynamics.Spacecraft.digest`) and signed by the configured
+:mod:`att_sim.models.epoch`'s span; needed by a zone that moves); then its context: made for this spacecraft
+configuration (name and :attr:`~att_sim.models.dynamics.Spacecraft.digest`) and signed by the configured
 key (:mod:`att_msgs_py.signing`). :func:`check_start` compares a plan's first sample with the
 current state, and the epoch of a plan with moving zones with the current instant (the scenario's
 epoch + sim time; UTC arithmetic, a leap second in between is a second off). Each returns
@@ -23,9 +23,9 @@ import numpy as np
 from att_msgs_py import signing, validation
 from att_msgs_py.errors import ErrorCode, RequestError
 from att_msgs_py.types import ControlKind, Interpolation, Plan, State, Status
-from att_sim import epoch as epochs
-from att_sim import rotations as rot
-from att_sim.dynamics import Spacecraft
+from att_sim.models import epoch as epochs
+from att_sim.models import rotations as rot
+from att_sim.models.dynamics import Spacecraft
 
 LIMIT_TOLERANCE = 1e-6       # relative: plan controls may touch their limit, not exceed it
 MAX_PLAN_RATE = 10.0         # rad/s, any body axis: beyond it a plan is not a slew

@@ -19,8 +19,8 @@ from att_msgs_py.types import Plan
 from att_planner.guidance import Reference
 from att_planner.guidance import reference as guidance_reference
 from att_planner.guidance.laws import BlendedLaw
-from att_sim import rotations as rot
-from att_sim.dynamics import Spacecraft
+from att_sim.models import rotations as rot
+from att_sim.models.dynamics import Spacecraft
 
 HANDOVER_RATE_MATCH = 1e-4     # rad/s: a plan ending this close to the law's rate hands over directly
 HANDOVER_ATTITUDE_MATCH = 1e-3  # rad: ... and this close to its attitude (else: through the blend)

@@ -16,7 +16,7 @@ from dataclasses import dataclass
 from att_msgs_py import validation
 from att_msgs_py.errors import ErrorCode, RequestError
 from att_msgs_py.types import State
-from att_sim.dynamics import Spacecraft
+from att_sim.models.dynamics import Spacecraft
 
 MAX_BODY_RATE = 10.0          # rad/s, any axis
 MAX_FIELD = 1e-3              # T (the geomagnetic field is below 7e-5 T)

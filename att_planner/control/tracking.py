@@ -23,8 +23,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from att_msgs_py.types import Interpolation, Plan
-from att_sim import rotations as rot
-from att_sim.dynamics import Spacecraft
+from att_sim.models import rotations as rot
+from att_sim.models.dynamics import Spacecraft
 
 
 @dataclass

@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from att_sim import rotations as rot
+from att_sim.models import rotations as rot
 
 # the references as given, and turned by π about x, y, z (the method of sequential rotations)
 REFERENCE_ROTATIONS = (rot.IDENTITY, np.array([1.0, 0.0, 0.0, 0.0]), np.array([0.0, 1.0, 0.0, 0.0]),

@@ -6,9 +6,9 @@ import math
 
 from att_msgs_py.errors import ConfigError, ErrorCode
 from att_planner.estimation.estimator import Estimator, EstimatorConfig
-from att_sim import world
-from att_sim.scenario import Scenario
-from att_sim.sensors.specs import ARCSEC, DEG, HOUR, NANOTESLA
+from att_sim.models import world
+from att_sim.models.scenario import Scenario
+from att_sim.models.sensor_specs import ARCSEC, DEG, HOUR, NANOTESLA
 
 
 def estimator_config(param, s: Scenario) -> EstimatorConfig:

@@ -63,8 +63,8 @@ from att_planner.estimation import mekf
 from att_planner.estimation.attitude_determination import quest, sun_vector
 from att_planner.estimation.inputs import DipoleLog, InputChecks
 from att_planner.estimation.lockstep import resume
-from att_sim import rotations as rot
-from att_sim.sensors.specs import SensorSpecs
+from att_sim.models import rotations as rot
+from att_sim.models.sensor_specs import SensorSpecs
 
 LOST_COVARIANCE = math.pi**2        # rad²: the attitude covariance published without an estimate
 FLICKER_HORIZON = 300.0            # s: the bias random walk of the default tuning grows by B in this time
@@ -125,7 +125,7 @@ class Estimator:
     def __init__(self, specs: SensorSpecs, config: EstimatorConfig, environment=None, frame_id: str = "",
                  body_frame_id: str = ""):
         """``specs``: the datasheets (mountings, ranges); ``environment``: the onboard models of
-        the field and the Sun (:meth:`att_sim.world.Environment.bodies`), needed for vector updates."""
+        the field and the Sun (:meth:`att_sim.models.world.Environment.bodies`), needed for vector updates."""
         self.specs, self.config, self.environment = specs, config, environment
         self.frame_id, self.body_frame_id = frame_id, body_frame_id
         self._sigma3: tuple = (None, 0.0)        # (state, its attitude 3σ): health()'s cache

@@ -16,7 +16,7 @@ import numpy as np
 from att_msgs_py import validation
 from att_msgs_py.errors import ErrorCode, RequestError
 from att_msgs_py.types import GyroMeasurement, MagnetometerMeasurement, StarTrackerMeasurement, SunSensorMeasurement
-from att_sim.sensors.specs import SensorSpecs
+from att_sim.models.sensor_specs import SensorSpecs
 
 BAD = ErrorCode.INVALID_MEASUREMENT
 MAX_RATE = 100.0          # rad/s: no gyro outputs more

@@ -38,7 +38,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from att_sim import rotations as rot
+from att_sim.models import rotations as rot
 
 I3 = np.eye(3)
 
@@ -114,7 +114,7 @@ def process_noise(arw: float, rrw: float, dt: float) -> np.ndarray:
     return Q
 
 
-OFF_DIAGONAL = ((0, 1), (0, 2), (1, 0), (1, 2), (2, 0), (2, 1))   # as att_sim.rotations.small_error_matrix
+OFF_DIAGONAL = ((0, 1), (0, 2), (1, 0), (1, 2), (2, 0), (2, 1))   # as att_sim.models.rotations.small_error_matrix
 
 
 def scale_misalignment_sensitivity(omega: np.ndarray) -> np.ndarray:

@@ -17,7 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from att_sim import rotations as rot
+from att_sim.models import rotations as rot
 
 DIFFERENCE_STEP = 0.5          # s: the step of the central differences
 

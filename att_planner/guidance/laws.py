@@ -28,8 +28,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from att_sim import rotations as rot
-from att_sim.geomagnetic import EARTH_ROTATION_RATE
+from att_sim.models import rotations as rot
+from att_sim.models.geomagnetic import EARTH_ROTATION_RATE
 
 WGS84_A = 6378137.0                       # m, equatorial radius
 WGS84_F = 1.0 / 298.257223563             # flattening
@@ -82,7 +82,7 @@ class Sky:
 
     @classmethod
     def of(cls, environment) -> Sky:
-        """The sky of an :class:`att_sim.world.Environment` (the onboard models of the scenario);
+        """The sky of an :class:`att_sim.models.world.Environment` (the onboard models of the scenario);
         the orbit's states are remembered for the last few times asked (a reference differentiates
         its law at three times, each asking for the orbit more than once)."""
         field_model = environment.field

@@ -20,7 +20,7 @@ import numpy as np
 from att_msgs_py.types import Plan, Status
 from att_planner.problem import ManeuverProblem
 from att_planner.verification import rejection, verify
-from att_sim import rotations as rot
+from att_sim.models import rotations as rot
 
 
 @dataclass

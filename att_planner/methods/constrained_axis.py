@@ -38,7 +38,7 @@ from att_planner.methods.axis_rotations import (
 from att_planner.problem import ManeuverProblem
 from att_planner.verification import clearances
 from att_planner.zones import ZoneSky, same_axis
-from att_sim import rotations as rot
+from att_sim.models import rotations as rot
 
 METHOD = "constrained_axis"
 RIDE_ITERATIONS = 4        # fixed-point iterations on the ride time t* and the widening

@@ -25,7 +25,7 @@ from att_msgs_py.types import Interpolation, Plan, Status
 from att_planner.methods.axis_rotations import eigenaxis_leg, goal_attitude, legs_plan, no_torque_limit
 from att_planner.problem import ManeuverProblem
 from att_planner.verification import clearances
-from att_sim import rotations as rot
+from att_sim.models import rotations as rot
 
 METHOD = "eigenaxis_smooth"
 

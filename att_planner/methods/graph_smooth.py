@@ -45,7 +45,7 @@ from att_msgs_py.types import Interpolation, Plan, Status
 from att_planner.cones import BOUNDARY_TOLERANCE, boundary_end_zones
 from att_planner.methods.axis_rotations import eigenaxis_leg, no_torque_limit
 from att_planner.problem import ManeuverProblem
-from att_sim import rotations as rot
+from att_sim.models import rotations as rot
 
 METHOD = "graph_smooth"
 NODES_PER_ZONE = 16               # directions round each keep-out zone of the main sensor

@@ -1,5 +1,5 @@
 """Quaternion algebra for CasADi expressions (SX or MX), the symbolic twins of
-:mod:`att_sim.rotations` used by the collocation and multiple-shooting transcriptions.
+:mod:`att_sim.models.rotations` used by the collocation and multiple-shooting transcriptions.
 Quaternions ``[x, y, z, w]``, Hamilton product, body-to-inertial (the suite's convention)."""
 from __future__ import annotations
 
@@ -14,7 +14,7 @@ def quat_mul(p, q):
 
 def error_vector(q, q_ref):
     """Vector part of ``q_ref* ⊗ q``: zero iff q = ±q_ref (unit quaternions); the argument order
-    of :func:`att_sim.rotations.error_vector`, without its sign choice."""
+    of :func:`att_sim.models.rotations.error_vector`, without its sign choice."""
     return q_ref[3] * q[:3] - q[3] * q_ref[:3] - ca.cross(q_ref[:3], q[:3])
 
 

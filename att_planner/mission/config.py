@@ -40,7 +40,7 @@ from att_msgs_py.types import SECONDARY_KINDS
 from att_planner.mission import targets as target_lists
 from att_planner.mission.ground import GroundTrack, site_mode
 from att_planner.mission.scheduler import MissionTarget
-from att_sim import scenario as scen
+from att_sim.models import scenario as scen
 
 # key -> (default, low, high); None default: required
 NUMBERS = {"horizon_s": (None, 60.0, 7 * 86_400.0), "margin_deg": (1.0, 0.0, 30.0), "rate_hz": (5.0, 0.5, 50.0),

@@ -25,10 +25,10 @@ from att_msgs_py.types import MissionEventKind as Kind
 from att_planner.guidance.laws import Sky as GuidanceSky
 from att_planner.guidance.modes import law_of
 from att_planner.zones import ZoneSky
-from att_sim import rotations as rot
-from att_sim import scenario as scen
-from att_sim import world
-from att_sim.ephemeris import Sky
+from att_sim.models import rotations as rot
+from att_sim.models import scenario as scen
+from att_sim.models import world
+from att_sim.models.ephemeris import Sky
 
 
 def events_of(log: dict) -> list:

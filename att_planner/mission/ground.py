@@ -28,7 +28,7 @@ from att_planner.guidance import reference
 from att_planner.guidance.laws import Sky as GuidanceSky
 from att_planner.guidance.laws import geodetic_to_itrs
 from att_planner.guidance.modes import law_of
-from att_sim import world
+from att_sim.models import world
 
 TORQUE_SHARE = 0.8             # of the planning torque limit a site's tracking may take
 

@@ -44,9 +44,9 @@ from att_msgs_py.types import Zone
 from att_planner.methods.axis_rotations import axis_acceleration
 from att_planner.methods.schedule.order_search import observed_prefix, orders_by_lower_bound, spans, visibility_grid
 from att_planner.zones import ZoneSky
-from att_sim import rotations as rot
-from att_sim import scenario as scen
-from att_sim.ephemeris import Sky
+from att_sim.models import rotations as rot
+from att_sim.models import scenario as scen
+from att_sim.models.ephemeris import Sky
 
 MAX_ORDERS = 5_000            # orders examined per decision (the search is best-first: the good ones come early)
 HOLD_CHECK_STEP = 10.0        # s between the zone checks of an attitude held while waiting

@@ -30,8 +30,8 @@ from pathlib import Path
 import numpy as np
 
 from att_msgs_py.errors import ConfigError, ErrorCode, clip
-from att_sim import rotations as rot
-from att_sim import scenario as scen
+from att_sim.models import rotations as rot
+from att_sim.models import scenario as scen
 
 KINDS = {"inertial": ("name", "ra_deg", "dec_deg", "dwell_s"),
          "ground": ("name", "lat_deg", "lon_deg", "alt_m", "dwell_s")}

@@ -1,7 +1,7 @@
 """Planner node: serves ``/planner/plan_maneuver`` (PlanManeuver) and publishes every returned
 plan on the latched ``/planner/plans`` for the controller and the recorder; with ``plan_markers``
 (default true) it also publishes the latest plan's boresight path for the 3D view on the latched
-``/planner/plan_markers`` (visualization_msgs/MarkerArray, :func:`att_sim.scene.plan_shapes`): the
+``/planner/plan_markers`` (visualization_msgs/MarkerArray, :func:`att_sim.models.scene.plan_shapes`): the
 planner shows its own plans, so the simulator stays on the truth side.
 
 Callbacks only translate: message -> :class:`ManeuverRequest` -> :func:`validate_maneuver` ->
@@ -42,8 +42,8 @@ from att_planner.service.requests import MAX_TIME_BUDGET, ManeuverRequest, valid
 from att_planner.service.warm import warm, warm_requests
 from att_planner.service.worker import call_isolated, run_isolated, set_max_parallel, set_warm_up, start_pool, warm_up
 from att_planner.verification import TOLERANCES, Tolerances
-from att_sim import scenario as scen
-from att_sim import scene
+from att_sim.models import scenario as scen
+from att_sim.models import scene
 
 
 class PlannerNode(Node):

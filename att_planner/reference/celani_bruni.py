@@ -5,8 +5,8 @@ import numpy as np
 
 from att_msgs_py.types import Cone
 from att_planner.problem import ManeuverProblem
-from att_sim import rotations as rot
-from att_sim.dynamics import Spacecraft
+from att_sim.models import rotations as rot
+from att_sim.models.dynamics import Spacecraft
 
 PUBLISHED = {
     # t_f (s for earth_obs, TU for swift) and compute time where given

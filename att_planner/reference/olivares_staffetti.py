@@ -5,8 +5,8 @@ from __future__ import annotations
 import numpy as np
 
 from att_planner.problem import ManeuverProblem
-from att_sim import dynamics as dyn
-from att_sim import rotations as rot
+from att_sim.models import dynamics as dyn
+from att_sim.models import rotations as rot
 
 _TARGETS_SCALAR_LAST = {
     "a": (0.13002, 0.01137, 0.08641, 0.98767), "b": (0.19616, 0.09147, 0.41260, 0.88482),

@@ -16,8 +16,8 @@ import numpy as np
 
 from att_msgs_py.types import Cone
 from att_planner.problem import ManeuverProblem
-from att_sim import rotations as rot
-from att_sim.dynamics import Spacecraft
+from att_sim.models import rotations as rot
+from att_sim.models.dynamics import Spacecraft
 
 BOUNDARY_CASES = {"ba1": (45.0, 90.0, True), "ba2": (23.0, 70.0, True),     # θ (deg), φ (deg), forced arc
                   "bp1": (45.0, 90.0, False), "bp2": (23.0, 70.0, False)}

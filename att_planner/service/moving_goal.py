@@ -19,8 +19,8 @@ from att_msgs_py.types import PointingMode
 from att_planner.guidance import reference
 from att_planner.guidance.laws import Sky
 from att_planner.guidance.modes import law_of
-from att_sim import world
-from att_sim.scenario import Scenario
+from att_sim.models import world
+from att_sim.models.scenario import Scenario
 
 
 def goal_law(mode: PointingMode, scenario: Scenario, epoch: datetime | None,

@@ -41,8 +41,8 @@ from att_planner.service.requests import ValidRequest, ValidSchedule
 from att_planner.service.sky import lattice
 from att_planner.service.wheels import slow_for_wheels
 from att_planner.verification import TOLERANCES, VERIFY_STEPS, Tolerances, rejection, verify
-from att_sim.ephemeris import de421
-from att_sim.epoch import timescale
+from att_sim.models.ephemeris import de421
+from att_sim.models.epoch import timescale
 
 VERIFY_RESERVE = 0.1        # fraction of the time budget kept for verification and fallback
 VERIFY_RESERVE_MIN = 0.1    # s (at most half the budget)

@@ -1,12 +1,12 @@
 """The real sky of a request (no ROS): its epoch, orbit and zones, checked into what a problem needs.
 
 * **Epoch** (``builtin_interfaces/Time``, UTC seconds since 1970): the request's, or when it is zero
-  the scenario's ``epoch``; within the ephemeris span of :mod:`att_sim.epoch` (1900-2050) and the
+  the scenario's ``epoch``; within the ephemeris span of :mod:`att_sim.models.epoch` (1900-2050) and the
   wire's int32 seconds (before 2038-01-19T03:14:07Z), since the plan carries it back
   (INVALID_EPOCH). Without one anywhere the request may only have inertial zones.
-* **Orbit**: the request's TLE (both lines; :class:`att_sim.orbit.TLEOrbit` at the request's
+* **Orbit**: the request's TLE (both lines; :class:`att_sim.models.orbit.TLEOrbit` at the request's
   epoch, checked column by column and by its checksum: INVALID_ORBIT), or when both lines are
-  empty the scenario's orbit (:class:`att_sim.ephemeris.Sky` maps its time zero onto the epoch).
+  empty the scenario's orbit (:class:`att_sim.models.ephemeris.Sky` maps its time zero onto the epoch).
   It must stay above :data:`MIN_ALTITUDE` over the whole zone window (ORBIT_TOO_LOW; an SGP4
   failure, i.e. a decayed TLE, too).
 * **Zones**: at most :data:`MAX_ZONES`, each checked field by field
@@ -21,14 +21,14 @@ from datetime import datetime
 from att_msgs_py import validation
 from att_msgs_py.errors import ErrorCode, RequestError
 from att_msgs_py.types import Zone
-from att_sim import epoch as epochs
-from att_sim import orbit as orbits
-from att_sim.ephemeris import Sky
-from att_sim.scenario import Scenario
+from att_sim.models import epoch as epochs
+from att_sim.models import orbit as orbits
+from att_sim.models.ephemeris import Sky
+from att_sim.models.scenario import Scenario
 
 MAX_ZONES = 16                 # zones of one request (besides its cones): each is a constraint at every sample
 MAX_TLE_LENGTH = 80            # characters of a TLE line (69 are used; trailing blanks are dropped)
-MIN_ALTITUDE = 150e3           # m (att_sim.orbit.check_altitude's default)
+MIN_ALTITUDE = 150e3           # m (att_sim.models.orbit.check_altitude's default)
 
 
 @dataclass(frozen=True)

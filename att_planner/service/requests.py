@@ -31,9 +31,9 @@ from att_planner.problem import ManeuverProblem, MovingGoal
 from att_planner.service.moving_goal import goal_law
 from att_planner.service.real_sky import RequestSky, check_orbit_window, resolve_sky
 from att_planner.service.sky import closed_sky
-from att_sim import rotations as rot
-from att_sim import scenario as scen
-from att_sim.dynamics import Spacecraft
+from att_sim.models import rotations as rot
+from att_sim.models import scenario as scen
+from att_sim.models.dynamics import Spacecraft
 
 MAX_CONES = 16
 MAX_OPTIONS = 16

@@ -23,7 +23,7 @@ from att_msgs_py.types import Cone
 from att_planner.service.planning import plan_maneuver
 from att_planner.service.requests import ManeuverRequest, ValidRequest, validate_maneuver
 from att_planner.verification import TOLERANCES, Tolerances
-from att_sim import scenario as scen
+from att_sim.models import scenario as scen
 
 DEMO_KEYS = ("initial_attitude", "final_attitude", "sensor_axis")
 WARM_BUDGET = 60.0          # s each warm-up plan may take (it builds; the request it stands for will not)

@@ -20,8 +20,8 @@ more (a solve then takes a fraction of that), so:
 A worker that dies is replaced. At most ``max_parallel`` solve at once (the rest wait, within their
 own budget).
 
-A problem with a sky (issue 13) crosses to the child as it is: :class:`att_sim.ephemeris.Sky` and
-:class:`att_sim.orbit.TLEOrbit` pickle as their recipes (epoch and orbit, epoch and lines), since
+A problem with a sky (issue 13) crosses to the child as it is: :class:`att_sim.models.ephemeris.Sky` and
+:class:`att_sim.models.orbit.TLEOrbit` pickle as their recipes (epoch and orbit, epoch and lines), since
 skyfield's and SGP4's objects do not; the child rebuilds their tables as it needs them.
 """
 from __future__ import annotations
@@ -37,7 +37,7 @@ from att_planner.problem import ManeuverProblem
 from att_planner.service.planning import run_method
 
 _CONTEXT = multiprocessing.get_context("forkserver")
-_CONTEXT.set_forkserver_preload(["att_planner.service.planning", "numpy", "scipy.optimize", "att_sim.ephemeris",
+_CONTEXT.set_forkserver_preload(["att_planner.service.planning", "numpy", "scipy.optimize", "att_sim.models.ephemeris",
                                  "skyfield.api", "sgp4.api", "casadi", "att_planner.methods.time_optimal.smooth"])
 _SLOTS = threading.BoundedSemaphore(max(1, os.cpu_count() or 1))
 KILL_GRACE = 0.5            # s after the wait before the child is terminated

@@ -1,6 +1,6 @@
 """The simulator, estimator and controller cores wired as their nodes wire them, in one process.
 
-:class:`ClosedLoop` runs :class:`att_sim.simulation.Simulation`, the
+:class:`ClosedLoop` runs :class:`att_sim.truth.simulation.Simulation`, the
 :class:`~att_planner.estimation.estimator.Estimator` and the
 :class:`~att_planner.control.controller.Controller` of a scenario — built by the same functions as
 the nodes (:func:`~att_planner.control.configure.controller_from_scenario`,
@@ -28,11 +28,11 @@ from att_msgs_py.types import Health, ManeuverResult, Plan, PointingMode
 from att_planner.control.configure import controller_from_scenario
 from att_planner.estimation.configure import estimator_from_scenario
 from att_planner.estimation.estimator import Estimator
-from att_sim import dynamics as dyn
-from att_sim import rotations as rot
-from att_sim.scenario import Scenario
-from att_sim.sensors import Readings
-from att_sim.simulation import DEFAULT_STEP, Checks, Simulation
+from att_sim.models import dynamics as dyn
+from att_sim.models import rotations as rot
+from att_sim.models.scenario import Scenario
+from att_sim.truth.sensors import Readings
+from att_sim.truth.simulation import DEFAULT_STEP, Checks, Simulation
 
 
 class Reprocessing(NamedTuple):

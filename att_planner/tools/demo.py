@@ -41,9 +41,9 @@ from att_planner.service.warm import maneuver_from_scenario
 from att_planner.tools.launch import isolated_env, join_env, start_suite
 from att_planner.tools.review import review
 from att_planner.zones import ZoneSky, zones_from_cones
-from att_sim import rotations as rot
-from att_sim import scenario as scen
-from att_sim.ephemeris import Sky
+from att_sim.models import rotations as rot
+from att_sim.models import scenario as scen
+from att_sim.models.ephemeris import Sky
 
 
 def zone_margins(scenario: scen.Scenario, maneuver: dict, t: np.ndarray, q: np.ndarray) -> tuple[list, np.ndarray]:

@@ -19,7 +19,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 NODE_MODULES = {
-    "simulator": "att_sim.simulator_node",
+    "simulator": "att_sim.truth.simulator_node",
     "controller": "att_planner.nodes.controller_node",
     "estimator": "att_planner.nodes.estimator_node",
     "planner": "att_planner.nodes.planner_node",
@@ -119,7 +119,7 @@ class Suite:
 def default_nodes(scenario: str) -> tuple[str, ...]:
     """The nodes of a whole run of ``scenario``: recorder, simulator, the estimator when the
     scenario has a gyro (its controller then flies on the estimate), controller and planner."""
-    from att_sim import scenario as scen
+    from att_sim.models import scenario as scen
 
     estimator = ("estimator",) if scen.load(scenario).sensors.gyro is not None else ()
     return ("recorder", "simulator", *estimator, "controller", "planner")

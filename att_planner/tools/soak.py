@@ -18,7 +18,7 @@ from att_msgs_py.log import read_log
 from att_msgs_py.topics import COMMAND, STATE
 from att_planner.tools.launch import isolated_env, start_suite
 from att_planner.tools.review.run import settling_time
-from att_sim import scenario as scen
+from att_sim.models import scenario as scen
 
 LOCKSTEP_TIMEOUT = 5.0
 LOCKSTEP_SUSPENDED = "free-running at RTF"     # the simulator's warning when no command answered a state

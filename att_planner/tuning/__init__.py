@@ -10,8 +10,8 @@ rates ``|ω_i| ≤ 0.1 rad/s``, orbit argument ``ψ``)::
 Building blocks, all pure numpy:
 
 * :mod:`.settling` — the problem data and :func:`simulate_settling`: one vectorised RK4
-  (:func:`att_sim.dynamics.rk4`) integration of many (gain, initial condition) cases at once, with
-  the field code of :mod:`att_sim.environment` and the law written out per row; finished cases are
+  (:func:`att_sim.models.dynamics.rk4`) integration of many (gain, initial condition) cases at once, with
+  the field code of :mod:`att_sim.models.environment` and the law written out per row; finished cases are
   retired and the batch shrinks. :func:`truth_settling_time` re-checks one case through the truth
   dynamics.
 * :mod:`.evaluation` — :class:`BatchEvaluator`, the one place simulations run: in process, or

@@ -1,6 +1,6 @@
 """The settling-time problem of Bruni & Celani: its data, and the settling time of many
 (gain, initial condition) cases integrated as one batch (the batch simulator), with the truth-path
-check of one case through :mod:`att_sim.dynamics`."""
+check of one case through :mod:`att_sim.models.dynamics`."""
 from __future__ import annotations
 
 import math
@@ -10,8 +10,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from att_planner.control.magnetorquer import dipole_command
-from att_sim import dynamics as dyn
-from att_sim import environment as env
+from att_sim.models import dynamics as dyn
+from att_sim.models import environment as env
 
 # ---------------------------------------------------------------------------------------------
 # Problem data
@@ -119,7 +119,7 @@ class _BatchModel:
     """Right-hand side ``f(t, x)`` of the Bruni–Celani closed loop for a batch, component-first ``(7, N)``.
 
     State rows ``[q_x, q_y, q_z, q_w, ω_x, ω_y, ω_z]``; every operation is on whole rows so one
-    call advances all cases. Field: :func:`att_sim.environment.dipole_field_components`; law:
+    call advances all cases. Field: :func:`att_sim.models.environment.dipole_field_components`; law:
     the expression of :func:`att_planner.control.magnetorquer.dipole_command` written out per row
     (``m × B_b`` with ``m = −m* sat(B_b × (κ_p q_v + κ_d ω)/m*)``).
     """
@@ -141,7 +141,8 @@ class _BatchModel:
         self.kp, self.kd, self.cpsi, self.spsi = self.kp[keep], self.kd[keep], self.cpsi[keep], self.spsi[keep]
 
     def __call__(self, t: float, x: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
-        """``ẋ`` at ``t``, written into ``out`` when given (the work-array path of :func:`att_sim.dynamics.rk4`)."""
+        """``ẋ`` at ``t``, written into ``out`` when given (the work-array path of
+        :func:`att_sim.models.dynamics.rk4`)."""
         case = self.case
         qx, qy, qz, qw, wx, wy, wz = x
         c, s = math.cos(self.n * t), math.sin(self.n * t)
@@ -175,12 +176,12 @@ class _BatchModel:
 
 
 def _work(x: np.ndarray) -> tuple:
-    """Work arrays of :func:`att_sim.dynamics.rk4` for the batch ``x``."""
+    """Work arrays of :func:`att_sim.models.dynamics.rk4` for the batch ``x``."""
     return tuple(np.empty_like(x) for _ in range(5))
 
 
 def _step(model: _BatchModel, t: float, x: np.ndarray, dt: float, work: tuple) -> np.ndarray:
-    """The batch advanced in place by one :func:`att_sim.dynamics.rk4` step, quaternions renormalised."""
+    """The batch advanced in place by one :func:`att_sim.models.dynamics.rk4` step, quaternions renormalised."""
     return dyn.renormalised(dyn.rk4(model, t, x, dt, work))
 
 
@@ -324,10 +325,10 @@ def truth_settling_time(case: MagnetorquerCase, kp: float, kd: float, h, *, dt: 
                         settings: SimSettings = SimSettings()) -> tuple[float, int]:
     """Settling time (orbits) and status of one case through the simulator's truth path.
 
-    :func:`att_sim.dynamics.step` like the simulator node: the dipole ``m`` of
+    :func:`att_sim.models.dynamics.step` like the simulator node: the dipole ``m`` of
     :func:`att_planner.control.magnetorquer.dipole_command` (from the field at the step's start, as a
     sampled controller sees it) held over the step, the field ``B_b`` of
-    :func:`att_sim.environment.field_body` evaluated at every RK4 stage — none of the batch code. The
+    :func:`att_sim.models.environment.field_body` evaluated at every RK4 stage — none of the batch code. The
     same settling rule as :func:`simulate_settling` (cap, quiet window).
     """
     q0, w0, psi = initial_states(h)

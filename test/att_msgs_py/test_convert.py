@@ -14,7 +14,7 @@ from att_msgs_py import convert, signing, validation
 from att_msgs_py.errors import ErrorCode, RequestError
 from att_msgs_py.log.definitions import SEPARATOR, message_definition
 from att_msgs_py.types import ZONE_BODIES, Cone, Interpolation, Plan, State, Status, Verification, Zone
-from att_sim import rotations as rot
+from att_sim.models import rotations as rot
 
 
 def test_quaternion_vector_time_round_trip():

@@ -8,7 +8,7 @@ from visualization_msgs.msg import Marker, MarkerArray
 from att_msgs_py import markers, topics
 from att_msgs_py.log.definitions import message_definition
 from att_msgs_py.types import Shape, ShapeKind
-from att_sim import rotations as rot
+from att_sim.models import rotations as rot
 
 SHAPES = [Shape("zones", 0, "eci", ShapeKind.TRIANGLES, np.arange(9.0).reshape(3, 3), (1.0, 0.0, 0.0, 0.3)),
           Shape("zone_rims", 0, "eci", ShapeKind.LINE, np.ones((4, 3)), (1.0, 0.0, 0.0, 1.0), 0.02),

@@ -18,7 +18,7 @@ from att_planner.reference.time_optimal_cases import boundary_problem
 from att_planner.service.planning import plan_maneuver, run_method
 from att_planner.service.requests import ManeuverRequest, validate_maneuver
 from att_planner.verification import clearances, rejection, verify
-from att_sim import rotations as rot
+from att_sim.models import rotations as rot
 from helpers.truth import truth_check
 
 TH_A, TH_B = math.radians(30), math.radians(20)

@@ -10,8 +10,8 @@ from att_planner.methods.constrained_axis import plan_constrained_axis
 from att_planner.methods.eigenaxis import plan_eigenaxis
 from att_planner.problem import ManeuverProblem
 from att_planner.verification import TOLERANCES, rejection, verify
-from att_sim import rotations as rot
-from att_sim.dynamics import Spacecraft
+from att_sim.models import rotations as rot
+from att_sim.models.dynamics import Spacecraft
 
 R_E = 6378.137e3
 Y = np.array([0.0, 1.0, 0.0])

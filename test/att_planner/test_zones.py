@@ -11,8 +11,8 @@ from att_planner import cones as cone_checks
 from att_planner.problem import ManeuverProblem
 from att_planner.reference.time_optimal_cases import case_problem
 from att_planner.zones import FIT_TOLERANCE, ZoneSky, zones_from_cones
-from att_sim import rotations as rot
-from att_sim.dynamics import Spacecraft
+from att_sim.models import rotations as rot
+from att_sim.models.dynamics import Spacecraft
 
 R_E = 6378.137e3
 
@@ -220,8 +220,8 @@ def test_default_window_bounds_the_slew():
 
 def test_the_real_sky_of_leo_observatory_fits_within_tolerance():
     """The issue's TLE (≈ 577 km, 14.96 rev/day) on 2026-12-21: Sun, Moon and Earth limb + 10 deg."""
-    from att_sim.ephemeris import Sky
-    from att_sim.orbit import TLEOrbit
+    from att_sim.models.ephemeris import Sky
+    from att_sim.models.orbit import TLEOrbit
 
     epoch = "2026-12-21T00:00:00Z"
     line1 = "1 28485U          26355.00000000  .00000000  00000-0  20000-4 0    07"

@@ -27,7 +27,7 @@ sys.path.insert(0, str(HERE.parents[1]))
 
 from att_msgs_py.types import Cone  # noqa: E402
 from att_planner.tools.launch import isolated_env, join_env, start_suite  # noqa: E402
-from att_sim import rotations as rot  # noqa: E402
+from att_sim.models import rotations as rot  # noqa: E402
 
 FIXTURE = HERE / "swift_short.mcap"
 SENSOR = np.array([1.0, 0.0, 0.0])

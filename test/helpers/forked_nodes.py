@@ -9,7 +9,7 @@ import multiprocessing
 import os
 import sys
 
-NODE_MODULES = ("att_sim.simulator_node", "att_planner.nodes.controller_node", "att_planner.nodes.estimator_node",
+NODE_MODULES = ("att_sim.truth.simulator_node", "att_planner.nodes.controller_node", "att_planner.nodes.estimator_node",
                 "att_planner.nodes.planner_node", "att_msgs_py.log.recorder_node")
 
 

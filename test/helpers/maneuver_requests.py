@@ -6,7 +6,7 @@ import math
 import numpy as np
 
 from att_planner.service.requests import ManeuverRequest, validate_maneuver
-from att_sim import rotations as rot
+from att_sim.models import rotations as rot
 
 NAN, INF = float("nan"), float("inf")
 GOAL = rot.from_axis_angle([0, 0, 1], math.radians(135))

@@ -8,7 +8,7 @@ import math
 from pathlib import Path
 
 from att_msgs_py import topics
-from att_sim import rotations as rot
+from att_sim.models import rotations as rot
 
 FIXTURE = Path(__file__).parents[1] / "data" / "swift_short.mcap"
 # the 3D view's topics and the mission events (issue 17) are recorded since after the fixture was made

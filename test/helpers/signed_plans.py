@@ -6,7 +6,7 @@ from cryptography.hazmat.primitives.asymmetric.ed25519 import Ed25519PrivateKey
 from att_msgs_py import convert, signing
 from att_msgs_py.types import Plan
 from att_planner.control.plan_checks import PlanContext
-from att_sim import scenario
+from att_sim.models import scenario
 
 KEY = Ed25519PrivateKey.generate()       # this test process's planner key
 

@@ -1,7 +1,7 @@
 """Test skies: the zones' sky interface of :class:`att_planner.zones.ZoneSky` without an ephemeris."""
 import numpy as np
 
-from att_sim import rotations as rot
+from att_sim.models import rotations as rot
 
 C = np.sqrt(0.5)
 RATE = np.deg2rad(0.25)          # rad/s: the Sun descends along the 45° meridian

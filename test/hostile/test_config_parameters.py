@@ -27,7 +27,7 @@ from att_msgs_py import convert, qos, topics
 from att_msgs_py.errors import ConfigError, ErrorCode, RequestError
 from att_planner.service.requests import load_spacecraft
 from att_planner.tools.launch import NODE_MODULES, isolated_env
-from att_sim import scenario
+from att_sim.models import scenario
 from helpers import forked_nodes
 
 BASE = {
@@ -57,7 +57,7 @@ def edited(**changes):
     return yaml.safe_dump(doc)
 
 
-GAINS = (Path(scenario.__file__).resolve().parents[1] / "config" / "controller_gains.yaml").read_text()
+GAINS = (Path(scenario.__file__).resolve().parents[2] / "config" / "controller_gains.yaml").read_text()
 BAD_SCENARIOS = {
     "a list": ("- 1\n- 2\n", "a mapping"),
     "a scalar": ("just some text\n", "a mapping"),
@@ -268,7 +268,7 @@ REFUSAL = re.compile(r"^(\w+)\.py: \[(\d+) (\w+)\] (.+)$")
 
 
 def write_files(tmp: Path) -> None:
-    swift = (Path(scenario.__file__).resolve().parents[1] / "config" / "swift_demo.yaml").read_text()
+    swift = (Path(scenario.__file__).resolve().parents[2] / "config" / "swift_demo.yaml").read_text()
     (tmp / "list.yaml").write_text("- 1\n- 2\n")
     (tmp / "broken.yaml").write_text("{{{ not yaml\n")
     (tmp / "bad_step.yaml").write_text(swift.replace("step: 0.05 ", "step: 5.0 "))

@@ -14,8 +14,8 @@ from att_msgs.msg import ControllerStatus, SpacecraftState
 from att_msgs_py import convert, qos, signing, topics
 from att_planner.methods.eigenaxis import plan_eigenaxis_smooth
 from att_planner.problem import ManeuverProblem
-from att_sim import rotations as rot
-from att_sim import scenario
+from att_sim.models import rotations as rot
+from att_sim.models import scenario
 
 pytestmark = pytest.mark.ros
 

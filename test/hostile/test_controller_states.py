@@ -16,9 +16,9 @@ from att_msgs_py.types import ControlMode
 from att_planner.control.controller import Controller, ControllerConfig
 from att_planner.methods.eigenaxis import plan_eigenaxis_smooth
 from att_planner.problem import ManeuverProblem
-from att_sim import rotations as rot
-from att_sim import scenario
-from att_sim.simulation import Simulation
+from att_sim.models import rotations as rot
+from att_sim.models import scenario
+from att_sim.truth.simulation import Simulation
 from helpers.signed_plans import KEY, context, issue
 
 SWIFT = scenario.load("swift_demo")

@@ -21,8 +21,8 @@ from att_planner.nodes.client import check_strings, maneuver_request
 from att_planner.service.planning import plan_maneuver, run_method
 from att_planner.service.requests import MAX_CONES, MAX_OPTIONS, MAX_TARGETS, validate_schedule
 from att_planner.service.worker import run_isolated, warm_up
-from att_sim import rotations as rot
-from att_sim import scenario as scen
+from att_sim.models import rotations as rot
+from att_sim.models import scenario as scen
 from helpers.maneuver_requests import GOAL, INF, NAN, request, validate
 
 TINY = 5e-324                   # the smallest denormal

@@ -12,7 +12,7 @@ import pytest
 
 from att_msgs_py.errors import ErrorCode
 from att_planner.nodes.client import maneuver_request
-from att_sim import rotations as rot
+from att_sim.models import rotations as rot
 
 pytestmark = pytest.mark.ros
 

@@ -1,6 +1,6 @@
 """Hostile inputs to the simulator: actuator commands and resets, refused with a code and a sentence.
 
-The ROS-free cases drive :class:`~att_sim.simulation.Simulation` with the checks the simulator node
+The ROS-free cases drive :class:`~att_sim.truth.simulation.Simulation` with the checks the simulator node
 configures (stamps within one step ahead and ``command_timeout`` behind, the body frame, limits
 ``command_limit_factor`` x the actuator limits, reset rate ``max_reset_rate``). Each hostile input
 must be refused with its code and a sentence naming the field, and must change nothing: the state
@@ -26,9 +26,9 @@ from att_msgs.srv import ResetSimulator
 from att_msgs_py import convert, qos, topics
 from att_msgs_py.errors import ErrorCode
 from att_msgs_py.types import Command, ControlMode
-from att_sim import rotations as rot
-from att_sim import scenario
-from att_sim.simulation import Checks, Simulation
+from att_sim.models import rotations as rot
+from att_sim.models import scenario
+from att_sim.truth.simulation import Checks, Simulation
 
 SWIFT = scenario.load("swift_demo")
 SC = SWIFT.spacecraft

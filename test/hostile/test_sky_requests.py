@@ -16,8 +16,8 @@ from att_msgs_py.types import Zone
 from att_planner.nodes.client import maneuver_request
 from att_planner.service.real_sky import MAX_ZONES
 from att_planner.service.requests import validate_schedule
-from att_sim import rotations as rot
-from att_sim.orbit import tle_checksum
+from att_sim.models import rotations as rot
+from att_sim.models.orbit import tle_checksum
 from helpers.maneuver_requests import GOAL, INF, NAN, request, validate
 
 TLE = ("1 28485U          26355.00000000  .00000000  00000-0  20000-4 0    07",

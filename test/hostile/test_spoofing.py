@@ -17,7 +17,7 @@ from att_msgs_py import convert, qos, signing, topics
 from att_msgs_py.errors import ErrorCode
 from att_msgs_py.types import State
 from att_planner.nodes.client import maneuver_request
-from att_sim import rotations as rot
+from att_sim.models import rotations as rot
 
 pytestmark = pytest.mark.ros
 

@@ -38,7 +38,7 @@ from att_msgs.msg import (
 from att_msgs_py import qos, topics
 from att_msgs_py.errors import ErrorCode
 from att_planner.nodes.client import maneuver_request
-from att_sim import rotations as rot
+from att_sim.models import rotations as rot
 
 pytestmark = pytest.mark.ros
 

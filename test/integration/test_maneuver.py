@@ -16,7 +16,7 @@ from att_msgs_py.topics import COMMAND, PLANS, STATE
 from att_msgs_py.types import Cone, Stage, Status
 from att_planner.cones import margins
 from att_planner.nodes.client import maneuver_request
-from att_sim import rotations as rot
+from att_sim.models import rotations as rot
 
 pytestmark = pytest.mark.ros
 

@@ -16,9 +16,9 @@ from att_msgs_py.topics import MISSION_EVENTS, PLANS, STATE
 from att_msgs_py.types import MissionEventKind as Kind
 from att_planner.mission.targets import load as load_targets
 from att_planner.tools.review import review
-from att_sim import rotations as rot
-from att_sim import scenario as scen
-from att_sim.ephemeris import Sky
+from att_sim.models import rotations as rot
+from att_sim.models import scenario as scen
+from att_sim.models.ephemeris import Sky
 from helpers.missions import fly_written
 
 pytestmark = pytest.mark.ros

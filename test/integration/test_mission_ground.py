@@ -13,7 +13,7 @@ from att_msgs_py import convert
 from att_msgs_py.log import read_log
 from att_msgs_py.topics import MISSION_EVENTS, STATE
 from att_msgs_py.types import MissionEventKind as Kind
-from att_sim import rotations as rot
+from att_sim.models import rotations as rot
 from helpers.independent import site_sight
 from helpers.missions import fly_written
 

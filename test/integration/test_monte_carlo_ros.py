@@ -14,8 +14,8 @@ from att_msgs_py.log import read_log
 from att_msgs_py.topics import CONTROLLER_STATUS, SENSOR_TRUTH, STATE
 from att_planner.nodes.client import maneuver_request
 from att_planner.tools.monte_carlo.run import checked, loop_for
-from att_sim import dispersions as disp
-from att_sim import rotations as rot
+from att_sim.models import rotations as rot
+from att_sim.truth import dispersions as disp
 
 pytestmark = pytest.mark.ros
 

@@ -25,7 +25,7 @@ from att_msgs_py.log.repair import LogFileError, Scan, scan_records
 from att_msgs_py.types import ControlMode
 from att_planner.nodes.client import SuiteClient, maneuver_request
 from att_planner.tools.launch import Suite, isolated_env
-from att_sim import rotations as rot
+from att_sim.models import rotations as rot
 
 pytestmark = pytest.mark.ros
 

@@ -13,9 +13,9 @@ from scipy.spatial.transform import Rotation
 from att_msgs_py import topics
 from att_msgs_py.log import read_log
 from att_planner.nodes.client import maneuver_request
-from att_sim import rotations as rot
-from att_sim import scenario as scen
-from att_sim.world import Environment
+from att_sim.models import rotations as rot
+from att_sim.models import scenario as scen
+from att_sim.models.world import Environment
 
 SCENARIO = "leo_observatory"                    # GCRS, TLE orbit, Sun/Moon/Earth-limb keep-out zones on +y
 END = 6.0                                       # s of sim time

@@ -13,7 +13,7 @@ from att_msgs_py.errors import ErrorCode
 from att_msgs_py.log import read_log
 from att_msgs_py.topics import COMMAND, STATE
 from att_planner.reference.olivares_staffetti import olivares_targets
-from att_sim import rotations as rot
+from att_sim.models import rotations as rot
 
 pytestmark = pytest.mark.ros
 DWELL = 20.0                  # s held on target a

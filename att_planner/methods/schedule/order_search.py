@@ -17,8 +17,8 @@ from att_planner.methods.schedule.transcription import (
     cached_transcription,
 )
 from att_planner.problem import ManeuverProblem
-from att_sim import dynamics as dyn
-from att_sim import rotations as rot
+from att_sim.models import dynamics as dyn
+from att_sim.models import rotations as rot
 
 MAX_ORDERS_EXAMINED = 200_000     # orders the search may look at (windows can rule out many in a row)
 

@@ -12,7 +12,7 @@ from att_planner.methods.schedule.transcription import SUBSTEPS, eigenaxis_rest_
 from att_planner.problem import ManeuverProblem
 from att_planner.verification import rejection
 from att_planner.verification import verify as verify_plan
-from att_sim import rotations as rot
+from att_sim.models import rotations as rot
 
 METHOD = "schedule"
 MAX_SUBSTEPS = 8                  # RK4 steps per ZOH interval a refinement may reach

@@ -24,8 +24,8 @@ import casadi as ca
 import numpy as np
 
 from att_planner.methods import symbolic
-from att_sim import dynamics as dyn
-from att_sim import rotations as rot
+from att_sim.models import dynamics as dyn
+from att_sim.models import rotations as rot
 
 SUBSTEPS = 1              # RK4 steps per ZOH interval in the schedule NLPs (default everywhere)
 
@@ -36,7 +36,7 @@ class _Scaling:
     u = T_u / T̄ ∈ [−1, 1], time τ = t / t_sat with t_sat = h̄ / T̄ (so dh/dτ = u).
     ``rate_matrix`` W maps h to the body rate per unit τ, ω t_sat = W h (equation (1)).
     The NLP's wheel state is the relative speed ν = (Ω − Gᵀω) / Ω̄ = M h, M = 𝟙 + I_w Gᵀ J⁻¹ G
-    (by (1)), so the truth model's limit |ν| ≤ 1 (att_sim.dynamics) is a box on it: a row M h
+    (by (1)), so the truth model's limit |ν| ≤ 1 (att_sim.models.dynamics) is a box on it: a row M h
     next to the box on h, 2.5e-5 inside it for the Olivares spacecraft, left IPOPT nearly
     coincident barriers (in C's fast run one start took 975 iterations to Infeasible_Problem_Detected)."""
 
@@ -59,7 +59,7 @@ def _scaling(sc: dyn.Spacecraft) -> _Scaling:
 
 def _interval_map(scale: _Scaling, substeps: int) -> ca.Function:
     """One ZOH interval: (q, ν, u, dτ) -> (q⁺, ν⁺). ν is linear in τ (exact, dν/dτ = M u), q by
-    RK4 (:func:`att_sim.dynamics.rk4` on the CasADi expressions), ω t_sat = W M⁻¹ ν."""
+    RK4 (:func:`att_sim.models.dynamics.rk4` on the CasADi expressions), ω t_sat = W M⁻¹ ν."""
     n_w = scale.rate_matrix.shape[1]
     q, nu, u, dtau = ca.SX.sym("q", 4), ca.SX.sym("nu", n_w), ca.SX.sym("u", n_w), ca.SX.sym("dtau")
     W = ca.DM(np.linalg.solve(scale.relative.T, scale.rate_matrix.T).T)

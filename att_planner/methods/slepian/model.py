@@ -9,7 +9,7 @@ from scipy.signal.windows import dpss
 
 from att_planner.cones import BOUNDARY_TOLERANCE, SMOOTH_END_RAMP, boundary_end_zones, end_ramp
 from att_planner.problem import ManeuverProblem
-from att_sim import rotations as rot
+from att_sim.models import rotations as rot
 
 PAPER_M, PAPER_N, PAPER_W = 4, 500, 0.015
 METHODS = ("slepian_minimum_time", "mssa", "dfsp")

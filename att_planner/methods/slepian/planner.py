@@ -22,9 +22,9 @@ from att_planner.methods.slepian.model import (
 )
 from att_planner.methods.slepian.sqp import SlepianResult, slepian_result, solve_min_time_local, solve_mssa
 from att_planner.problem import ManeuverProblem
-from att_sim import dynamics as dyn
-from att_sim import rotations as rot
-from att_sim.dynamics import Spacecraft
+from att_sim.models import dynamics as dyn
+from att_sim.models import rotations as rot
+from att_sim.models.dynamics import Spacecraft
 
 DEFAULT_M = {"slepian_minimum_time": 8, "mssa": PAPER_M, "dfsp": PAPER_M}
 EXPLORE_N = 60          # samples of the coarse grid of the minimum-time multistart
@@ -217,7 +217,7 @@ def physical_profile(man: SmoothManeuver, alpha: np.ndarray, spacecraft: Spacecr
     never below the torque-limited one) or sqrt(J_s T*/T̄).
 
     The q/ω references at the knots are the rigid-body response to exactly this torque from rest
-    (one RK4 step per sample, :func:`att_sim.dynamics.simulate_profile`), so the controller tracks
+    (one RK4 step per sample, :func:`att_sim.models.dynamics.simulate_profile`), so the controller tracks
     what the torque does; the ZOH model attitudes R_k lead it by about half a sample.
     Without ``spacecraft`` the references are the model's R_k and ω*(τ_{k−1})/t_f.
     """

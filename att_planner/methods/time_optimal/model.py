@@ -15,7 +15,7 @@ from att_planner.methods.axis_rotations import time_unit
 from att_planner.methods.time_optimal import collocation as col
 from att_planner.problem import ManeuverProblem
 from att_planner.zones import clenshaw
-from att_sim import rotations as rot
+from att_sim.models import rotations as rot
 
 # Relative tightening of the rate and wheel-momentum bounds at the collocation points, so that
 # the truth trajectory between them stays within the bound itself.

@@ -59,7 +59,7 @@ from att_planner.methods.time_optimal.routes import Route, candidate_routes, rou
 from att_planner.methods.time_optimal.swarm import swarm_plan
 from att_planner.problem import ManeuverProblem
 from att_planner.verification import clearances, integrate, measure, rejection
-from att_sim import rotations as rot
+from att_sim.models import rotations as rot
 
 METHOD = "time_optimal"
 CONVERGED_VIOLATION = 1e-5      # an IPOPT answer counts as solved below this constraint violation

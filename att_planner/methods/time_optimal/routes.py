@@ -23,7 +23,7 @@ from att_planner.methods.time_optimal import collocation as col
 from att_planner.methods.time_optimal.model import BOUND_MARGIN, Scaling
 from att_planner.problem import ManeuverProblem
 from att_planner.verification import clearances
-from att_sim import rotations as rot
+from att_sim.models import rotations as rot
 
 
 @dataclass

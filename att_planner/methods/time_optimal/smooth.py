@@ -39,7 +39,7 @@ from att_planner.methods.time_optimal.model import Scaling, rigid_body_dynamics,
 from att_planner.methods.time_optimal.planner import CONVERGED_VIOLATION, _truth_violation_intervals
 from att_planner.problem import ManeuverProblem
 from att_planner.verification import integrate, measure, rejection
-from att_sim import rotations as rot
+from att_sim.models import rotations as rot
 
 METHOD = "smooth_collocation"
 DEFAULT_INTERVALS = 30

@@ -23,7 +23,7 @@ import numpy as np
 from att_msgs_py.types import Plan
 from att_planner.methods.time_optimal.model import Scaling
 from att_planner.problem import ManeuverProblem
-from att_sim import rotations as rot
+from att_sim.models import rotations as rot
 
 DEGREE = 4            # Chebyshev polynomials T_0 … T_DEGREE per axis
 STEPS = 48            # ZOH torque steps (RK4, one per step)

@@ -22,7 +22,7 @@ from att_planner.methods.constrained_axis import plan_constrained_axis
 from att_planner.methods.time_optimal import plan_time_optimal
 from att_planner.reference.time_optimal_cases import BOUNDARY_CASES, PUBLISHED, boundary_problem
 from att_planner.verification import rejection, verify
-from att_sim import rotations as rot
+from att_sim.models import rotations as rot
 
 # Cone axes (body) spanning the torque box's fundamental triangle (z, the xz diagonal, the cube
 # diagonal) and its centre; the sensor turned about each by SWEEP_ROLLS.

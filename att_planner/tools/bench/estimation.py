@@ -36,8 +36,8 @@ from att_planner.tools.demo import maneuver_from_scenario, request_and_execute, 
 from att_planner.tools.launch import isolated_env, join_env, start_suite
 from att_planner.tools.review.estimation import TOPICS, estimation_of, estimation_summary
 from att_planner.tools.review.run import extract_run
-from att_sim import rotations as rot
-from att_sim import scenario as scen
+from att_sim.models import rotations as rot
+from att_sim.models import scenario as scen
 
 FIGURES = ("attitude_error_rms_arcsec", "attitude_error_max_arcsec", "bias_error_final_deg_per_h", "nees_mean",
            "final_pointing_error_deg", "final_pointing_sigmas", "pointing_bound_deg", "min_cone_margin_deg",

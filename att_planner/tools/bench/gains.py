@@ -4,7 +4,7 @@
 orbits in ≤ 60 s). ``--mode robust``: min-max over H (target: a thorough worst case no worse than
 the published robust gains' under the same check, in ≤ 600 s). Every figure in the table is
 re-measured here: the settling times at ICs (20), (22), (23) with the reference step, the
-returned gains through the truth path (att_sim.dynamics stepping), and in robust mode the thorough
+returned gains through the truth path (att_sim.models.dynamics stepping), and in robust mode the thorough
 independent search over H (same call, same seed, for our gains and the published ones).
 
 JSON: ``{"mode", "kp", "kd", "ts", "worst_ic", "evaluations", "solve_seconds"}`` — ``ts`` is the

@@ -39,8 +39,8 @@ from att_planner.tools.closed_loop import ClosedLoop
 from att_planner.tools.launch import isolated_env, join_env, start_suite
 from att_planner.tools.loop_log import open_loop_log
 from att_planner.tools.review.pointing import SATURATED, TOPICS, pointing_of, pointing_summary
-from att_sim import scenario as scen
-from att_sim import world
+from att_sim.models import scenario as scen
+from att_sim.models import world
 
 NODES = ("recorder", "simulator", "controller")
 SETTLE = 600.0             # s after the pointing starts before its error counts (the start transient)

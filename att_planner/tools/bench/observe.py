@@ -19,7 +19,7 @@ from att_planner.methods import schedule as sch
 from att_planner.mission import targets as tl
 from att_planner.tools.bench import sky
 from att_planner.verification import rejection
-from att_sim import scenario as scen
+from att_sim.models import scenario as scen
 
 DEFAULT_SOURCES = ("crab_nebula", "m87", "vega", "andromeda")
 

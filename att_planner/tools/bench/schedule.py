@@ -17,7 +17,7 @@ import numpy as np
 from att_planner.methods import schedule as sch
 from att_planner.reference import olivares_staffetti as ref
 from att_planner.verification import rejection
-from att_sim import rotations as rot
+from att_sim.models import rotations as rot
 
 
 def configure(parser) -> None:

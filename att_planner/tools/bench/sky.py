@@ -54,11 +54,11 @@ from att_planner.problem import ManeuverProblem
 from att_planner.service.planning import plan_maneuver, run_method
 from att_planner.service.requests import ValidRequest
 from att_planner.verification import integrate, rejection
-from att_sim import rotations as rot
-from att_sim.dynamics import Spacecraft
-from att_sim.ephemeris import Sky
-from att_sim.epoch import format_epoch, parse_epoch
-from att_sim.orbit import TLEOrbit
+from att_sim.models import rotations as rot
+from att_sim.models.dynamics import Spacecraft
+from att_sim.models.ephemeris import Sky
+from att_sim.models.epoch import format_epoch, parse_epoch
+from att_sim.models.orbit import TLEOrbit
 
 EARTH_OBS_J = (3000.0, 4500.0, 6000.0)      # kg m², principal (smooth benchmark, Celani & Bruni 2021)
 EARTH_OBS_TORQUE = 0.25                     # N m per body axis

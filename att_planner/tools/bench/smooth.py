@@ -19,7 +19,7 @@ import numpy as np
 from att_planner.methods import slepian as S
 from att_planner.reference.celani_bruni import CASES, PUBLISHED, benchmark_problem
 from att_planner.verification import integrate, measure, rejection
-from att_sim import rotations as rot
+from att_sim.models import rotations as rot
 
 UNITS = {"earth_obs": "s", "swift": "TU"}
 PUBLISHED_KEY = {"slepian_minimum_time": None, "mssa": "mssa", "dfsp": "dfsp"}

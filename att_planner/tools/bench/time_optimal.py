@@ -22,7 +22,7 @@ from att_planner.methods.time_optimal import plan_time_optimal
 from att_planner.reference.time_optimal_cases import BOUNDARY_CASES, CASES, PUBLISHED, case_problem
 from att_planner.tools.bench import boundary
 from att_planner.verification import rejection, verify
-from att_sim import rotations as rot
+from att_sim.models import rotations as rot
 
 METHODS = {"eigenaxis": plan_eigenaxis, "constrained_axis": plan_constrained_axis,
            "time_optimal": plan_time_optimal}

@@ -5,7 +5,7 @@
     att-mc rerun campaigns/swift_demo.yaml SEED --mcap run.mcap           # one run's full log
 
 The plan is made once on the nominal model (:func:`~att_planner.tools.closed_loop.plan_in_process`),
-then every run flies it on its dispersed truth (:mod:`att_sim.dispersions`,
+then every run flies it on its dispersed truth (:mod:`att_sim.truth.dispersions`,
 :mod:`~att_planner.tools.monte_carlo.run`) on a Dask cluster
 (:mod:`~att_planner.tools.monte_carlo.cluster`), rows streamed back with a progress bar. Ctrl-C
 stops the campaign and writes the report of the runs that finished. Writes the table (CSV), the
@@ -26,7 +26,7 @@ from att_planner.tools.monte_carlo import report
 from att_planner.tools.monte_carlo.cluster import ClusterError, client_for, local_workers, stream
 from att_planner.tools.monte_carlo.run import checked, planned
 from att_planner.tools.tune import ProgressBar
-from att_sim import dispersions as disp
+from att_sim.truth import dispersions as disp
 
 MAX_WORKERS = 1024
 

@@ -1,5 +1,5 @@
 """One run of a Monte Carlo campaign: the plan made once on the nominal model, flown on the run's
-dispersed truth (:mod:`att_sim.dispersions`) by :class:`~att_planner.tools.closed_loop.ClosedLoop`
+dispersed truth (:mod:`att_sim.truth.dispersions`) by :class:`~att_planner.tools.closed_loop.ClosedLoop`
 — the simulator, estimator and controller cores the nodes run — and judged as the planner judges
 its plans (:func:`att_planner.verification.rejection` with :data:`~att_planner.verification.TOLERANCES`)
 on the flown truth.
@@ -31,12 +31,12 @@ from att_planner.estimation.lockstep import reprocess_together
 from att_planner.tools.closed_loop import ClosedLoop, Reprocessing, plan_in_process
 from att_planner.tools.demo import maneuver_from_scenario, zone_margins
 from att_planner.verification import rejection
-from att_sim import dispersions as disp
-from att_sim import rotations as rot
-from att_sim import scenario as scen
-from att_sim.dispersions import DEG
-from att_sim.lockstep import Lockstep
-from att_sim.simulation import Checks, Simulation
+from att_sim.models import rotations as rot
+from att_sim.models import scenario as scen
+from att_sim.truth import dispersions as disp
+from att_sim.truth.dispersions import DEG
+from att_sim.truth.lockstep import Lockstep
+from att_sim.truth.simulation import Checks, Simulation
 
 OUTCOMES = ("success", "code", "final_error_deg", "final_rate", "min_margin_deg", "peak_wheel_ratio",
             "peak_torque_ratio", "settling_time", "start_time", "cpu_seconds", "reason")
@@ -142,12 +142,12 @@ class _Flight:
 def fly_together(setup: Setup, runs: list[tuple[int, int]], tap=None) -> list[dict]:
     """The rows of ``(run, seed)`` pairs (applied values and outcomes, :data:`OUTCOMES`), flown in
     lockstep: each run converges, then flies the plan, as it would alone; at each step the runs'
-    gyros measure together (:meth:`Lockstep.sense <att_sim.lockstep.Lockstep.sense>`), their
+    gyros measure together (:meth:`Lockstep.sense <att_sim.truth.lockstep.Lockstep.sense>`), their
     estimators reprocess together (:func:`~att_planner.estimation.lockstep.reprocess_together`:
     their propagations as one stack), their controllers share the plan's reference (one plan object,
     issued once with the loops' one key: :class:`~att_planner.control.tracking.ReferenceMemo`) and
     compute its tracking law as rows (:func:`~att_planner.control.lockstep.track_together`), and
-    the simulations of the runs still going advance together (:class:`att_sim.lockstep.Lockstep`) —
+    the simulations of the runs still going advance together (:class:`att_sim.truth.lockstep.Lockstep`) —
     every run to the bits it reaches alone. ``cpu_seconds``: the group's CPU time shared equally.
     ``tap``: see :attr:`ClosedLoop.tap` (a full log; one run)."""
     cpu = time.process_time()

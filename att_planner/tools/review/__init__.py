@@ -34,7 +34,7 @@ duration) and the settle and hold on its final attitude after it; the peak body 
 against the planning limit ``torque_max`` and the actuator (wheel) limit, and only the latter is
 flagged when exceeded (:func:`.summary.notes`).
 
-Limits come from the scenario named by the plan (``att_sim.scenario.load(plan.spacecraft)``) or
+Limits come from the scenario named by the plan (``att_sim.models.scenario.load(plan.spacecraft)``) or
 ``--scenario``; so do the epoch and orbit the moving zones are placed with: the simulator's, whose
 sim time zero is the scenario's epoch (:func:`.summary.zone_sky_for`; a scenario without an epoch
 flew no real sky, and its moving zones are left out with a note). Modules: :mod:`.run` (the

@@ -23,7 +23,7 @@ import numpy as np
 from att_msgs_py.log import TopicLog
 from att_msgs_py.topics import ESTIMATE, IMU, MAGNETOMETER, SENSOR_TRUTH, STAR_TRACKER, STATE
 from att_msgs_py.types import Health, TrackerStatus
-from att_sim import rotations as rot
+from att_sim.models import rotations as rot
 
 TOPICS = [STATE, ESTIMATE, SENSOR_TRUTH, STAR_TRACKER, IMU, MAGNETOMETER]
 ARCSEC = math.degrees(1.0) * 3600.0          # arcsec per rad

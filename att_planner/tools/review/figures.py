@@ -15,8 +15,8 @@ from att_planner.control import tracking
 from att_planner.tools.review.run import MODE_NAMES, Run, reference_error
 from att_planner.tools.review.summary import body_torque_limits, finite_limit
 from att_planner.zones import ZoneSky, same_axis
-from att_sim import rotations as rot
-from att_sim.dynamics import Spacecraft
+from att_sim.models import rotations as rot
+from att_sim.models.dynamics import Spacecraft
 
 
 def _basis(center: np.ndarray):

@@ -24,9 +24,9 @@ from att_msgs_py.types import MissionEventKind as Kind
 from att_planner.mission.day import events_of, mission_zones, target_table
 from att_planner.tools.review.run import MODE_NAMES
 from att_planner.zones import ZoneSky
-from att_sim import rotations as rot
-from att_sim import scenario as scen
-from att_sim.ephemeris import Sky
+from att_sim.models import rotations as rot
+from att_sim.models import scenario as scen
+from att_sim.models.ephemeris import Sky
 
 TOPICS = [STATE, CONTROLLER_STATUS, MISSION_EVENTS]
 SKY_SAMPLES = 2000                 # points of each track on the sky plot

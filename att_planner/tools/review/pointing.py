@@ -20,7 +20,7 @@ from att_msgs_py.log import TopicLog
 from att_msgs_py.topics import COMMAND, CONTROLLER_STATUS, STATE
 from att_msgs_py.types import ControlMode
 from att_planner.tools.review.run import MODE_NAMES
-from att_sim.dynamics import Spacecraft
+from att_sim.models.dynamics import Spacecraft
 
 TOPICS = [STATE, COMMAND, CONTROLLER_STATUS]
 SATURATED = 0.999                  # of the wheel speed limit: a wheel at its limit

@@ -10,7 +10,7 @@ from att_msgs_py.log import TopicLog
 from att_msgs_py.topics import COMMAND, PLANS, STATE
 from att_msgs_py.types import ControlMode, Plan
 from att_planner.control import tracking
-from att_sim import rotations as rot
+from att_sim.models import rotations as rot
 
 MODE_NAMES = {ControlMode.IDLE: "idle", ControlMode.MAGNETORQUER_PD: "magnetorquer PD",
               ControlMode.PLAN_TRACKING: "plan tracking", ControlMode.SAFE: "safe", ControlMode.POINTING: "pointing"}

@@ -11,11 +11,11 @@ from att_msgs_py.log import TopicLog
 from att_planner.tools.review.run import SETTLING_THRESHOLD, Run, extract_run, settling_time
 from att_planner.verification import peak_magnitude
 from att_planner.zones import ZoneSky, zones_from_cones
-from att_sim import rotations as rot
-from att_sim import scenario as scen
-from att_sim.dynamics import Spacecraft
-from att_sim.ephemeris import Sky
-from att_sim.epoch import format_epoch
+from att_sim.models import rotations as rot
+from att_sim.models import scenario as scen
+from att_sim.models.dynamics import Spacecraft
+from att_sim.models.ephemeris import Sky
+from att_sim.models.epoch import format_epoch
 
 
 def _ratio(peak: float, limit: float | None):

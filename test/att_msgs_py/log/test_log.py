@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 from att_msgs_py.log import LogWriter, iter_records, read_log
-from att_sim import rotations as rot
+from att_sim.models import rotations as rot
 from helpers.regression_log import CHANNEL_TYPES, FIXTURE, GOAL, STATE_FIELDS, TOPIC_TYPES
 
 

@@ -11,11 +11,11 @@ from att_msgs_py.types import Cone, ControlKind, ControlMode, Plan, Status, Zone
 from att_planner.control.controller import Controller, ControllerConfig
 from att_planner.methods.eigenaxis import plan_eigenaxis_smooth
 from att_planner.problem import ManeuverProblem
-from att_sim import rotations as rot
-from att_sim import scenario
-from att_sim.ephemeris import Sky
-from att_sim.orbit import CircularOrbit
-from att_sim.simulation import Simulation
+from att_sim.models import rotations as rot
+from att_sim.models import scenario
+from att_sim.models.ephemeris import Sky
+from att_sim.models.orbit import CircularOrbit
+from att_sim.truth.simulation import Simulation
 from helpers.signed_plans import context, issue
 
 GOAL = rot.from_axis_angle([0.3, -0.5, 1.0], 1.2)

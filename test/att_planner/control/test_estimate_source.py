@@ -20,8 +20,8 @@ from att_planner.control.controller import Controller, ControllerConfig
 from att_planner.control.measured_state import MeasuredState
 from att_planner.methods.eigenaxis import plan_eigenaxis_smooth
 from att_planner.problem import ManeuverProblem
-from att_sim import rotations as rot
-from att_sim import scenario
+from att_sim.models import rotations as rot
+from att_sim.models import scenario
 from helpers.signed_plans import context, issue
 
 SWIFT = scenario.load("swift_demo")

@@ -16,9 +16,9 @@ from att_planner.guidance.modes import law_of
 from att_planner.methods.eigenaxis import plan_eigenaxis_smooth
 from att_planner.problem import ManeuverProblem
 from att_planner.tools.closed_loop import ClosedLoop, plan_in_process
-from att_sim import rotations as rot
-from att_sim import scenario as scen
-from att_sim import world
+from att_sim.models import rotations as rot
+from att_sim.models import scenario as scen
+from att_sim.models import world
 
 SWIFT = scen.load("swift_demo")
 

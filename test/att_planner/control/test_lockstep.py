@@ -11,9 +11,9 @@ from att_planner.control.controller import Controller, ControllerConfig
 from att_planner.control.lockstep import track_together, tracked_reference
 from att_planner.methods.eigenaxis import plan_eigenaxis_smooth
 from att_planner.problem import ManeuverProblem
-from att_sim import rotations as rot
-from att_sim import scenario
-from att_sim.simulation import Simulation
+from att_sim.models import rotations as rot
+from att_sim.models import scenario
+from att_sim.truth.simulation import Simulation
 from helpers.signed_plans import context, issue
 
 

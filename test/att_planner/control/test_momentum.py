@@ -13,11 +13,11 @@ from att_planner.control import momentum, tracking
 from att_planner.control.controller import Controller, ControllerConfig
 from att_planner.control.plan_checks import PlanContext
 from att_planner.guidance.laws import Sky
-from att_sim import dynamics as dyn
-from att_sim import rotations as rot
-from att_sim import scenario as scen
-from att_sim import world
-from att_sim.simulation import Simulation
+from att_sim.models import dynamics as dyn
+from att_sim.models import rotations as rot
+from att_sim.models import scenario as scen
+from att_sim.models import world
+from att_sim.truth.simulation import Simulation
 from helpers.signed_plans import KEY
 
 PYRAMID = np.array([[1, 1, 1], [-1, 1, 1], [-1, -1, 1], [1, -1, 1]], float).T / math.sqrt(3.0)

@@ -8,9 +8,9 @@ from att_msgs_py.types import Command, ControlMode
 from att_planner.control import tracking
 from att_planner.methods.eigenaxis import plan_eigenaxis, plan_eigenaxis_smooth
 from att_planner.problem import ManeuverProblem
-from att_sim import rotations as rot
-from att_sim import scenario
-from att_sim.simulation import Simulation
+from att_sim.models import rotations as rot
+from att_sim.models import scenario
+from att_sim.truth.simulation import Simulation
 
 
 @pytest.fixture

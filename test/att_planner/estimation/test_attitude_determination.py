@@ -9,7 +9,7 @@ import pytest
 from scipy.stats import chi2
 
 from att_planner.estimation.attitude_determination import quest, sun_vector, triad
-from att_sim import rotations as rot
+from att_sim.models import rotations as rot
 
 RNG = np.random.default_rng(2026)
 

@@ -20,8 +20,8 @@ from att_msgs_py.types import (
 from att_planner.estimation.estimator import Estimator, EstimatorConfig
 from att_planner.estimation.inputs import Sources
 from att_planner.estimation.lockstep import reprocess_together
-from att_sim import rotations as rot
-from att_sim.sensors.specs import (
+from att_sim.models import rotations as rot
+from att_sim.models.sensor_specs import (
     ARCSEC,
     DEG,
     HOUR,
@@ -31,7 +31,7 @@ from att_sim.sensors.specs import (
     StarTrackerSpec,
     SunSensorSpec,
 )
-from att_sim.world import Bodies
+from att_sim.models.world import Bodies
 
 MOUNT = rot.from_axis_angle([0, 1, 0], 0.5)
 GYRO = GyroSpec(rate=20.0, arw=0.01 * DEG / math.sqrt(HOUR), rrw=0.01 * DEG / HOUR / math.sqrt(HOUR),

@@ -15,11 +15,11 @@ from scipy.stats import chi2
 from att_msgs_py.types import GyroMeasurement
 from att_planner.estimation import mekf
 from att_planner.estimation.estimator import Estimator, EstimatorConfig
-from att_sim import rotations as rot
-from att_sim.sensors.gyro import Gyro
-from att_sim.sensors.specs import ARCSEC, DEG, HOUR, GyroSpec, SensorSpecs, StarTrackerSpec
-from att_sim.sensors.star_tracker import StarTracker
-from att_sim.world import Bodies
+from att_sim.models import rotations as rot
+from att_sim.models.sensor_specs import ARCSEC, DEG, HOUR, GyroSpec, SensorSpecs, StarTrackerSpec
+from att_sim.models.world import Bodies
+from att_sim.truth.sensors.gyro import Gyro
+from att_sim.truth.sensors.star_tracker import StarTracker
 
 RUNS = 50
 SKY = Bodies(np.array([7e6, 0.0, 0.0]), np.zeros(3), np.array([-1.0, 0.0, 0.0]), 1.0, None, None, 1.0)

@@ -14,9 +14,9 @@ from att_msgs_py.types import PointingMode
 from att_planner.guidance import reference
 from att_planner.guidance.laws import Sky, two_vector_attitude
 from att_planner.guidance.modes import law_of
-from att_sim import rotations as rot
-from att_sim import scenario as scen
-from att_sim import world
+from att_sim.models import rotations as rot
+from att_sim.models import scenario as scen
+from att_sim.models import world
 
 SWIFT = scen.load("swift_demo")
 LEO = scen.load("leo_observatory")
@@ -74,8 +74,8 @@ def test_ground_target_line_of_sight_is_skyfields():
     WGS-84 position and its EarthSatellite (another path than the suite's ITRS table)."""
     from skyfield.api import wgs84
 
-    from att_sim.ephemeris import de421
-    from att_sim.epoch import skyfield_times
+    from att_sim.models.ephemeris import de421
+    from att_sim.models.epoch import skyfield_times
 
     lat, lon, alt = math.radians(-15.8), math.radians(-47.9), 1100.0
     sky = sky_of(LEO)

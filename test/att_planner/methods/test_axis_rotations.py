@@ -6,8 +6,8 @@ from att_msgs_py.types import Status
 from att_planner.methods.constrained_axis import plan_constrained_axis
 from att_planner.methods.eigenaxis import plan_eigenaxis
 from att_planner.problem import ManeuverProblem
-from att_sim import rotations as rot
-from att_sim.dynamics import Spacecraft
+from att_sim.models import rotations as rot
+from att_sim.models.dynamics import Spacecraft
 from helpers.truth import truth_check
 
 

@@ -14,8 +14,8 @@ from att_planner.problem import ManeuverProblem
 from att_planner.reference.celani_bruni import benchmark_problem
 from att_planner.tools.bench.sky import case_problem
 from att_planner.verification import rejection, verify
-from att_sim import rotations as rot
-from att_sim.dynamics import Spacecraft
+from att_sim.models import rotations as rot
+from att_sim.models.dynamics import Spacecraft
 
 
 def test_arc_extremes_are_those_of_the_sampled_arc():

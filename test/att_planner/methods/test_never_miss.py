@@ -24,7 +24,7 @@ from att_planner.reference.celani_bruni import benchmark_problem
 from att_planner.service.planning import plan_maneuver, run_method
 from att_planner.service.requests import ValidRequest
 from att_planner.verification import rejection, verify
-from att_sim import rotations as rot
+from att_sim.models import rotations as rot
 
 pytestmark = pytest.mark.slow
 SETS = range(24)

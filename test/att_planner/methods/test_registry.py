@@ -13,7 +13,7 @@ from att_msgs_py.errors import ErrorCode, RequestError
 from att_planner import methods
 from att_planner.service.planning import plan_maneuver, run_method
 from att_planner.service.requests import ManeuverRequest, validate_maneuver
-from att_sim import rotations as rot
+from att_sim.models import rotations as rot
 
 BUDGET = 2.0        # s per request: the corners are about running at all, not about the best plan
 

@@ -11,7 +11,7 @@ from att_planner.methods.schedule.order_search import tour_bound, visibility
 from att_planner.methods.schedule.planner import zone_window
 from att_planner.reference import olivares_staffetti as ref
 from att_planner.verification import integrate, rejection
-from att_sim import rotations as rot
+from att_sim.models import rotations as rot
 from helpers.skies import DescendingSky
 
 GRID = 6

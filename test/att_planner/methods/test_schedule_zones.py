@@ -10,7 +10,7 @@ from att_msgs_py.types import Cone, Status, Zone
 from att_planner.methods import schedule as sch
 from att_planner.reference import olivares_staffetti as ref
 from att_planner.verification import integrate, rejection, verify
-from att_sim import rotations as rot
+from att_sim.models import rotations as rot
 from helpers.skies import DescendingSky
 
 GRID = 10

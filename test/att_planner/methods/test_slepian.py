@@ -13,8 +13,8 @@ from att_planner.methods import slepian as S
 from att_planner.problem import ManeuverProblem
 from att_planner.reference.celani_bruni import CASES, benchmark_problem
 from att_planner.verification import integrate, measure
-from att_sim import rotations as rot
-from att_sim.dynamics import Spacecraft
+from att_sim.models import rotations as rot
+from att_sim.models.dynamics import Spacecraft
 
 N_SMALL, W_SMALL = 120, 7.5 / 120      # same time-bandwidth product as the paper's N = 500, W = 0.015
 

@@ -13,8 +13,8 @@ from att_planner.problem import ManeuverProblem
 from att_planner.reference.celani_bruni import benchmark_problem
 from att_planner.verification import rejection, verify
 from att_planner.zones import zones_from_cones
-from att_sim import rotations as rot
-from att_sim.dynamics import Spacecraft
+from att_sim.models import rotations as rot
+from att_sim.models.dynamics import Spacecraft
 
 N_SMALL, W_SMALL = 120, 7.5 / 120      # same time-bandwidth product as the paper's N = 500, W = 0.015
 X, Y, Z = np.eye(3)

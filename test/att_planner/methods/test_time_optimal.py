@@ -16,7 +16,7 @@ from att_planner.methods.time_optimal import collocation as col
 from att_planner.methods.time_optimal import mesh as meshes
 from att_planner.methods.time_optimal import model, plan_time_optimal
 from att_planner.reference.time_optimal_cases import case_problem
-from att_sim import rotations as rot
+from att_sim.models import rotations as rot
 from helpers.truth import truth_check
 
 VALID = (Status.OPTIMAL, Status.FEASIBLE)

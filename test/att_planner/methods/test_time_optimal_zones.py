@@ -22,8 +22,8 @@ from att_planner.methods.time_optimal.model import (
 )
 from att_planner.problem import ManeuverProblem
 from att_planner.verification import rejection, verify
-from att_sim import rotations as rot
-from att_sim.dynamics import Spacecraft
+from att_sim.models import rotations as rot
+from att_sim.models.dynamics import Spacecraft
 
 VALID = (Status.OPTIMAL, Status.FEASIBLE)
 TU = 50.0                                   # s: J = TU² I with T̄ = 1 N m, so 1 TU = 50 s

@@ -11,8 +11,8 @@ from att_msgs_py.types import MissionEvent, MissionEventKind
 from att_planner.mission.day import target_table
 from att_planner.mission.ground import GroundTrack, site_mode
 from att_planner.mission.targets import Site, pointing_attitude
-from att_sim import rotations as rot
-from att_sim import scenario as scen
+from att_sim.models import rotations as rot
+from att_sim.models import scenario as scen
 
 EPOCH = datetime(2026, 12, 21, tzinfo=UTC)
 SCENARIO = scen.load("leo_observatory")                     # its epoch is EPOCH

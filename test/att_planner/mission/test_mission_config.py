@@ -7,7 +7,7 @@ import pytest
 
 from att_msgs_py.errors import ConfigError, ErrorCode
 from att_planner.mission import config as mc
-from att_sim import rotations as rot
+from att_sim.models import rotations as rot
 
 GOOD = {"targets": "observatory", "sensor_axis": [0.0, 1.0, 0.0], "horizon_s": 3600}
 

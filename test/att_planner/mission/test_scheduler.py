@@ -8,8 +8,8 @@ import pytest
 
 from att_planner.mission import targets as tl
 from att_planner.mission.scheduler import MissionScheduler, MissionTarget, slew_estimate
-from att_sim import rotations as rot
-from att_sim import scenario as scen
+from att_sim.models import rotations as rot
+from att_sim.models import scenario as scen
 
 HORIZON = 6 * 3600.0
 SENSOR = np.array([0.0, 1.0, 0.0])                 # leo_observatory's zones are of sensor +y

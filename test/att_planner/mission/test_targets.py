@@ -9,7 +9,7 @@ from att_msgs_py.errors import ConfigError, ErrorCode
 from att_planner.methods.schedule.order_search import visibility
 from att_planner.mission import targets as tl
 from att_planner.tools.bench import sky
-from att_sim import rotations as rot
+from att_sim.models import rotations as rot
 
 
 def test_the_shipped_lists_load():

@@ -20,8 +20,8 @@ from att_planner.service import planning
 from att_planner.service.planning import plan_maneuver, prepare, run_method
 from att_planner.service.requests import MAX_CONES, ManeuverRequest, validate_maneuver
 from att_planner.service.worker import run_isolated, warm_up
-from att_sim import rotations as rot
-from att_sim import scenario as scen
+from att_sim.models import rotations as rot
+from att_sim.models import scenario as scen
 
 BUDGET = 0.5            # s
 GRACE = 1.0             # s an answer may come after the budget

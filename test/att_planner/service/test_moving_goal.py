@@ -18,9 +18,9 @@ from att_planner.service.moving_goal import goal_law
 from att_planner.service.planning import plan_maneuver
 from att_planner.service.requests import ManeuverRequest, validate_maneuver
 from att_planner.service.worker import run_isolated, warm_up
-from att_sim import rotations as rot
-from att_sim import scenario as scen
-from att_sim import world
+from att_sim.models import rotations as rot
+from att_sim.models import scenario as scen
+from att_sim.models import world
 
 LEO = scen.load("leo_momentum")
 NADIR = PointingMode("nadir")

@@ -15,7 +15,7 @@ from att_planner.methods import Method
 from att_planner.service.planning import plan_maneuver, run_method
 from att_planner.service.worker import run_isolated, warm_up
 from att_planner.verification import TOLERANCES
-from att_sim import rotations as rot
+from att_sim.models import rotations as rot
 from helpers.maneuver_requests import EARTH, request, validate
 
 

@@ -8,7 +8,7 @@ import pytest
 
 from att_msgs_py.errors import ErrorCode, RequestError
 from att_planner.service.requests import MAX_CONES
-from att_sim import rotations as rot
+from att_sim.models import rotations as rot
 from helpers.maneuver_requests import INF, NAN, request, validate
 
 BAD_REQUESTS = {

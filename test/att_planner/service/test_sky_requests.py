@@ -21,10 +21,10 @@ from att_planner.tools.review.figures import figure_sky
 from att_planner.tools.review.run import Run
 from att_planner.tools.review.summary import summary_of, zone_sky_for
 from att_planner.zones import ZoneSky
-from att_sim import rotations as rot
-from att_sim import scenario as scen
-from att_sim.ephemeris import Sky
-from att_sim.orbit import TLEOrbit
+from att_sim.models import rotations as rot
+from att_sim.models import scenario as scen
+from att_sim.models.ephemeris import Sky
+from att_sim.models.orbit import TLEOrbit
 from helpers.maneuver_requests import EARTH, SUN, request, validate
 
 TLE = ("1 28485U          26355.00000000  .00000000  00000-0  20000-4 0    07",

@@ -14,8 +14,8 @@ from att_planner.problem import ManeuverProblem
 from att_planner.service.wheels import smallest_slowdown, time_scaled
 from att_planner.tools.closed_loop import plan_in_process
 from att_planner.verification import body_plan_wheel_speeds, integrate, verify
-from att_sim import rotations as rot
-from att_sim import scenario as scen
+from att_sim.models import rotations as rot
+from att_sim.models import scenario as scen
 from helpers.own_rk4 import integrate as own_rk4
 
 SLEW = rot.from_axis_angle([0, 0, 1], math.radians(90))

@@ -12,8 +12,8 @@ import pytest
 from att_msgs_py.types import Health, TrackerStatus
 from att_planner.tools.closed_loop import ClosedLoop, plan_in_process
 from att_planner.tools.demo import maneuver_from_scenario, zone_margins
-from att_sim import rotations as rot
-from att_sim import scenario as scen
+from att_sim.models import rotations as rot
+from att_sim.models import scenario as scen
 
 SWIFT = scen.load("swift_demo")
 

@@ -21,7 +21,7 @@ from att_msgs_py.topics import COMMAND, ESTIMATE, IMU, PLANS, STAR_TRACKER, STAT
 from att_planner.tools.monte_carlo import report
 from att_planner.tools.monte_carlo import run as run_module
 from att_planner.tools.monte_carlo.run import checked, fly, fly_together, planned
-from att_sim import dispersions as disp
+from att_sim.truth import dispersions as disp
 
 DATA = Path(__file__).resolve().parents[2] / "data"
 CAMPAIGN = DATA / "campaigns" / "short.yaml"

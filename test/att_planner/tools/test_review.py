@@ -15,9 +15,9 @@ from att_planner.cones import margins
 from att_planner.tools.review import extract_run, format_summary, settling_time, summarize
 from att_planner.tools.review import main as review_main
 from att_planner.tools.review.summary import body_torque_limits
-from att_sim import rotations as rot
-from att_sim import scenario as scen
-from att_sim.dynamics import Spacecraft
+from att_sim.models import rotations as rot
+from att_sim.models import scenario as scen
+from att_sim.models.dynamics import Spacecraft
 from helpers.regression_log import FIXTURE, GOAL, TOPIC_TYPES
 
 FIXTURE_SETTLE_TIME = 5.0          # the controller's settle_time when the fixture was recorded (make_fixture.py)

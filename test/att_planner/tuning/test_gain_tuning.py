@@ -11,9 +11,9 @@ from att_planner.control.magnetorquer import control_torque, dipole_command
 from att_planner.reference.bruni_celani import PUBLISHED_GAINS, PUBLISHED_ICS, robust_seeds
 from att_planner.tools import tune as tune_cli
 from att_planner.tuning.settling import _BatchModel
-from att_sim import dynamics as dyn
-from att_sim import environment as env
-from att_sim import rotations as rot
+from att_sim.models import dynamics as dyn
+from att_sim.models import environment as env
+from att_sim.models import rotations as rot
 
 CASE = gt.MagnetorquerCase()
 
@@ -89,7 +89,7 @@ def test_published_ic20_figures_reproduce():
 
 
 def test_batch_integration_agrees_with_truth_dynamics_stepping():
-    """Same gains and ICs through att_sim.dynamics.step with every input held over each 1 s step
+    """Same gains and ICs through att_sim.models.dynamics.step with every input held over each 1 s step
     (the simulator's scheme before the per-stage environment of issue 13) and through the batch RK4
     (inputs evaluated at the RK4 stages): after
     400 s of tumbling the states differ only by the hold's first-order effect (< 0.3°)."""

@@ -1,0 +1,80 @@
+"""Actuator datasheets of a scenario: the ``actuators`` group, in datasheet units, converted once to SI.
+
+A scenario's ``/**`` section may hold (datasheet units; every key optional)::
+
+    actuators:
+      wheels: {coulomb_friction_Nm, viscous_friction_Nm_s, friction_speed_rad_s,
+               torque_quantization_Nm, torque_noise_Nm, power_max_W}
+      magnetorquers: {quantization_Am2, misalignment_deg}
+
+The datasheets are shared: the truth's imperfect actuators (:mod:`att_sim.truth.actuators`) apply
+them, and the flight software compensates the friction it expects from them
+(:meth:`WheelDriveSpec.friction`).
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from att_sim.models.config_group import Group
+
+DEG = math.pi / 180.0
+
+
+@dataclass(frozen=True)
+class WheelDriveSpec:
+    coulomb_friction: float = 0.0       # N m
+    viscous_friction: float = 0.0       # N m s/rad
+    friction_speed: float = 1.0         # rad/s: the Coulomb term's smoothing ν_s
+    torque_quantization: float = 0.0    # N m per count; 0: none
+    torque_noise: float = 0.0           # N m 1σ, per control step
+    power_max: float = math.inf         # W: motor torque ≤ P_max/|ν| while speeding the wheel up
+    torque_scale: tuple = ()            # per wheel: delivered/commanded torque (a campaign's dispersion); (): 1
+
+    def friction(self, speed: np.ndarray) -> np.ndarray:
+        """Friction torques opposing relative wheel speeds ``speed`` (N m)."""
+        speed = np.asarray(speed, float)
+        return np.array([self.friction_at(v) for v in speed.ravel().tolist()]).reshape(speed.shape)
+
+    def friction_at(self, speed: float) -> float:
+        """Friction torque opposing one relative wheel speed (N m): ``c tanh(ν/ν_s) + b ν``."""
+        return self.coulomb_friction * math.tanh(speed / self.friction_speed) + self.viscous_friction * speed
+
+
+@dataclass(frozen=True)
+class MagnetorquerSpec:
+    quantization: float = 0.0           # A m² per count; 0: none
+    misalignment: float = 0.0           # rad 1σ per off-diagonal element
+    scale: tuple = ()                   # per coil: produced/commanded dipole (a campaign's dispersion); (): 1
+
+
+@dataclass(frozen=True)
+class ActuatorSpecs:
+    wheels: WheelDriveSpec | None = None
+    magnetorquers: MagnetorquerSpec | None = None
+
+
+def actuators_from_params(values, label: str = "actuators") -> ActuatorSpecs:
+    """The ``actuators`` group (ValueError naming the field)."""
+    g = Group(values, label)
+    wheels = magnetorquers = None
+    if "wheels" in g:
+        w = g.group("wheels")
+        wheels = WheelDriveSpec(
+            coulomb_friction=w.number("coulomb_friction_Nm", 0.0, 0.0, 10.0),
+            viscous_friction=w.number("viscous_friction_Nm_s", 0.0, 0.0, 10.0),
+            friction_speed=w.number("friction_speed_rad_s", 1.0, 0.0, 1e3, low_open=True),
+            torque_quantization=w.number("torque_quantization_Nm", 0.0, 0.0, 10.0),
+            torque_noise=w.number("torque_noise_Nm", 0.0, 0.0, 10.0),
+            power_max=w.number("power_max_W", math.inf, 0.0, math.inf, low_open=True))
+        w.done()
+    if "magnetorquers" in g:
+        m = g.group("magnetorquers")
+        magnetorquers = MagnetorquerSpec(quantization=m.number("quantization_Am2", 0.0, 0.0, 100.0),
+                                         misalignment=m.number("misalignment_deg", 0.0, 0.0, 10.0) * DEG)
+        m.done()
+    g.read.update(("wheels", "magnetorquers"))
+    g.done()
+    return ActuatorSpecs(wheels, magnetorquers)

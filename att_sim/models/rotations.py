@@ -1,0 +1,275 @@
+"""Attitude conventions for the whole suite, written down once.
+
+Convention (used everywhere, messages included):
+
+* A quaternion is a numpy array ``[x, y, z, w]`` (geometry_msgs order, scalar last),
+  Hamilton product, unit norm.
+* It describes the attitude of the **body frame with respect to the inertial frame**
+  (body-to-inertial): ``v_inertial = dcm(q) @ v_body``. The attitude matrix of
+  Bruni & Celani / Wertz, ``C(q)`` (inertial-to-body), is ``dcm(q).T``.
+* Kinematics: ``q_dot = 0.5 * q ⊗ [omega, 0]`` with ``omega`` the body rate in body axes;
+  equivalently ``R_dot = R hat(omega)``. This equals the Olivares–Staffetti form
+  ``q_dot = 0.5 Q(omega) q`` and the Bruni–Celani form ``q_v_dot = 0.5 (q_v × ω + q4 ω)``.
+* ``q`` and ``-q`` are the same attitude; errors are computed sign-independently.
+
+All functions accept a single quaternion ``(4,)`` or a stack ``(..., 4)``.
+"""
+from __future__ import annotations
+
+import math
+from operator import mul
+
+import numpy as np
+
+IDENTITY = np.array([0.0, 0.0, 0.0, 1.0])
+
+
+_NEXT_AXIS = (1, 2, 0)
+_PREV_AXIS = (2, 0, 1)
+
+
+def cross(a: np.ndarray, b: np.ndarray, axis: int = -1) -> np.ndarray:
+    """``a × b`` along ``axis``, broadcasting (cheaper than ``np.cross`` on small stacks and on
+    component-first batches; two single vectors take the scalar formula, the dynamics' hot path)."""
+    if len(np.shape(a)) == 1 and len(np.shape(b)) == 1:
+        return np.array(cross_floats(np.asarray(a, float).tolist(), np.asarray(b, float).tolist()))
+    a1, a2 = np.take(a, _NEXT_AXIS, axis), np.take(a, _PREV_AXIS, axis)
+    b1, b2 = np.take(b, _NEXT_AXIS, axis), np.take(b, _PREV_AXIS, axis)
+    return a1 * b2 - a2 * b1
+
+
+def cross_floats(a, b) -> tuple[float, float, float]:
+    """``a × b`` of two 3-sequences of Python floats (the formula of :func:`cross` for one pair), or
+    of arrays of runs, component by component (:mod:`att_sim.truth.lockstep`)."""
+    (a0, a1, a2), (b0, b1, b2) = a, b
+    return a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0
+
+
+def hat(v: np.ndarray) -> np.ndarray:
+    """Skew-symmetric matrix ``v×`` so that ``hat(a) @ b == cross(a, b)``; works on stacks."""
+    v = np.asarray(v, dtype=float)
+    out = np.zeros(v.shape[:-1] + (3, 3))
+    out[..., 0, 1], out[..., 0, 2] = -v[..., 2], v[..., 1]
+    out[..., 1, 0], out[..., 1, 2] = v[..., 2], -v[..., 0]
+    out[..., 2, 0], out[..., 2, 1] = -v[..., 1], v[..., 0]
+    return out
+
+
+def normalize(q: np.ndarray) -> np.ndarray:
+    """``q`` (or each row) over its norm. A single vector takes the scalar sum of squares, in the
+    order numpy's reduction adds them (the same bits, several times faster)."""
+    q = np.asarray(q, dtype=float)
+    if q.ndim == 1:
+        total = 0.0
+        for c in q.tolist():
+            total += c * c
+        return q / math.sqrt(total)
+    return q / np.linalg.norm(q, axis=-1, keepdims=True)
+
+
+def multiply(p: np.ndarray, q: np.ndarray) -> np.ndarray:
+    """Hamilton product ``p ⊗ q`` (scalar last). Two single quaternions take the scalar formula
+    (the same operations in the same order as the array one, so the same bits, several times faster)."""
+    p, q = np.asarray(p, float), np.asarray(q, float)
+    if p.shape == (4,) and q.shape == (4,):
+        (px, py, pz, pw), (qx, qy, qz, qw) = p.tolist(), q.tolist()
+        return np.array([pw * qx + qw * px + (py * qz - pz * qy), pw * qy + qw * py + (pz * qx - px * qz),
+                         pw * qz + qw * pz + (px * qy - py * qx), pw * qw - (px * qx + py * qy + pz * qz)])
+    pv, pw = p[..., :3], p[..., 3:]
+    qv, qw = q[..., :3], q[..., 3:]
+    v = pw * qv + qw * pv + cross(pv, qv)
+    w = pw * qw - np.sum(pv * qv, axis=-1, keepdims=True)
+    return np.concatenate([v, w], axis=-1)
+
+
+def conjugate(q: np.ndarray) -> np.ndarray:
+    q = np.array(q, dtype=float)
+    if q.shape == (4,):                 # one quaternion: the same negation on Python floats
+        x, y, z, w = q.tolist()
+        return np.array([-x, -y, -z, w])
+    q[..., :3] *= -1.0
+    return q
+
+
+def dcm(q: np.ndarray) -> np.ndarray:
+    """Body-to-inertial rotation matrix ``R(q)`` (``v_i = R v_b``)."""
+    q = np.asarray(q, dtype=float)
+    if q.shape == (4,):                 # one quaternion: the same formula on Python floats
+        x, y, z, w = q.tolist()
+        return np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+                         [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+                         [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)]])
+    x, y, z, w = q[..., 0], q[..., 1], q[..., 2], q[..., 3]
+    out = np.empty(q.shape[:-1] + (3, 3))
+    out[..., 0, 0] = 1 - 2 * (y * y + z * z)
+    out[..., 0, 1] = 2 * (x * y - z * w)
+    out[..., 0, 2] = 2 * (x * z + y * w)
+    out[..., 1, 0] = 2 * (x * y + z * w)
+    out[..., 1, 1] = 1 - 2 * (x * x + z * z)
+    out[..., 1, 2] = 2 * (y * z - x * w)
+    out[..., 2, 0] = 2 * (x * z - y * w)
+    out[..., 2, 1] = 2 * (y * z + x * w)
+    out[..., 2, 2] = 1 - 2 * (x * x + y * y)
+    return out
+
+
+def to_body(q, v) -> list:
+    """``dcm(q)ᵀ v``, an inertial vector in body axes, component by component: ``q`` and ``v`` are
+    sequences of Python floats (one vector) or of arrays (a batch, one array per component); the same
+    operations either way."""
+    x, y, z, w = q
+    v0, v1, v2 = v
+    return [(1 - 2 * (y * y + z * z)) * v0 + 2 * (x * y + z * w) * v1 + 2 * (x * z - y * w) * v2,
+            2 * (x * y - z * w) * v0 + (1 - 2 * (x * x + z * z)) * v1 + 2 * (y * z + x * w) * v2,
+            2 * (x * z + y * w) * v0 + 2 * (y * z - x * w) * v1 + (1 - 2 * (x * x + y * y)) * v2]
+
+
+def from_dcm(R: np.ndarray) -> np.ndarray:
+    """Quaternion of a body-to-inertial matrix (Shepperd's method, w >= 0)."""
+    R = np.asarray(R, dtype=float)
+    flat = R.reshape(-1, 3, 3)
+    out = np.empty((flat.shape[0], 4))
+    for n, m in enumerate(flat):
+        tr = np.trace(m)
+        k = int(np.argmax([m[0, 0], m[1, 1], m[2, 2], tr]))
+        if k == 3:
+            s = 2.0 * np.sqrt(1.0 + tr)
+            q = [(m[2, 1] - m[1, 2]) / s, (m[0, 2] - m[2, 0]) / s, (m[1, 0] - m[0, 1]) / s, 0.25 * s]
+        else:
+            i, j, l = k, (k + 1) % 3, (k + 2) % 3
+            s = 2.0 * np.sqrt(1.0 + m[i, i] - m[j, j] - m[l, l])
+            q = np.empty(4)
+            q[i] = 0.25 * s
+            q[j] = (m[j, i] + m[i, j]) / s
+            q[l] = (m[l, i] + m[i, l]) / s
+            q[3] = (m[l, j] - m[j, l]) / s
+        q = np.asarray(q, float)
+        out[n] = q if q[3] >= 0 else -q
+    return out.reshape(R.shape[:-2] + (4,))
+
+
+def from_axis_angle(axis: np.ndarray, angle) -> np.ndarray:
+    axis = np.asarray(axis, dtype=float)
+    axis = axis / np.linalg.norm(axis, axis=-1, keepdims=True)
+    half = 0.5 * np.asarray(angle, dtype=float)[..., None]
+    return np.concatenate([axis * np.sin(half), np.cos(half)], axis=-1)
+
+
+def to_axis_angle(q: np.ndarray) -> tuple[np.ndarray, float]:
+    """Axis and angle in [0, π] of a single quaternion (shortest rotation)."""
+    axis, angle = _axis_angle(q)
+    return np.array(axis), angle
+
+
+def _axis_angle(q) -> tuple[tuple[float, float, float], float]:
+    """:func:`to_axis_angle` on Python floats (``q`` normalised as :func:`normalize` does: the same bits)."""
+    x, y, z, w = np.asarray(q, float).tolist()
+    n = math.sqrt(x * x + y * y + z * z + w * w)
+    x, y, z, w = (x / n, y / n, z / n, w / n) if n > 0 else (math.nan,) * 4     # numpy's 0/0
+    if w < 0:
+        x, y, z, w = -x, -y, -z, -w
+    s = math.sqrt(x * x + y * y + z * z)
+    angle = 2.0 * math.atan2(s, w)
+    return ((x / s, y / s, z / s) if s > 1e-15 else (1.0, 0.0, 0.0)), angle
+
+
+def slerp(q0: np.ndarray, q1: np.ndarray, s) -> np.ndarray:
+    """Attitude(s) a fraction ``s`` (scalar or array) of the way from q0 to q1 along the shortest
+    rotation: ``q0 ⊗ (q0* ⊗ q1)^s``; shape ``(4,)`` or ``s.shape + (4,)``."""
+    axis, angle = to_axis_angle(multiply(conjugate(q0), q1))
+    s = np.asarray(s, dtype=float)
+    return multiply(q0, from_axis_angle(np.broadcast_to(axis, s.shape + (3,)), s * angle))
+
+
+def orthonormal_basis(v: np.ndarray, references=((1.0, 0.0, 0.0), (0.0, 1.0, 0.0))) -> tuple[np.ndarray, np.ndarray]:
+    """Unit vectors ``(e1, e2)`` completing the unit ``v`` to a right-handed frame (e1, e2, v):
+    ``e1 = v × a / |v × a|``, ``e2 = v × e1``, with ``a`` the first of ``references`` that is not
+    within about 25° of ``v`` (the second otherwise)."""
+    v = np.asarray(v, dtype=float)
+    v = v / np.linalg.norm(v)
+    first, second = (np.asarray(r, dtype=float) for r in references)
+    a = first if abs(v @ first) < 0.9 else second
+    e1 = np.cross(v, a)
+    e1 /= np.linalg.norm(e1)
+    return e1, np.cross(v, e1)
+
+
+def exp_map(phi: np.ndarray) -> np.ndarray:
+    """Quaternion of the rotation vector ``phi`` (``exp(hat(phi))``), stable near zero."""
+    phi = np.asarray(phi, dtype=float)
+    if phi.shape == (3,):               # one vector: the same formula on Python floats
+        angle = math.sqrt(phi @ phi)
+        k = math.sin(0.5 * angle) / angle if angle > 1e-8 else 0.5 - angle**2 / 48.0
+        x, y, z = phi.tolist()
+        return np.array([x * k, y * k, z * k, math.cos(0.5 * angle)])
+    angle = np.linalg.norm(phi, axis=-1, keepdims=True)
+    half = 0.5 * angle
+    # sin(half)/angle with its Taylor series near 0
+    k = np.where(angle > 1e-8, np.sin(half) / np.where(angle > 1e-8, angle, 1.0), 0.5 - angle**2 / 48.0)
+    return np.concatenate([phi * k, np.cos(half)], axis=-1)
+
+
+def expm_so3(phi: np.ndarray) -> np.ndarray:
+    """Rotation matrix ``exp(hat(phi))`` (Rodrigues)."""
+    return dcm(exp_map(phi))
+
+
+def angle_between(q1: np.ndarray, q2: np.ndarray) -> np.ndarray:
+    """Rotation angle (rad, in [0, π]) taking attitude q1 to q2; sign-independent (two single
+    quaternions: a float, on Python floats)."""
+    q1, q2 = np.asarray(q1, float), np.asarray(q2, float)
+    if q1.shape == (4,) and q2.shape == (4,):
+        a, b = q1.tolist(), q2.tolist()
+        norms = math.sqrt(sum(map(mul, a, a)) * sum(map(mul, b, b)))
+        return 2.0 * math.acos(min(abs(sum(map(mul, a, b))) / norms, 1.0)) if norms > 0 else math.nan
+    d = np.abs(np.sum(normalize(q1) * normalize(q2), axis=-1))
+    return 2.0 * np.arccos(np.clip(d, -1.0, 1.0))
+
+
+def error_vector(q: np.ndarray, q_ref: np.ndarray) -> np.ndarray:
+    """Attitude error ``q_ref^* ⊗ q`` vector part, sign chosen with w >= 0 (body frame)."""
+    q, q_ref = np.asarray(q, float), np.asarray(q_ref, float)
+    if q.shape == (4,) and q_ref.shape == (4,):         # one pair: multiply's scalar formula, p = q_ref*
+        (rx, ry, rz, pw), (qx, qy, qz, qw) = q_ref.tolist(), q.tolist()
+        px, py, pz = -rx, -ry, -rz
+        e = [pw * qx + qw * px + (py * qz - pz * qy), pw * qy + qw * py + (pz * qx - px * qz),
+             pw * qz + qw * pz + (px * qy - py * qx)]
+        return np.array([-c for c in e] if pw * qw - (px * qx + py * qy + pz * qz) < 0 else e)
+    e = multiply(conjugate(q_ref), q)
+    sign = np.where(e[..., 3:] < 0, -1.0, 1.0)
+    return (e * sign)[..., :3]
+
+
+def propagate_constant_rate(q: np.ndarray, omega: np.ndarray, dt: float) -> np.ndarray:
+    """Exact attitude after ``dt`` at constant body rate: ``q ⊗ exp(omega dt)`` (rows of ``q`` and
+    ``omega`` with a column of ``dt``: each row's)."""
+    return multiply(q, exp_map(np.asarray(omega) * dt))
+
+
+def log_map(q: np.ndarray) -> np.ndarray:
+    """Rotation vector (axis × angle, angle in [0, π]) of a quaternion, or of each row: the inverse
+    of :func:`exp_map` (rows: :func:`to_axis_angle`'s operations element by element, the same bits)."""
+    q = np.asarray(q, float)
+    if q.ndim == 1:
+        (x, y, z), angle = _axis_angle(q)
+        return np.array([x * angle, y * angle, z * angle])
+    with np.errstate(invalid="ignore", divide="ignore"):
+        x, y, z, w = q.T
+        n = np.sqrt(x * x + y * y + z * z + w * w)
+        sign = np.where(w / n < 0, -1.0, 1.0)
+        x, y, z, w = x / n * sign, y / n * sign, z / n * sign, w / n * sign
+        s = np.sqrt(x * x + y * y + z * z)
+        angle = 2.0 * np.array([math.atan2(a, b) for a, b in zip(s.tolist(), w.tolist())])   # numpy's differs
+        axis = np.where((s > 1e-15)[:, None], np.array([x / s, y / s, z / s]).T, np.array([1.0, 0.0, 0.0]))
+    return axis * angle[:, None]
+
+
+OFF_DIAGONAL = ((0, 1), (0, 2), (1, 0), (1, 2), (2, 0), (2, 1))
+
+
+def small_error_matrix(rng: np.random.Generator, scale_sigma: float, misalignment_sigma: float) -> np.ndarray:
+    """``I + S + M``: scale factors on the diagonal, misalignment angles off it, drawn from their 1σ."""
+    m = np.eye(3) + np.diag(rng.normal(0.0, scale_sigma, 3))
+    for (i, j), angle in zip(OFF_DIAGONAL, rng.normal(0.0, misalignment_sigma, 6)):
+        m[i, j] = angle
+    return m

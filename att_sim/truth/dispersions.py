@@ -1,0 +1,268 @@
+"""Monte Carlo campaigns (issue 16): the dispersed truth of one run, drawn from its seed.
+
+A campaign file (YAML, ``yaml.safe_load``; one mapping ``campaign:``) names a scenario and declares
+how the truth departs from the model the plan was made with::
+
+    campaign:
+      scenario: swift_demo          # a scenario name: a file stem under config/ or $ATT_CONFIG_PATH
+      seed: 16                      # campaign seed s
+      runs: 1000                    # default run count (att-mc --runs overrides)
+      settle_tolerance_deg: 0.01    # settling: the error to the goal stays below this after the plan
+      converge_timeout: 30.0        # s of sim time for the estimate to converge before the maneuver
+      dispersions:
+        inertia_scale: {distribution: normal, three_sigma: 0.05, truncate: 3}
+        wheel_misalignment_deg: {distribution: uniform, low: -0.2, high: 0.2}
+
+Distributions: ``normal`` (``mean`` default 0, ``sigma`` or ``three_sigma``, optional ``truncate``:
+kept within ``truncate`` sigmas by inverting the CDF between the two bounds, so each draw costs one
+uniform and the count never depends on the values) and ``uniform`` (``low`` < ``high``). Every
+component of a dispersion is drawn independently from it; :data:`DISPERSIONS` lists the names, their
+sizes and units.
+
+Seeds: run ``i`` of campaign seed ``s`` has the run seed ``SeedSequence(s, spawn_key=(i,))``'s first
+32-bit word (:func:`run_seed`); everything of the run comes from that one integer — each dispersion
+from its own stream ``SeedSequence(seed, spawn_key=(DISPERSION_STREAM, k))`` (``k`` its index in
+:data:`DISPERSIONS`, so declaring another dispersion changes no other's values), and the sensors'
+noise and drawn biases, the wheel drives' noise and the coils' misalignment from the sensor streams
+of :mod:`att_sim.truth.sensors` with that seed. A run is therefore reproduced by its seed alone.
+
+Physical inertia: a draw whose inertia is not positive definite or breaks the triangle inequality
+(each principal moment at most the sum of the other two) is **refused**, naming the run's seed
+(:func:`truth` raises ValueError; the campaign tool checks every run before any flies) — a
+resampled run would no longer be reproducible from its seed, and a declared distribution that
+reaches non-physical bodies is a mistake to fix in the file.
+"""
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass, replace
+from datetime import timedelta
+from pathlib import Path
+
+import numpy as np
+import yaml
+from scipy.special import ndtr, ndtri
+
+from att_sim.models import rotations as rot
+from att_sim.models import scenario as scen
+from att_sim.models.actuator_specs import MagnetorquerSpec, WheelDriveSpec
+from att_sim.models.config_group import Group
+from att_sim.truth.sensors import STREAMS
+
+DISPERSION_STREAM = 1000 + len(STREAMS)     # spawn_key (DISPERSION_STREAM, k): clear of the sensors' streams
+MAX_RUNS = 10_000_000
+MAX_FILE_BYTES = 100_000
+DEG = math.pi / 180.0
+
+
+# name -> (components as a function of the spacecraft, unit and meaning)
+DISPERSIONS = {
+    "inertia_scale": (lambda sc: 3, "relative error of each principal moment of inertia"),
+    "inertia_rotation_deg": (lambda sc: 3, "rotation vector of the principal axes (deg, body)"),
+    "wheel_misalignment_deg": (lambda sc: 2 * sc.n_wheels, "two perpendicular tilts of each wheel axis (deg)"),
+    "wheel_inertia_scale": (lambda sc: 1, "relative error of the wheels' spin inertia"),
+    "wheel_torque_scale": (lambda sc: sc.n_wheels, "relative error of each wheel drive's torque (scale factor)"),
+    "magnetorquer_scale": (lambda sc: 3, "relative error of each magnetorquer coil's dipole (scale factor)"),
+    "com_offset_m": (lambda sc: 3, "centre of mass offset (m, body): facets' centres of pressure move by -offset"),
+    "epoch_offset_s": (lambda sc: 1, "the truth's epoch minus the flight software's (s): orbit, sky and field move"),
+    "initial_attitude_error_deg": (lambda sc: 3, "rotation vector of the initial attitude error (deg, body)"),
+    "initial_rate_error": (lambda sc: 3, "initial body rate error (rad/s)"),
+}
+
+
+@dataclass(frozen=True)
+class Distribution:
+    kind: str                   # "normal" | "uniform"
+    a: float                    # normal: mean; uniform: low
+    b: float                    # normal: sigma; uniform: high
+    truncate: float = math.inf  # normal: kept within truncate sigmas
+
+    def draw(self, rng: np.random.Generator, n: int) -> np.ndarray:
+        """``n`` independent draws (inverse CDF of one uniform each)."""
+        u = rng.random(n)
+        if self.kind == "uniform":
+            return self.a + (self.b - self.a) * u
+        lo = ndtr(-self.truncate)
+        return self.a + self.b * ndtri(lo + (1.0 - 2.0 * lo) * u)
+
+    def moments(self) -> tuple[float, float]:
+        """Mean and standard deviation of the distribution (truncated normal: Johnson, Kotz &
+        Balakrishnan 1994, §10.1: ``σ² (1 − 2kφ(k)/(2Φ(k) − 1))``)."""
+        if self.kind == "uniform":
+            return 0.5 * (self.a + self.b), (self.b - self.a) / math.sqrt(12.0)
+        k = self.truncate
+        if math.isinf(k):
+            return self.a, self.b
+        phi = math.exp(-0.5 * k * k) / math.sqrt(2.0 * math.pi)
+        return self.a, self.b * math.sqrt(1.0 - 2.0 * k * phi / (2.0 * ndtr(k) - 1.0))
+
+
+@dataclass(frozen=True)
+class Campaign:
+    path: Path
+    scenario: str
+    seed: int
+    runs: int
+    dispersions: dict             # name -> Distribution, in DISPERSIONS order
+    settle_tolerance: float       # rad
+    converge_timeout: float       # s
+
+
+def distribution_from(g: Group) -> Distribution:
+    kind = g.choice("distribution", ("normal", "uniform"))
+    if kind == "uniform":
+        low, high = g.number("low"), g.number("high")
+        if not low < high:
+            raise ValueError(f"{g.label}: low {low:g} must be below high {high:g}")
+        g.done()
+        return Distribution(kind, low, high)
+    mean = g.number("mean", 0.0)
+    if ("sigma" in g) == ("three_sigma" in g):
+        raise ValueError(f"{g.label} needs exactly one of sigma, three_sigma")
+    sigma = g.number("sigma", low=0.0) if "sigma" in g else g.number("three_sigma", low=0.0) / 3.0
+    truncate = g.number("truncate", math.inf, 0.0, math.inf, low_open=True)
+    g.done()
+    return Distribution(kind, mean, sigma, truncate)
+
+
+def campaign_from(doc, path: Path) -> Campaign:
+    """The checked ``campaign`` mapping (ValueError naming the field)."""
+    if not isinstance(doc, Mapping) or set(doc) != {"campaign"}:
+        keys = ", ".join(map(str, doc)) if isinstance(doc, Mapping) else type(doc).__name__
+        raise ValueError(f"a campaign file holds one mapping 'campaign:', got {keys[:120]}")
+    g = Group(doc["campaign"], "campaign")
+    name = g.name("scenario")
+    seed = g.number("seed", low=0, high=2**63 - 1)
+    runs = g.number("runs", 100, 1, MAX_RUNS)
+    if seed != int(seed) or runs != int(runs):
+        raise ValueError("campaign.seed and campaign.runs must be integers")
+    settle = g.number("settle_tolerance_deg", 0.01, 0.0, 180.0, low_open=True) * DEG
+    converge = g.number("converge_timeout", 30.0, 0.0, 3600.0, low_open=True)
+    d = g.group("dispersions")
+    unknown = sorted(str(k) for k in d.values if k not in DISPERSIONS)
+    if unknown:
+        raise ValueError(f"campaign.dispersions has unknown name(s) {', '.join(unknown)[:120]} "
+                         f"(known: {', '.join(DISPERSIONS)})")
+    dispersions = {k: distribution_from(d.group(k)) for k in DISPERSIONS if k in d}
+    g.done()
+    return Campaign(path, name, int(seed), int(runs), dispersions, settle, converge)
+
+
+def load_campaign(path) -> Campaign:
+    """The campaign file at ``path`` (ValueError: one sentence naming the file and the field)."""
+    path = Path(path)
+    try:
+        if path.stat().st_size > MAX_FILE_BYTES:
+            raise ValueError(f"{path.stat().st_size} bytes; a campaign file has at most {MAX_FILE_BYTES}")
+        with open(path, encoding="utf-8") as fh:
+            return campaign_from(yaml.safe_load(fh), path)
+    except (OSError, UnicodeDecodeError, yaml.YAMLError) as exc:
+        raise ValueError(f"campaign {path}: cannot be read ({' '.join(str(exc).split())[:200]})") from None
+    except ValueError as exc:
+        raise ValueError(f"campaign {path}: {exc}") from None
+
+
+def run_seed(campaign_seed: int, run: int) -> int:
+    """The seed of run ``run`` of a campaign (see module docstring)."""
+    return int(np.random.SeedSequence(campaign_seed, spawn_key=(run,)).generate_state(1)[0])
+
+
+def draw(campaign: Campaign, scenario: scen.Scenario, seed: int) -> dict[str, np.ndarray]:
+    """The applied values of the run of seed ``seed``: each declared dispersion's components."""
+    out = {}
+    for k, name in enumerate(DISPERSIONS):
+        if name in campaign.dispersions:
+            rng = np.random.default_rng(np.random.SeedSequence(seed, spawn_key=(DISPERSION_STREAM, k)))
+            out[name] = campaign.dispersions[name].draw(rng, DISPERSIONS[name][0](scenario.spacecraft))
+    return out
+
+
+def inertia_problem(inertia: np.ndarray) -> str | None:
+    """Why the symmetric ``inertia`` is not a rigid body's (None when it is): positive definite,
+    each principal moment at most the sum of the other two."""
+    if not np.all(np.isfinite(inertia)):
+        return "not finite"
+    moments = np.linalg.eigvalsh(inertia)
+    if moments[0] <= 0:
+        return f"not positive definite (principal moments {np.array2string(moments, precision=4)})"
+    if moments[2] > moments[0] + moments[1]:
+        return (f"principal moments {np.array2string(moments, precision=4)} break the triangle inequality "
+                f"({moments[2]:.6g} > {moments[0]:.6g} + {moments[1]:.6g})")
+    return None
+
+
+def _tilted(axes: np.ndarray, tilts_rad: np.ndarray) -> np.ndarray:
+    """Each unit column of ``axes`` turned by its two tilts about two axes perpendicular to it."""
+    out = np.empty_like(axes)
+    for i, (a, b) in enumerate(tilts_rad.reshape(-1, 2)):
+        e1, e2 = rot.orthonormal_basis(axes[:, i])
+        out[:, i] = rot.dcm(rot.exp_map(a * e1 + b * e2)) @ axes[:, i]
+    return out
+
+
+@dataclass(frozen=True)
+class Truth:
+    """The dispersed truth of one run: the scenario the simulator integrates, its start and seed."""
+
+    scenario: scen.Scenario
+    q0: np.ndarray
+    omega0: np.ndarray
+    seed: int
+
+
+def truth(scenario: scen.Scenario, values: dict, seed: int, q0=rot.IDENTITY, omega0=(0.0, 0.0, 0.0)) -> Truth:
+    """``scenario`` with the applied ``values`` (:func:`draw`) and the nominal start ``q0``,
+    ``omega0`` dispersed; ValueError naming the seed when the draw is not physical or a dispersion
+    has nothing to act on."""
+    zero = {name: np.zeros(DISPERSIONS[name][0](scenario.spacecraft)) for name in DISPERSIONS}
+    v = {**zero, **values}
+    if "epoch_offset_s" in values:
+        if scenario.epoch is None:
+            raise ValueError(f"epoch_offset_s: scenario '{scenario.name}' has no epoch, so an epoch offset would "
+                             f"change nothing")
+        scenario = scen.with_epoch(scenario, scenario.epoch + timedelta(seconds=float(v["epoch_offset_s"][0])))
+    sc, actuators, environment = scenario.spacecraft, scenario.actuators, scenario.environment
+    moments, axes = np.linalg.eigh(sc.inertia)
+    turn = rot.dcm(rot.exp_map(v["inertia_rotation_deg"] * DEG)) @ axes
+    inertia = turn @ np.diag(moments * (1.0 + v["inertia_scale"])) @ turn.T
+    inertia = 0.5 * (inertia + inertia.T)
+    problem = inertia_problem(inertia)
+    if problem is not None:
+        raise ValueError(f"run seed {seed}: the dispersed inertia is {problem}; narrow inertia_scale or "
+                         f"inertia_rotation_deg (a non-physical draw is refused, never resampled)")
+    wheel_inertia = sc.wheel_inertia * (1.0 + float(v["wheel_inertia_scale"][0]))
+    if wheel_inertia < 0:
+        raise ValueError(f"run seed {seed}: the dispersed wheel inertia {wheel_inertia:.6g} is negative")
+    sc = replace(sc, inertia=inertia, wheel_axes=_tilted(sc.wheel_axes, v["wheel_misalignment_deg"] * DEG),
+                 wheel_inertia=wheel_inertia)
+    if "wheel_torque_scale" in values:
+        scale = 1.0 + v["wheel_torque_scale"]
+        if np.any(scale < 0):
+            raise ValueError(f"run seed {seed}: a wheel torque scale factor is negative ({scale.min():.6g})")
+        actuators = replace(actuators, wheels=replace(actuators.wheels or WheelDriveSpec(), torque_scale=tuple(scale)))
+    if "magnetorquer_scale" in values:
+        if not sc.dipole_max > 0:
+            raise ValueError(f"magnetorquer_scale: scenario '{scenario.name}' has no magnetorquers")
+        scale = 1.0 + v["magnetorquer_scale"]
+        if np.any(scale < 0):
+            raise ValueError(f"run seed {seed}: a magnetorquer scale factor is negative ({scale.min():.6g})")
+        actuators = replace(actuators, magnetorquers=replace(actuators.magnetorquers or MagnetorquerSpec(),
+                                                             scale=tuple(scale)))
+    if "com_offset_m" in values:
+        if not (environment.get("solar_pressure") or environment.get("drag")):
+            raise ValueError(f"com_offset_m: scenario '{scenario.name}' has no solar pressure or drag, so a centre "
+                             f"of mass offset would change nothing")
+        offset = v["com_offset_m"]
+        environment = {**environment, "facets": [replace(f, center_B=tuple(np.asarray(f.center_B) - offset))
+                                                 for f in environment["facets"]]}
+    q = rot.multiply(np.asarray(q0, float), rot.exp_map(v["initial_attitude_error_deg"] * DEG))
+    dispersed = replace(scenario, spacecraft=sc, actuators=actuators, environment=environment)
+    return Truth(dispersed, q, np.asarray(omega0, float) + v["initial_rate_error"], seed)
+
+
+def seed_truth(campaign: Campaign, scenario: scen.Scenario, seed: int, q0=rot.IDENTITY,
+               omega0=(0.0, 0.0, 0.0)) -> tuple[Truth, dict]:
+    """The run of seed ``seed`` of ``campaign`` on ``scenario``: its truth and applied values."""
+    values = draw(campaign, scenario, seed)
+    return truth(scenario, values, seed, q0, omega0), values

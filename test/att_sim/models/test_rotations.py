@@ -1,0 +1,76 @@
+"""The attitude convention: body-to-inertial, [x, y, z, w], Hamilton product."""
+import numpy as np
+import pytest
+
+from att_sim.models import rotations as rot
+
+RNG = np.random.default_rng(7)
+
+
+def random_quaternions(n):
+    return rot.normalize(RNG.normal(size=(n, 4)))
+
+
+def test_dcm_maps_body_to_inertial_and_composes_like_the_product():
+    q = rot.from_axis_angle([0, 0, 1], np.pi / 2)
+    assert rot.dcm(q) @ np.array([1.0, 0, 0]) == pytest.approx([0, 1, 0], abs=1e-15)
+    p, r = random_quaternions(2)
+    assert np.allclose(rot.dcm(rot.multiply(p, r)), rot.dcm(p) @ rot.dcm(r))
+
+
+def test_from_dcm_inverts_dcm_up_to_sign():
+    for q in random_quaternions(50):
+        back = rot.from_dcm(rot.dcm(q))
+        assert min(np.linalg.norm(back - q), np.linalg.norm(back + q)) < 1e-12
+
+
+def test_exp_map_matches_rodrigues_and_small_angles():
+    phi = np.array([0.3, -0.2, 0.9])
+    angle = np.linalg.norm(phi)
+    K = rot.hat(phi / angle)
+    rodrigues = np.eye(3) + np.sin(angle) * K + (1 - np.cos(angle)) * K @ K
+    assert np.allclose(rot.expm_so3(phi), rodrigues)
+    assert np.allclose(rot.exp_map([1e-12, 0, 0]), [5e-13, 0, 0, 1])
+
+
+def test_kinematics_convention_q_dot_is_half_q_times_omega():
+    q, w, dt = random_quaternions(1)[0], np.array([0.1, -0.3, 0.2]), 1e-6
+    numeric = (rot.propagate_constant_rate(q, w, dt) - q) / dt
+    assert np.allclose(numeric, 0.5 * rot.multiply(q, np.append(w, 0)), atol=1e-6)
+    # R_dot = R hat(omega)
+    R_dot = (rot.dcm(rot.propagate_constant_rate(q, w, dt)) - rot.dcm(q)) / dt
+    assert np.allclose(R_dot, rot.dcm(q) @ rot.hat(w), atol=1e-5)
+
+
+def test_angle_between_is_sign_independent():
+    q = random_quaternions(1)[0]
+    r = rot.multiply(q, rot.from_axis_angle([1, 1, 0], 0.4))
+    assert rot.angle_between(q, -r) == pytest.approx(0.4)
+    assert np.allclose(rot.error_vector(-r, q), rot.error_vector(r, q))
+
+
+def test_one_quaternion_fast_paths_agree_with_the_stacked_forms():
+    """dcm, exp_map and to_axis_angle take Python-float paths for one quaternion or vector (the
+    loops' hot path); each row of a stack goes through numpy's: the same values to the last ulps."""
+    qs = random_quaternions(20)
+    stacked = rot.dcm(qs)
+    for q, R in zip(qs, stacked):
+        assert np.array_equal(rot.dcm(q), R)
+    phis = np.vstack([RNG.normal(size=(10, 3)), RNG.normal(size=(5, 3)) * 1e-9, np.zeros((1, 3))])
+    for phi, q in zip(phis, rot.exp_map(phis)):
+        assert np.allclose(rot.exp_map(phi), q, rtol=4e-16, atol=1e-300)
+    for q in qs:
+        axis, angle = rot.to_axis_angle(q)
+        assert np.allclose(rot.from_axis_angle(axis, angle), q if q[3] >= 0 else -q, rtol=0, atol=4e-16)
+
+
+def test_log_map_of_rows_gives_each_row_its_bits_alone():
+    """The lockstep's gyros take the rotations of all runs as rows: each row is the one quaternion's
+    log map bit for bit — small and zero rotations, w < 0, unnormalised, zero and non-finite rows."""
+    qs = np.vstack([random_quaternions(200) * RNG.uniform(1e-3, 1e3, (200, 1)),
+                    [[1e-12, -2e-13, 3e-14, -1.0], [0.0, 0.0, 0.0, 1.0], [0.0, 0.0, 0.0, 0.0],
+                     [np.nan, 0.0, 0.0, 1.0], [0.6, 0.8, 0.0, 0.0]]])
+    rows = rot.log_map(qs)
+    for q, row in zip(qs, rows):
+        assert rot.log_map(q).tobytes() == row.tobytes()
+    assert np.allclose(rot.exp_map(rows[:200]), rot.normalize(qs[:200]) * np.sign(qs[:200, 3:]), atol=1e-12)

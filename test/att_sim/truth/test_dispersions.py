@@ -1,0 +1,187 @@
+"""Monte Carlo dispersions (issue 16): the draws follow the declared distributions, a run is
+reproduced by its seed alone, the dispersed truth carries exactly the drawn values, and every bad
+campaign is refused in one sentence naming the field (or the seed of a non-physical draw)."""
+from __future__ import annotations
+
+import math
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+import pytest
+from scipy import stats
+
+from att_sim.models import rotations as rot
+from att_sim.models import scenario as scen
+from att_sim.truth import dispersions as disp
+from att_sim.truth.simulation import Simulation
+
+ROOT = Path(__file__).resolve().parents[3]
+SHIPPED = disp.load_campaign(ROOT / "campaigns" / "swift_demo.yaml")
+SWIFT = scen.load("swift_demo")
+DRAWS = 3000
+
+
+def campaign(dispersions: dict, **fields) -> disp.Campaign:
+    doc = {"campaign": {"scenario": "swift_demo", "seed": 3, **fields, "dispersions": dispersions}}
+    return disp.campaign_from(doc, Path("test.yaml"))
+
+
+@pytest.fixture(scope="module")
+def drawn():
+    runs = [disp.draw(SHIPPED, SWIFT, disp.run_seed(SHIPPED.seed, i)) for i in range(DRAWS)]
+    return {name: np.array([r[name] for r in runs]) for name in SHIPPED.dispersions}
+
+
+def test_the_shipped_campaign_declares_the_issues_dispersions():
+    d = SHIPPED.dispersions
+    assert d["inertia_scale"].b * 3 == pytest.approx(0.05) and d["wheel_torque_scale"].b * 3 == pytest.approx(0.10)
+    assert d["wheel_misalignment_deg"].b * 3 == pytest.approx(0.5)
+    assert d["initial_attitude_error_deg"].b * 3 == pytest.approx(0.1)
+    assert d["initial_rate_error"].b * 3 == pytest.approx(1e-4)
+    assert all(x.kind == "normal" and x.truncate == 3 for x in d.values())
+
+
+def test_the_applied_values_follow_the_declared_distributions(drawn):
+    """Every component against scipy's truncated normal (an independent implementation): the
+    Kolmogorov–Smirnov test at 0.1 %, the sample mean and deviation within 4 standard errors."""
+    for name, values in drawn.items():
+        d = SHIPPED.dispersions[name]
+        mean, std = d.moments()
+        law = stats.truncnorm(-d.truncate, d.truncate, loc=d.a, scale=d.b)
+        assert std == pytest.approx(law.std(), rel=1e-9)
+        for k in range(values.shape[1]):
+            v = values[:, k]
+            assert stats.kstest(v, law.cdf).pvalue > 1e-3, (name, k)
+            assert abs(v.mean() - mean) < 4 * std / math.sqrt(DRAWS), (name, k)
+            assert abs(v.std(ddof=1) / std - 1) < 4 / math.sqrt(2 * DRAWS), (name, k)
+            assert np.abs(v - mean).max() <= d.truncate * d.b
+
+
+def test_uniform_draws_stay_within_their_bounds_and_fill_them():
+    c = campaign({"initial_rate_error": {"distribution": "uniform", "low": -2e-4, "high": 1e-4}})
+    v = np.concatenate([disp.draw(c, SWIFT, disp.run_seed(c.seed, i))["initial_rate_error"] for i in range(2000)])
+    assert v.min() >= -2e-4 and v.max() <= 1e-4
+    assert stats.kstest(v, stats.uniform(-2e-4, 3e-4).cdf).pvalue > 1e-3
+    assert c.dispersions["initial_rate_error"].moments() == pytest.approx((-0.5e-4, 3e-4 / math.sqrt(12)))
+
+
+def test_a_run_is_reproduced_by_its_seed_alone_and_declaring_another_dispersion_changes_no_other():
+    seed = disp.run_seed(SHIPPED.seed, 17)
+    assert seed == disp.run_seed(SHIPPED.seed, 17) != disp.run_seed(SHIPPED.seed, 18)
+    a, b = disp.draw(SHIPPED, SWIFT, seed), disp.draw(SHIPPED, SWIFT, seed)
+    assert all(np.array_equal(a[k], b[k]) for k in a)
+    only = campaign({"initial_rate_error": {"distribution": "normal", "three_sigma": 1e-4, "truncate": 3}})
+    assert np.array_equal(disp.draw(only, SWIFT, seed)["initial_rate_error"], a["initial_rate_error"])
+
+
+def test_the_dispersed_truth_carries_the_drawn_values():
+    seed = disp.run_seed(SHIPPED.seed, 3)
+    truth, v = disp.seed_truth(SHIPPED, SWIFT, seed)
+    sc = truth.scenario.spacecraft
+    # swift_demo's inertia is 100 I: the principal moments are 100 (1 + scale), in some order
+    assert np.sort(np.linalg.eigvalsh(sc.inertia)) == pytest.approx(np.sort(100 * (1 + v["inertia_scale"])))
+    tilts = np.hypot(*v["wheel_misalignment_deg"].reshape(-1, 2).T)
+    turned = np.degrees(np.arccos(np.clip(np.sum(sc.wheel_axes * SWIFT.spacecraft.wheel_axes, axis=0), -1, 1)))
+    assert turned == pytest.approx(tilts, rel=1e-6)
+    assert sc.wheel_inertia == pytest.approx(0.01 * (1 + v["wheel_inertia_scale"][0]))
+    assert truth.scenario.actuators.wheels.torque_scale == pytest.approx(tuple(1 + v["wheel_torque_scale"]))
+    assert truth.scenario.actuators.wheels.coulomb_friction == SWIFT.actuators.wheels.coulomb_friction
+    assert math.degrees(rot.angle_between(truth.q0, rot.IDENTITY)) == pytest.approx(
+        np.linalg.norm(v["initial_attitude_error_deg"]))
+    assert truth.omega0 == pytest.approx(v["initial_rate_error"])
+    assert SWIFT.spacecraft.inertia[0, 0] == 100.0                   # the nominal scenario is untouched
+
+
+def test_the_drives_deliver_the_scaled_torque():
+    c = campaign({"wheel_torque_scale": {"distribution": "uniform", "low": 0.2, "high": 0.3}})
+    ideal = replace(SWIFT, actuators=replace(SWIFT.actuators, wheels=None))
+    truth, v = disp.seed_truth(c, ideal, 5)
+    sim = Simulation.for_scenario(truth.scenario)
+    held = sim.wheel_drive.hold(np.array([0.1, -0.1, 0.05]))
+    assert held == pytest.approx(np.array([0.1, -0.1, 0.05]) * (1 + v["wheel_torque_scale"]), rel=1e-12)
+
+
+def test_a_non_physical_inertia_is_refused_naming_the_runs_seed():
+    c = campaign({"inertia_scale": {"distribution": "uniform", "low": -0.9, "high": 2.0}})
+    refused = []
+    for i in range(20):
+        seed = disp.run_seed(c.seed, i)
+        try:
+            disp.seed_truth(c, SWIFT, seed)
+        except ValueError as err:
+            refused.append((seed, str(err)))
+    assert refused, "a draw this wide breaks the triangle inequality in 20 runs"
+    seed, message = refused[0]
+    assert f"seed {seed}" in message and "triangle inequality" in message and "never resampled" in message
+    assert disp.inertia_problem(np.diag([1.0, 1.0, -0.5])).startswith("not positive definite")
+    assert disp.inertia_problem(np.diag([1.0, 2.0, 3.0])) is None
+
+
+BAD = {
+    "not a campaign": ({"scenario": "swift_demo"}, "one mapping 'campaign:'"),
+    "unknown key": ({"campaign": {"scenario": "swift_demo", "seed": 1, "rnus": 3}}, "rnus"),
+    "unknown dispersion": ({"campaign": {"scenario": "swift_demo", "seed": 1,
+                                         "dispersions": {"inertia_scal": {}}}}, "inertia_scal"),
+    "no runs": ({"campaign": {"scenario": "swift_demo", "seed": 1, "runs": 0}}, "campaign.runs"),
+    "fractional runs": ({"campaign": {"scenario": "swift_demo", "seed": 1, "runs": 2.5}}, "integers"),
+    "negative seed": ({"campaign": {"scenario": "swift_demo", "seed": -1}}, "campaign.seed"),
+    "no seed": ({"campaign": {"scenario": "swift_demo"}}, "campaign.seed is missing"),
+    "unknown distribution": ({"campaign": {"scenario": "swift_demo", "seed": 1, "dispersions": {
+        "inertia_scale": {"distribution": "cauchy", "sigma": 1}}}}, "normal, uniform"),
+    "sigma and three_sigma": ({"campaign": {"scenario": "swift_demo", "seed": 1, "dispersions": {
+        "inertia_scale": {"distribution": "normal", "sigma": 0.1, "three_sigma": 0.3}}}}, "exactly one"),
+    "negative sigma": ({"campaign": {"scenario": "swift_demo", "seed": 1, "dispersions": {
+        "inertia_scale": {"distribution": "normal", "sigma": -0.1}}}}, "inertia_scale.sigma"),
+    "uniform upside down": ({"campaign": {"scenario": "swift_demo", "seed": 1, "dispersions": {
+        "inertia_scale": {"distribution": "uniform", "low": 0.1, "high": -0.1}}}}, "below high"),
+    "unknown distribution key": ({"campaign": {"scenario": "swift_demo", "seed": 1, "dispersions": {
+        "inertia_scale": {"distribution": "normal", "sigma": 0.1, "mu": 1}}}}, "mu"),
+    "truncate zero": ({"campaign": {"scenario": "swift_demo", "seed": 1, "dispersions": {
+        "inertia_scale": {"distribution": "normal", "sigma": 0.1, "truncate": 0}}}}, "truncate"),
+}
+
+
+@pytest.mark.parametrize("name", BAD)
+def test_a_bad_campaign_is_refused_naming_the_field(name):
+    doc, words = BAD[name]
+    with pytest.raises(ValueError, match=words.replace(".", r"\.").replace("'", "'")):
+        disp.campaign_from(doc, Path("bad.yaml"))
+
+
+def test_the_coils_deliver_the_scaled_dipole():
+    c = campaign({"magnetorquer_scale": {"distribution": "uniform", "low": -0.3, "high": -0.2}})
+    ideal = replace(SWIFT, actuators=replace(SWIFT.actuators, magnetorquers=None))
+    truth, v = disp.seed_truth(c, ideal, 5)
+    coils = Simulation.for_scenario(truth.scenario).magnetorquers
+    m = np.array([2.0, -1.0, 0.5])
+    assert coils(m) == pytest.approx(m * (1 + v["magnetorquer_scale"]), rel=1e-12)
+
+
+def test_an_epoch_offset_moves_the_truths_orbit_and_sky():
+    """leo_observatory's epoch moved by the draw: the orbit's position at t = 0 is where the nominal
+    orbit is at the offset (the TLE is the same), and the Sun and the zones follow."""
+    leo = scen.load("leo_observatory")
+    c = replace(campaign({"epoch_offset_s": {"distribution": "uniform", "low": 100.0, "high": 200.0}}),
+                scenario="leo_observatory")
+    truth, v = disp.seed_truth(c, leo, 9)
+    offset = float(v["epoch_offset_s"][0])
+    assert 100.0 <= offset <= 200.0
+    assert (truth.scenario.epoch - leo.epoch).total_seconds() == pytest.approx(offset, abs=1e-6)
+    moved, nominal = truth.scenario.orbit_model, leo.orbit_model
+    assert moved.position(np.array([0.0, 60.0])) == pytest.approx(nominal.position(np.array([offset, offset + 60.0])),
+                                                                 abs=0.01)      # m
+    assert leo.epoch == scen.load("leo_observatory").epoch                # the nominal scenario is untouched
+    with pytest.raises(ValueError, match="'swift_demo' has no epoch"):
+        disp.seed_truth(campaign({"epoch_offset_s": {"distribution": "normal", "sigma": 1.0}}), SWIFT, 1)
+
+
+def test_bad_files_and_a_dispersion_with_nothing_to_act_on_are_refused(tmp_path):
+    with pytest.raises(ValueError, match="cannot be read"):
+        disp.load_campaign(tmp_path / "missing.yaml")
+    (tmp_path / "broken.yaml").write_text("campaign: {{{\n")
+    with pytest.raises(ValueError, match=r"broken\.yaml: cannot be read"):
+        disp.load_campaign(tmp_path / "broken.yaml")
+    c = campaign({"com_offset_m": {"distribution": "normal", "sigma": 0.01}})
+    with pytest.raises(ValueError, match="no solar pressure or drag"):
+        disp.seed_truth(c, SWIFT, 1)
