@@ -5,11 +5,13 @@ A recorder killed with SIGKILL leaves its file without data end, summary, footer
 perhaps with its last chunk cut short; ``rosbags`` and ``mcap``'s seeking reader refuse such a file.
 :func:`scan_records` reads it with ``mcap``'s :class:`~mcap.stream_reader.StreamReader` (every read
 bounded by what is left of the file, so a damaged length field cannot allocate more) and stops
-at the first record that is cut or fails its CRC; :func:`repair` writes every record read before
-that point (header, schemas, channels with their metadata, messages byte for byte with their log
-time, publish time and sequence, attachments, metadata) through ``mcap``'s Writer, which adds the
-index and the summary. A chunk the kill cut short is dropped: the recorder flushes a chunk at least
-every 0.5 s, so that is all that is lost.
+at the first record that is cut, fails its CRC or has an opcode the MCAP specification does not
+define (the specification lets a reader skip such a record; a suite log holds none, so one is a
+damaged byte: a chunk's opcode flipped would otherwise drop that chunk and go on after it).
+:func:`repair` writes every record read before that point (header, schemas, channels with their
+metadata, messages byte for byte with their log time, publish time and sequence, attachments,
+metadata) through ``mcap``'s Writer, which adds the index and the summary. A chunk the kill cut
+short is dropped: the recorder flushes a chunk at least every 0.5 s, so that is all that is lost.
 """
 from __future__ import annotations
 
@@ -21,6 +23,7 @@ from pathlib import Path
 
 import zstandard
 from mcap.exceptions import McapError
+from mcap.opcode import Opcode
 from mcap.records import (
     Attachment,
     Channel,
@@ -43,6 +46,7 @@ MAX_CHUNK_BYTES = 1 << 30          # an uncompressed chunk claiming more is dama
 DAMAGE = (McapError, ValueError, EOFError, struct.error, zstandard.ZstdError, RuntimeError, MemoryError,
           KeyError, IndexError)
 KEPT = (Header, Schema, Channel, Message, Attachment, Metadata)
+_OPCODES = frozenset(int(o) for o in Opcode)
 
 
 class LogFileError(ValueError):
@@ -79,6 +83,15 @@ class Scan:
     @property
     def dropped_bytes(self) -> int:
         return self.size - self.good_bytes
+
+
+class _StrictReader(StreamReader):
+    """mcap's stream reader that refuses a record of an unknown opcode instead of skipping it."""
+
+    def _read_record(self, opcode: int, length: int):
+        if opcode not in _OPCODES:
+            raise ValueError(f"record of unknown opcode 0x{opcode:02x}")
+        return super()._read_record(opcode, length)
 
 
 class _Bounded:
@@ -177,7 +190,7 @@ def scan_records(path: str | Path, scan: Scan | None = None) -> Iterator:
     scan.path, scan.size, scan.good_bytes = path, size, len(MAGIC)
     with open(path, "rb") as fh:
         view = _Bounded(fh, size)
-        records = StreamReader(view, emit_chunks=True, record_size_limit=None).records
+        records = _StrictReader(view, emit_chunks=True, record_size_limit=None).records
         footer, start = False, len(MAGIC)
         while True:
             try:

@@ -128,6 +128,25 @@ def test_a_cut_and_damaged_file_repairs_to_a_prefix_of_its_messages(finished, tm
     assert got == original[:len(got)]
 
 
+@pytest.mark.parametrize("opcode", [0x00, 0x10, 0x80, 0xFF])
+def test_a_chunk_whose_opcode_was_flipped_ends_the_recovery_before_it(finished, tmp_path, opcode):
+    """MCAP lets a reader skip a record of unknown opcode; in a suite log that is a damaged byte, and
+    skipping it would drop a whole chunk and go on after it, so the recovery stops there."""
+    path, original = finished
+    with open(path, "rb") as fh:
+        chunks = sorted(make_reader(fh).get_summary().chunk_indexes, key=lambda c: c.chunk_start_offset)
+    third = chunks[2]
+    data = bytearray(path.read_bytes())
+    assert data[third.chunk_start_offset] == 0x06          # a Chunk record starts there
+    data[third.chunk_start_offset] = opcode
+    damaged = tmp_path / "damaged.mcap"
+    damaged.write_bytes(bytes(data))
+    done = repair(damaged, tmp_path / "out.mcap")
+    got = records_of(done.output)
+    assert got == original[:2 * PER_CHUNK]
+    assert done.source.problem.startswith(f"damaged record at byte {third.chunk_start_offset}")
+
+
 def test_a_killed_writers_file_is_refused_by_rosbags_and_mcap_and_opens_once_repaired(tmp_path):
     from rosbags.highlevel import AnyReader, AnyReaderError
     from rosbags.typesys import Stores, get_typestore
