@@ -30,10 +30,6 @@ The decisions, each from where the spacecraft holds at that moment:
    :data:`RECOVERY_LIMIT` s at most);
 6. with no target left, the spacecraft holds until the horizon, leaving a zone's path by a park, and
    reports the end.
-
-The controller's hold after a ground site is asked again every :data:`RECOVERY_STEP` s (at most
-:data:`RECOVERY_LIMIT` s) while it refuses: the site's pass can blind both star trackers, and a mode
-starts on a converged estimate.
 """
 from __future__ import annotations
 
@@ -67,7 +63,8 @@ class MissionExecutive:
     :class:`~att_planner.mission.scheduler.MissionTarget`) ordered by ``scheduler`` (what
     :class:`~att_planner.mission.scheduler.MissionScheduler` answers). ``settle``: the controller's
     hold on a plan's end before it reports it done (s); ``blend``: its blend into a site's law (s);
-    ``converged``: the estimate's health before any :class:`EstimateHealth` (True without an estimator)."""
+    ``converged``: the estimate's health before any :class:`~.executive_io.EstimateHealth` (True without
+    an estimator)."""
 
     def __init__(self, scheduler, targets: dict, *, horizon: float, start_lead: float, time_budget: float,
                  settle: float, blend: float, sensor_axis_B=None, pointing_tolerance: float = 0.0,
@@ -76,14 +73,13 @@ class MissionExecutive:
         self.horizon, self.start_lead, self.time_budget = horizon, start_lead, time_budget
         self.settle, self.blend = settle, blend
         self.sensor_axis_B = np.zeros(3) if sensor_axis_B is None else np.asarray(sensor_axis_B, float)
-        self.pointing_tolerance = pointing_tolerance
-        self.frame_id, self.zone_names = frame_id, tuple(zone_names)
+        self.pointing_tolerance, self.frame_id, self.zone_names = pointing_tolerance, frame_id, tuple(zone_names)
         self.converged, self._health_t = converged, -math.inf
         self.t, self.q_BN = None, None                   # the latest state heard
         self.t_day, self.q_hold_BN, self.holding = None, None, False    # where the day's decisions stand
         self.remaining, self.observed, self.attempts = list(targets), 0, Counter()
         self.phase, self.done, self.ignored = "starting", False, []
-        self._awaited = None        # ("time", until, then, action) or ("request", number, answer types, then, action)
+        self._awaited: io.Awaited | None = None
         self._numbers = itertools.count(1)
         self._out: list = []
 
@@ -101,10 +97,8 @@ class MissionExecutive:
                    frame_id=mission.scenario.frame_id, zone_names=tuple(z.name for z in mission.zones),
                    converged=converged)
 
-    # ---- the event loop ----
-
     def on(self, event: io.ExecutiveEvent) -> list:
-        """Take ``event``; the actions to take, in order (the last one awaits the next event)."""
+        """Take ``event``; the actions to take, in order (:attr:`awaiting` the one to answer)."""
         self._out = []
         if self.done:
             self.ignored.append(event)
@@ -114,8 +108,7 @@ class MissionExecutive:
         if isinstance(event, io.EstimateHealth) and event.t >= self._health_t:
             self.converged, self._health_t = bool(event.converged), event.t
         awaited = self._awaited
-        answer = awaited is not None and awaited[0] == "request" and isinstance(event, awaited[2]) \
-            and event.request == awaited[1]
+        answer = awaited is not None and isinstance(event, awaited.answers) and event.request == awaited.action.request
         if isinstance(event, io.RESULTS) and not answer:
             self.ignored.append(event)
         if self.phase == "starting":
@@ -123,10 +116,10 @@ class MissionExecutive:
                 self._begin()
         elif answer:
             self._awaited = None
-            awaited[3](event)
-        elif awaited is not None and awaited[0] == "time" and self.t >= awaited[1]:
+            awaited.then(event)
+        elif awaited is not None and isinstance(awaited.action, io.WaitUntil) and self.t >= awaited.action.t:
             self._awaited = None
-            awaited[2]()
+            awaited.then()
         return self._out
 
     @property
@@ -134,18 +127,18 @@ class MissionExecutive:
         """The action whose answer the executive waits for (a :class:`~.executive_io.WaitUntil` or a
         request), None before the first state and after the end. An action list may hold waits that
         later events in the same delivery already satisfied: this one is what to answer."""
-        return self._awaited[-1] if self._awaited is not None else None
+        return self._awaited.action if self._awaited is not None else None
 
     def _await_time(self, until: float, phase: str, then: Callable) -> None:
         assert self._awaited is None, "one thing awaited at a time"
         action = io.WaitUntil(until)
-        self._awaited, self.phase = ("time", until, then, action), phase
+        self._awaited, self.phase = io.Awaited(action, then), phase
         self._out.append(action)
 
     def _request(self, make: Callable, phase: str, answers: tuple, then: Callable) -> None:
         assert self._awaited is None, "one thing awaited at a time"
         action = make(next(self._numbers))
-        self._awaited, self.phase = ("request", action.request, answers, then, action), phase
+        self._awaited, self.phase = io.Awaited(action, then, answers), phase
         self._out.append(action)
 
     def _report(self, kind: Kind, target: str = "", start: float = 0.0, end: float = 0.0, plan_id: str = "",
@@ -292,8 +285,6 @@ class MissionExecutive:
         zone until ``start_lead`` from now and the estimate converged."""
         return self.converged and self.scheduler.clear(q_hold_BN, t, t + self.start_lead)
 
-    # ---- slews ----
-
     def _plan(self, name: str, q_from_BN, q_to_BN, t_start: float, budget: float | None, then: Callable) -> None:
         """Ask for the plan; ``then`` its :class:`PlanReturned`, or None after a refusal (reported)."""
         def answered(event):
@@ -405,8 +396,9 @@ class MissionExecutive:
     def _hold(self, name: str | None, then: Callable) -> None:
         """Hold still after reaching or leaving target ``name`` (None: where the day starts) in the
         controller's inertial pointing mode (the mode that dumps momentum): a source's attitude, else
-        the attitude of that moment. After a site the hold is asked again while the controller
-        refuses it (module docstring). ``then`` the attitude held."""
+        the attitude of that moment. After a site, whose pass can blind both star trackers (a mode
+        starts on a converged estimate), the hold is asked again every :data:`RECOVERY_STEP` s, at
+        most :data:`RECOVERY_LIMIT` s, while the controller refuses it. ``then`` the attitude held."""
         target = self.targets[name] if name is not None else None
         fixed = target is not None and not target.moving
         q_BN = target.attitude if fixed else None

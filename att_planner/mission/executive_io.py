@@ -7,7 +7,9 @@ repeats.
 """
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 
@@ -132,6 +134,15 @@ class SetPointing:
 
     request: int
     q_BN: np.ndarray | None = None
+
+
+class Awaited(NamedTuple):
+    """What the executive waits for: the answer to ``action`` (of a type of ``answers``; none for a
+    :class:`~.executive_io.WaitUntil`: the time) and what follows it."""
+
+    action: object
+    then: Callable
+    answers: tuple = ()
 
 
 RESULTS = (PlanReturned, PlanRefused, ManeuverEnded, PointingSet)
