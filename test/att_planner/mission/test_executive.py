@@ -274,31 +274,22 @@ def test_recovery_gives_up_after_its_limit_and_the_day_still_ends():
 
 
 def test_a_ground_site_is_flown_to_its_arrival_dwelt_after_the_blend_and_its_hold_asked_again():
-    class Track:
-        mode = PointingMode("ground")
-
-        def attitudes(self, t):
-            return np.array([q_about_z(float(x) / 100.0) for x in np.atleast_1d(t)])
-
-        def line_of_sight(self, t):
-            return np.array([[1.0, 0.0, 0.0]])
-
-    site = MissionTarget("site", 120.0, track=Track())
+    site = MissionTarget("site", 120.0, track=Site())
     visible_from = 800.0
     ex = executive(Scheduler({"site": 800.0}, visible={"site": visible_from}), [site], horizon=3000.0)
     refused_until = 1025.0              # the hold after the dwell (which ends at 960 s) is refused until then
     world = World(ex, duration=lambda action: 59.0, refuse_hold=lambda t: 900.0 < t < refused_until).run()
     plan = world.plans[0]
     # arrival at the visibility, the plan's goal the law's attitude then, start = arrival - slew estimate
-    assert plan.t_start == visible_from - 60.0 and np.allclose(plan.q_to_BN, Track().attitudes(visible_from)[0])
+    assert plan.t_start == visible_from - 60.0 and np.allclose(plan.q_to_BN, Site().attitudes(visible_from)[0])
     slew = world.reports(Kind.SLEW)[0]
     assert slew.start == visible_from - 59.0                   # the plan's duration within the match: flown
     maneuver = next(x for x in world.actions if isinstance(x, io.StartManeuver))
-    assert maneuver.pointing_after == Track.mode
+    assert maneuver.pointing_after == Site.mode
     end = visible_from - 59.0 + 59.0 + SETTLE
     dwell = world.reports(Kind.DWELL)[0]
     assert (dwell.start, dwell.end) == (end + BLEND, end + BLEND + 120.0)
-    assert dwell.pointing == Track.mode
+    assert dwell.pointing == Site.mode
     # after the dwell the hold (the attitude of the moment) is asked every step until accepted
     after = [x for x in world.actions if isinstance(x, io.SetPointing)][1:]
     t_dwell_end = end + BLEND + 120.0
@@ -357,3 +348,78 @@ def test_repeated_states_and_health_reports_do_not_change_the_day(duplicate):
     noisy = Noisy(executive(Scheduler({"a": 300.0, "b": 900.0}), [a, b])).run()
     assert [(e.t, e.event, e.target, e.start, e.end) for e in noisy.reports()] == \
         [(e.t, e.event, e.target, e.start, e.end) for e in plain.reports()]
+
+
+class Site:
+    """A ground site's track whose law turns about z with time."""
+
+    mode = PointingMode("ground")
+
+    def attitudes(self, t):
+        return np.array([q_about_z(float(x) / 100.0) for x in np.atleast_1d(t)])
+
+    def line_of_sight(self, t):
+        return np.array([[1.0, 0.0, 0.0]])
+
+
+def test_a_site_plan_whose_duration_moves_its_start_is_planned_again_four_times_at_most():
+    site = MissionTarget("site", 120.0, track=Site())
+    ex = executive(Scheduler({"site": 800.0}, visible={"site": 800.0}), [site])
+    world = World(ex, duration=lambda action: 50.0).run()
+    # the arrival fixed at the visibility (800 s); the start from the estimate (60 s), then from the
+    # first plan's duration (50 s, 10 s off): the second plan fits
+    assert [p.t_start for p in world.plans] == [800.0 - 60.0, 800.0 - 50.0]
+    assert world.reports(Kind.SLEW)[0].start == 800.0 - 50.0
+    # a plan longer than the estimate cannot arrive at 800 s from its start: the arrival moves to the
+    # visibility after start + duration and the start stays
+    ex = executive(Scheduler({"site": 800.0}, visible={"site": 800.0}), [site])
+    world = World(ex, duration=lambda action: 70.0).run()
+    assert [p.t_start for p in world.plans] == [740.0, 740.0]
+    assert np.allclose(world.plans[1].q_to_BN, Site().attitudes(740.0 + 70.0)[0])
+    durations = iter([50.0, 40.0, 30.0, 20.0] * exe.MAX_ATTEMPTS)
+    ex = executive(Scheduler({"site": 800.0}, visible={"site": 800.0}), [site])
+    world = World(ex, duration=lambda action: next(durations)).run()
+    refused = [e.message for e in world.reports(Kind.REFUSED)]
+    assert refused == ["four plans did not fit the site's visibility"] * exe.MAX_ATTEMPTS
+    assert len(world.plans) == exe.SITE_PLANS * exe.MAX_ATTEMPTS and not world.reports(Kind.SLEW)
+
+
+def test_a_zone_about_to_cover_the_start_attitude_is_escaped_by_a_quick_park():
+    a, p = source("a", 30.0), source("p", 90.0)
+
+    def clear(q, t0, t1):               # the start attitude is covered from t = 80 s on: clear for the escape lead
+        return not (np.array_equal(q, IDENTITY) and t1 > 80.0)
+    ex = executive(Scheduler({"a": 900.0}, clear=clear, parks=["p"]), [a, p])
+    world = World(ex).run()
+    assert world.logs()[0] == "a zone is about to cover the held attitude: leaving it"
+    escape = world.plans[0]
+    assert (escape.target, escape.t_start, escape.time_budget) == ("p", exe.ESCAPE_LEAD, exe.ESCAPE_BUDGET)
+    park = world.reports(Kind.PARK)[0]
+    assert (park.start, park.end) == (exe.ESCAPE_LEAD + 50.0 + SETTLE, exe.ESCAPE_LEAD + 2.0 * LEAD)
+    assert world.plans[1].target == "a" and np.array_equal(world.plans[1].q_from_BN, p.attitude)
+
+
+def test_after_the_last_target_a_zone_due_at_the_held_attitude_is_left_for_a_park():
+    p = source("p", 90.0)
+    ex = executive(Scheduler({}, keeps=lambda q, t0, t1: not (np.array_equal(q, IDENTITY) and t1 > 150.0),
+                             parks=["p"]), [p], horizon=900.0)
+    world = World(ex).run()
+    assert [(e.event, e.target) for e in world.reports()] == \
+        [(Kind.MISSED, "p"), (Kind.SLEW, "p"), (Kind.PARK, "p"), (Kind.ENDED, "")]
+    park = world.reports(Kind.PARK)[0]
+    assert world.plans[0].t_start == LEAD and (park.start, park.end) == (LEAD + 50.0 + SETTLE, 900.0)
+    assert world.reports(Kind.ENDED)[0].t == 900.0
+
+
+def test_a_refusal_while_the_held_attitude_cannot_start_a_slew_is_not_counted():
+    a = source("a", 30.0)
+
+    def clear(q, t0, t1):               # a zone passes the start attitude's lead from t = 140 s to 200 s
+        return not (np.array_equal(q, IDENTITY) and 140.0 <= t0 < 200.0 and t1 > t0)
+    ex = executive(Scheduler({"a": 300.0}, clear=clear), [a])
+    world = World(ex, refuse_plan=lambda action: action.request == 2).run()   # request 1 is the first hold
+    assert len(world.reports(Kind.REFUSED)) == 1 and ex.attempts["a"] == 0
+    assert "holding: a zone reaches the held attitude" in world.logs()[0]
+    # decided again at the first check clear of the zone (200 s), a's start its arrival - slew or a lead on
+    assert [p.t_start for p in world.plans] == [300.0 - 60.0, max(300.0 - 60.0, 200.0 + LEAD)]
+    assert [e.target for e in world.reports(Kind.DWELL)] == ["a"]
