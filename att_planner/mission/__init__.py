@@ -1,1 +1,1 @@
-"""Missions (issue 17): the target lists a day in orbit observes (:mod:`.targets`)."""
+"""Missions: the target lists a day in orbit observes (:mod:`.targets`)."""

@@ -1,4 +1,4 @@
-"""A mission file (issue 17): which targets to observe, from which scenario, for how long, and how
+"""A mission file: which targets to observe, from which scenario, for how long, and how
 the day is flown. One YAML file under ``config/missions/`` (read with ``yaml.safe_load`` only)::
 
     targets: observatory           # a target list (config/targets/observatory.yaml); its scenario is flown

@@ -1,4 +1,4 @@
-"""The figures of a flown mission (issue 17), measured from its MCAP log alone (no ROS).
+"""The figures of a flown mission, measured from its MCAP log alone (no ROS).
 
 The log's ``/mission/events`` say what was flown (dwells, slews, parks, misses, with why); the truth
 state says how: a target's pointing error is the largest angle, over its dwell, between the body

@@ -1,6 +1,6 @@
-"""Ground sites of a mission (issue 17): when a site can be observed and the attitude that tracks it.
+"""Ground sites of a mission: when a site can be observed and the attitude that tracks it.
 
-A site is observed with the controller's ``ground`` pointing mode (issue 15): the sensor axis on the
+A site is observed with the controller's ``ground`` pointing mode: the sensor axis on the
 line of sight to the site, carried by the Earth's rotation, a secondary body axis as close as
 possible to a named direction (:mod:`att_planner.guidance.laws`). :class:`GroundTrack` gives, over
 an array of times (s past the scenario's epoch):

@@ -1,4 +1,4 @@
-"""A day's observation order (issue 17): which target next, when, and which cannot be observed.
+"""A day's observation order: which target next, when, and which cannot be observed.
 
 The mission flies one slew at a time (each planned and verified by the planner among the moving
 zones), so the order it follows is re-decided from where the spacecraft is, whenever a slew ends or

@@ -1,4 +1,4 @@
-"""Target lists of a mission (issue 17): YAML files of what to observe and for how long.
+"""Target lists of a mission: YAML files of what to observe and for how long.
 
 Two kinds, one file each (``config/targets/``; read with ``yaml.safe_load`` only)::
 
@@ -17,7 +17,7 @@ Two kinds, one file each (``config/targets/``; read with ``yaml.safe_load`` only
 An inertial source becomes a schedule target attitude (:func:`pointing_attitude`): the scenario's
 sensor axis on the source, the body axis after it (x → z → y → x) as near ``roll_reference`` as the
 pointing allows (the vernal equinox where the source lies within a degree of the reference). A
-ground site stays a site: the pointing modes (issue 15) track it through its dwell. Every field is
+ground site stays a site: the pointing modes track it through its dwell. Every field is
 checked; a bad file is refused with a :class:`~att_msgs_py.errors.ConfigError` naming the file,
 the target and the field.
 """

@@ -1,0 +1,498 @@
+"""The mission executive: what a day in orbit does next, decided from events, without ROS.
+
+:class:`MissionExecutive` flies a mission's target list from its first state to the horizon. It is a state
+machine: :meth:`MissionExecutive.on` takes one event (of :mod:`.executive_io`: :class:`Tick`, a state
+heard at sim time ``t``; :class:`EstimateHealth`; the answer to one of its requests) and returns the
+actions to take (:class:`Report` a mission event, :class:`Log`, :class:`WaitUntil` a sim time,
+:class:`RequestPlan`, :class:`StartManeuver`, :class:`SetPointing`). Time comes in the events only:
+there is no clock, thread or sleep inside. At most one thing is awaited at a time, a sim time or the
+answer to the request carrying the pending ``request`` number; an answer with another number (late,
+repeated, unknown) is ignored and kept in :attr:`MissionExecutive.ignored`, a state older than the
+latest is ignored for the time and attitude. What the executive waits for now is :attr:`phase`.
+
+The decisions, each from where the spacecraft holds at that moment:
+
+1. :class:`~att_planner.mission.scheduler.MissionScheduler` decides the order (targets no zone leaves
+   visible for their dwell before the horizon are missed, with the zone that covers them);
+2. the first of the order's first three targets whose slew can wait for its start at the held
+   attitude clear of the zones is planned ``start_lead`` s of sim time before its start (later when
+   the target becomes visible later), planned again when it would arrive before the target is
+   visible (three plans at most; a ground site: its arrival fixed first, four plans at most);
+3. when none can wait there, the spacecraft parks at a source clear until the first one's start
+   (the nearest three tried), or holds for :data:`RECOVERY_STEP` s, and decides again;
+4. the controller flies the plan and holds the target for its dwell (a ground site after the
+   controller's blend into its law); then back to 1. A slew the planner or the controller refuses
+   counts as an attempt at its target when the held attitude can start another slew: after
+   :data:`MAX_ATTEMPTS` attempts the target is missed;
+5. a held attitude that cannot start a slew (estimate not converged, a zone or the trackers' blind
+   sky within the lead) is recovered: left for a park when a zone is about to cover it and the
+   estimate is converged, else held until a slew can start (checked every :data:`RECOVERY_STEP` s,
+   :data:`RECOVERY_LIMIT` s at most);
+6. with no target left, the spacecraft holds until the horizon, leaving a zone's path by a park, and
+   reports the end.
+"""
+from __future__ import annotations
+
+import itertools
+import math
+from collections import Counter
+from collections.abc import Callable
+
+import numpy as np
+
+from att_msgs_py.types import MissionEvent
+from att_msgs_py.types import MissionEventKind as Kind
+from att_planner.mission import executive_io as io
+from att_planner.mission.scheduler import MissionScheduler
+
+SITE_DURATION_MATCH = 2.0      # s: a site's plan starts within this of the start its sky was planned for
+SITE_ARRIVAL_SLACK = 1.0       # s: a slew to a site must arrive within this of the site's visibility
+SLEW_FACTOR = 1.25             # planned slew / bang-coast-bang estimate (1.18 measured on the rate-bounded day)
+MAX_ATTEMPTS = 2               # slews refused per target before it is missed
+SOURCE_PLANS = 3               # plans of one slew to a source that arrive before it is visible, at most
+SITE_PLANS = 4                 # plans of one slew to a ground site that do not fit its visibility, at most
+PARKS_TRIED = 3                # nearest park sources tried per park
+RECOVERY_STEP = 10.0           # s of sim time between the checks of a held attitude that cannot start a slew
+RECOVERY_LIMIT = 1800.0        # s of sim time a mission waits for it at most
+ESCAPE_LEAD = 60.0             # s of sim time from the request to the start of a slew away from a zone's path
+ESCAPE_BUDGET = 2.0            # s of wall time the planner gets for it
+
+
+class MissionExecutive:
+    """The decisions of one mission (module docstring) over ``targets`` (name ->
+    :class:`~att_planner.mission.scheduler.MissionTarget`) ordered by ``scheduler`` (what
+    :class:`~att_planner.mission.scheduler.MissionScheduler` answers). ``settle``: the controller's
+    hold on a plan's end before it reports it done (s); ``blend``: its blend into a site's law (s);
+    ``converged``: the estimate's health before any :class:`~.executive_io.EstimateHealth` (True without
+    an estimator)."""
+
+    def __init__(self, scheduler, targets: dict, *, horizon: float, start_lead: float, time_budget: float,
+                 settle: float, blend: float, sensor_axis_B=None, pointing_tolerance: float = 0.0,
+                 frame_id: str = "", zone_names: tuple = (), converged: bool = False):
+        self.scheduler, self.targets = scheduler, targets
+        self.horizon, self.start_lead, self.time_budget = horizon, start_lead, time_budget
+        self.settle, self.blend = settle, blend
+        self.sensor_axis_B = np.zeros(3) if sensor_axis_B is None else np.asarray(sensor_axis_B, float)
+        self.pointing_tolerance, self.frame_id, self.zone_names = pointing_tolerance, frame_id, tuple(zone_names)
+        self.converged, self._health_t = converged, -math.inf
+        self.t, self.q_BN = None, None                   # the latest state heard
+        self.t_day, self.q_hold_BN, self.holding = None, None, False    # where the day's decisions stand
+        self.remaining, self.observed, self.attempts = list(targets), 0, Counter()
+        self.phase, self.done, self.ignored = "starting", False, []
+        self._awaited: io.Awaited | None = None
+        self._numbers = itertools.count(1)
+        self._out: list = []
+
+    @classmethod
+    def of_mission(cls, mission, settle: float, converged: bool) -> MissionExecutive:
+        """The executive of a :class:`~att_planner.mission.config.MissionConfig`, its scheduler as the
+        mission file says (the controller's ``settle``; the estimate's health at the start)."""
+        targets = mission.targets()
+        scheduler = MissionScheduler(mission.scenario, targets, mission.horizon, zones=mission.zones,
+                                     margin=mission.margin, lead=mission.start_lead, rate_max=mission.rate_max,
+                                     slew_factor=SLEW_FACTOR, settle=settle, blend=mission.handover_blend)
+        return cls(scheduler, targets, horizon=mission.horizon, start_lead=mission.start_lead,
+                   time_budget=mission.time_budget, settle=settle, blend=mission.handover_blend,
+                   sensor_axis_B=mission.sensor_axis, pointing_tolerance=mission.pointing_tolerance,
+                   frame_id=mission.scenario.frame_id, zone_names=tuple(z.name for z in mission.zones),
+                   converged=converged)
+
+    def on(self, event: io.ExecutiveEvent) -> list:
+        """Take ``event``; the actions to take, in order (:attr:`awaiting` the one to answer)."""
+        self._out = []
+        if self.done:
+            self.ignored.append(event)
+            return self._out
+        if self.t is None or event.t >= self.t:
+            self.t, self.q_BN = float(event.t), np.asarray(event.q_BN, float)
+        if isinstance(event, io.EstimateHealth) and event.t >= self._health_t:
+            self.converged, self._health_t = bool(event.converged), event.t
+        awaited = self._awaited
+        answer = awaited is not None and isinstance(event, awaited.answers) and event.request == awaited.action.request
+        if isinstance(event, io.RESULTS) and not answer:
+            self.ignored.append(event)
+        if self.phase == "starting":
+            if isinstance(event, io.Tick):
+                self._begin()
+        elif answer:
+            self._awaited = None
+            awaited.then(event)
+        elif awaited is not None and isinstance(awaited.action, io.WaitUntil) and self.t >= awaited.action.t:
+            self._awaited = None
+            awaited.then()
+        return self._out
+
+    @property
+    def awaiting(self):
+        """The action whose answer the executive waits for (a :class:`~.executive_io.WaitUntil` or a
+        request), None before the first state and after the end. An action list may hold waits that
+        later events in the same delivery already satisfied: this one is what to answer."""
+        return self._awaited.action if self._awaited is not None else None
+
+    def _await_time(self, until: float, phase: str, then: Callable) -> None:
+        assert self._awaited is None, "one thing awaited at a time"
+        action = io.WaitUntil(until)
+        self._awaited, self.phase = io.Awaited(action, then), phase
+        self._out.append(action)
+
+    def _request(self, make: Callable, phase: str, answers: tuple, then: Callable) -> None:
+        assert self._awaited is None, "one thing awaited at a time"
+        action = make(next(self._numbers))
+        self._awaited, self.phase = io.Awaited(action, then, answers), phase
+        self._out.append(action)
+
+    def _report(self, kind: Kind, target: str = "", start: float = 0.0, end: float = 0.0, plan_id: str = "",
+                message: str = "") -> None:
+        q_BN, direction_N, pointing = np.array([0.0, 0.0, 0.0, 1.0]), np.zeros(3), None
+        if target:
+            at = start or self.t
+            q_BN, direction_N = self.targets[target].attitudes(at)[0], self.targets[target].direction_at(at)
+            pointing = self.targets[target].track.mode if self.targets[target].moving else None
+        self._out.append(io.Report(MissionEvent(
+            self.t, kind, target, start, end, q_BN, direction_N, self.sensor_axis_B if target else np.zeros(3),
+            self.pointing_tolerance if target else 0.0, plan_id, message, self.frame_id, pointing, self.zone_names)))
+
+    def _log(self, t: float, text: str) -> None:
+        self._out.append(io.Log(t, text))
+
+    # ---- the day (decisions 1-4 and 6) ----
+
+    def _begin(self) -> None:
+        self.t_day, self.q_hold_BN = self.t, self.q_BN
+        self._next()
+
+    def _next(self) -> None:
+        """Decide again from where the spacecraft holds, or end the day."""
+        if not (self.remaining and self.t_day < self.horizon):
+            return self._finish()
+        if not self.startable(self.q_hold_BN, self.t_day):
+            return self._recover(self.q_hold_BN, self.t_day, math.inf, self._recovered)
+        self._recovered((self.q_hold_BN, self.t_day))
+
+    def _recovered(self, held: tuple) -> None:
+        self.q_hold_BN, self.t_day = held
+        if self.holding:
+            return self._decide()
+
+        def held_here(q_BN):               # the attitude the day starts at, held (not left to drift)
+            self.q_hold_BN, self.holding = q_BN, True
+            self._decide()
+        self._hold(None, held_here)
+
+    def _decide(self) -> None:
+        t, q_hold_BN = self.t_day, self.q_hold_BN
+        decision = self.scheduler.decide(t, q_hold_BN, self.remaining)
+        for name, why in decision.missed.items():
+            self._report(Kind.MISSED, name, message=why)
+            self.remaining.remove(name)
+        if not decision.order:
+            return self._finish()
+        self._report(Kind.SCHEDULED, message="order " + ", ".join(
+            f"{k} at {a:.0f} s" for k, a in zip(decision.order, decision.arrivals)))
+        name, t_start = self.next_slew(decision, q_hold_BN, t)
+        if name is not None:
+            return self._await_time(t_start - self.start_lead, "waiting", lambda: self._slew(name, t_start))
+
+        def parked(result):                # the held attitude cannot wait: park, then decide again
+            if result is not None:
+                self.q_hold_BN, self.t_day = result
+                return self._next()
+            self._log(t, f"no source to park at until t = {t_start:.0f} s: holding")
+            self._await_time(t + RECOVERY_STEP, "holding", self._stepped)
+        self._park(q_hold_BN, t, t_start, None, None, parked)
+
+    def _stepped(self) -> None:
+        self.t_day = self.t
+        self._next()
+
+    def next_slew(self, decision, q_hold_BN, t: float) -> tuple:
+        """The first of the decided order's first three targets whose slew can wait for its start at
+        ``q_hold_BN`` clear of the zones: (name, start) or (None, the first target's start)."""
+        first = None
+        for name, arrival in list(zip(decision.order, decision.arrivals))[:3]:
+            start = max(t + self.start_lead, arrival - self.scheduler.slew_to(name, q_hold_BN, arrival))
+            first = start if first is None else first
+            if self.scheduler.clear(q_hold_BN, t, start):
+                return name, start
+        return None, first
+
+    def _slew(self, name: str, t_start: float) -> None:
+        self.t_day = self.t
+        t_start = max(t_start, self.t_day + self.start_lead)
+        if self.targets[name].moving:
+            return self._fly_to_site(name, self.q_hold_BN, t_start, lambda end: self._arrived(name, end))
+        self._fly(name, self.q_hold_BN, t_start, True, None, lambda end: self._arrived(name, end))
+
+    def _arrived(self, name: str, end: float | None) -> None:
+        target = self.targets[name]
+        if end is None:
+            self.q_hold_BN, self.t_day = self.q_BN, self.t
+            if self.startable(self.q_hold_BN, self.t_day):     # the slew itself was refused: the target's count
+                self.count_attempt(name)
+            return self._next()
+        start = self.scheduler.observable_from(name, end)
+        if start is None or (start > end + SITE_ARRIVAL_SLACK if target.moving
+                             else not self.scheduler.clear(target.attitude, end, start)):
+            self._report(Kind.REFUSED, name, message="arrived too late for this visibility window: deciding again")
+            self.count_attempt(name)
+
+            def held(q_BN):
+                self.q_hold_BN, self.t_day = q_BN, self.t
+                self._next()
+            return self._hold(name, held)
+        if target.moving:                              # the controller blends into the site's law first
+            return self._dwell(name, end + self.blend)
+        self._hold(name, lambda _q_BN: self._dwell(name, start))
+
+    def _dwell(self, name: str, start: float) -> None:
+        target = self.targets[name]
+        self._report(Kind.DWELL, name, start, start + target.dwell, message=f"observing for {target.dwell:g} s")
+
+        def observed(q_BN):
+            self.q_hold_BN = q_BN
+            self.remaining.remove(name)
+            self.observed += 1
+            self._next()
+
+        def dwelt():
+            self.t_day = self.t
+            if target.moving:
+                return self._hold(name, observed)
+            observed(target.attitude)
+        self._await_time(start + target.dwell, "dwelling", dwelt)
+
+    def count_attempt(self, name: str) -> None:
+        """One more failed attempt at target ``name``: missed after :data:`MAX_ATTEMPTS`."""
+        self.attempts[name] += 1
+        if self.attempts[name] >= MAX_ATTEMPTS:
+            self.remaining.remove(name)
+            self._report(Kind.MISSED, name, message=f"{MAX_ATTEMPTS} attempts at it failed (above)")
+
+    def _finish(self) -> None:
+        for name in self.remaining:
+            self._report(Kind.MISSED, name, message=f"not reached before the mission ended (horizon "
+                                                    f"{self.horizon:g} s)")
+        self._hold_until(self.q_hold_BN, self.t_day, self.horizon, self._ended)
+
+    def _ended(self) -> None:
+        self._report(Kind.ENDED, message=f"{self.observed} targets held for their dwell, "
+                                         f"{len(self.targets) - self.observed} missed or not reached at "
+                                         f"t = {self.t:.0f} s")
+        self.phase, self.done = "ended", True
+
+    def startable(self, q_hold_BN, t: float) -> bool:
+        """Whether a slew can start from ``q_hold_BN`` soon after ``t``: the attitude clear of every
+        zone until ``start_lead`` from now and the estimate converged."""
+        return self.converged and self.scheduler.clear(q_hold_BN, t, t + self.start_lead)
+
+    def _plan(self, name: str, q_from_BN, q_to_BN, t_start: float, budget: float | None, then: Callable) -> None:
+        """Ask for the plan; ``then`` its :class:`PlanReturned`, or None after a refusal (reported)."""
+        def answered(event):
+            if isinstance(event, io.PlanRefused):
+                self._report(Kind.REFUSED, name, message=f"planner: code {event.code}: {event.message}")
+                return then(None)
+            then(event)
+        budget = budget or self.time_budget
+        self._request(lambda number: io.RequestPlan(number, name, q_from_BN, q_to_BN, t_start, budget), "planning",
+                      (io.PlanReturned, io.PlanRefused), answered)
+
+    def _fly(self, name: str, q_from_BN, t_start: float, wait_for_visibility: bool, budget: float | None,
+             then: Callable) -> None:
+        """Plan the slew to source ``name`` from ``q_from_BN`` starting at ``t_start`` and fly it;
+        ``then`` its end time, or None after a refusal (none while the estimate is not converged). A
+        plan that would arrive before the target is visible for its dwell (``wait_for_visibility``)
+        is planned again to arrive then."""
+        q_to_BN = self.targets[name].attitude
+        if not self.converged:
+            return then(None)
+        plans = 0
+
+        def planned(plan):
+            nonlocal plans, t_start
+            if plan is None:
+                return then(None)
+            plans += 1
+            arrival = t_start + plan.duration + self.settle          # the controller reports it done then
+            visible = self.scheduler.observable_from(name, arrival) if wait_for_visibility else arrival
+            if visible is None:
+                self._report(Kind.REFUSED, name, message=f"the slew would arrive at {arrival:.0f} s, after the "
+                                                         "target's last visibility before the horizon")
+                return then(None)
+            if visible <= arrival + 1.0:
+                return self._execute(name, plan, t_start, None, then)
+            if plans == SOURCE_PLANS:
+                self._report(Kind.REFUSED, name, message=f"three slews arrived before the target is visible "
+                                                         f"at {visible:.0f} s")
+                return then(None)
+            t_start = visible - plan.duration - self.settle
+            self._plan(name, q_from_BN, q_to_BN, t_start, budget, planned)
+        self._plan(name, q_from_BN, q_to_BN, t_start, budget, planned)
+
+    def _fly_to_site(self, name: str, q_from_BN, t_start: float, then: Callable) -> None:
+        """Plan a slew from ``q_from_BN``, starting at ``t_start`` or later, that arrives at rest on
+        ground site ``name``'s tracking attitude when the site is visible for its blend and dwell, and
+        fly it, handing over to the site's pointing mode; ``then`` the arrival time, or None. The
+        arrival ``T`` is fixed first (the site's law at ``T`` is the plan's goal), then the start
+        ``T - duration`` (planned again while the plan's duration moves its start's sky by more than
+        :data:`SITE_DURATION_MATCH` s)."""
+        target = self.targets[name]
+        if not self.converged:
+            return then(None)
+        arrival = self.scheduler.observable_from(name, t_start + self.scheduler.slew_to(name, q_from_BN, t_start))
+        duration, guess, plans = None, None, 0
+
+        def attempt():
+            nonlocal guess
+            if plans == SITE_PLANS:
+                self._report(Kind.REFUSED, name, message="four plans did not fit the site's visibility")
+                return then(None)
+            if arrival is None:
+                self._report(Kind.REFUSED, name, message="the slew cannot arrive before the site's last "
+                                                         "visibility before the horizon")
+                return then(None)
+            guess = duration or self.scheduler.slew_to(name, q_from_BN, t_start)
+            self._plan(name, q_from_BN, target.attitudes(arrival)[0], max(t_start, arrival - guess), None, planned)
+
+        def planned(plan):
+            nonlocal duration, arrival, plans
+            if plan is None:
+                return then(None)
+            duration, plans = plan.duration, plans + 1
+            if arrival - duration < t_start:               # longer than estimated: a later visibility
+                arrival = self.scheduler.observable_from(name, t_start + duration)
+                return attempt()
+            if abs(duration - guess) <= SITE_DURATION_MATCH:
+                return self._execute(name, plan, arrival - duration, target.track.mode, then)
+            attempt()
+        attempt()
+
+    def _execute(self, name: str, plan: io.PlanReturned, t_start: float, pointing_after, then: Callable) -> None:
+        """Fly ``plan`` from ``t_start`` (``pointing_after``: the mode the controller hands over to at
+        its end); ``then`` the time the controller reports it done, or None after a refusal."""
+        late = self.t - t_start
+        if late > 0:            # never flown: no slew event (a slew event is a slew started)
+            self._report(Kind.REFUSED, name, plan_id=plan.plan_id,
+                         message=f"planning ended {late:.1f} s of sim time after the slew's start ({plan.method}, "
+                                 f"planned in {plan.solve_seconds:.2f} s): start_lead is too short")
+            return then(None)
+        self._report(Kind.SLEW, name, t_start, t_start + plan.duration, plan.plan_id,
+                     f"{plan.method} {plan.duration:.1f} s, {math.degrees(plan.min_cone_margin):.2f} deg "
+                     f"from the zones, planned in {plan.solve_seconds:.2f} s")
+
+        def flown(event):
+            if not event.success:
+                self._report(Kind.REFUSED, name, plan_id=plan.plan_id,
+                             message=f"controller: code {event.code}: {event.message}")
+                return then(None)
+            then(self.t)
+
+        def start():
+            self._request(lambda number: io.StartManeuver(number, plan.plan_id, plan.duration, pointing_after),
+                          "slewing", (io.ManeuverEnded,), flown)
+        self._await_time(t_start, "waiting", start)
+
+    # ---- holds, parks and recovery (decisions 3, 5 and 6) ----
+
+    def _hold(self, name: str | None, then: Callable) -> None:
+        """Hold still after reaching or leaving target ``name`` (None: where the day starts) in the
+        controller's inertial pointing mode (the mode that dumps momentum): a source's attitude, else
+        the attitude of that moment. After a site, whose pass can blind both star trackers (a mode
+        starts on a converged estimate), the hold is asked again every :data:`RECOVERY_STEP` s, at
+        most :data:`RECOVERY_LIMIT` s, while the controller refuses it. ``then`` the attitude held."""
+        target = self.targets[name] if name is not None else None
+        fixed = target is not None and not target.moving
+        q_BN = target.attitude if fixed else None
+        t = self.t
+        end = t + (RECOVERY_LIMIT if target is not None and target.moving else 0.0)
+        asked, refusals = t, 0
+
+        def answered(event):
+            nonlocal refusals
+            if not event.success:
+                refusals += 1
+                if refusals == 1:
+                    self._log(t, f"the controller refused the hold {name or 'here'} (code {event.code}: "
+                                 f"{event.message})" + (f": still tracking it, asking every {RECOVERY_STEP:g} s"
+                                                        if end > t else ""))
+                if asked < end:
+                    return self._await_time(asked + RECOVERY_STEP, "holding", ask)
+            then(target.attitude if fixed else self.q_BN)
+
+        def ask(first: bool = False):
+            nonlocal asked
+            if not first:
+                asked = self.t
+            self._request(lambda number: io.SetPointing(number, q_BN), "holding", (io.PointingSet,), answered)
+        ask(first=True)
+
+    def _park(self, q_hold_BN, t: float, until: float, lead: float | None, budget: float | None,
+              then: Callable) -> None:
+        """Slew to a source that stays visible until ``until`` (:meth:`MissionScheduler.parks`, the
+        nearest :data:`PARKS_TRIED`), starting ``lead`` s after ``t`` (default ``start_lead``), planned
+        in ``budget``, and hold it; ``then`` (its attitude, the time after) or None when none was flown."""
+        names = self.scheduler.parks(q_hold_BN, t, until)[:PARKS_TRIED]
+
+        def attempt(i: int, t: float):
+            if i == len(names):
+                return then(None)
+            name = names[i]
+
+            def flown(end):
+                if end is None:
+                    return attempt(i + 1, self.t)
+                self._report(Kind.PARK, name, end, max(end, until),
+                             message=f"waiting at {name} until t = {until:.0f} s" if end < until else
+                             f"parked at {name} after the t = {until:.0f} s it was to wait until: deciding again")
+                self._hold(name, lambda q_BN: then((q_BN, end)))
+            self._fly(name, q_hold_BN, t + (lead or self.start_lead), False, budget, flown)
+        attempt(0, t)
+
+    def _recover(self, q_hold_BN, t: float, until: float, then: Callable) -> None:
+        """Get back to where a slew can start (:meth:`startable`): with a converged estimate a zone is
+        about to cover the held attitude, so leave it while it is clear for :data:`ESCAPE_LEAD` s (a
+        park planned in :data:`ESCAPE_BUDGET` s); else (or when no park was flown) hold until a slew
+        can start, at most :data:`RECOVERY_LIMIT` s and not past ``until``. ``then`` (the attitude
+        held, the time then)."""
+        def hold_still():
+            why = ("the estimate is not converged" if not self.converged else
+                   "a zone reaches the held attitude, or no tracker sees the sky, within the lead")
+            self._log(t, f"holding: {why}")
+            check(t)
+
+        end = min(t + RECOVERY_LIMIT, until)
+
+        def check(t_now: float):
+            if t_now < end and not self.startable(q_hold_BN, t_now):
+                return self._await_time(t_now + RECOVERY_STEP, "recovering", lambda: check(self.t))
+            then((q_hold_BN, t_now))
+
+        if self.converged and self.scheduler.clear(q_hold_BN, t, t + ESCAPE_LEAD):
+            self._log(t, "a zone is about to cover the held attitude: leaving it")
+            return self._park(q_hold_BN, t, t + ESCAPE_LEAD + 2.0 * self.start_lead, ESCAPE_LEAD, ESCAPE_BUDGET,
+                              lambda parked: then(parked) if parked is not None else hold_still())
+        hold_still()
+
+    def _hold_until(self, q_hold_BN, t: float, until: float, then: Callable) -> None:
+        """With nothing left to observe, hold (dumping) until ``until`` (the horizon: the day is flown
+        whole); a zone due at the held attitude within two leads is left for a park at a source clear
+        for :data:`RECOVERY_LIMIT` s (or until ``until``), within one lead as :meth:`_recover` does
+        (no slew follows: the trackers' view of the sky does not matter here)."""
+        lead = self.start_lead
+
+        def step(q_BN, t_now: float):
+            self._await_time(min(until, t_now + RECOVERY_STEP), "holding", lambda: loop(q_BN, self.t))
+
+        def loop(q_BN, t_now: float):
+            if t_now >= until:
+                return then()
+            if self.scheduler.keeps_zones(q_BN, t_now, min(until, t_now + 2.0 * lead)):
+                return step(q_BN, t_now)
+
+            def parked(result):
+                if result is not None:
+                    return loop(*result)
+                if not self.scheduler.keeps_zones(q_BN, t_now, min(until, t_now + lead)):
+                    return self._recover(q_BN, t_now, until, lambda held: step(*held))
+                step(q_BN, t_now)
+            self._park(q_BN, t_now, min(until, t_now + RECOVERY_LIMIT), None, None, parked)
+        loop(q_hold_BN, t)
