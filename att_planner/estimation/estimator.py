@@ -282,7 +282,7 @@ class Estimator:
             P_att, P_bias = np.eye(3) * LOST_COVARIANCE, np.eye(3) * self.config.initial_bias_sigma**2
             q, bias = self.last_q, self.last_bias
         else:
-            P_att, P_bias, q, bias = x.P[:3, :3].copy(), x.P[3:, 3:].copy(), x.q, x.bias
+            P_att, P_bias, q, bias = x.P[:3, :3].copy(), x.P[3:, 3:].copy(), x.q_BN, x.bias_B
             self.last_q, self.last_bias = q, bias
         return AttitudeEstimate(t=t, q=q.copy(), omega=omega_measured - bias, gyro_bias=bias.copy(),
                                 attitude_covariance=P_att, bias_covariance=P_bias, health=int(health),
@@ -317,7 +317,7 @@ class Estimator:
         steps = self.reprocess_steps(start)
         request = next(steps, None)
         while request is not None:
-            request = resume(steps, mekf.update(*request) if isinstance(request, mekf.Correction)
+            request = resume(steps, mekf.update([request])[0] if isinstance(request, mekf.Correction)
                              else self.propagate_to(*request))
 
     def reprocess_steps(self, start: int):
@@ -364,8 +364,8 @@ class Estimator:
         if x is None or t <= x.t:
             return x
         dt, extra = self.interval(x, t, saturated)
-        x = mekf.propagate(x, omega, dt, self.config.arw, self.config.rrw, self.consider, extra)
-        return self.checked(t, x, mekf.healthy(x.P))
+        x = mekf.propagate([x], omega[None], [dt], self.config.arw, self.config.rrw, self.consider, [extra])[0]
+        return self.checked(t, x, mekf.healthy(x.P[None])[0])
 
     def interval(self, x: mekf.FilterState, t: float, saturated: bool) -> tuple[float, float]:
         """``dt`` from ``x`` to ``t`` and the attitude variance a saturated sample adds over it."""
@@ -391,20 +391,20 @@ class Estimator:
             name, q_S = r.data
             mounting = self.trackers[name].mounting
             C = rot.dcm(mounting)
-            y = mekf.attitude_residual(x.q, rot.multiply(q_S, rot.conjugate(mounting)))
+            y = mekf.attitude_residual(x.q_BN, rot.multiply(q_S, rot.conjugate(mounting)))
             H, R = mekf.attitude_sensitivity(), C @ self.trackers[name].covariance @ C.T
         elif r.t - self.last_tracker <= self.config.vector_fallback_after or self.environment is None:
             return x
         else:
             reference, measured, R = self._vector(r)
-            y, H = mekf.vector_residual(x.q, measured, reference)
+            y, H = mekf.vector_residual(x.q_BN, measured, reference)
         first = r.accepted is None
         result = yield mekf.Correction(x, y, H, R, self.gates[3] if first else math.inf)
         if first and self._decided(r, result):
             return self._lose(r.t, f"{self.config.lost_after} star tracker measurements in a row rejected")
         if not (r.accepted and result.accepted):
             return x
-        if not mekf.healthy(result.state.P):
+        if not mekf.healthy(result.state.P[None])[0]:
             return self._lose(r.t, f"covariance not positive definite after a {r.kind} update at t = {r.t:.3f} s")
         self.last_update = max(self.last_update, r.t)
         if r.kind == "tracker":

@@ -4,8 +4,8 @@ The runs of a Monte Carlo task step in lockstep: at each step every run's estima
 (catches up with its gyro sample, replays a late tracker sample). :func:`reprocess_together` runs
 their :meth:`Estimator.reprocess_steps <att_planner.estimation.estimator.Estimator.reprocess_steps>`
 side by side and, at each turn, propagates the filters of one tuning as one stack
-(:func:`att_planner.estimation.mekf.propagate_runs`) and makes the Kalman updates asked as stacks
-(:func:`att_planner.estimation.mekf.update_runs`), each to the bits it reaches alone; each
+(:func:`att_planner.estimation.mekf.propagate`) and makes the Kalman updates asked as stacks
+(:func:`att_planner.estimation.mekf.update`), each to the bits it reaches alone; each
 estimator's own operations keep their order.
 """
 from __future__ import annotations
@@ -50,10 +50,10 @@ def _largest_variances(estimators: list[Estimator]) -> None:
 
 def _answer_together(requests: list[tuple[Estimator, tuple]]) -> list:
     """The answer to each estimator's request: its Kalman updates (:class:`~.mekf.Correction`)
-    as stacks (:func:`~.mekf.update_runs`), its propagations by :func:`_propagate_together`."""
+    as stacks (:func:`~.mekf.update`), its propagations by :func:`_propagate_together`."""
     out = [None] * len(requests)
     corrections = [i for i, (_, request) in enumerate(requests) if isinstance(request, mekf.Correction)]
-    for i, answer in zip(corrections, mekf.update_runs([requests[i][1] for i in corrections])):
+    for i, answer in zip(corrections, mekf.update([requests[i][1] for i in corrections])):
         out[i] = answer
     propagations = [i for i, (_, request) in enumerate(requests) if not isinstance(request, mekf.Correction)]
     for i, answer in zip(propagations, _propagate_together([requests[i] for i in propagations])):
@@ -79,9 +79,9 @@ def _propagate_together(requests: list[tuple[Estimator, tuple]]) -> list:
             states.append(x)
             omegas.append(omega)
             intervals.append(e.interval(x, t, saturated))
-        propagated = mekf.propagate_runs(states, np.array(omegas), [dt for dt, _ in intervals], first.config.arw,
+        propagated = mekf.propagate(states, np.array(omegas), [dt for dt, _ in intervals], first.config.arw,
                                          first.config.rrw, first.consider, [extra for _, extra in intervals])
-        for i, x, ok in zip(stack, propagated, mekf.healthy_runs(np.array([x.P for x in propagated]))):
+        for i, x, ok in zip(stack, propagated, mekf.healthy(np.array([x.P for x in propagated]))):
             e, (_, _, t, _) = requests[i]
             out[i] = e.checked(t, x, ok)
     return out

@@ -90,8 +90,8 @@ def test_a_late_tracker_measurement_is_applied_at_its_instant():
     for _, m in queue:
         late.on_star_tracker(m)
     a, b = late.state, in_order.state
-    assert rot.angle_between(a.q, b.q) < 1e-12 and np.allclose(a.P, b.P, rtol=1e-9, atol=1e-30)
-    assert rot.angle_between(a.q, truth(5.0)) < 1e-9 and late.health(5.0) == Health.CONVERGED
+    assert rot.angle_between(a.q_BN, b.q_BN) < 1e-12 and np.allclose(a.P, b.P, rtol=1e-9, atol=1e-30)
+    assert rot.angle_between(a.q_BN, truth(5.0)) < 1e-9 and late.health(5.0) == Health.CONVERGED
 
 
 def test_initialisation_from_the_first_tracker_or_from_quest_on_sun_and_field():
@@ -302,5 +302,5 @@ def test_estimators_reprocessed_together_reach_the_states_they_reach_alone():
     for (a, _, _), (b, _, _) in zip(alone, together):
         assert (a.state is None) == (b.state is None) and a.rejected == b.rejected and a.lost_at == b.lost_at
         if a.state is not None:
-            for name in ("t", "q", "bias", "P", "C"):
+            for name in ("t", "q_BN", "bias_B", "P", "C"):
                 np.testing.assert_array_equal(getattr(a.state, name), getattr(b.state, name))
