@@ -48,14 +48,14 @@ def test_filters_propagated_as_one_stack_reach_the_bits_they_reach_alone():
         states.append(mekf.FilterState(1.0, q / np.linalg.norm(q), rng.normal(0, 1e-5, 3), A @ A.T * 1e-8))
         rates.append(rng.normal(0, 10.0 ** -k, 3))        # down to 1e-5 rad/s: the series branch
     dts, extras = rng.uniform(0.02, 0.2, 6), [0.0, 1e-9, 0.0, 0.0, 0.0, 2e-10]
-    together = mekf.propagate(states, np.array(rates), dts, 1e-6, 1e-9, consider, extras)
-    together = mekf.propagate(together, np.array(rates), dts, 1e-6, 1e-9, consider, extras)   # C ≠ 0 now
-    for x, w, dt, extra, got in zip(states, rates, dts, extras, together):
+    batch = mekf.propagate(states, np.array(rates), dts, 1e-6, 1e-9, consider, extras)
+    batch = mekf.propagate(batch, np.array(rates), dts, 1e-6, 1e-9, consider, extras)   # C ≠ 0 now
+    for x, w, dt, extra, got in zip(states, rates, dts, extras, batch):
         alone = mekf.propagate(mekf.propagate([x], w[None], [dt], 1e-6, 1e-9, consider, [extra]), w[None], [dt],
                                1e-6, 1e-9, consider, [extra])[0]
         for name in ("t", "q_BN", "bias_B", "P", "C"):
             np.testing.assert_array_equal(getattr(got, name), getattr(alone, name))
-    stack = np.array([x.P for x in together])
+    stack = np.array([x.P for x in batch])
     assert mekf.healthy(stack) == [True] * 6
     stack[2, 0, 0], stack[4, 1, 1] = -1.0, np.nan
     assert mekf.healthy(stack) == [True, True, False, True, False, True]
@@ -79,14 +79,14 @@ def test_kalman_updates_as_stacks_reach_the_bits_they_reach_alone():
         corrections.append(mekf.Correction(x, y, H, np.eye(3) * 1e-8 * (1 + k % 4), 30.0 if k % 2 else math.inf))
     singular = mekf.Correction(corrections[0].x, np.ones(3), np.zeros((3, 6)), np.zeros((3, 3)))     # S = 0
     for cs in (corrections, corrections + [singular]):
-        together = mekf.update(cs)
-        for c, got in zip(cs, together):
+        batch = mekf.update(cs)
+        for c, got in zip(cs, batch):
             alone = mekf.update([c])[0]
             assert (got.accepted, repr(got.d2)) == (alone.accepted, repr(alone.d2))
             for name in ("t", "q_BN", "bias_B", "P", "C"):
                 np.testing.assert_array_equal(getattr(got.state, name), getattr(alone.state, name))
-    assert 0 < sum(u.accepted for u in together) < len(corrections)
-    assert not together[-1].accepted and together[-1].d2 == math.inf and together[-1].state is singular.x
+    assert 0 < sum(u.accepted for u in batch) < len(corrections)
+    assert not batch[-1].accepted and batch[-1].d2 == math.inf and batch[-1].state is singular.x
 
 
 def test_process_noise_matches_van_loans_discretisation():
