@@ -35,12 +35,12 @@ def _unit(v) -> np.ndarray:
     return v / n
 
 
-def triad(b1, b2, r1, r2) -> np.ndarray:
-    """Body-to-inertial quaternion from two observations (``b`` body, ``r`` inertial); the first
-    pair is matched exactly. ValueError when either pair is parallel (no attitude)."""
-    b1, b2, r1, r2 = (_unit(v) for v in (b1, b2, r1, r2))
+def triad(b1_B, b2_B, r1_N, r2_N) -> np.ndarray:
+    """The attitude ``q_BN`` from two observations (``b_B`` in body axes of the inertial ``r_N``); the
+    first pair is matched exactly. ValueError when either pair is parallel (no attitude)."""
+    b1_B, b2_B, r1_N, r2_N = (_unit(v) for v in (b1_B, b2_B, r1_N, r2_N))
     frames = []
-    for u, v in ((b1, b2), (r1, r2)):
+    for u, v in ((b1_B, b2_B), (r1_N, r2_N)):
         w = np.cross(u, v)
         n = float(np.linalg.norm(w))
         if n < 1e-8:
@@ -78,12 +78,13 @@ def _quest_once(b: np.ndarray, r: np.ndarray, w: np.ndarray) -> tuple[np.ndarray
     return q / np.linalg.norm(q), abs(gamma)
 
 
-def quest(body, reference, weights) -> tuple[np.ndarray, np.ndarray]:
-    """Optimal body-to-inertial quaternion for unit observations ``body`` (n, 3) of the inertial
-    ``reference`` (n, 3) with ``weights`` (n,) (use 1/σ_i²), and its attitude-error covariance in
-    body axes (rad², valid for weights 1/σ_i²). ValueError for fewer than two non-parallel vectors."""
-    b = np.array([_unit(v) for v in np.atleast_2d(body)])
-    r = np.array([_unit(v) for v in np.atleast_2d(reference)])
+def quest(observed_B, reference_N, weights) -> tuple[np.ndarray, np.ndarray]:
+    """The optimal attitude ``q_BN`` for unit observations ``observed_B`` (n, 3, body axes) of the
+    inertial ``reference_N`` (n, 3) with ``weights`` (n,) (use 1/σ_i²), and its attitude-error
+    covariance in body axes (rad², valid for weights 1/σ_i²). ValueError for fewer than two
+    non-parallel vectors."""
+    b = np.array([_unit(v) for v in np.atleast_2d(observed_B)])
+    r = np.array([_unit(v) for v in np.atleast_2d(reference_N)])
     w = np.asarray(weights, float).reshape(-1)
     if len(b) != len(r) or len(b) != len(w) or len(b) < 2 or np.any(~np.isfinite(w)) or np.any(w <= 0):
         raise ValueError("QUEST needs at least two observations with matching references and positive weights")
@@ -96,13 +97,13 @@ def quest(body, reference, weights) -> tuple[np.ndarray, np.ndarray]:
     return rot.normalize(rot.multiply(q_k, q_rotated)), np.linalg.inv(information)
 
 
-def sun_vector(values, normals, threshold: float) -> np.ndarray | None:
-    """Sun direction in body axes from coarse sun sensor outputs (cosine law ``I_i = n_iᵀ s``) by
+def sun_vector(values, normals_B, threshold: float) -> np.ndarray | None:
+    """Sun direction in body axes (``sun_B``) from coarse sun sensor outputs (cosine law ``I_i = n_iᵀ s``) by
     least squares over the detectors above ``threshold``; None when fewer than three lit detectors
     span the space (eclipse, or the Sun seen by too few)."""
     values = np.asarray(values, float)
     lit = values > threshold
-    n = np.asarray(normals, float)[lit]
+    n = np.asarray(normals_B, float)[lit]
     if lit.sum() < 3 or np.linalg.matrix_rank(n, tol=1e-3) < 3:
         return None
     s, *_ = np.linalg.lstsq(n, values[lit], rcond=None)

@@ -4,7 +4,7 @@
 :class:`~att_planner.estimation.estimator.Estimator` and the
 :class:`~att_planner.control.controller.Controller` of a scenario — built by the same functions as
 the nodes (:func:`~att_planner.control.configure.controller_from_scenario`,
-:func:`~att_planner.estimation.configure.estimator_from_scenario`) from the scenario's sections, with
+:func:`~att_planner.estimation.from_scenario.estimator_from_scenario`) from the scenario's sections, with
 ``overrides`` on top — and passes what the nodes would publish, in the order the simulator publishes
 it: each step the sensors' readings, then the state; the estimator's estimate (or the truth state)
 to the controller; its command, at each control instant, back to the simulator. No DDS: tests, the
@@ -26,8 +26,8 @@ from att_msgs_py.errors import RequestError
 from att_msgs_py.parameters import SectionReader
 from att_msgs_py.types import Health, ManeuverResult, Plan, PointingMode
 from att_planner.control.configure import controller_from_scenario
-from att_planner.estimation.configure import estimator_from_scenario
 from att_planner.estimation.estimator import Estimator
+from att_planner.estimation.from_scenario import estimator_from_scenario
 from att_sim.models import dynamics as dyn
 from att_sim.models import rotations as rot
 from att_sim.models.scenario import Scenario
@@ -241,7 +241,7 @@ class ClosedLoop:
         self.trace.append(
             sim.t, sim.x.copy(), self.controller.state.q.copy(),
             est.state.P[:3, :3].copy() if filtered else np.full((3, 3), math.nan),
-            est.state.bias.copy() if filtered else np.full(3, math.nan),
+            est.state.bias_B.copy() if filtered else np.full(3, math.nan),
             sim.sensors.gyro.bias.copy() if sim.sensors and sim.sensors.gyro else np.zeros(3),
             int(est.health(sim.t)) if est is not None else int(Health.CONVERGED), self.tracker_status,
             np.array(command.wheel_torques, float), np.array(command.dipole, float), int(command.mode),

@@ -27,7 +27,7 @@ from att_msgs_py.types import Health, ManeuverResult, Plan, Verification
 from att_planner.control.controller import Controller
 from att_planner.control.lockstep import track_together
 from att_planner.control.tracking import ReferenceMemo
-from att_planner.estimation.lockstep import reprocess_together
+from att_planner.estimation.estimator import replay
 from att_planner.tools.closed_loop import ClosedLoop, Reprocessing, plan_in_process
 from att_planner.tools.demo import maneuver_from_scenario, zone_margins
 from att_planner.verification import rejection
@@ -143,7 +143,7 @@ def fly_together(setup: Setup, runs: list[tuple[int, int]], tap=None) -> list[di
     """The rows of ``(run, seed)`` pairs (applied values and outcomes, :data:`OUTCOMES`), flown in
     lockstep: each run converges, then flies the plan, as it would alone; at each step the runs'
     gyros measure together (:meth:`Lockstep.sense <att_sim.truth.lockstep.Lockstep.sense>`), their
-    estimators reprocess together (:func:`~att_planner.estimation.lockstep.reprocess_together`:
+    estimators reprocess together (:func:`~att_planner.estimation.estimator.replay`:
     their propagations as one stack), their controllers share the plan's reference (one plan object,
     issued once with the loops' one key: :class:`~att_planner.control.tracking.ReferenceMemo`) and
     compute its tracking law as rows (:func:`~att_planner.control.lockstep.track_together`), and
@@ -169,7 +169,7 @@ def fly_together(setup: Setup, runs: list[tuple[int, int]], tap=None) -> list[di
         exchanges = [f.loop.exchange_steps(r) for f, r in zip(going, readings)]
         while exchanges:                # each turn: every exchange to its next job, those of a kind done together
             turn = [(steps, next(steps, None)) for steps in exchanges]
-            reprocess_together([job for _, job in turn if isinstance(job, Reprocessing)])
+            replay([job for _, job in turn if isinstance(job, Reprocessing)])
             track_together([job for _, job in turn if isinstance(job, Controller)])
             exchanges = [steps for steps, job in turn if job is not None]
         if lockstep is not None:

@@ -33,12 +33,12 @@ def test_transition_matches_the_matrix_exponential_of_the_error_dynamics():
     for omega in (np.array([0.01, -0.02, 0.03]), np.array([1.0, 2.0, -0.5]), np.array([1e-9, 0.0, 0.0])):
         F = np.zeros((6, 6))
         F[:3, :3], F[:3, 3:] = -rot.hat(omega), -np.eye(3)
-        assert np.allclose(mekf.transition(omega, 0.1), expm(F * 0.1), atol=1e-12)
+        assert np.allclose(mekf.transition(omega[None], [0.1])[0], expm(F * 0.1), atol=1e-12)
 
 
 def test_filters_propagated_as_one_stack_reach_the_bits_they_reach_alone():
-    """propagate_runs (lockstep Monte Carlo runs) is propagate filter by filter: the same products of
-    each, whatever the stack; and healthy_runs says which covariances are usable."""
+    """propagate on a stack (a Monte Carlo batch) is propagate filter by filter, each a stack of one: the
+    same products of each, whatever the stack; and healthy says which covariances are usable."""
     rng = np.random.default_rng(11)
     consider = np.array([50e-6**2] * 3 + [1e-4**2] * 6)
     states, rates = [], []
@@ -48,22 +48,24 @@ def test_filters_propagated_as_one_stack_reach_the_bits_they_reach_alone():
         states.append(mekf.FilterState(1.0, q / np.linalg.norm(q), rng.normal(0, 1e-5, 3), A @ A.T * 1e-8))
         rates.append(rng.normal(0, 10.0 ** -k, 3))        # down to 1e-5 rad/s: the series branch
     dts, extras = rng.uniform(0.02, 0.2, 6), [0.0, 1e-9, 0.0, 0.0, 0.0, 2e-10]
-    together = mekf.propagate_runs(states, np.array(rates), dts, 1e-6, 1e-9, consider, extras)
-    together = mekf.propagate_runs(together, np.array(rates), dts, 1e-6, 1e-9, consider, extras)   # C ≠ 0 now
-    for x, w, dt, extra, got in zip(states, rates, dts, extras, together):
-        alone = mekf.propagate(mekf.propagate(x, w, dt, 1e-6, 1e-9, consider, extra), w, dt, 1e-6, 1e-9, consider,
-                               extra)
-        for name in ("t", "q", "bias", "P", "C"):
+    batch = mekf.propagate(states, np.array(rates), dts, 1e-6, 1e-9, consider, extras)
+    batch = mekf.propagate(batch, np.array(rates), dts, 1e-6, 1e-9, consider, extras)   # C ≠ 0 now
+    for x, w, dt, extra, got in zip(states, rates, dts, extras, batch):
+        alone = mekf.propagate(mekf.propagate([x], w[None], [dt], 1e-6, 1e-9, consider, [extra]), w[None], [dt],
+                               1e-6, 1e-9, consider, [extra])[0]
+        for name in ("t", "q_BN", "bias_B", "P", "C"):
             np.testing.assert_array_equal(getattr(got, name), getattr(alone, name))
-    stack = np.array([x.P for x in together])
-    assert mekf.healthy_runs(stack) == [True] * 6
+    stack = np.array([x.P for x in batch])
+    assert mekf.healthy(stack) == [True] * 6
     stack[2, 0, 0], stack[4, 1, 1] = -1.0, np.nan
-    assert mekf.healthy_runs(stack) == [True, True, False, True, False, True]
+    assert mekf.healthy(stack) == [True, True, False, True, False, True]
+    assert [mekf.healthy(p[None])[0] for p in stack] == [True, True, False, True, False, True]
 
 
 def test_kalman_updates_as_stacks_reach_the_bits_they_reach_alone():
-    """update_runs (lockstep runs' tracker updates at one instant) is update filter by filter, the gate's
-    rejections included; a stack with a singular innovation covariance is made update by update."""
+    """update on a stack (a Monte Carlo batch's tracker updates at one instant) is update filter by filter,
+    each a stack of one, the gate's rejections included; a stack with a singular innovation covariance is
+    made update by update, that one rejected."""
     rng = np.random.default_rng(12)
     corrections = []
     for k in range(30):
@@ -73,17 +75,18 @@ def test_kalman_updates_as_stacks_reach_the_bits_they_reach_alone():
         x = mekf.FilterState(2.0, q, bias, P, C)
         y, H = rng.normal(0, 1e-4 * (1 + 30 * (k % 3 == 0)), 3), mekf.attitude_sensitivity()
         if k % 7 == 6:
-            y, H = mekf.vector_residual(x.q, np.array([1.0, 0.01, 0.0]), np.array([0.0, 1.0, 0.0]))
+            y, H = mekf.vector_residual(x.q_BN, np.array([1.0, 0.01, 0.0]), np.array([0.0, 1.0, 0.0]))
         corrections.append(mekf.Correction(x, y, H, np.eye(3) * 1e-8 * (1 + k % 4), 30.0 if k % 2 else math.inf))
     singular = mekf.Correction(corrections[0].x, np.ones(3), np.zeros((3, 6)), np.zeros((3, 3)))     # S = 0
     for cs in (corrections, corrections + [singular]):
-        together = mekf.update_runs(cs)
-        for c, got in zip(cs, together):
-            alone = mekf.update(*c)
+        batch = mekf.update(cs)
+        for c, got in zip(cs, batch):
+            alone = mekf.update([c])[0]
             assert (got.accepted, repr(got.d2)) == (alone.accepted, repr(alone.d2))
-            for name in ("t", "q", "bias", "P", "C"):
+            for name in ("t", "q_BN", "bias_B", "P", "C"):
                 np.testing.assert_array_equal(getattr(got.state, name), getattr(alone.state, name))
-    assert 0 < sum(u.accepted for u in together) < len(corrections)
+    assert 0 < sum(u.accepted for u in batch) < len(corrections)
+    assert not batch[-1].accepted and batch[-1].d2 == math.inf and batch[-1].state is singular.x
 
 
 def test_process_noise_matches_van_loans_discretisation():
@@ -133,10 +136,10 @@ def fly(seed: int, gyro: GyroSpec, config: EstimatorConfig, duration: float = 60
         if k == 0:
             est.on_star_tracker(m)
         x = est.state
-        err = np.concatenate([2 * rot.error_vector(q, x.q), g.bias - x.bias])
+        err = np.concatenate([2 * rot.error_vector(q, x.q_BN), g.bias - x.bias_B])
         nees.append(err @ np.linalg.solve(x.P, err))
         att.append(err[:3] @ np.linalg.solve(x.P[:3, :3], err[:3]))
-    return Run(np.array(nees), np.array(att), g.bias - est.state.bias, np.sqrt(np.diag(est.state.P)[3:]))
+    return Run(np.array(nees), np.array(att), g.bias - est.state.bias_B, np.sqrt(np.diag(est.state.P)[3:]))
 
 
 def matched(gyro: GyroSpec, **kwargs) -> EstimatorConfig:

@@ -1,5 +1,5 @@
-"""The estimator core of a scenario, built from its parameters (no ROS): the node and the in-process
-closed loop build the same filter (see :mod:`att_planner.control.configure`)."""
+"""The estimator core of a scenario, built from its sensors' datasheets and the estimator's parameters
+(no ROS): the node and the in-process closed loop build the same filter."""
 from __future__ import annotations
 
 import math
