@@ -27,10 +27,10 @@ from att_planner.control.reference import Reference
 from att_sim.models import rotations as rot
 
 
-def rotation_vector_rate(phi, omega) -> np.ndarray:
-    """dφ/dt of the rotation ``exp(φ)`` turning at body rate ``omega``: ``J_r⁻¹(φ) ω`` =
-    ω + ½ φ × ω + (1/θ²)(1 − (θ/2) cot(θ/2)) φ × (φ × ω), θ = |φ| (< 2π)."""
-    phi, omega = np.asarray(phi, float), np.asarray(omega, float)
+def rotation_vector_rate(phi, omega_RN_R) -> np.ndarray:
+    """dφ/dt of the rotation ``exp(φ)`` of a frame R turning at ``omega_RN_R`` (its own axes):
+    ``J_r⁻¹(φ) ω`` = ω + ½ φ × ω + (1/θ²)(1 − (θ/2) cot(θ/2)) φ × (φ × ω), θ = |φ| (< 2π)."""
+    phi, omega = np.asarray(phi, float), np.asarray(omega_RN_R, float)
     theta = math.sqrt(phi @ phi)
     c = (1.0 - 0.5 * theta / math.tan(0.5 * theta)) / theta**2 if theta > 1e-4 else 1.0 / 12.0 + theta**2 / 720.0
     turn = rot.cross(phi, omega)
