@@ -3,7 +3,7 @@
 Subscribes ``/spacecraft/state`` and the latched ``/planner/plans``; publishes
 ``/actuator/command`` and ``/controller/status`` at ``control_rate`` (Hz of sim time): a command is
 computed when a state at or after the next control instant arrives, and stamped with that state's
-time (the simulator's lockstep waits for it); serves ``/controller/set_mode`` and the
+time (the simulator waits for it before it advances); serves ``/controller/set_mode`` and the
 ``/controller/execute`` action (ExecuteManeuver), which runs for the maneuver's duration plus
 ``settle_time`` and reports progress as feedback (the zone margins of the feedback are taken
 on the scenario's sky: its epoch and orbit).

@@ -73,7 +73,7 @@ def _tracking(start_error_deg: float, ctx):
     return sim, core
 
 
-def test_controllers_stepping_together_command_what_each_commands_alone():
+def test_controllers_stepped_as_a_batch_command_what_each_commands_alone():
     """Three controllers stepped together and the same three stepped alone (built alike) command
     the same torques at every step (to 1e-12 relative); a controller in another mode, stepped among
     them, commands what it commands alone."""
