@@ -1,7 +1,9 @@
 """The controller's numerics without ROS: mode, plan cache, the maneuver being flown, one step at a time.
 
-:class:`Controller` holds what the controller node used to keep in dictionaries: the latest state,
-the mode, the received plans, the :class:`Maneuver` being executed and the attitude held after it.
+:class:`Controller` is the mode manager: it holds the latest state, the mode, the received plans,
+the :class:`~.maneuver.Maneuver` being executed (its zones: :mod:`.maneuver`), the handover to a
+pointing law at its end and the attitude held after it, and authenticates mode requests
+(:mod:`.mode_authentication`).
 Its inputs are plain types (:mod:`att_msgs_py.types`), its outputs a :class:`StepOutput` per
 control instant (actuator command, status, action feedback, the result of a maneuver that ended).
 The node (:mod:`att_planner.nodes.controller_node`) only translates messages; tests drive the
@@ -14,18 +16,14 @@ starts only near the current state (:func:`~.plan_checks.check_start`). The cach
 count and bytes (oldest first, never the plan being flown). A controller whose first state shows
 the spacecraft rotating faster than ``safe_rate_threshold`` goes to safe mode by itself.
 
-Laws per mode: IDLE commands nothing; MAGNETORQUER_PD the PD-like law of Bruni & Celani
-(:mod:`.magnetorquer`); SAFE rate damping through the wheels (τ = −k_d ω); PLAN_TRACKING the plan's
-feedforward plus quaternion PD feedback (:mod:`.tracking`) for the plan's duration plus a settle
-time, then a hold of its final attitude.
-
-The feedback's ``min_cone_margin`` covers the plan's cones and zones at their true positions now:
-a :class:`~att_planner.zones.ZoneSky` of the plan, built once when it starts, on the controller's
-``sky`` (:class:`att_sim.models.ephemeris.Sky` at the scenario epoch, whose time is sim time), evaluated
-straight from the ephemeris at the current state's time (one evaluation per feedback). The truth
-does not depend on the plan's epoch: a plan made for another start instant shows the margins it
-really has. Without a ``sky`` (a scenario with no epoch) the moving zones are left out: the margin
-is that of the cones and inertial zones only.
+Laws per mode, each a pure function of its module: IDLE commands nothing; MAGNETORQUER_PD the
+PD-like law of Bruni & Celani (:mod:`.magnetorquer`); SAFE rate damping, then Sun pointing
+(:mod:`.safe`); POINTING a guidance law's reference (:mod:`.pointing`); PLAN_TRACKING the plan's
+feedforward plus the PD law (:mod:`.tracking`) for the plan's duration plus a settle time, then a
+hold of its final attitude. The wheel laws share one PD law (:mod:`.pd`) and one realisation by
+the wheels (:mod:`.wheels`). :func:`step_controllers` steps several controllers at once (the runs
+of a Monte Carlo task), the tracking law evaluated as rows of runs; :meth:`Controller.step` is that
+step of one controller.
 """
 from __future__ import annotations
 
@@ -34,7 +32,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from att_msgs_py import signing
 from att_msgs_py.errors import ErrorCode, RequestError
 from att_msgs_py.types import (
     CONTROL_MODES,
@@ -50,61 +47,22 @@ from att_msgs_py.types import (
     PointingMode,
     State,
 )
-from att_planner.control import momentum, tracking
+from att_planner.control import momentum, safe, tracking, wheels
+from att_planner.control.controller_config import ControllerConfig
 from att_planner.control.magnetorquer import dipole_command
+from att_planner.control.maneuver import Maneuver, plan_zones
 from att_planner.control.measured_state import MeasuredState
+from att_planner.control.mode_authentication import ModeAuthentication
 from att_planner.control.plan_cache import PlanCache
 from att_planner.control.plan_checks import PlanContext, check_start
-from att_planner.control.pointing import handover_law, pointing_torque
+from att_planner.control.pointing import handover_law, law_reference, pointing_torque
+from att_planner.control.reference import Reference, at_rest, stack
 from att_planner.control.state_gate import GateConfig, StateGate
-from att_planner.guidance import reference as guidance_reference
 from att_planner.guidance.laws import Sky as GuidanceSky
 from att_planner.guidance.modes import law_of
-from att_planner.zones import ZoneSky, zones_from_cones
 from att_sim.models import rotations as rot
 from att_sim.models.dynamics import Spacecraft
 from att_sim.models.ephemeris import Sky
-
-
-@dataclass(frozen=True)
-class ControllerConfig:
-    """Gains and timing (the controller node's parameters)."""
-
-    control_period: float = 0.1        # s of sim time between commands
-    settle_time: float = 20.0          # s held on the final attitude after the plan ends
-    tracking_kp: float = 0.4           # N m / rad, attitude feedback around the plan reference
-    tracking_kd: float = 10.0          # N m s / rad
-    kp: float = 2e5                    # magnetorquer PD-like law (Bruni & Celani)
-    kd: float = 1e8
-    m_max: float = math.inf            # A m² per coil (default: the spacecraft's dipole limit)
-    safe_kd: float = 10.0              # N m s / rad, rate damping of the safe mode
-    feedback_period: float = 0.5       # s of sim time between action feedbacks
-    max_cached_plans: int = 50
-    max_cache_bytes: int = 64 * 1024 * 1024   # serialized plans kept
-    safe_rate_threshold: float = 0.005  # rad/s: found rotating faster at start, the controller damps (safe mode)
-    dumping: bool = False              # magnetorquer momentum dumping (issue 15)
-    dumping_gain: float = 1e-3         # 1/s: k of m = k (Δh × B)/|B|²
-    null_space_gain: float = 0.05      # 1/s: wheel speeds' null-space component to its bias (more than 3 wheels)
-    null_space_speed: float = 0.0      # rad/s: that bias, along each null-space direction
-    safe_sun_axis: tuple = (0.0, 0.0, 1.0)   # body axis the safe mode points at the Sun once the rates are damped
-    handover_blend: float = 60.0       # s: a plan ending at rest enters a moving pointing reference this smoothly
-
-    @property
-    def feedback_every(self) -> int:
-        """Control steps between action feedbacks."""
-        return max(1, round(self.feedback_period / self.control_period))
-
-
-@dataclass
-class Maneuver:
-    """The plan being executed, from sim time ``t0``, its zones (:meth:`Controller.start`) and the
-    pointing law it hands over to at its end (None: hold its final attitude after a settle time)."""
-
-    plan: Plan
-    t0: float
-    zones: ZoneSky | None = None
-    ticks: int = 0
-    after: object = None
 
 
 @dataclass
@@ -127,14 +85,11 @@ class StateOutcome:
     ended: ManeuverResult | None = None
 
 
-ZONE_FIT_WINDOW = 1.0                          # s: a ZoneSky needs a window; the controller uses its truth only
-
-
 USABLE = (Health.CONVERGED, Health.PROPAGATING)   # estimates the attitude laws may fly on
 
 
 class Controller:
-    def __init__(self, context: PlanContext, config: ControllerConfig = ControllerConfig(),
+    def __init__(self, context: PlanContext, config: ControllerConfig | None = None,
                  mode: int = ControlMode.IDLE, body_frame_id: str = "body", gate: GateConfig | None = None,
                  sky: Sky | None = None, measured: MeasuredState | None = None, friction=None,
                  guidance_sky: GuidanceSky | None = None):
@@ -142,7 +97,8 @@ class Controller:
         speeds and field, blanking the magnetometer; None: on truth states (:meth:`accept_state`).
         ``friction``: the wheel drives' expected friction torque at relative speeds ν (a callable,
         :meth:`att_sim.models.actuator_specs.WheelDriveSpec.friction`), compensated in every wheel command.
-        ``guidance_sky``: the onboard orbit, Sun and Earth the pointing laws look at (issue 15)."""
+        ``guidance_sky``: the onboard orbit, Sun and Earth the pointing laws look at."""
+        config = ControllerConfig() if config is None else config
         self.context, self.config, self.mode, self.body_frame_id = context, config, mode, body_frame_id
         self.measured, self.friction = measured, friction
         self.estimate_health: Health | None = None     # of the latest accepted estimate
@@ -150,16 +106,14 @@ class Controller:
         self.gate = StateGate(context.spacecraft, context.frame_id, body_frame_id, gate or GateConfig())
         self.next_control = -math.inf
         self.maneuver: Maneuver | None = None
-        self.hold_q: np.ndarray | None = None          # final attitude held after a maneuver
+        self.hold_q_RN: np.ndarray | None = None       # final attitude held after a maneuver
         self.cache = PlanCache(context, config.max_cached_plans, config.max_cache_bytes)
-        self.references = tracking.ReferenceMemo()     # the plan's reference (shared by lockstep runs)
-        self.prepared: tuple | None = None             # (state, reference, wheel torques) of the law, done ahead
+        self.references = tracking.ReferenceMemo()     # the plan's reference (shared by the runs of a task)
         self.guidance_sky = guidance_sky
         self.pointing = None                           # the pointing law of MODE_POINTING (guidance.laws)
         self.safe_law = None                           # the safe mode's Sun pointing, built when first used
         self.dumping = config.dumping
-        self.mode_key = None                           # Ed25519 public key mode requests must verify against
-        self.mode_sequence = 0                         # sequence of the last authenticated mode request
+        self.authentication = ModeAuthentication()     # of mode requests (no key: none)
 
     @property
     def spacecraft(self) -> Spacecraft:
@@ -168,6 +122,20 @@ class Controller:
     @property
     def state(self) -> State | None:
         return self.gate.last
+
+    @property
+    def mode_key(self):
+        """The Ed25519 public key mode requests must verify against (None: no check)."""
+        return self.authentication.key
+
+    @mode_key.setter
+    def mode_key(self, key) -> None:
+        self.authentication.key = key
+
+    @property
+    def mode_sequence(self) -> int:
+        """The sequence number of the last authenticated mode request."""
+        return self.authentication.sequence
 
     @property
     def m_max(self) -> float:
@@ -235,7 +203,7 @@ class Controller:
             out.ended = self.abort(f"aborted: {why}")
             out.note = f"{why}: maneuver aborted, safe mode (rate damping)"
         elif self.mode in (ControlMode.MAGNETORQUER_PD, ControlMode.PLAN_TRACKING, ControlMode.POINTING):
-            self.mode, self.hold_q, self.pointing = ControlMode.SAFE, None, None
+            self.mode, self.hold_q_RN, self.pointing = ControlMode.SAFE, None, None
             out.note = f"{why}: safe mode (rate damping)"
         return out
 
@@ -250,15 +218,7 @@ class Controller:
     def authorize_mode(self, payload: bytes, signature: bytes, signer: str, sequence: int) -> RequestError | None:
         """Why a mode request (signed bytes ``payload``) is not authentic, when :attr:`mode_key` is
         set; its ``sequence`` must be above the last accepted one (no replay)."""
-        if self.mode_key is None:
-            return None
-        why = signing.check(payload, signature, signer, self.mode_key, "the mode request")
-        if why is None and sequence <= self.mode_sequence:
-            why = f"sequence {sequence} is not above the last accepted {self.mode_sequence} (a replayed request)"
-        if why is not None:
-            return RequestError(ErrorCode.MODE_NOT_AUTHENTIC, why)
-        self.mode_sequence = sequence
-        return None
+        return self.authentication.check(payload, signature, signer, sequence)
 
     def set_mode(self, mode: int, pointing: PointingMode | None = None,
                  dumping: bool | None = None) -> tuple[ErrorCode, str, ManeuverResult | None]:
@@ -312,23 +272,13 @@ class Controller:
         except RequestError as err:
             return err
         try:
-            zones = self.zone_sky(plan)
+            zones = plan_zones(plan, self.sky)
         except ValueError as err:
             return RequestError(ErrorCode.INVALID_PLAN, f"plan '{plan.plan_id}': its zones cannot be placed in the "
                                                         f"sky now: {err}")
         self.maneuver = Maneuver(plan, self.state.t, zones, after=law)
         self.mode, self.pointing = ControlMode.PLAN_TRACKING, None
         return None
-
-    def zone_sky(self, plan: Plan) -> ZoneSky | None:
-        """The plan's cones and zones on :attr:`sky` (moving zones left out without one); None
-        when there are none. Only its truth is used (any time): the fit is over a short window."""
-        zones = zones_from_cones(plan.cones, plan.sensor_axis) + [z for z in plan.zones
-                                                                  if self.sky is not None or z.body == "inertial"]
-        if not zones:
-            return None
-        moving = any(z.body != "inertial" for z in zones)
-        return ZoneSky(zones, self.sky if moving else None, window=ZONE_FIT_WINDOW)
 
     def abort(self, message: str) -> ManeuverResult:
         """End the running maneuver unsuccessfully (cancelled, or safe mode); safe mode follows."""
@@ -344,7 +294,45 @@ class Controller:
         return True
 
     def step(self, cancel_requested: bool = False) -> StepOutput:
-        """Command and status for the latest state; ``cancel_requested`` aborts a running maneuver."""
+        """Command and status for the latest state; ``cancel_requested`` aborts a running maneuver
+        (:func:`step_controllers` of this controller alone)."""
+        return step_controllers([self], [cancel_requested])[0]
+
+    def tracking_reference(self) -> Reference | None:
+        """The reference the next step's plan tracking flies about (the plan's now, or the held
+        attitude), None when it flies none."""
+        if self.mode != ControlMode.PLAN_TRACKING:
+            return None
+        if self.maneuver is not None:
+            return self.references(self.maneuver.plan, self.state.t - self.maneuver.t0)
+        return at_rest(self.hold_q_RN) if self.hold_q_RN is not None else None
+
+    def tracks_body_torque(self) -> bool:
+        """Whether the next step's command is the tracking law realised by the wheels (a plan of body
+        torques, or the hold after a maneuver; a plan of wheel torques feeds its torques forward)."""
+        m = self.maneuver
+        return m is None or m.plan.control_kind != ControlKind.WHEEL_TORQUE
+
+    def tracking_law(self) -> tuple:
+        """What the tracking law depends on besides the state and the reference: the model (the
+        object), gains, null-space control and friction compensation. Controllers of one law
+        evaluate it as rows (:func:`step_controllers`)."""
+        k = self.config
+        return id(self.spacecraft), k.tracking_kp, k.tracking_kd, k.null_space_speed, k.null_space_gain, self.friction
+
+    def tracking_command(self, states: list[State], ref: Reference) -> np.ndarray:
+        """Wheel torques (rows) of this controller's tracking law for rows of ``states`` about the
+        rows of ``ref``: :func:`~.tracking.tracking_torque` through :func:`~.wheels.wheel_command`."""
+        sc, c = self.spacecraft, self.config
+        omega_BN_B = np.array([s.omega for s in states])
+        torque_B = tracking.tracking_torque(np.array([s.q for s in states]), omega_BN_B, ref, c.tracking_kp,
+                                            c.tracking_kd)
+        return wheels.wheel_command(sc, torque_B, omega_BN_B, np.array([s.wheel_speeds for s in states]),
+                                    c.null_space_speed, c.null_space_gain, self.friction)
+
+    def step_with(self, cancel_requested: bool, ref: Reference | None, tracked: np.ndarray | None) -> StepOutput:
+        """The step of :func:`step_controllers` once the tracking law is evaluated: ``ref`` from
+        :meth:`tracking_reference`, ``tracked`` its wheel torques (when :meth:`tracks_body_torque`)."""
         s = self.state
         cmd = Command(mode=self.mode, wheel_torques=np.zeros(self.spacecraft.n_wheels), t=s.t,
                       frame_id=self.body_frame_id)
@@ -359,11 +347,11 @@ class Controller:
         elif self.mode == ControlMode.POINTING and self.pointing is not None:
             self._point(out, self.pointing)
         elif self.mode == ControlMode.PLAN_TRACKING and self.maneuver is not None:
-            self._track(out, cancel_requested)
-        elif self.mode == ControlMode.PLAN_TRACKING and self.hold_q is not None:
-            cmd.wheel_torques = self._wheel_command(tracking.Reference(self.hold_q, np.zeros(3), np.zeros(3)))
+            self._track(out, cancel_requested, ref, tracked)
+        elif self.mode == ControlMode.PLAN_TRACKING and self.hold_q_RN is not None:
+            cmd.wheel_torques = tracked
             status.message = "holding the final attitude of the last maneuver"
-            status.reference_q, status.attitude_error = self.hold_q, float(rot.angle_between(s.q, self.hold_q))
+            status.reference_q, status.attitude_error = self.hold_q_RN, float(rot.angle_between(s.q, self.hold_q_RN))
         status.dumping = self.dumping
         if self.measured is not None:
             self.measured.dipoles.record(s.t, cmd.dipole)
@@ -377,84 +365,64 @@ class Controller:
                 ControllerStatus(mode=self.mode, t=t, state_stale=True, message="no state (wall clock)",
                                  frame_id=self.body_frame_id))
 
-    def _wheels(self, body_torque: np.ndarray, wheel_speed: np.ndarray | None = None) -> np.ndarray:
-        """Motor torques that put ``body_torque`` on the body, the expected drive friction compensated
-        (``wheel_speed``: the inertial spin rates the gyroscopic term uses; default the state's), and
-        with more than three wheels the null-space control of their speeds (no body torque)."""
-        s, sc, c = self.state, self.spacecraft, self.config
-        extra = momentum.null_space_torques(sc, s.wheel_speeds, c.null_space_speed, c.null_space_gain)
-        if self.friction is not None:
-            extra = extra + self.friction(s.wheel_speeds - sc.wheel_axes.T @ s.omega)
-        return tracking.wheel_torques(sc, body_torque, s.omega, s.wheel_speeds if wheel_speed is None else wheel_speed,
-                                      extra)
+    def _wheels(self, torque_B: np.ndarray, gyroscopic_speeds: np.ndarray | None = None) -> np.ndarray:
+        """Motor torques that put ``torque_B`` on the body at the latest state (:func:`~.wheels.wheel_command`
+        of one row; ``gyroscopic_speeds``: the spin rates the gyroscopic term uses, default the state's)."""
+        s, c = self.state, self.config
+        return wheels.wheel_command(self.spacecraft, np.asarray(torque_B, float)[None], s.omega[None],
+                                    s.wheel_speeds[None], c.null_space_speed, c.null_space_gain, self.friction,
+                                    None if gyroscopic_speeds is None else gyroscopic_speeds[None])[0]
 
     def _point(self, out: StepOutput, law) -> None:
-        """Track ``law``'s reference (feedforward + PD) through the wheels, dumping momentum with the
-        magnetorquers when that is on (their torque fed forward to the wheels)."""
+        """Track ``law``'s reference (:func:`~.pointing.pointing_torque`) through the wheels, dumping
+        momentum with the magnetorquers when that is on (their torque fed forward to the wheels)."""
         s, sc, c = self.state, self.spacecraft, self.config
-        ref = guidance_reference(law.attitude, s.t)
+        ref = law_reference(law, s.t)
         tau = pointing_torque(sc, s.q, s.omega, ref, c.tracking_kp, c.tracking_kd)
         blank = self.measured is not None and self.measured.blank(s.t, c.control_period)
         if self.dumping and not blank and sc.n_wheels:
-            h_wheels = sc.wheel_axes @ (sc.wheel_inertia * s.wheel_speeds)
-            out.command.dipole = momentum.desaturation_dipole(h_wheels, np.zeros(3), s.field_body, c.dumping_gain,
+            h_wheels_B = sc.wheel_axes @ (sc.wheel_inertia * s.wheel_speeds)
+            out.command.dipole = momentum.desaturation_dipole(h_wheels_B, np.zeros(3), s.field_body, c.dumping_gain,
                                                               self.m_max)
         out.command.wheel_torques = self._wheels(tau - rot.cross(out.command.dipole, s.field_body))
         st = out.status
-        st.guidance, st.reference_q, st.reference_rate = law.name, ref.q, ref.omega
-        st.attitude_error = float(rot.angle_between(s.q, ref.q))
+        st.guidance, st.reference_q, st.reference_rate = law.name, ref.q_RN, ref.omega_RN_R
+        st.attitude_error = float(rot.angle_between(s.q, ref.q_RN))
         if law.degenerate:
             st.message = f"pointing {law.name}: the directions are parallel now; holding the last attitude"
 
     def _safe(self, out: StepOutput) -> None:
-        """Rate damping (τ = −k_d ω); once the rates are below ``safe_rate_threshold``, with a Sun to
-        see and an attitude to trust, the safe Sun pointing (``safe_sun_axis`` on the Sun, the orbit
-        normal as secondary)."""
+        """The safe-mode law (:mod:`.safe`): rate damping; once the rates are below
+        ``safe_rate_threshold``, with a Sun to see and an attitude to trust, the safe Sun pointing
+        (``safe_sun_axis`` on the Sun, the orbit normal as secondary)."""
         s, c = self.state, self.config
         sun_ok = self.guidance_sky is not None and self.guidance_sky.sun is not None and \
             (self.measured is None or self.estimate_health in USABLE)
-        if not sun_ok or float(np.linalg.norm(s.omega)) > c.safe_rate_threshold:
-            out.command.wheel_torques = self._wheels(-c.safe_kd * s.omega)
+        if not sun_ok or not safe.damped(s.omega, c.safe_rate_threshold):
+            out.command.wheel_torques = self._wheels(safe.damping_torque(s.omega, c.safe_kd))
             return
         if self.safe_law is None:
-            axis = np.asarray(c.safe_sun_axis, float)
-            mode = PointingMode("sun", primary_axis=axis, secondary_axis=rot.orthonormal_basis(axis)[0],
-                                secondary="orbit_normal")
             try:
-                self.safe_law = law_of(mode, self.guidance_sky, s.t, s.q)
+                self.safe_law = law_of(safe.sun_mode(c.safe_sun_axis), self.guidance_sky, s.t, s.q)
             except RequestError:
-                out.command.wheel_torques = self._wheels(-c.safe_kd * s.omega)
+                out.command.wheel_torques = self._wheels(safe.damping_torque(s.omega, c.safe_kd))
                 return
         self._point(out, self.safe_law)
 
-    def _wheel_command(self, ref: tracking.Reference) -> np.ndarray:
-        """Wheel torques of the tracking law about a body-torque reference (the ones :meth:`prepare`
-        was given for this state and reference, when it was)."""
-        prepared, self.prepared = self.prepared, None
-        s, c = self.state, self.config
-        if prepared is not None and prepared[0] is s and prepared[1] is ref:
-            return prepared[2]
-        return self._wheels(tracking.tracking_torque(s.q, s.omega, ref, c.tracking_kp, c.tracking_kd))
-
-    def prepare(self, reference: tracking.Reference, wheel_torques: np.ndarray) -> None:
-        """Give the next :meth:`step` the tracking law's wheel torques about ``reference`` for the
-        latest state, computed elsewhere (:func:`att_planner.control.lockstep.track_together`)."""
-        self.prepared = (self.state, reference, wheel_torques)
-
-    def _track(self, out: StepOutput, cancel_requested: bool) -> None:
-        """One plan-tracking step: command, feedback every ``feedback_period``, the end."""
+    def _track(self, out: StepOutput, cancel_requested: bool, ref: Reference, tracked: np.ndarray | None) -> None:
+        """One plan-tracking step about ``ref`` (``tracked``: the tracking law's wheel torques):
+        command, feedback every ``feedback_period``, the end."""
         s, m, sc = self.state, self.maneuver, self.spacecraft
         plan = m.plan
         elapsed = s.t - m.t0
-        ref = self.references(plan, elapsed)
         if plan.control_kind == ControlKind.WHEEL_TORQUE:
             # the plan's wheel torques as feedforward, PD feedback about its reference states
-            fb = tracking.tracking_torque(s.q, s.omega, tracking.Reference(ref.q, ref.omega, np.zeros(3)),
-                                          self.config.tracking_kp, self.config.tracking_kd)
-            u = ref.torque + self._wheels(fb, np.zeros(sc.n_wheels))
+            fb = tracking.tracking_torque(s.q, s.omega, ref, self.config.tracking_kp, self.config.tracking_kd,
+                                          feedforward=False)
+            u = ref.torque_R + self._wheels(fb, np.zeros(sc.n_wheels))
             u = np.clip(u, -sc.wheel_torque_max, sc.wheel_torque_max)
         else:
-            u = self._wheel_command(ref)
+            u = tracked
         out.command.wheel_torques = u
         out.command.plan_id = out.status.plan_id = plan.plan_id
         m.ticks += 1
@@ -462,18 +430,18 @@ class Controller:
             span = max(plan.duration + self.config.settle_time, 1e-9)
             out.feedback = ManeuverFeedback(
                 elapsed=float(elapsed), progress=float(min(1.0, elapsed / span)),
-                attitude_error=float(rot.angle_between(s.q, ref.q)),
+                attitude_error=float(rot.angle_between(s.q, ref.q_RN)),
                 min_cone_margin=float(m.zones.margins(s.t, s.q, true=True).min()) if m.zones else math.inf)
         if cancel_requested:
             out.result = self.abort("cancelled")
             return
         out.status.plan_progress = float(min(1.0, elapsed / max(plan.duration, 1e-9)))
-        out.status.reference_q, out.status.reference_rate = ref.q, ref.omega
-        out.status.attitude_error = float(rot.angle_between(s.q, ref.q))
+        out.status.reference_q, out.status.reference_rate = ref.q_RN, ref.omega_RN_R
+        out.status.attitude_error = float(rot.angle_between(s.q, ref.q_RN))
         if m.after is not None and elapsed >= plan.duration:
             law = handover_law(m.after, plan, s.t, self.config.handover_blend)
             out.result = self._end(True, ErrorCode.OK, f"maneuver complete; pointing {law.name}")
-            self.mode, self.pointing, self.hold_q = ControlMode.POINTING, law, None
+            self.mode, self.pointing, self.hold_q_RN = ControlMode.POINTING, law, None
             out.status.message = f"maneuver complete; pointing {law.name}"
             return
         if elapsed >= plan.duration + self.config.settle_time:
@@ -489,8 +457,28 @@ class Controller:
             duration=max(0.0, float(s.t - self.maneuver.t0)),   # 0 when a new timeline began
             final_attitude_error=float(rot.angle_between(s.q, plan.q[-1])),
             final_rate=float(np.linalg.norm(s.omega)))
-        self.hold_q = plan.q[-1] if success else None
+        self.hold_q_RN = plan.q[-1] if success else None
         self.maneuver = None
         if code == ErrorCode.ABORTED:
             self.mode = ControlMode.SAFE
         return result
+
+
+def step_controllers(controllers: list[Controller], cancel_requested: list[bool] | None = None) -> list[StepOutput]:
+    """Step each controller (at its latest state; ``cancel_requested``: per controller, default
+    none) as it steps alone; the tracking law of those flying it through the wheels is evaluated
+    as rows, one evaluation per group of controllers of one :meth:`~Controller.tracking_law`
+    (the runs of a Monte Carlo task: one nominal model, the same gains)."""
+    cancel = [False] * len(controllers) if cancel_requested is None else cancel_requested
+    refs = [c.tracking_reference() for c in controllers]
+    tracked: list[np.ndarray | None] = [None] * len(controllers)
+    waiting = [i for i, (c, ref) in enumerate(zip(controllers, refs)) if ref is not None and c.tracks_body_torque()]
+    while waiting:
+        first = controllers[waiting[0]]
+        law = first.tracking_law()
+        group = [i for i in waiting if controllers[i].tracking_law() == law]
+        rows = first.tracking_command([controllers[i].state for i in group], stack([refs[i] for i in group]))
+        for i, row in zip(group, rows):
+            tracked[i] = row
+        waiting = [i for i in waiting if tracked[i] is None]
+    return [c.step_with(k, ref, u) for c, k, ref, u in zip(controllers, cancel, refs, tracked)]

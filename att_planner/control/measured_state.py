@@ -31,7 +31,7 @@ class MeasuredState:
         self.checks = InputChecks(specs, frame_id, body_frame_id)
         self.dipoles = DipoleLog()
         self.wheel_speeds: np.ndarray | None = None     # relative to the body, rad/s
-        self.field = np.zeros(3)                        # T, body axes: the latest clean sample
+        self.field_B = np.zeros(3)                      # T, body axes: the latest clean sample
         self.magnetometer_period = 1.0 / specs.magnetometer.rate if specs.magnetometer else None
 
     def on_wheel_speeds(self, m: WheelSpeedMeasurement) -> None:
@@ -50,7 +50,7 @@ class MeasuredState:
     def on_magnetometer(self, m: MagnetometerMeasurement) -> None:
         field = self.checks.magnetometer(m)
         if self.dipoles.clean(m.t):
-            self.field = field
+            self.field_B = field
 
     def blank(self, t: float, period: float) -> bool:
         """Whether a magnetometer sample falls in the control period (t, t + period]: the coils
@@ -73,4 +73,4 @@ class MeasuredState:
         relative = self.wheel_speeds if n else np.zeros(0)
         inertial = relative + self.spacecraft.wheel_axes.T @ omega if n else relative
         return State(t=estimate.t, q=np.asarray(estimate.q, float), omega=omega, wheel_speeds=inertial,
-                     field_body=self.field.copy(), frame_id=estimate.frame_id, body_frame_id=estimate.body_frame_id)
+                     field_body=self.field_B.copy(), frame_id=estimate.frame_id, body_frame_id=estimate.body_frame_id)

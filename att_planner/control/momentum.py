@@ -1,4 +1,4 @@
-"""Wheel momentum management (issue 15, no ROS): magnetorquer desaturation and null-space control.
+"""Wheel momentum management (no ROS, pure): magnetorquer desaturation and null-space control.
 
 * **Desaturation** (the cross-product law; Camillo & Markley 1980, Basilisk ``mtbMomentumManagement``):
   with ``Δh = h_w − h_target`` the wheels' momentum above its target (body axes, ``h_w = G I_w Ω``),
@@ -22,14 +22,15 @@ from att_sim.models import rotations as rot
 from att_sim.models.dynamics import Spacecraft
 
 
-def desaturation_dipole(wheel_momentum, target, field_body, gain: float, dipole_max: float) -> np.ndarray:
-    """``m = k (Δh × B)/|B|²`` (A m²), scaled down as a whole to ``dipole_max`` per coil; zero
-    without a field."""
-    b = np.asarray(field_body, float)
+def desaturation_dipole(h_wheels_B, h_target_B, field_B, gain: float, dipole_max: float) -> np.ndarray:
+    """``m = k (Δh × B)/|B|²`` (A m², body axes) of the wheels' momentum ``h_wheels_B`` above
+    ``h_target_B`` (N m s) in the field ``field_B`` (T), scaled down as a whole to ``dipole_max`` per
+    coil; zero without a field."""
+    b = np.asarray(field_B, float)
     b2 = float(b @ b)
     if not b2 > 0.0:
         return np.zeros(3)
-    m = gain * rot.cross(np.asarray(wheel_momentum, float) - np.asarray(target, float), b) / b2
+    m = gain * rot.cross(np.asarray(h_wheels_B, float) - np.asarray(h_target_B, float), b) / b2
     peak = float(np.max(np.abs(m)))
     return m * (dipole_max / peak) if peak > dipole_max else m
 
@@ -47,10 +48,10 @@ def null_space(sc: Spacecraft) -> np.ndarray:
     return _null_basis(np.ascontiguousarray(sc.wheel_axes, float).tobytes(), sc.n_wheels)
 
 
-def null_space_torques(sc: Spacecraft, wheel_speed, bias_speed: float, gain: float) -> np.ndarray:
+def null_space_torques(sc: Spacecraft, wheel_speeds, bias_speed: float, gain: float) -> np.ndarray:
     """``u_n = −k_n I_w N (Nᵀ Ω − c_b)`` (N m per wheel): drives each null-space speed component to
     ``bias_speed`` and puts no torque on the body (rows of runs' speeds: each row's, to its bits alone)."""
-    w = np.asarray(wheel_speed, float)
+    w = np.asarray(wheel_speeds, float)
     N = null_space(sc)
     if not N.size:
         return np.zeros(w.shape[:-1] + (sc.n_wheels,))

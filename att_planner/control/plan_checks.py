@@ -23,6 +23,7 @@ import numpy as np
 from att_msgs_py import signing, validation
 from att_msgs_py.errors import ErrorCode, RequestError
 from att_msgs_py.types import ControlKind, Interpolation, Plan, State, Status
+from att_planner.control import pd
 from att_sim.models import epoch as epochs
 from att_sim.models import rotations as rot
 from att_sim.models.dynamics import Spacecraft
@@ -156,14 +157,16 @@ def check_plan(plan: Plan, payload: bytes, ctx: PlanContext) -> RequestError | N
 
 
 def check_start(plan: Plan, state: State, ctx: PlanContext) -> RequestError | None:
-    """Why ``plan`` cannot start from ``state`` (its first attitude or rate too far away)."""
+    """Why ``plan`` cannot start from ``state`` (its first attitude or rate, in the plan's reference axes, too far
+    away)."""
     angle = rot.angle_between(state.q, plan.q[0])
     if angle > ctx.max_start_attitude_error:
         return RequestError(ErrorCode.PLAN_CONTEXT,
                             f"plan '{plan.plan_id}' starts {math.degrees(angle):.2f} deg from the current attitude "
                             f"(at most {math.degrees(ctx.max_start_attitude_error):.2f} deg, parameter "
                             "max_start_attitude_error_deg)")
-    rate_error = float(np.linalg.norm(state.omega - plan.omega[0]))
+    q_BR = pd.relative_attitude(state.q, plan.q[0])          # the rate error ω_BN_B − [BR] ω_RN_R
+    rate_error = float(np.linalg.norm(state.omega - pd.to_body(q_BR, plan.omega[0])))
     if rate_error > ctx.max_start_rate_error:
         return RequestError(ErrorCode.PLAN_CONTEXT,
                             f"plan '{plan.plan_id}' starts at a rate {rate_error:.4g} rad/s from the current one "

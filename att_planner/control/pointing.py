@@ -1,14 +1,13 @@
-"""Tracking a guidance reference (issue 15, no ROS): feedforward plus quaternion PD feedback.
+"""Pointing law (no ROS, pure): tracking a guidance reference with feedforward plus the PD law.
 
-With the body's attitude error from the reference ``q_e = q_R* ⊗ q`` and ``C = R(q_e)ᵀ`` (reference
-axes to body axes), the reference rate and acceleration in body axes are ``ω_r = C ω_R`` and
-``ω̇_r = C ω̇_R``, and the body torque demanded is (Schaub & Junkins, *Analytical Mechanics of Space
-Systems*, §8.3; Basilisk ``mrpFeedback``)::
+With the attitude error ``q_BR = q_RN* ⊗ q_BN``, the reference rate and acceleration in body axes
+are ``ω_RN_B = [BR] ω_RN_R`` and ``ω̇_RN_B = [BR] ω̇_RN_R``, and the body torque demanded is
+(Schaub & Junkins, *Analytical Mechanics of Space Systems*, §8.3; Basilisk ``mrpFeedback``)::
 
-    τ = J (ω̇_r − ω × ω_r) + ω × J ω − K_p 2 sign(e_w) e_v − K_d (ω − ω_r)
+    τ_B = J (ω̇_RN_B − ω_BN_B × ω_RN_B) + ω_BN_B × J ω_BN_B − K_p 2 sign(q_BR,w) q_BR,v − K_d (ω_BN_B − ω_RN_B)
 
 The wheels' own gyroscopic term ``ω × G I_w Ω`` is compensated where the demand becomes wheel
-torques (:func:`att_planner.control.tracking.wheel_torques`). A constant-rate reference (nadir on a
+torques (:func:`att_planner.control.wheels.wheel_torques`). A constant-rate reference (nadir on a
 circular orbit) is then held with no steady error: the feedforward carries the whole torque.
 """
 from __future__ import annotations
@@ -16,7 +15,8 @@ from __future__ import annotations
 import numpy as np
 
 from att_msgs_py.types import Plan
-from att_planner.guidance import Reference
+from att_planner.control import pd
+from att_planner.control.reference import Reference
 from att_planner.guidance import reference as guidance_reference
 from att_planner.guidance.laws import BlendedLaw
 from att_sim.models import rotations as rot
@@ -26,19 +26,27 @@ HANDOVER_RATE_MATCH = 1e-4     # rad/s: a plan ending this close to the law's ra
 HANDOVER_ATTITUDE_MATCH = 1e-3  # rad: ... and this close to its attitude (else: through the blend)
 
 
-def body_reference(q, ref: Reference) -> tuple[np.ndarray, np.ndarray]:
-    """The reference rate and acceleration in body axes at attitude ``q``."""
-    C = rot.dcm(rot.multiply(rot.conjugate(ref.q), q)).T
-    return C @ ref.omega, C @ ref.omega_dot
+def law_reference(law, t: float) -> Reference:
+    """The reference of the pointing ``law`` at ``t``: its attitude and the rate and acceleration
+    the guidance differentiates from it (:func:`att_planner.guidance.reference`), in the law's axes."""
+    g = guidance_reference(law.attitude, t)
+    return Reference(g.q, g.omega, g.omega_dot)
 
 
-def pointing_torque(sc: Spacecraft, q, omega, ref: Reference, kp: float, kd: float) -> np.ndarray:
-    """Body torque (N m) that tracks ``ref`` from attitude ``q`` and rate ``omega`` (module docstring)."""
-    omega = np.asarray(omega, float)
-    w_r, w_r_dot = body_reference(q, ref)
+def _inertia_times(J: np.ndarray, v: np.ndarray) -> np.ndarray:
+    return np.matmul(J, v[..., None])[..., 0]
+
+
+def pointing_torque(sc: Spacecraft, q_BN, omega_BN_B, ref: Reference, kp: float, kd: float) -> np.ndarray:
+    """Body torque ``τ_B`` (N m) that tracks ``ref`` from attitude ``q_BN`` and rate ``omega_BN_B``
+    (module docstring; single vectors or rows of runs)."""
+    omega = np.asarray(omega_BN_B, float)
+    q_BR = pd.relative_attitude(q_BN, ref.q_RN)
+    omega_RN_B, omega_dot_RN_B = pd.to_body(q_BR, ref.omega_RN_R), pd.to_body(q_BR, ref.omega_dot_RN_R)
     J = sc.inertia
-    feedforward = J @ (w_r_dot - rot.cross(omega, w_r)) + rot.cross(omega, J @ omega)
-    return feedforward - kp * 2.0 * rot.error_vector(q, ref.q) - kd * (omega - w_r)
+    feedforward = _inertia_times(J, omega_dot_RN_B - rot.cross(omega, omega_RN_B)) + \
+        rot.cross(omega, _inertia_times(J, omega))
+    return feedforward + pd.pd_torque(q_BR, omega - omega_RN_B, kp, kd)
 
 
 def handover_law(law, plan: Plan, t: float, blend: float):
@@ -46,7 +54,7 @@ def handover_law(law, plan: Plan, t: float, blend: float):
     on the law's attitude at its rate (a slew planned to end on the moving target, flown when
     planned), else the law entered through :class:`~att_planner.guidance.laws.BlendedLaw` over
     ``blend`` s (a plan ending at rest)."""
-    ref = guidance_reference(law.attitude, t)
-    matched = (float(np.linalg.norm(plan.omega[-1] - ref.omega)) <= HANDOVER_RATE_MATCH
-               and rot.angle_between(plan.q[-1], ref.q) <= HANDOVER_ATTITUDE_MATCH)
+    ref = law_reference(law, t)
+    matched = (float(np.linalg.norm(plan.omega[-1] - ref.omega_RN_R)) <= HANDOVER_RATE_MATCH
+               and rot.angle_between(plan.q[-1], ref.q_RN) <= HANDOVER_ATTITUDE_MATCH)
     return law if matched or blend <= 0 else BlendedLaw(law, t, blend)

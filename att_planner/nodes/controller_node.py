@@ -3,7 +3,7 @@
 Subscribes ``/spacecraft/state`` and the latched ``/planner/plans``; publishes
 ``/actuator/command`` and ``/controller/status`` at ``control_rate`` (Hz of sim time): a command is
 computed when a state at or after the next control instant arrives, and stamped with that state's
-time (the simulator's lockstep waits for it); serves ``/controller/set_mode`` and the
+time (the simulator waits for it before it advances); serves ``/controller/set_mode`` and the
 ``/controller/execute`` action (ExecuteManeuver), which runs for the maneuver's duration plus
 ``settle_time`` and reports progress as feedback (the zone margins of the feedback are taken
 on the scenario's sky: its epoch and orbit).
@@ -22,7 +22,7 @@ count, and they only serve the state gate's skew check.
 Watchdog: when no state came for ``wall_timeout`` s of wall time the controller commands zero
 and reports ``state_stale`` until states flow again.
 
-``state_source`` (issue 14): ``truth`` flies on ``/spacecraft/state``; ``estimate`` (the default of a
+``state_source``: ``truth`` flies on ``/spacecraft/state``; ``estimate`` (the default of a
 scenario with a gyro) flies on ``/estimator/attitude`` with the wheel speeds of
 ``/sensors/wheel_speeds`` and the field of ``/sensors/magnetometer``
 (:class:`att_planner.control.measured_state.MeasuredState`), compensating the wheel drives' expected
@@ -55,7 +55,7 @@ from att_msgs_py.node_runner import (
     subscribe_when_heard,
 )
 from att_msgs_py.types import ManeuverResult
-from att_planner.control.configure import controller_from_scenario, public_key
+from att_planner.control.from_scenario import controller_from_scenario, public_key
 from att_planner.estimation.inputs import Sources
 from att_sim.models import scenario as scen
 

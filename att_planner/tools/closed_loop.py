@@ -3,7 +3,7 @@
 :class:`ClosedLoop` runs :class:`att_sim.truth.simulation.Simulation`, the
 :class:`~att_planner.estimation.estimator.Estimator` and the
 :class:`~att_planner.control.controller.Controller` of a scenario — built by the same functions as
-the nodes (:func:`~att_planner.control.configure.controller_from_scenario`,
+the nodes (:func:`~att_planner.control.from_scenario.controller_from_scenario`,
 :func:`~att_planner.estimation.from_scenario.estimator_from_scenario`) from the scenario's sections, with
 ``overrides`` on top — and passes what the nodes would publish, in the order the simulator publishes
 it: each step the sensors' readings, then the state; the estimator's estimate (or the truth state)
@@ -25,7 +25,7 @@ from att_msgs_py import convert, signing, topics
 from att_msgs_py.errors import RequestError
 from att_msgs_py.parameters import SectionReader
 from att_msgs_py.types import Health, ManeuverResult, Plan, PointingMode
-from att_planner.control.configure import controller_from_scenario
+from att_planner.control.from_scenario import controller_from_scenario
 from att_planner.estimation.estimator import Estimator
 from att_planner.estimation.from_scenario import estimator_from_scenario
 from att_sim.models import dynamics as dyn
@@ -143,7 +143,9 @@ class ClosedLoop:
         <att_planner.estimation.estimator.Estimator.reprocess>`), which the caller does — at once,
         or for many loops together (:func:`~att_planner.tools.monte_carlo.run.fly_together`, which
         also senses for them: ``readings``, the simulation's now) — and the controller when it is
-        about to step (its tracking law may be prepared then: :mod:`att_planner.control.lockstep`)."""
+        about to step, to which the caller may send its :class:`StepOutput
+        <att_planner.control.controller.StepOutput>`
+        (:func:`~att_planner.control.controller.step_controllers` of many loops; None: it steps alone)."""
         sim, ctl, est = self.sim, self.controller, self.estimator
         readings = sim.sense() if readings is None else readings
         t = sim.t
@@ -179,8 +181,8 @@ class ClosedLoop:
         if outcome is not None:
             self._outcome(outcome)
             if ctl.due():
-                yield ctl
-                out = ctl.step()
+                out = yield ctl
+                out = ctl.step() if out is None else out
                 if out.result is not None:
                     self.result = out.result
                 if self.tap is not None:

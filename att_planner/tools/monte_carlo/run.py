@@ -24,8 +24,7 @@ import numpy as np
 from cryptography.hazmat.primitives.asymmetric.ed25519 import Ed25519PrivateKey
 
 from att_msgs_py.types import Health, ManeuverResult, Plan, Verification
-from att_planner.control.controller import Controller
-from att_planner.control.lockstep import track_together
+from att_planner.control.controller import Controller, step_controllers
 from att_planner.control.tracking import ReferenceMemo
 from att_planner.estimation.estimator import replay
 from att_planner.tools.closed_loop import ClosedLoop, Reprocessing, plan_in_process
@@ -146,7 +145,7 @@ def fly_together(setup: Setup, runs: list[tuple[int, int]], tap=None) -> list[di
     estimators reprocess together (:func:`~att_planner.estimation.estimator.replay`:
     their propagations as one stack), their controllers share the plan's reference (one plan object,
     issued once with the loops' one key: :class:`~att_planner.control.tracking.ReferenceMemo`) and
-    compute its tracking law as rows (:func:`~att_planner.control.lockstep.track_together`), and
+    compute its tracking law as rows (:func:`~att_planner.control.controller.step_controllers`), and
     the simulations of the runs still going advance together (:class:`att_sim.truth.lockstep.Lockstep`) —
     every run to the bits it reaches alone. ``cpu_seconds``: the group's CPU time shared equally.
     ``tap``: see :attr:`ClosedLoop.tap` (a full log; one run)."""
@@ -167,10 +166,13 @@ def fly_together(setup: Setup, runs: list[tuple[int, int]], tap=None) -> list[di
         going = still
         readings = lockstep.sense() if lockstep is not None else [None] * len(going)
         exchanges = [f.loop.exchange_steps(r) for f, r in zip(going, readings)]
+        outputs = {}
         while exchanges:                # each turn: every exchange to its next job, those of a kind done together
-            turn = [(steps, next(steps, None)) for steps in exchanges]
+            turn = [(steps, _resume(steps, outputs.pop(steps, None))) for steps in exchanges]
             replay([job for _, job in turn if isinstance(job, Reprocessing)])
-            track_together([job for _, job in turn if isinstance(job, Controller)])
+            stepping = [(steps, job) for steps, job in turn if isinstance(job, Controller)]
+            for (steps, _), out in zip(stepping, step_controllers([job for _, job in stepping])):
+                outputs[steps] = out
             exchanges = [steps for steps, job in turn if job is not None]
         if lockstep is not None:
             lockstep.advance(going[0].loop.step)
@@ -178,6 +180,14 @@ def fly_together(setup: Setup, runs: list[tuple[int, int]], tap=None) -> list[di
             going[0].loop.sim.advance(going[0].loop.step)
     share = (time.process_time() - cpu) / max(len(flights), 1)
     return [{**f.row, "cpu_seconds": share} for f in flights]
+
+
+def _resume(steps, value):
+    """The generator ``steps`` sent ``value``: its next job, None when it has finished."""
+    try:
+        return steps.send(value)
+    except StopIteration:
+        return None
 
 
 def fly(setup: Setup, seed: int, run: int = -1, tap=None) -> dict:

@@ -46,7 +46,7 @@ def small_circle(direction: np.ndarray, half_angle: float, n: int = 361) -> np.n
 
 def _planned_path(plan: Plan, n: int = 400) -> np.ndarray:
     ts = np.linspace(plan.t[0], plan.t[-1], n)
-    return np.array([tracking.plan_reference(plan, t).q for t in ts])
+    return np.array([tracking.plan_reference(plan, t).q_RN for t in ts])
 
 
 CONE_COLORS = ["#d62728", "#1f77b4", "#7f7f7f", "#9467bd", "#8c564b", "#e377c2", "#bcbd22", "#17becf"]

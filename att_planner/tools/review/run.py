@@ -130,4 +130,4 @@ def settling_time(t: np.ndarray, q: np.ndarray, threshold: float = SETTLING_THRE
 
 def reference_error(run: Run) -> np.ndarray:
     """Angle (rad) between the recorded attitude and the plan reference the controller tracked."""
-    return np.array([rot.angle_between(q, tracking.plan_reference(run.plan, t).q) for t, q in zip(run.t, run.q)])
+    return np.array([rot.angle_between(q, tracking.plan_reference(run.plan, t).q_RN) for t, q in zip(run.t, run.q)])

@@ -99,7 +99,7 @@ def test_cancellation_ends_the_maneuver_in_safe_mode(world):
     core.next_control = -math.inf
     out = core.step(cancel_requested=True)
     assert out.result.error_code == ErrorCode.ABORTED and out.result.message == "cancelled"
-    assert core.mode == ControlMode.SAFE and core.hold_q is None
+    assert core.mode == ControlMode.SAFE and core.hold_q_RN is None
 
 
 @pytest.mark.parametrize("change, code, words", [

@@ -130,9 +130,9 @@ def test_the_coils_are_off_over_each_control_period_that_ends_at_a_magnetometer_
     assert off == [0.45, 0.95, 1.45, 1.95]          # the period ending at each 0.5 s sample
     # a sample taken while the coils were on is not used; one after an off period is
     core.measured.on_magnetometer(MagnetometerMeasurement(1.45, np.array([9e-5, 0, 0]), np.eye(3), "body"))
-    assert core.measured.field[0] == pytest.approx(2e-5)
+    assert core.measured.field_B[0] == pytest.approx(2e-5)
     core.measured.on_magnetometer(MagnetometerMeasurement(1.5, np.array([3e-5, 0, 0]), np.eye(3), "body"))
-    assert core.measured.field[0] == pytest.approx(3e-5)
+    assert core.measured.field_B[0] == pytest.approx(3e-5)
 
 
 def test_expected_friction_is_added_to_every_wheel_command():

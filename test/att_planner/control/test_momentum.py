@@ -1,4 +1,4 @@
-"""Momentum management (issue 15): the cross-product law's torque, the pyramid's null space, the
+"""Momentum management: the cross-product law's torque, the pyramid's null space, the
 distribution of a torque over four wheels, and a closed loop that dumps the wheels' momentum while
 pointing (and keeps it without dumping)."""
 from __future__ import annotations
@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from att_msgs_py.types import ControlMode, PointingMode
-from att_planner.control import momentum, tracking
+from att_planner.control import momentum, wheels
 from att_planner.control.controller import Controller, ControllerConfig
 from att_planner.control.plan_checks import PlanContext
 from att_planner.guidance.laws import Sky
@@ -50,9 +50,9 @@ def test_the_pyramids_null_space_moves_the_wheels_and_not_the_body():
 
 def test_four_wheels_share_a_torque_and_keep_its_direction_at_saturation():
     demand = np.array([0.02, -0.03, 0.01])
-    u = tracking.wheel_torques(SC, demand, np.zeros(3), np.zeros(4))
+    u = wheels.wheel_torques(SC, demand[None], np.zeros((1, 3)), np.zeros((1, 4)))[0]
     assert np.allclose(-PYRAMID @ u, demand, atol=1e-15)
-    big = tracking.wheel_torques(SC, 20 * demand, np.zeros(3), np.zeros(4))
+    big = wheels.wheel_torques(SC, 20 * demand[None], np.zeros((1, 3)), np.zeros((1, 4)))[0]
     assert np.max(np.abs(big)) == pytest.approx(SC.wheel_torque_max)
     produced = -PYRAMID @ big
     assert np.allclose(np.cross(produced, demand), 0.0, atol=1e-12) and produced @ demand > 0

@@ -5,7 +5,8 @@ import numpy as np
 import pytest
 
 from att_msgs_py.types import Command, ControlMode
-from att_planner.control import tracking
+from att_planner.control import tracking, wheels
+from att_planner.control.reference import Reference
 from att_planner.methods.eigenaxis import plan_eigenaxis, plan_eigenaxis_smooth
 from att_planner.problem import ManeuverProblem
 from att_sim.models import rotations as rot
@@ -27,7 +28,7 @@ def test_tracking_law_flies_an_eigenaxis_plan_with_wheels(sim):
     for _ in range(int((plan.duration + 30) / dt)):
         ref = tracking.plan_reference(plan, sim.t)
         tau = tracking.tracking_torque(sim.x[:4], sim.x[4:7], ref, kp=1.0, kd=16.0)
-        u = tracking.wheel_torques(sim.sc, tau, sim.x[4:7], sim.x[7:])
+        u = wheels.wheel_torques(sim.sc, tau[None], sim.x[4:7][None], sim.x[7:][None])[0]
         sim.set_command(Command(ControlMode.PLAN_TRACKING, u))
         sim.advance(dt)
     assert rot.angle_between(sim.x[:4], goal) < math.radians(0.05)
@@ -56,12 +57,37 @@ def test_a_three_knot_bang_bang_plan_is_tracked_as_it_flies(sim):
     for t in np.linspace(0.0, tf, 23):
         phi = 0.5 * alpha * t**2 if t <= tf / 2 else angle - 0.5 * alpha * (tf - t) ** 2
         ref = tracking.plan_reference(plan, t)
-        assert rot.angle_between(ref.q, rot.from_axis_angle([0, 0, 1], phi)) < 1e-9
+        assert rot.angle_between(ref.q_RN, rot.from_axis_angle([0, 0, 1], phi)) < 1e-9
     dt, worst = 0.1, 0.0
     for _ in range(int(tf / dt)):
         ref = tracking.plan_reference(plan, sim.t)
-        worst = max(worst, rot.angle_between(sim.x[:4], ref.q))
+        worst = max(worst, rot.angle_between(sim.x[:4], ref.q_RN))
         tau = tracking.tracking_torque(sim.x[:4], sim.x[4:7], ref, kp=1.0, kd=16.0)
-        sim.set_command(Command(ControlMode.PLAN_TRACKING, tracking.wheel_torques(sim.sc, tau, sim.x[4:7], sim.x[7:])))
+        u = wheels.wheel_torques(sim.sc, tau[None], sim.x[4:7][None], sim.x[7:][None])[0]
+        sim.set_command(Command(ControlMode.PLAN_TRACKING, u))
         sim.advance(dt)
     assert worst < math.radians(0.05)
+
+
+def test_the_reference_rate_is_rotated_into_body_axes():
+    """120° off a reference turning at 0.1 rad/s: the law's rate error is ω_BN_B − [BR] ω_RN_R and its
+    feedforward [BR] τ_R, against an independent recomputation with scipy's rotation matrices
+    ([NB], [NR]); a body turning with the reference at a fixed offset has no rate error (the
+    unrotated form ω_BN_B − ω_RN_R, right only to first order in the attitude error, is 0.17 rad/s off)."""
+    from scipy.spatial.transform import Rotation
+
+    q_RN = rot.from_axis_angle([0.2, -0.7, 0.4], 0.9)
+    q_BN = rot.multiply(q_RN, rot.from_axis_angle([1.0, 0.3, -0.5], np.radians(120.0)))
+    omega_RN_R, torque_R = np.array([0.06, -0.05, 0.06]), np.array([0.02, 0.01, -0.03])
+    ref = Reference(q_RN, omega_RN_R, np.zeros(3), torque_R)
+    dcm_BR = Rotation.from_quat(q_BN).as_matrix().T @ Rotation.from_quat(q_RN).as_matrix()
+    q_BR = Rotation.from_matrix(dcm_BR.T).as_quat()                      # B relative to R, [x, y, z, w]
+    e = q_BR[:3] * np.sign(q_BR[3])
+    kp, kd = 1.0, 16.0
+    for omega_BN_B in (np.array([0.01, 0.02, -0.03]), dcm_BR @ omega_RN_R):
+        expected = dcm_BR @ torque_R - 2.0 * kp * e - kd * (omega_BN_B - dcm_BR @ omega_RN_R)
+        assert np.allclose(tracking.tracking_torque(q_BN, omega_BN_B, ref, kp, kd), expected, rtol=0, atol=1e-12)
+    locked = dcm_BR @ omega_RN_R                                          # turning with R: ω_BR = 0
+    feedback = tracking.tracking_torque(q_BN, locked, ref, kp, kd, feedforward=False)
+    assert np.allclose(feedback, -2.0 * kp * e, rtol=0, atol=1e-12)
+    assert np.linalg.norm(locked - omega_RN_R) > 0.1                      # what the unrotated form would damp

@@ -1,4 +1,4 @@
-"""The controller core of a scenario, built from its parameters (no ROS).
+"""The controller core built from a scenario and its parameters (no ROS).
 
 :func:`controller_from_scenario` reads every parameter of the controller's core through ``param``
 — the node's :class:`~att_msgs_py.node_runner.ParameterReader` (ROS parameters over the scenario's
