@@ -24,7 +24,7 @@ import numpy as np
 from att_msgs_py import validation
 from att_msgs_py.errors import ErrorCode, RequestError
 from att_msgs_py.types import Cone, Zone
-from att_planner.zones import ZoneSky, same_axis
+from att_planner.zones import FittedZones, same_axis
 from att_sim.models import rotations as rot
 
 BOUNDARY_TOLERANCE = 1e-6   # rad: an end direction this far inside a boundary is on it
@@ -167,7 +167,7 @@ def _angle(a: np.ndarray, b: np.ndarray) -> float:
     return float(np.arccos(np.clip(a @ b / (np.linalg.norm(a) * np.linalg.norm(b)), -1.0, 1.0)))
 
 
-def contradictory_zones(zone_sky: ZoneSky) -> str:
+def contradictory_zones(zone_sky: FittedZones) -> str:
     """Why no boresight satisfies the zones of one sensor at t = 0, or '': a keep-in cone entirely
     inside a keep-out cone (γ + θ_in ≤ θ_out), or two keep-in cones that do not meet (γ > θ_1 + θ_2).
     Only pairs are checked: a keep-in cone covered by several keep-out cones together is not."""
@@ -191,7 +191,7 @@ def contradictory_zones(zone_sky: ZoneSky) -> str:
 GOAL_CHECK_TIMES = 2001      # times over the zones' window at which a goal is judged against moving zones
 
 
-def zone_at_end(problem, zone_sky: ZoneSky | None = None) -> str:
+def zone_at_end(problem, zone_sky: FittedZones | None = None) -> str:
     """Why the start or the goal violates a zone, or '': the start at t = 0; the goal at every
     time of the zones' window (``GOAL_CHECK_TIMES`` times over [0, window]): the arrival time is
     not known before planning, so a goal is refused only when no arrival time in the window clears

@@ -20,8 +20,8 @@ feedforward plus quaternion PD feedback (:mod:`.tracking`) for the plan's durati
 time, then a hold of its final attitude.
 
 The feedback's ``min_cone_margin`` covers the plan's cones and zones at their true positions now:
-a :class:`~att_planner.zones.ZoneSky` of the plan, built once when it starts, on the controller's
-``sky`` (:class:`att_sim.models.ephemeris.Sky` at the scenario epoch, whose time is sim time), evaluated
+a :class:`~att_planner.zones.FittedZones` of the plan, built once when it starts, on the controller's
+``sky`` (:class:`att_sim.models.ephemeris.Ephemeris` at the scenario epoch, whose time is sim time), evaluated
 straight from the ephemeris at the current state's time (one evaluation per feedback). The truth
 does not depend on the plan's epoch: a plan made for another start instant shows the margins it
 really has. Without a ``sky`` (a scenario with no epoch) the moving zones are left out: the margin
@@ -58,12 +58,12 @@ from att_planner.control.plan_checks import PlanContext, check_start
 from att_planner.control.pointing import handover_law, pointing_torque
 from att_planner.control.state_gate import GateConfig, StateGate
 from att_planner.guidance import reference as guidance_reference
-from att_planner.guidance.laws import Sky as GuidanceSky
+from att_planner.guidance.laws import PointingGeometry
 from att_planner.guidance.modes import law_of
-from att_planner.zones import ZoneSky, zones_from_cones
+from att_planner.zones import FittedZones, zones_from_cones
 from att_sim.models import rotations as rot
 from att_sim.models.dynamics import Spacecraft
-from att_sim.models.ephemeris import Sky
+from att_sim.models.ephemeris import Ephemeris
 
 
 @dataclass(frozen=True)
@@ -102,7 +102,7 @@ class Maneuver:
 
     plan: Plan
     t0: float
-    zones: ZoneSky | None = None
+    zones: FittedZones | None = None
     ticks: int = 0
     after: object = None
 
@@ -127,7 +127,7 @@ class StateOutcome:
     ended: ManeuverResult | None = None
 
 
-ZONE_FIT_WINDOW = 1.0                          # s: a ZoneSky needs a window; the controller uses its truth only
+ZONE_FIT_WINDOW = 1.0                          # s: a FittedZones needs a window; the controller uses its truth only
 
 
 USABLE = (Health.CONVERGED, Health.PROPAGATING)   # estimates the attitude laws may fly on
@@ -136,8 +136,8 @@ USABLE = (Health.CONVERGED, Health.PROPAGATING)   # estimates the attitude laws 
 class Controller:
     def __init__(self, context: PlanContext, config: ControllerConfig = ControllerConfig(),
                  mode: int = ControlMode.IDLE, body_frame_id: str = "body", gate: GateConfig | None = None,
-                 sky: Sky | None = None, measured: MeasuredState | None = None, friction=None,
-                 guidance_sky: GuidanceSky | None = None):
+                 sky: Ephemeris | None = None, measured: MeasuredState | None = None, friction=None,
+                 guidance_sky: PointingGeometry | None = None):
         """``measured``: fly on attitude estimates (:meth:`accept_estimate`) with measured wheel
         speeds and field, blanking the magnetometer; None: on truth states (:meth:`accept_state`).
         ``friction``: the wheel drives' expected friction torque at relative speeds ν (a callable,
@@ -320,7 +320,7 @@ class Controller:
         self.mode, self.pointing = ControlMode.PLAN_TRACKING, None
         return None
 
-    def zone_sky(self, plan: Plan) -> ZoneSky | None:
+    def zone_sky(self, plan: Plan) -> FittedZones | None:
         """The plan's cones and zones on :attr:`sky` (moving zones left out without one); None
         when there are none. Only its truth is used (any time): the fit is over a short window."""
         zones = zones_from_cones(plan.cones, plan.sensor_axis) + [z for z in plan.zones
@@ -328,7 +328,7 @@ class Controller:
         if not zones:
             return None
         moving = any(z.body != "inertial" for z in zones)
-        return ZoneSky(zones, self.sky if moving else None, window=ZONE_FIT_WINDOW)
+        return FittedZones(zones, self.sky if moving else None, window=ZONE_FIT_WINDOW)
 
     def abort(self, message: str) -> ManeuverResult:
         """End the running maneuver unsuccessfully (cancelled, or safe mode); safe mode follows."""

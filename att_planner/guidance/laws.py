@@ -72,17 +72,18 @@ def geodetic_to_itrs(latitude: float, longitude: float, altitude: float) -> np.n
 
 
 @dataclass
-class Sky:
-    """What the laws look at: ``state(t) -> (r, v)`` (inertial, m and m/s), ``sun(t)`` (unit, from
-    the spacecraft; None without an epoch) and ``itrs(t)`` (the GCRS→ITRS rotation matrix)."""
+class PointingGeometry:
+    """The geometry the pointing laws look at: ``state(t) -> (r_N, v_N)`` (the spacecraft's inertial
+    position and velocity, m and m/s), ``sun(t)`` (unit, from the spacecraft, inertial axes; None
+    without an epoch) and ``itrs(t)`` (the GCRS→ITRS rotation matrix)."""
 
     state: Callable
     sun: Callable | None
     itrs: Callable
 
     @classmethod
-    def of(cls, environment) -> Sky:
-        """The sky of an :class:`att_sim.models.world.Environment` (the onboard models of the scenario);
+    def of(cls, environment) -> PointingGeometry:
+        """The pointing geometry of an :class:`att_sim.models.world.Environment` (the onboard models of the scenario);
         the orbit's states are remembered for the last few times asked (a reference differentiates
         its law at three times, each asking for the orbit more than once)."""
         field_model = environment.field
@@ -150,7 +151,7 @@ def _unit(v) -> np.ndarray:
     return v / math.sqrt(float(v @ v))
 
 
-def directions(sky: Sky) -> dict[str, Callable]:
+def directions(sky: PointingGeometry) -> dict[str, Callable]:
     """The named directions of :data:`SECONDARY` as functions of time (unit, inertial)."""
     def nadir(t):
         return -_unit(sky.state(t)[0])
@@ -171,7 +172,7 @@ def directions(sky: Sky) -> dict[str, Callable]:
     return out
 
 
-def ground_line_of_sight(sky: Sky, latitude: float, longitude: float, altitude: float) -> Callable:
+def ground_line_of_sight(sky: PointingGeometry, latitude: float, longitude: float, altitude: float) -> Callable:
     """The unit line of sight from the spacecraft to a ground point, as a function of time."""
     r_itrs = geodetic_to_itrs(latitude, longitude, altitude)
 

@@ -19,7 +19,7 @@ from att_msgs_py.errors import ErrorCode, RequestError
 from att_msgs_py.types import POINTING_KINDS, SECONDARY_KINDS, PointingMode
 from att_planner.guidance.laws import (
     FixedAttitude,
-    Sky,
+    PointingGeometry,
     TwoVectorLaw,
     directions,
     ground_line_of_sight,
@@ -38,7 +38,7 @@ def _angle(value, name: str, low: float, high: float) -> float:
     return validation.number(value, name, BAD, low, high)
 
 
-def law_of(mode: PointingMode, sky: Sky, t: float, q_now: np.ndarray):
+def law_of(mode: PointingMode, sky: PointingGeometry, t: float, q_now: np.ndarray):
     """The pointing law of ``mode`` on ``sky``, with an attitude at ``t`` (``q_now``: the current
     attitude, held by an inertial mode without one); RequestError 314 otherwise."""
     kind = validation.text(mode.kind, "pointing.kind", BAD)

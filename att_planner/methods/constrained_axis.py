@@ -9,7 +9,7 @@ an eigenaxis rotation instead of the last two legs). Every leg is a rest-to-rest
 ways around each keep-out zone are tried and the fastest sequence that clears every zone is kept.
 
 Zones that move: every candidate is judged with the margins of each dense sample at its physical
-time (:func:`.axis_rotations.leg_path`, :meth:`att_planner.zones.ZoneSky.margins`), never a
+time (:func:`.axis_rotations.leg_path`, :meth:`att_planner.zones.FittedZones.margins`), never a
 snapshot. The ride is built about the zone as it is at ``t*``, the middle of the ride, on a circle
 widened by how far the zone's axis and half-angle move during the ride; ``t*`` and that widening
 are found by a few fixed-point iterations (:data:`RIDE_ITERATIONS`) of the construction. When a
@@ -37,7 +37,7 @@ from att_planner.methods.axis_rotations import (
 )
 from att_planner.problem import ManeuverProblem
 from att_planner.verification import clearances
-from att_planner.zones import ZoneSky, same_axis
+from att_planner.zones import FittedZones, same_axis
 from att_sim.models import rotations as rot
 
 METHOD = "constrained_axis"
@@ -138,7 +138,7 @@ def _legs_time(problem: ManeuverProblem, legs: list[AxisLeg]) -> tuple[float, fl
     return float(t[-1]), float(m.min()) if m.size else np.inf
 
 
-def _moving_ride(problem: ManeuverProblem, zs: ZoneSky, z: int, side: int, ride_margin: float,
+def _moving_ride(problem: ManeuverProblem, zs: FittedZones, z: int, side: int, ride_margin: float,
                  finish: str) -> tuple[list[AxisLeg] | None, float, float]:
     """``(legs, t*, widening)``: the riding legs about zone ``z`` as it is at the middle ``t*`` of the
     ride, on a circle widened by the zone's motion during the ride (how far its axis turns from
@@ -164,7 +164,7 @@ def _moving_ride(problem: ManeuverProblem, zs: ZoneSky, z: int, side: int, ride_
     return legs, t_star, widen
 
 
-def _detours(problem: ManeuverProblem, zs: ZoneSky) -> list[tuple[str, list[AxisLeg]]]:
+def _detours(problem: ManeuverProblem, zs: FittedZones) -> list[tuple[str, list[AxisLeg]]]:
     """Two-leg routes for a path that a zone overtakes (moving zones): *escape* — a λ-rotation
     taking a keep-out zone's sensor straight away from the zone's axis (as at t = 0) by
     :data:`ESCAPES`, then the eigenaxis to the goal; *tilt* — two eigenaxis legs through the

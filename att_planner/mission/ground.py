@@ -25,8 +25,7 @@ import numpy as np
 
 from att_msgs_py.types import PointingMode
 from att_planner.guidance import reference
-from att_planner.guidance.laws import Sky as GuidanceSky
-from att_planner.guidance.laws import geodetic_to_itrs
+from att_planner.guidance.laws import PointingGeometry, geodetic_to_itrs
 from att_planner.guidance.modes import law_of
 from att_sim.models import world
 
@@ -52,7 +51,7 @@ class GroundTrack:
     def __init__(self, scenario, site, mode: PointingMode, min_elevation: float, torque_share: float = TORQUE_SHARE):
         self.site, self.mode, self.min_elevation = site, mode, float(min_elevation)
         self.environment = world.Environment.from_scenario(scenario)
-        self.law = law_of(mode, GuidanceSky.of(self.environment), 0.0, np.array([0.0, 0.0, 0.0, 1.0]))
+        self.law = law_of(mode, PointingGeometry.of(self.environment), 0.0, np.array([0.0, 0.0, 0.0, 1.0]))
         self.spacecraft = scenario.spacecraft
         self.torque_limit = torque_share * self.spacecraft.body_torque_max
         self.r_itrs = geodetic_to_itrs(site.latitude, site.longitude, site.altitude)

@@ -17,7 +17,7 @@ import numpy as np
 
 from att_msgs_py.types import PointingMode
 from att_planner.guidance import reference
-from att_planner.guidance.laws import Sky
+from att_planner.guidance.laws import PointingGeometry
 from att_planner.guidance.modes import law_of
 from att_sim.models import world
 from att_sim.models.scenario import Scenario
@@ -27,7 +27,7 @@ def goal_law(mode: PointingMode, scenario: Scenario, epoch: datetime | None,
              q_start: np.ndarray) -> Callable[[float], tuple[np.ndarray, np.ndarray]]:
     """``t ↦ (q, ω)`` of ``mode``'s law at plan time ``t`` (RequestError 314 for a bad mode)."""
     offset = 0.0 if epoch is None or scenario.epoch is None else (epoch - scenario.epoch).total_seconds()
-    law = law_of(mode, Sky.of(world.Environment.from_scenario(scenario)), offset, q_start)
+    law = law_of(mode, PointingGeometry.of(world.Environment.from_scenario(scenario)), offset, q_start)
 
     def motion(t: float) -> tuple[np.ndarray, np.ndarray]:
         ref = reference(law.attitude, offset + t)

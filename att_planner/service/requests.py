@@ -29,7 +29,7 @@ from att_planner.cones import BOUNDARY_TOLERANCE, boundary_arc_issue, check_zone
 from att_planner.methods import Method
 from att_planner.problem import ManeuverProblem, MovingGoal
 from att_planner.service.moving_goal import goal_law
-from att_planner.service.real_sky import RequestSky, check_orbit_window, resolve_sky
+from att_planner.service.real_sky import RequestGeometry, check_orbit_window, resolve_sky
 from att_planner.service.sky import closed_sky
 from att_sim.models import rotations as rot
 from att_sim.models import scenario as scen
@@ -150,7 +150,7 @@ def zone_window(problem: ManeuverProblem, legs: int = 1) -> float:
     return problem.default_window() * legs + sum(problem.target_dwell.values()) + max(closes, default=0.0)
 
 
-def check_sky(problem: ManeuverProblem, real: RequestSky, legs: int = 1) -> None:
+def check_sky(problem: ManeuverProblem, real: RequestGeometry, legs: int = 1) -> None:
     """The orbit lasts the window (ORBIT_TOO_LOW), then the zones' own checks
     (:func:`att_planner.cones.check_zones`)."""
     if real.sky is not None:

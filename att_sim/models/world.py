@@ -7,7 +7,7 @@
   ``B_b = C(q) B_N(t, r(t))``; for IGRF-14 the inertial field is tabulated along the orbit in
   10-minute tracks (:meth:`~att_sim.models.geomagnetic.GeomagneticField.track`, < 1e-3 nT) built as t
   reaches them;
-* sky: :class:`att_sim.models.ephemeris.Sky` for the Sun's position and the conical shadow;
+* sky: :class:`att_sim.models.ephemeris.Ephemeris` for the Sun's position and the conical shadow;
 * torques (:mod:`att_sim.models.disturbances`), each switched by :class:`Flags`: gravity gradient, solar
   radiation pressure on the facets (zero in umbra, scaled by the visible fraction of the Sun),
   aerodynamic drag on the facets with the exponential density of :mod:`att_sim.models.atmosphere` at the
@@ -37,7 +37,7 @@ from att_sim.models import atmosphere, disturbances
 from att_sim.models import rotations as rot
 from att_sim.models.dynamics import Spacecraft
 from att_sim.models.environment import EARTH_RADIUS, OrbitParams
-from att_sim.models.ephemeris import Sky, shadow_function
+from att_sim.models.ephemeris import Ephemeris, shadow_function
 from att_sim.models.geomagnetic import GeomagneticField
 from att_sim.models.orbit import CircularOrbit, Orbit
 
@@ -91,7 +91,7 @@ class _Now(NamedTuple):
 class Environment:
     """Orbit, field, sky and disturbances of one spacecraft (see module docstring)."""
 
-    def __init__(self, epoch: datetime | None, orbit: Orbit, field: GeomagneticField, sky: Sky | None,
+    def __init__(self, epoch: datetime | None, orbit: Orbit, field: GeomagneticField, sky: Ephemeris | None,
                  spacecraft: Spacecraft, facets=(), residual_dipole=None, flags: Flags = Flags(),
                  drag_coefficient: float = 2.2):
         self.epoch, self.orbit, self.field, self.sky, self.spacecraft = epoch, orbit, field, sky, spacecraft
@@ -119,14 +119,14 @@ class Environment:
         flags = Flags(gravity_gradient=e.get("gravity_gradient", False) if gravity_gradient is None
                       else bool(gravity_gradient),
                       solar_pressure=e.get("solar_pressure", False), drag=e.get("drag", False))
-        sky = None if scenario.epoch is None else Sky(scenario.epoch, scenario.orbit_model)
+        sky = None if scenario.epoch is None else Ephemeris(scenario.epoch, scenario.orbit_model)
         return cls(scenario.epoch, scenario.orbit_model, GeomagneticField(scenario.field_model, scenario.epoch),
                    sky, scenario.spacecraft, e.get("facets", ()), e.get("residual_dipole"), flags,
                    e.get("drag_coefficient", 2.2))
 
     def with_orbit(self, orbit: Orbit) -> Environment:
         """The same environment on another orbit (caches fresh)."""
-        sky = None if self.sky is None else Sky(self.sky.epoch, orbit)
+        sky = None if self.sky is None else Ephemeris(self.sky.epoch, orbit)
         return Environment(self.epoch, orbit, self.field, sky, self.spacecraft, self.facets, self.residual_dipole,
                            self.flags, self.drag_coefficient)
 

@@ -7,7 +7,7 @@ middle of every interval (the attitude there by one more RK4 step of half the in
 node, the propagation itself unchanged), tightened by a margin δ like the time-optimal NLP's:
 keep-out ``a_z · R(q) s_z ≤ cos(θ_z + δ)``, keep-in ``≥ cos(θ_z − δ)``. A moving zone is evaluated
 at the point's physical time over the whole tour, ``t = t_sat Σ dτ`` of the intervals before it
-(so a leg starts at the sum of the earlier legs' durations), through the ZoneSky's Chebyshev series
+(so a leg starts at the sum of the earlier legs' durations), through the FittedZones' Chebyshev series
 of that CasADi expression: exact in the phase durations. The tour is then bounded by the zones'
 window. Without zones nothing is added: the NLP is the zone-free one.
 
@@ -136,7 +136,7 @@ class MultiphaseTranscription:
     Built once per (number of targets, intervals per phase); the target quaternions of an order
     and the end attitude are NLP parameters, so every order of the same set reuses the solver.
     Either end may be at rest (h = 0) or a passage (only ω_z = 0), chosen per solve. ``zones``: a
-    :class:`att_planner.zones.ZoneSky` (module docstring) with ``zone_margin`` δ (rad), or None.
+    :class:`att_planner.zones.FittedZones` (module docstring) with ``zone_margin`` δ (rad), or None.
     """
 
     def __init__(self, sc: dyn.Spacecraft, n_targets: int, intervals: int = 12, substeps: int = SUBSTEPS,
@@ -284,7 +284,7 @@ class MultiphaseTranscription:
 
     def _zone_function(self, margin: float) -> ca.Function:
         """``(q, τ) -> g`` (moving zones, τ the tour's normalised time) or ``q -> g`` (none moving):
-        the zone constraints ``g ≤ 0`` of :meth:`att_planner.zones.ZoneSky.casadi_constraints`."""
+        the zone constraints ``g ≤ 0`` of :meth:`att_planner.zones.FittedZones.casadi_constraints`."""
         q, tau = ca.SX.sym("q", 4), ca.SX.sym("tau")
         moving = self.zones.moving
         g = ca.vertcat(*self.zones.casadi_constraints(tau * self.scale.t_sat if moving else 0.0,
@@ -435,7 +435,7 @@ def cached_transcription(sc: dyn.Spacecraft, n_targets: int, intervals: int, sub
                          rate_max: float, expand: bool | None = None, zones=None,
                          zone_margin: float = 0.0) -> MultiphaseTranscription:
     """Solver cache: an NLP depends only on the spacecraft, the number of targets, the grid and the
-    zones (a ZoneSky, by identity: the cached NLP holds it, so its id stays unique)."""
+    zones (a FittedZones, by identity: the cached NLP holds it, so its id stays unique)."""
     zone_key = None if zones is None or not zones.zones else (id(zones), float(zone_margin))
     key = (sc.inertia.tobytes(), sc.wheel_axes.tobytes(), sc.wheel_inertia, sc.wheel_torque_max,
            sc.wheel_speed_max, n_targets, intervals, substeps, rate_max, expand, zone_key)

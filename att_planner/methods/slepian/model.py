@@ -101,7 +101,7 @@ class SmoothManeuver:
     instead, w the end ramp of a smooth plan (:func:`att_planner.cones.end_ramp`, ``SMOOTH_END_RAMP``).
     Static zones (``zone_sky`` None): constant axes
     ``cone_dirs`` and ``cone_cos`` = cos(θ_z + σ_z m). Moving zones: ``zone_sky``
-    (:class:`att_planner.zones.ZoneSky`) gives a_z(t), θ_z(t) and their rates, and ``cone_dirs``,
+    (:class:`att_planner.zones.FittedZones`) gives a_z(t), θ_z(t) and their rates, and ``cone_dirs``,
     ``cone_cos`` hold the values at t = 0.
     """
 
@@ -122,7 +122,7 @@ class SmoothManeuver:
     zone_sign: np.ndarray = field(default_factory=lambda: np.zeros(0))   # (Z,) +1 keep-out, −1 keep-in
     zone_margin: float = 0.0
     zone_ramp: np.ndarray = field(default_factory=lambda: np.zeros(0, bool))   # (Z,) margins ramped at the ends
-    zone_sky: Any = None                                     # ZoneSky of moving zones, else None
+    zone_sky: Any = None                                     # FittedZones of moving zones, else None
     sky_memo: dict = field(default_factory=dict, compare=False, repr=False)   # (K, t_f, rates) → zone sky arrays
 
     @property

@@ -114,7 +114,7 @@ def path_function(problem: ManeuverProblem, s: Scaling, n_state: int = 7, cone_m
     ``a_z · b_z ≤ cos(θ_z + δ)``, keep-in ``a_z · b_z ≥ cos(θ_z − δ)``, i.e.
     ``σ_z (a_z · b_z − cos(θ_z + σ_z δ)) ≤ 0``. A fixed zone's data are in ``p``
     (:data:`ZONE_PARAMETERS`). When a zone moves, ``t`` is the normalised time from the start and
-    ``a_z``, ``θ_z`` are the ZoneSky's Chebyshev series of ``t τ_u``, so the collocation couples them
+    ``a_z``, ``θ_z`` are the FittedZones' Chebyshev series of ``t τ_u``, so the collocation couples them
     exactly to ``t_f``: their coefficients are in ``p`` too (:func:`motion_parameters`, the series in
     ``x = α t + β``) when every moving zone is one series of a degree of :data:`MOTION_DEGREES`,
     otherwise the series are constants of the function (tightened by ``cone_margin``). The wheels'
@@ -249,7 +249,7 @@ def weighted_path_function(problem: ManeuverProblem, s: Scaling, cone_margin: fl
     ``a · b ≥ cos(θ + ε)`` (an equality there would repeat the fixed start and the final pointing,
     which IPOPT cannot solve: rank-deficient constraints). When a zone moves,
     the function is ``(x, u, t[, w]) -> g`` with ``t`` the normalised time from the start: ``a_z(t τ_u)``
-    and ``θ_z(t τ_u)`` are the ZoneSky's Chebyshev series of that CasADi expression, so the
+    and ``θ_z(t τ_u)`` are the FittedZones' Chebyshev series of that CasADi expression, so the
     collocation couples them exactly to ``t_f``. Without motion it is ``(x, u[, w]) -> g`` with the
     zones constant (no time dependence is built)."""
     x, u, t, w = ca.SX.sym("x", n_state), ca.SX.sym("u", 3), ca.SX.sym("t"), ca.SX.sym("w")
@@ -292,7 +292,7 @@ def transcription(problem: ManeuverProblem, s: Scaling, mesh: np.ndarray, contro
 
     The NLP is built once per shape and kept (:data:`CACHE_SIZE`): the spacecraft's inertia, the
     number of intervals, the zones' count and series degree (moving zones of many pieces: their
-    ZoneSky), the bounds on the
+    FittedZones), the bounds on the
     rate and momentum, the kind of goal and the settings. The mesh, the zones' data, the goal and the
     momentum scale are its parameters, the start and the duration's bounds its variables' bounds
     (set here), so a second problem of that shape only copies it (:meth:`.collocation.Transcription.copy`).

@@ -22,7 +22,7 @@ series in t_f (:func:`.model.moving_goal_values`), so the slew ends on it at its
 The zones are ``problem.zone_sky()`` (:mod:`att_planner.zones`: today's cones as inertial zones of
 the sensor ``r``, then Sun, Moon, Earth-limb and inertial zones, each of its own sensor). A zone
 that moves is imposed at each collocation point's physical time ``t = τ_k t_f`` through the
-ZoneSky's Chebyshev series of that CasADi expression, so the NLP's derivatives with respect to t_f
+FittedZones' Chebyshev series of that CasADi expression, so the NLP's derivatives with respect to t_f
 are exact (no frozen snapshot is iterated); ``t_f`` is then bounded by the series' window. Without
 motion the constraints are constants and the NLP is today's.
 

@@ -39,7 +39,7 @@ class Route:
 
 def zone_margin(problem: ManeuverProblem, t: np.ndarray, q: np.ndarray) -> float:
     """Smallest margin (rad) of attitudes ``q`` (K, 4) at times ``t`` (K,) s over every zone of the
-    problem (:meth:`att_planner.zones.ZoneSky.margins`, the fitted motion; a time past the zones'
+    problem (:meth:`att_planner.zones.FittedZones.margins`, the fitted motion; a time past the zones'
     window counts as its end, for a guess only); +inf without zones."""
     zones = problem.zone_sky()
     m = zones.margins(np.minimum(t, zones.window), q)

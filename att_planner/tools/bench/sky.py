@@ -5,7 +5,7 @@ default method (``slepian_minimum_time``) through the planner service's pipeline
 (:func:`att_planner.service.planning.plan_maneuver`: the method, then the suite's one verification):
 
 * ``frozen``: the method sees every zone as it is at the start epoch
-  (:meth:`att_planner.zones.ZoneSky.frozen_zones`, inertial cones — what planners that read the
+  (:meth:`att_planner.zones.FittedZones.frozen_zones`, inertial cones — what planners that read the
   zone directions once do);
 * ``moving``: the method sees the zones' motion (:meth:`ManeuverProblem.zone_sky`, Chebyshev fits).
 
@@ -56,7 +56,7 @@ from att_planner.service.requests import ValidRequest
 from att_planner.verification import integrate, rejection
 from att_sim.models import rotations as rot
 from att_sim.models.dynamics import Spacecraft
-from att_sim.models.ephemeris import Sky
+from att_sim.models.ephemeris import Ephemeris
 from att_sim.models.epoch import format_epoch, parse_epoch
 from att_sim.models.orbit import TLEOrbit
 
@@ -120,7 +120,7 @@ def case_problem(name: str, offset: float | None = None) -> tuple[SkyCase, Maneu
     zones = [Zone(n, body, sensor, math.radians(deg)) for n, body, deg in case.zones]
     sc = Spacecraft(inertia=np.diag(EARTH_OBS_J), body_torque_max=EARTH_OBS_TORQUE)
     problem = ManeuverProblem(sc, rot.normalize(np.array(case.q_initial)), rot.normalize(np.array(case.q_final)),
-                              sensor_axis=sensor, zones=zones, epoch=start, sky=Sky(start, orbit))
+                              sensor_axis=sensor, zones=zones, epoch=start, sky=Ephemeris(start, orbit))
     return case, problem
 
 

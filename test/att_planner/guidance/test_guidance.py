@@ -12,7 +12,7 @@ import pytest
 from att_msgs_py.errors import ErrorCode, RequestError
 from att_msgs_py.types import PointingMode
 from att_planner.guidance import reference
-from att_planner.guidance.laws import Sky, two_vector_attitude
+from att_planner.guidance.laws import PointingGeometry, two_vector_attitude
 from att_planner.guidance.modes import law_of
 from att_sim.models import rotations as rot
 from att_sim.models import scenario as scen
@@ -23,8 +23,8 @@ LEO = scen.load("leo_observatory")
 RNG = np.random.default_rng(15)
 
 
-def sky_of(s) -> Sky:
-    return Sky.of(world.Environment.from_scenario(s))
+def sky_of(s) -> PointingGeometry:
+    return PointingGeometry.of(world.Environment.from_scenario(s))
 
 
 def unit(v):

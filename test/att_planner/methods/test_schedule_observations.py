@@ -12,7 +12,7 @@ from att_planner.methods.schedule.planner import zone_window
 from att_planner.reference import olivares_staffetti as ref
 from att_planner.verification import integrate, rejection
 from att_sim.models import rotations as rot
-from helpers.skies import DescendingSky
+from helpers.skies import DescendingEphemeris
 
 GRID = 6
 TARGETS = ref.olivares_targets("A")
@@ -108,7 +108,7 @@ def test_a_moving_zone_defers_an_observation_until_the_target_is_clear():
     210 s in: a target there is covered for a while, and its observation must avoid that time."""
     target = rot.from_axis_angle([0.0, 0.0, 1.0], np.deg2rad(45.0))
     problem = replace(ref.problem(targets={"sun side": target}), zones=[Zone("sun", "sun", X, np.deg2rad(15.0))],
-                      sky=DescendingSky(), target_dwell={"sun side": 120.0})
+                      sky=DescendingEphemeris(), target_dwell={"sun side": 120.0})
     zones = problem.zone_sky(zone_window(problem))
     visible = visibility(zones, target, (0.0, np.inf))
     assert len(visible) >= 2 and visible[0][0] == 0.0              # clear, covered, clear again (and so on:

@@ -11,7 +11,7 @@ from att_planner.methods import schedule as sch
 from att_planner.reference import olivares_staffetti as ref
 from att_planner.verification import integrate, rejection, verify
 from att_sim.models import rotations as rot
-from helpers.skies import DescendingSky
+from helpers.skies import DescendingEphemeris
 
 GRID = 10
 X = np.array([1.0, 0.0, 0.0])
@@ -24,7 +24,7 @@ def tour():
     140 s each way. A 15° Sun zone descends through that plane at azimuth 45° about 210 s in (the
     return leg's middle) and is far above it during the outbound leg."""
     free = ref.problem(targets={"t": rot.from_axis_angle([0.0, 0.0, 1.0], np.deg2rad(90.0))})
-    moving = replace(free, zones=[Zone("sun", "sun", X, np.deg2rad(15.0))], sky=DescendingSky())
+    moving = replace(free, zones=[Zone("sun", "sun", X, np.deg2rad(15.0))], sky=DescendingEphemeris())
     options = {"search_intervals": GRID, "intervals": GRID}
     return moving, sch.plan_schedule(free, **options), sch.plan_schedule(moving, **options)
 

@@ -20,7 +20,7 @@ N_SMALL, W_SMALL = 120, 7.5 / 120      # same time-bandwidth product as the pape
 X, Y, Z = np.eye(3)
 
 
-class SweepSky:
+class SweepEphemeris:
     """A sky with known motion: the 'Sun' at azimuth 90° in the x-y plane's normal plane, its elevation
     ``elevation0 − rate·t`` (rotating about x); the 'Moon' 10° off +z precessing at 0.3 rad/s; the
     'Earth' along −x with an angular radius 0.5 + 0.05 sin(0.4 t) rad."""
@@ -59,7 +59,7 @@ def _frozen(problem):
 def _sweep_problem(elevation0_deg, rate_deg, keep_in_deg=40.0):
     zones = [Zone("sun", "sun", X, np.radians(20.0)),
              Zone("antenna", "moon", Z, np.radians(keep_in_deg), keep_in=True)]
-    return _swift_problem(zones, SweepSky(elevation0_deg, rate_deg))
+    return _swift_problem(zones, SweepEphemeris(elevation0_deg, rate_deg))
 
 
 @pytest.fixture(scope="module")
@@ -67,7 +67,7 @@ def three_sensors():
     """Keep-out Sun on x, keep-in Moon on z, keep-out Earth limb (varying radius) on −y; M = 4, N = 60."""
     zones = [Zone("sun", "sun", X, np.radians(20.0)), Zone("antenna", "moon", Z, np.radians(40.0), keep_in=True),
              Zone("earth", "earth_limb", -Y, np.radians(5.0))]
-    pb = _swift_problem(zones, SweepSky(40.0, 12.0))
+    pb = _swift_problem(zones, SweepEphemeris(40.0, 12.0))
     return S.build_maneuver(pb, M=4, N=60, W=7.5 / 60, cone_margin=1e-3)
 
 
@@ -93,7 +93,7 @@ def test_zone_rows_and_their_tf_derivative_match_finite_differences(three_sensor
 
 
 def test_zone_rows_agree_with_the_zone_margins(three_sensors):
-    """c_kz ≤ 0 exactly where ZoneSky.margins ≥ 0 (keep-out and keep-in, three sensors)."""
+    """c_kz ≤ 0 exactly where FittedZones.margins ≥ 0 (keep-out and keep-in, three sensors)."""
     man = replace(three_sensors, zone_margin=0.0)
     alpha = np.random.default_rng(8).normal(size=12) * 15.0
     ev = S.evaluate(man, alpha, tf=3.0)

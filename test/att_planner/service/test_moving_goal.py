@@ -12,7 +12,7 @@ import pytest
 from att_msgs_py.errors import ErrorCode, RequestError
 from att_msgs_py.types import PointingMode, Stage
 from att_planner.guidance import reference
-from att_planner.guidance.laws import Sky
+from att_planner.guidance.laws import PointingGeometry
 from att_planner.guidance.modes import law_of
 from att_planner.service.moving_goal import goal_law
 from att_planner.service.planning import plan_maneuver
@@ -36,7 +36,7 @@ def validate(method="time_optimal", mode=NADIR, **fields):
 def test_the_goal_is_the_controllers_law_shifted_by_the_plans_epoch():
     later = LEO.epoch.replace(second=LEO.epoch.second + 30)
     motion = goal_law(PointingMode("nadir"), LEO, later, rot.IDENTITY)
-    law = law_of(PointingMode("nadir"), Sky.of(world.Environment.from_scenario(LEO)), 0.0, rot.IDENTITY)
+    law = law_of(PointingMode("nadir"), PointingGeometry.of(world.Environment.from_scenario(LEO)), 0.0, rot.IDENTITY)
     q, w = motion(100.0)
     ref = reference(law.attitude, 130.0)
     assert rot.angle_between(q, ref.q) < 1e-12 and np.allclose(w, ref.omega, atol=1e-15)
