@@ -36,7 +36,7 @@ ARC_TOLERANCE = 1e-4        # rad: a forced boundary arc keeps |margin| within t
 
 def boresight(q: np.ndarray, sensor_axis: np.ndarray) -> np.ndarray:
     """Inertial boresight direction(s) for attitude(s) ``q``."""
-    return rot.dcm(q) @ np.asarray(sensor_axis, float)
+    return rot.dcm_NB(q) @ np.asarray(sensor_axis, float)
 
 
 def direction_margins(direction: np.ndarray, cones: list[Cone]) -> np.ndarray:

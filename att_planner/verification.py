@@ -69,7 +69,7 @@ def clearances(problem: ManeuverProblem, t: np.ndarray, q: np.ndarray, true: boo
     m = zone_sky.margins(t, q, true=true)
     if not m.size:
         return m
-    R = rot.dcm(np.asarray(q, float).reshape(-1, 4))
+    R = rot.dcm_NB(np.asarray(q, float).reshape(-1, 4))
     near = np.zeros(m.shape, bool)
     for s in np.unique(zone_sky.sensor_axes, axis=0):              # once per sensor
         b = R @ (s / np.linalg.norm(s))
@@ -98,7 +98,7 @@ def measure(problem: ManeuverProblem, plan: Plan, traj: dyn.Trajectory) -> Verif
     elif problem.sensor_target is None:
         final_error = float(rot.angle_between(traj.q[-1], problem.q_final))
     else:
-        reached = rot.dcm(traj.q[-1]) @ np.asarray(problem.sensor_axis, float)
+        reached = rot.dcm_NB(traj.q[-1]) @ np.asarray(problem.sensor_axis, float)
         target = np.asarray(problem.sensor_target, float)
         final_error = float(np.arccos(np.clip(reached @ target / np.linalg.norm(target), -1.0, 1.0)))
     passage_errors, passage_rates = [], []
@@ -211,8 +211,8 @@ def body_plan_wheel_speeds(problem: ManeuverProblem, q: np.ndarray, omega: np.nd
         return zeros, zeros.copy()
     speeds0 = np.zeros(sc.n_wheels) if problem.wheel_speeds is None else np.asarray(problem.wheel_speeds, float)
     h0_B = sc.wheel_axes @ (sc.wheel_inertia * speeds0)
-    H_N = rot.dcm(q[0]) @ h0_B
-    h_B = np.einsum("kji,j->ki", rot.dcm(q), H_N)                          # R_kᵀ H_N
+    H_N = rot.dcm_NB(q[0]) @ h0_B
+    h_B = np.einsum("kji,j->ki", rot.dcm_NB(q), H_N)                          # R_kᵀ H_N
     stored = speeds0 + (h_B - h0_B) @ sc.wheel_axes_pinv.T / sc.wheel_inertia
     slew = -omega @ (sc.wheel_axes_pinv @ sc.inertia).T / sc.wheel_inertia - omega @ sc.wheel_axes
     return stored, slew

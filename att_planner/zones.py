@@ -285,7 +285,7 @@ class FittedZones:
         out = np.zeros((len(q), Z))
         if not Z:
             return out
-        R = rot.dcm(q)
+        R = rot.dcm_NB(q)
         A, theta = self.at(t, true) if self.moving else (None, None)
         for s, static, moving in self._groups:
             b = R @ s

@@ -45,7 +45,7 @@ SENSOR = np.array([0.0, 1.0, 0.0])
 
 def margins(t, q, axis=SENSOR):
     ax, half = sky(t)
-    b = np.einsum("kij,j->ki", rot.dcm(q), axis)
+    b = np.einsum("kij,j->ki", rot.dcm_NB(q), axis)
     return np.arccos(np.clip(np.einsum("kzi,ki->kz", ax, b), -1, 1)) - half
 
 
@@ -63,7 +63,7 @@ def main(start=0.0, stop=5800.0, step=100.0):
             continue
         traj = integrate(prob, plan)
         ax0, h0 = sky(off)
-        b = np.einsum("kij,j->ki", rot.dcm(traj.q), base.sensor_axis)
+        b = np.einsum("kij,j->ki", rot.dcm_NB(traj.q), base.sensor_axis)
         frozen = np.arccos(np.clip(b @ ax0[0].T, -1, 1)) - h0[0]
         true = margins(off + traj.t, traj.q)
         end_true = margins(off + plan.duration, base.q_final[None])

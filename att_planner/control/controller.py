@@ -401,8 +401,8 @@ class Controller:
                                                               self.m_max)
         out.command.wheel_torques = self._wheels(tau - rot.cross(out.command.dipole, s.field_body))
         st = out.status
-        st.guidance, st.reference_q, st.reference_rate = law.name, ref.q, ref.omega
-        st.attitude_error = float(rot.angle_between(s.q, ref.q))
+        st.guidance, st.reference_q, st.reference_rate = law.name, ref.q_RN, ref.omega_RN_R
+        st.attitude_error = float(rot.angle_between(s.q, ref.q_RN))
         if law.degenerate:
             st.message = f"pointing {law.name}: the directions are parallel now; holding the last attitude"
 

@@ -28,8 +28,8 @@ HANDOVER_ATTITUDE_MATCH = 1e-3  # rad: ... and this close to its attitude (else:
 
 def body_reference(q, ref: Reference) -> tuple[np.ndarray, np.ndarray]:
     """The reference rate and acceleration in body axes at attitude ``q``."""
-    C = rot.dcm(rot.multiply(rot.conjugate(ref.q), q)).T
-    return C @ ref.omega, C @ ref.omega_dot
+    C = rot.dcm_BN(rot.multiply(rot.conjugate(ref.q_RN), q))
+    return C @ ref.omega_RN_R, C @ ref.omega_dot_RN_R
 
 
 def pointing_torque(sc: Spacecraft, q, omega, ref: Reference, kp: float, kd: float) -> np.ndarray:
@@ -38,7 +38,7 @@ def pointing_torque(sc: Spacecraft, q, omega, ref: Reference, kp: float, kd: flo
     w_r, w_r_dot = body_reference(q, ref)
     J = sc.inertia
     feedforward = J @ (w_r_dot - rot.cross(omega, w_r)) + rot.cross(omega, J @ omega)
-    return feedforward - kp * 2.0 * rot.error_vector(q, ref.q) - kd * (omega - w_r)
+    return feedforward - kp * 2.0 * rot.error_vector(q, ref.q_RN) - kd * (omega - w_r)
 
 
 def handover_law(law, plan: Plan, t: float, blend: float):
@@ -47,6 +47,6 @@ def handover_law(law, plan: Plan, t: float, blend: float):
     planned), else the law entered through :class:`~att_planner.guidance.laws.BlendedLaw` over
     ``blend`` s (a plan ending at rest)."""
     ref = guidance_reference(law.attitude, t)
-    matched = (float(np.linalg.norm(plan.omega[-1] - ref.omega)) <= HANDOVER_RATE_MATCH
-               and rot.angle_between(plan.q[-1], ref.q) <= HANDOVER_ATTITUDE_MATCH)
+    matched = (float(np.linalg.norm(plan.omega[-1] - ref.omega_RN_R)) <= HANDOVER_RATE_MATCH
+               and rot.angle_between(plan.q[-1], ref.q_RN) <= HANDOVER_ATTITUDE_MATCH)
     return law if matched or blend <= 0 else BlendedLaw(law, t, blend)

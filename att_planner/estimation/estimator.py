@@ -390,7 +390,7 @@ class Estimator:
         if r.kind == "tracker":
             name, q_S = r.data
             mounting = self.trackers[name].mounting
-            C = rot.dcm(mounting)
+            C = rot.dcm_NB(mounting)
             y = mekf.attitude_residual(x.q, rot.multiply(q_S, rot.conjugate(mounting)))
             H, R = mekf.attitude_sensitivity(), C @ self.trackers[name].covariance @ C.T
         elif r.t - self.last_tracker <= self.config.vector_fallback_after or self.environment is None:
@@ -444,7 +444,7 @@ class Estimator:
         if r.kind == "tracker":
             name, q_S = r.data
             spec = self.trackers[name]
-            C = rot.dcm(spec.mounting)
+            C = rot.dcm_NB(spec.mounting)
             q = rot.multiply(q_S, rot.conjugate(spec.mounting))
             P_att = C @ spec.covariance @ C.T
         else:

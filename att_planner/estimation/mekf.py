@@ -180,7 +180,7 @@ def attitude_sensitivity() -> np.ndarray:
 def vector_residual(q_estimate: np.ndarray, measured_B: np.ndarray, reference_N: np.ndarray
                     ) -> tuple[np.ndarray, np.ndarray]:
     """Residual and sensitivity (3×6) of a body-axis measurement of the inertial vector ``reference_N``."""
-    predicted = rot.dcm(q_estimate).T @ np.asarray(reference_N, float)
+    predicted = rot.dcm_BN(q_estimate) @ np.asarray(reference_N, float)
     return np.asarray(measured_B, float) - predicted, np.hstack([rot.hat(predicted), np.zeros((3, 3))])
 
 

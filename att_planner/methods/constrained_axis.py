@@ -94,7 +94,7 @@ def cone_riding_legs(problem: ManeuverProblem, zone_index: int, side: int, ride_
     own_sensor = same_axis(sensor, problem.sensor_axis)
     q0 = rot.normalize(np.asarray(problem.q_initial, float))
     q_goal = goal_attitude(problem)
-    b0, bf = rot.dcm(q0) @ r, rot.dcm(q_goal) @ r
+    b0, bf = rot.dcm_NB(q0) @ r, rot.dcm_NB(q_goal) @ r
     rho = theta + ride_margin
     beta0, psi0 = _polar(b0, w, u, v)
     betaf, psif = _polar(bf, w, u, v)
@@ -114,7 +114,7 @@ def cone_riding_legs(problem: ManeuverProblem, zone_index: int, side: int, ride_
         q = rot.multiply(rot.from_axis_angle(leg.axis, leg.angle), q)
     if finish == "eigenaxis":
         return legs + [eigenaxis_leg(q, q_goal, "eigenaxis to goal")]
-    b2 = rot.dcm(q) @ r
+    b2 = rot.dcm_NB(q) @ r
     legs.append(_great_circle_leg(b2, bf, "tangent to target"))
     q = rot.multiply(rot.from_axis_angle(legs[-1].axis, legs[-1].angle), q)
     if problem.sensor_target is None or not own_sensor:
@@ -174,7 +174,7 @@ def _detours(problem: ManeuverProblem, zs: FittedZones) -> list[tuple[str, list[
     q_goal = goal_attitude(problem)
     routes = []
     for z in np.flatnonzero(~zs.keep_in):
-        b0 = rot.dcm(q0) @ (zs.sensor_axes[z] / np.linalg.norm(zs.sensor_axes[z]))
+        b0 = rot.dcm_NB(q0) @ (zs.sensor_axes[z] / np.linalg.norm(zs.sensor_axes[z]))
         away = np.cross(zs.true_axes(0.0)[z], b0)
         if np.linalg.norm(away) < 1e-9:
             continue

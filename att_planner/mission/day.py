@@ -50,7 +50,7 @@ def sight_line(event, scenario: scen.Scenario):
         return lambda t: np.broadcast_to(rot.normalize(np.asarray(event.direction, float)), (np.size(t), 3))
     law = law_of(event.pointing, PointingGeometry.of(world.Environment.from_scenario(scenario)), event.start,
                  np.array([0.0, 0.0, 0.0, 1.0]))
-    return lambda t: np.array([law.primary(float(x)) for x in np.atleast_1d(t)]).reshape(-1, 3)
+    return lambda t: np.array([law.primary_N(float(x)) for x in np.atleast_1d(t)]).reshape(-1, 3)
 
 
 def target_table(events: list, t: np.ndarray, q: np.ndarray, margins: np.ndarray,
@@ -70,7 +70,7 @@ def target_table(events: list, t: np.ndarray, q: np.ndarray, margins: np.ndarray
                          "pointing_error_deg": None, "why": e.message})
             continue
         inside = (t >= e.start) & (t <= e.end)
-        b = np.einsum("kij,j->ki", rot.dcm(q[inside]).reshape(-1, 3, 3), np.asarray(e.sensor_axis, float))
+        b = np.einsum("kij,j->ki", rot.dcm_NB(q[inside]).reshape(-1, 3, 3), np.asarray(e.sensor_axis, float))
         err = np.arccos(np.clip(np.einsum("ki,ki->k", b, sight_line(e, scenario)(t[inside])), -1.0, 1.0))
         covered = bool(inside.any() and margins[inside].min() < 0.0)
         complete = bool(inside.any() and t[inside][-1] >= e.end - step)

@@ -71,7 +71,7 @@ class GroundTrack:
 
     def line_of_sight(self, t) -> np.ndarray:
         """The unit line of sight from the spacecraft to the site at each time of ``t``, (K, 3)."""
-        return np.array([self.law.primary(float(x)) for x in np.atleast_1d(t)])
+        return np.array([self.law.primary_N(float(x)) for x in np.atleast_1d(t)])
 
     def torque(self, t) -> np.ndarray:
         """The largest per-axis torque (N m) tracking the site takes at each time of ``t`` (module docstring)."""
@@ -79,8 +79,8 @@ class GroundTrack:
         out = []
         for x in np.atleast_1d(t):
             ref = reference(self.law.attitude, float(x))
-            wheel = J @ ref.omega_dot
-            out.append(max(np.abs(wheel).max(), np.abs(wheel + np.cross(ref.omega, J @ ref.omega)).max()))
+            wheel = J @ ref.omega_dot_RN_R
+            out.append(max(np.abs(wheel).max(), np.abs(wheel + np.cross(ref.omega_RN_R, J @ ref.omega_RN_R)).max()))
         return np.array(out)
 
     def trackable(self, t) -> np.ndarray:

@@ -99,7 +99,7 @@ def tracker_skies(scenario: scen.Scenario, sky: Ephemeris, window: float) -> lis
     the body), one :class:`FittedZones` per tracker."""
     out = []
     for spec in scenario.sensors.star_trackers:
-        axis = rot.dcm(spec.mounting) @ np.array([0.0, 0.0, 1.0])
+        axis = rot.dcm_NB(spec.mounting) @ np.array([0.0, 0.0, 1.0])
         zones = [Zone(f"{spec.name}_{e.body}", e.body, axis, e.half_angle, False, e.direction) for e in spec.exclusions]
         if zones:
             out.append(FittedZones(zones, sky, window=window))

@@ -31,6 +31,6 @@ def goal_law(mode: PointingMode, scenario: Scenario, epoch: datetime | None,
 
     def motion(t: float) -> tuple[np.ndarray, np.ndarray]:
         ref = reference(law.attitude, offset + t)
-        return ref.q, ref.omega
+        return ref.q_RN, ref.omega_RN_R
 
     return motion

@@ -20,7 +20,7 @@ body axes; the torque of a force ``F`` on it is ``c × F``. Facets do not shadow
 * residual dipole ``τ = m × B``; gravity gradient ``τ = (3μ/|r|⁵) r_b × (J r_b)``, ``r_b = C(q) r``.
 
 Frames: ``q`` is body-to-inertial (:mod:`att_sim.models.rotations`); inertial vectors go to the body by
-``C(q) = dcm(q).T``. Every function broadcasts over stacks of ``q`` and the vectors.
+``C(q) = dcm_BN(q)``. Every function broadcasts over stacks of ``q`` and the vectors.
 """
 from __future__ import annotations
 
@@ -122,7 +122,7 @@ def facets_from_params(params, field: str = "environment.facets") -> list[Facet]
 
 def _body(q, v_N) -> tuple:
     """``C(q) v`` as three components: floats for one attitude and one vector (the simulator's
-    per-stage path), arrays for stacks. Same matrix as :func:`att_sim.models.rotations.dcm`, transposed."""
+    per-stage path), arrays for stacks. Same matrix as :func:`att_sim.models.rotations.dcm_NB`, transposed."""
     q, v = np.asarray(q, float), np.asarray(v_N, float)
     if q.shape != (4,) or v.shape != (3,):
         b = to_body(q, v)

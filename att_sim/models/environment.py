@@ -16,7 +16,7 @@ Model of Bruni & Celani (the magnetorquer PD-gain study, issue 6), in the inerti
 
 All functions broadcast: ``t`` and ``arg0`` (ψ) may be arrays, so many cases are evaluated at once.
 Vectors come back with a trailing axis of 3. Body-frame helpers use the suite's convention
-(:mod:`att_sim.models.rotations`): the inertial-to-body matrix ``C(q)`` of the paper is ``dcm(q).T``.
+(:mod:`att_sim.models.rotations`): the inertial-to-body matrix ``C(q)`` of the paper is ``dcm_BN(q)``.
 """
 from __future__ import annotations
 
@@ -133,9 +133,9 @@ def field_inertial(orbit: OrbitParams, t, arg0=None, dipole: DipoleModel = DEFAU
     return np.stack(np.broadcast_arrays(*dipole_field_components(orbit, r_hat, m_hat, dipole)), -1)
 
 
-def to_body(q, v_inertial) -> np.ndarray:
-    """``C(q) v = dcm(q).T v``: an inertial vector in body axes (stacks broadcast)."""
-    return np.einsum("...ji,...j->...i", rot.dcm(q), np.asarray(v_inertial, float))
+def to_body(q_BN, v_N) -> np.ndarray:
+    """``v_B = C(q) v_N = [BN] v_N``: an inertial vector in body axes (stacks broadcast)."""
+    return np.einsum("...ji,...j->...i", rot.dcm_NB(q_BN), np.asarray(v_N, float))
 
 
 def field_body(orbit: OrbitParams, t, q, arg0=None, dipole: DipoleModel = DEFAULT_DIPOLE) -> np.ndarray:

@@ -187,7 +187,7 @@ class Environment:
     def torques(self, t: float, q: np.ndarray) -> dict[str, np.ndarray]:
         """Each active disturbance torque (N m, body axes) at time ``t`` and attitude ``q``."""
         now = self._now(t)
-        return self._torques(now, q, rot.dcm(q).T @ now.field_N)
+        return self._torques(now, q, rot.dcm_BN(q) @ now.field_N)
 
     def _torques(self, now: _Now, q: np.ndarray, field_b: np.ndarray) -> dict[str, np.ndarray]:
         out, f = {}, self.flags

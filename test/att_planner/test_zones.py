@@ -96,7 +96,7 @@ def test_casadi_evaluation_is_the_numpy_one(long_sky):
     g = ca.Function("g", [t, R], [ca.vertcat(*zs.casadi_constraints(t, R))])
     q = rot.from_axis_angle([1.0, 0.3, 0.2], 2.0)
     m = zs.margins(700.0, q)[0]
-    assert np.array_equal(np.array(g(700.0, rot.dcm(q))).ravel() <= 0, m >= 0)
+    assert np.array_equal(np.array(g(700.0, rot.dcm_NB(q))).ravel() <= 0, m >= 0)
 
 
 def test_outside_the_window_the_fit_refuses_but_the_truth_answers(long_sky):

@@ -12,12 +12,12 @@ class DescendingEphemeris:
     """An ephemeris whose Sun starts at azimuth 45°, elevation 52° and turns down its meridian at RATE
     (the interface :class:`att_planner.zones.FittedZones` reads; Moon and Earth unused)."""
 
-    d0 = rot.dcm(rot.from_axis_angle([-C, C, 0.0], -np.deg2rad(52.0))) @ np.array([C, C, 0.0])
+    d0 = rot.dcm_NB(rot.from_axis_angle([-C, C, 0.0], -np.deg2rad(52.0))) @ np.array([C, C, 0.0])
 
     def sun_direction(self, t):
         t = np.asarray(t, float)
         turn = rot.from_axis_angle(np.broadcast_to([-C, C, 0.0], t.shape + (3,)), RATE * t)
-        return rot.dcm(turn) @ self.d0
+        return rot.dcm_NB(turn) @ self.d0
 
     moon_direction = sun_direction
 

@@ -67,7 +67,7 @@ def test_the_log_holds_the_events_plans_and_the_dwells_on_target(flown):
         held = (t >= e.start) & (t <= e.end)
         assert held.sum() >= mission.rate * (e.end - e.start) - 1
         assert np.abs(dipole[held]).max() > 0.0                   # held in pointing mode: momentum dumped
-        boresight = np.einsum("nij,j->ni", rot.dcm(q[held]), mission.sensor_axis)
+        boresight = np.einsum("nij,j->ni", rot.dcm_NB(q[held]), mission.sensor_axis)
         assert np.degrees(np.arccos(np.clip(boresight @ e.direction, -1, 1))).max() <= 0.05
         for body, direction in (("sun", sky.sun_direction(t[held])), ("moon", sky.moon_direction(t[held]))):
             angle = np.arccos(np.clip(np.einsum("ni,ni->n", boresight, direction), -1, 1))

@@ -288,7 +288,7 @@ class MultiphaseTranscription:
         q, tau = ca.SX.sym("q", 4), ca.SX.sym("tau")
         moving = self.zones.moving
         g = ca.vertcat(*self.zones.casadi_constraints(tau * self.scale.t_sat if moving else 0.0,
-                                                      symbolic.dcm(q), margin))
+                                                      symbolic.dcm_NB(q), margin))
         return ca.Function("zones", [q, tau] if moving else [q], [g])
 
     # -- guesses ----------------------------------------------------------------------------
@@ -343,12 +343,12 @@ class MultiphaseTranscription:
             for z in np.flatnonzero(zs.margins(t[k], out[k])[0] < 0):
                 s_z = zs.sensor_axes[z] / np.linalg.norm(zs.sensor_axes[z])
                 a, theta = zs.axes(t[k])[z], zs.half_angles(t[k])[z]
-                b = rot.dcm(out[k]) @ s_z
+                b = rot.dcm_NB(out[k]) @ s_z
                 radial = b - (b @ a) * a
                 if zs.keep_in[z]:
                     rho, side = theta - beyond, radial
                 else:                   # off the plane of b_{k-1}, b_{k+1}: round the zone
-                    normal = np.cross(rot.dcm(q[k - 1]) @ s_z, rot.dcm(q[k + 1]) @ s_z)
+                    normal = np.cross(rot.dcm_NB(q[k - 1]) @ s_z, rot.dcm_NB(q[k + 1]) @ s_z)
                     normal = normal - (normal @ a) * a
                     rho = theta + beyond
                     side = radial + (normal / np.linalg.norm(normal) if np.linalg.norm(normal) > 1e-12 else 0.0)

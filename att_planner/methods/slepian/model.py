@@ -30,7 +30,7 @@ def _log_so3(R: np.ndarray) -> np.ndarray:
     if th < 1e-6:
         return w * (1.0 + th * th / 6.0)
     if th > np.pi - 1e-6:                     # θ ≈ π: axis from the symmetric part
-        axis = rot.to_axis_angle(rot.from_dcm(R))[0]
+        axis = rot.to_axis_angle(rot.from_dcm_NB(R))[0]
         return axis * th
     return w * (th / np.sin(th))
 
@@ -187,7 +187,7 @@ def build_maneuver(problem: ManeuverProblem, M: int = PAPER_M, N: int = PAPER_N,
         smallest = np.eye(3)[np.argmin(np.abs(target))]    # never within 25° of the target
         tbasis = np.stack(rot.orthonormal_basis(target, references=(smallest, smallest)))
     return SmoothManeuver(slepian_basis(N, W, M), J / scale, scale, float(problem.spacecraft.body_torque_max),
-                          rot.dcm(problem.q_initial), rot.dcm(problem.q_final), r, dirs, cos, target, tbasis, W,
+                          rot.dcm_NB(problem.q_initial), rot.dcm_NB(problem.q_final), r, dirs, cos, target, tbasis, W,
                           np.array(sensors), np.array(index, int), sign, float(cone_margin),
                           boundary_end_zones(problem, cone_margin), sky if sky.moving else None)
 

@@ -228,11 +228,11 @@ def physical_profile(man: SmoothManeuver, alpha: np.ndarray, spacecraft: Spacecr
     torque = np.zeros((N + 1, 3))
     torque[:N] = ev.torque * man.inertia_scale / tf**2
     if spacecraft is None:
-        q = rot.from_dcm(ev.R)
+        q = rot.from_dcm_NB(ev.R)
         omega = np.zeros((N + 1, 3))
         omega[1:] = ev.omega / tf
     else:
-        x0 = dyn.initial_state(spacecraft, rot.from_dcm(man.R_initial))
+        x0 = dyn.initial_state(spacecraft, rot.from_dcm_NB(man.R_initial))
         traj = dyn.simulate_profile(spacecraft, x0, t, torque, kind=ControlKind.BODY_TORQUE,
                                     interpolation=Interpolation.ZOH, max_step=tf / N)
         q, omega = traj.q, traj.omega

@@ -90,7 +90,7 @@ def wheel_speed_values(problem: ManeuverProblem, s: Scaling) -> np.ndarray:
     M1 = sc.wheel_axes_pinv / (sc.wheel_inertia * limit)
     M2 = (sc.wheel_axes_pinv @ sc.inertia / sc.wheel_inertia + sc.wheel_axes.T) / (s.tu * limit)
     a = (speeds0 - sc.wheel_axes_pinv @ h0_B / sc.wheel_inertia) / limit
-    H_N = rot.dcm(rot.normalize(np.asarray(problem.q_initial, float))) @ h0_B
+    H_N = rot.dcm_NB(rot.normalize(np.asarray(problem.q_initial, float))) @ h0_B
     return np.concatenate([M1.ravel(order="F"), M2.ravel(order="F"), a, H_N])
 
 
@@ -131,7 +131,7 @@ def path_function(problem: ManeuverProblem, s: Scaling, n_state: int = 7, cone_m
     x, u, t = ca.SX.sym("x", n_state), ca.SX.sym("u", 3), ca.SX.sym("t")
     per_zone = 0 if degree is None else motion_parameters(degree)
     p = ca.SX.sym("p", ZONE_PARAMETERS * sum(fixed) + per_zone * moving + 7 * wheels + 3 * bool(wheels) + momentum)
-    R = symbolic.dcm(x[:4])
+    R = symbolic.dcm_NB(x[:4])
     g = []
     for k in range(sum(fixed)):
         sign, sensor, axis, cos = (p[ZONE_PARAMETERS * k], p[ZONE_PARAMETERS * k + 1:ZONE_PARAMETERS * k + 4],
@@ -257,7 +257,7 @@ def weighted_path_function(problem: ManeuverProblem, s: Scaling, cone_margin: fl
     ramped = boundary_end_zones(problem, cone_margin)
     margins = [-BOUNDARY_TOLERANCE + (cone_margin + BOUNDARY_TOLERANCE) * w if near else cone_margin
                for near in ramped]
-    R = symbolic.dcm(x[:4])
+    R = symbolic.dcm_NB(x[:4])
     if problem.boundary_cone is not None:
         margins[problem.boundary_cone] = 0.0
     g = zones.casadi_constraints(t * s.tu if zones.moving else 0.0, R, margins)
@@ -365,7 +365,7 @@ def _build(problem: ManeuverProblem, s: Scaling, mesh: np.ndarray, control: str,
         tr.add_constraint(symbolic.error_vector(q_end, tr.extra), 0.0, 0.0)
     else:
         target, e1, e2, r = (tr.extra[3 * k:3 * k + 3] for k in range(4))
-        b = ca.mtimes(symbolic.dcm(q_end), r)
+        b = ca.mtimes(symbolic.dcm_NB(q_end), r)
         tr.add_constraint(ca.vertcat(ca.dot(e1, b), ca.dot(e2, b)), 0.0, 0.0)
         tr.add_constraint(ca.dot(target, b), 0.0, np.inf)
     tr.minimize(v.duration)

@@ -69,7 +69,7 @@ def _leg_route_functions(problem: ManeuverProblem, scaling: Scaling, legs):
     total = sum(leg.angle for leg in legs)
     alpha, peak = np.inf, np.inf
     for leg in legs:
-        e = rot.dcm(q).T @ leg.axis
+        e = rot.dcm_BN(q) @ leg.axis
         alpha = min(alpha, axis_acceleration(scaling.Jn, e, total, 1.0))
         peak = min(peak, _peak_rate(problem, scaling, e))
         starts.append(q)
@@ -155,7 +155,7 @@ def candidate_routes(problem: ManeuverProblem, scaling: Scaling, tilt_deg: float
             _estimate(problem, scaling, routes[-1])
     if problem.sensor_target is not None:
         r = np.asarray(problem.sensor_axis, float)
-        b = rot.dcm(rot.normalize(np.asarray(problem.q_final, float))) @ r
+        b = rot.dcm_NB(rot.normalize(np.asarray(problem.q_final, float))) @ r
         s = np.asarray(problem.sensor_target, float)
         if b @ s / np.linalg.norm(b) / np.linalg.norm(s) > np.cos(np.deg2rad(0.5)):
             full = replace(problem, sensor_target=None)

@@ -80,7 +80,7 @@ def cost(problem: ManeuverProblem, s: Scaling, coefficients: np.ndarray, tf: np.
     else:
         r = np.asarray(problem.sensor_axis, float) / np.linalg.norm(problem.sensor_axis)
         target = np.asarray(problem.sensor_target, float) / np.linalg.norm(problem.sensor_target)
-        error = np.arccos(np.clip(rot.dcm(q_end) @ r @ target, -1.0, 1.0))
+        error = np.arccos(np.clip(rot.dcm_NB(q_end) @ r @ target, -1.0, 1.0))
     end = error + np.linalg.norm(x[:, -1, 4:], axis=1)
     zones = problem.zone_sky()
     violation = np.zeros(P)

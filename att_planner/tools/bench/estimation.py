@@ -80,7 +80,7 @@ def figures(mcap: Path, scenario: scen.Scenario, maneuver: dict) -> dict:
     error = 2 * rot.error_vector(run.q[-1], maneuver["qf"])            # goal -> truth, body axes
     pointing = {}
     if tracker is not None:
-        C = rot.dcm(tracker.mounting)
+        C = rot.dcm_NB(tracker.mounting)
         pointing = {"final_pointing_sigmas": float(np.sqrt(error @ np.linalg.solve(C @ tracker.covariance @ C.T,
                                                                                     error))),
                     "pointing_bound_deg": float(np.degrees(3 * np.sqrt(np.trace(tracker.covariance))))}

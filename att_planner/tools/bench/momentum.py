@@ -64,7 +64,7 @@ def start_state(s: scen.Scenario, t: float) -> tuple[np.ndarray, np.ndarray, np.
     bias = float(s.node_params.get("controller", {}).get("null_space_speed", 0.0))
     N = null_space(s.spacecraft)
     wheels = N @ np.full(N.shape[1], bias) if N.size else np.zeros(s.spacecraft.n_wheels)
-    return ref.q, ref.omega, wheels + s.spacecraft.wheel_axes.T @ ref.omega      # inertial spin rates
+    return ref.q_RN, ref.omega_RN_R, wheels + s.spacecraft.wheel_axes.T @ ref.omega_RN_R      # inertial spin rates
 
 
 def fly(s: scen.Scenario, dumping: bool, seconds: float, out: Path) -> dict:

@@ -51,7 +51,7 @@ def verification(problem, plan) -> dict:
     why = rejection(ver)
     applied = np.abs(plan.torque[:-1]).max(axis=1)
     tmax = problem.spacecraft.body_torque_max
-    return dict(asdict(ver), trace_residual=float(3.0 - np.trace(rot.dcm(problem.q_final).T @ rot.dcm(traj.q[-1]))),
+    return dict(asdict(ver), trace_residual=float(3.0 - np.trace(rot.dcm_BN(problem.q_final) @ rot.dcm_NB(traj.q[-1]))),
                 start_torque_ratio=float(applied[0] / tmax), end_torque_ratio=float(applied[-1] / tmax),
                 passes=why is None, rejection=why)
 

@@ -51,7 +51,7 @@ def _verification(problem, plan) -> dict:
 def _semi_free_row(args) -> dict:
     """time_optimal with only the sensor direction imposed (Melton's semi-free final attitude)."""
     problem = case_problem(args.case)
-    problem = replace(problem, sensor_target=rot.dcm(problem.q_final) @ problem.sensor_axis,
+    problem = replace(problem, sensor_target=rot.dcm_NB(problem.q_final) @ problem.sensor_axis,
                       deadline=time.monotonic() + args.budget)
     plan = plan_time_optimal(problem, starts=args.starts)
     ver = _verification(problem, plan)       # semi-free: the attitude error is the boresight's

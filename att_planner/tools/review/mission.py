@@ -164,7 +164,7 @@ def figure_mission_sky(run: MissionLog, path: Path) -> Path:
     ax = fig.subplots()
     pick = np.unique(np.linspace(0, len(run.t) - 1, SKY_SAMPLES).astype(int))
     t = run.t[pick]
-    _track(ax, rot.dcm(run.q[pick]) @ run.sensor_axis, color="k", lw=0.6, label="boresight")
+    _track(ax, rot.dcm_NB(run.q[pick]) @ run.sensor_axis, color="k", lw=0.6, label="boresight")
     _track(ax, run.sky.sun_direction(t), color="orange", lw=3, label="Sun")
     _track(ax, run.sky.moon_direction(t), color="0.5", lw=3, label="Moon")
     _track(ax, run.sky.nadir(t), color="tab:blue", lw=0.5, ls=":", label="nadir (Earth zone axis)")

@@ -174,7 +174,7 @@ def test_feedback_margin_covers_the_zones_at_their_true_position_now():
         outputs = fly(sim, core, 2.0, states=states)
         flown[name] = [(o.feedback, x) for o, x in zip(outputs, states) if o.feedback is not None]
     for (fb, state), (fb_none, _) in zip(flown["sky"], flown["none"]):
-        b = rot.dcm(state.q)
+        b = rot.dcm_NB(state.q)
         cone_m = math.acos(np.dot(b[:, 0], cone.direction)) - cone.half_angle
         sun_m = math.acos(np.dot(b[:, 0], sky.sun_direction(state.t))) - sun.half_angle
         limb_m = sky.earth_angular_radius(state.t) + limb.half_angle - math.acos(np.dot(b[:, 2], sky.nadir(state.t)))

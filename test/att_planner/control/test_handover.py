@@ -27,12 +27,12 @@ def test_the_blend_starts_at_rest_on_the_law_and_joins_it():
     law = law_of(PointingMode("nadir"), PointingGeometry.of(world.Environment.from_scenario(SWIFT)), 0.0, rot.IDENTITY)
     blended = BlendedLaw(law, 100.0, 60.0)
     start = reference(blended.attitude, 100.0, h=0.05)
-    assert rot.angle_between(start.q, law.attitude(100.0)) < 1e-12
-    assert np.linalg.norm(start.omega) < 0.05 * np.linalg.norm(reference(law.attitude, 100.0).omega)
+    assert rot.angle_between(start.q_RN, law.attitude(100.0)) < 1e-12
+    assert np.linalg.norm(start.omega_RN_R) < 0.05 * np.linalg.norm(reference(law.attitude, 100.0).omega_RN_R)
     for t in (160.0, 200.0):
         assert rot.angle_between(blended.attitude(t), law.attitude(t)) < 1e-12
     middle = reference(blended.attitude, 140.0)
-    assert np.linalg.norm(middle.omega) == pytest.approx(4 / 3 * SWIFT.orbit.mean_motion, rel=1e-3)
+    assert np.linalg.norm(middle.omega_RN_R) == pytest.approx(4 / 3 * SWIFT.orbit.mean_motion, rel=1e-3)
 
 
 @pytest.mark.slow
@@ -75,8 +75,8 @@ def test_a_time_optimal_slew_ends_on_nadir_at_its_rate_and_hands_over_directly()
                            end_pointing=PointingMode("nadir"))
     end = t0 + plan.duration
     goal = reference(law.attitude, end)
-    assert rot.angle_between(plan.q[-1], goal.q) < 1e-5
-    assert np.linalg.norm(plan.omega[-1] - goal.omega) < 1e-6 < 0.5 * np.linalg.norm(goal.omega)
+    assert rot.angle_between(plan.q[-1], goal.q_RN) < 1e-5
+    assert np.linalg.norm(plan.omega[-1] - goal.omega_RN_R) < 1e-6 < 0.5 * np.linalg.norm(goal.omega_RN_R)
     assert loop.execute(plan, after=PointingMode("nadir")) is None
     loop.run(plan.duration + 120.0)
     assert loop.controller.pointing.name == "nadir" and not isinstance(loop.controller.pointing, BlendedLaw)

@@ -27,7 +27,7 @@ def _reference_tf(problem, alpha, N, W):
     J = problem.spacecraft.inertia
     dw = np.vstack([np.zeros(3), np.diff(w, axis=0) * N])
     T = dw @ J.T + np.cross(w, w @ J.T)
-    R = rot.dcm(problem.q_initial)
+    R = rot.dcm_NB(problem.q_initial)
     Rs = [R]
     for k in range(N):
         R = R @ expm(rot.hat(w[k] / N))
@@ -37,7 +37,7 @@ def _reference_tf(problem, alpha, N, W):
 
 def _verify(problem, plan):
     traj = integrate(problem, plan, steps=4 * (len(plan.t) - 1))
-    trace = 3.0 - np.trace(rot.dcm(problem.q_final).T @ rot.dcm(traj.q[-1]))
+    trace = 3.0 - np.trace(rot.dcm_BN(problem.q_final) @ rot.dcm_NB(traj.q[-1]))
     return measure(problem, plan, traj), trace
 
 
@@ -145,7 +145,7 @@ def test_dfsp_never_worsens_a_feasible_start_and_respects_budget():
 
 def test_goal_inside_a_cone_is_refused_with_a_clear_message():
     pb = benchmark_problem("swift")
-    goal_boresight = rot.dcm(pb.q_final) @ pb.sensor_axis
+    goal_boresight = rot.dcm_NB(pb.q_final) @ pb.sensor_axis
     pb.cones = list(pb.cones) + [Cone(goal_boresight, np.radians(10.0), "star")]
     plan = S.plan_slepian(pb, N=N_SMALL, W=W_SMALL)
     assert plan.status == Status.FAILED

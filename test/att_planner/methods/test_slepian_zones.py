@@ -97,7 +97,7 @@ def test_zone_rows_agree_with_the_zone_margins(three_sensors):
     man = replace(three_sensors, zone_margin=0.0)
     alpha = np.random.default_rng(8).normal(size=12) * 15.0
     ev = S.evaluate(man, alpha, tf=3.0)
-    m = man.zone_sky.margins(np.linspace(0.0, 3.0, man.N + 1), rot.from_dcm(ev.R))
+    m = man.zone_sky.margins(np.linspace(0.0, 3.0, man.N + 1), rot.from_dcm_NB(ev.R))
     assert (m < 0).any() and (m > 0).any()
     np.testing.assert_array_equal(ev.cones <= 0, m >= 0)
 
@@ -146,7 +146,7 @@ def test_static_keep_in_zone_of_another_sensor_is_respected():
     minimum-time plan tilts it further)."""
     free = _swift_problem([], None)
     plan = S.plan_slepian(free, N=N_SMALL, W=W_SMALL, starts=3)
-    tilt = np.degrees(np.arccos(np.clip(rot.dcm(plan.q) @ Z @ Z, -1.0, 1.0))).max()
+    tilt = np.degrees(np.arccos(np.clip(rot.dcm_NB(plan.q) @ Z @ Z, -1.0, 1.0))).max()
     assert tilt > 3.0
     pb = _swift_problem([Zone("antenna", "inertial", Z, np.radians(3.0), keep_in=True, direction=Z)], None)
     plan = S.plan_slepian(pb, N=N_SMALL, W=W_SMALL, starts=3)

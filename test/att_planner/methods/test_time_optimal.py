@@ -85,19 +85,19 @@ def test_an_nlp_is_built_once_per_shape_and_shared(monkeypatch):
 @pytest.mark.parametrize("case", ["bilimoria_wie", "swift"])
 def test_semi_free_final_attitude_is_never_slower(case, bw_plans, swift_plan):
     problem, full = (bw_plans[0], bw_plans[1]) if case == "bilimoria_wie" else swift_plan
-    target = rot.dcm(problem.q_final) @ problem.sensor_axis
+    target = rot.dcm_NB(problem.q_final) @ problem.sensor_axis
     semi = plan_time_optimal(replace(problem, sensor_target=target))
     assert semi.status in VALID
     assert semi.duration <= full.duration + 1e-6
     ver, traj = truth_check(problem, semi)
-    pointing = np.arccos(np.clip(rot.dcm(traj.q[-1]) @ problem.sensor_axis @ target, -1, 1))
+    pointing = np.arccos(np.clip(rot.dcm_NB(traj.q[-1]) @ problem.sensor_axis @ target, -1, 1))
     assert pointing <= np.deg2rad(0.5) and ver.final_rate <= 1e-2 and ver.min_cone_margin >= 0
 
 
 def test_arbitrary_initial_attitude_gives_the_same_time(swift_plan):
     problem, plan = swift_plan
     frame = rot.from_axis_angle([0.3, -0.5, 0.8], 1.1)        # rotate the whole scene
-    R = rot.dcm(frame)
+    R = rot.dcm_NB(frame)
     moved = replace(problem, q_initial=rot.multiply(frame, problem.q_initial),
                     q_final=rot.multiply(frame, problem.q_final),
                     cones=[Cone(R @ c.direction, c.half_angle, c.name) for c in problem.cones])

@@ -102,7 +102,7 @@ def test_zone_constraints_are_exact_functions_of_time():
     dgdt = ca.Function("dgdt", [x, u, t], [ca.jacobian(path(x, u, t, values), t)])
     zs = problem.zone_sky()
     q = rot.from_axis_angle([0.2, 0.3, 1.0], 1.1)
-    b = rot.dcm(q) @ X
+    b = rot.dcm_NB(q) @ X
     state = np.concatenate([q, np.zeros(3)])
     for tn in (0.0, 1.3, 2.9):
         ts = tn * s.tu

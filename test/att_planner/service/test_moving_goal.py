@@ -39,7 +39,7 @@ def test_the_goal_is_the_controllers_law_shifted_by_the_plans_epoch():
     law = law_of(PointingMode("nadir"), PointingGeometry.of(world.Environment.from_scenario(LEO)), 0.0, rot.IDENTITY)
     q, w = motion(100.0)
     ref = reference(law.attitude, 130.0)
-    assert rot.angle_between(q, ref.q) < 1e-12 and np.allclose(w, ref.omega, atol=1e-15)
+    assert rot.angle_between(q, ref.q_RN) < 1e-12 and np.allclose(w, ref.omega_RN_R, atol=1e-15)
 
 
 def test_a_valid_request_carries_the_moving_goal_and_a_first_guess_of_its_end():

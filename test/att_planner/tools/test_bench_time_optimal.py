@@ -20,7 +20,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from helpers.own_rk4 import dcm, integrate
+from helpers.own_rk4 import dcm_NB, integrate
 
 BENCHMARKS = Path(os.environ.get("ATT_TO_BENCHMARKS", Path(__file__).resolve().parents[3] / "benchmarks"))
 CASES = ("ba1", "ba2", "bp1", "bp2")
@@ -36,7 +36,7 @@ def _checked(case: str):
     payload = json.loads((BENCHMARKS / f"time_optimal_{case}.json").read_text())
     times, states = integrate(payload["J"], np.asarray(payload["t"], float), payload["torque"],
                               payload["q_initial"], SUBSTEPS, dense=True)
-    b = dcm(states[:, :4]) @ np.asarray(payload["sensor_axis"], float)
+    b = dcm_NB(states[:, :4]) @ np.asarray(payload["sensor_axis"], float)
     cone = payload["cones"][0]
     margin = np.arccos(np.clip(b @ np.asarray(cone["direction"], float), -1.0, 1.0)) - cone["half_angle"]
     return payload, times, states, b, margin

@@ -43,7 +43,7 @@ def test_the_tf_transform_rotates_body_vectors_into_the_inertial_frame_as_the_st
     r = msg.transform.rotation
     as_tf = Rotation.from_quat([r.x, r.y, r.z, r.w])          # tf: v_parent = R v_child, scalar last
     v_B = np.array([[1.0, 0, 0], [0, 1.0, 0], [0.2, -0.4, 0.9]])
-    assert np.allclose(as_tf.apply(v_B), (rot.dcm(q_BN) @ v_B.T).T, atol=1e-12)
+    assert np.allclose(as_tf.apply(v_B), (rot.dcm_NB(q_BN) @ v_B.T).T, atol=1e-12)
     t = msg.transform.translation
     assert (t.x, t.y, t.z) == (0.0, 0.0, 0.0)                 # the view is centred on the spacecraft
     # the boresight arrow drawn in the body frame lands where the plan path (inertial) puts it

@@ -107,7 +107,7 @@ def test_each_torque_is_its_model_at_the_stage_state(leo):
     assert set(tq) == {"gravity_gradient", "solar_pressure", "drag", "residual_dipole"}
     facets = leo.environment["facets"]
     sun = e.sky.sun(t) - r
-    b_body = rot.dcm(Q).T @ e.field.field_inertial(t, r)
+    b_body = rot.dcm_BN(Q) @ e.field.field_inertial(t, r)
     v_rel = v - np.cross([0.0, 0.0, 7.292115e-5], r)           # the air co-rotates
     rho = atmosphere.density(np.linalg.norm(r) - env.EARTH_RADIUS)
     expected = {
