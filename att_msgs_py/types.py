@@ -107,7 +107,7 @@ class Zone:
 
 @dataclass
 class Verification:
-    """A plan integrated through the truth dynamics (``att_msgs/PlanVerification``).
+    """A plan predicted by verification's prediction model (``att_msgs/PlanVerification``).
 
     The fields from ``duration`` on are not on the wire.
     """

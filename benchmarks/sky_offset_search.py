@@ -15,7 +15,7 @@ from skyfield.api import EarthSatellite, load, load_file
 from att_msgs_py.types import Cone
 from att_planner.methods.slepian import plan_slepian
 from att_planner.reference.celani_bruni import benchmark_problem
-from att_planner.verification import integrate
+from att_planner.verification import predict
 from att_sim import rotations as rot
 
 L1 = "1 28485U          26355.00000000  .00000000  00000-0  20000-4 0    07"
@@ -61,7 +61,7 @@ def main(start=0.0, stop=5800.0, step=100.0):
         if not plan.success:
             print(f"{off:7.0f}  ends {np.degrees(ends.min(axis=0)).round(2)}  {plan.status} {plan.message[:60]}")
             continue
-        traj = integrate(prob, plan)
+        traj = predict(prob, plan)
         ax0, h0 = sky(off)
         b = np.einsum("kij,j->ki", rot.dcm_NB(traj.q), base.sensor_axis)
         frozen = np.arccos(np.clip(b @ ax0[0].T, -1, 1)) - h0[0]

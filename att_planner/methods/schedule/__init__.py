@@ -2,10 +2,10 @@
 
 Olivares & Staffetti (2018): visit every target attitude once, in the fastest order, starting and
 ending at rest, with wheel torques ``|T_u,i| ≤ T̄`` and wheel speeds ``|Ω_i| ≤ Ω̄`` (inertial, and
-relative to the body, the speed the truth model of :mod:`att_sim.models.dynamics` limits); at each target
+relative to the body, the speed the model of :mod:`att_sim.models.dynamics` limits); at each target
 the body rate about z is zero (the other rates are free and carry over).
 
-Model (the truth model of :mod:`att_sim.models.dynamics`, J = I_s the total inertia, G the wheel axes)::
+Model (the model of :mod:`att_sim.models.dynamics`, J = I_s the total inertia, G the wheel axes)::
 
     q̇ = ½ q ⊗ [ω, 0],   J ω̇ = −ω × (J ω + G I_w Ω) − G T_u,   I_w Ω̇ = T_u.
 

@@ -36,7 +36,7 @@ class _Scaling:
     u = T_u / T̄ ∈ [−1, 1], time τ = t / t_sat with t_sat = h̄ / T̄ (so dh/dτ = u).
     ``rate_matrix`` W maps h to the body rate per unit τ, ω t_sat = W h (equation (1)).
     The NLP's wheel state is the relative speed ν = (Ω − Gᵀω) / Ω̄ = M h, M = 𝟙 + I_w Gᵀ J⁻¹ G
-    (by (1)), so the truth model's limit |ν| ≤ 1 (att_sim.models.dynamics) is a box on it: a row M h
+    (by (1)), so the dynamics model's limit |ν| ≤ 1 (att_sim.models.dynamics) is a box on it: a row M h
     next to the box on h, 2.5e-5 inside it for the Olivares spacecraft, left IPOPT nearly
     coincident barriers (in C's fast run one start took 975 iterations to Infeasible_Problem_Detected)."""
 

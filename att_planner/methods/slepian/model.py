@@ -95,7 +95,7 @@ class SmoothManeuver:
     ``zone_sensors[zone_sensor_index[z]]`` (one row per distinct axis), sign σ_z = ``zone_sign``
     (+1 keep-out, −1 keep-in) and constraint c_kz = σ_z (a_z(t_k)·R_k s_z − cos(θ_z(t_k) + σ_z m)) ≤ 0
     at t_k = τ_k t_f. The optimiser keeps the angular margin m = ``zone_margin`` (outside a
-    keep-out zone, inside a keep-in one) so that the truth integration of the ZOH torque (which
+    keep-out zone, inside a keep-in one) so that the predicted trajectory of the ZOH torque (which
     lags the model by half a sample) stays clear; a zone with an end on its boundary
     (``zone_ramp``, :func:`att_planner.cones.boundary_end_zones`) gets ``−tol + (m + tol) w(τ_k)``
     instead, w the end ramp of a smooth plan (:func:`att_planner.cones.end_ramp`, ``SMOOTH_END_RAMP``).

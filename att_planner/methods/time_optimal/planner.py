@@ -38,7 +38,7 @@ routes — eigenaxis both ways round, tilted two-leg routes and the cone-riding 
 each turned into a continuous bang-bang guess and solved on a coarse mesh; (2) the best converged
 solution is refined: intervals where the torque switches or a zone constraint fails between
 collocation points are split (in quarters, once by default) and the NLP re-solved from the
-interpolated solution; (3) the torque is integrated through the truth dynamics
+interpolated solution; (3) the torque is integrated through the prediction model
 (:mod:`att_planner.verification`); a failure refines again.
 """
 from __future__ import annotations
@@ -58,7 +58,7 @@ from att_planner.methods.time_optimal.model import Scaling, plan_arrays, scaling
 from att_planner.methods.time_optimal.routes import Route, candidate_routes, route_guess, select_routes, zone_margin
 from att_planner.methods.time_optimal.swarm import swarm_plan
 from att_planner.problem import ManeuverProblem
-from att_planner.verification import clearances, integrate, measure, rejection
+from att_planner.verification import clearances, measure, predict, rejection
 from att_sim.models import rotations as rot
 
 METHOD = "time_optimal"
@@ -170,7 +170,7 @@ class _Incumbent:
     def check(self, sol: col.PhaseSolution):
         """Truth verification of ``sol``: (accepted, plan with its verification, trajectory)."""
         plan = self.run.plan(sol)
-        traj = integrate(self.run.problem, plan)
+        traj = predict(self.run.problem, plan)
         plan.verification = measure(self.run.problem, plan, traj)
         return rejection(plan.verification) is None, plan, traj
 

@@ -5,7 +5,7 @@ observatory sources (``config/targets/observatory.yaml``, each held ``--dwell`` 
 :func:`att_planner.methods.schedule.plan_schedule` for ``leo_observatory``'s spacecraft (its wheels)
 from the real-sky case's start (:mod:`.sky`), twice: without any zone, and among the scenario's
 Sun, Moon and Earth-limb zones at their true positions (each observation kept out of them too).
-Both plans are verified by the truth integration; the JSON gives, per run, the order, t_f, the
+Both plans are verified by the prediction model; the JSON gives, per run, the order, t_f, the
 passages and observation ends, the verification, the compute time and the wheel-torque profile
 (``t``, ``torque``, ZOH) so that the plans can be integrated independently, and the zones' cost:
 the ratio of the two tours' t_f.

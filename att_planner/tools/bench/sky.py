@@ -9,7 +9,7 @@ default method (``slepian_minimum_time``) through the planner service's pipeline
   zone directions once do);
 * ``moving``: the method sees the zones' motion (:meth:`ManeuverProblem.zone_sky`, Chebyshev fits).
 
-Both are verified against the motion: the truth integration of the plan's ZOH torque from rest at
+Both are verified against the motion: the prediction of the plan's ZOH torque from rest at
 ``q_initial``, every zone at its true position (orbit by SGP4, Sun and Moon by DE421) at every
 dense-grid time. The table gives t_f, compute, the minimum margin of each zone against the motion
 and the zone a plan enters; the JSON holds the issue's format (case, epoch, TLE, spacecraft,
@@ -53,7 +53,7 @@ from att_planner import methods
 from att_planner.problem import ManeuverProblem
 from att_planner.service.planning import plan_maneuver, run_method
 from att_planner.service.requests import ValidRequest
-from att_planner.verification import integrate, rejection
+from att_planner.verification import predict, rejection
 from att_sim.models import rotations as rot
 from att_sim.models.dynamics import Spacecraft
 from att_sim.models.ephemeris import Ephemeris
@@ -174,7 +174,7 @@ def verification(problem: ManeuverProblem, planned: ManeuverProblem, plan) -> di
     why = rejection(ver)
     margins = dict(zip(ver.zone_names, ver.cone_margins))
     worst = min(margins, key=margins.get) if margins else None
-    traj = integrate(problem, plan)
+    traj = predict(problem, plan)
     own = planned.zone_sky().margins(traj.t, traj.q).min(axis=0)
     return dict(asdict(ver), passes=why is None, rejection=why, zone_margins_vs_motion=margins,
                 entered=worst if worst is not None and margins[worst] < 0 else None,

@@ -18,7 +18,7 @@ import numpy as np
 
 from att_planner.methods import slepian as S
 from att_planner.reference.celani_bruni import CASES, PUBLISHED, benchmark_problem
-from att_planner.verification import integrate, measure, rejection
+from att_planner.verification import measure, predict, rejection
 from att_sim.models import rotations as rot
 
 UNITS = {"earth_obs": "s", "swift": "TU"}
@@ -46,7 +46,7 @@ def verification(problem, plan) -> dict:
     issue's figures: 3 − tr(R_fᵀ R(t_f)) and the torque at the first and last applied samples."""
     if not plan.success:
         return {"passes": False, "reason": plan.message}
-    traj = integrate(problem, plan)
+    traj = predict(problem, plan)
     ver = measure(problem, plan, traj)
     why = rejection(ver)
     applied = np.abs(plan.torque[:-1]).max(axis=1)

@@ -4,7 +4,7 @@
 (issue 19, :mod:`.boundary`).
 
 ``att-bench time-optimal --case {bilimoria_wie,swift} [--method M] [--budget S] --json PATH`` runs
-every method on the case, re-verifies each plan from rest at identity through the truth dynamics
+every method on the case, re-verifies each plan from rest at identity through the prediction model
 (:func:`att_planner.verification.verify`, the suite's one verification and tolerances), prints a
 table next to the published figures and writes the JSON of ``--method`` (default
 ``time_optimal``). Times are in TU (J = I, T̄ = 1).

@@ -10,7 +10,7 @@ from att_planner.methods import schedule as sch
 from att_planner.methods.schedule.order_search import tour_bound, visibility
 from att_planner.methods.schedule.planner import zone_window
 from att_planner.reference import olivares_staffetti as ref
-from att_planner.verification import integrate, rejection
+from att_planner.verification import predict, rejection
 from att_sim.models import rotations as rot
 from helpers.skies import DescendingEphemeris
 
@@ -24,7 +24,7 @@ X = np.array([1.0, 0.0, 0.0])
 def _held(problem, plan):
     """Per observation: the largest attitude error (rad) and body rate (rad/s) of the integrated plan
     over its dwell."""
-    traj = integrate(problem, plan)
+    traj = predict(problem, plan)
     out = []
     for p in plan.passages:
         inside = (traj.t >= p.time + 1e-9) & (traj.t <= p.time + p.dwell)

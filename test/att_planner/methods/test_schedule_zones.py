@@ -9,7 +9,7 @@ import pytest
 from att_msgs_py.types import Cone, Status, Zone
 from att_planner.methods import schedule as sch
 from att_planner.reference import olivares_staffetti as ref
-from att_planner.verification import integrate, rejection, verify
+from att_planner.verification import predict, rejection, verify
 from att_sim.models import rotations as rot
 from helpers.skies import DescendingEphemeris
 
@@ -31,7 +31,7 @@ def tour():
 
 def _leg_margins(problem, plan):
     """Smallest true zone margin (rad) on each leg of an integrated plan."""
-    traj = integrate(problem, plan)
+    traj = predict(problem, plan)
     m = problem.zone_sky().margins(traj.t, traj.q, true=True).min(axis=1)
     ends = [0.0, *(p.time for p in plan.passages), plan.duration]
     return [m[(traj.t >= a) & (traj.t <= b)].min() for a, b in zip(ends[:-1], ends[1:])]

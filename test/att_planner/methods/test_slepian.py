@@ -1,5 +1,5 @@
 """Slepian smooth maneuver planner (issue 3): conventions, exact gradients, plans checked by the
-truth dynamics, smooth ends, refusals. Kept small (coarse N) so the file runs in well under 60 s."""
+prediction model, smooth ends, refusals. Kept small (coarse N) so the file runs in well under 60 s."""
 import time
 
 import numpy as np
@@ -12,7 +12,7 @@ from att_planner import methods
 from att_planner.methods import slepian as S
 from att_planner.problem import ManeuverProblem
 from att_planner.reference.celani_bruni import CASES, benchmark_problem
-from att_planner.verification import integrate, measure
+from att_planner.verification import measure, predict
 from att_sim.models import rotations as rot
 from att_sim.models.dynamics import Spacecraft
 
@@ -36,7 +36,7 @@ def _reference_tf(problem, alpha, N, W):
 
 
 def _verify(problem, plan):
-    traj = integrate(problem, plan, steps=4 * (len(plan.t) - 1))
+    traj = predict(problem, plan, steps=4 * (len(plan.t) - 1))
     trace = 3.0 - np.trace(rot.dcm_BN(problem.q_final) @ rot.dcm_NB(traj.q[-1]))
     return measure(problem, plan, traj), trace
 
@@ -96,7 +96,7 @@ def test_evaluation_follows_the_issue_conventions():
 
 
 def test_minimum_time_plan_is_verified_smooth_and_reproducible():
-    """Arbitrary start attitude; torque ZOH from rest through the truth dynamics meets the goal,
+    """Arbitrary start attitude; torque ZOH from rest through the prediction model meets the goal,
     stays outside the cones on a dense grid, and starts/ends at (nearly) zero torque."""
     pb = benchmark_problem("swift")
     q0 = rot.from_axis_angle([0.0, 0.0, 1.0], -0.4)           # sensor still clear of the cones

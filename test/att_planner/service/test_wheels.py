@@ -13,7 +13,7 @@ from att_msgs_py.types import ControlKind
 from att_planner.problem import ManeuverProblem
 from att_planner.service.wheels import smallest_slowdown, time_scaled
 from att_planner.tools.closed_loop import plan_in_process
-from att_planner.verification import body_plan_wheel_speeds, integrate, verify
+from att_planner.verification import body_plan_wheel_speeds, predict, verify
 from att_sim.models import rotations as rot
 from att_sim.models import scenario as scen
 from helpers.own_rk4 import integrate as own_rk4
@@ -46,7 +46,7 @@ def test_the_wheels_of_a_body_torque_plan_conserve_the_total_momentum_and_keep_t
     speeds0 = np.linspace(-0.6, 0.7, sc.n_wheels) * sc.wheel_speed_max
     p = plan(name)
     problem = ManeuverProblem(sc, rot.IDENTITY, SLEW, wheel_speeds=speeds0)
-    traj = integrate(problem, p)
+    traj = predict(problem, p)
     stored, slew = body_plan_wheel_speeds(problem, traj.q, traj.omega)
     relative = stored + slew
     assert relative[0] == pytest.approx(speeds0, abs=1e-9)

@@ -48,7 +48,7 @@ def test_law_matches_formula_saturates_and_is_pd_when_unsaturated():
 
 
 def test_batch_right_hand_side_equals_truth_dynamics():
-    """The batch RHS is the truth model's derivative with Inputs(dipole=m, field_body=B_b)."""
+    """The batch RHS is the dynamics model's derivative with Inputs(dipole=m, field_body=B_b)."""
     rng = np.random.default_rng(1)
     n = 12
     h = gt.H_LOWER + rng.random((n, 7)) * (gt.H_UPPER - gt.H_LOWER)
