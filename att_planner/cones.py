@@ -5,7 +5,7 @@ axis ``w_i`` and half-angle ``θ_i`` (:class:`att_msgs_py.types.Cone`) is respec
 ``rᵀ Rᵀ w_i ≤ cos θ_i``. The *margin* is the angle between boresight and cone axis minus the
 half-angle (rad): ≥ 0 means outside the cone.
 
-Boundary ends (issue 19): a start or goal direction within :data:`BOUNDARY_TOLERANCE` of a boundary
+Boundary ends: a start or goal direction within :data:`BOUNDARY_TOLERANCE` of a boundary
 is on it (plannable); only one inside by more is refused (:func:`endpoint_in_cone`). A path that
 leaves such an end is necessarily near the boundary while its boresight is near the end, so the
 verification asks margin ≥ −tol within :data:`END_RADIUS` of the path's own start and final
@@ -14,7 +14,7 @@ tightening of such a zone up from −tol over the first and last :data:`END_RAMP
 (:func:`end_ramp`). A forced boundary arc (``ManeuverProblem.boundary_cone``) keeps the boresight
 on one cone's boundary for the whole maneuver (:func:`boundary_arc_issue`).
 
-The checks of a request's zones (issue 13; :mod:`att_planner.zones`) are here too:
+The checks of a request's zones (:mod:`att_planner.zones`) are here too:
 :func:`zone_issue` gives the code and sentence of the first bad zone, contradiction or violated end.
 """
 from __future__ import annotations
@@ -149,7 +149,7 @@ def blocked_endpoint(problem) -> str:
             f"({np.degrees(depth):.2f} deg inside its {np.degrees(cone.half_angle):.1f} deg half-angle)")
 
 
-# ---------------------------------------------------------------------- zones (issue 13)
+# ---------------------------------------------------------------------- zones
 
 
 def invalid_zone(index: int, zone: Zone) -> str:

@@ -30,7 +30,7 @@ GOAL_DEGREE = 16         # of a moving goal's series of the attitude (sign-conti
 
 
 class MovingGoal:
-    """A goal that moves (a pointing law, issue 15): ``t ↦ (q, ω)`` from the law in this process, or
+    """A goal that moves (a pointing law): ``t ↦ (q, ω)`` from the law in this process, or
     from its Chebyshev series over ``[0, window]`` (the Chebyshev points of the first kind) after
     pickling: a planner's child process gets the series, the verification the law."""
 
@@ -74,18 +74,18 @@ class ManeuverProblem:
     * ``targets``: name → attitude, every one to be passed through once, in any order, on the way
       from ``q_initial`` to ``q_final`` (a schedule; Olivares & Staffetti 2018: at a passage the
       attitude is the target's and the body rate about body z is zero). ``target_dwell``: the
-      targets observed, held at rest for that many seconds (issue 17); ``target_windows``: the
+      targets observed, held at rest for that many seconds; ``target_windows``: the
       span each observation must lie in (s from the start); a target is never observed while a
       zone covers it.
     * ``rate_max`` (rad/s per body axis) and ``wheel_momentum_max`` (N m s per wheel, the momentum
       the wheels store producing a body-torque plan with zero total momentum): bounds a plan must
       keep, checked by the verification; infinite when not imposed.
-    * ``cones``: inertial keep-out cones of ``sensor_axis`` (as before issue 13); ``zones``: further
+    * ``cones``: inertial keep-out cones of ``sensor_axis``; ``zones``: further
       zones, each with its own sensor axis, moving or not (:class:`att_msgs_py.types.Zone`);
       ``epoch``: the UTC instant of t = 0; ``sky``: the sky seen from the spacecraft
       (:class:`att_sim.models.ephemeris.Ephemeris`, needed by sun, moon and earth_limb zones).
       :meth:`zone_sky` joins them: what every method and the verification use.
-    * ``goal_motion``: a goal that moves (a pointing law, issue 15:
+    * ``goal_motion``: a goal that moves (a pointing law:
       :class:`MovingGoal`, made by :mod:`att_planner.service.moving_goal`): ``t ↦ (q, ω)``, the attitude and
       body rate the plan must reach at its final time ``t`` (``q_final``: its attitude at a first
       estimate of that time, for guesses); None: ``q_final`` at rest.

@@ -15,8 +15,8 @@ its rate), every passage of a schedule (attitude, rate about body z), every zone
 position at that sample's time (straight from the sky, not the planners' fit, at any time), and the
 control, wheel-speed (relative to the body), body-rate and wheel-momentum limits.
 
-Zones are judged by their *clearance* above the floor a sample may reach (:func:`clearances`, issue
-19): the margin, plus :data:`~att_planner.cones.BOUNDARY_TOLERANCE` where the boresight is within
+Zones are judged by their *clearance* above the floor a sample may reach (:func:`clearances`): the
+margin, plus :data:`~att_planner.cones.BOUNDARY_TOLERANCE` where the boresight is within
 :data:`~att_planner.cones.END_RADIUS` of the path's own start or final boresight (an end may lie on
 a boundary, within the tolerance); for a forced boundary arc's cone
 :data:`~att_planner.cones.ARC_TOLERANCE` − |margin| (the boresight stays on the boundary). The

@@ -1,8 +1,8 @@
-"""Zones that move (issue 13): the sensor zones of a problem as functions of time.
+"""Zones that move: the sensor zones of a problem as functions of time.
 
 Zone ``z`` (:class:`att_msgs_py.types.Zone`) has a body sensor axis ``s_z``, a unit inertial axis
-``a_z(t)`` and a half-angle ``θ_z(t)``: ``inertial`` a fixed direction and half-angle (today's
-cones), ``sun`` / ``moon`` the direction from the spacecraft (:class:`att_sim.models.ephemeris.Ephemeris`),
+``a_z(t)`` and a half-angle ``θ_z(t)``: ``inertial`` a fixed direction and half-angle (a keep-out
+cone), ``sun`` / ``moon`` the direction from the spacecraft (:class:`att_sim.models.ephemeris.Ephemeris`),
 ``earth_limb`` the nadir −r̂(t) with ``asin(R_E/|r(t)|) + half_angle``. Its margin at attitude ``q``
 is, with the boresight ``b = R(q) s_z / |s_z|`` and ``γ = angle(b, a_z)``::
 
@@ -39,7 +39,7 @@ CHECK_POINTS = 8 * (MAX_DEGREE + 1)    # points of the fine grid the fit is chec
 
 
 def zones_from_cones(cones: list[Cone], sensor_axis) -> list[Zone]:
-    """Today's keep-out cones as inertial keep-out zones of the one sensor ``sensor_axis``."""
+    """A problem's keep-out cones as inertial keep-out zones of the one sensor ``sensor_axis``."""
     return [Zone(c.name, "inertial", np.asarray(sensor_axis, float), c.half_angle, False, c.direction)
             for c in cones]
 

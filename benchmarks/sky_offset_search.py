@@ -1,9 +1,9 @@
-"""Offset search of att-bench sky's leo_observatory case (issue 13): the start offset after
+"""Offset search of att-bench sky's leo_observatory case: the start offset after
 2026-12-21T00:00Z at which the plan made against the frozen zones enters the moving Earth-limb zone
 when verified against the motion.
 
-Self-contained: skyfield directly for the sky, today's Cone-based slepian_minimum_time for the
-frozen plan (frozen zones are inertial cones), the suite's truth integration for the attitude.
+Self-contained: skyfield directly for the sky, the Cone-based slepian_minimum_time for the
+frozen plan (frozen zones are inertial cones), the verification's prediction for the attitude.
 Usage (from the repository root): .venv/bin/python benchmarks/sky_offset_search.py [start stop step]
 """
 import sys

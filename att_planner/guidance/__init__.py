@@ -1,4 +1,4 @@
-"""Guidance (issue 15): where the spacecraft should point at each instant, without ROS.
+"""Guidance: where the spacecraft should point at each instant, without ROS.
 
 A pointing law (:mod:`.laws`) gives the reference attitude ``q_RN(t)`` (body-to-inertial) of a mode —
 inertial hold, nadir/LVLH with a yaw, Sun pointing, a ground target (Earth rotation included) or an

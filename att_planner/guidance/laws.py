@@ -185,7 +185,7 @@ def ground_line_of_sight(geometry: PointingGeometry, latitude: float, longitude:
 @dataclass
 class BlendedLaw:
     """``law`` entered from rest at ``start`` (s) through a time warp (the smooth planner's plans end
-    at rest: issue 15): over ``duration`` s the reference is ``law(start + w(τ))`` with
+    at rest): over ``duration`` s the reference is ``law(start + w(τ))`` with
     ``w(τ) = τ − τ(1 − τ/T)²``, so it starts on the law's attitude at ``start`` with zero rate, runs
     up to 4/3 of the law's rate, and joins the law exactly (``w(T) = T``, ``w'(T) = 1``) at
     ``start + T``; the law itself after."""

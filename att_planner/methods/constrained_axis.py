@@ -1,5 +1,5 @@
 """The constrained rotation axis: λ-rotations (:mod:`.axis_rotations`) that take the sensor round
-the keep-out zones, moving or not (issue 13).
+the keep-out zones, moving or not.
 
 When the eigenaxis sweeps a sensor through a keep-out zone, that sensor goes around it on the
 shortest path around a spherical cap: a great circle tangent to a circle just outside the zone, a
@@ -101,7 +101,7 @@ def cone_riding_legs(problem: ManeuverProblem, zone_index: int, side: int, ride_
     if min(beta0, betaf) < theta - BOUNDARY_TOLERANCE or rho >= np.pi / 2:
         return None
     # Right spherical triangle (w, tangent point, b): cos A = tan ρ / tan β at the cone axis; an end
-    # inside the riding circle or on it within BOUNDARY_TOLERANCE (issue 19) joins it radially (A = 0).
+    # inside the riding circle or on it within BOUNDARY_TOLERANCE joins it radially (A = 0).
     A0, Af = (0.0 if beta - rho <= BOUNDARY_TOLERANCE else np.arccos(np.clip(np.tan(rho) / np.tan(beta), -1, 1))
               for beta in (beta0, betaf))
     psi1 = psi0 + side * A0

@@ -1,4 +1,4 @@
-"""The constructive first plan (issue 18): the quickest sequence of rest-to-rest λ-rotations that
+"""The constructive first plan: the quickest sequence of rest-to-rest λ-rotations that
 takes the sensors round every zone, found on a graph of sensor directions and flown with a C¹ torque.
 
 **Graph.** Nodes are directions of ``problem.sensor_axis``: its start and goal directions (the
@@ -19,7 +19,7 @@ whose extremes over [0, φ] are at the ends or at ϑ* = atan2(B, A) (the maximum
 and ϑ* + π (the minimum), in closed form (:func:`arc_cosines`). Every zone of every sensor is
 checked on every leg with :data:`EDGE_MARGIN` (each sensor's direction follows from the attitude
 the leg starts from), but a leg from the start or to the goal only with −BOUNDARY_TOLERANCE from a
-zone that end lies on (issue 19: an end on a boundary). A zone that moves is checked in
+zone that end lies on (an end on a boundary, :mod:`att_planner.cones`). A zone that moves is checked in
 :data:`PIECES` time pieces of the leg, each as the cap about its axis at mid-piece widened by how
 far it can move in half a piece (its largest speed over the window).
 

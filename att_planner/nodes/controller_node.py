@@ -22,7 +22,7 @@ count, and they only serve the state gate's skew check.
 Watchdog: when no state came for ``wall_timeout`` s of wall time the controller commands zero
 and reports ``state_stale`` until states flow again.
 
-``state_source`` (issue 14): ``truth`` flies on ``/spacecraft/state``; ``estimate`` (the default of a
+``state_source``: ``truth`` flies on ``/spacecraft/state``; ``estimate`` (the default of a
 scenario with a gyro) flies on ``/estimator/attitude`` with the wheel speeds of
 ``/sensors/wheel_speeds`` and the field of ``/sensors/magnetometer``
 (:class:`att_planner.control.measured_state.MeasuredState`), compensating the wheel drives' expected

@@ -1,5 +1,5 @@
-"""The time-optimal slew cases (issue 4): Bilimoria & Wie (1993) and the Swift-like keep-out case
-of Melton (2018), with their published figures; Melton's (2012) boundary cases (issue 19). J = I,
+"""The time-optimal slew cases: Bilimoria & Wie (1993) and the Swift-like keep-out case
+of Melton (2018), with their published figures; Melton's (2012) boundary cases. J = I,
 T̄ = 1: times in TU.
 
 Boundary cases (Melton 2012, §3): the sensor starts on the boundary of a cone of half-angle θ and
@@ -44,7 +44,7 @@ def boundary_problem(case: str, orientation=rot.IDENTITY) -> ManeuverProblem:
 
 
 def case_problem(case: str) -> ManeuverProblem:
-    """The issue's test cases: J = I, T̄ = 1, rest to rest from identity."""
+    """The published test cases (module docstring): J = I, T̄ = 1, rest to rest from identity."""
     if case in BOUNDARY_CASES:
         return boundary_problem(case)
     sc = Spacecraft(np.eye(3), body_torque_max=1.0)

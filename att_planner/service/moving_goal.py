@@ -1,4 +1,4 @@
-"""Slews that end on a moving target (issue 15): the goal of a maneuver request with ``end_pointing``.
+"""Slews that end on a moving target: the goal of a maneuver request with ``end_pointing``.
 
 The plan must reach, at its final time, the attitude and body rate of the pointing law the
 controller will hand over to (:mod:`att_planner.guidance`): the law of the scenario's own models

@@ -9,9 +9,9 @@ checked by the registry (:mod:`att_planner.methods`). Field checks are the share
 string is free of control characters (INVALID_TEXT) and at most ``MAX_NAME_LENGTH`` characters
 (SIZE_LIMIT). Cones and zones that close the sky between the start and goal sensor directions are
 refused as INFEASIBLE before any solving (:mod:`att_planner.service.sky`). The real sky (epoch,
-orbit, zones: issue 13) is checked by :mod:`att_planner.service.real_sky`, then the zones against
+orbit, zones) is checked by :mod:`att_planner.service.real_sky`, then the zones against
 each other and the ends (:func:`att_planner.cones.check_zones`: CONTRADICTORY_ZONES, ZONE_AT_END).
-A request without epoch, TLE and zones is checked and planned exactly as before.
+A request without epoch, TLE and zones is checked and planned against its inertial cones alone.
 """
 from __future__ import annotations
 

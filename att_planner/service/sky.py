@@ -13,12 +13,12 @@ lattice point within ``h``, and the nearest lattice points of two nearby path po
 start and goal in different pieces of this slightly fattened sky. Cones that do not overlap
 cannot close anything (the complement of disjoint caps is connected) and cost nothing.
 
-Zones (issue 13) are tested sensor by sensor (the zones sharing one sensor axis; a keep-in zone
+Zones are tested sensor by sensor (the zones sharing one sensor axis; a keep-in zone
 is free inside its cap). A moving zone is replaced by a fixed cap about its axis at t = 0 holding
 every direction that is free at some time of the zone window (:func:`relaxed_caps`: keep-out
 caps shrunk, keep-in caps grown by the zone's motion), so a path that is free at each of its own
 times lies in the relaxed sky and the test still never refuses a feasible request whose maneuver
-fits in the window. Fixed zones (and today's cones) are their caps at t = 0 exactly.
+fits in the window. Fixed zones (and the keep-out cones) are their caps at t = 0 exactly.
 """
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""Plans that respect the wheels (issue 15): a plan whose wheels would pass their speed limit is
+"""Plans that respect the wheels: a plan whose wheels would pass their speed limit is
 slowed in time, or refused.
 
 The wheels that fly a body-torque plan hold the momentum the body gives up

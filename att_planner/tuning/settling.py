@@ -20,7 +20,7 @@ from att_sim.models import environment as env
 
 @dataclass(frozen=True)
 class MagnetorquerCase:
-    """Spacecraft, orbit and settling threshold of the study (defaults: the issue's case)."""
+    """Spacecraft, orbit and settling threshold of the study (defaults: Bruni & Celani's case)."""
 
     inertia: tuple = (27.0, 17.0, 25.0)           # kg m², principal (diagonal) inertia
     m_max: float = 10.0                           # A m² per coil (m*)

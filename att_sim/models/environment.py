@@ -1,6 +1,6 @@
 """Orbit and geomagnetic environment: circular orbit, tilted-dipole field, gravity gradient.
 
-Model of Bruni & Celani (the magnetorquer PD-gain study, issue 6), in the inertial (ECI) frame:
+Model of Bruni & Celani (the magnetorquer PD-gain study), in the inertial (ECI) frame:
 
 * circular orbit of radius ``R = R_E + altitude``, mean motion ``n = sqrt(μ / R³)``; the position in
   the orbital plane ``R [cos(n t + ψ), sin(n t + ψ), 0]`` is rotated by the inclination ``i``
@@ -65,7 +65,7 @@ class OrbitParams:
 
 @dataclass(frozen=True)
 class DipoleModel:
-    """Tilted-dipole geomagnetic field constants (defaults: the issue's values)."""
+    """Tilted-dipole geomagnetic field constants (defaults: Bruni & Celani's values)."""
 
     strength: float = DIPOLE_STRENGTH
     coelevation: float = DIPOLE_COELEVATION

@@ -1,4 +1,4 @@
-"""The sky seen from the spacecraft (issue 13): Sun, Moon, Earth and the Earth's shadow.
+"""The sky seen from the spacecraft: Sun, Moon, Earth and the Earth's shadow.
 
 * Sun and Moon: geometric geocentric positions from JPL DE421 (Folkner, Williams & Boggs, IPN Progress
   Report 42-178, 2009) through skyfield, opened offline from the ``de421.bsp`` packaged by

@@ -1,4 +1,4 @@
-"""What the 3D view shows, without ROS (issue 17): the zones as cones where they are now, the
+"""What the 3D view shows, without ROS: the zones as cones where they are now, the
 sensor boresights, the Sun, Moon and Earth directions, and a plan's boresight path, as plain
 :class:`att_msgs_py.types.Shape` (:mod:`att_msgs_py.markers` makes the messages).
 

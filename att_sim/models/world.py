@@ -1,6 +1,6 @@
 """The environment the simulator integrates: orbit, geomagnetic field, Sun and shadow, disturbance torques.
 
-:class:`Environment` composes the models of the real sky (issue 13) for one spacecraft:
+:class:`Environment` composes the models of the real sky for one spacecraft:
 
 * orbit: any :class:`att_sim.models.orbit.Orbit` (circular, Kepler + J2, TLE/SGP4), GCRS, t past the epoch;
 * field: :class:`att_sim.models.geomagnetic.GeomagneticField` (``dipole`` or ``igrf14``), in body axes
@@ -21,8 +21,8 @@
 cached — the two middle stages share a time and the last stage's time is the next step's first — so
 a step costs two time evaluations and four attitude evaluations.
 
-A scenario without the real sky's keys (:func:`Environment.from_scenario`) is today's world: the
-circular orbit, the tilted dipole and optionally the gravity gradient, nothing else.
+A scenario without the real sky's keys (:func:`Environment.from_scenario`) has the circular world
+(:meth:`Environment.circular`): the circular orbit, the tilted dipole and optionally the gravity gradient, nothing else.
 """
 from __future__ import annotations
 
@@ -107,7 +107,7 @@ class Environment:
 
     @classmethod
     def circular(cls, spacecraft: Spacecraft, orbit: OrbitParams, gravity_gradient: bool = False) -> Environment:
-        """Today's world: circular orbit, tilted dipole, optional gravity gradient, no epoch."""
+        """The circular world of Bruni & Celani: circular orbit, tilted dipole, optional gravity gradient, no epoch."""
         return cls(None, CircularOrbit(orbit), GeomagneticField("dipole"), None, spacecraft,
                    flags=Flags(gravity_gradient=gravity_gradient))
 

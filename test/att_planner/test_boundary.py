@@ -1,4 +1,4 @@
-"""Boundary ends and forced boundary arcs (issue 19): an end within BOUNDARY_TOLERANCE of a cone or
+"""Boundary ends and forced boundary arcs: an end within BOUNDARY_TOLERANCE of a cone or
 zone boundary plans with every method; one inside by more is refused (112, 154); a forced boundary
 arc is planned, verified on the boundary and refused when it cannot be flown; Melton's two stages."""
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""The verification judges every zone at its true position at each dense sample's time (issue 13)."""
+"""The verification judges every zone at its true position at each dense sample's time."""
 import math
 from dataclasses import replace
 

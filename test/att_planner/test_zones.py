@@ -1,4 +1,4 @@
-"""Zones that move (issue 13): the Chebyshev representation, margins, the frozen baseline, the
+"""Zones that move: the Chebyshev representation, margins, the frozen baseline, the
 request checks and the real sky."""
 import math
 
@@ -151,7 +151,7 @@ def test_frozen_zones_stay_where_they_were_at_t0(long_sky):
     assert fm[0, 2] == pytest.approx(mm[0, 2], abs=1e-8)
 
 
-def test_cones_as_zones_reproduce_todays_margins_exactly():
+def test_cones_as_zones_reproduce_the_cone_margins_exactly():
     problem = case_problem("swift")
     q = rot.normalize(np.random.default_rng(2).normal(size=(500, 4)))
     expected = cone_checks.margins(q, problem.sensor_axis, problem.cones)
@@ -219,7 +219,7 @@ def test_default_window_bounds_the_slew():
 
 
 def test_the_real_sky_of_leo_observatory_fits_within_tolerance():
-    """The issue's TLE (≈ 577 km, 14.96 rev/day) on 2026-12-21: Sun, Moon and Earth limb + 10 deg."""
+    """A LEO TLE (≈ 577 km, 14.96 rev/day) on 2026-12-21: Sun, Moon and Earth limb + 10 deg."""
     from att_sim.models.ephemeris import Ephemeris
     from att_sim.models.orbit import TLEOrbit
 

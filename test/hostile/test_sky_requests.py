@@ -1,4 +1,4 @@
-"""Hostile real-sky requests (issue 13): every bad epoch, TLE, orbit and zone refused with its code
+"""Hostile real-sky requests: every bad epoch, TLE, orbit and zone refused with its code
 and a sentence naming the field (ROS-free, against the service logic), and over ROS one moving-zone
 PlanManeuver whose plan comes back with its epoch and zones, signed over them."""
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""att-mission through the nodes (issue 17): a short mission of two sources on leo_observatory's
+"""att-mission through the nodes: a short mission of two sources on leo_observatory's
 real sky, flown by the simulator, estimator, controller and planner nodes; the log holds every event
 and plan, each source is held for its dwell on target (checked here from the truth states against
 the source's direction, with the Sun and Moon from the sky, apart from the day's own report), and the

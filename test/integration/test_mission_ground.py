@@ -1,4 +1,4 @@
-"""att-mission of Earth observation through the nodes (issue 17): one ground site on the
+"""att-mission of Earth observation through the nodes: one ground site on the
 leo_observatory orbit (a pass 30 deg high from 1200 s), flown by the simulator, estimator, controller
 and planner nodes: the slew arrives at rest on the site's tracking attitude as it rises, the controller blends
 into the ground pointing mode over 180 s and follows the site through its dwell. The pointing error is checked

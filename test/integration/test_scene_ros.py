@@ -1,4 +1,4 @@
-"""The 3D view through the nodes (issue 17): a real-sky run of the simulator and the planner,
+"""The 3D view through the nodes: a real-sky run of the simulator and the planner,
 recorded; the log, decoded by rosbags from its own definitions, holds /tf with the body frame under
 the inertial one (the state's attitude) and the Earth-fixed frame (skyfield's ITRS, at -r), the
 zones' cones where the sky puts them, their margins, and the plan's boresight path."""

@@ -11,7 +11,7 @@ at the point's physical time over the whole tour, ``t = t_sat Σ dτ`` of the in
 of that CasADi expression: exact in the phase durations. The tour is then bounded by the zones'
 window. Without zones nothing is added: the NLP is the zone-free one.
 
-Observations (issue 17): each target's dwell (τ) is a parameter, in the order's sequence; a target
+Observations: each target's dwell (τ) is a parameter, in the order's sequence; a target
 with one is reached at rest (its x and y rates zero too) and held, torque-free, before the next leg,
 so every later node's time moves by it; each arrival time is a constraint row whose bounds are the
 target's window (both set per solve); moving zones are kept on a held target through its dwell."""
@@ -223,8 +223,8 @@ class MultiphaseTranscription:
         return g, np.full(n, -np.inf), np.full(n, np.inf)
 
     def _wheel_speed_rows(self, V, bound_margin: float):
-        """The inertial wheel speed h = M⁻¹ν within the limit too (as before the truth model limited
-        the relative speed), only on the wheels where the box on ν does not already imply it (none
+        """The inertial wheel speed h = M⁻¹ν within the limit too (besides the relative
+        speed the dynamics limit), only on the wheels where the box on ν does not already imply it (none
         with wheels on principal axes: M is then diagonal, ≥ 1). Both are linear in ν, so the bounds
         at the nodes hold everywhere."""
         inverse = self._per_nu(np.eye(self.sc.n_wheels))

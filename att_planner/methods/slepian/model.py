@@ -172,7 +172,7 @@ def build_maneuver(problem: ManeuverProblem, M: int = PAPER_M, N: int = PAPER_N,
     cos = np.cos(np.asarray(sky.half_angles(0.0), float).reshape(-1) + sign * cone_margin)
     r = np.asarray(problem.sensor_axis, float)
     r = r / np.linalg.norm(r)
-    sensors = [r]           # the problem's sensor first: today's cones share it
+    sensors = [r]           # the problem's sensor first: the cones share it
     index = []
     for z in zones:
         s = np.asarray(z.sensor_axis, float)
@@ -239,8 +239,8 @@ def _zone_cos(man: SmoothManeuver, K: int) -> np.ndarray:
 
 def _static_zones(man: SmoothManeuver, R: np.ndarray, jac: bool):
     """Constant zones: c = σ (b·a − cos(θ + σ m)) and the (N+1, Z, 3) vectors σ b × a, one
-    product per distinct sensor (a single sensor: exactly the cone rows of issue 3)."""
-    if len(man.zone_sensors) == 1:      # the fast path of today's cones
+    product per distinct sensor (a single sensor: exactly the cone rows of Celani & Bruni 2021)."""
+    if len(man.zone_sensors) == 1:      # the fast path of the cones
         b = R @ man.zone_sensors[0]
         values = b @ man.cone_dirs.T - _zone_cos(man, R.shape[0])
         bw = rot.cross(b[:, None, :], man.cone_dirs[None, :, :]) if jac else None

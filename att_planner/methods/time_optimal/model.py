@@ -298,7 +298,7 @@ def transcription(problem: ManeuverProblem, s: Scaling, mesh: np.ndarray, contro
     (set here), so a second problem of that shape only copies it (:meth:`.collocation.Transcription.copy`).
     Moving zones (timed path constraints) keep one t_f; fixed ones chain copies of it per interval
     (a banded KKT system, far fewer iterations; with moving zones the copies took more). A problem
-    with a boundary end or a forced boundary arc (:func:`boundary_case`, issue 19) gets an NLP of its
+    with a boundary end or a forced boundary arc (:func:`boundary_case`) gets an NLP of its
     own, with :func:`weighted_path_function`'s constraints."""
     smooth = torque_accel is not None
     zones = problem.zone_sky()

@@ -8,7 +8,7 @@ Zones that move (:mod:`att_planner.zones`): a route's margin is measured against
 physical time the route passes each attitude (its bang-bang timing), and a moving keep-out zone is
 ridden as the cone it is when the sensor passes it: frozen at the time of the eigenaxis route's
 closest approach, then once more at the time of the riding route's own closest approach. Inertial
-zones are constant, so for today's cones every route is what it was.
+zones are constant, so among keep-out cones alone every route is the frozen one.
 """
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""Minimum time with a C¹ torque (issue 18): the time-optimal collocation of :mod:`.planner` with the
+"""Minimum time with a C¹ torque: the time-optimal collocation of :mod:`.planner` with the
 torque a smooth state instead of a bang-bang control.
 
 Normalised as in :mod:`.planner` (time unit ``τ_u = sqrt(J0/T̄)``, torque ``u = T/T̄``), the state is

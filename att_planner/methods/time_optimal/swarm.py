@@ -1,5 +1,5 @@
 """Melton's (2012) two-stage proposal, its first stage: a particle swarm over a Chebyshev torque
-parametrisation, a fast global search whose best plan seeds the collocation (issue 19).
+parametrisation, a fast global search whose best plan seeds the collocation.
 
 Each particle is ``(c, t_f)``: per body axis the torque ``u_j(τ) = tanh(Σ_k c_jk T_k(2τ − 1))``
 (Chebyshev polynomials ``T_k`` up to :data:`DEGREE`; tanh keeps ``|u_j| < 1`` and lets large

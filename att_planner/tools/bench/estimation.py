@@ -1,4 +1,4 @@
-"""estimation: the demo maneuver flown closed loop on the attitude estimate, and on the truth (issue 14).
+"""estimation: the demo maneuver flown closed loop on the attitude estimate, and on the truth.
 
 ``att-bench estimation [--scenario swift_demo] [--out DIR] --json PATH`` runs the scenario's demo
 maneuver twice through the ROS nodes (recorder, simulator, estimator, controller, planner, as

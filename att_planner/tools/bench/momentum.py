@@ -1,4 +1,4 @@
-"""momentum: nadir pointing for days, with and without magnetorquer dumping (issue 15).
+"""momentum: nadir pointing for days, with and without magnetorquer dumping.
 
 ``att-bench momentum [--scenario leo_momentum] [--orbits 15] --json PATH`` runs the scenario through
 the ROS nodes (recorder, simulator, controller: the controller on the truth state) twice from the

@@ -1,4 +1,4 @@
-"""observe: what the zones cost a schedule of observations (issue 17), on the real sky.
+"""observe: what the zones cost a schedule of observations, on the real sky.
 
 ``att-bench observe [--sources a,b,...] [--dwell S] [--substeps K] --json PATH`` plans a tour of
 observatory sources (``config/targets/observatory.yaml``, each held ``--dwell`` s) with

@@ -1,4 +1,4 @@
-"""Time-optimal attitude schedule through unordered targets (Olivares & Staffetti 2018), issue 5.
+"""Time-optimal attitude schedule through unordered targets (Olivares & Staffetti 2018).
 
 ``att-bench schedule --experiment {A,B,C} --json PATH`` plans experiment A (targets a–f), B (a–l)
 or C (a–r) with :func:`att_planner.methods.schedule.plan_schedule`, integrates the wheel torques

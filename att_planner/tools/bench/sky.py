@@ -1,4 +1,4 @@
-"""sky: plans against the real, moving sky (issue 13) — the zones frozen at the start vs their motion.
+"""sky: plans against the real, moving sky — the zones frozen at the start vs their motion.
 
 ``att-bench sky --case {leo_observatory,moon_parallax} --json PATH`` plans each case twice with the
 default method (``slepian_minimum_time``) through the planner service's pipeline
@@ -12,7 +12,7 @@ default method (``slepian_minimum_time``) through the planner service's pipeline
 Both are verified against the motion: the prediction of the plan's ZOH torque from rest at
 ``q_initial``, every zone at its true position (orbit by SGP4, Sun and Moon by DE421) at every
 dense-grid time. The table gives t_f, compute, the minimum margin of each zone against the motion
-and the zone a plan enters; the JSON holds the issue's format (case, epoch, TLE, spacecraft,
+and the zone a plan enters; the JSON holds everything to redo it (case, epoch, TLE, spacecraft,
 attitudes, zones, both plans with their torques and verifications), so that the plans can be
 re-checked without the suite (test/att_planner/tools/test_bench_sky.py does so with its own RK4 and
 skyfield).
@@ -20,7 +20,7 @@ skyfield).
 Cases (:data:`CASES`), the earth_obs spacecraft of the smooth benchmark (J = diag(3000, 4500, 6000)
 kg m², 0.25 N m) with sensor +y and keep-out zones Sun 47°, Moon 23°, Earth limb + 10°:
 
-* ``leo_observatory`` — the issue's: the 135° slew about body x from identity, in the issue's
+* ``leo_observatory`` — the 135° slew about body x from identity, in a
   580 km / 20.56° TLE orbit, starting 460 s after 2026-12-21T00:00:00Z. The Earth-limb zone
   (76.6° about nadir, sweeping at orbit rate) then lies 3.5° from the start direction and rises
   over the first part of the path at ≈ 0.06°/s: the plan made against the frozen limb is overtaken
@@ -89,7 +89,7 @@ SSO_TLE = ("1 90001U          27079.00000000  .00000000  00000-0  20000-4 0    0
 
 CASES = {
     "leo_observatory": SkyCase(
-        "issue 13: earth_obs 135 deg about body x, the Earth limb rising over the first part of the path",
+        "earth_obs 135 deg about body x, the Earth limb rising over the first part of the path",
         LEO_TLE, "2026-12-21T00:00:00Z", 460.0, tuple(rot.IDENTITY),
         tuple(rot.from_axis_angle(np.array([1.0, 0.0, 0.0]), 0.75 * math.pi))),
     "moon_parallax": SkyCase(

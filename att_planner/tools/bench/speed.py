@@ -1,4 +1,4 @@
-"""speed: anytime planning (issue 18) — the first verified plan, the best smooth plan, the time-optimal one.
+"""speed: anytime planning — the first verified plan, the best smooth plan, the time-optimal one.
 
 ``att-bench speed [--case ...] [--repeats 20] [--ros] --json PATH`` plans each case through the
 planner service's pipeline in this process (:func:`att_planner.service.planning.plan_maneuver`:

@@ -1,7 +1,7 @@
-"""Time-optimal keep-out slews (issue 4): eigenaxis, constrained axis and collocation compared.
+"""Time-optimal keep-out slews: eigenaxis, constrained axis and collocation compared.
 
-``att-bench time-optimal --case {ba1,ba2,bp1,bp2} [--sweep]`` runs Melton's boundary cases instead
-(issue 19, :mod:`.boundary`).
+``att-bench time-optimal --case {ba1,ba2,bp1,bp2} [--sweep]`` runs Melton's (2012) boundary cases instead
+(:mod:`.boundary`).
 
 ``att-bench time-optimal --case {bilimoria_wie,swift} [--method M] [--budget S] --json PATH`` runs
 every method on the case, re-verifies each plan from rest at identity through the prediction model

@@ -1,4 +1,4 @@
-"""The review of a mission's log (issue 17): numpy, and two figures.
+"""The review of a mission's log: numpy, and two figures.
 
 :func:`mission_of` gathers a log with ``/mission/events`` (``att-mission``): the events, the truth
 states (attitude, wheels relative to the body, applied dipole), the controller's modes and the

@@ -289,7 +289,7 @@ def format_summary(s: dict, with_notes: bool = True) -> str:
 
 
 def mission_lines(m: dict | None) -> list[str]:
-    """The mission's table (issue 17): a line per target, observed (start, dwell, pointing error) or missed (why)."""
+    """The mission's table: a line per target, observed (start, dwell, pointing error) or missed (why)."""
     if not m:
         return []
     lines = [f"mission               {m['observed']} targets observed, {m['missed']} missed; smallest zone margin "

@@ -1,4 +1,4 @@
-"""A slew that ends on a moving reference hands over to the pointing mode without a jump (issue 15):
+"""A slew that ends on a moving reference hands over to the pointing mode without a jump:
 a smooth rest-to-rest slew aimed at where the nadir reference will be at its arrival, entered
 through the time-warp blend, then nadir pointing; in process, on the truth."""
 from __future__ import annotations

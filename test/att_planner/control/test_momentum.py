@@ -1,4 +1,4 @@
-"""Momentum management (issue 15): the cross-product law's torque, the pyramid's null space, the
+"""Momentum management: the cross-product law's torque, the pyramid's null space, the
 distribution of a torque over four wheels, and a closed loop that dumps the wheels' momentum while
 pointing (and keeps it without dumping)."""
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""Guidance against hand-checked and independently computed cases (issue 15): the nadir reference
+"""Guidance against hand-checked and independently computed cases: the nadir reference
 turns at the orbit rate about the orbit normal, a ground target's line of sight is skyfield's, the
 Sun is on the primary axis, the two-vector alignment puts the primary exactly and the secondary as
 close as it can, and every hostile pointing request is refused with 314 naming the field."""

@@ -1,4 +1,4 @@
-"""Never miss a feasible plan (issue 18): on random keep-out sets — the Swift cones plus three to ten
+"""Never miss a feasible plan: on random keep-out sets — the Swift cones plus three to ten
 8–20° cones near the eigenaxis path, start and goal clear — whenever a method finds a feasible path
 the smooth planners find a verified smooth plan too: the default method through the planner
 service (seeded with the first plan) and slepian_minimum_time on its own (which seeds itself with

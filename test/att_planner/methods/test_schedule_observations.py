@@ -1,4 +1,4 @@
-"""Schedules that observe (issue 17): each target held at rest for its dwell, within its window and
+"""Schedules that observe: each target held at rest for its dwell, within its window and
 while no zone covers it; the order search checked against every order solved."""
 from dataclasses import replace
 

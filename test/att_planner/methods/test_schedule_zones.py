@@ -1,4 +1,4 @@
-"""Schedules among zones that move (issue 13): every leg keeps every zone at its physical time along
+"""Schedules among zones that move: every leg keeps every zone at its physical time along
 the whole tour (a leg starts when the earlier legs end), checked by att_planner.verification at the
 zones' true positions."""
 from dataclasses import replace

@@ -1,4 +1,4 @@
-"""Slepian smooth maneuver planner (issue 3): conventions, exact gradients, plans checked by the
+"""Slepian smooth maneuver planner: conventions, exact gradients, plans checked by the
 prediction model, smooth ends, refusals. Kept small (coarse N) so the file runs in well under 60 s."""
 import time
 
@@ -20,7 +20,7 @@ N_SMALL, W_SMALL = 120, 7.5 / 120      # same time-bandwidth product as the pape
 
 
 def _reference_tf(problem, alpha, N, W):
-    """The issue's conventions written out naively (loop, scipy expm), independent of the module."""
+    """The conventions of Celani & Bruni (2021) written out naively (loop, scipy expm), independent of the module."""
     alpha = np.asarray(alpha)
     V = dpss(N, N * W, Kmax=alpha.shape[1]).T
     w = V @ alpha.T
@@ -112,7 +112,7 @@ def test_minimum_time_plan_is_verified_smooth_and_reproducible():
     tmax = pb.spacecraft.body_torque_max
     assert np.abs(plan.torque[[0, 1, -3, -2, -1]]).max() <= 2e-3 * tmax      # smooth ends
     assert np.abs(plan.torque).max() == pytest.approx(tmax, rel=1e-9)         # time-optimal: T* hits T̄
-    # the reported t_f and α reproduce each other under the issue's conventions
+    # the reported t_f and α reproduce each other under the conventions of Celani & Bruni (2021)
     tf_ref, _ = _reference_tf(pb, np.array(plan.stats["alpha"]), N_SMALL, W_SMALL)
     assert plan.duration == pytest.approx(tf_ref, rel=1e-9) == pytest.approx(plan.stats["tf"], rel=1e-9)
     # the references are the rigid-body response to the torque

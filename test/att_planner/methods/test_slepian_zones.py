@@ -1,6 +1,6 @@
-"""Slepian methods against moving zones (issue 13): the zone rows at t_k = τ_k t_f and their exact
+"""Slepian methods against moving zones: the zone rows at t_k = τ_k t_f and their exact
 t_f derivative, a zone sweeping into the frozen plan's path, keep-in zones of another sensor, and
-cone-only problems planned exactly as before. A synthetic sky (known rates) keeps it fast."""
+cone-only problems planned exactly as the cone-only planner does. A synthetic sky (known rates) keeps it fast."""
 from dataclasses import replace
 
 import numpy as np
@@ -158,9 +158,9 @@ def test_static_keep_in_zone_of_another_sensor_is_respected():
     ("swift", "slepian_minimum_time", {"starts": 3}, 4.495894450757781),
     ("earth_obs", "mssa", {"restarts": 4}, 1176.7675894755068),
 ])
-def test_cone_only_plans_are_unchanged(case, method, options, tf):
-    """t_f as before issue 13 (pinned from that code, to the solvers' convergence: MSSA iterates t_f to
-    1e-7, and on another CPU its BLAS rounds differently: 1176.76759 on the machine that pinned it,
+def test_cone_only_plans_keep_their_pinned_t_f(case, method, options, tf):
+    """t_f of the cone-only planner (pinned from the planner without zones, to the solvers' convergence:
+    MSSA iterates t_f to 1e-7, and on another CPU its BLAS rounds differently: 1176.76759 on the machine that pinned it,
     1176.76731 on an AMD EPYC), and the cones given as inertial zones plan identically (bit for bit)."""
     pb = benchmark_problem(case)
     plan = S.plan_slepian(pb, method=method, N=N_SMALL, W=W_SMALL, **options)

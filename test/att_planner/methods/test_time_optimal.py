@@ -1,4 +1,4 @@
-"""Time-optimal keep-out slews (issue 4): the collocation planner against its baselines.
+"""Time-optimal keep-out slews: the collocation planner against its baselines.
 
 Every plan is checked by integrating its torque through the prediction model (att_planner.verification).
 """
@@ -55,7 +55,7 @@ def test_cone_constraints_hold_on_a_dense_grid(swift_plan):
 
 
 def test_swift_plan_is_within_half_a_percent_of_its_optimum_after_one_refinement(swift_plan):
-    """Issue 18: one refinement round in quarters (the default) instead of three bisections; t_f
+    """One refinement round in quarters (the default) instead of three bisections; t_f
     within 0.5 % of the 3.06648 TU those reached, and the plan verified."""
     problem, plan = swift_plan
     assert plan.duration == pytest.approx(3.06648, rel=5e-3) and plan.duration >= 3.06648 * (1 - 1e-4)

@@ -1,4 +1,4 @@
-"""Time-optimal slews among zones that move, keep-in zones and several sensors (issue 13).
+"""Time-optimal slews among zones that move, keep-in zones and several sensors.
 
 The zones move in a synthetic sky (a "Sun" turning about the inertial z axis at a known rate), so
 the expected geometry is known by hand; every plan is judged by att_planner.verification, which
@@ -138,7 +138,7 @@ def test_keep_in_zone_of_a_second_sensor_is_kept(bw_plans):
 
 
 def test_inertial_zones_plan_like_the_cones(swift_plan):
-    """Today's cones given as inertial keep-out zones of the same sensor: the same NLP, the same plan."""
+    """The keep-out cones given as inertial keep-out zones of the same sensor: the same NLP, the same plan."""
     problem, plan = swift_plan
     as_zones = replace(problem, cones=[], zones=problem.zone_sky().zones)
     assert not as_zones.zone_sky().moving

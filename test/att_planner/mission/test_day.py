@@ -1,4 +1,4 @@
-"""The day's table (issue 17) from a log's events and truth states: a dwell held within the
+"""The day's table from a log's events and truth states: a dwell held within the
 tolerance is observed; one that drifts, one a zone covers, one the log cuts short, and a miss are
 not, each with why; a ground site's dwell is judged along its moving line of sight."""
 import math

@@ -1,4 +1,4 @@
-"""Mission files (issue 17): the shipped day loads; every key of a hostile file is refused with the
+"""Mission files: the shipped day loads; every key of a hostile file is refused with the
 file and the key named."""
 import math
 

@@ -1,4 +1,4 @@
-"""The mission's observation order (issue 17): on leo_observatory's day every observable source is
+"""The mission's observation order: on leo_observatory's day every observable source is
 ordered inside its visibility before the horizon; the two covered all day are missed with their
 zone named; a late decision drops what no longer fits."""
 import math

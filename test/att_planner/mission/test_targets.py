@@ -1,4 +1,4 @@
-"""Target lists (issue 17): the shipped observatory and Earth-observation lists, the attitude that
+"""Target lists: the shipped observatory and Earth-observation lists, the attitude that
 points the sensor at a source, and hostile files refused with the file, target and field named."""
 from dataclasses import replace
 

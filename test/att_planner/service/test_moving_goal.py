@@ -1,4 +1,4 @@
-"""Requests for a slew that ends on a pointing mode (issue 15): planned by time_optimal only, not
+"""Requests for a slew that ends on a pointing mode: planned by time_optimal only, not
 with a semi-free goal, the mode checked field by field; the goal's law is the controller's."""
 from __future__ import annotations
 

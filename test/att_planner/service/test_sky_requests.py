@@ -1,6 +1,7 @@
 """The planner service in the real sky (no ROS): where a request's epoch and orbit come from, zones
 in the problem and through a solver child, the closed-sky test with moving zones and several
-sensors, zone padding, requests without a sky unchanged, and the review of a flown plan's zones."""
+sensors, zone padding, requests without a sky planned against their cones alone, and the review of
+a flown plan's zones."""
 from __future__ import annotations
 
 import math
@@ -36,7 +37,7 @@ X, Y = np.array([1.0, 0.0, 0.0]), np.array([0.0, 1.0, 0.0])
 ZONES = [Zone("sun", "sun", X, math.radians(47)), Zone("moon", "moon", X, math.radians(23)),
          Zone("earth", "earth_limb", X, math.radians(10))]
 SUN_Y = Zone("sun", "sun", Y, math.radians(47))
-LEO_GOAL = rot.from_axis_angle([1, 0, 0], math.radians(135))      # the issue's earth_obs slew, sensor +y
+LEO_GOAL = rot.from_axis_angle([1, 0, 0], math.radians(135))      # the earth_obs slew of att-bench sky, sensor +y
 
 
 def sky_request(epoch=EPOCH, zones=ZONES, tle=TLE, **fields):

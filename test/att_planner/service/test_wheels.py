@@ -1,4 +1,4 @@
-"""Plans that respect the wheels (issue 15): the wheels' speeds along a body-torque plan from momentum
+"""Plans that respect the wheels: the wheels' speeds along a body-torque plan from momentum
 conservation, a plan that would saturate a wheel slowed in time and verified, one that saturates at
 any speed refused, and the request's wheel speeds checked."""
 from __future__ import annotations

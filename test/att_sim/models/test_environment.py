@@ -1,4 +1,4 @@
-"""Orbit, tilted-dipole field and gravity-gradient helpers of att_sim.models.environment (issue 6)."""
+"""Orbit, tilted-dipole field and gravity-gradient helpers of att_sim.models.environment."""
 import math
 
 import numpy as np

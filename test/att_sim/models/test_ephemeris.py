@@ -1,4 +1,4 @@
-"""The sky seen from the spacecraft (att_sim.models.ephemeris, issue 13): DE421 Sun and Moon, shadow."""
+"""The sky seen from the spacecraft (att_sim.models.ephemeris): DE421 Sun and Moon, shadow."""
 import math
 import pickle
 import time
@@ -60,7 +60,7 @@ def test_earth_directions_and_angular_radius(sky):
     np.testing.assert_allclose(sky.nadir(t), -r / np.linalg.norm(r, axis=-1, keepdims=True))
     rho = sky.earth_angular_radius(t)
     np.testing.assert_allclose(np.sin(rho), env.EARTH_RADIUS / np.linalg.norm(r, axis=-1))
-    assert math.degrees(float(np.mean(rho))) == pytest.approx(66.4, abs=0.6)   # the issue's ~66° limb at 580 km
+    assert math.degrees(float(np.mean(rho))) == pytest.approx(66.4, abs=0.6)   # a ~66° limb at 580 km
     np.testing.assert_allclose(sky.velocity(t), sky.orbit.state(t)[1])
 
 

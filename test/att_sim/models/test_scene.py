@@ -1,4 +1,4 @@
-"""The 3D view's geometry (issue 17): cones at their zones' half-angles about the zones' current
+"""The 3D view's geometry: cones at their zones' half-angles about the zones' current
 axes (the planner's definition), boresights and paths through the attitude convention, frames."""
 import math
 
