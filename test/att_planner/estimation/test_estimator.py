@@ -43,7 +43,7 @@ SUN_N = np.array([0.6, 0.8, 0.0])
 FIELD_N = np.array([1e-5, -2e-5, 2.5e-5])
 
 
-class Sky:
+class FixedEnvironment:
     """A fixed sun and field: the onboard models the estimator asks."""
 
     def bodies(self, t):
@@ -52,7 +52,7 @@ class Sky:
 
 def estimator(**config) -> Estimator:
     base = dict(publish_period=0.05, arw=GYRO.arw, rrw=GYRO.rrw, initial_bias_sigma=GYRO.initial_bias)
-    return Estimator(SPECS, EstimatorConfig(**{**base, **config}), Sky(), "eci", "body")
+    return Estimator(SPECS, EstimatorConfig(**{**base, **config}), FixedEnvironment(), "eci", "body")
 
 
 def gyro(t, omega=(0.0, 0.0, 0.0)) -> GyroMeasurement:
