@@ -411,7 +411,7 @@ class Controller:
         see and an attitude to trust, the safe Sun pointing (``safe_sun_axis`` on the Sun, the orbit
         normal as secondary)."""
         s, c = self.state, self.config
-        sun_ok = self.guidance_sky is not None and self.guidance_sky.sun is not None and \
+        sun_ok = self.guidance_sky is not None and self.guidance_sky.sun_N is not None and \
             (self.measured is None or self.estimate_health in USABLE)
         if not sun_ok or float(np.linalg.norm(s.omega)) > c.safe_rate_threshold:
             out.command.wheel_torques = self._wheels(-c.safe_kd * s.omega)

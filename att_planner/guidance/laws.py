@@ -73,23 +73,24 @@ def geodetic_to_itrs(latitude: float, longitude: float, altitude: float) -> np.n
 
 @dataclass
 class PointingGeometry:
-    """The geometry the pointing laws look at: ``state(t) -> (r_N, v_N)`` (the spacecraft's inertial
-    position and velocity, m and m/s), ``sun(t)`` (unit, from the spacecraft, inertial axes; None
-    without an epoch) and ``itrs(t)`` (the GCRS→ITRS rotation matrix)."""
+    """The geometry the pointing laws look at: ``state_N(t) -> (r_N, v_N)`` (the spacecraft's inertial
+    position and velocity, m and m/s), ``sun_N(t)`` (unit, from the spacecraft, inertial axes; None
+    without an epoch) and ``dcm_EN(t)`` (the GCRS→ITRS rotation matrix: inertial N to Earth-fixed E
+    axes, ``r_E = [EN] r_N``)."""
 
-    state: Callable
-    sun: Callable | None
-    itrs: Callable
+    state_N: Callable
+    sun_N: Callable | None
+    dcm_EN: Callable
 
     @classmethod
     def of(cls, environment) -> PointingGeometry:
-        """The pointing geometry of an :class:`att_sim.models.world.Environment` (the onboard models of the scenario);
-        the orbit's states are remembered for the last few times asked (a reference differentiates
+        """The pointing geometry of an :class:`att_sim.models.world.Environment` (the onboard models of
+        the scenario); the orbit's states are remembered for the last few times asked (a reference differentiates
         its law at three times, each asking for the orbit more than once)."""
         field_model = environment.field
-        itrs = field_model.itrs_rotation if field_model.epoch is not None else earth_turning
-        sun = None if environment.sky is None else environment.sky.sun_direction
-        return cls(_remembered(environment.orbit.state), sun, itrs)
+        dcm_EN = field_model.itrs_rotation if field_model.epoch is not None else earth_turning
+        sun_N = None if environment.sky is None else environment.sky.sun_direction
+        return cls(_remembered(environment.orbit.state), sun_N, dcm_EN)
 
 
 @dataclass
@@ -155,21 +156,21 @@ def _unit(v) -> np.ndarray:
 def directions(geometry: PointingGeometry) -> dict[str, Callable]:
     """The named directions of :data:`SECONDARY` as functions of time (unit, inertial)."""
     def nadir(t):
-        return -_unit(geometry.state(t)[0])
+        return -_unit(geometry.state_N(t)[0])
 
     def velocity(t):
-        r, v = geometry.state(t)
+        r, v = geometry.state_N(t)
         r_hat = _unit(r)
         return _unit(v - (v @ r_hat) * r_hat)
 
     def orbit_normal(t):
-        r, v = geometry.state(t)
+        r, v = geometry.state_N(t)
         return _unit(rot.cross(r, v))
 
     out = {"nadir": nadir, "velocity": velocity, "orbit_normal": orbit_normal,
            "north": lambda t: np.array([0.0, 0.0, 1.0])}
-    if geometry.sun is not None:
-        out["sun"] = lambda t: _unit(geometry.sun(t))
+    if geometry.sun_N is not None:
+        out["sun"] = lambda t: _unit(geometry.sun_N(t))
     return out
 
 
@@ -178,7 +179,7 @@ def ground_line_of_sight(geometry: PointingGeometry, latitude: float, longitude:
     r_itrs = geodetic_to_itrs(latitude, longitude, altitude)
 
     def sight(t):
-        return _unit(np.asarray(geometry.itrs(t)).T @ r_itrs - geometry.state(t)[0])
+        return _unit(np.asarray(geometry.dcm_EN(t)).T @ r_itrs - geometry.state_N(t)[0])
     return sight
 
 

@@ -52,7 +52,7 @@ def test_nadir_reference_turns_at_the_orbit_rate_about_the_orbit_normal():
     n = SWIFT.orbit.mean_motion
     for t in (0.0, 1234.5, 4000.0):
         ref = reference(law.attitude, t)
-        r, v = sky.state(t)
+        r, v = sky.state_N(t)
         R = rot.dcm_NB(ref.q_RN)
         assert np.allclose(R @ [0, 0, 1], -unit(r), atol=1e-12)                  # body z on nadir
         assert np.allclose(R @ [1, 0, 0], unit(v), atol=1e-9)                   # body x along-track
@@ -96,7 +96,7 @@ def test_sun_and_inertial_targets_and_holds():
     sky = sky_of(LEO)
     sun = law_of(PointingMode("sun", primary_axis=np.array([1.0, 0.0, 0.0]), secondary_axis=np.array([0.0, 1.0, 0.0]),
                               secondary="north"), sky, 0.0, rot.IDENTITY)
-    assert np.allclose(rot.dcm_NB(sun.attitude(50.0)) @ [1, 0, 0], sky.sun(50.0), atol=1e-12)
+    assert np.allclose(rot.dcm_NB(sun.attitude(50.0)) @ [1, 0, 0], sky.sun_N(50.0), atol=1e-12)
     target = unit([1, 2, 3])
     law = law_of(PointingMode("inertial_target", primary_axis=np.array([0.0, 0.0, 1.0]), target_direction=target,
                               secondary="inertial", secondary_direction=np.array([1.0, 0.0, 0.0])), sky, 0.0,
