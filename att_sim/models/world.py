@@ -184,19 +184,19 @@ class Environment:
                       moon, now.shadow)
 
     # -- per attitude --------------------------------------------------------------------------
-    def torques(self, t: float, q: np.ndarray) -> dict[str, np.ndarray]:
-        """Each active disturbance torque (N m, body axes) at time ``t`` and attitude ``q``."""
+    def torques(self, t: float, q_BN: np.ndarray) -> dict[str, np.ndarray]:
+        """Each active disturbance torque (N m, body axes) at time ``t`` and attitude ``q_BN``."""
         now = self._now(t)
-        return self._torques(now, q, rot.dcm_BN(q) @ now.field_N)
+        return self._torques(now, q_BN, rot.dcm_BN(q_BN) @ now.field_N)
 
-    def _torques(self, now: _Now, q: np.ndarray, field_b: np.ndarray) -> dict[str, np.ndarray]:
+    def _torques(self, now: _Now, q_BN: np.ndarray, field_b: np.ndarray) -> dict[str, np.ndarray]:
         out, f = {}, self.flags
         if f.gravity_gradient:
-            out["gravity_gradient"] = disturbances.gravity_gradient_torque(now.r, q, self.spacecraft.inertia)
+            out["gravity_gradient"] = disturbances.gravity_gradient_torque(now.r, q_BN, self.spacecraft.inertia)
         if f.solar_pressure:
-            out["solar_pressure"] = disturbances.srp_torque(self.facets, q, now.sun_N, now.sun_distance, now.shadow)
+            out["solar_pressure"] = disturbances.srp_torque(self.facets, q_BN, now.sun_N, now.sun_distance, now.shadow)
         if f.drag:
-            out["drag"] = disturbances.drag_torque(self.facets, q, now.v_rel, now.density, self.drag_coefficient)
+            out["drag"] = disturbances.drag_torque(self.facets, q_BN, now.v_rel, now.density, self.drag_coefficient)
         if self.residual_dipole is not None:
             out["residual_dipole"] = disturbances.residual_dipole_torque(self.residual_dipole, field_b)
         return out
@@ -233,15 +233,15 @@ class Environment:
         f = self.flags
         return f.gravity_gradient or f.solar_pressure or f.drag or self.residual_dipole is not None
 
-    def disturbance(self, t: float, q: np.ndarray, field_b: np.ndarray) -> np.ndarray | None:
-        """The sum of the active disturbance torques (N m, body axes) at time ``t``, attitude ``q``
+    def disturbance(self, t: float, q_BN: np.ndarray, field_b: np.ndarray) -> np.ndarray | None:
+        """The sum of the active disturbance torques (N m, body axes) at time ``t``, attitude ``q_BN``
         and body field ``field_b`` (None when none is active)."""
-        torques = self._torques(self._now(t), q, field_b)
+        torques = self._torques(self._now(t), q_BN, field_b)
         return sum(torques.values()) if torques else None
 
-    def sample(self, t: float, q: np.ndarray) -> Sample:
-        """Field, total disturbance torque, position and shadow at time ``t`` and attitude ``q``."""
-        return self.sample_of(t, *self.stage(t, np.asarray(q, float)))
+    def sample(self, t: float, q_BN: np.ndarray) -> Sample:
+        """Field, total disturbance torque, position and shadow at time ``t`` and attitude ``q_BN``."""
+        return self.sample_of(t, *self.stage(t, np.asarray(q_BN, float)))
 
     def sample_of(self, t: float, field_b: np.ndarray, torque: np.ndarray | None) -> Sample:
         """:meth:`sample` of the attitude whose :meth:`stage` values at ``t`` are ``field_b``, ``torque``."""
