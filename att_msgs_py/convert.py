@@ -266,7 +266,7 @@ def result_msg(r: types.ManeuverResult) -> ExecuteManeuver.Result:
                                   final_rate=float(r.final_rate))
 
 
-# -- sensors and the estimate (issue 14) ----------------------------------------------------------
+# -- sensors and the estimate ----------------------------------------------------------
 
 NOT_PROVIDED = [-1.0] + [0.0] * 8      # a covariance sensor_msgs marks "not provided"
 

@@ -1,4 +1,4 @@
-"""Messages of the 3D view (issue 17): ``/tf`` transforms, the zones' margins and ``visualization_msgs/MarkerArray``
+"""Messages of the 3D view: ``/tf`` transforms, the zones' margins and ``visualization_msgs/MarkerArray``
 from the plain :class:`att_msgs_py.types.Shape` (the conversions of :mod:`att_msgs_py.convert`,
 for Foxglove's 3D panel and RViz).
 

@@ -75,10 +75,10 @@ ZONE_BODIES = ("inertial", "sun", "moon", "earth_limb")
 
 @dataclass(frozen=True)
 class Zone:
-    """A zone of a body-fixed sensor (issue 13): the boresight ``R(q) sensor_axis`` stays out of
+    """A zone of a body-fixed sensor: the boresight ``R(q) sensor_axis`` stays out of
     (``keep_in`` False) or inside (True) a cone about a target seen from the spacecraft.
 
-    ``body`` (:data:`ZONE_BODIES`): ``inertial`` (the fixed unit ``direction``, today's cones),
+    ``body`` (:data:`ZONE_BODIES`): ``inertial`` (the fixed unit ``direction``: a keep-out cone),
     ``sun`` or ``moon`` (the direction from the spacecraft), ``earth_limb`` (axis −r̂, the nadir,
     and half-angle asin(R_E/|r|) + ``half_angle``: there ``half_angle`` is the margin beyond the
     limb). ``half_angle`` in rad. Vectors are normalised when they have a finite, non-zero norm
@@ -107,7 +107,7 @@ class Zone:
 
 @dataclass
 class Verification:
-    """A plan integrated through the truth dynamics (``att_msgs/PlanVerification``).
+    """A plan predicted by verification's prediction model (``att_msgs/PlanVerification``).
 
     The fields from ``duration`` on are not on the wire.
     """
@@ -179,7 +179,7 @@ class Plan:
     Context, filled by the planner service: ``plan_id``, ``spacecraft``, ``frame_id``,
     ``sensor_axis``, ``cones``, ``verification`` and, for a schedule, the ``passages``; then
     ``spacecraft_digest``, ``key_id`` and the Ed25519 ``signature`` (:mod:`att_msgs_py.signing`);
-    ``zones`` (:class:`Zone`, besides the cones) and the ``epoch`` of t = 0 (issue 13). A method
+    ``zones`` (:class:`Zone`, besides the cones) and the ``epoch`` of t = 0. A method
     that finds nothing returns a plan without samples and status FAILED (or BUDGET_EXPIRED).
     ``nit``, ``nfev``, ``stats`` and ``passages`` are not on the wire.
     """
@@ -297,7 +297,7 @@ class ManeuverResult:
 
 
 # ---------------------------------------------------------------------------------------------
-# Sensors and the attitude estimate (issue 14)
+# Sensors and the attitude estimate
 # ---------------------------------------------------------------------------------------------
 
 class TrackerStatus(IntEnum):
@@ -401,7 +401,7 @@ class AttitudeEstimate:
 
 
 # ---------------------------------------------------------------------------------------------
-# Pointing modes (issue 15)
+# Pointing modes
 # ---------------------------------------------------------------------------------------------
 
 POINTING_KINDS = ("inertial", "nadir", "sun", "ground", "inertial_target")
@@ -435,7 +435,7 @@ class ShapeKind(StrEnum):
 
 @dataclass(frozen=True)
 class Shape:
-    """One marker of the 3D view (issue 17): ``points`` (N, 3) m in frame ``frame_id`` (a
+    """One marker of the 3D view: ``points`` (N, 3) m in frame ``frame_id`` (a
     triangle list, a line strip, or an arrow's tail and head), colour ``rgba`` in [0, 1], line or
     shaft ``width`` m. ``(ns, id)`` names it, so a newer shape with the same name replaces it."""
 

@@ -5,7 +5,7 @@ axis ``w_i`` and half-angle ``θ_i`` (:class:`att_msgs_py.types.Cone`) is respec
 ``rᵀ Rᵀ w_i ≤ cos θ_i``. The *margin* is the angle between boresight and cone axis minus the
 half-angle (rad): ≥ 0 means outside the cone.
 
-Boundary ends (issue 19): a start or goal direction within :data:`BOUNDARY_TOLERANCE` of a boundary
+Boundary ends: a start or goal direction within :data:`BOUNDARY_TOLERANCE` of a boundary
 is on it (plannable); only one inside by more is refused (:func:`endpoint_in_cone`). A path that
 leaves such an end is necessarily near the boundary while its boresight is near the end, so the
 verification asks margin ≥ −tol within :data:`END_RADIUS` of the path's own start and final
@@ -14,7 +14,7 @@ tightening of such a zone up from −tol over the first and last :data:`END_RAMP
 (:func:`end_ramp`). A forced boundary arc (``ManeuverProblem.boundary_cone``) keeps the boresight
 on one cone's boundary for the whole maneuver (:func:`boundary_arc_issue`).
 
-The checks of a request's zones (issue 13; :mod:`att_planner.zones`) are here too:
+The checks of a request's zones (:mod:`att_planner.zones`) are here too:
 :func:`zone_issue` gives the code and sentence of the first bad zone, contradiction or violated end.
 """
 from __future__ import annotations
@@ -24,7 +24,7 @@ import numpy as np
 from att_msgs_py import validation
 from att_msgs_py.errors import ErrorCode, RequestError
 from att_msgs_py.types import Cone, Zone
-from att_planner.zones import ZoneSky, same_axis
+from att_planner.zones import FittedZones, same_axis
 from att_sim.models import rotations as rot
 
 BOUNDARY_TOLERANCE = 1e-6   # rad: an end direction this far inside a boundary is on it
@@ -36,7 +36,7 @@ ARC_TOLERANCE = 1e-4        # rad: a forced boundary arc keeps |margin| within t
 
 def boresight(q: np.ndarray, sensor_axis: np.ndarray) -> np.ndarray:
     """Inertial boresight direction(s) for attitude(s) ``q``."""
-    return rot.dcm(q) @ np.asarray(sensor_axis, float)
+    return rot.dcm_NB(q) @ np.asarray(sensor_axis, float)
 
 
 def direction_margins(direction: np.ndarray, cones: list[Cone]) -> np.ndarray:
@@ -149,7 +149,7 @@ def blocked_endpoint(problem) -> str:
             f"({np.degrees(depth):.2f} deg inside its {np.degrees(cone.half_angle):.1f} deg half-angle)")
 
 
-# ---------------------------------------------------------------------- zones (issue 13)
+# ---------------------------------------------------------------------- zones
 
 
 def invalid_zone(index: int, zone: Zone) -> str:
@@ -167,7 +167,7 @@ def _angle(a: np.ndarray, b: np.ndarray) -> float:
     return float(np.arccos(np.clip(a @ b / (np.linalg.norm(a) * np.linalg.norm(b)), -1.0, 1.0)))
 
 
-def contradictory_zones(zone_sky: ZoneSky) -> str:
+def contradictory_zones(zone_sky: FittedZones) -> str:
     """Why no boresight satisfies the zones of one sensor at t = 0, or '': a keep-in cone entirely
     inside a keep-out cone (γ + θ_in ≤ θ_out), or two keep-in cones that do not meet (γ > θ_1 + θ_2).
     Only pairs are checked: a keep-in cone covered by several keep-out cones together is not."""
@@ -191,7 +191,7 @@ def contradictory_zones(zone_sky: ZoneSky) -> str:
 GOAL_CHECK_TIMES = 2001      # times over the zones' window at which a goal is judged against moving zones
 
 
-def zone_at_end(problem, zone_sky: ZoneSky | None = None) -> str:
+def zone_at_end(problem, zone_sky: FittedZones | None = None) -> str:
     """Why the start or the goal violates a zone, or '': the start at t = 0; the goal at every
     time of the zones' window (``GOAL_CHECK_TIMES`` times over [0, window]): the arrival time is
     not known before planning, so a goal is refused only when no arrival time in the window clears

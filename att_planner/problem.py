@@ -19,18 +19,18 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from att_msgs_py.types import Cone, Zone
-from att_planner.zones import ZoneSky, clenshaw, zones_from_cones
+from att_planner.zones import FittedZones, clenshaw, zones_from_cones
 from att_sim.models import rotations as rot
 from att_sim.models.dynamics import Spacecraft
 
 if TYPE_CHECKING:          # the annotations only: att_sim.models.ephemeris loads skyfield
-    from att_sim.models.ephemeris import Sky
+    from att_sim.models.ephemeris import Ephemeris
 
 GOAL_DEGREE = 16         # of a moving goal's series of the attitude (sign-continuous) and the rate
 
 
 class MovingGoal:
-    """A goal that moves (a pointing law, issue 15): ``t ↦ (q, ω)`` from the law in this process, or
+    """A goal that moves (a pointing law): ``t ↦ (q, ω)`` from the law in this process, or
     from its Chebyshev series over ``[0, window]`` (the Chebyshev points of the first kind) after
     pickling: a planner's child process gets the series, the verification the law."""
 
@@ -74,18 +74,18 @@ class ManeuverProblem:
     * ``targets``: name → attitude, every one to be passed through once, in any order, on the way
       from ``q_initial`` to ``q_final`` (a schedule; Olivares & Staffetti 2018: at a passage the
       attitude is the target's and the body rate about body z is zero). ``target_dwell``: the
-      targets observed, held at rest for that many seconds (issue 17); ``target_windows``: the
+      targets observed, held at rest for that many seconds; ``target_windows``: the
       span each observation must lie in (s from the start); a target is never observed while a
       zone covers it.
     * ``rate_max`` (rad/s per body axis) and ``wheel_momentum_max`` (N m s per wheel, the momentum
       the wheels store producing a body-torque plan with zero total momentum): bounds a plan must
       keep, checked by the verification; infinite when not imposed.
-    * ``cones``: inertial keep-out cones of ``sensor_axis`` (as before issue 13); ``zones``: further
+    * ``cones``: inertial keep-out cones of ``sensor_axis``; ``zones``: further
       zones, each with its own sensor axis, moving or not (:class:`att_msgs_py.types.Zone`);
       ``epoch``: the UTC instant of t = 0; ``sky``: the sky seen from the spacecraft
-      (:class:`att_sim.models.ephemeris.Sky`, needed by sun, moon and earth_limb zones).
+      (:class:`att_sim.models.ephemeris.Ephemeris`, needed by sun, moon and earth_limb zones).
       :meth:`zone_sky` joins them: what every method and the verification use.
-    * ``goal_motion``: a goal that moves (a pointing law, issue 15:
+    * ``goal_motion``: a goal that moves (a pointing law:
       :class:`MovingGoal`, made by :mod:`att_planner.service.moving_goal`): ``t ↦ (q, ω)``, the attitude and
       body rate the plan must reach at its final time ``t`` (``q_final``: its attitude at a first
       estimate of that time, for guesses); None: ``q_final`` at rest.
@@ -110,7 +110,7 @@ class ManeuverProblem:
     wheel_momentum_max: float = math.inf
     zones: list[Zone] = field(default_factory=list)
     epoch: datetime | None = None
-    sky: Sky | None = None
+    sky: Ephemeris | None = None
     boundary_cone: int | None = None
     wheel_speeds: np.ndarray | None = None      # rad/s relative to the body at the start (at rest); None: stopped
     goal_motion: MovingGoal | None = None       # t -> (q, ω) of a moving goal
@@ -121,17 +121,17 @@ class ManeuverProblem:
     def time_left(self) -> float:
         return np.inf if self.deadline is None else self.deadline - time.monotonic()
 
-    def zone_sky(self, window: float | None = None) -> ZoneSky:
+    def zone_sky(self, window: float | None = None) -> FittedZones:
         """The cones (first, as inertial keep-out zones of ``sensor_axis``) and the zones over
         ``[0, window]`` s, built once per window and field values (the last :data:`ZONE_SKY_CACHE` kept).
 
         Default window: :meth:`default_window`. A plan longer than the window cannot be judged
-        against the fitted zones (the ZoneSky refuses those times); a method asks for a longer
+        against the fitted zones (the FittedZones refuses those times); a method asks for a longer
         window then.
         """
         if window is None:
             window = self.default_window()
-        # by value (the fields of the cones and zones); the sky by identity (the cached ZoneSky holds it)
+        # by value (the fields of the cones and zones); the sky by identity (the cached FittedZones holds it)
         key = (float(window), id(self.sky), np.asarray(self.sensor_axis, float).tobytes(),
                tuple((c.direction.tobytes(), c.half_angle, c.name) for c in self.cones),
                tuple((z.name, z.body, z.sensor_axis.tobytes(), z.half_angle, z.keep_in,
@@ -140,7 +140,7 @@ class ManeuverProblem:
             if len(self._zone_skies) >= ZONE_SKY_CACHE:
                 self._zone_skies.pop(next(iter(self._zone_skies)))      # the oldest
             zones = zones_from_cones(self.cones, self.sensor_axis) + list(self.zones)
-            self._zone_skies[key] = ZoneSky(zones, self.sky, float(window))
+            self._zone_skies[key] = FittedZones(zones, self.sky, float(window))
         return self._zone_skies[key]
 
     def default_window(self) -> float:

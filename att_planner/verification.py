@@ -1,19 +1,22 @@
-"""The one verification of a plan: integrate its controls through the truth dynamics and measure
-it against its problem, with one named set of tolerances (:data:`TOLERANCES`).
+"""The one verification of a plan: predict its trajectory with the prediction model and measure it
+against its problem, with one named set of tolerances (:data:`TOLERANCES`).
 
-Every plan the planner returns carries these figures, and the methods and the benchmarks judge
-plans by them; nothing is taken from a planner's own model. The integration is
-:func:`att_sim.models.dynamics.simulate_profile` (RK4 with inputs switched exactly at the knots for
-zero-order hold, :data:`VERIFY_STEPS` steps over the plan at least), from the problem's initial
-attitude at rest with the wheels stopped. Checked: the final attitude (semi-free: the boresight
+The prediction model (:func:`prediction_model`) is the problem's nominal spacecraft flown through
+the shared rigid-body and wheel equations of :mod:`att_sim.models.dynamics`: no dispersions, no
+disturbances, no sensor or actuator errors (those belong to the truth simulation, which the flight
+side never sees). Every plan the planner returns carries these figures, and the methods and the
+benchmarks judge plans by them; nothing is taken from a planner's own transcription. The
+prediction is :func:`att_sim.models.dynamics.simulate_profile` (RK4 with inputs switched exactly at
+the knots for zero-order hold, :data:`VERIFY_STEPS` steps over the plan at least), from the
+problem's initial attitude at rest with the wheels stopped. Checked: the final attitude (semi-free: the boresight
 on its target; a moving goal: its attitude at the final time) and rate (a moving goal: relative to
 its rate), every passage of a schedule (attitude, rate about body z), every zone
 (the cones, then the zones: :meth:`ManeuverProblem.zone_sky`) at every dense sample at its TRUE
 position at that sample's time (straight from the sky, not the planners' fit, at any time), and the
 control, wheel-speed (relative to the body), body-rate and wheel-momentum limits.
 
-Zones are judged by their *clearance* above the floor a sample may reach (:func:`clearances`, issue
-19): the margin, plus :data:`~att_planner.cones.BOUNDARY_TOLERANCE` where the boresight is within
+Zones are judged by their *clearance* above the floor a sample may reach (:func:`clearances`): the
+margin, plus :data:`~att_planner.cones.BOUNDARY_TOLERANCE` where the boresight is within
 :data:`~att_planner.cones.END_RADIUS` of the path's own start or final boresight (an end may lie on
 a boundary, within the tolerance); for a forced boundary arc's cone
 :data:`~att_planner.cones.ARC_TOLERANCE` − |margin| (the boresight stays on the boundary). The
@@ -35,9 +38,14 @@ from att_sim.models import rotations as rot
 VERIFY_STEPS = 2000         # RK4 steps over the plan (at least one per control interval)
 
 
+def prediction_model(problem: ManeuverProblem) -> dyn.Spacecraft:
+    """The spacecraft a plan is predicted with: the problem's nominal one (module docstring)."""
+    return problem.spacecraft
+
+
 @dataclass(frozen=True)
 class Tolerances:
-    """Acceptance of a plan after integration through the dynamics."""
+    """Acceptance of a plan's predicted trajectory."""
 
     attitude: float = math.radians(0.5)    # rad: final (semi-free: boresight) and passage attitude error
     rate: float = 1e-3                     # rad/s: final ‖ω‖, |ω_z| at each passage, ‖ω‖ through an observation
@@ -48,11 +56,12 @@ class Tolerances:
 TOLERANCES = Tolerances()
 
 
-def integrate(problem: ManeuverProblem, plan: Plan, steps: int = VERIFY_STEPS) -> dyn.Trajectory:
-    """The plan's controls integrated from the problem's start at rest: a wheel-torque plan from the
-    problem's wheel speeds, a body-torque plan with the wheels stopped (the rigid body it was planned
-    for; :func:`wheel_speeds_along` gives the wheels that produce its torque)."""
-    sc = problem.spacecraft
+def predict(problem: ManeuverProblem, plan: Plan, steps: int = VERIFY_STEPS) -> dyn.Trajectory:
+    """The trajectory the prediction model flies under the plan's controls from the problem's start at
+    rest: a wheel-torque plan from the problem's wheel speeds, a body-torque plan with the wheels
+    stopped (the rigid body it was planned for; :func:`wheel_speeds_along` gives the wheels that
+    produce its torque)."""
+    sc = prediction_model(problem)
     wheels = plan.control_kind == ControlKind.WHEEL_TORQUE and problem.wheel_speeds is not None
     x0 = dyn.initial_state(sc, problem.q_initial, wheel_speed=problem.wheel_speeds if wheels else None)
     return dyn.simulate_profile(sc, x0, plan.t, plan.torque, kind=str(plan.control_kind),
@@ -69,7 +78,7 @@ def clearances(problem: ManeuverProblem, t: np.ndarray, q: np.ndarray, true: boo
     m = zone_sky.margins(t, q, true=true)
     if not m.size:
         return m
-    R = rot.dcm(np.asarray(q, float).reshape(-1, 4))
+    R = rot.dcm_NB(np.asarray(q, float).reshape(-1, 4))
     near = np.zeros(m.shape, bool)
     for s in np.unique(zone_sky.sensor_axes, axis=0):              # once per sensor
         b = R @ (s / np.linalg.norm(s))
@@ -82,8 +91,8 @@ def clearances(problem: ManeuverProblem, t: np.ndarray, q: np.ndarray, true: boo
 
 
 def measure(problem: ManeuverProblem, plan: Plan, traj: dyn.Trajectory) -> Verification:
-    """The verification figures of ``plan`` from its integrated trajectory ``traj``."""
-    sc = problem.spacecraft
+    """The verification figures of ``plan`` from its predicted trajectory ``traj``."""
+    sc = prediction_model(problem)
     wheels = plan.control_kind == ControlKind.WHEEL_TORQUE
     controls = np.asarray(plan.torque, float).reshape(len(plan.t), -1)
     applied = controls[:-1] if plan.interpolation == Interpolation.ZOH and len(controls) > 1 else controls
@@ -98,7 +107,7 @@ def measure(problem: ManeuverProblem, plan: Plan, traj: dyn.Trajectory) -> Verif
     elif problem.sensor_target is None:
         final_error = float(rot.angle_between(traj.q[-1], problem.q_final))
     else:
-        reached = rot.dcm(traj.q[-1]) @ np.asarray(problem.sensor_axis, float)
+        reached = rot.dcm_NB(traj.q[-1]) @ np.asarray(problem.sensor_axis, float)
         target = np.asarray(problem.sensor_target, float)
         final_error = float(np.arccos(np.clip(reached @ target / np.linalg.norm(target), -1.0, 1.0)))
     passage_errors, passage_rates = [], []
@@ -130,8 +139,8 @@ def measure(problem: ManeuverProblem, plan: Plan, traj: dyn.Trajectory) -> Verif
 
 
 def verify(problem: ManeuverProblem, plan: Plan, steps: int = VERIFY_STEPS) -> Verification:
-    """Integrate the plan through the truth dynamics and measure it against its problem."""
-    return measure(problem, plan, integrate(problem, plan, steps))
+    """Predict the plan's trajectory with the prediction model and measure it against its problem."""
+    return measure(problem, plan, predict(problem, plan, steps))
 
 
 def rejection(ver: Verification, tol: Tolerances = TOLERANCES) -> str | None:
@@ -185,10 +194,10 @@ def _wheel_momentum(sc: dyn.Spacecraft, traj: dyn.Trajectory, wheels: bool) -> n
 
 
 def wheel_speeds_along(problem: ManeuverProblem, plan: Plan, traj: dyn.Trajectory) -> np.ndarray:
-    """The wheels' speeds relative to the body along the trajectory, ``Ω − Gᵀω`` (K, N): what the
-    truth model limits (:func:`att_sim.models.dynamics.relative_wheel_speed`). A wheel-torque plan
-    integrates its wheels; a body-torque plan's are :func:`body_plan_wheel_speeds` (the two parts summed)."""
-    sc = problem.spacecraft
+    """The wheels' speeds relative to the body along the trajectory, ``Ω − Gᵀω`` (K, N): the speed the
+    wheel limit of the dynamics applies to (:func:`att_sim.models.dynamics.relative_wheel_speed`). A wheel-torque plan
+    predicts its wheels; a body-torque plan's are :func:`body_plan_wheel_speeds` (the two parts summed)."""
+    sc = prediction_model(problem)
     if plan.control_kind == ControlKind.WHEEL_TORQUE:
         return traj.wheel_speed - traj.omega @ sc.wheel_axes
     stored, slew = body_plan_wheel_speeds(problem, traj.q, traj.omega)
@@ -205,14 +214,14 @@ def body_plan_wheel_speeds(problem: ManeuverProblem, q: np.ndarray, omega: np.nd
     the pseudo-inverse, as the controller distributes a torque; a null-space spin stays). *stored*:
     ``Ω₀ + G⁺ (Rᵀ H_N − G I_w Ω₀) / I_w``, what the stored momentum becomes as the body turns;
     *slew*: ``−G⁺ J ω / I_w − Gᵀ ω``, the slew's own share (∝ ω)."""
-    sc = problem.spacecraft
+    sc = prediction_model(problem)
     zeros = np.zeros((len(q), sc.n_wheels))
     if not (sc.n_wheels and sc.wheel_inertia > 0):
         return zeros, zeros.copy()
     speeds0 = np.zeros(sc.n_wheels) if problem.wheel_speeds is None else np.asarray(problem.wheel_speeds, float)
     h0_B = sc.wheel_axes @ (sc.wheel_inertia * speeds0)
-    H_N = rot.dcm(q[0]) @ h0_B
-    h_B = np.einsum("kji,j->ki", rot.dcm(q), H_N)                          # R_kᵀ H_N
+    H_N = rot.dcm_NB(q[0]) @ h0_B
+    h_B = np.einsum("kji,j->ki", rot.dcm_NB(q), H_N)                          # R_kᵀ H_N
     stored = speeds0 + (h_B - h0_B) @ sc.wheel_axes_pinv.T / sc.wheel_inertia
     slew = -omega @ (sc.wheel_axes_pinv @ sc.inertia).T / sc.wheel_inertia - omega @ sc.wheel_axes
     return stored, slew

@@ -1,8 +1,8 @@
-"""Zones that move (issue 13): the sensor zones of a problem as functions of time.
+"""Zones that move: the sensor zones of a problem as functions of time.
 
 Zone ``z`` (:class:`att_msgs_py.types.Zone`) has a body sensor axis ``s_z``, a unit inertial axis
-``a_z(t)`` and a half-angle ``θ_z(t)``: ``inertial`` a fixed direction and half-angle (today's
-cones), ``sun`` / ``moon`` the direction from the spacecraft (:class:`att_sim.models.ephemeris.Sky`),
+``a_z(t)`` and a half-angle ``θ_z(t)``: ``inertial`` a fixed direction and half-angle (a keep-out
+cone), ``sun`` / ``moon`` the direction from the spacecraft (:class:`att_sim.models.ephemeris.Ephemeris`),
 ``earth_limb`` the nadir −r̂(t) with ``asin(R_E/|r(t)|) + half_angle``. Its margin at attitude ``q``
 is, with the boresight ``b = R(q) s_z / |s_z|`` and ``γ = angle(b, a_z)``::
 
@@ -13,15 +13,15 @@ on pieces ``[a, b]`` (one piece unless a degree above :data:`MAX_DEGREE` would b
 interpolated at the Chebyshev points of the first kind (Trefethen, *Approximation Theory and
 Approximation Practice*, 2013, ch. 3-4) with the degree raised until the error against the sky on a
 fine grid is at most half of :data:`FIT_TOLERANCE` (axis: |a_fit − a_true|, an angle bound;
-half-angle: |θ_fit − θ_true|), checked when the ZoneSky is built: the grid has at least 8 points
+half-angle: |θ_fit − θ_true|), checked when the FittedZones is built: the grid has at least 8 points
 per oscillation of the error of a degree-40 fit, so the error between its points stays within the
 tolerance. The series are summed by Clenshaw's
-recurrence, the same arithmetic in numpy and in CasADi (:meth:`ZoneSky.casadi`), so that
+recurrence, the same arithmetic in numpy and in CasADi (:meth:`FittedZones.casadi`), so that
 collocation and SQP constraints are exact functions of a symbolic time; their derivatives are those
 of the series (exact, not finite differences). A fitted axis is unit to within the tolerance
-(margins use angles, which do not depend on its length). Outside ``[0, window]`` a moving ZoneSky
+(margins use angles, which do not depend on its length). Outside ``[0, window]`` a moving FittedZones
 refuses numpy evaluation (ValueError); symbolic users must bound their time by ``window``.
-Verification does not use the fit: :meth:`ZoneSky.true_axes` and :meth:`ZoneSky.true_half_angles`
+Verification does not use the fit: :meth:`FittedZones.true_axes` and :meth:`FittedZones.true_half_angles`
 come straight from the sky, at any time.
 """
 from __future__ import annotations
@@ -39,7 +39,7 @@ CHECK_POINTS = 8 * (MAX_DEGREE + 1)    # points of the fine grid the fit is chec
 
 
 def zones_from_cones(cones: list[Cone], sensor_axis) -> list[Zone]:
-    """Today's keep-out cones as inertial keep-out zones of the one sensor ``sensor_axis``."""
+    """A problem's keep-out cones as inertial keep-out zones of the one sensor ``sensor_axis``."""
     return [Zone(c.name, "inertial", np.asarray(sensor_axis, float), c.half_angle, False, c.direction)
             for c in cones]
 
@@ -69,10 +69,12 @@ def _chebyshev_interpolant(values: np.ndarray) -> np.ndarray:
     return coef
 
 
-class ZoneSky:
-    """The zones of a problem over ``[0, window]`` s (module docstring).
+class FittedZones:
+    """The zones of a problem over ``[0, window]`` s, their motion fitted by Chebyshev series
+    (module docstring).
 
-    ``zones``: list of Zone (cones first when built by the problem); ``sky``: any object with
+    ``zones``: list of Zone (cones first when built by the problem); ``sky``: an ephemeris
+    (:class:`att_sim.models.ephemeris.Ephemeris`) or any object with
     ``sun_direction(t)``, ``moon_direction(t)``, ``nadir(t)`` and ``earth_angular_radius(t)``
     (vectorised, t seconds past the epoch), needed when a zone is not inertial. Attributes:
     ``moving`` (a zone is not inertial), ``names``, ``keep_in`` (Z,), ``sensor_axes`` (Z, 3),
@@ -177,7 +179,7 @@ class ZoneSky:
         if t.size and (t.min() < -slack or t.max() > self.window + slack):
             bad = t.min() if t.min() < -slack else t.max()
             raise ValueError(f"t = {bad:.6g} s is outside the zones' window [0, {self.window:.6g}] s "
-                             f"(build the ZoneSky over the whole maneuver)")
+                             f"(build the FittedZones over the whole maneuver)")
         out = np.empty((len(t), 4 * len(self._moving)))
         piece = np.clip(np.searchsorted(self.pieces, t, side="right") - 1, 0, len(self._coef) - 1)
         for p, (coef, dcoef) in enumerate(zip(self._coef, self._dcoef)):
@@ -283,7 +285,7 @@ class ZoneSky:
         out = np.zeros((len(q), Z))
         if not Z:
             return out
-        R = rot.dcm(q)
+        R = rot.dcm_NB(q)
         A, theta = self.at(t, true) if self.moving else (None, None)
         for s, static, moving in self._groups:
             b = R @ s
@@ -304,6 +306,6 @@ class ZoneSky:
         return [z if z.body == "inertial" else Zone(z.name, "inertial", z.sensor_axis, float(th0[i]), z.keep_in, a0[i])
                 for i, z in enumerate(self.zones)]
 
-    def frozen(self) -> ZoneSky:
+    def frozen(self) -> FittedZones:
         """The zones frozen at t = 0 (:meth:`frozen_zones`), same window."""
-        return ZoneSky(self.frozen_zones(), None, self.window, self.tolerance)
+        return FittedZones(self.frozen_zones(), None, self.window, self.tolerance)

@@ -1,9 +1,9 @@
-"""Offset search of att-bench sky's leo_observatory case (issue 13): the start offset after
+"""Offset search of att-bench sky's leo_observatory case: the start offset after
 2026-12-21T00:00Z at which the plan made against the frozen zones enters the moving Earth-limb zone
 when verified against the motion.
 
-Self-contained: skyfield directly for the sky, today's Cone-based slepian_minimum_time for the
-frozen plan (frozen zones are inertial cones), the suite's truth integration for the attitude.
+Self-contained: skyfield directly for the sky, the Cone-based slepian_minimum_time for the
+frozen plan (frozen zones are inertial cones), the verification's prediction for the attitude.
 Usage (from the repository root): .venv/bin/python benchmarks/sky_offset_search.py [start stop step]
 """
 import sys
@@ -15,7 +15,7 @@ from skyfield.api import EarthSatellite, load, load_file
 from att_msgs_py.types import Cone
 from att_planner.methods.slepian import plan_slepian
 from att_planner.reference.celani_bruni import benchmark_problem
-from att_planner.verification import integrate
+from att_planner.verification import predict
 from att_sim import rotations as rot
 
 L1 = "1 28485U          26355.00000000  .00000000  00000-0  20000-4 0    07"
@@ -45,7 +45,7 @@ SENSOR = np.array([0.0, 1.0, 0.0])
 
 def margins(t, q, axis=SENSOR):
     ax, half = sky(t)
-    b = np.einsum("kij,j->ki", rot.dcm(q), axis)
+    b = np.einsum("kij,j->ki", rot.dcm_NB(q), axis)
     return np.arccos(np.clip(np.einsum("kzi,ki->kz", ax, b), -1, 1)) - half
 
 
@@ -61,9 +61,9 @@ def main(start=0.0, stop=5800.0, step=100.0):
         if not plan.success:
             print(f"{off:7.0f}  ends {np.degrees(ends.min(axis=0)).round(2)}  {plan.status} {plan.message[:60]}")
             continue
-        traj = integrate(prob, plan)
+        traj = predict(prob, plan)
         ax0, h0 = sky(off)
-        b = np.einsum("kij,j->ki", rot.dcm(traj.q), base.sensor_axis)
+        b = np.einsum("kij,j->ki", rot.dcm_NB(traj.q), base.sensor_axis)
         frozen = np.arccos(np.clip(b @ ax0[0].T, -1, 1)) - h0[0]
         true = margins(off + traj.t, traj.q)
         end_true = margins(off + plan.duration, base.q_final[None])

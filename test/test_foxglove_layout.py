@@ -1,4 +1,4 @@
-"""docs/foxglove_layout.json (issue 17) cannot silently rot: it is the classic Foxglove layout
+"""docs/foxglove_layout.json cannot silently rot: it is the classic Foxglove layout
 (``configById`` + a mosaic ``layout`` tree naming every panel once), and every topic and message
 path it references is one the suite records, down to the field."""
 import json

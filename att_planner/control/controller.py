@@ -56,13 +56,13 @@ from att_planner.control.mode_authentication import ModeAuthentication
 from att_planner.control.plan_cache import PlanCache
 from att_planner.control.plan_checks import PlanContext, check_start
 from att_planner.control.pointing import handover_law, law_reference, pointing_torque
-from att_planner.control.reference import Reference, at_rest, stack
 from att_planner.control.state_gate import GateConfig, StateGate
-from att_planner.guidance.laws import Sky as GuidanceSky
+from att_planner.guidance import Reference, at_rest, stack
+from att_planner.guidance.laws import PointingGeometry
 from att_planner.guidance.modes import law_of
 from att_sim.models import rotations as rot
 from att_sim.models.dynamics import Spacecraft
-from att_sim.models.ephemeris import Sky
+from att_sim.models.ephemeris import Ephemeris
 
 
 @dataclass
@@ -91,8 +91,8 @@ USABLE = (Health.CONVERGED, Health.PROPAGATING)   # estimates the attitude laws 
 class Controller:
     def __init__(self, context: PlanContext, config: ControllerConfig | None = None,
                  mode: int = ControlMode.IDLE, body_frame_id: str = "body", gate: GateConfig | None = None,
-                 sky: Sky | None = None, measured: MeasuredState | None = None, friction=None,
-                 guidance_sky: GuidanceSky | None = None):
+                 sky: Ephemeris | None = None, measured: MeasuredState | None = None, friction=None,
+                 guidance_sky: PointingGeometry | None = None):
         """``measured``: fly on attitude estimates (:meth:`accept_estimate`) with measured wheel
         speeds and field, blanking the magnetometer; None: on truth states (:meth:`accept_state`).
         ``friction``: the wheel drives' expected friction torque at relative speeds ν (a callable,
@@ -396,7 +396,7 @@ class Controller:
         ``safe_rate_threshold``, with a Sun to see and an attitude to trust, the safe Sun pointing
         (``safe_sun_axis`` on the Sun, the orbit normal as secondary)."""
         s, c = self.state, self.config
-        sun_ok = self.guidance_sky is not None and self.guidance_sky.sun is not None and \
+        sun_ok = self.guidance_sky is not None and self.guidance_sky.sun_N is not None and \
             (self.measured is None or self.estimate_health in USABLE)
         if not sun_ok or not safe.damped(s.omega, c.safe_rate_threshold):
             out.command.wheel_torques = self._wheels(safe.damping_torque(s.omega, c.safe_kd))

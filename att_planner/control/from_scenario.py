@@ -19,9 +19,9 @@ from att_planner.control.controller import Controller, ControllerConfig
 from att_planner.control.measured_state import MeasuredState
 from att_planner.control.plan_checks import PlanContext
 from att_planner.control.state_gate import GateConfig
-from att_planner.guidance.laws import Sky as GuidanceSky
+from att_planner.guidance.laws import PointingGeometry
 from att_sim.models import world
-from att_sim.models.ephemeris import Sky
+from att_sim.models.ephemeris import Ephemeris
 from att_sim.models.scenario import Scenario
 
 STATE_SOURCES = ("truth", "estimate")
@@ -105,10 +105,10 @@ def controller_from_scenario(param, scenario: Scenario, key=None) -> Controller:
     source = param("state_source", "estimate" if scenario.sensors.gyro else "truth", choices=list(STATE_SOURCES))
     wheels = scenario.actuators.wheels
     compensate = param("friction_compensation", bool(wheels and (wheels.coulomb_friction or wheels.viscous_friction)))
-    sky = None if scenario.epoch is None else Sky(scenario.epoch, scenario.orbit_model)
+    sky = None if scenario.epoch is None else Ephemeris(scenario.epoch, scenario.orbit_model)
     mode = param("initial_mode", int(ControlMode.IDLE),
                  choices=[int(m) for m in ControlMode if m not in (ControlMode.PLAN_TRACKING, ControlMode.POINTING)])
     return Controller(plan_context(param, scenario, key), controller_config(param, scenario), mode,
                       scenario.body_frame_id, gate_config(param), sky, measured_state(source, scenario),
                       wheels.friction if compensate and wheels else None,
-                      GuidanceSky.of(world.Environment.from_scenario(scenario)))
+                      PointingGeometry.of(world.Environment.from_scenario(scenario)))

@@ -16,8 +16,8 @@ import numpy as np
 
 from att_msgs_py.types import Plan
 from att_planner.control import pd
-from att_planner.control.reference import Reference
-from att_planner.guidance import reference as guidance_reference
+from att_planner.guidance import Reference
+from att_planner.guidance import reference as guidance_reference  # the function
 from att_planner.guidance.laws import BlendedLaw
 from att_sim.models import rotations as rot
 from att_sim.models.dynamics import Spacecraft
@@ -29,8 +29,7 @@ HANDOVER_ATTITUDE_MATCH = 1e-3  # rad: ... and this close to its attitude (else:
 def law_reference(law, t: float) -> Reference:
     """The reference of the pointing ``law`` at ``t``: its attitude and the rate and acceleration
     the guidance differentiates from it (:func:`att_planner.guidance.reference`), in the law's axes."""
-    g = guidance_reference(law.attitude, t)
-    return Reference(g.q, g.omega, g.omega_dot)
+    return guidance_reference(law.attitude, t)
 
 
 def _inertia_times(J: np.ndarray, v: np.ndarray) -> np.ndarray:

@@ -23,7 +23,7 @@ import numpy as np
 
 from att_msgs_py.types import Interpolation, Plan
 from att_planner.control import pd
-from att_planner.control.reference import Reference
+from att_planner.guidance import Reference
 from att_sim.models import rotations as rot
 
 

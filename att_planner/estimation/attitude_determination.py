@@ -48,7 +48,7 @@ def triad(b1_B, b2_B, r1_N, r2_N) -> np.ndarray:
         w /= n
         frames.append(np.column_stack([u, w, np.cross(u, w)]))
     body, inertial = frames
-    return rot.normalize(rot.from_dcm(inertial @ body.T))
+    return rot.normalize(rot.from_dcm_NB(inertial @ body.T))
 
 
 def _quest_once(b: np.ndarray, r: np.ndarray, w: np.ndarray) -> tuple[np.ndarray, float]:
@@ -92,7 +92,7 @@ def quest(observed_B, reference_N, weights) -> tuple[np.ndarray, np.ndarray]:
     if np.linalg.cond(information) > 1e12:
         raise ValueError("QUEST needs two observations that are not parallel")
     # references r' = R_k r (R_k symmetric) give A' = A R_k, so R(q) = R_k R(q'): q = q_k ⊗ q'
-    candidates = [(q_k, *_quest_once(b, r @ rot.dcm(q_k), w)) for q_k in REFERENCE_ROTATIONS]
+    candidates = [(q_k, *_quest_once(b, r @ rot.dcm_NB(q_k), w)) for q_k in REFERENCE_ROTATIONS]
     q_k, q_rotated, _ = max(candidates, key=lambda c: c[2])
     return rot.normalize(rot.multiply(q_k, q_rotated)), np.linalg.inv(information)
 

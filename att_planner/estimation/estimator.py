@@ -251,7 +251,7 @@ class Estimator:
         if r.kind == "tracker":
             name, q_SN = r.data
             q_SB = self.trackers[name].mounting
-            dcm_BS = rot.dcm(q_SB)
+            dcm_BS = rot.dcm_NB(q_SB)
             y = mekf.attitude_residual(x.q_BN, rot.multiply(q_SN, rot.conjugate(q_SB)))
             H, R = mekf.attitude_sensitivity(), dcm_BS @ self.trackers[name].covariance @ dcm_BS.T
         elif r.t - self.monitor.last_tracker <= self.config.vector_fallback_after or self.environment is None:
@@ -290,7 +290,7 @@ class Estimator:
         if r.kind == "tracker":
             name, q_SN = r.data
             spec = self.trackers[name]
-            dcm_BS = rot.dcm(spec.mounting)
+            dcm_BS = rot.dcm_NB(spec.mounting)
             q_BN = rot.multiply(q_SN, rot.conjugate(spec.mounting))
             P_att = dcm_BS @ spec.covariance @ dcm_BS.T
         else:

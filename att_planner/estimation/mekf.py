@@ -181,7 +181,7 @@ def attitude_sensitivity() -> np.ndarray:
 def vector_residual(q_BN_estimate: np.ndarray, measured_B: np.ndarray, reference_N: np.ndarray
                     ) -> tuple[np.ndarray, np.ndarray]:
     """Residual and sensitivity (3×6) of a body-axis measurement of the inertial vector ``reference_N``."""
-    predicted_B = rot.dcm(q_BN_estimate).T @ np.asarray(reference_N, float)
+    predicted_B = rot.dcm_BN(q_BN_estimate) @ np.asarray(reference_N, float)
     return np.asarray(measured_B, float) - predicted_B, np.hstack([rot.hat(predicted_B), np.zeros((3, 3))])
 
 

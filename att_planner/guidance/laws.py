@@ -37,13 +37,13 @@ WGS84_E2 = WGS84_F * (2.0 - WGS84_F)      # first eccentricity squared
 PARALLEL = 1e-6                           # |P × S| (unit vectors) below this: no attitude
 
 
-def two_vector_attitude(primary_body, secondary_body, primary, secondary) -> np.ndarray:
-    """The body-to-inertial quaternion putting ``primary_body`` on ``primary`` and
-    ``secondary_body`` as close as possible to ``secondary`` (all unit-normalised here); ValueError
-    when either pair is parallel (within :data:`PARALLEL`): then no rotation about the primary is
-    defined."""
+def two_vector_attitude(primary_B, secondary_B, primary_N, secondary_N) -> np.ndarray:
+    """The attitude ``q_RN`` (body-to-inertial) putting the body axis ``primary_B`` on the inertial
+    direction ``primary_N`` and ``secondary_B`` as close as possible to ``secondary_N`` (all
+    unit-normalised here); ValueError when either pair is parallel (within :data:`PARALLEL`): then no
+    rotation about the primary is defined."""
     frames = []
-    for a, b, what in ((primary_body, secondary_body, "body axes"), (primary, secondary, "directions")):
+    for a, b, what in ((primary_B, secondary_B, "body axes"), (primary_N, secondary_N, "directions")):
         a = np.asarray(a, float) / np.linalg.norm(a)
         b = np.asarray(b, float) / np.linalg.norm(b)
         c = rot.cross(a, b)
@@ -53,7 +53,7 @@ def two_vector_attitude(primary_body, secondary_body, primary, secondary) -> np.
         c /= n
         frames.append(np.column_stack([a, c, rot.cross(a, c)]))
     body, inertial = frames
-    return rot.normalize(rot.from_dcm(inertial @ body.T))
+    return rot.normalize(rot.from_dcm_NB(inertial @ body.T))
 
 
 def earth_turning(t: float) -> np.ndarray:
@@ -72,63 +72,66 @@ def geodetic_to_itrs(latitude: float, longitude: float, altitude: float) -> np.n
 
 
 @dataclass
-class Sky:
-    """What the laws look at: ``state(t) -> (r, v)`` (inertial, m and m/s), ``sun(t)`` (unit, from
-    the spacecraft; None without an epoch) and ``itrs(t)`` (the GCRS→ITRS rotation matrix)."""
+class PointingGeometry:
+    """The geometry the pointing laws look at: ``state_N(t) -> (r_N, v_N)`` (the spacecraft's inertial
+    position and velocity, m and m/s), ``sun_N(t)`` (unit, from the spacecraft, inertial axes; None
+    without an epoch) and ``dcm_EN(t)`` (the GCRS→ITRS rotation matrix: inertial N to Earth-fixed E
+    axes, ``r_E = [EN] r_N``)."""
 
-    state: Callable
-    sun: Callable | None
-    itrs: Callable
+    state_N: Callable
+    sun_N: Callable | None
+    dcm_EN: Callable
 
     @classmethod
-    def of(cls, environment) -> Sky:
-        """The sky of an :class:`att_sim.models.world.Environment` (the onboard models of the scenario);
-        the orbit's states are remembered for the last few times asked (a reference differentiates
+    def of(cls, environment) -> PointingGeometry:
+        """The pointing geometry of an :class:`att_sim.models.world.Environment` (the onboard models of
+        the scenario); the orbit's states are remembered for the last few times asked (a reference differentiates
         its law at three times, each asking for the orbit more than once)."""
         field_model = environment.field
-        itrs = field_model.itrs_rotation if field_model.epoch is not None else earth_turning
-        sun = None if environment.sky is None else environment.sky.sun_direction
-        return cls(_remembered(environment.orbit.state), sun, itrs)
+        dcm_EN = field_model.itrs_rotation if field_model.epoch is not None else earth_turning
+        sun_N = None if environment.sky is None else environment.sky.sun_direction
+        return cls(_remembered(environment.orbit.state), sun_N, dcm_EN)
 
 
 @dataclass
 class TwoVectorLaw:
-    """A pointing law: ``primary_axis`` (body) on ``primary(t)``, ``secondary_axis`` (body) as close as
-    possible to ``secondary(t)``, then ``yaw`` (rad) about the primary axis."""
+    """A pointing law: the body axis ``primary_B`` on the inertial direction ``primary_N(t)``,
+    ``secondary_B`` as close as possible to ``secondary_N(t)``, then ``yaw`` (rad) about the primary
+    axis; :meth:`attitude` is the reference attitude ``q_RN(t)``."""
 
     name: str
-    primary_axis: np.ndarray
-    secondary_axis: np.ndarray
-    primary: Callable
-    secondary: Callable
+    primary_B: np.ndarray
+    secondary_B: np.ndarray
+    primary_N: Callable
+    secondary_N: Callable
     yaw: float = 0.0
-    last: np.ndarray | None = field(default=None, repr=False)
+    last_q_RN: np.ndarray | None = field(default=None, repr=False)
     degenerate: bool = False                   # the last attitude asked for was held, not computed
 
     def attitude(self, t: float) -> np.ndarray:
         try:
-            q = two_vector_attitude(self.primary_axis, self.secondary_axis, self.primary(t), self.secondary(t))
+            q_RN = two_vector_attitude(self.primary_B, self.secondary_B, self.primary_N(t), self.secondary_N(t))
         except ValueError:
-            if self.last is None:
+            if self.last_q_RN is None:
                 raise
             self.degenerate = True
-            return self.last
+            return self.last_q_RN
         if self.yaw:
-            q = rot.multiply(q, rot.from_axis_angle(self.primary_axis, self.yaw))
-        self.degenerate, self.last = False, q
-        return q
+            q_RN = rot.multiply(q_RN, rot.from_axis_angle(self.primary_B, self.yaw))
+        self.degenerate, self.last_q_RN = False, q_RN
+        return q_RN
 
 
 @dataclass
 class FixedAttitude:
-    """Inertial hold."""
+    """Inertial hold of the reference attitude ``q_RN``."""
 
-    q: np.ndarray
+    q_RN: np.ndarray
     name: str = "inertial"
     degenerate: bool = False
 
     def attitude(self, t: float) -> np.ndarray:
-        return self.q
+        return self.q_RN
 
 
 def _remembered(state: Callable, size: int = 8) -> Callable:
@@ -150,40 +153,40 @@ def _unit(v) -> np.ndarray:
     return v / math.sqrt(float(v @ v))
 
 
-def directions(sky: Sky) -> dict[str, Callable]:
+def directions(geometry: PointingGeometry) -> dict[str, Callable]:
     """The named directions of :data:`SECONDARY` as functions of time (unit, inertial)."""
     def nadir(t):
-        return -_unit(sky.state(t)[0])
+        return -_unit(geometry.state_N(t)[0])
 
     def velocity(t):
-        r, v = sky.state(t)
+        r, v = geometry.state_N(t)
         r_hat = _unit(r)
         return _unit(v - (v @ r_hat) * r_hat)
 
     def orbit_normal(t):
-        r, v = sky.state(t)
+        r, v = geometry.state_N(t)
         return _unit(rot.cross(r, v))
 
     out = {"nadir": nadir, "velocity": velocity, "orbit_normal": orbit_normal,
            "north": lambda t: np.array([0.0, 0.0, 1.0])}
-    if sky.sun is not None:
-        out["sun"] = lambda t: _unit(sky.sun(t))
+    if geometry.sun_N is not None:
+        out["sun"] = lambda t: _unit(geometry.sun_N(t))
     return out
 
 
-def ground_line_of_sight(sky: Sky, latitude: float, longitude: float, altitude: float) -> Callable:
+def ground_line_of_sight(geometry: PointingGeometry, latitude: float, longitude: float, altitude: float) -> Callable:
     """The unit line of sight from the spacecraft to a ground point, as a function of time."""
     r_itrs = geodetic_to_itrs(latitude, longitude, altitude)
 
     def sight(t):
-        return _unit(np.asarray(sky.itrs(t)).T @ r_itrs - sky.state(t)[0])
+        return _unit(np.asarray(geometry.dcm_EN(t)).T @ r_itrs - geometry.state_N(t)[0])
     return sight
 
 
 @dataclass
 class BlendedLaw:
     """``law`` entered from rest at ``start`` (s) through a time warp (the smooth planner's plans end
-    at rest: issue 15): over ``duration`` s the reference is ``law(start + w(τ))`` with
+    at rest): over ``duration`` s the reference is ``law(start + w(τ))`` with
     ``w(τ) = τ − τ(1 − τ/T)²``, so it starts on the law's attitude at ``start`` with zero rate, runs
     up to 4/3 of the law's rate, and joins the law exactly (``w(T) = T``, ``w'(T) = 1``) at
     ``start + T``; the law itself after."""

@@ -5,7 +5,8 @@
 finite angles in range (latitude in [−π/2, π/2], longitude and yaw in [−π, π], altitude in
 [−500 m, 100 km]), a unit inertial direction where one is needed, a quaternion within 1e-3 of unit
 norm (or all zero: the current attitude); then builds the law of :mod:`.laws` on the onboard
-``sky`` and checks it has an attitude now (the primary and secondary directions not parallel).
+:class:`.laws.PointingGeometry` and checks it has an attitude now (the primary and secondary
+directions not parallel).
 Every refusal is :class:`~att_msgs_py.errors.RequestError` 314 INVALID_POINTING naming the field.
 """
 from __future__ import annotations
@@ -19,7 +20,7 @@ from att_msgs_py.errors import ErrorCode, RequestError
 from att_msgs_py.types import POINTING_KINDS, SECONDARY_KINDS, PointingMode
 from att_planner.guidance.laws import (
     FixedAttitude,
-    Sky,
+    PointingGeometry,
     TwoVectorLaw,
     directions,
     ground_line_of_sight,
@@ -38,22 +39,23 @@ def _angle(value, name: str, low: float, high: float) -> float:
     return validation.number(value, name, BAD, low, high)
 
 
-def law_of(mode: PointingMode, sky: Sky, t: float, q_now: np.ndarray):
-    """The pointing law of ``mode`` on ``sky``, with an attitude at ``t`` (``q_now``: the current
-    attitude, held by an inertial mode without one); RequestError 314 otherwise."""
+def law_of(mode: PointingMode, geometry: PointingGeometry, t: float, q_BN: np.ndarray):
+    """The pointing law of ``mode`` on ``geometry``, with an attitude at ``t`` (``q_BN``: the current
+    body attitude, held by an inertial mode without one); RequestError 314 otherwise."""
     kind = validation.text(mode.kind, "pointing.kind", BAD)
     if kind not in POINTING_KINDS:
         raise RequestError(BAD, f"pointing.kind '{kind[:40]}' is not one of {', '.join(POINTING_KINDS)}")
     if kind == "inertial":
         q = validation.finite_array(mode.attitude, "pointing.attitude", BAD, (4,))
-        return FixedAttitude(np.array(q_now, float) if not np.any(q) else
+        return FixedAttitude(np.array(q_BN, float) if not np.any(q) else
                              validation.unit_quaternion(q, "pointing.attitude", BAD))
     primary_axis = _axis(mode.primary_axis, "pointing.primary_axis")
     secondary_axis = _axis(mode.secondary_axis, "pointing.secondary_axis")
     yaw = _angle(mode.yaw, "pointing.yaw", -math.pi, math.pi)
-    named = directions(sky)
+    named = directions(geometry)
     if kind == "ground":
-        primary = ground_line_of_sight(sky, _angle(mode.latitude, "pointing.latitude", -math.pi / 2, math.pi / 2),
+        primary = ground_line_of_sight(geometry,
+                                       _angle(mode.latitude, "pointing.latitude", -math.pi / 2, math.pi / 2),
                                        _angle(mode.longitude, "pointing.longitude", -math.pi, math.pi),
                                        _angle(mode.altitude, "pointing.altitude", -500.0, MAX_ALTITUDE))
     elif kind == "inertial_target":

@@ -109,11 +109,11 @@ def _slepian(variant: str, description: str, seeded: bool = False) -> Method:
 # Bounds of the maneuver the collocation methods take as options.
 _RATE_MAX = Option(1e-6, 10.0, limit=True, doc="rad/s per body axis")
 _MOMENTUM_MAX = Option(1e-6, 1e4, limit=True, doc="N m s per wheel")
-# Basis size, DPSS length and half-bandwidth of the Slepian methods (issue 3).
+# Basis size, DPSS length and half-bandwidth of the Slepian methods.
 SLEPIAN_OPTIONS = {"M": Option(2, 12, True, doc="basis size"), "N": Option(50, 2000, True, doc="samples"),
                    "W": Option(1e-4, 0.25, doc="half-bandwidth")}
 
-# The forced boundary arc (issue 19): the index of the request's cone whose boundary the sensor rides
+# The forced boundary arc: the index of the request's cone whose boundary the sensor rides
 # (at most 16 cones per request); a bound of the maneuver, checked against the cones by the service.
 BOUNDARY_CONE = Option(0, 15, True, limit=True, doc="index of the cone whose boundary the sensor rides")
 
@@ -121,11 +121,11 @@ BOUNDARY_CONE = Option(0, 15, True, limit=True, doc="index of the cone whose bou
 REGISTRY = [
     Method("smooth_collocation", "att_planner.methods.time_optimal.smooth", "plan_smooth_collocation",
            "minimum time with a C1 torque (its second derivative bounded; torque and its rate zero at both ends) "
-           "by Hermite-Simpson collocation with IPOPT, started from the first plan (issue 18); zone-aware",
+           "by Hermite-Simpson collocation with IPOPT, started from the first plan; zone-aware",
            {"intervals": Option(4, 200, True), "torque_accel": Option(1.0, 1e4, doc="|d2T/dt2| in T/tu^2"),
             "cone_margin_deg": Option(0.0, 5.0), "rate_max": _RATE_MAX, "wheel_momentum_max": _MOMENTUM_MAX},
            seeded=True),
-    _slepian("slepian_minimum_time", "smooth torque on a Slepian basis, t_f minimised exactly (issue 3); zone-aware",
+    _slepian("slepian_minimum_time", "smooth torque on a Slepian basis, t_f minimised exactly; zone-aware",
              seeded=True),
     Method("time_optimal", "att_planner.methods.time_optimal.planner", "plan_time_optimal",
            "minimum-time bang-bang slew by direct collocation with IPOPT (Melton 2012); zone-aware",

@@ -116,7 +116,7 @@ def _kinematics(problem: ManeuverProblem, legs: list[AxisLeg]):
     for leg in legs:
         if leg.angle <= 1e-12:
             continue
-        e = rot.dcm(q).T @ leg.axis
+        e = rot.dcm_BN(q) @ leg.axis
         alpha = axis_acceleration(sc.inertia, e, leg.angle, sc.body_torque_max)
         yield leg, q, e, alpha, 2.0 * np.sqrt(leg.angle / alpha)
         q = rot.multiply(_axis_rotation(leg.axis, leg.angle), q)
@@ -125,7 +125,7 @@ def _kinematics(problem: ManeuverProblem, legs: list[AxisLeg]):
 def _semi_free_goal(problem: ManeuverProblem) -> np.ndarray:
     """Attitude reached by the shortest rotation taking the sensor onto ``sensor_target``."""
     q0 = rot.normalize(np.asarray(problem.q_initial, float))
-    b0 = rot.dcm(q0) @ problem.sensor_axis
+    b0 = rot.dcm_NB(q0) @ problem.sensor_axis
     b0 = b0 / np.linalg.norm(b0)
     s = np.asarray(problem.sensor_target, float) / np.linalg.norm(problem.sensor_target)
     axis = np.cross(b0, s)

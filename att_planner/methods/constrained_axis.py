@@ -1,5 +1,5 @@
 """The constrained rotation axis: λ-rotations (:mod:`.axis_rotations`) that take the sensor round
-the keep-out zones, moving or not (issue 13).
+the keep-out zones, moving or not.
 
 When the eigenaxis sweeps a sensor through a keep-out zone, that sensor goes around it on the
 shortest path around a spherical cap: a great circle tangent to a circle just outside the zone, a
@@ -9,7 +9,7 @@ an eigenaxis rotation instead of the last two legs). Every leg is a rest-to-rest
 ways around each keep-out zone are tried and the fastest sequence that clears every zone is kept.
 
 Zones that move: every candidate is judged with the margins of each dense sample at its physical
-time (:func:`.axis_rotations.leg_path`, :meth:`att_planner.zones.ZoneSky.margins`), never a
+time (:func:`.axis_rotations.leg_path`, :meth:`att_planner.zones.FittedZones.margins`), never a
 snapshot. The ride is built about the zone as it is at ``t*``, the middle of the ride, on a circle
 widened by how far the zone's axis and half-angle move during the ride; ``t*`` and that widening
 are found by a few fixed-point iterations (:data:`RIDE_ITERATIONS`) of the construction. When a
@@ -37,7 +37,7 @@ from att_planner.methods.axis_rotations import (
 )
 from att_planner.problem import ManeuverProblem
 from att_planner.verification import clearances
-from att_planner.zones import ZoneSky, same_axis
+from att_planner.zones import FittedZones, same_axis
 from att_sim.models import rotations as rot
 
 METHOD = "constrained_axis"
@@ -94,14 +94,14 @@ def cone_riding_legs(problem: ManeuverProblem, zone_index: int, side: int, ride_
     own_sensor = same_axis(sensor, problem.sensor_axis)
     q0 = rot.normalize(np.asarray(problem.q_initial, float))
     q_goal = goal_attitude(problem)
-    b0, bf = rot.dcm(q0) @ r, rot.dcm(q_goal) @ r
+    b0, bf = rot.dcm_NB(q0) @ r, rot.dcm_NB(q_goal) @ r
     rho = theta + ride_margin
     beta0, psi0 = _polar(b0, w, u, v)
     betaf, psif = _polar(bf, w, u, v)
     if min(beta0, betaf) < theta - BOUNDARY_TOLERANCE or rho >= np.pi / 2:
         return None
     # Right spherical triangle (w, tangent point, b): cos A = tan ρ / tan β at the cone axis; an end
-    # inside the riding circle or on it within BOUNDARY_TOLERANCE (issue 19) joins it radially (A = 0).
+    # inside the riding circle or on it within BOUNDARY_TOLERANCE joins it radially (A = 0).
     A0, Af = (0.0 if beta - rho <= BOUNDARY_TOLERANCE else np.arccos(np.clip(np.tan(rho) / np.tan(beta), -1, 1))
               for beta in (beta0, betaf))
     psi1 = psi0 + side * A0
@@ -114,7 +114,7 @@ def cone_riding_legs(problem: ManeuverProblem, zone_index: int, side: int, ride_
         q = rot.multiply(rot.from_axis_angle(leg.axis, leg.angle), q)
     if finish == "eigenaxis":
         return legs + [eigenaxis_leg(q, q_goal, "eigenaxis to goal")]
-    b2 = rot.dcm(q) @ r
+    b2 = rot.dcm_NB(q) @ r
     legs.append(_great_circle_leg(b2, bf, "tangent to target"))
     q = rot.multiply(rot.from_axis_angle(legs[-1].axis, legs[-1].angle), q)
     if problem.sensor_target is None or not own_sensor:
@@ -138,7 +138,7 @@ def _legs_time(problem: ManeuverProblem, legs: list[AxisLeg]) -> tuple[float, fl
     return float(t[-1]), float(m.min()) if m.size else np.inf
 
 
-def _moving_ride(problem: ManeuverProblem, zs: ZoneSky, z: int, side: int, ride_margin: float,
+def _moving_ride(problem: ManeuverProblem, zs: FittedZones, z: int, side: int, ride_margin: float,
                  finish: str) -> tuple[list[AxisLeg] | None, float, float]:
     """``(legs, t*, widening)``: the riding legs about zone ``z`` as it is at the middle ``t*`` of the
     ride, on a circle widened by the zone's motion during the ride (how far its axis turns from
@@ -164,7 +164,7 @@ def _moving_ride(problem: ManeuverProblem, zs: ZoneSky, z: int, side: int, ride_
     return legs, t_star, widen
 
 
-def _detours(problem: ManeuverProblem, zs: ZoneSky) -> list[tuple[str, list[AxisLeg]]]:
+def _detours(problem: ManeuverProblem, zs: FittedZones) -> list[tuple[str, list[AxisLeg]]]:
     """Two-leg routes for a path that a zone overtakes (moving zones): *escape* — a λ-rotation
     taking a keep-out zone's sensor straight away from the zone's axis (as at t = 0) by
     :data:`ESCAPES`, then the eigenaxis to the goal; *tilt* — two eigenaxis legs through the
@@ -174,7 +174,7 @@ def _detours(problem: ManeuverProblem, zs: ZoneSky) -> list[tuple[str, list[Axis
     q_goal = goal_attitude(problem)
     routes = []
     for z in np.flatnonzero(~zs.keep_in):
-        b0 = rot.dcm(q0) @ (zs.sensor_axes[z] / np.linalg.norm(zs.sensor_axes[z]))
+        b0 = rot.dcm_NB(q0) @ (zs.sensor_axes[z] / np.linalg.norm(zs.sensor_axes[z]))
         away = np.cross(zs.true_axes(0.0)[z], b0)
         if np.linalg.norm(away) < 1e-9:
             continue

@@ -1,4 +1,4 @@
-"""The constructive first plan (issue 18): the quickest sequence of rest-to-rest λ-rotations that
+"""The constructive first plan: the quickest sequence of rest-to-rest λ-rotations that
 takes the sensors round every zone, found on a graph of sensor directions and flown with a C¹ torque.
 
 **Graph.** Nodes are directions of ``problem.sensor_axis``: its start and goal directions (the
@@ -19,7 +19,7 @@ whose extremes over [0, φ] are at the ends or at ϑ* = atan2(B, A) (the maximum
 and ϑ* + π (the minimum), in closed form (:func:`arc_cosines`). Every zone of every sensor is
 checked on every leg with :data:`EDGE_MARGIN` (each sensor's direction follows from the attitude
 the leg starts from), but a leg from the start or to the goal only with −BOUNDARY_TOLERANCE from a
-zone that end lies on (issue 19: an end on a boundary). A zone that moves is checked in
+zone that end lies on (an end on a boundary, :mod:`att_planner.cones`). A zone that moves is checked in
 :data:`PIECES` time pieces of the leg, each as the cap about its axis at mid-piece widened by how
 far it can move in half a piece (its largest speed over the window).
 
@@ -123,7 +123,7 @@ class _Zones:
         from the start or to the goal (``ending``) only −BOUNDARY_TOLERANCE from a zone an end lies on."""
         ok = np.ones(len(phi), bool)
         margin = np.where(ending[:, None] & self.ends[None], -BOUNDARY_TOLERANCE, EDGE_MARGIN)    # (E, Z)
-        b = rot.dcm(q) @ self.sensors.T                                   # (3, Z) sensor directions at q
+        b = rot.dcm_NB(q) @ self.sensors.T                                   # (3, Z) sensor directions at q
         fixed = ~self.moving
         if fixed.any():
             low, high = arc_cosines(b.T[fixed][None], n[:, None], phi[:, None], self.axes[fixed])
@@ -181,7 +181,7 @@ def leg_durations(problem: ManeuverProblem, q: np.ndarray, n: np.ndarray, phi: n
     """Durations (s) of legs about the inertial axes ``n`` (E, 3) by ``phi`` (E,) from attitude ``q``
     (module docstring: within T̄ on the knots, and the rate and momentum bounds)."""
     sc = problem.spacecraft
-    e = n @ rot.dcm(q)                                   # body axes: Rᵀ n
+    e = n @ rot.dcm_NB(q)                                   # body axes: Rᵀ n
     Je = e @ sc.inertia.T
     gyro = rot.cross(e, Je)[:, None]
     shape = Je[:, None] * _DDP[None, :, None] + (phi[:, None, None] * _DP[None, :, None] ** 2) * gyro
@@ -234,7 +234,7 @@ def search(problem: ManeuverProblem, zones: _Zones, q0: np.ndarray, q_goal: np.n
     heuristic, the shortest single leg through the angle left to the goal direction
     (T² ≥ φ λ_min max|p''| / (√3 T̄): e × J e ⟂ J e, so |shape| ≥ |J e| |p''|), never overestimates."""
     sensor = np.asarray(problem.sensor_axis, float) / np.linalg.norm(problem.sensor_axis)
-    graph = _Graph(problem, zones, rot.dcm(q0) @ sensor, goal_dir, t_ref)
+    graph = _Graph(problem, zones, rot.dcm_NB(q0) @ sensor, goal_dir, t_ref)
     N = len(graph.dirs)
     end = N if q_goal is not None else 1
     scale = np.linalg.eigvalsh(problem.spacecraft.inertia)[0] * np.abs(_DDP).max()
@@ -281,7 +281,7 @@ def legs_profile(problem: ManeuverProblem, q0: np.ndarray, legs: list):
     ts, taus, qs, ws = [np.zeros(1)], [np.zeros((1, 3))], [q0[None]], [np.zeros((1, 3))]
     q, t0 = q0, 0.0
     for n, phi, T in legs:
-        e = rot.dcm(q).T @ n
+        e = rot.dcm_BN(q) @ n
         Je = J @ e
         rate, accel = phi * _DP / T, phi * _DDP / T**2
         ts.append(t0 + T * _S[1:])
@@ -302,7 +302,7 @@ def plan_graph_smooth(problem: ManeuverProblem) -> Plan:
     sensor = np.asarray(problem.sensor_axis, float) / np.linalg.norm(problem.sensor_axis)
     if problem.sensor_target is None:
         q_goal = rot.normalize(np.asarray(problem.q_final, float))
-        goal_dir = rot.dcm(q_goal) @ sensor
+        goal_dir = rot.dcm_NB(q_goal) @ sensor
     else:
         q_goal, goal_dir = None, np.asarray(problem.sensor_target, float) / np.linalg.norm(problem.sensor_target)
     zones = _Zones(problem)

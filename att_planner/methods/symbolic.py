@@ -12,15 +12,15 @@ def quat_mul(p, q):
     return ca.vertcat(pw * qv + qw * pv + ca.cross(pv, qv), pw * qw - ca.dot(pv, qv))
 
 
-def error_vector(q, q_ref):
-    """Vector part of ``q_ref* ⊗ q``: zero iff q = ±q_ref (unit quaternions); the argument order
-    of :func:`att_sim.models.rotations.error_vector`, without its sign choice."""
-    return q_ref[3] * q[:3] - q[3] * q_ref[:3] - ca.cross(q_ref[:3], q[:3])
+def error_vector(q_BN, q_RN):
+    """Vector part of ``q_BR = q_RN* ⊗ q_BN``: zero iff q_BN = ±q_RN (unit quaternions); the argument
+    order of :func:`att_sim.models.rotations.error_vector`, without its sign choice."""
+    return q_RN[3] * q_BN[:3] - q_BN[3] * q_RN[:3] - ca.cross(q_RN[:3], q_BN[:3])
 
 
-def dcm(q):
-    """Body-to-inertial rotation matrix ``R(q)``."""
-    x, y, z, w = q[0], q[1], q[2], q[3]
+def dcm_NB(q_BN):
+    """``[NB]``, the body-to-inertial matrix of the attitude ``q_BN`` (:func:`att_sim.models.rotations.dcm_NB`)."""
+    x, y, z, w = q_BN[0], q_BN[1], q_BN[2], q_BN[3]
     return ca.vertcat(
         ca.horzcat(1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)),
         ca.horzcat(2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)),

@@ -7,7 +7,7 @@ ground site's line of sight at each time, from the event's pointing mode on the 
 counts as observed when that error stays within the event's tolerance (the mission's
 ``pointing_tolerance``), no zone covers the boresight during the dwell and the log holds all of
 it. The zones' margins (those the events name as the mission's) are taken at every recorded
-state's time with the Sun, Moon and Earth at their true positions (:class:`att_planner.zones.ZoneSky`
+state's time with the Sun, Moon and Earth at their true positions (:class:`att_planner.zones.FittedZones`
 on the scenario's sky); the wheels' peak speed relative to the body against the scenario's limit.
 """
 from __future__ import annotations
@@ -22,13 +22,13 @@ from att_msgs_py import convert
 from att_msgs_py.log import read_log
 from att_msgs_py.topics import MISSION_EVENTS, STATE
 from att_msgs_py.types import MissionEventKind as Kind
-from att_planner.guidance.laws import Sky as GuidanceSky
+from att_planner.guidance.laws import PointingGeometry
 from att_planner.guidance.modes import law_of
-from att_planner.zones import ZoneSky
+from att_planner.zones import FittedZones
 from att_sim.models import rotations as rot
 from att_sim.models import scenario as scen
 from att_sim.models import world
-from att_sim.models.ephemeris import Sky
+from att_sim.models.ephemeris import Ephemeris
 
 
 def events_of(log: dict) -> list:
@@ -48,9 +48,9 @@ def sight_line(event, scenario: scen.Scenario):
     site's from its pointing mode (the controller's law on the scenario's orbit), else the direction."""
     if event.pointing is None:
         return lambda t: np.broadcast_to(rot.normalize(np.asarray(event.direction, float)), (np.size(t), 3))
-    law = law_of(event.pointing, GuidanceSky.of(world.Environment.from_scenario(scenario)), event.start,
+    law = law_of(event.pointing, PointingGeometry.of(world.Environment.from_scenario(scenario)), event.start,
                  np.array([0.0, 0.0, 0.0, 1.0]))
-    return lambda t: np.array([law.primary(float(x)) for x in np.atleast_1d(t)]).reshape(-1, 3)
+    return lambda t: np.array([law.primary_N(float(x)) for x in np.atleast_1d(t)]).reshape(-1, 3)
 
 
 def target_table(events: list, t: np.ndarray, q: np.ndarray, margins: np.ndarray,
@@ -70,7 +70,7 @@ def target_table(events: list, t: np.ndarray, q: np.ndarray, margins: np.ndarray
                          "pointing_error_deg": None, "why": e.message})
             continue
         inside = (t >= e.start) & (t <= e.end)
-        b = np.einsum("kij,j->ki", rot.dcm(q[inside]).reshape(-1, 3, 3), np.asarray(e.sensor_axis, float))
+        b = np.einsum("kij,j->ki", rot.dcm_NB(q[inside]).reshape(-1, 3, 3), np.asarray(e.sensor_axis, float))
         err = np.arccos(np.clip(np.einsum("ki,ki->k", b, sight_line(e, scenario)(t[inside])), -1.0, 1.0))
         covered = bool(inside.any() and margins[inside].min() < 0.0)
         complete = bool(inside.any() and t[inside][-1] >= e.end - step)
@@ -91,7 +91,7 @@ def day_report(mcap_path: str | Path, scenario: scen.Scenario) -> dict:
     state, events = log[STATE], events_of(log)
     zones = mission_zones(events, scenario)
     t, q = np.asarray(state["header.stamp"], float), np.asarray(state["attitude"], float)
-    zone_sky = ZoneSky(zones, Sky(scenario.epoch, scenario.orbit_model),
+    zone_sky = FittedZones(zones, Ephemeris(scenario.epoch, scenario.orbit_model),
                        window=max(1.0, float(t[-1] - t[0])))
     margins = zone_sky.margins(t, q, true=True)
     table = target_table(events, t, q, margins, scenario)

@@ -25,8 +25,7 @@ import numpy as np
 
 from att_msgs_py.types import PointingMode
 from att_planner.guidance import reference
-from att_planner.guidance.laws import Sky as GuidanceSky
-from att_planner.guidance.laws import geodetic_to_itrs
+from att_planner.guidance.laws import PointingGeometry, geodetic_to_itrs
 from att_planner.guidance.modes import law_of
 from att_sim.models import world
 
@@ -52,7 +51,7 @@ class GroundTrack:
     def __init__(self, scenario, site, mode: PointingMode, min_elevation: float, torque_share: float = TORQUE_SHARE):
         self.site, self.mode, self.min_elevation = site, mode, float(min_elevation)
         self.environment = world.Environment.from_scenario(scenario)
-        self.law = law_of(mode, GuidanceSky.of(self.environment), 0.0, np.array([0.0, 0.0, 0.0, 1.0]))
+        self.law = law_of(mode, PointingGeometry.of(self.environment), 0.0, np.array([0.0, 0.0, 0.0, 1.0]))
         self.spacecraft = scenario.spacecraft
         self.torque_limit = torque_share * self.spacecraft.body_torque_max
         self.r_itrs = geodetic_to_itrs(site.latitude, site.longitude, site.altitude)
@@ -72,7 +71,7 @@ class GroundTrack:
 
     def line_of_sight(self, t) -> np.ndarray:
         """The unit line of sight from the spacecraft to the site at each time of ``t``, (K, 3)."""
-        return np.array([self.law.primary(float(x)) for x in np.atleast_1d(t)])
+        return np.array([self.law.primary_N(float(x)) for x in np.atleast_1d(t)])
 
     def torque(self, t) -> np.ndarray:
         """The largest per-axis torque (N m) tracking the site takes at each time of ``t`` (module docstring)."""
@@ -80,8 +79,8 @@ class GroundTrack:
         out = []
         for x in np.atleast_1d(t):
             ref = reference(self.law.attitude, float(x))
-            wheel = J @ ref.omega_dot
-            out.append(max(np.abs(wheel).max(), np.abs(wheel + np.cross(ref.omega, J @ ref.omega)).max()))
+            wheel = J @ ref.omega_dot_RN_R
+            out.append(max(np.abs(wheel).max(), np.abs(wheel + np.cross(ref.omega_RN_R, J @ ref.omega_RN_R)).max()))
         return np.array(out)
 
     def trackable(self, t) -> np.ndarray:

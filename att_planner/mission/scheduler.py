@@ -43,10 +43,10 @@ import numpy as np
 from att_msgs_py.types import Zone
 from att_planner.methods.axis_rotations import axis_acceleration
 from att_planner.methods.schedule.order_search import observed_prefix, orders_by_lower_bound, spans, visibility_grid
-from att_planner.zones import ZoneSky
+from att_planner.zones import FittedZones
 from att_sim.models import rotations as rot
 from att_sim.models import scenario as scen
-from att_sim.models.ephemeris import Sky
+from att_sim.models.ephemeris import Ephemeris
 
 MAX_ORDERS = 5_000            # orders examined per decision (the search is best-first: the good ones come early)
 HOLD_CHECK_STEP = 10.0        # s between the zone checks of an attitude held while waiting
@@ -94,15 +94,15 @@ class Decision:
     left_out: list = ()
 
 
-def tracker_skies(scenario: scen.Scenario, sky: Sky, window: float) -> list[ZoneSky]:
+def tracker_skies(scenario: scen.Scenario, sky: Ephemeris, window: float) -> list[FittedZones]:
     """Each star tracker's exclusions as keep-out zones of its boresight (the sensor frame's +z in
-    the body), one :class:`ZoneSky` per tracker."""
+    the body), one :class:`FittedZones` per tracker."""
     out = []
     for spec in scenario.sensors.star_trackers:
-        axis = rot.dcm(spec.mounting) @ np.array([0.0, 0.0, 1.0])
+        axis = rot.dcm_NB(spec.mounting) @ np.array([0.0, 0.0, 1.0])
         zones = [Zone(f"{spec.name}_{e.body}", e.body, axis, e.half_angle, False, e.direction) for e in spec.exclusions]
         if zones:
-            out.append(ZoneSky(zones, sky, window=window))
+            out.append(FittedZones(zones, sky, window=window))
     return out
 
 
@@ -131,8 +131,8 @@ class MissionScheduler:
         self.scenario, self.horizon, self.targets = scenario, float(horizon), dict(targets)
         self.slew_factor, self.lead, self.rate_max = slew_factor, lead, rate_max
         self.settle, self.blend = settle, blend
-        sky = Sky(scenario.epoch, scenario.orbit_model)
-        self.zones = ZoneSky(list(scenario.zones if zones is None else zones), sky, window=self.horizon)
+        sky = Ephemeris(scenario.epoch, scenario.orbit_model)
+        self.zones = FittedZones(list(scenario.zones if zones is None else zones), sky, window=self.horizon)
         self.trackers = tracker_skies(scenario, sky, self.horizon)
         self.grid = visibility_grid(0.0, self.horizon)
         self.visible = {k: self._site_spans(target, margin) if target.moving else

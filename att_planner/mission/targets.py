@@ -181,7 +181,7 @@ def pointing_attitude(sensor_axis, direction, roll_reference=CELESTIAL_NORTH) ->
     r_inertial = rot.normalize(ref - (ref @ d) * d)
     body = np.column_stack([s, r_body, np.cross(s, r_body)])
     inertial = np.column_stack([d, r_inertial, np.cross(d, r_inertial)])
-    return rot.from_dcm(inertial @ body.T)
+    return rot.from_dcm_NB(inertial @ body.T)
 
 
 def next_axis(sensor_axis) -> np.ndarray:

@@ -1,5 +1,5 @@
-"""The time-optimal slew cases (issue 4): Bilimoria & Wie (1993) and the Swift-like keep-out case
-of Melton (2018), with their published figures; Melton's (2012) boundary cases (issue 19). J = I,
+"""The time-optimal slew cases: Bilimoria & Wie (1993) and the Swift-like keep-out case
+of Melton (2018), with their published figures; Melton's (2012) boundary cases. J = I,
 T̄ = 1: times in TU.
 
 Boundary cases (Melton 2012, §3): the sensor starts on the boundary of a cone of half-angle θ and
@@ -35,16 +35,16 @@ def boundary_problem(case: str, orientation=rot.IDENTITY) -> ManeuverProblem:
     (a quaternion: cone axis ``R z``, sensor ``R r``); BA cases carry the forced arc (``boundary_cone`` 0)."""
     theta_deg, phi_deg, arc = BOUNDARY_CASES[case]
     theta, phi = np.deg2rad(theta_deg), np.deg2rad(phi_deg)
-    R = rot.dcm(np.asarray(orientation, float))
+    R = rot.dcm_NB(np.asarray(orientation, float))
     axis, sensor = R @ np.array([0.0, 0.0, 1.0]), R @ np.array([np.sin(theta), 0.0, np.cos(theta)])
-    target = rot.dcm(rot.from_axis_angle(axis, -phi)) @ sensor
+    target = rot.dcm_NB(rot.from_axis_angle(axis, -phi)) @ sensor
     return ManeuverProblem(Spacecraft(np.eye(3), body_torque_max=1.0), rot.IDENTITY.copy(), rot.IDENTITY.copy(),
                            sensor, [Cone(axis, theta, "cone")], sensor_target=target,
                            boundary_cone=0 if arc else None)
 
 
 def case_problem(case: str) -> ManeuverProblem:
-    """The issue's test cases: J = I, T̄ = 1, rest to rest from identity."""
+    """The published test cases (module docstring): J = I, T̄ = 1, rest to rest from identity."""
     if case in BOUNDARY_CASES:
         return boundary_problem(case)
     sc = Spacecraft(np.eye(3), body_torque_max=1.0)

@@ -1,4 +1,4 @@
-"""Slews that end on a moving target (issue 15): the goal of a maneuver request with ``end_pointing``.
+"""Slews that end on a moving target: the goal of a maneuver request with ``end_pointing``.
 
 The plan must reach, at its final time, the attitude and body rate of the pointing law the
 controller will hand over to (:mod:`att_planner.guidance`): the law of the scenario's own models
@@ -17,7 +17,7 @@ import numpy as np
 
 from att_msgs_py.types import PointingMode
 from att_planner.guidance import reference
-from att_planner.guidance.laws import Sky
+from att_planner.guidance.laws import PointingGeometry
 from att_planner.guidance.modes import law_of
 from att_sim.models import world
 from att_sim.models.scenario import Scenario
@@ -27,10 +27,10 @@ def goal_law(mode: PointingMode, scenario: Scenario, epoch: datetime | None,
              q_start: np.ndarray) -> Callable[[float], tuple[np.ndarray, np.ndarray]]:
     """``t ↦ (q, ω)`` of ``mode``'s law at plan time ``t`` (RequestError 314 for a bad mode)."""
     offset = 0.0 if epoch is None or scenario.epoch is None else (epoch - scenario.epoch).total_seconds()
-    law = law_of(mode, Sky.of(world.Environment.from_scenario(scenario)), offset, q_start)
+    law = law_of(mode, PointingGeometry.of(world.Environment.from_scenario(scenario)), offset, q_start)
 
     def motion(t: float) -> tuple[np.ndarray, np.ndarray]:
         ref = reference(law.attitude, offset + t)
-        return ref.q, ref.omega
+        return ref.q_RN, ref.omega_RN_R
 
     return motion

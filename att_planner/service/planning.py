@@ -1,13 +1,13 @@
 """The planner's service logic without ROS: a first plan, the requested method, verify, fall back.
 
-:func:`plan_maneuver` answers in stages (anytime planning, issue 18): the constructive first plan
+:func:`plan_maneuver` answers in stages (anytime planning): the constructive first plan
 (:data:`FIRST_METHOD`, tens of milliseconds), then the requested method seeded with it as long as
 the budget allows, then, if neither verified, the smooth eigenaxis slew. Each plan is integrated
-through the truth dynamics (:mod:`att_planner.verification`) and accepted only if it meets the
+through the prediction model (:mod:`att_planner.verification`) and accepted only if it meets the
 tolerances; the method's accepted plan is returned, else the first plan (status BUDGET_EXPIRED
 when the budget left the method no time or ran out in it, FALLBACK when the method failed), else
 the eigenaxis slew with status FALLBACK when only it verifies; otherwise the answer is an error. No unverified
-plan ever leaves, and the outcome reports every stage and its time. Zones (issue 13) travel in the
+plan ever leaves, and the outcome reports every stage and its time. Zones travel in the
 problem: the method plans against their motion (:meth:`ManeuverProblem.zone_sky`), padded like the
 cones (:func:`padded`), and every plan, the fallback's too, is verified against the unpadded zones
 at their true positions. :func:`plan_schedule_request` does the same for a schedule (no fallback

@@ -6,7 +6,7 @@
   (INVALID_EPOCH). Without one anywhere the request may only have inertial zones.
 * **Orbit**: the request's TLE (both lines; :class:`att_sim.models.orbit.TLEOrbit` at the request's
   epoch, checked column by column and by its checksum: INVALID_ORBIT), or when both lines are
-  empty the scenario's orbit (:class:`att_sim.models.ephemeris.Sky` maps its time zero onto the epoch).
+  empty the scenario's orbit (:class:`att_sim.models.ephemeris.Ephemeris` maps its time zero onto the epoch).
   It must stay above :data:`MIN_ALTITUDE` over the whole zone window (ORBIT_TOO_LOW; an SGP4
   failure, i.e. a decayed TLE, too).
 * **Zones**: at most :data:`MAX_ZONES`, each checked field by field
@@ -23,7 +23,7 @@ from att_msgs_py.errors import ErrorCode, RequestError
 from att_msgs_py.types import Zone
 from att_sim.models import epoch as epochs
 from att_sim.models import orbit as orbits
-from att_sim.models.ephemeris import Sky
+from att_sim.models.ephemeris import Ephemeris
 from att_sim.models.scenario import Scenario
 
 MAX_ZONES = 16                 # zones of one request (besides its cones): each is a constraint at every sample
@@ -32,14 +32,14 @@ MIN_ALTITUDE = 150e3           # m (att_sim.models.orbit.check_altitude's defaul
 
 
 @dataclass(frozen=True)
-class RequestSky:
-    """What a request's real sky adds to its problem: the epoch of t = 0 (None: none), the
-    checked zones, and the sky seen from the spacecraft (None unless an orbit is given or a zone
-    moves; ``moving``: a zone moves, the problem gets the sky)."""
+class RequestGeometry:
+    """What a request's epoch, orbit and zones add to its problem: the epoch of t = 0 (None: none),
+    the checked zones, and the ephemeris seen from the spacecraft (None unless an orbit is given or a
+    zone moves; ``moving``: a zone moves, the problem gets the ephemeris)."""
 
     epoch: datetime | None
     zones: list[Zone]
-    sky: Sky | None
+    sky: Ephemeris | None
     moving: bool
 
 
@@ -91,7 +91,7 @@ def resolve_orbit(tle: tuple[str, str] | None, epoch: datetime, scenario: Scenar
         raise RequestError(ErrorCode.INVALID_ORBIT, f"tle_line1/tle_line2: {err}") from None
 
 
-def check_orbit_window(sky: Sky, window: float) -> None:
+def check_orbit_window(sky: Ephemeris, window: float) -> None:
     """The spacecraft stays above :data:`MIN_ALTITUDE` from the epoch to ``window`` s after it."""
     t0 = sky.orbit_offset
     try:
@@ -102,7 +102,7 @@ def check_orbit_window(sky: Sky, window: float) -> None:
 
 
 def resolve_sky(sec: int, nanosec: int, raw_zones: list, tle_line1: str, tle_line2: str,
-                scenario: Scenario) -> RequestSky:
+                scenario: Scenario) -> RequestGeometry:
     """Check the real-sky fields of a request against ``scenario`` (module docstring; the orbit's
     altitude over the window is :func:`check_orbit_window`'s, once the window is known)."""
     zones = check_zones(list(raw_zones))
@@ -113,5 +113,5 @@ def resolve_sky(sec: int, nanosec: int, raw_zones: list, tle_line1: str, tle_lin
         needs = f"zone '{moving.name}' (body {moving.body}) moves with the sky" if moving else "a TLE is given"
         raise RequestError(ErrorCode.INVALID_EPOCH, f"epoch is zero and scenario '{scenario.name}' has none, but "
                                                     f"{needs}: give the maneuver's start epoch")
-    sky = None if moving is None and tle is None else Sky(epoch, resolve_orbit(tle, epoch, scenario))
-    return RequestSky(epoch, zones, sky, moving is not None)
+    sky = None if moving is None and tle is None else Ephemeris(epoch, resolve_orbit(tle, epoch, scenario))
+    return RequestGeometry(epoch, zones, sky, moving is not None)

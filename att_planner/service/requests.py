@@ -9,9 +9,9 @@ checked by the registry (:mod:`att_planner.methods`). Field checks are the share
 string is free of control characters (INVALID_TEXT) and at most ``MAX_NAME_LENGTH`` characters
 (SIZE_LIMIT). Cones and zones that close the sky between the start and goal sensor directions are
 refused as INFEASIBLE before any solving (:mod:`att_planner.service.sky`). The real sky (epoch,
-orbit, zones: issue 13) is checked by :mod:`att_planner.service.real_sky`, then the zones against
+orbit, zones) is checked by :mod:`att_planner.service.real_sky`, then the zones against
 each other and the ends (:func:`att_planner.cones.check_zones`: CONTRADICTORY_ZONES, ZONE_AT_END).
-A request without epoch, TLE and zones is checked and planned exactly as before.
+A request without epoch, TLE and zones is checked and planned against its inertial cones alone.
 """
 from __future__ import annotations
 
@@ -29,7 +29,7 @@ from att_planner.cones import BOUNDARY_TOLERANCE, boundary_arc_issue, check_zone
 from att_planner.methods import Method
 from att_planner.problem import ManeuverProblem, MovingGoal
 from att_planner.service.moving_goal import goal_law
-from att_planner.service.real_sky import RequestSky, check_orbit_window, resolve_sky
+from att_planner.service.real_sky import RequestGeometry, check_orbit_window, resolve_sky
 from att_planner.service.sky import closed_sky
 from att_sim.models import rotations as rot
 from att_sim.models import scenario as scen
@@ -150,7 +150,7 @@ def zone_window(problem: ManeuverProblem, legs: int = 1) -> float:
     return problem.default_window() * legs + sum(problem.target_dwell.values()) + max(closes, default=0.0)
 
 
-def check_sky(problem: ManeuverProblem, real: RequestSky, legs: int = 1) -> None:
+def check_sky(problem: ManeuverProblem, real: RequestGeometry, legs: int = 1) -> None:
     """The orbit lasts the window (ORBIT_TOO_LOW), then the zones' own checks
     (:func:`att_planner.cones.check_zones`)."""
     if real.sky is not None:

@@ -13,12 +13,12 @@ lattice point within ``h``, and the nearest lattice points of two nearby path po
 start and goal in different pieces of this slightly fattened sky. Cones that do not overlap
 cannot close anything (the complement of disjoint caps is connected) and cost nothing.
 
-Zones (issue 13) are tested sensor by sensor (the zones sharing one sensor axis; a keep-in zone
+Zones are tested sensor by sensor (the zones sharing one sensor axis; a keep-in zone
 is free inside its cap). A moving zone is replaced by a fixed cap about its axis at t = 0 holding
 every direction that is free at some time of the zone window (:func:`relaxed_caps`: keep-out
 caps shrunk, keep-in caps grown by the zone's motion), so a path that is free at each of its own
 times lies in the relaxed sky and the test still never refuses a feasible request whose maneuver
-fits in the window. Fixed zones (and today's cones) are their caps at t = 0 exactly.
+fits in the window. Fixed zones (and the keep-out cones) are their caps at t = 0 exactly.
 """
 from __future__ import annotations
 
@@ -32,7 +32,7 @@ from scipy.sparse.csgraph import connected_components
 from scipy.spatial import ConvexHull, cKDTree
 
 from att_planner.cones import boresight
-from att_planner.zones import ZoneSky
+from att_planner.zones import FittedZones
 
 LATTICE_POINTS = 20_000
 SLACK = 1.1            # free: margin > -SLACK h (h: the lattice's covering radius)
@@ -79,7 +79,7 @@ class Cap:
     keep_in: bool
 
 
-def relaxed_caps(zone_sky: ZoneSky, zones: np.ndarray) -> list[Cap]:
+def relaxed_caps(zone_sky: FittedZones, zones: np.ndarray) -> list[Cap]:
     """Zones ``zones`` (indices) of ``zone_sky`` as fixed caps about their axes at t = 0 that contain
     every direction free at some time of the window: a moving keep-out zone shrunk by how far its
     axis strays from a(0) (and its half-angle drops), a keep-in zone grown likewise; ``δ``, the
@@ -140,7 +140,7 @@ def separated(caps: list[Cap], start: np.ndarray, goal: np.ndarray) -> bool:
     return not (pieces[0] & pieces[1])
 
 
-def closed_sky(zone_sky: ZoneSky, q_initial, q_final, sensor_axis, sensor_target=None) -> np.ndarray | None:
+def closed_sky(zone_sky: FittedZones, q_initial, q_final, sensor_axis, sensor_target=None) -> np.ndarray | None:
     """The sensor axis whose zones certainly separate its start direction from its goal direction
     (for ``sensor_axis`` with a semi-free goal: from ``sensor_target``), or None when a path may
     exist for every sensor. Zones are taken as :func:`relaxed_caps` over the window; with a

@@ -1,4 +1,4 @@
-"""Warm planner workers (issue 18): the NLPs of the shapes a planner serves, built before it serves.
+"""Warm planner workers: the NLPs of the shapes a planner serves, built before it serves.
 
 A collocation method builds its NLP once per problem shape (spacecraft inertia, interval count,
 zones and their kind, goal; :func:`att_planner.methods.time_optimal.model.transcription`) and keeps

@@ -1,4 +1,4 @@
-"""Plans that respect the wheels (issue 15): a plan whose wheels would pass their speed limit is
+"""Plans that respect the wheels: a plan whose wheels would pass their speed limit is
 slowed in time, or refused.
 
 The wheels that fly a body-torque plan hold the momentum the body gives up
@@ -20,7 +20,7 @@ import numpy as np
 
 from att_msgs_py.types import ControlKind, Plan
 from att_planner.problem import ManeuverProblem
-from att_planner.verification import body_plan_wheel_speeds, integrate
+from att_planner.verification import body_plan_wheel_speeds, predict
 
 MAX_SLOWDOWN = 20.0         # a plan is slowed at most this many times
 LIMIT_MARGIN = 1e-3         # the slowed plan aims this fraction inside the limit (the dense grid moves)
@@ -52,7 +52,7 @@ def slow_for_wheels(problem: ManeuverProblem, plan: Plan) -> tuple[Plan | None, 
         return None, "a wheel-torque plan is not slowed (its wheels' gyroscopic torque does not scale)"
     if problem.goal_motion is not None:
         return None, "a plan that ends on a moving goal is not slowed (it would miss the goal)"
-    traj = integrate(problem, plan)
+    traj = predict(problem, plan)
     stored, slew = body_plan_wheel_speeds(problem, traj.q, traj.omega)
     c = smallest_slowdown(stored, slew, sc.wheel_speed_max * (1.0 - LIMIT_MARGIN))
     if not math.isfinite(c):

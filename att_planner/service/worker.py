@@ -20,7 +20,7 @@ more (a solve then takes a fraction of that), so:
 A worker that dies is replaced. At most ``max_parallel`` solve at once (the rest wait, within their
 own budget).
 
-A problem with a sky (issue 13) crosses to the child as it is: :class:`att_sim.models.ephemeris.Sky` and
+A problem with a sky crosses to the child as it is: :class:`att_sim.models.ephemeris.Ephemeris` and
 :class:`att_sim.models.orbit.TLEOrbit` pickle as their recipes (epoch and orbit, epoch and lines), since
 skyfield's and SGP4's objects do not; the child rebuilds their tables as it needs them.
 """

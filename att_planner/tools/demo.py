@@ -40,10 +40,10 @@ from att_planner.nodes.client import client_session, maneuver_request
 from att_planner.service.warm import maneuver_from_scenario
 from att_planner.tools.launch import isolated_env, join_env, start_suite
 from att_planner.tools.review import review
-from att_planner.zones import ZoneSky, zones_from_cones
+from att_planner.zones import FittedZones, zones_from_cones
 from att_sim.models import rotations as rot
 from att_sim.models import scenario as scen
-from att_sim.models.ephemeris import Sky
+from att_sim.models.ephemeris import Ephemeris
 
 
 def zone_margins(scenario: scen.Scenario, maneuver: dict, t: np.ndarray, q: np.ndarray) -> tuple[list, np.ndarray]:
@@ -52,8 +52,8 @@ def zone_margins(scenario: scen.Scenario, maneuver: dict, t: np.ndarray, q: np.n
     zones = zones_from_cones(maneuver["cones"], maneuver["sensor"]) + maneuver["zones"]
     if not zones:
         return [], np.zeros((len(t), 0))
-    sky = Sky(scenario.epoch, scenario.orbit_model) if scenario.epoch is not None else None
-    zone_sky = ZoneSky(zones, sky if any(z.body != "inertial" for z in zones) else None, window=1.0)
+    sky = Ephemeris(scenario.epoch, scenario.orbit_model) if scenario.epoch is not None else None
+    zone_sky = FittedZones(zones, sky if any(z.body != "inertial" for z in zones) else None, window=1.0)
     return [z.name for z in zones], zone_sky.margins(t, q, true=True)
 
 

@@ -1,6 +1,6 @@
 """Robust magnetorquer PD gains (Bruni & Celani): batch settling-time simulation and min-max search.
 
-The problem (issue 6): choose the gains ``(κ_p, κ_d)`` of the law of
+The problem: choose the gains ``(κ_p, κ_d)`` of the law of
 :mod:`att_planner.control.magnetorquer` to minimise the settling time ``t_s`` (orbits) of the
 attitude ``|q_i| ≤ ν`` under the worst initial condition of the set ``H`` (attitude ``(ρ, φ, θ)``,
 rates ``|ω_i| ≤ 0.1 rad/s``, orbit argument ``ψ``)::

@@ -20,7 +20,7 @@ from att_sim.models import environment as env
 
 @dataclass(frozen=True)
 class MagnetorquerCase:
-    """Spacecraft, orbit and settling threshold of the study (defaults: the issue's case)."""
+    """Spacecraft, orbit and settling threshold of the study (defaults: Bruni & Celani's case)."""
 
     inertia: tuple = (27.0, 17.0, 25.0)           # kg m², principal (diagonal) inertia
     m_max: float = 10.0                           # A m² per coil (m*)
@@ -187,7 +187,7 @@ def _step(model: _BatchModel, t: float, x: np.ndarray, dt: float, work: tuple) -
 
 def propagate(case: MagnetorquerCase, kp, kd, h, t_end: float, dt: float) -> np.ndarray:
     """States ``(N, 7)`` ``[q, ω]`` at ``t_end`` of the batch closed loop (same step as the
-    settling simulator); used to check it against the truth dynamics."""
+    settling simulator); used to check it against :mod:`att_sim.models.dynamics`."""
     h = np.atleast_2d(np.asarray(h, float))
     q0, w0, psi = initial_states(h)
     n = h.shape[0]

@@ -20,7 +20,7 @@ body axes; the torque of a force ``F`` on it is ``c × F``. Facets do not shadow
 * residual dipole ``τ = m × B``; gravity gradient ``τ = (3μ/|r|⁵) r_b × (J r_b)``, ``r_b = C(q) r``.
 
 Frames: ``q`` is body-to-inertial (:mod:`att_sim.models.rotations`); inertial vectors go to the body by
-``C(q) = dcm(q).T``. Every function broadcasts over stacks of ``q`` and the vectors.
+``C(q) = dcm_BN(q)``. Every function broadcasts over stacks of ``q`` and the vectors.
 """
 from __future__ import annotations
 
@@ -120,10 +120,10 @@ def facets_from_params(params, field: str = "environment.facets") -> list[Facet]
     return out
 
 
-def _body(q, v_N) -> tuple:
-    """``C(q) v`` as three components: floats for one attitude and one vector (the simulator's
-    per-stage path), arrays for stacks. Same matrix as :func:`att_sim.models.rotations.dcm`, transposed."""
-    q, v = np.asarray(q, float), np.asarray(v_N, float)
+def _body(q_BN, v_N) -> tuple:
+    """``v_B = [BN] v_N`` as three components: floats for one attitude and one vector (the
+    simulator's per-stage path), arrays for stacks (:func:`att_sim.models.rotations.dcm_BN`)."""
+    q, v = np.asarray(q_BN, float), np.asarray(v_N, float)
     if q.shape != (4,) or v.shape != (3,):
         b = to_body(q, v)
         return b[..., 0], b[..., 1], b[..., 2]
@@ -151,7 +151,7 @@ def _all(condition) -> bool:
     return condition if isinstance(condition, bool) else bool(np.all(condition))
 
 
-def srp_torque(facets, q, sun_direction_N, sun_distance_m, shadow) -> np.ndarray:
+def srp_torque(facets, q_BN, sun_direction_N, sun_distance_m, shadow) -> np.ndarray:
     """Solar-radiation-pressure torque (N m, body): flat facets, ``sun_direction_N`` from the
     spacecraft to the Sun (normalised here), ``sun_distance_m`` (m), ``shadow`` in [0, 1]."""
     d, nu = _plain(sun_distance_m), _plain(shadow)
@@ -159,7 +159,7 @@ def srp_torque(facets, q, sun_direction_N, sun_distance_m, shadow) -> np.ndarray
         raise ValueError(f"sun_distance_m must be > 0 m, got {sun_distance_m}")
     if not _all((nu >= 0.0) & (nu <= 1.0)):
         raise ValueError(f"shadow must be a visible fraction of the solar disc in [0, 1], got {shadow}")
-    sx, sy, sz = _body(q, sun_direction_N)
+    sx, sy, sz = _body(q_BN, sun_direction_N)
     norm = (sx * sx + sy * sy + sz * sz) ** 0.5
     if not _all((norm > 0.0) & (norm < math.inf)):
         raise ValueError("sun_direction_N must be a nonzero vector")
@@ -177,7 +177,7 @@ def srp_torque(facets, q, sun_direction_N, sun_distance_m, shadow) -> np.ndarray
     return _vector_out(tx, ty, tz, sx * p)
 
 
-def drag_torque(facets, q, v_rel_N, density, cd: float = DRAG_COEFFICIENT) -> np.ndarray:
+def drag_torque(facets, q_BN, v_rel_N, density, cd: float = DRAG_COEFFICIENT) -> np.ndarray:
     """Aerodynamic torque (N m, body): flat facets facing the flow, velocity ``v_rel_N`` (m/s,
     inertial axes) relative to the atmosphere, air ``density`` (kg/m³)."""
     rho_air = _plain(density)
@@ -185,7 +185,7 @@ def drag_torque(facets, q, v_rel_N, density, cd: float = DRAG_COEFFICIENT) -> np
         raise ValueError(f"density must be at least 0 kg/m³, got {density}")
     if not (math.isfinite(cd) and cd > 0.0):
         raise ValueError(f"cd must be a finite drag coefficient > 0, got {cd}")
-    vx, vy, vz = _body(q, v_rel_N)
+    vx, vy, vz = _body(q_BN, v_rel_N)
     if not _all(abs(vx) + abs(vy) + abs(vz) < math.inf):          # NaN fails too
         raise ValueError("v_rel_N must be finite")
     k_air = -0.5 * cd * rho_air                     # F = −½ρC_d A (n̂·v̂)|v|² v̂ = −½ρC_d A (n̂·v) v
@@ -214,9 +214,9 @@ def residual_dipole_torque(m_B, B_B) -> np.ndarray:
     return rot.cross(np.asarray(m_B, float), np.asarray(B_B, float))
 
 
-def gravity_gradient_torque(r_N, q, inertia) -> np.ndarray:
-    """``(3μ/|r|⁵) r_b × (J r_b)``, ``r_b = C(q) r_N`` (N m, body), at any position ``r_N`` (m)."""
-    x, y, z = _body(q, r_N)
+def gravity_gradient_torque(r_N, q_BN, inertia) -> np.ndarray:
+    """``(3μ/|r|⁵) r_b × (J r_b)``, ``r_b = C(q_BN) r_N`` (N m, body), at any position ``r_N`` (m)."""
+    x, y, z = _body(q_BN, r_N)
     (j00, j01, j02), (j10, j11, j12), (j20, j21, j22) = np.asarray(inertia, float).tolist()
     jx, jy, jz = j00 * x + j01 * y + j02 * z, j10 * x + j11 * y + j12 * z, j20 * x + j21 * y + j22 * z
     k = 3.0 * EARTH_MU / (x * x + y * y + z * z) ** 2.5

@@ -279,7 +279,7 @@ def step(sc: Spacecraft, x: np.ndarray, inputs: Inputs, dt: float,
 
 def angular_momentum_inertial(sc: Spacecraft, x: np.ndarray) -> np.ndarray:
     h_b = sc.inertia @ x[4:7] + sc.wheel_axes @ (sc.wheel_inertia * x[7:])
-    return rot.dcm(x[:4]) @ h_b
+    return rot.dcm_NB(x[:4]) @ h_b
 
 
 def kinetic_energy(sc: Spacecraft, x: np.ndarray) -> float:

@@ -1,6 +1,6 @@
 """Orbit and geomagnetic environment: circular orbit, tilted-dipole field, gravity gradient.
 
-Model of Bruni & Celani (the magnetorquer PD-gain study, issue 6), in the inertial (ECI) frame:
+Model of Bruni & Celani (the magnetorquer PD-gain study), in the inertial (ECI) frame:
 
 * circular orbit of radius ``R = R_E + altitude``, mean motion ``n = sqrt(μ / R³)``; the position in
   the orbital plane ``R [cos(n t + ψ), sin(n t + ψ), 0]`` is rotated by the inclination ``i``
@@ -16,7 +16,7 @@ Model of Bruni & Celani (the magnetorquer PD-gain study, issue 6), in the inerti
 
 All functions broadcast: ``t`` and ``arg0`` (ψ) may be arrays, so many cases are evaluated at once.
 Vectors come back with a trailing axis of 3. Body-frame helpers use the suite's convention
-(:mod:`att_sim.models.rotations`): the inertial-to-body matrix ``C(q)`` of the paper is ``dcm(q).T``.
+(:mod:`att_sim.models.rotations`): the inertial-to-body matrix ``C(q)`` of the paper is ``dcm_BN(q)``.
 """
 from __future__ import annotations
 
@@ -65,7 +65,7 @@ class OrbitParams:
 
 @dataclass(frozen=True)
 class DipoleModel:
-    """Tilted-dipole geomagnetic field constants (defaults: the issue's values)."""
+    """Tilted-dipole geomagnetic field constants (defaults: Bruni & Celani's values)."""
 
     strength: float = DIPOLE_STRENGTH
     coelevation: float = DIPOLE_COELEVATION
@@ -133,19 +133,19 @@ def field_inertial(orbit: OrbitParams, t, arg0=None, dipole: DipoleModel = DEFAU
     return np.stack(np.broadcast_arrays(*dipole_field_components(orbit, r_hat, m_hat, dipole)), -1)
 
 
-def to_body(q, v_inertial) -> np.ndarray:
-    """``C(q) v = dcm(q).T v``: an inertial vector in body axes (stacks broadcast)."""
-    return np.einsum("...ji,...j->...i", rot.dcm(q), np.asarray(v_inertial, float))
+def to_body(q_BN, v_N) -> np.ndarray:
+    """``v_B = C(q) v_N = [BN] v_N``: an inertial vector in body axes (stacks broadcast)."""
+    return np.einsum("...ji,...j->...i", rot.dcm_NB(q_BN), np.asarray(v_N, float))
 
 
-def field_body(orbit: OrbitParams, t, q, arg0=None, dipole: DipoleModel = DEFAULT_DIPOLE) -> np.ndarray:
-    """``B_b = C(q) B_i(t)`` (T)."""
-    return to_body(q, field_inertial(orbit, t, arg0, dipole))
+def field_body(orbit: OrbitParams, t, q_BN, arg0=None, dipole: DipoleModel = DEFAULT_DIPOLE) -> np.ndarray:
+    """``B_b = C(q_BN) B_i(t)`` (T)."""
+    return to_body(q_BN, field_inertial(orbit, t, arg0, dipole))
 
 
-def gravity_gradient_torque(orbit: OrbitParams, t, q, inertia, arg0=None) -> np.ndarray:
+def gravity_gradient_torque(orbit: OrbitParams, t, q_BN, inertia, arg0=None) -> np.ndarray:
     """Gravity-gradient torque in body axes (N m): ``(3μ/R³) r̂_b × (J r̂_b)``."""
     r = position(orbit, t, arg0)
-    r_b = to_body(q, r / orbit.radius)
+    r_b = to_body(q_BN, r / orbit.radius)
     j_r = np.einsum("ij,...j->...i", np.asarray(inertia, float), r_b)
     return 3.0 * EARTH_MU / orbit.radius**3 * np.cross(r_b, j_r)

@@ -1,4 +1,4 @@
-"""The sky seen from the spacecraft (issue 13): Sun, Moon, Earth and the Earth's shadow.
+"""The sky seen from the spacecraft: Sun, Moon, Earth and the Earth's shadow.
 
 * Sun and Moon: geometric geocentric positions from JPL DE421 (Folkner, Williams & Boggs, IPN Progress
   Report 42-178, 2009) through skyfield, opened offline from the ``de421.bsp`` packaged by
@@ -32,7 +32,7 @@ SUN_RADIUS = 696.0e6        # m (Montenbruck & Gill 2000 §3.4.2)
 BODY_STEP = 600.0           # s, node spacing of the Sun/Moon tables
 BODY_CHUNK = 144            # intervals per chunk (1 day)
 
-__all__ = ["EARTH_RADIUS", "SUN_RADIUS", "Sky", "de421", "shadow_function"]
+__all__ = ["EARTH_RADIUS", "SUN_RADIUS", "Ephemeris", "de421", "shadow_function"]
 
 
 @lru_cache(maxsize=1)
@@ -83,8 +83,9 @@ def _shadow_scalar(rx, ry, rz, sx, sy, sz) -> float:
     return min(1.0, max(0.0, 1.0 - area / (math.pi * a * a)))
 
 
-class Sky:
-    """Sun, Moon and Earth seen from the spacecraft of ``orbit``, ``t`` in SI seconds past ``epoch``.
+class Ephemeris:
+    """The ephemeris seen from a spacecraft: the Sun, the Moon and the Earth from the spacecraft of
+    ``orbit``, ``t`` in SI seconds past ``epoch``.
 
     The orbit's own time zero (its ``epoch``) may differ from ``epoch``; an epoch-free orbit
     (:class:`att_sim.models.orbit.CircularOrbit`) is taken to start at ``epoch``.
@@ -107,7 +108,7 @@ class Sky:
 
     def __reduce__(self):
         """Pickles as its recipe (the DE421 handle does not pickle); tables are rebuilt."""
-        return (Sky, (self.epoch, self.orbit))
+        return (Ephemeris, (self.epoch, self.orbit))
 
     def sun_vector(self, t) -> np.ndarray:
         """Vector from the spacecraft to the Sun (m): ``sun(t) − position(t)``."""

@@ -1,4 +1,4 @@
-"""Epoch and time scales of the real sky (issue 13).
+"""Epoch and time scales of the real sky.
 
 An epoch is a timezone-aware :class:`datetime` in UTC; sim time ``t`` is SI seconds past it. Text is
 ISO 8601 (``datetime.fromisoformat``, Python ≥ 3.11: ``Z`` or a ``±HH:MM`` offset; naive text is

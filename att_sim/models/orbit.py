@@ -1,4 +1,4 @@
-"""Orbits of the real sky (issue 13): circular (Bruni–Celani), Kepler with J2 secular rates, TLE/SGP4.
+"""Orbits of the real sky: circular (Bruni–Celani), Kepler with J2 secular rates, TLE/SGP4.
 
 Every orbit gives ``state(t) -> (r, v)`` (m, m/s) in GCRS (Earth-centred, ICRF axes), ``t`` in SI
 seconds past its ``epoch`` (sim time zero), scalar or array (leading shape kept, trailing 3).
@@ -68,7 +68,7 @@ class Orbit:
 
 
 class CircularOrbit(Orbit):
-    """Today's circular orbit (:class:`att_sim.models.environment.OrbitParams`); no epoch needed."""
+    """The circular orbit of Bruni & Celani (:class:`att_sim.models.environment.OrbitParams`); no epoch needed."""
 
     def __init__(self, params: env.OrbitParams):
         self.params = params
@@ -402,8 +402,8 @@ def _number(mapping: dict, key: str) -> float:
 
 
 def orbit_from_mapping(mapping: dict, epoch=None) -> Orbit:
-    """The scenario's ``orbit`` group as an :class:`Orbit` (``type`` absent: circular, today's keys and
-    defaults); ``epoch`` (sim time zero) is required for kepler and tle."""
+    """The scenario's ``orbit`` group as an :class:`Orbit` (``type`` absent: circular, with the
+    circular orbit's keys and defaults); ``epoch`` (sim time zero) is required for kepler and tle."""
     if not isinstance(mapping, dict):
         raise ValueError(f"orbit must be a mapping, got {type(mapping).__name__}")
     kind = mapping.get("type", "circular")

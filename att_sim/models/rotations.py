@@ -4,12 +4,15 @@ Convention (used everywhere, messages included):
 
 * A quaternion is a numpy array ``[x, y, z, w]`` (geometry_msgs order, scalar last),
   Hamilton product, unit norm.
-* It describes the attitude of the **body frame with respect to the inertial frame**
-  (body-to-inertial): ``v_inertial = dcm(q) @ v_body``. The attitude matrix of
-  Bruni & Celani / Wertz, ``C(q)`` (inertial-to-body), is ``dcm(q).T``.
-* Kinematics: ``q_dot = 0.5 * q ⊗ [omega, 0]`` with ``omega`` the body rate in body axes;
-  equivalently ``R_dot = R hat(omega)``. This equals the Olivares–Staffetti form
-  ``q_dot = 0.5 Q(omega) q`` and the Bruni–Celani form ``q_v_dot = 0.5 (q_v × ω + q4 ω)``.
+* ``q_BN`` is the attitude of the **body frame B with respect to the inertial frame N**
+  (Basilisk's naming: ``q_RN`` a reference frame R, ``omega_BN_B`` the rate of B relative to N in
+  B axes). Its matrices: ``dcm_NB(q_BN)`` takes body to inertial axes, ``v_N = [NB] v_B``;
+  ``dcm_BN(q_BN) = dcm_NB(q_BN)ᵀ`` takes inertial to body axes, ``v_B = [BN] v_N``: the ``[BN]`` of
+  Schaub & Junkins, *Analytical Mechanics of Space Systems* (2018) §3.2, and the attitude matrix
+  ``C(q)`` of Bruni & Celani and of Wertz (1978).
+* Kinematics: ``q̇_BN = ½ q_BN ⊗ [omega_BN_B, 0]``; equivalently ``[NB]˙ = [NB] hat(omega_BN_B)``.
+  This equals the Olivares–Staffetti form ``q_dot = 0.5 Q(omega) q`` and the Bruni–Celani form
+  ``q_v_dot = 0.5 (q_v × ω + q4 ω)``.
 * ``q`` and ``-q`` are the same attitude; errors are computed sign-independently.
 
 All functions accept a single quaternion ``(4,)`` or a stack ``(..., 4)``.
@@ -91,9 +94,10 @@ def conjugate(q: np.ndarray) -> np.ndarray:
     return q
 
 
-def dcm(q: np.ndarray) -> np.ndarray:
-    """Body-to-inertial rotation matrix ``R(q)`` (``v_i = R v_b``)."""
-    q = np.asarray(q, dtype=float)
+def dcm_NB(q_BN: np.ndarray) -> np.ndarray:
+    """``[NB]``, the body-to-inertial matrix of the attitude ``q_BN`` (``v_N = [NB] v_B``): the
+    transpose of Schaub & Junkins' ``[BN]`` (:func:`dcm_BN`)."""
+    q = np.asarray(q_BN, dtype=float)
     if q.shape == (4,):                 # one quaternion: the same formula on Python floats
         x, y, z, w = q.tolist()
         return np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
@@ -113,20 +117,26 @@ def dcm(q: np.ndarray) -> np.ndarray:
     return out
 
 
-def to_body(q, v) -> list:
-    """``dcm(q)ᵀ v``, an inertial vector in body axes, component by component: ``q`` and ``v`` are
-    sequences of Python floats (one vector) or of arrays (a batch, one array per component); the same
-    operations either way."""
-    x, y, z, w = q
-    v0, v1, v2 = v
+def dcm_BN(q_BN: np.ndarray) -> np.ndarray:
+    """``[BN] = [NB]ᵀ``, the inertial-to-body matrix of the attitude ``q_BN`` (``v_B = [BN] v_N``;
+    Schaub & Junkins 2018 §3.2): the transposed view of :func:`dcm_NB`."""
+    return np.swapaxes(dcm_NB(q_BN), -1, -2)
+
+
+def to_body(q_BN, v_N) -> list:
+    """``v_B = [BN] v_N``, an inertial vector in body axes, component by component: ``q_BN`` and
+    ``v_N`` are sequences of Python floats (one vector) or of arrays (a batch, one array per
+    component); the same operations either way."""
+    x, y, z, w = q_BN
+    v0, v1, v2 = v_N
     return [(1 - 2 * (y * y + z * z)) * v0 + 2 * (x * y + z * w) * v1 + 2 * (x * z - y * w) * v2,
             2 * (x * y - z * w) * v0 + (1 - 2 * (x * x + z * z)) * v1 + 2 * (y * z + x * w) * v2,
             2 * (x * z + y * w) * v0 + 2 * (y * z - x * w) * v1 + (1 - 2 * (x * x + y * y)) * v2]
 
 
-def from_dcm(R: np.ndarray) -> np.ndarray:
-    """Quaternion of a body-to-inertial matrix (Shepperd's method, w >= 0)."""
-    R = np.asarray(R, dtype=float)
+def from_dcm_NB(dcm_NB: np.ndarray) -> np.ndarray:
+    """``q_BN`` of a body-to-inertial matrix ``[NB]`` (Shepperd's method, w >= 0)."""
+    R = np.asarray(dcm_NB, dtype=float)
     flat = R.reshape(-1, 3, 3)
     out = np.empty((flat.shape[0], 4))
     for n, m in enumerate(flat):
@@ -210,8 +220,8 @@ def exp_map(phi: np.ndarray) -> np.ndarray:
 
 
 def expm_so3(phi: np.ndarray) -> np.ndarray:
-    """Rotation matrix ``exp(hat(phi))`` (Rodrigues)."""
-    return dcm(exp_map(phi))
+    """Rotation matrix ``exp(hat(phi))`` (Rodrigues): ``[NB]`` of the rotation vector ``phi``."""
+    return dcm_NB(exp_map(phi))
 
 
 def angle_between(q1: np.ndarray, q2: np.ndarray) -> np.ndarray:
@@ -226,9 +236,10 @@ def angle_between(q1: np.ndarray, q2: np.ndarray) -> np.ndarray:
     return 2.0 * np.arccos(np.clip(d, -1.0, 1.0))
 
 
-def error_vector(q: np.ndarray, q_ref: np.ndarray) -> np.ndarray:
-    """Attitude error ``q_ref^* ⊗ q`` vector part, sign chosen with w >= 0 (body frame)."""
-    q, q_ref = np.asarray(q, float), np.asarray(q_ref, float)
+def error_vector(q_BN: np.ndarray, q_RN: np.ndarray) -> np.ndarray:
+    """Vector part of the attitude error ``q_BR = q_RN* ⊗ q_BN`` of the body B relative to the
+    reference R, sign chosen with w >= 0 (B axes)."""
+    q, q_ref = np.asarray(q_BN, float), np.asarray(q_RN, float)
     if q.shape == (4,) and q_ref.shape == (4,):         # one pair: multiply's scalar formula, p = q_ref*
         (rx, ry, rz, pw), (qx, qy, qz, qw) = q_ref.tolist(), q.tolist()
         px, py, pz = -rx, -ry, -rz
@@ -240,10 +251,10 @@ def error_vector(q: np.ndarray, q_ref: np.ndarray) -> np.ndarray:
     return (e * sign)[..., :3]
 
 
-def propagate_constant_rate(q: np.ndarray, omega: np.ndarray, dt: float) -> np.ndarray:
-    """Exact attitude after ``dt`` at constant body rate: ``q ⊗ exp(omega dt)`` (rows of ``q`` and
-    ``omega`` with a column of ``dt``: each row's)."""
-    return multiply(q, exp_map(np.asarray(omega) * dt))
+def propagate_constant_rate(q_BN: np.ndarray, omega_BN_B: np.ndarray, dt: float) -> np.ndarray:
+    """Exact attitude after ``dt`` at constant body rate: ``q_BN ⊗ exp(omega_BN_B dt)`` (rows of
+    ``q_BN`` and ``omega_BN_B`` with a column of ``dt``: each row's)."""
+    return multiply(q_BN, exp_map(np.asarray(omega_BN_B) * dt))
 
 
 def log_map(q: np.ndarray) -> np.ndarray:

@@ -7,7 +7,7 @@ shared part without ROS, for the planner (which plans for any named spacecraft) 
 Files are read with ``yaml.safe_load`` only: nothing in them is ever evaluated.
 
 Keys of the shared part: ``frame_id``, ``body_frame_id``, ``spacecraft``, ``orbit`` and the real
-sky's (issue 13; files without them keep today's circular orbit, tilted dipole, gravity gradient
+sky's (files without them fly the circular orbit and tilted dipole, the gravity gradient
 only as the simulator's parameter): ``epoch`` (ISO 8601 UTC, sim time zero), ``orbit.type``
 (``circular``, ``kepler``, ``tle``: :func:`att_sim.models.orbit.orbit_from_mapping`), ``field_model``
 (``dipole`` or ``igrf14``), ``environment`` (disturbance switches, residual dipole, facets:
@@ -81,8 +81,8 @@ class Scenario:
     field_model: str = "dipole"                    # 'dipole' (Bruni–Celani) or 'igrf14'
     environment: dict = field(default_factory=dict)   # environment_from_params of the 'environment' group
     zones: list[Zone] = field(default_factory=list)   # zones_from_params of the 'zones' group
-    sensors: SensorSpecs = field(default_factory=SensorSpecs)        # the 'sensors' group (issue 14)
-    actuators: ActuatorSpecs = field(default_factory=ActuatorSpecs)  # the 'actuators' group (issue 14)
+    sensors: SensorSpecs = field(default_factory=SensorSpecs)        # the 'sensors' group
+    actuators: ActuatorSpecs = field(default_factory=ActuatorSpecs)  # the 'actuators' group
 
 
 SPACECRAFT_KEYS = ("inertia", "torque_max", "wheel_axes", "wheel_inertia", "wheel_torque_max", "wheel_speed_max",
@@ -209,7 +209,8 @@ def epoch_from_params(path, shared: dict) -> datetime | None:
 
 
 def orbit_model_from_params(path, shared: dict, epoch: datetime | None) -> orbits.Orbit:
-    """The ``orbit`` group as an :class:`att_sim.models.orbit.Orbit` (circular: today's keys and defaults)."""
+    """The ``orbit`` group as an :class:`att_sim.models.orbit.Orbit` (circular: the circular orbit's keys
+    and defaults)."""
     p = shared.get("orbit", {})
     if p.get("type", "circular") == "circular":
         return orbits.CircularOrbit(orbit_from_params(p))

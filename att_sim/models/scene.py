@@ -1,4 +1,4 @@
-"""What the 3D view shows, without ROS (issue 17): the zones as cones where they are now, the
+"""What the 3D view shows, without ROS: the zones as cones where they are now, the
 sensor boresights, the Sun, Moon and Earth directions, and a plan's boresight path, as plain
 :class:`att_msgs_py.types.Shape` (:mod:`att_msgs_py.markers` makes the messages).
 
@@ -45,7 +45,7 @@ def earth_fixed(environment, t: float, r_N) -> tuple[np.ndarray, np.ndarray]:
     ``r_N`` (m): ``(q_EN, origin_N)``, the rotation with ``p_N = R(q_EN) p_E`` (the transpose of
     the field's GCRS → ITRS rotation, IAU 2006 by skyfield) and the Earth's centre at ``−r_N``."""
     R_EN = environment.field.itrs_rotation(np.asarray(t, float))        # r_E = R r_N
-    return rot.from_dcm(R_EN.T), -np.asarray(r_N, float)
+    return rot.from_dcm_NB(R_EN.T), -np.asarray(r_N, float)
 
 
 def zone_views(zones: list[Zone], bodies: Bodies) -> list[ZoneView]:
@@ -71,7 +71,7 @@ def zone_margins(zones: list[Zone], views: list[ZoneView], q_BN) -> np.ndarray:
     if not views:
         return np.zeros(0)
     s_B = np.array([z.sensor_axis / np.linalg.norm(z.sensor_axis) for z in zones])
-    b_N = s_B @ rot.dcm(np.asarray(q_BN, float)).T
+    b_N = s_B @ rot.dcm_BN(np.asarray(q_BN, float))
     a_N = np.array([v.axis_N for v in views])
     gamma = np.arctan2(np.linalg.norm(np.cross(b_N, a_N), axis=1), np.einsum("ij,ij->i", b_N, a_N))
     theta = np.array([v.half_angle for v in views])
@@ -98,7 +98,7 @@ def cone_triangles(rim: np.ndarray) -> np.ndarray:
 def boresight_path(q_BN, sensor_axis_B, length: float = LENGTH) -> np.ndarray:
     """(K, 3) inertial boresight ``length R(q_BN) s_B / |s_B|`` along the attitudes ``q_BN`` (K, 4)."""
     s_B = np.asarray(sensor_axis_B, float) / np.linalg.norm(sensor_axis_B)
-    return length * np.einsum("kij,j->ki", rot.dcm(np.asarray(q_BN, float).reshape(-1, 4)), s_B)
+    return length * np.einsum("kij,j->ki", rot.dcm_NB(np.asarray(q_BN, float).reshape(-1, 4)), s_B)
 
 
 def zone_shapes(views: list[ZoneView], frame_N: str, length: float = LENGTH) -> list[Shape]:

@@ -1,13 +1,13 @@
 """The environment the simulator integrates: orbit, geomagnetic field, Sun and shadow, disturbance torques.
 
-:class:`Environment` composes the models of the real sky (issue 13) for one spacecraft:
+:class:`Environment` composes the models of the real sky for one spacecraft:
 
 * orbit: any :class:`att_sim.models.orbit.Orbit` (circular, Kepler + J2, TLE/SGP4), GCRS, t past the epoch;
 * field: :class:`att_sim.models.geomagnetic.GeomagneticField` (``dipole`` or ``igrf14``), in body axes
   ``B_b = C(q) B_N(t, r(t))``; for IGRF-14 the inertial field is tabulated along the orbit in
   10-minute tracks (:meth:`~att_sim.models.geomagnetic.GeomagneticField.track`, < 1e-3 nT) built as t
   reaches them;
-* sky: :class:`att_sim.models.ephemeris.Sky` for the Sun's position and the conical shadow;
+* sky: :class:`att_sim.models.ephemeris.Ephemeris` for the Sun's position and the conical shadow;
 * torques (:mod:`att_sim.models.disturbances`), each switched by :class:`Flags`: gravity gradient, solar
   radiation pressure on the facets (zero in umbra, scaled by the visible fraction of the Sun),
   aerodynamic drag on the facets with the exponential density of :mod:`att_sim.models.atmosphere` at the
@@ -21,8 +21,8 @@
 cached — the two middle stages share a time and the last stage's time is the next step's first — so
 a step costs two time evaluations and four attitude evaluations.
 
-A scenario without the real sky's keys (:func:`Environment.from_scenario`) is today's world: the
-circular orbit, the tilted dipole and optionally the gravity gradient, nothing else.
+A scenario without the real sky's keys (:func:`Environment.from_scenario`) has the circular world
+(:meth:`Environment.circular`): the circular orbit, the tilted dipole and optionally the gravity gradient, nothing else.
 """
 from __future__ import annotations
 
@@ -37,7 +37,7 @@ from att_sim.models import atmosphere, disturbances
 from att_sim.models import rotations as rot
 from att_sim.models.dynamics import Spacecraft
 from att_sim.models.environment import EARTH_RADIUS, OrbitParams
-from att_sim.models.ephemeris import Sky, shadow_function
+from att_sim.models.ephemeris import Ephemeris, shadow_function
 from att_sim.models.geomagnetic import GeomagneticField
 from att_sim.models.orbit import CircularOrbit, Orbit
 
@@ -91,7 +91,7 @@ class _Now(NamedTuple):
 class Environment:
     """Orbit, field, sky and disturbances of one spacecraft (see module docstring)."""
 
-    def __init__(self, epoch: datetime | None, orbit: Orbit, field: GeomagneticField, sky: Sky | None,
+    def __init__(self, epoch: datetime | None, orbit: Orbit, field: GeomagneticField, sky: Ephemeris | None,
                  spacecraft: Spacecraft, facets=(), residual_dipole=None, flags: Flags = Flags(),
                  drag_coefficient: float = 2.2):
         self.epoch, self.orbit, self.field, self.sky, self.spacecraft = epoch, orbit, field, sky, spacecraft
@@ -107,7 +107,7 @@ class Environment:
 
     @classmethod
     def circular(cls, spacecraft: Spacecraft, orbit: OrbitParams, gravity_gradient: bool = False) -> Environment:
-        """Today's world: circular orbit, tilted dipole, optional gravity gradient, no epoch."""
+        """The circular world of Bruni & Celani: circular orbit, tilted dipole, optional gravity gradient, no epoch."""
         return cls(None, CircularOrbit(orbit), GeomagneticField("dipole"), None, spacecraft,
                    flags=Flags(gravity_gradient=gravity_gradient))
 
@@ -119,14 +119,14 @@ class Environment:
         flags = Flags(gravity_gradient=e.get("gravity_gradient", False) if gravity_gradient is None
                       else bool(gravity_gradient),
                       solar_pressure=e.get("solar_pressure", False), drag=e.get("drag", False))
-        sky = None if scenario.epoch is None else Sky(scenario.epoch, scenario.orbit_model)
+        sky = None if scenario.epoch is None else Ephemeris(scenario.epoch, scenario.orbit_model)
         return cls(scenario.epoch, scenario.orbit_model, GeomagneticField(scenario.field_model, scenario.epoch),
                    sky, scenario.spacecraft, e.get("facets", ()), e.get("residual_dipole"), flags,
                    e.get("drag_coefficient", 2.2))
 
     def with_orbit(self, orbit: Orbit) -> Environment:
         """The same environment on another orbit (caches fresh)."""
-        sky = None if self.sky is None else Sky(self.sky.epoch, orbit)
+        sky = None if self.sky is None else Ephemeris(self.sky.epoch, orbit)
         return Environment(self.epoch, orbit, self.field, sky, self.spacecraft, self.facets, self.residual_dipole,
                            self.flags, self.drag_coefficient)
 
@@ -184,19 +184,19 @@ class Environment:
                       moon, now.shadow)
 
     # -- per attitude --------------------------------------------------------------------------
-    def torques(self, t: float, q: np.ndarray) -> dict[str, np.ndarray]:
-        """Each active disturbance torque (N m, body axes) at time ``t`` and attitude ``q``."""
+    def torques(self, t: float, q_BN: np.ndarray) -> dict[str, np.ndarray]:
+        """Each active disturbance torque (N m, body axes) at time ``t`` and attitude ``q_BN``."""
         now = self._now(t)
-        return self._torques(now, q, rot.dcm(q).T @ now.field_N)
+        return self._torques(now, q_BN, rot.dcm_BN(q_BN) @ now.field_N)
 
-    def _torques(self, now: _Now, q: np.ndarray, field_b: np.ndarray) -> dict[str, np.ndarray]:
+    def _torques(self, now: _Now, q_BN: np.ndarray, field_b: np.ndarray) -> dict[str, np.ndarray]:
         out, f = {}, self.flags
         if f.gravity_gradient:
-            out["gravity_gradient"] = disturbances.gravity_gradient_torque(now.r, q, self.spacecraft.inertia)
+            out["gravity_gradient"] = disturbances.gravity_gradient_torque(now.r, q_BN, self.spacecraft.inertia)
         if f.solar_pressure:
-            out["solar_pressure"] = disturbances.srp_torque(self.facets, q, now.sun_N, now.sun_distance, now.shadow)
+            out["solar_pressure"] = disturbances.srp_torque(self.facets, q_BN, now.sun_N, now.sun_distance, now.shadow)
         if f.drag:
-            out["drag"] = disturbances.drag_torque(self.facets, q, now.v_rel, now.density, self.drag_coefficient)
+            out["drag"] = disturbances.drag_torque(self.facets, q_BN, now.v_rel, now.density, self.drag_coefficient)
         if self.residual_dipole is not None:
             out["residual_dipole"] = disturbances.residual_dipole_torque(self.residual_dipole, field_b)
         return out
@@ -233,15 +233,15 @@ class Environment:
         f = self.flags
         return f.gravity_gradient or f.solar_pressure or f.drag or self.residual_dipole is not None
 
-    def disturbance(self, t: float, q: np.ndarray, field_b: np.ndarray) -> np.ndarray | None:
-        """The sum of the active disturbance torques (N m, body axes) at time ``t``, attitude ``q``
+    def disturbance(self, t: float, q_BN: np.ndarray, field_b: np.ndarray) -> np.ndarray | None:
+        """The sum of the active disturbance torques (N m, body axes) at time ``t``, attitude ``q_BN``
         and body field ``field_b`` (None when none is active)."""
-        torques = self._torques(self._now(t), q, field_b)
+        torques = self._torques(self._now(t), q_BN, field_b)
         return sum(torques.values()) if torques else None
 
-    def sample(self, t: float, q: np.ndarray) -> Sample:
-        """Field, total disturbance torque, position and shadow at time ``t`` and attitude ``q``."""
-        return self.sample_of(t, *self.stage(t, np.asarray(q, float)))
+    def sample(self, t: float, q_BN: np.ndarray) -> Sample:
+        """Field, total disturbance torque, position and shadow at time ``t`` and attitude ``q_BN``."""
+        return self.sample_of(t, *self.stage(t, np.asarray(q_BN, float)))
 
     def sample_of(self, t: float, field_b: np.ndarray, torque: np.ndarray | None) -> Sample:
         """:meth:`sample` of the attitude whose :meth:`stage` values at ``t`` are ``field_b``, ``torque``."""

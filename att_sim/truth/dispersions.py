@@ -197,7 +197,7 @@ def _tilted(axes: np.ndarray, tilts_rad: np.ndarray) -> np.ndarray:
     out = np.empty_like(axes)
     for i, (a, b) in enumerate(tilts_rad.reshape(-1, 2)):
         e1, e2 = rot.orthonormal_basis(axes[:, i])
-        out[:, i] = rot.dcm(rot.exp_map(a * e1 + b * e2)) @ axes[:, i]
+        out[:, i] = rot.dcm_NB(rot.exp_map(a * e1 + b * e2)) @ axes[:, i]
     return out
 
 
@@ -224,7 +224,7 @@ def truth(scenario: scen.Scenario, values: dict, seed: int, q0=rot.IDENTITY, ome
         scenario = scen.with_epoch(scenario, scenario.epoch + timedelta(seconds=float(v["epoch_offset_s"][0])))
     sc, actuators, environment = scenario.spacecraft, scenario.actuators, scenario.environment
     moments, axes = np.linalg.eigh(sc.inertia)
-    turn = rot.dcm(rot.exp_map(v["inertia_rotation_deg"] * DEG)) @ axes
+    turn = rot.dcm_NB(rot.exp_map(v["inertia_rotation_deg"] * DEG)) @ axes
     inertia = turn @ np.diag(moments * (1.0 + v["inertia_scale"])) @ turn.T
     inertia = 0.5 * (inertia + inertia.T)
     problem = inertia_problem(inertia)

@@ -134,7 +134,7 @@ def test_plan_round_trips_epoch_and_zones_and_old_logs_have_neither():
     assert convert.plan_from_msg(convert.plan_msg(Plan(t=plan.t, torque=plan.torque, q=plan.q,
                                                        omega=plan.omega))).epoch is None
 
-    class OldPlan:                       # a ManeuverPlan decoded from a log recorded before issue 13
+    class OldPlan:                       # a ManeuverPlan decoded from a log recorded without the zone fields
         def __init__(self, msg):
             self._msg = msg
 

@@ -1,4 +1,4 @@
-"""Messages of the 3D view (issue 17): marker arrays that replace rather than accumulate, shapes
+"""Messages of the 3D view: marker arrays that replace rather than accumulate, shapes
 that survive the wire, and /tf and markers that the recorder can describe in a log."""
 import numpy as np
 from rclpy.serialization import deserialize_message, serialize_message

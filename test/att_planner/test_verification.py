@@ -1,4 +1,4 @@
-"""The verification judges every zone at its true position at each dense sample's time (issue 13)."""
+"""The verification judges every zone at its true position at each dense sample's time."""
 import math
 from dataclasses import replace
 
@@ -17,7 +17,7 @@ R_E = 6378.137e3
 Y = np.array([0.0, 1.0, 0.0])
 
 
-class PolarSky:
+class PolarEphemeris:
     """Only the Earth of a synthetic sky: circular orbit of radius 26 378 km in the x-z plane,
     at phase ``u0`` at t = 0, period 5800 s (the nadir turns 3.7 deg a minute about −y); the Earth's
     disc is 14.0 deg in radius, the limb zone with its 10 deg margin 24.0 deg."""
@@ -43,7 +43,7 @@ def _problem(u0_deg=240, **kw):
     sc = Spacecraft(np.diag([3000.0, 4500.0, 6000.0]), body_torque_max=0.25)
     zones = [Zone("limb", "earth_limb", Y, math.radians(10))] + kw.pop("zones", [])
     return ManeuverProblem(sc, rot.IDENTITY.copy(), rot.from_axis_angle([1.0, 0.0, 0.0], math.radians(135)), Y,
-                           zones=zones, sky=PolarSky(u0_deg), **kw)
+                           zones=zones, sky=PolarEphemeris(u0_deg), **kw)
 
 
 @pytest.fixture(scope="module")

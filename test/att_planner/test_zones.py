@@ -1,4 +1,4 @@
-"""Zones that move (issue 13): the Chebyshev representation, margins, the frozen baseline, the
+"""Zones that move: the Chebyshev representation, margins, the frozen baseline, the
 request checks and the real sky."""
 import math
 
@@ -10,14 +10,14 @@ from att_msgs_py.types import Zone
 from att_planner import cones as cone_checks
 from att_planner.problem import ManeuverProblem
 from att_planner.reference.time_optimal_cases import case_problem
-from att_planner.zones import FIT_TOLERANCE, ZoneSky, zones_from_cones
+from att_planner.zones import FIT_TOLERANCE, FittedZones, zones_from_cones
 from att_sim.models import rotations as rot
 from att_sim.models.dynamics import Spacecraft
 
 R_E = 6378.137e3
 
 
-class CircularSky:
+class CircularEphemeris:
     """A synthetic sky: circular equatorial orbit of radius ``R_E + altitude`` (x at t = 0, moving
     towards y), the Sun fixed far along +x, the Moon fixed at 384 000 km along +y."""
 
@@ -52,7 +52,7 @@ class CircularSky:
         return np.arcsin(R_E / np.linalg.norm(self.position(t), axis=-1))
 
 
-SKY = CircularSky()
+SKY = CircularEphemeris()
 Y = np.array([0.0, 1.0, 0.0])
 ZONES = [Zone("sun", "sun", Y, math.radians(47)), Zone("moon", "moon", Y, math.radians(23)),
          Zone("limb", "earth_limb", Y, math.radians(10)),
@@ -61,7 +61,7 @@ ZONES = [Zone("sun", "sun", Y, math.radians(47)), Zone("moon", "moon", Y, math.r
 
 @pytest.fixture(scope="module")
 def long_sky():
-    return ZoneSky(ZONES, SKY, 20000.0)        # 3.4 orbits: several pieces
+    return FittedZones(ZONES, SKY, 20000.0)        # 3.4 orbits: several pieces
 
 
 def test_fit_is_within_its_tolerance_between_the_check_points_and_its_derivative_is_exact(long_sky):
@@ -96,30 +96,30 @@ def test_casadi_evaluation_is_the_numpy_one(long_sky):
     g = ca.Function("g", [t, R], [ca.vertcat(*zs.casadi_constraints(t, R))])
     q = rot.from_axis_angle([1.0, 0.3, 0.2], 2.0)
     m = zs.margins(700.0, q)[0]
-    assert np.array_equal(np.array(g(700.0, rot.dcm(q))).ravel() <= 0, m >= 0)
+    assert np.array_equal(np.array(g(700.0, rot.dcm_NB(q))).ravel() <= 0, m >= 0)
 
 
 def test_outside_the_window_the_fit_refuses_but_the_truth_answers(long_sky):
     with pytest.raises(ValueError, match="outside the zones' window"):
         long_sky.axes(long_sky.window + 1.0)
     assert long_sky.true_axes(long_sky.window + 1.0).shape == (4, 3)
-    assert ZoneSky(ZONES[3:], None, 10.0).axes(1e6).shape == (1, 3)       # inertial: any time
+    assert FittedZones(ZONES[3:], None, 10.0).axes(1e6).shape == (1, 3)       # inertial: any time
 
 
 def test_a_sky_that_is_not_finite_is_refused_not_fitted_or_judged():
-    class Decayed(CircularSky):
+    class Decayed(CircularEphemeris):
         def position(self, t):
             return np.where(np.asarray(t)[..., None] > 400.0, np.nan, super().position(t))
 
     with pytest.raises(ValueError, match="not finite at t = 4"):
-        ZoneSky(ZONES, Decayed(), 600.0)
-    zs = ZoneSky(ZONES, Decayed(), 300.0)
+        FittedZones(ZONES, Decayed(), 600.0)
+    zs = FittedZones(ZONES, Decayed(), 300.0)
     with pytest.raises(ValueError, match="not finite"):
         zs.margins(np.array([100.0, 500.0]), rot.IDENTITY, true=True)
 
 
 def test_earth_limb_at_580_km_is_66_deg_plus_its_margin():
-    zs = ZoneSky(ZONES[2:3], SKY, 600.0)
+    zs = FittedZones(ZONES[2:3], SKY, 600.0)
     expected = math.degrees(math.asin(R_E / (R_E + 580e3)))
     assert expected == pytest.approx(66.44, abs=0.01)
     assert math.degrees(zs.half_angles(300.0)[0]) == pytest.approx(expected + 10.0, abs=1e-6)
@@ -127,7 +127,7 @@ def test_earth_limb_at_580_km_is_66_deg_plus_its_margin():
 
 def test_a_zone_rotating_at_the_orbit_rate_margins_by_hand():
     """Boresight +y body = +x inertial at identity; the nadir −(cos nt, sin nt, 0) is π − nt away."""
-    zs = ZoneSky([Zone("limb", "earth_limb", Y, 0.0), Zone("limb in", "earth_limb", Y, 0.0, keep_in=True)],
+    zs = FittedZones([Zone("limb", "earth_limb", Y, 0.0), Zone("limb in", "earth_limb", Y, 0.0, keep_in=True)],
                  SKY, 1200.0)
     q = rot.from_axis_angle([0.0, 0.0, 1.0], -math.pi / 2)          # body +y -> inertial +x
     t = np.linspace(0, 1200, 7)
@@ -151,11 +151,11 @@ def test_frozen_zones_stay_where_they_were_at_t0(long_sky):
     assert fm[0, 2] == pytest.approx(mm[0, 2], abs=1e-8)
 
 
-def test_cones_as_zones_reproduce_todays_margins_exactly():
+def test_cones_as_zones_reproduce_the_cone_margins_exactly():
     problem = case_problem("swift")
     q = rot.normalize(np.random.default_rng(2).normal(size=(500, 4)))
     expected = cone_checks.margins(q, problem.sensor_axis, problem.cones)
-    zs = ZoneSky(zones_from_cones(problem.cones, problem.sensor_axis), None, 600.0)
+    zs = FittedZones(zones_from_cones(problem.cones, problem.sensor_axis), None, 600.0)
     assert np.array_equal(zs.margins(np.zeros(500), q), expected)
     assert np.array_equal(problem.zone_sky().margins(0.0, q, true=True), expected)
     assert problem.zone_sky() is problem.zone_sky()             # cached
@@ -195,7 +195,7 @@ def test_contradictory_zones_and_a_goal_judged_at_t0():
     assert code == ErrorCode.CONTRADICTORY_ZONES and "do not meet" in why
     # another sensor's keep-in cone is no contradiction
     c = Zone("c", "inertial", [1.0, 0.0, 0.0], 0.3, True, [1.0, 0.0, 0.0])
-    assert cone_checks.contradictory_zones(ZoneSky([a, c], None, 10.0)) == ""
+    assert cone_checks.contradictory_zones(FittedZones([a, c], None, 10.0)) == ""
     # the goal (boresight −z) inside the Sun zone at t = 0
     sun = Zone("sun", "sun", Y, 0.5)
     goal = rot.from_axis_angle([0.0, 0.0, 1.0], -math.pi / 2)          # +y body -> +x: the Sun
@@ -219,15 +219,15 @@ def test_default_window_bounds_the_slew():
 
 
 def test_the_real_sky_of_leo_observatory_fits_within_tolerance():
-    """The issue's TLE (≈ 577 km, 14.96 rev/day) on 2026-12-21: Sun, Moon and Earth limb + 10 deg."""
-    from att_sim.models.ephemeris import Sky
+    """A LEO TLE (≈ 577 km, 14.96 rev/day) on 2026-12-21: Sun, Moon and Earth limb + 10 deg."""
+    from att_sim.models.ephemeris import Ephemeris
     from att_sim.models.orbit import TLEOrbit
 
     epoch = "2026-12-21T00:00:00Z"
     line1 = "1 28485U          26355.00000000  .00000000  00000-0  20000-4 0    07"
     line2 = "2 28485  20.5600  60.0000 0005000  90.0000  10.0000 14.95764766    08"
-    sky = Sky(epoch, TLEOrbit(epoch, line1, line2))
-    zs = ZoneSky(ZONES[:3], sky, 3000.0)
+    sky = Ephemeris(epoch, TLEOrbit(epoch, line1, line2))
+    zs = FittedZones(ZONES[:3], sky, 3000.0)
     assert zs.moving and zs.fit_error <= FIT_TOLERANCE
     t = np.random.default_rng(3).uniform(0, 3000, 500)
     assert np.abs(zs.axes(t) - zs.true_axes(t)).max() <= FIT_TOLERANCE

@@ -15,7 +15,7 @@ from importlib.resources import files
 
 import numpy as np
 
-from helpers.own_rk4 import dcm
+from helpers.own_rk4 import dcm_NB
 
 R_EARTH = 6378.137e3          # m, WGS-84 equatorial radius
 
@@ -56,13 +56,13 @@ def margins(payload, t, q):
     ``cones`` (keep-out cones of its ``sensor_axis``) and ``zones`` (against the true sky)."""
     out = {}
     for c in payload.get("cones", []):
-        b = dcm(q) @ np.asarray(payload["sensor_axis"], float)
+        b = dcm_NB(q) @ np.asarray(payload["sensor_axis"], float)
         gamma = np.arccos(np.clip(b @ np.asarray(c["direction"], float) / np.linalg.norm(b, axis=1), -1.0, 1.0))
         out[c["name"]] = gamma - c["half_angle"]
     moving = [z for z in payload.get("zones", []) if z["body"] != "inertial"]
     axes, limb = sky(payload, t) if moving else ({}, None)
     for z in payload.get("zones", []):
-        b = dcm(q) @ np.asarray(z["sensor_axis"], float)
+        b = dcm_NB(q) @ np.asarray(z["sensor_axis"], float)
         if z["body"] == "inertial":
             a, half = np.broadcast_to(np.asarray(z["direction"], float), b.shape), z["half_angle"]
         elif z["body"] == "earth_limb":

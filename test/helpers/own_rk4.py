@@ -8,9 +8,9 @@ from __future__ import annotations
 import numpy as np
 
 
-def dcm(q):
-    """Body-to-inertial rotation matrices of unit quaternions q (K, 4) = (x, y, z, w)."""
-    x, y, z, w = np.moveaxis(np.asarray(q, float), -1, 0)
+def dcm_NB(q_BN):
+    """``[NB]``, the body-to-inertial matrices of unit quaternions q_BN (K, 4) = (x, y, z, w)."""
+    x, y, z, w = np.moveaxis(np.asarray(q_BN, float), -1, 0)
     return np.stack([np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)], -1),
                      np.stack([2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)], -1),
                      np.stack([2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)], -1)], -2)

@@ -11,7 +11,7 @@ from att_msgs_py import topics
 from att_sim.models import rotations as rot
 
 FIXTURE = Path(__file__).parents[1] / "data" / "swift_short.mcap"
-# the 3D view's topics and the mission events (issue 17) are recorded since after the fixture was made
+# the 3D view's topics and the mission events are recorded since after the fixture was made
 # (test_scene_ros and test_mission check them)
 VIEW_TOPICS = {topics.TF, topics.SIM_MARKERS, topics.PLAN_MARKERS, topics.ZONE_MARGINS, topics.MISSION_EVENTS}
 CHANNEL_TYPES = {t: name for t, name in topics.RECORDED.items() if t not in VIEW_TOPICS}   # a channel each

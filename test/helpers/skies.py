@@ -1,4 +1,5 @@
-"""Test skies: the zones' sky interface of :class:`att_planner.zones.ZoneSky` without an ephemeris."""
+"""Test ephemerides: the interface :class:`att_planner.zones.FittedZones` reads of
+:class:`att_sim.models.ephemeris.Ephemeris`, from closed-form motions instead of DE421."""
 import numpy as np
 
 from att_sim.models import rotations as rot
@@ -7,16 +8,16 @@ C = np.sqrt(0.5)
 RATE = np.deg2rad(0.25)          # rad/s: the Sun descends along the 45° meridian
 
 
-class DescendingSky:
-    """A sky whose Sun starts at azimuth 45°, elevation 52° and turns down its meridian at RATE
-    (the zones' sky interface of :class:`att_planner.zones.ZoneSky`; Moon and Earth unused)."""
+class DescendingEphemeris:
+    """An ephemeris whose Sun starts at azimuth 45°, elevation 52° and turns down its meridian at RATE
+    (the interface :class:`att_planner.zones.FittedZones` reads; Moon and Earth unused)."""
 
-    d0 = rot.dcm(rot.from_axis_angle([-C, C, 0.0], -np.deg2rad(52.0))) @ np.array([C, C, 0.0])
+    d0 = rot.dcm_NB(rot.from_axis_angle([-C, C, 0.0], -np.deg2rad(52.0))) @ np.array([C, C, 0.0])
 
     def sun_direction(self, t):
         t = np.asarray(t, float)
         turn = rot.from_axis_angle(np.broadcast_to([-C, C, 0.0], t.shape + (3,)), RATE * t)
-        return rot.dcm(turn) @ self.d0
+        return rot.dcm_NB(turn) @ self.d0
 
     moon_direction = sun_direction
 

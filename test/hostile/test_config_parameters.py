@@ -96,7 +96,7 @@ BAD_SCENARIOS = {
     "node section without ros__parameters": (edited(simulator={"step": 0.1}), "section 'simulator'"),
     "a file over 1 MB": ("# " + "x" * 1_100_000 + "\n" + yaml.safe_dump(BASE), "bytes"),
     "not UTF-8": (b"\xff\xfe/**: \x00\x81", "cannot be read"),
-    # sensors and actuators (issue 14)
+    # sensors and actuators
     "sensors a list": (edited(sensors=[1, 2]), "sensors must be a mapping"),
     "sensors unknown kind": (edited(sensors={"lidar": {}}), "sensors has unknown key(s) lidar"),
     "gyro ARW negative": (edited(sensors={"gyro": {"arw_deg_per_sqrt_h": -0.1}}), "sensors.gyro.arw_deg_per_sqrt_h"),
@@ -222,7 +222,7 @@ NODE_CASES = {
     "planner: unknown warm-up scenario": ("planner", ["-p", "warm_up_scenarios:=swift_demo,no_such_scenario"], C,
                                           ["no_such_scenario"]),
     "planner: plan_markers integer": ("planner", ["-p", "plan_markers:=2"], P, ["'plan_markers'", "true or false"]),
-    # issue 14: the simulator's seed, the controller's state source, the estimator's tuning
+    # the simulator's seed, the controller's state source, the estimator's tuning
     "simulator seed negative": (SIM, ["-p", "seed:=-1"], P, ["'seed'"]),
     "simulator seed text": (SIM, ["-p", "seed:=lucky"], P, ["'seed'", "integer"]),
     "controller state_source unknown": ("controller", ["-p", "state_source:=oracle"], P,
@@ -230,7 +230,7 @@ NODE_CASES = {
     "controller estimate without tachometers": ("controller", ["-p", "scenario:=olivares_staffetti", "-p",
                                                                "state_source:=estimate"], P,
                                                 ["'state_source'", "wheel_tachometer"]),
-    # issue 16: a campaign's dispersed truth
+    # a campaign's dispersed truth
     "simulator campaign without run_seed": (SIM, ["-p", "campaign:={tmp}/campaign.yaml"], P,
                                             ["'campaign'", "'run_seed'"]),
     "simulator run_seed without campaign": (SIM, ["-p", "run_seed:=5"], P, ["'campaign'", "'run_seed'"]),
@@ -253,7 +253,7 @@ NODE_CASES = {
     "controller: start_timeout zero": ("controller", ["-p", "start_timeout:=0.0"], P, ["'start_timeout'"]),
     "estimator: unknown parameter (typo)": ("estimator", ["-p", "gate_probabilty:=0.99"], P, ["gate_probabilty"]),
     "estimator: unknown scenario": ("estimator", ["-p", "scenario:=no_such_scenario"], C, ["no_such_scenario"]),
-    # issue 17: the live bridge
+    # the live bridge
     "bridge: port text": ("bridge", ["-p", "port:=http"], P, ["'port'", "integer"]),
     "bridge: port a float": ("bridge", ["-p", "port:=8765.0"], P, ["'port'", "integer"]),
     "bridge: port negative": ("bridge", ["-p", "port:=-1"], P, ["'port'", "[0, 65535]"]),

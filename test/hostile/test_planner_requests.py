@@ -119,7 +119,7 @@ MANEUVER_CASES = {
                             "option_values has 0"),
     # a sky closed by cones: refused before any solving
     "ring around the start": (dict(cones=ring(X)), ErrorCode.INFEASIBLE, "cones: the 8 keep-out cones close the sky"),
-    "ring around the goal": (dict(cones=ring(rot.dcm(GOAL) @ X)), ErrorCode.INFEASIBLE, "start and goal sensor"),
+    "ring around the goal": (dict(cones=ring(rot.dcm_NB(GOAL) @ X)), ErrorCode.INFEASIBLE, "start and goal sensor"),
     "ring around the semi-free target": (dict(cones=ring([0, 1, 0]), semi_free=True, sensor_target=[0, 1, 0]),
                                          ErrorCode.INFEASIBLE, "start and sensor_target sensor directions"),
     "six 50 deg cones, pocket to pocket": (dict(cones=SIX_AXES, sensor_axis=DIAGONAL, q_final=QUARTER_Z),

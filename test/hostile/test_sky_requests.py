@@ -1,4 +1,4 @@
-"""Hostile real-sky requests (issue 13): every bad epoch, TLE, orbit and zone refused with its code
+"""Hostile real-sky requests: every bad epoch, TLE, orbit and zone refused with its code
 and a sentence naming the field (ROS-free, against the service logic), and over ROS one moving-zone
 PlanManeuver whose plan comes back with its epoch and zones, signed over them."""
 from __future__ import annotations
@@ -196,7 +196,7 @@ def schedule(**fields):
 
 
 def test_schedule_requests_get_the_same_sky_checks():
-    target_dir = rot.dcm(rot.from_axis_angle([0, 0, 1], 1.0)) @ X
+    target_dir = rot.dcm_NB(rot.from_axis_angle([0, 0, 1], 1.0)) @ X
     cases = [(dict(zones=[inertial(target_dir, 0.2, name="star")]), ErrorCode.ZONE_AT_END,
               "targets[0] ('a') is inside keep-out zone star"),
              (dict(epoch=ZERO_EPOCH, tle=("", ""), zones=[SUN]), ErrorCode.INVALID_EPOCH, "moves with the sky"),

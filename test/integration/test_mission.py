@@ -18,7 +18,7 @@ from att_planner.mission.targets import load as load_targets
 from att_planner.tools.review import review
 from att_sim.models import rotations as rot
 from att_sim.models import scenario as scen
-from att_sim.models.ephemeris import Sky
+from att_sim.models.ephemeris import Ephemeris
 from helpers.missions import fly_written
 
 pytestmark = pytest.mark.ros
@@ -60,14 +60,14 @@ def test_the_log_holds_the_events_plans_and_the_dwells_on_target(flown):
     plan_ids = {m.plan_id for m in log[PLANS].messages}
     assert {e.plan_id for e in events if e.event == Kind.SLEW} <= plan_ids
     t, q = np.asarray(log[STATE]["header.stamp"]), np.asarray(log[STATE]["attitude"])
-    sky = Sky(mission.scenario.epoch, mission.scenario.orbit_model)
+    sky = Ephemeris(mission.scenario.epoch, mission.scenario.orbit_model)
     zones = {z.body: z for z in mission.scenario.zones}
     dipole = np.asarray(log[STATE]["dipole"])
     for e in (e for e in events if e.event == Kind.DWELL):
         held = (t >= e.start) & (t <= e.end)
         assert held.sum() >= mission.rate * (e.end - e.start) - 1
         assert np.abs(dipole[held]).max() > 0.0                   # held in pointing mode: momentum dumped
-        boresight = np.einsum("nij,j->ni", rot.dcm(q[held]), mission.sensor_axis)
+        boresight = np.einsum("nij,j->ni", rot.dcm_NB(q[held]), mission.sensor_axis)
         assert np.degrees(np.arccos(np.clip(boresight @ e.direction, -1, 1))).max() <= 0.05
         for body, direction in (("sun", sky.sun_direction(t[held])), ("moon", sky.moon_direction(t[held]))):
             angle = np.arccos(np.clip(np.einsum("ni,ni->n", boresight, direction), -1, 1))

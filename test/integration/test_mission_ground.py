@@ -51,7 +51,7 @@ def test_the_truth_follows_skyfields_line_of_sight_through_the_dwell(flown):
     assert held.sum() >= mission.rate * SITE["dwell_s"] - 1
     sight = site_sight(mission.scenario.epoch.isoformat(), report["tle"], SITE["lat_deg"], SITE["lon_deg"],
                        SITE["alt_m"], t[held])
-    boresight = np.einsum("nij,j->ni", rot.dcm(q[held]), mission.sensor_axis)
+    boresight = np.einsum("nij,j->ni", rot.dcm_NB(q[held]), mission.sensor_axis)
     error = np.degrees(np.arccos(np.clip(np.einsum("ni,ni->n", boresight, sight), -1, 1)))
     assert error.max() <= 0.1
     moved = np.degrees(np.arccos(np.clip(sight[0] @ sight[-1], -1, 1)))

@@ -1,4 +1,4 @@
-"""The 3D view through the nodes (issue 17): a real-sky run of the simulator and the planner,
+"""The 3D view through the nodes: a real-sky run of the simulator and the planner,
 recorded; the log, decoded by rosbags from its own definitions, holds /tf with the body frame under
 the inertial one (the state's attitude) and the Earth-fixed frame (skyfield's ITRS, at -r), the
 zones' cones where the sky puts them, their margins, and the plan's boresight path."""
@@ -93,7 +93,7 @@ def test_a_recorded_real_sky_run_holds_tf_markers_and_the_plan_path(ros_suite):
         q = states[round(stamp(t), 6)].attitude               # the state at the transform's time
         r = t.transform.rotation
         assert np.allclose(Rotation.from_quat([r.x, r.y, r.z, r.w]).as_matrix(),
-                           rot.dcm(np.array([q.x, q.y, q.z, q.w])), atol=1e-12)
+                           rot.dcm_NB(np.array([q.x, q.y, q.z, q.w])), atol=1e-12)
 
     sc = scen.load(SCENARIO)
     env = Environment.from_scenario(sc)
@@ -119,7 +119,7 @@ def test_a_recorded_real_sky_run_holds_tf_markers_and_the_plan_path(ros_suite):
     for m in margins[::10]:
         assert list(m.names) == ["sun", "moon", "earth"] and m.min_margin == min(m.margins)
         q = states[round(stamp(m), 6)].attitude
-        b_N = rot.dcm(np.array([q.x, q.y, q.z, q.w])) @ [0.0, 1.0, 0.0]        # the zones' sensor +y
+        b_N = rot.dcm_NB(np.array([q.x, q.y, q.z, q.w])) @ [0.0, 1.0, 0.0]        # the zones' sensor +y
         bodies = env.bodies(stamp(m))
         for value, z, axis in zip(m.margins, sc.zones, (bodies.sun, bodies.moon, bodies.nadir), strict=True):
             half = z.half_angle + (bodies.earth_radius if z.body == "earth_limb" else 0.0)
@@ -130,5 +130,5 @@ def test_a_recorded_real_sky_run_holds_tf_markers_and_the_plan_path(ros_suite):
     plan = response.plan
     assert path.ns == "plan_path" and path.header.frame_id == "gcrs" and len(path.points) == len(plan.attitudes)
     last = plan.attitudes[-1]
-    end_boresight = rot.dcm(np.array([last.x, last.y, last.z, last.w])) @ [0, 2.0, 0]
+    end_boresight = rot.dcm_NB(np.array([last.x, last.y, last.z, last.w])) @ [0, 2.0, 0]
     assert np.allclose([path.points[-1].x, path.points[-1].y, path.points[-1].z], end_boresight, atol=1e-9)

@@ -1,5 +1,5 @@
 """PlanSchedule over ROS: a 2-target tour planned by the planner node, verified, executed; the first
-target observed (held for a dwell, issue 17), the second flown through."""
+target observed (held for a dwell), the second flown through."""
 from __future__ import annotations
 
 import math

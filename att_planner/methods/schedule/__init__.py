@@ -2,10 +2,10 @@
 
 Olivares & Staffetti (2018): visit every target attitude once, in the fastest order, starting and
 ending at rest, with wheel torques ``|T_u,i| ≤ T̄`` and wheel speeds ``|Ω_i| ≤ Ω̄`` (inertial, and
-relative to the body, the speed the truth model of :mod:`att_sim.models.dynamics` limits); at each target
+relative to the body, the speed the model of :mod:`att_sim.models.dynamics` limits); at each target
 the body rate about z is zero (the other rates are free and carry over).
 
-Model (the truth model of :mod:`att_sim.models.dynamics`, J = I_s the total inertia, G the wheel axes)::
+Model (the model of :mod:`att_sim.models.dynamics`, J = I_s the total inertia, G the wheel axes)::
 
     q̇ = ½ q ⊗ [ω, 0],   J ω̇ = −ω × (J ω + G I_w Ω) − G T_u,   I_w Ω̇ = T_u.
 
@@ -39,12 +39,12 @@ and given that the NLPs reach their global minima). :func:`exhaustive_order_sear
 orders as an independent check (time reversal maps a schedule of an order onto one of the
 reversed order with the same duration, so pairs must agree).
 
-Zones (issue 13, :mod:`.transcription`): the cones and zones of ``problem.zone_sky()``, moving
+Zones (:mod:`.transcription`): the cones and zones of ``problem.zone_sky()``, moving
 or not, keep-out or keep-in, each of its own sensor, are kept at every node and interval midpoint
 of every leg at its physical time along the tour (a leg starts at the sum of the earlier legs'
 durations), exactly in the phase durations; the leg bounds leave them out (still lower bounds).
 
-Observations (issue 17, ``problem.target_dwell`` and ``target_windows``): a target held at rest for
+Observations (``problem.target_dwell`` and ``target_windows``): a target held at rest for
 its dwell, observed within its window and never while a zone covers it; the order search bounds each
 order with its waits (:func:`.order_search.tour_bound`) and drops orders that miss a window.
 

@@ -119,7 +119,7 @@ VISIBILITY_STEP = 10.0      # s between the samples of a target's visibility amo
 def visibility(zones, q: np.ndarray, window: tuple, margin: float = 0.0,
                step: float = VISIBILITY_STEP) -> list[tuple]:
     """The intervals ``(opens, closes)`` (s) within ``window`` in which attitude ``q`` keeps every
-    zone of ``zones`` (a ZoneSky or None) by ``margin`` rad: among moving zones, runs of clear
+    zone of ``zones`` (a FittedZones or None) by ``margin`` rad: among moving zones, runs of clear
     samples ``step`` s apart (within the zones' window, where their fit holds); [] if never."""
     opens, closes = float(window[0]), float(window[1])
     if zones is not None and zones.moving:
@@ -200,7 +200,7 @@ class OrderSolver:
     substeps: int = SUBSTEPS
     rate_max: float = np.inf
     deadline: float | None = None
-    zones: object = None              # att_planner.zones.ZoneSky or None
+    zones: object = None              # att_planner.zones.FittedZones or None
     zone_margin: float = 0.0          # rad, δ of every zone constraint
     dwell: dict = field(default_factory=dict)       # name -> s held at the target (absent: a passage)
     visible: dict = field(default_factory=dict)     # name -> sorted (opens, closes) s it may be observed in

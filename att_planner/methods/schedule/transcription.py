@@ -7,11 +7,11 @@ middle of every interval (the attitude there by one more RK4 step of half the in
 node, the propagation itself unchanged), tightened by a margin δ like the time-optimal NLP's:
 keep-out ``a_z · R(q) s_z ≤ cos(θ_z + δ)``, keep-in ``≥ cos(θ_z − δ)``. A moving zone is evaluated
 at the point's physical time over the whole tour, ``t = t_sat Σ dτ`` of the intervals before it
-(so a leg starts at the sum of the earlier legs' durations), through the ZoneSky's Chebyshev series
+(so a leg starts at the sum of the earlier legs' durations), through the FittedZones' Chebyshev series
 of that CasADi expression: exact in the phase durations. The tour is then bounded by the zones'
 window. Without zones nothing is added: the NLP is the zone-free one.
 
-Observations (issue 17): each target's dwell (τ) is a parameter, in the order's sequence; a target
+Observations: each target's dwell (τ) is a parameter, in the order's sequence; a target
 with one is reached at rest (its x and y rates zero too) and held, torque-free, before the next leg,
 so every later node's time moves by it; each arrival time is a constraint row whose bounds are the
 target's window (both set per solve); moving zones are kept on a held target through its dwell."""
@@ -36,7 +36,7 @@ class _Scaling:
     u = T_u / T̄ ∈ [−1, 1], time τ = t / t_sat with t_sat = h̄ / T̄ (so dh/dτ = u).
     ``rate_matrix`` W maps h to the body rate per unit τ, ω t_sat = W h (equation (1)).
     The NLP's wheel state is the relative speed ν = (Ω − Gᵀω) / Ω̄ = M h, M = 𝟙 + I_w Gᵀ J⁻¹ G
-    (by (1)), so the truth model's limit |ν| ≤ 1 (att_sim.models.dynamics) is a box on it: a row M h
+    (by (1)), so the dynamics model's limit |ν| ≤ 1 (att_sim.models.dynamics) is a box on it: a row M h
     next to the box on h, 2.5e-5 inside it for the Olivares spacecraft, left IPOPT nearly
     coincident barriers (in C's fast run one start took 975 iterations to Infeasible_Problem_Detected)."""
 
@@ -136,7 +136,7 @@ class MultiphaseTranscription:
     Built once per (number of targets, intervals per phase); the target quaternions of an order
     and the end attitude are NLP parameters, so every order of the same set reuses the solver.
     Either end may be at rest (h = 0) or a passage (only ω_z = 0), chosen per solve. ``zones``: a
-    :class:`att_planner.zones.ZoneSky` (module docstring) with ``zone_margin`` δ (rad), or None.
+    :class:`att_planner.zones.FittedZones` (module docstring) with ``zone_margin`` δ (rad), or None.
     """
 
     def __init__(self, sc: dyn.Spacecraft, n_targets: int, intervals: int = 12, substeps: int = SUBSTEPS,
@@ -223,8 +223,8 @@ class MultiphaseTranscription:
         return g, np.full(n, -np.inf), np.full(n, np.inf)
 
     def _wheel_speed_rows(self, V, bound_margin: float):
-        """The inertial wheel speed h = M⁻¹ν within the limit too (as before the truth model limited
-        the relative speed), only on the wheels where the box on ν does not already imply it (none
+        """The inertial wheel speed h = M⁻¹ν within the limit too (besides the relative
+        speed the dynamics limit), only on the wheels where the box on ν does not already imply it (none
         with wheels on principal axes: M is then diagonal, ≥ 1). Both are linear in ν, so the bounds
         at the nodes hold everywhere."""
         inverse = self._per_nu(np.eye(self.sc.n_wheels))
@@ -284,11 +284,11 @@ class MultiphaseTranscription:
 
     def _zone_function(self, margin: float) -> ca.Function:
         """``(q, τ) -> g`` (moving zones, τ the tour's normalised time) or ``q -> g`` (none moving):
-        the zone constraints ``g ≤ 0`` of :meth:`att_planner.zones.ZoneSky.casadi_constraints`."""
+        the zone constraints ``g ≤ 0`` of :meth:`att_planner.zones.FittedZones.casadi_constraints`."""
         q, tau = ca.SX.sym("q", 4), ca.SX.sym("tau")
         moving = self.zones.moving
         g = ca.vertcat(*self.zones.casadi_constraints(tau * self.scale.t_sat if moving else 0.0,
-                                                      symbolic.dcm(q), margin))
+                                                      symbolic.dcm_NB(q), margin))
         return ca.Function("zones", [q, tau] if moving else [q], [g])
 
     # -- guesses ----------------------------------------------------------------------------
@@ -343,12 +343,12 @@ class MultiphaseTranscription:
             for z in np.flatnonzero(zs.margins(t[k], out[k])[0] < 0):
                 s_z = zs.sensor_axes[z] / np.linalg.norm(zs.sensor_axes[z])
                 a, theta = zs.axes(t[k])[z], zs.half_angles(t[k])[z]
-                b = rot.dcm(out[k]) @ s_z
+                b = rot.dcm_NB(out[k]) @ s_z
                 radial = b - (b @ a) * a
                 if zs.keep_in[z]:
                     rho, side = theta - beyond, radial
                 else:                   # off the plane of b_{k-1}, b_{k+1}: round the zone
-                    normal = np.cross(rot.dcm(q[k - 1]) @ s_z, rot.dcm(q[k + 1]) @ s_z)
+                    normal = np.cross(rot.dcm_NB(q[k - 1]) @ s_z, rot.dcm_NB(q[k + 1]) @ s_z)
                     normal = normal - (normal @ a) * a
                     rho = theta + beyond
                     side = radial + (normal / np.linalg.norm(normal) if np.linalg.norm(normal) > 1e-12 else 0.0)
@@ -435,7 +435,7 @@ def cached_transcription(sc: dyn.Spacecraft, n_targets: int, intervals: int, sub
                          rate_max: float, expand: bool | None = None, zones=None,
                          zone_margin: float = 0.0) -> MultiphaseTranscription:
     """Solver cache: an NLP depends only on the spacecraft, the number of targets, the grid and the
-    zones (a ZoneSky, by identity: the cached NLP holds it, so its id stays unique)."""
+    zones (a FittedZones, by identity: the cached NLP holds it, so its id stays unique)."""
     zone_key = None if zones is None or not zones.zones else (id(zones), float(zone_margin))
     key = (sc.inertia.tobytes(), sc.wheel_axes.tobytes(), sc.wheel_inertia, sc.wheel_torque_max,
            sc.wheel_speed_max, n_targets, intervals, substeps, rate_max, expand, zone_key)

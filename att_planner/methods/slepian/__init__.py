@@ -2,8 +2,8 @@
 
 In normalised time τ = t/t_f ∈ [0, 1] the body rate is ω*_j(τ_ℓ) = Σ_k α_jk v_k(τ_ℓ), with v_k the
 first M discrete prolate spheroidal sequences of length N and half-bandwidth W (unit energy,
-``scipy.signal.windows.dpss(N, N W, Kmax=M)``). With the conventions of the issue (Celani & Bruni
-2021, Celani & Lucarelli), on τ_ℓ = (ℓ−1)/N, ℓ = 1..N, Δτ = 1/N:
+``scipy.signal.windows.dpss(N, N W, Kmax=M)``). With the conventions of Celani & Bruni
+(2021) and Celani & Lucarelli, on τ_ℓ = (ℓ−1)/N, ℓ = 1..N, Δτ = 1/N:
 
 * attitude by zero-order hold, R_{ℓ+1} = R_ℓ exp(Δτ ω*_ℓ×) (N+1 attitudes, R_1 = R_i);
 * torque T*_ℓ = J (ω*_ℓ − ω*_{ℓ−1})/Δτ + ω*_ℓ × J ω*_ℓ (backward difference, zero at ℓ = 1);
@@ -20,10 +20,10 @@ product of exponentials (equivalent to the spectral formula for ∂exp(A + xB)/�
 Lucarelli, and regular at α = 0, where an eigen-decomposition formula meets the triple zero
 eigenvalue of 0× and needs its confluent limit; here J_r(0) = I).
 
-Zones (issue 13; :mod:`att_planner.zones`): zone z with body sensor axis s_z, sign σ_z (+1 keep-out,
+Zones (:mod:`att_planner.zones`): zone z with body sensor axis s_z, sign σ_z (+1 keep-out,
 −1 keep-in), axis a_z(t) and half-angle θ_z(t) is the row c_kz = σ_z (a_z(t_k)·R_k s_z − cos(θ_z(t_k) +
 σ_z m)) ≤ 0 at the physical time t_k = τ_k t_f. A cone is a static keep-out zone (no t_f in its row:
-cone-only plans are exactly those of issue 3). With moving zones the rows couple to t_f, the
+cone-only plans are exactly those of Celani & Bruni's cone rows). With moving zones the rows couple to t_f, the
 minimum-time program's epigraph variable in other units (t_f = sqrt(J_s s/T̄)), through the exact
 column ∂c/∂t_f = σ τ_k (ȧ·R_k s + sin θ̃ θ̇) (:mod:`.model`, :class:`.sqp._Rows`); MSSA holds t_f per
 solve and iterates it to its fixed point, DFSP takes each point's own t_f.
@@ -31,7 +31,7 @@ solve and iterates it to its fixed point, DFSP takes each point's own t_f.
 The final-attitude equality tr(R_fᵀ R_{N+1}) = 3 of the papers has a vanishing gradient at its
 solution (it is a maximum of the trace), which breaks the constraint qualification of any SQP/IP
 solver. The solvers here use the equivalent, well-conditioned 3-vector vee(log(R_fᵀ R_{N+1})) = 0
-(exact Jacobian through the inverse left Jacobian); the issue's quantity 3 − tr(...) is reported.
+(exact Jacobian through the inverse left Jacobian); the residual 3 − tr(...) is reported.
 
 Modules: :mod:`.model` (basis, discretisation, exact derivatives), :mod:`.sqp` (SLSQP on a working
 set of rows: MSSA and one local minimum-time solve), :mod:`.dfsp`, :mod:`.planner` (the global

@@ -30,7 +30,7 @@ def _log_so3(R: np.ndarray) -> np.ndarray:
     if th < 1e-6:
         return w * (1.0 + th * th / 6.0)
     if th > np.pi - 1e-6:                     # θ ≈ π: axis from the symmetric part
-        axis = rot.to_axis_angle(rot.from_dcm(R))[0]
+        axis = rot.to_axis_angle(rot.from_dcm_NB(R))[0]
         return axis * th
     return w * (th / np.sin(th))
 
@@ -95,13 +95,13 @@ class SmoothManeuver:
     ``zone_sensors[zone_sensor_index[z]]`` (one row per distinct axis), sign σ_z = ``zone_sign``
     (+1 keep-out, −1 keep-in) and constraint c_kz = σ_z (a_z(t_k)·R_k s_z − cos(θ_z(t_k) + σ_z m)) ≤ 0
     at t_k = τ_k t_f. The optimiser keeps the angular margin m = ``zone_margin`` (outside a
-    keep-out zone, inside a keep-in one) so that the truth integration of the ZOH torque (which
+    keep-out zone, inside a keep-in one) so that the predicted trajectory of the ZOH torque (which
     lags the model by half a sample) stays clear; a zone with an end on its boundary
     (``zone_ramp``, :func:`att_planner.cones.boundary_end_zones`) gets ``−tol + (m + tol) w(τ_k)``
     instead, w the end ramp of a smooth plan (:func:`att_planner.cones.end_ramp`, ``SMOOTH_END_RAMP``).
     Static zones (``zone_sky`` None): constant axes
     ``cone_dirs`` and ``cone_cos`` = cos(θ_z + σ_z m). Moving zones: ``zone_sky``
-    (:class:`att_planner.zones.ZoneSky`) gives a_z(t), θ_z(t) and their rates, and ``cone_dirs``,
+    (:class:`att_planner.zones.FittedZones`) gives a_z(t), θ_z(t) and their rates, and ``cone_dirs``,
     ``cone_cos`` hold the values at t = 0.
     """
 
@@ -122,7 +122,7 @@ class SmoothManeuver:
     zone_sign: np.ndarray = field(default_factory=lambda: np.zeros(0))   # (Z,) +1 keep-out, −1 keep-in
     zone_margin: float = 0.0
     zone_ramp: np.ndarray = field(default_factory=lambda: np.zeros(0, bool))   # (Z,) margins ramped at the ends
-    zone_sky: Any = None                                     # ZoneSky of moving zones, else None
+    zone_sky: Any = None                                     # FittedZones of moving zones, else None
     sky_memo: dict = field(default_factory=dict, compare=False, repr=False)   # (K, t_f, rates) → zone sky arrays
 
     @property
@@ -172,7 +172,7 @@ def build_maneuver(problem: ManeuverProblem, M: int = PAPER_M, N: int = PAPER_N,
     cos = np.cos(np.asarray(sky.half_angles(0.0), float).reshape(-1) + sign * cone_margin)
     r = np.asarray(problem.sensor_axis, float)
     r = r / np.linalg.norm(r)
-    sensors = [r]           # the problem's sensor first: today's cones share it
+    sensors = [r]           # the problem's sensor first: the cones share it
     index = []
     for z in zones:
         s = np.asarray(z.sensor_axis, float)
@@ -187,7 +187,7 @@ def build_maneuver(problem: ManeuverProblem, M: int = PAPER_M, N: int = PAPER_N,
         smallest = np.eye(3)[np.argmin(np.abs(target))]    # never within 25° of the target
         tbasis = np.stack(rot.orthonormal_basis(target, references=(smallest, smallest)))
     return SmoothManeuver(slepian_basis(N, W, M), J / scale, scale, float(problem.spacecraft.body_torque_max),
-                          rot.dcm(problem.q_initial), rot.dcm(problem.q_final), r, dirs, cos, target, tbasis, W,
+                          rot.dcm_NB(problem.q_initial), rot.dcm_NB(problem.q_final), r, dirs, cos, target, tbasis, W,
                           np.array(sensors), np.array(index, int), sign, float(cone_margin),
                           boundary_end_zones(problem, cone_margin), sky if sky.moving else None)
 
@@ -239,8 +239,8 @@ def _zone_cos(man: SmoothManeuver, K: int) -> np.ndarray:
 
 def _static_zones(man: SmoothManeuver, R: np.ndarray, jac: bool):
     """Constant zones: c = σ (b·a − cos(θ + σ m)) and the (N+1, Z, 3) vectors σ b × a, one
-    product per distinct sensor (a single sensor: exactly the cone rows of issue 3)."""
-    if len(man.zone_sensors) == 1:      # the fast path of today's cones
+    product per distinct sensor (a single sensor: exactly the cone rows of Celani & Bruni 2021)."""
+    if len(man.zone_sensors) == 1:      # the fast path of the cones
         b = R @ man.zone_sensors[0]
         values = b @ man.cone_dirs.T - _zone_cos(man, R.shape[0])
         bw = rot.cross(b[:, None, :], man.cone_dirs[None, :, :]) if jac else None

@@ -74,8 +74,8 @@ def solve_min_time(man: SmoothManeuver, *, basis_sizes: tuple = (4, 8), starts: 
        x ~ N(0, start_scale²), then α = 0 (eigenaxis-like); each a local epigraph solve, runaway
        starts are cut.
     2. Continuation of the best coarse solution over ``basis_sizes`` (zero-padded α), still coarse.
-    3. Refinement at the full N with the final basis size: t_f and α follow the issue's
-       conventions exactly. ``end_ratio`` keeps torque and rate ≈ 0 at both ends for M > 4.
+    3. Refinement at the full N with the final basis size: t_f and α follow the
+       conventions of Celani & Bruni (2021) exactly. ``end_ratio`` keeps torque and rate ≈ 0 at both ends for M > 4.
     With a deadline (``time_budget`` or ``deadline``) stage 1 stops at half the budget and stage
     2 at three quarters, so the refinement always gets its turn.
     ``seeds``: α (3, M ≤ the final basis size, at N) of other plans (:func:`plan_alpha`), each solved
@@ -228,11 +228,11 @@ def physical_profile(man: SmoothManeuver, alpha: np.ndarray, spacecraft: Spacecr
     torque = np.zeros((N + 1, 3))
     torque[:N] = ev.torque * man.inertia_scale / tf**2
     if spacecraft is None:
-        q = rot.from_dcm(ev.R)
+        q = rot.from_dcm_NB(ev.R)
         omega = np.zeros((N + 1, 3))
         omega[1:] = ev.omega / tf
     else:
-        x0 = dyn.initial_state(spacecraft, rot.from_dcm(man.R_initial))
+        x0 = dyn.initial_state(spacecraft, rot.from_dcm_NB(man.R_initial))
         traj = dyn.simulate_profile(spacecraft, x0, t, torque, kind=ControlKind.BODY_TORQUE,
                                     interpolation=Interpolation.ZOH, max_step=tf / N)
         q, omega = traj.q, traj.omega

@@ -14,8 +14,8 @@ from att_planner.methods.slepian.model import Evaluation, SmoothManeuver, evalua
 
 @dataclass
 class SlepianResult:
-    """Solution of one solver: α (3, M) in the issue's convention, t_f, whether it meets the
-    constraints, and the outcome fields every result of the suite has."""
+    """Solution of one solver: α (3, M) in the convention of :mod:`att_planner.methods.slepian`, t_f,
+    whether it meets the constraints, and the outcome fields every result of the suite has."""
 
     alpha: np.ndarray
     tf: float

@@ -1,5 +1,5 @@
 """The IPOPT iteration callback of :class:`.collocation.Transcription`: a deadline, and the best
-feasible iterate met on the way (anytime answers, issue 18)."""
+feasible iterate met on the way (anytime answers)."""
 from __future__ import annotations
 
 import time

@@ -21,7 +21,7 @@ an expression of the duration variables, so its derivatives with respect to them
 keep-out zones); :mod:`~att_planner.methods.time_optimal.mesh` checks them between those points and
 refines the mesh where they fail. A phase may give
 the path constraints a last input ``w(τ)``, a known function of the mesh fraction (the ramp of a
-tightening near the ends, issue 19), evaluated at each point.
+tightening near the ends), evaluated at each point.
 
 Phases are joined, bounded and scored through :class:`Transcription` (``add_constraint``,
 ``minimize``), so the same machinery serves a single free-time slew and a multiphase schedule.

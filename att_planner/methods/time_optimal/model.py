@@ -90,7 +90,7 @@ def wheel_speed_values(problem: ManeuverProblem, s: Scaling) -> np.ndarray:
     M1 = sc.wheel_axes_pinv / (sc.wheel_inertia * limit)
     M2 = (sc.wheel_axes_pinv @ sc.inertia / sc.wheel_inertia + sc.wheel_axes.T) / (s.tu * limit)
     a = (speeds0 - sc.wheel_axes_pinv @ h0_B / sc.wheel_inertia) / limit
-    H_N = rot.dcm(rot.normalize(np.asarray(problem.q_initial, float))) @ h0_B
+    H_N = rot.dcm_NB(rot.normalize(np.asarray(problem.q_initial, float))) @ h0_B
     return np.concatenate([M1.ravel(order="F"), M2.ravel(order="F"), a, H_N])
 
 
@@ -114,7 +114,7 @@ def path_function(problem: ManeuverProblem, s: Scaling, n_state: int = 7, cone_m
     ``a_z · b_z ≤ cos(θ_z + δ)``, keep-in ``a_z · b_z ≥ cos(θ_z − δ)``, i.e.
     ``σ_z (a_z · b_z − cos(θ_z + σ_z δ)) ≤ 0``. A fixed zone's data are in ``p``
     (:data:`ZONE_PARAMETERS`). When a zone moves, ``t`` is the normalised time from the start and
-    ``a_z``, ``θ_z`` are the ZoneSky's Chebyshev series of ``t τ_u``, so the collocation couples them
+    ``a_z``, ``θ_z`` are the FittedZones' Chebyshev series of ``t τ_u``, so the collocation couples them
     exactly to ``t_f``: their coefficients are in ``p`` too (:func:`motion_parameters`, the series in
     ``x = α t + β``) when every moving zone is one series of a degree of :data:`MOTION_DEGREES`,
     otherwise the series are constants of the function (tightened by ``cone_margin``). The wheels'
@@ -131,7 +131,7 @@ def path_function(problem: ManeuverProblem, s: Scaling, n_state: int = 7, cone_m
     x, u, t = ca.SX.sym("x", n_state), ca.SX.sym("u", 3), ca.SX.sym("t")
     per_zone = 0 if degree is None else motion_parameters(degree)
     p = ca.SX.sym("p", ZONE_PARAMETERS * sum(fixed) + per_zone * moving + 7 * wheels + 3 * bool(wheels) + momentum)
-    R = symbolic.dcm(x[:4])
+    R = symbolic.dcm_NB(x[:4])
     g = []
     for k in range(sum(fixed)):
         sign, sensor, axis, cos = (p[ZONE_PARAMETERS * k], p[ZONE_PARAMETERS * k + 1:ZONE_PARAMETERS * k + 4],
@@ -249,7 +249,7 @@ def weighted_path_function(problem: ManeuverProblem, s: Scaling, cone_margin: fl
     ``a · b ≥ cos(θ + ε)`` (an equality there would repeat the fixed start and the final pointing,
     which IPOPT cannot solve: rank-deficient constraints). When a zone moves,
     the function is ``(x, u, t[, w]) -> g`` with ``t`` the normalised time from the start: ``a_z(t τ_u)``
-    and ``θ_z(t τ_u)`` are the ZoneSky's Chebyshev series of that CasADi expression, so the
+    and ``θ_z(t τ_u)`` are the FittedZones' Chebyshev series of that CasADi expression, so the
     collocation couples them exactly to ``t_f``. Without motion it is ``(x, u[, w]) -> g`` with the
     zones constant (no time dependence is built)."""
     x, u, t, w = ca.SX.sym("x", n_state), ca.SX.sym("u", 3), ca.SX.sym("t"), ca.SX.sym("w")
@@ -257,7 +257,7 @@ def weighted_path_function(problem: ManeuverProblem, s: Scaling, cone_margin: fl
     ramped = boundary_end_zones(problem, cone_margin)
     margins = [-BOUNDARY_TOLERANCE + (cone_margin + BOUNDARY_TOLERANCE) * w if near else cone_margin
                for near in ramped]
-    R = symbolic.dcm(x[:4])
+    R = symbolic.dcm_NB(x[:4])
     if problem.boundary_cone is not None:
         margins[problem.boundary_cone] = 0.0
     g = zones.casadi_constraints(t * s.tu if zones.moving else 0.0, R, margins)
@@ -292,13 +292,13 @@ def transcription(problem: ManeuverProblem, s: Scaling, mesh: np.ndarray, contro
 
     The NLP is built once per shape and kept (:data:`CACHE_SIZE`): the spacecraft's inertia, the
     number of intervals, the zones' count and series degree (moving zones of many pieces: their
-    ZoneSky), the bounds on the
+    FittedZones), the bounds on the
     rate and momentum, the kind of goal and the settings. The mesh, the zones' data, the goal and the
     momentum scale are its parameters, the start and the duration's bounds its variables' bounds
     (set here), so a second problem of that shape only copies it (:meth:`.collocation.Transcription.copy`).
     Moving zones (timed path constraints) keep one t_f; fixed ones chain copies of it per interval
     (a banded KKT system, far fewer iterations; with moving zones the copies took more). A problem
-    with a boundary end or a forced boundary arc (:func:`boundary_case`, issue 19) gets an NLP of its
+    with a boundary end or a forced boundary arc (:func:`boundary_case`) gets an NLP of its
     own, with :func:`weighted_path_function`'s constraints."""
     smooth = torque_accel is not None
     zones = problem.zone_sky()
@@ -365,7 +365,7 @@ def _build(problem: ManeuverProblem, s: Scaling, mesh: np.ndarray, control: str,
         tr.add_constraint(symbolic.error_vector(q_end, tr.extra), 0.0, 0.0)
     else:
         target, e1, e2, r = (tr.extra[3 * k:3 * k + 3] for k in range(4))
-        b = ca.mtimes(symbolic.dcm(q_end), r)
+        b = ca.mtimes(symbolic.dcm_NB(q_end), r)
         tr.add_constraint(ca.vertcat(ca.dot(e1, b), ca.dot(e2, b)), 0.0, 0.0)
         tr.add_constraint(ca.dot(target, b), 0.0, np.inf)
     tr.minimize(v.duration)

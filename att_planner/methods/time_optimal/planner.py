@@ -15,16 +15,16 @@ torque ``u = T/T̄``, rate ``ω̃ = ω τ``)::
                     relative to the body within their limit (the momentum stored at the start turned
                     with the body plus the slew's share: :func:`.model.wheel_speed_constraints`).
 
-A moving goal (issue 15: ``problem.goal_motion``, a pointing law) replaces the final attitude and
+A moving goal (``problem.goal_motion``, a pointing law) replaces the final attitude and
 the final rest by ``vec(q_g(t_f)ᶜ ⊗ q(t_f)) = 0`` and ``ω̃(t_f) = ω̃_g(t_f)``, the goal's Chebyshev
 series in t_f (:func:`.model.moving_goal_values`), so the slew ends on it at its rate.
 
-The zones are ``problem.zone_sky()`` (:mod:`att_planner.zones`: today's cones as inertial zones of
+The zones are ``problem.zone_sky()`` (:mod:`att_planner.zones`: the keep-out cones as inertial zones of
 the sensor ``r``, then Sun, Moon, Earth-limb and inertial zones, each of its own sensor). A zone
 that moves is imposed at each collocation point's physical time ``t = τ_k t_f`` through the
-ZoneSky's Chebyshev series of that CasADi expression, so the NLP's derivatives with respect to t_f
+FittedZones' Chebyshev series of that CasADi expression, so the NLP's derivatives with respect to t_f
 are exact (no frozen snapshot is iterated); ``t_f`` is then bounded by the series' window. Without
-motion the constraints are constants and the NLP is today's.
+motion the constraints are constants and the NLP is the one of fixed cones.
 
 The ``½(1 − |q|²) q`` term vanishes on unit quaternions and makes the unit sphere attracting, so the
 discretised norm cannot drift. Transcription: Hermite–Simpson (:mod:`.collocation`, the model in :mod:`.model`)
@@ -38,7 +38,7 @@ routes — eigenaxis both ways round, tilted two-leg routes and the cone-riding 
 each turned into a continuous bang-bang guess and solved on a coarse mesh; (2) the best converged
 solution is refined: intervals where the torque switches or a zone constraint fails between
 collocation points are split (in quarters, once by default) and the NLP re-solved from the
-interpolated solution; (3) the torque is integrated through the truth dynamics
+interpolated solution; (3) the torque is integrated through the prediction model
 (:mod:`att_planner.verification`); a failure refines again.
 """
 from __future__ import annotations
@@ -58,7 +58,7 @@ from att_planner.methods.time_optimal.model import Scaling, plan_arrays, scaling
 from att_planner.methods.time_optimal.routes import Route, candidate_routes, route_guess, select_routes, zone_margin
 from att_planner.methods.time_optimal.swarm import swarm_plan
 from att_planner.problem import ManeuverProblem
-from att_planner.verification import clearances, integrate, measure, rejection
+from att_planner.verification import clearances, measure, predict, rejection
 from att_sim.models import rotations as rot
 
 METHOD = "time_optimal"
@@ -170,7 +170,7 @@ class _Incumbent:
     def check(self, sol: col.PhaseSolution):
         """Truth verification of ``sol``: (accepted, plan with its verification, trajectory)."""
         plan = self.run.plan(sol)
-        traj = integrate(self.run.problem, plan)
+        traj = predict(self.run.problem, plan)
         plan.verification = measure(self.run.problem, plan, traj)
         return rejection(plan.verification) is None, plan, traj
 

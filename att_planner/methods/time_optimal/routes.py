@@ -8,7 +8,7 @@ Zones that move (:mod:`att_planner.zones`): a route's margin is measured against
 physical time the route passes each attitude (its bang-bang timing), and a moving keep-out zone is
 ridden as the cone it is when the sensor passes it: frozen at the time of the eigenaxis route's
 closest approach, then once more at the time of the riding route's own closest approach. Inertial
-zones are constant, so for today's cones every route is what it was.
+zones are constant, so among keep-out cones alone every route is the frozen one.
 """
 from __future__ import annotations
 
@@ -39,7 +39,7 @@ class Route:
 
 def zone_margin(problem: ManeuverProblem, t: np.ndarray, q: np.ndarray) -> float:
     """Smallest margin (rad) of attitudes ``q`` (K, 4) at times ``t`` (K,) s over every zone of the
-    problem (:meth:`att_planner.zones.ZoneSky.margins`, the fitted motion; a time past the zones'
+    problem (:meth:`att_planner.zones.FittedZones.margins`, the fitted motion; a time past the zones'
     window counts as its end, for a guess only); +inf without zones."""
     zones = problem.zone_sky()
     m = zones.margins(np.minimum(t, zones.window), q)
@@ -69,7 +69,7 @@ def _leg_route_functions(problem: ManeuverProblem, scaling: Scaling, legs):
     total = sum(leg.angle for leg in legs)
     alpha, peak = np.inf, np.inf
     for leg in legs:
-        e = rot.dcm(q).T @ leg.axis
+        e = rot.dcm_BN(q) @ leg.axis
         alpha = min(alpha, axis_acceleration(scaling.Jn, e, total, 1.0))
         peak = min(peak, _peak_rate(problem, scaling, e))
         starts.append(q)
@@ -155,7 +155,7 @@ def candidate_routes(problem: ManeuverProblem, scaling: Scaling, tilt_deg: float
             _estimate(problem, scaling, routes[-1])
     if problem.sensor_target is not None:
         r = np.asarray(problem.sensor_axis, float)
-        b = rot.dcm(rot.normalize(np.asarray(problem.q_final, float))) @ r
+        b = rot.dcm_NB(rot.normalize(np.asarray(problem.q_final, float))) @ r
         s = np.asarray(problem.sensor_target, float)
         if b @ s / np.linalg.norm(b) / np.linalg.norm(s) > np.cos(np.deg2rad(0.5)):
             full = replace(problem, sensor_target=None)

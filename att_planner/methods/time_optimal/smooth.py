@@ -1,4 +1,4 @@
-"""Minimum time with a C¹ torque (issue 18): the time-optimal collocation of :mod:`.planner` with the
+"""Minimum time with a C¹ torque: the time-optimal collocation of :mod:`.planner` with the
 torque a smooth state instead of a bang-bang control.
 
 Normalised as in :mod:`.planner` (time unit ``τ_u = sqrt(J0/T̄)``, torque ``u = T/T̄``), the state is
@@ -16,7 +16,7 @@ torque's chain of integrators exactly, so the plan samples each interval's quadr
 given plans (``warm_starts``: the planner service passes its first plan) or, without them, from
 :func:`att_planner.methods.graph_smooth.plan_graph_smooth`'s plan; the durations of the intervals are
 built once per shape (:func:`.model.transcription`, which holds the NLP of both). The solution is
-integrated through the truth dynamics (:mod:`att_planner.verification`); where the dense grid
+integrated through the prediction model (:mod:`att_planner.verification`); where the dense grid
 enters a zone the mesh is bisected and the NLP solved again (:data:`REFINE_ROUNDS` times at most).
 Anytime: when the deadline stops IPOPT before it converges, the iterate of least t_f that met the
 constraints (:data:`.anytime.INCUMBENT_VIOLATION`) becomes the plan, if it verifies (on
@@ -38,7 +38,7 @@ from att_planner.methods.time_optimal import mesh as meshes
 from att_planner.methods.time_optimal.model import Scaling, rigid_body_dynamics, scaling, transcription
 from att_planner.methods.time_optimal.planner import CONVERGED_VIOLATION, _truth_violation_intervals
 from att_planner.problem import ManeuverProblem
-from att_planner.verification import integrate, measure, rejection
+from att_planner.verification import measure, predict, rejection
 from att_sim.models import rotations as rot
 
 METHOD = "smooth_collocation"
@@ -136,7 +136,7 @@ def plan_smooth_collocation(problem: ManeuverProblem, *, intervals: int = DEFAUL
         # not converged when the deadline came: the feasible iterate of least t_f, if it verifies
         sol = tr.phase_solution(incumbent if w is None else w)
         plan = smooth_plan(sol, s)
-        traj = integrate(problem, plan)
+        traj = predict(problem, plan)
         plan.verification = measure(problem, plan, traj)
         best = plan if best is None or rejection(plan.verification) is None else best
         # the plan's times are the solution's slowed by c: the truth's samples back on the solution's mesh

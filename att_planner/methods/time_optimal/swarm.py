@@ -1,5 +1,5 @@
 """Melton's (2012) two-stage proposal, its first stage: a particle swarm over a Chebyshev torque
-parametrisation, a fast global search whose best plan seeds the collocation (issue 19).
+parametrisation, a fast global search whose best plan seeds the collocation.
 
 Each particle is ``(c, t_f)``: per body axis the torque ``u_j(τ) = tanh(Σ_k c_jk T_k(2τ − 1))``
 (Chebyshev polynomials ``T_k`` up to :data:`DEGREE`; tanh keeps ``|u_j| < 1`` and lets large
@@ -80,7 +80,7 @@ def cost(problem: ManeuverProblem, s: Scaling, coefficients: np.ndarray, tf: np.
     else:
         r = np.asarray(problem.sensor_axis, float) / np.linalg.norm(problem.sensor_axis)
         target = np.asarray(problem.sensor_target, float) / np.linalg.norm(problem.sensor_target)
-        error = np.arccos(np.clip(rot.dcm(q_end) @ r @ target, -1.0, 1.0))
+        error = np.arccos(np.clip(rot.dcm_NB(q_end) @ r @ target, -1.0, 1.0))
     end = error + np.linalg.norm(x[:, -1, 4:], axis=1)
     zones = problem.zone_sky()
     violation = np.zeros(P)

@@ -1,4 +1,4 @@
-"""Melton's (2012) boundary cases (issue 19) for ``att-bench time-optimal --case {ba1,ba2,bp1,bp2}``.
+"""Melton's (2012) boundary cases for ``att-bench time-optimal --case {ba1,ba2,bp1,bp2}``.
 
 For the case: ``time_optimal`` (multi-start, the plan of the JSON whatever ``--method``; the others'
 figures under ``plans``), ``time_optimal`` with Melton's

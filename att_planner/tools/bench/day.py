@@ -1,4 +1,4 @@
-"""day: a day in orbit flown by the nodes (issue 17), its targets, margins and wheels.
+"""day: a day in orbit flown by the nodes, its targets, margins and wheels.
 
 ``att-bench day [--mission NAME] [--out DIR] --json PATH`` flies a mission file (default
 ``config/missions/observatory_day.yaml``: the observatory's 16 sources from ``leo_observatory``

@@ -1,4 +1,4 @@
-"""estimation: the demo maneuver flown closed loop on the attitude estimate, and on the truth (issue 14).
+"""estimation: the demo maneuver flown closed loop on the attitude estimate, and on the truth.
 
 ``att-bench estimation [--scenario swift_demo] [--out DIR] --json PATH`` runs the scenario's demo
 maneuver twice through the ROS nodes (recorder, simulator, estimator, controller, planner, as
@@ -80,7 +80,7 @@ def figures(mcap: Path, scenario: scen.Scenario, maneuver: dict) -> dict:
     error = 2 * rot.error_vector(run.q[-1], maneuver["qf"])            # goal -> truth, body axes
     pointing = {}
     if tracker is not None:
-        C = rot.dcm(tracker.mounting)
+        C = rot.dcm_NB(tracker.mounting)
         pointing = {"final_pointing_sigmas": float(np.sqrt(error @ np.linalg.solve(C @ tracker.covariance @ C.T,
                                                                                     error))),
                     "pointing_bound_deg": float(np.degrees(3 * np.sqrt(np.trace(tracker.covariance))))}

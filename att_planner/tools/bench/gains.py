@@ -1,4 +1,4 @@
-"""Magnetorquer PD gains (issue 6): fixed-IC and robust min-max tuning next to Bruni & Celani's figures.
+"""Magnetorquer PD gains: fixed-IC and robust min-max tuning next to Bruni & Celani's figures.
 
 ``att-bench gains --mode fixed --json PATH``: DIRECT on log gains at IC (20) (target t_s ≤ 1.78
 orbits in ≤ 60 s). ``--mode robust``: min-max over H (target: a thorough worst case no worse than

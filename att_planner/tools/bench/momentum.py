@@ -1,4 +1,4 @@
-"""momentum: nadir pointing for days, with and without magnetorquer dumping (issue 15).
+"""momentum: nadir pointing for days, with and without magnetorquer dumping.
 
 ``att-bench momentum [--scenario leo_momentum] [--orbits 15] --json PATH`` runs the scenario through
 the ROS nodes (recorder, simulator, controller: the controller on the truth state) twice from the
@@ -32,7 +32,7 @@ from att_msgs_py.log import read_log
 from att_msgs_py.types import ControlMode, PointingMode
 from att_planner.control.momentum import null_space
 from att_planner.guidance import reference
-from att_planner.guidance.laws import Sky
+from att_planner.guidance.laws import PointingGeometry
 from att_planner.guidance.modes import law_of
 from att_planner.nodes.client import client_session
 from att_planner.tools.closed_loop import ClosedLoop
@@ -58,12 +58,13 @@ def configure(parser):
 def start_state(s: scen.Scenario, t: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The nadir attitude and rate at sim time ``t`` and the wheel speeds at the controller's
     null-space bias."""
-    law = law_of(PointingMode("nadir"), Sky.of(world.Environment.from_scenario(s)), t, np.array([0, 0, 0, 1.0]))
+    geometry = PointingGeometry.of(world.Environment.from_scenario(s))
+    law = law_of(PointingMode("nadir"), geometry, t, np.array([0, 0, 0, 1.0]))
     ref = reference(law.attitude, t)
     bias = float(s.node_params.get("controller", {}).get("null_space_speed", 0.0))
     N = null_space(s.spacecraft)
     wheels = N @ np.full(N.shape[1], bias) if N.size else np.zeros(s.spacecraft.n_wheels)
-    return ref.q, ref.omega, wheels + s.spacecraft.wheel_axes.T @ ref.omega      # inertial spin rates
+    return ref.q_RN, ref.omega_RN_R, wheels + s.spacecraft.wheel_axes.T @ ref.omega_RN_R      # inertial spin rates
 
 
 def fly(s: scen.Scenario, dumping: bool, seconds: float, out: Path) -> dict:

@@ -1,11 +1,11 @@
-"""observe: what the zones cost a schedule of observations (issue 17), on the real sky.
+"""observe: what the zones cost a schedule of observations, on the real sky.
 
 ``att-bench observe [--sources a,b,...] [--dwell S] [--substeps K] --json PATH`` plans a tour of
 observatory sources (``config/targets/observatory.yaml``, each held ``--dwell`` s) with
 :func:`att_planner.methods.schedule.plan_schedule` for ``leo_observatory``'s spacecraft (its wheels)
 from the real-sky case's start (:mod:`.sky`), twice: without any zone, and among the scenario's
 Sun, Moon and Earth-limb zones at their true positions (each observation kept out of them too).
-Both plans are verified by the truth integration; the JSON gives, per run, the order, t_f, the
+Both plans are verified by the prediction model; the JSON gives, per run, the order, t_f, the
 passages and observation ends, the verification, the compute time and the wheel-torque profile
 (``t``, ``torque``, ZOH) so that the plans can be integrated independently, and the zones' cost:
 the ratio of the two tours' t_f.

@@ -1,8 +1,8 @@
-"""Time-optimal attitude schedule through unordered targets (Olivares & Staffetti 2018), issue 5.
+"""Time-optimal attitude schedule through unordered targets (Olivares & Staffetti 2018).
 
 ``att-bench schedule --experiment {A,B,C} --json PATH`` plans experiment A (targets a–f), B (a–l)
 or C (a–r) with :func:`att_planner.methods.schedule.plan_schedule`, integrates the wheel torques
-through the truth dynamics (:mod:`att_planner.verification`) and prints the result next to the
+through the prediction model (:mod:`att_planner.verification`) and prints the result next to the
 published one. ``--exhaustive`` (A) solves all 720 orders; ``--grid-study`` re-solves the winning
 order on several grids; the a→b rest-to-rest slew (published 57.05 s collocation / 57.59 s DIDO)
 is always reported.

@@ -1,18 +1,18 @@
-"""sky: plans against the real, moving sky (issue 13) — the zones frozen at the start vs their motion.
+"""sky: plans against the real, moving sky — the zones frozen at the start vs their motion.
 
 ``att-bench sky --case {leo_observatory,moon_parallax} --json PATH`` plans each case twice with the
 default method (``slepian_minimum_time``) through the planner service's pipeline
 (:func:`att_planner.service.planning.plan_maneuver`: the method, then the suite's one verification):
 
 * ``frozen``: the method sees every zone as it is at the start epoch
-  (:meth:`att_planner.zones.ZoneSky.frozen_zones`, inertial cones — what planners that read the
+  (:meth:`att_planner.zones.FittedZones.frozen_zones`, inertial cones — what planners that read the
   zone directions once do);
 * ``moving``: the method sees the zones' motion (:meth:`ManeuverProblem.zone_sky`, Chebyshev fits).
 
-Both are verified against the motion: the truth integration of the plan's ZOH torque from rest at
+Both are verified against the motion: the prediction of the plan's ZOH torque from rest at
 ``q_initial``, every zone at its true position (orbit by SGP4, Sun and Moon by DE421) at every
 dense-grid time. The table gives t_f, compute, the minimum margin of each zone against the motion
-and the zone a plan enters; the JSON holds the issue's format (case, epoch, TLE, spacecraft,
+and the zone a plan enters; the JSON holds everything to redo it (case, epoch, TLE, spacecraft,
 attitudes, zones, both plans with their torques and verifications), so that the plans can be
 re-checked without the suite (test/att_planner/tools/test_bench_sky.py does so with its own RK4 and
 skyfield).
@@ -20,7 +20,7 @@ skyfield).
 Cases (:data:`CASES`), the earth_obs spacecraft of the smooth benchmark (J = diag(3000, 4500, 6000)
 kg m², 0.25 N m) with sensor +y and keep-out zones Sun 47°, Moon 23°, Earth limb + 10°:
 
-* ``leo_observatory`` — the issue's: the 135° slew about body x from identity, in the issue's
+* ``leo_observatory`` — the 135° slew about body x from identity, in a
   580 km / 20.56° TLE orbit, starting 460 s after 2026-12-21T00:00:00Z. The Earth-limb zone
   (76.6° about nadir, sweeping at orbit rate) then lies 3.5° from the start direction and rises
   over the first part of the path at ≈ 0.06°/s: the plan made against the frozen limb is overtaken
@@ -53,10 +53,10 @@ from att_planner import methods
 from att_planner.problem import ManeuverProblem
 from att_planner.service.planning import plan_maneuver, run_method
 from att_planner.service.requests import ValidRequest
-from att_planner.verification import integrate, rejection
+from att_planner.verification import predict, rejection
 from att_sim.models import rotations as rot
 from att_sim.models.dynamics import Spacecraft
-from att_sim.models.ephemeris import Sky
+from att_sim.models.ephemeris import Ephemeris
 from att_sim.models.epoch import format_epoch, parse_epoch
 from att_sim.models.orbit import TLEOrbit
 
@@ -89,7 +89,7 @@ SSO_TLE = ("1 90001U          27079.00000000  .00000000  00000-0  20000-4 0    0
 
 CASES = {
     "leo_observatory": SkyCase(
-        "issue 13: earth_obs 135 deg about body x, the Earth limb rising over the first part of the path",
+        "earth_obs 135 deg about body x, the Earth limb rising over the first part of the path",
         LEO_TLE, "2026-12-21T00:00:00Z", 460.0, tuple(rot.IDENTITY),
         tuple(rot.from_axis_angle(np.array([1.0, 0.0, 0.0]), 0.75 * math.pi))),
     "moon_parallax": SkyCase(
@@ -120,7 +120,7 @@ def case_problem(name: str, offset: float | None = None) -> tuple[SkyCase, Maneu
     zones = [Zone(n, body, sensor, math.radians(deg)) for n, body, deg in case.zones]
     sc = Spacecraft(inertia=np.diag(EARTH_OBS_J), body_torque_max=EARTH_OBS_TORQUE)
     problem = ManeuverProblem(sc, rot.normalize(np.array(case.q_initial)), rot.normalize(np.array(case.q_final)),
-                              sensor_axis=sensor, zones=zones, epoch=start, sky=Sky(start, orbit))
+                              sensor_axis=sensor, zones=zones, epoch=start, sky=Ephemeris(start, orbit))
     return case, problem
 
 
@@ -174,7 +174,7 @@ def verification(problem: ManeuverProblem, planned: ManeuverProblem, plan) -> di
     why = rejection(ver)
     margins = dict(zip(ver.zone_names, ver.cone_margins))
     worst = min(margins, key=margins.get) if margins else None
-    traj = integrate(problem, plan)
+    traj = predict(problem, plan)
     own = planned.zone_sky().margins(traj.t, traj.q).min(axis=0)
     return dict(asdict(ver), passes=why is None, rejection=why, zone_margins_vs_motion=margins,
                 entered=worst if worst is not None and margins[worst] < 0 else None,

@@ -1,9 +1,9 @@
-"""smooth: Slepian-basis keep-out-cone maneuvers (issue 3) — ours vs MSSA vs DFSP vs published.
+"""smooth: Slepian-basis keep-out-cone maneuvers — ours vs MSSA vs DFSP vs published.
 
 ``att-bench smooth --case {earth_obs,swift} [--method ...] --json PATH`` plans the case with each
 method through :func:`att_planner.methods.slepian.plan_slepian`, verifies every plan with the
-suite's verification (:mod:`att_planner.verification`: truth dynamics, ZOH torque from rest, dense
-grid, the named tolerances), adds the issue's figures (3 − tr(R_fᵀR(t_f)), end torques) and prints
+suite's verification (:mod:`att_planner.verification`: prediction model, ZOH torque from rest, dense
+grid, the named tolerances), adds the figures of Celani & Bruni (3 − tr(R_fᵀR(t_f)), end torques) and prints
 t_f and compute time next to the published figures (Celani & Bruni 2021). The JSON holds the
 selected method's plan (``case, method, N, W, M, alpha, tf, solve_seconds, verification``) and
 every method run under ``runs``.
@@ -18,7 +18,7 @@ import numpy as np
 
 from att_planner.methods import slepian as S
 from att_planner.reference.celani_bruni import CASES, PUBLISHED, benchmark_problem
-from att_planner.verification import integrate, measure, rejection
+from att_planner.verification import measure, predict, rejection
 from att_sim.models import rotations as rot
 
 UNITS = {"earth_obs": "s", "swift": "TU"}
@@ -42,16 +42,16 @@ def configure(parser):
 
 
 def verification(problem, plan) -> dict:
-    """The suite's verification of the plan (truth integration of its ZOH torque from rest) and the
-    issue's figures: 3 − tr(R_fᵀ R(t_f)) and the torque at the first and last applied samples."""
+    """The suite's verification of the plan (prediction of its ZOH torque from rest) and the figures
+    of Celani & Bruni: 3 − tr(R_fᵀ R(t_f)) and the torque at the first and last applied samples."""
     if not plan.success:
         return {"passes": False, "reason": plan.message}
-    traj = integrate(problem, plan)
+    traj = predict(problem, plan)
     ver = measure(problem, plan, traj)
     why = rejection(ver)
     applied = np.abs(plan.torque[:-1]).max(axis=1)
     tmax = problem.spacecraft.body_torque_max
-    return dict(asdict(ver), trace_residual=float(3.0 - np.trace(rot.dcm(problem.q_final).T @ rot.dcm(traj.q[-1]))),
+    return dict(asdict(ver), trace_residual=float(3.0 - np.trace(rot.dcm_BN(problem.q_final) @ rot.dcm_NB(traj.q[-1]))),
                 start_torque_ratio=float(applied[0] / tmax), end_torque_ratio=float(applied[-1] / tmax),
                 passes=why is None, rejection=why)
 
@@ -79,7 +79,7 @@ def run(args) -> dict:
         runs += [run_method(case, S.DEFAULT_METHOD, args, M=int(m)) for m in args.also_M.split(",") if m.strip()]
     pub = PUBLISHED[case]
     unit = UNITS[case]
-    print(f"smooth / {case}: t_f in {unit} (conventions of issue 3: N={args.N}, W={args.W}); "
+    print(f"smooth / {case}: t_f in {unit} (conventions of Celani & Bruni 2021: N={args.N}, W={args.W}); "
           f"load {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores")
     print(f"{'method':24s} {'M':>3s} {'t_f':>10s} {'compute s':>10s} {'published':>10s} {'pub. compute':>13s} "
           f"{'verified':>8s} {'3-tr':>9s} {'margin deg':>10s}")

@@ -1,4 +1,4 @@
-"""Soak: simulator + controller + recorder for N orbits as fast as possible (issue 7)."""
+"""Soak: simulator + controller + recorder for N orbits as fast as possible."""
 from __future__ import annotations
 
 import tempfile

@@ -1,4 +1,4 @@
-"""speed: anytime planning (issue 18) — the first verified plan, the best smooth plan, the time-optimal one.
+"""speed: anytime planning — the first verified plan, the best smooth plan, the time-optimal one.
 
 ``att-bench speed [--case ...] [--repeats 20] [--ros] --json PATH`` plans each case through the
 planner service's pipeline in this process (:func:`att_planner.service.planning.plan_maneuver`:
@@ -13,7 +13,7 @@ start in a forked child):
 * ``time_optimal``: a request for ``time_optimal`` with a budget of :data:`TIME_OPTIMAL_BUDGET` s,
   whose t_f is the physical limit the smooth plans are compared with; median of ``--best-repeats``.
 
-Every plan is verified by the service (truth integration, every zone at its true position). Each
+Every plan is verified by the service (prediction model, every zone at its true position). Each
 entry of the JSON is ``{"case", "first": P, "best": P, "time_optimal_tf", ...}`` with
 ``P = {"method", "tf", "t", "torque", "interpolation", "solve_seconds", "verification", ...}``,
 the profile convention of the smooth and time-optimal benchmarks (``interpolation`` says how the

@@ -1,10 +1,10 @@
-"""Time-optimal keep-out slews (issue 4): eigenaxis, constrained axis and collocation compared.
+"""Time-optimal keep-out slews: eigenaxis, constrained axis and collocation compared.
 
-``att-bench time-optimal --case {ba1,ba2,bp1,bp2} [--sweep]`` runs Melton's boundary cases instead
-(issue 19, :mod:`.boundary`).
+``att-bench time-optimal --case {ba1,ba2,bp1,bp2} [--sweep]`` runs Melton's (2012) boundary cases instead
+(:mod:`.boundary`).
 
 ``att-bench time-optimal --case {bilimoria_wie,swift} [--method M] [--budget S] --json PATH`` runs
-every method on the case, re-verifies each plan from rest at identity through the truth dynamics
+every method on the case, re-verifies each plan from rest at identity through the prediction model
 (:func:`att_planner.verification.verify`, the suite's one verification and tolerances), prints a
 table next to the published figures and writes the JSON of ``--method`` (default
 ``time_optimal``). Times are in TU (J = I, T̄ = 1).
@@ -51,7 +51,7 @@ def _verification(problem, plan) -> dict:
 def _semi_free_row(args) -> dict:
     """time_optimal with only the sensor direction imposed (Melton's semi-free final attitude)."""
     problem = case_problem(args.case)
-    problem = replace(problem, sensor_target=rot.dcm(problem.q_final) @ problem.sensor_axis,
+    problem = replace(problem, sensor_target=rot.dcm_NB(problem.q_final) @ problem.sensor_axis,
                       deadline=time.monotonic() + args.budget)
     plan = plan_time_optimal(problem, starts=args.starts)
     ver = _verification(problem, plan)       # semi-free: the attitude error is the boresight's

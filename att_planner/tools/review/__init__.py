@@ -15,14 +15,14 @@ executed plan, else the last magnetorquer-PD run, else the whole log), and write
   speeds with their limit, magnetorquer dipoles (commanded vs applied) with saturation, cone and
   zone margins (moving zones at their true positions at each recorded time), controller mode;
 * ``overview.png`` — a screenshot-sized digest (sky, margins, torque, wheel speeds);
-* ``estimation.png`` (a log with the estimator's attitude, issue 14) — the estimation error per
+* ``estimation.png`` (a log with the estimator's attitude) — the estimation error per
   body axis with the filter's ±3σ, the gyro bias estimate against the truth, the estimate's health
   and the trackers' invalid samples, the gyro and magnetometer measured against the truth
   (:mod:`.estimation`); the summary gains the estimate's figures (``estimation``);
-* ``pointing.png`` (a log with a pointing mode, issue 15) — the mode timeline with the guidance,
+* ``pointing.png`` (a log with a pointing mode) — the mode timeline with the guidance,
   the pointing error from the reference, each wheel's momentum against its limit, the dipoles
   (:mod:`.pointing`); the summary gains ``pointing``;
-* ``mission.png`` and ``mission_sky.png`` (a log of ``att-mission``, issue 17) — the day's
+* ``mission.png`` and ``mission_sky.png`` (a log of ``att-mission``) — the day's
   timeline (a Gantt row per target: slews, dwells observed or not, parks, misses; the controller's
   mode), the zones' margins, wheel momentum and dipoles over the day, and the sky with the day's
   boresight track, the targets and the Sun, Moon and nadir tracks (:mod:`.mission`); the summary

@@ -1,4 +1,4 @@
-"""The attitude estimate of a recorded run against the truth (issue 14): numpy, and one figure.
+"""The attitude estimate of a recorded run against the truth: numpy, and one figure.
 
 :func:`estimation_of` matches the estimator's ``/estimator/attitude`` with the simulator's truth
 (``/spacecraft/state`` at the same stamps, the gyro's actual bias from ``/simulator/sensor_truth``)

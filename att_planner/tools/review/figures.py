@@ -14,7 +14,7 @@ from att_planner.cones import boresight
 from att_planner.control import tracking
 from att_planner.tools.review.run import MODE_NAMES, Run, reference_error
 from att_planner.tools.review.summary import body_torque_limits, finite_limit
-from att_planner.zones import ZoneSky, same_axis
+from att_planner.zones import FittedZones, same_axis
 from att_sim.models import rotations as rot
 from att_sim.models.dynamics import Spacecraft
 
@@ -80,7 +80,7 @@ def _zone_end_time(run: Run) -> float:
     return float(run.plan.duration) if run.kind == "maneuver" else float(run.t[-1])
 
 
-def _draw_zones(ax, run: Run, zones: ZoneSky, sensor: np.ndarray, center: np.ndarray) -> None:
+def _draw_zones(ax, run: Run, zones: FittedZones, sensor: np.ndarray, center: np.ndarray) -> None:
     """Every zone: a fixed one as its shaded cap; a moving one shaded where it is at the start, a
     long-dashed ring where it is at the end and the track of its axis in between. Keep-in zones are
     dash-dot rings (outside is forbidden); zones of another sensor than the plotted one are thin."""
@@ -106,7 +106,7 @@ def _draw_zones(ax, run: Run, zones: ZoneSky, sensor: np.ndarray, center: np.nda
         ax.text(cx, cy, label, color=color, fontsize=7 if not own else 8, ha="center", va="center", weight="bold")
 
 
-def plot_sky(ax, run: Run, zones: ZoneSky | None = None) -> None:
+def plot_sky(ax, run: Run, zones: FittedZones | None = None) -> None:
     """Boresight path on the celestial sphere with the zones (moving ones at start and end, with
     their track), start/goal and closest approaches (true zone positions at each recorded time).
     Other sensors' boresights are drawn thin and dotted."""
@@ -264,7 +264,7 @@ def plot_dipole(ax, run: Run, sc: Spacecraft | None) -> None:
     ax.legend(loc="upper right", fontsize=7, ncol=2)
 
 
-def plot_margins(ax, run: Run, zones: ZoneSky | None = None) -> None:
+def plot_margins(ax, run: Run, zones: FittedZones | None = None) -> None:
     """Margin to every cone and zone (moving zones at their true positions at each recorded time)."""
     if zones is not None and zones.zones:
         m = np.degrees(zones.margins(run.t, run.q, true=True))
@@ -310,7 +310,7 @@ def _time_label(run: Run) -> str:
                                                     else "")
 
 
-def figure_time_histories(run: Run, sc: Spacecraft | None, path: Path, zones: ZoneSky | None = None) -> Path:
+def figure_time_histories(run: Run, sc: Spacecraft | None, path: Path, zones: FittedZones | None = None) -> Path:
     plt, fig = _figure(figsize=(13, 12))
     axes = fig.subplots(4, 2, sharex=True)
     plot_attitude_error(axes[0, 0], run)
@@ -330,13 +330,13 @@ def figure_time_histories(run: Run, sc: Spacecraft | None, path: Path, zones: Zo
     return _save(plt, fig, path)
 
 
-def figure_sky(run: Run, path: Path, zones: ZoneSky | None = None) -> Path:
+def figure_sky(run: Run, path: Path, zones: FittedZones | None = None) -> Path:
     plt, fig = _figure(figsize=(7.5, 7.5))
     plot_sky(fig.add_subplot(1, 1, 1), run, zones)
     return _save(plt, fig, path, dpi=100)
 
 
-def figure_overview(run: Run, sc: Spacecraft | None, path: Path, zones: ZoneSky | None = None) -> Path:
+def figure_overview(run: Run, sc: Spacecraft | None, path: Path, zones: FittedZones | None = None) -> Path:
     """Screenshot-sized digest: the sky on the left; margins, body torque, wheel speeds on the right."""
     plt, fig = _figure(figsize=(12, 6.2))
     grid = fig.add_gridspec(3, 2, width_ratios=[1.0, 1.15])

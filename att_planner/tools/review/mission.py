@@ -1,4 +1,4 @@
-"""The review of a mission's log (issue 17): numpy, and two figures.
+"""The review of a mission's log: numpy, and two figures.
 
 :func:`mission_of` gathers a log with ``/mission/events`` (``att-mission``): the events, the truth
 states (attitude, wheels relative to the body, applied dipole), the controller's modes and the
@@ -23,10 +23,10 @@ from att_msgs_py.topics import CONTROLLER_STATUS, MISSION_EVENTS, STATE
 from att_msgs_py.types import MissionEventKind as Kind
 from att_planner.mission.day import events_of, mission_zones, target_table
 from att_planner.tools.review.run import MODE_NAMES
-from att_planner.zones import ZoneSky
+from att_planner.zones import FittedZones
 from att_sim.models import rotations as rot
 from att_sim.models import scenario as scen
-from att_sim.models.ephemeris import Sky
+from att_sim.models.ephemeris import Ephemeris
 
 TOPICS = [STATE, CONTROLLER_STATUS, MISSION_EVENTS]
 SKY_SAMPLES = 2000                 # points of each track on the sky plot
@@ -45,7 +45,7 @@ class MissionLog:
     mode_t: np.ndarray             # (m,) controller status instants
     mode: np.ndarray               # (m,)
     limit: float                   # N m s per wheel
-    sky: Sky
+    sky: Ephemeris
     sensor_axis: np.ndarray
 
 
@@ -56,8 +56,8 @@ def mission_of(log: dict[str, TopicLog], scenario: scen.Scenario | None) -> Miss
         return None
     state, sc = log[STATE], scenario.spacecraft
     t, q = np.asarray(state["header.stamp"], float), np.asarray(state["attitude"], float)
-    sky = Sky(scenario.epoch, scenario.orbit_model)
-    zones = ZoneSky(mission_zones(events, scenario), sky, window=max(1.0, float(t[-1] - t[0])))
+    sky = Ephemeris(scenario.epoch, scenario.orbit_model)
+    zones = FittedZones(mission_zones(events, scenario), sky, window=max(1.0, float(t[-1] - t[0])))
     margins = zones.margins(t, q, true=True)
     relative = np.asarray(state["wheel_speeds"], float) - np.asarray(state["body_rate"], float) @ sc.wheel_axes
     status = log.get(CONTROLLER_STATUS)
@@ -164,7 +164,7 @@ def figure_mission_sky(run: MissionLog, path: Path) -> Path:
     ax = fig.subplots()
     pick = np.unique(np.linspace(0, len(run.t) - 1, SKY_SAMPLES).astype(int))
     t = run.t[pick]
-    _track(ax, rot.dcm(run.q[pick]) @ run.sensor_axis, color="k", lw=0.6, label="boresight")
+    _track(ax, rot.dcm_NB(run.q[pick]) @ run.sensor_axis, color="k", lw=0.6, label="boresight")
     _track(ax, run.sky.sun_direction(t), color="orange", lw=3, label="Sun")
     _track(ax, run.sky.moon_direction(t), color="0.5", lw=3, label="Moon")
     _track(ax, run.sky.nadir(t), color="tab:blue", lw=0.5, ls=":", label="nadir (Earth zone axis)")

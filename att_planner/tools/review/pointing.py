@@ -1,4 +1,4 @@
-"""Pointing and momentum of a recorded run (issue 15): numpy, and one figure.
+"""Pointing and momentum of a recorded run: numpy, and one figure.
 
 :func:`pointing_of` reads the controller's status (mode, guidance, attitude error from its
 reference, momentum dumping), the truth state (wheel speeds relative to the body, as their limit

@@ -10,11 +10,11 @@ import numpy as np
 from att_msgs_py.log import TopicLog
 from att_planner.tools.review.run import SETTLING_THRESHOLD, Run, extract_run, settling_time
 from att_planner.verification import peak_magnitude
-from att_planner.zones import ZoneSky, zones_from_cones
+from att_planner.zones import FittedZones, zones_from_cones
 from att_sim.models import rotations as rot
 from att_sim.models import scenario as scen
 from att_sim.models.dynamics import Spacecraft
-from att_sim.models.ephemeris import Sky
+from att_sim.models.ephemeris import Ephemeris
 from att_sim.models.epoch import format_epoch
 
 
@@ -68,10 +68,10 @@ def _phase(run: Run, t: float) -> str:
 
 
 class _Later:
-    """``sky`` seen ``offset`` s later (what a :class:`ZoneSky` reads of a sky), so that t = 0 is
+    """``sky`` seen ``offset`` s later (what a :class:`FittedZones` reads of a sky), so that t = 0 is
     the reviewed segment's start."""
 
-    def __init__(self, sky: Sky, offset: float):
+    def __init__(self, sky: Ephemeris, offset: float):
         self.sky, self.offset = sky, float(offset)
 
     def sun_direction(self, t):
@@ -87,7 +87,7 @@ class _Later:
         return self.sky.earth_angular_radius(np.asarray(t, float) + self.offset)
 
 
-def zone_sky_for(run: Run, scenario: scen.Scenario | None) -> tuple[ZoneSky | None, str]:
+def zone_sky_for(run: Run, scenario: scen.Scenario | None) -> tuple[FittedZones | None, str]:
     """The reviewed plan's cones (first) and zones over the segment, t = 0 at its start, and a note
     ('' or why moving zones are left out). Moving zones are where the simulator flew them: the
     scenario's orbit and epoch (its sim time zero), seen at sim time ``run.t0 + t``; without a
@@ -105,16 +105,16 @@ def zone_sky_for(run: Run, scenario: scen.Scenario | None) -> tuple[ZoneSky | No
                 + ("no scenario is known" if scenario is None else f"scenario '{scenario.name}' has no epoch, so the "
                    "simulator flew no real sky"))
     elif moving:
-        sky = _Later(Sky(scenario.epoch, scenario.orbit_model), run.t0)
+        sky = _Later(Ephemeris(scenario.epoch, scenario.orbit_model), run.t0)
         flown = scenario.epoch + timedelta(seconds=run.t0)
         if plan.epoch is not None and abs((flown - plan.epoch).total_seconds()) > 1.0:
             note = (f"the plan was made for {format_epoch(plan.epoch)} but flown from {format_epoch(flown)} "
                     f"({(flown - plan.epoch).total_seconds():+.1f} s): zones are shown where they were when flown")
     window = max(float(run.t[-1]), plan.duration, 1.0)
-    return ZoneSky(zones, sky, window), note
+    return FittedZones(zones, sky, window), note
 
 
-def summary_of(run: Run, spacecraft: Spacecraft | None = None, zone_sky: ZoneSky | None = None,
+def summary_of(run: Run, spacecraft: Spacecraft | None = None, zone_sky: FittedZones | None = None,
                zones_note: str = "") -> dict:
     """The summary of a reviewed run; ``zone_sky`` (:func:`zone_sky_for`; None: the plan's cones)
     gives the margins."""
@@ -142,7 +142,7 @@ def summary_of(run: Run, spacecraft: Spacecraft | None = None, zone_sky: ZoneSky
         out["final_attitude_error_deg"] = None
     out["final_rate_rad_s"] = float(np.linalg.norm(run.omega[-1]))
     if zone_sky is None and run.plan is not None:
-        zone_sky = ZoneSky(zones_from_cones(run.plan.cones, run.plan.sensor_axis))
+        zone_sky = FittedZones(zones_from_cones(run.plan.cones, run.plan.sensor_axis))
     out["min_margin_deg"], out["closest_approach_s"], out["zones_note"] = {}, {}, zones_note
     if zone_sky is not None and zone_sky.zones:
         m = zone_sky.margins(run.t, run.q, true=True)
@@ -289,7 +289,7 @@ def format_summary(s: dict, with_notes: bool = True) -> str:
 
 
 def mission_lines(m: dict | None) -> list[str]:
-    """The mission's table (issue 17): a line per target, observed (start, dwell, pointing error) or missed (why)."""
+    """The mission's table: a line per target, observed (start, dwell, pointing error) or missed (why)."""
     if not m:
         return []
     lines = [f"mission               {m['observed']} targets observed, {m['missed']} missed; smallest zone margin "

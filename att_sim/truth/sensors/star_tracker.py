@@ -50,7 +50,7 @@ class StarTracker:
         """Whether the tracker sees its stars at sensor attitude ``q_SN`` and body rate ``omega_B``."""
         if float(np.linalg.norm(omega_B)) > self.spec.max_rate:
             return TrackerStatus.RATE
-        boresight = rot.dcm(q_SN) @ BORESIGHT_S
+        boresight = rot.dcm_NB(q_SN) @ BORESIGHT_S
         for exclusion in self.spec.exclusions:
             if exclusion_margin(exclusion, boresight, bodies) < 0.0:
                 return STATUS_OF_BODY[exclusion.body]

@@ -25,7 +25,7 @@ class SunSensors:
 
     def measure(self, t: float, q_BN: np.ndarray, bodies: Bodies, frame_id: str = "") -> SunSensorMeasurement:
         s = self.spec
-        cosines = s.normals @ (rot.dcm(q_BN).T @ bodies.sun)
+        cosines = s.normals @ (rot.dcm_BN(q_BN) @ bodies.sun)
         lit = np.where(cosines > self.cos_fov, np.maximum(cosines, 0.0) * bodies.shadow, 0.0)
         values = np.maximum(lit + self.rng.standard_normal(len(cosines)) * s.noise, 0.0)
         return SunSensorMeasurement(t=t, values=values, noise=s.noise, frame_id=frame_id)

@@ -1,5 +1,5 @@
 """The suite's MCAP logs: the regression log read back, decoded by an independent reader
-(``rosbags``, from the definitions in the file alone), and re-written by today's writer.
+(``rosbags``, from the definitions in the file alone), and re-written by the current writer.
 
 The regression log ``test/data/swift_short.mcap`` was recorded by the suite (regenerate it with
 ``test/data/make_fixture.py`` when the format changes on purpose): a 45° keep-out maneuver of the
@@ -69,7 +69,7 @@ def test_rosbags_decodes_every_message_of_a_suite_log(log):
 
 
 def test_rosbags_decodes_a_log_written_by_the_current_writer(tmp_path, log):
-    """Re-record the fixture's messages with today's LogWriter: schemas and layout still rosbag2's."""
+    """Re-record the fixture's messages with the current LogWriter: schemas and layout still rosbag2's."""
     from att_msgs_py.qos import recorded_topics
 
     out = tmp_path / "rewritten.mcap"

@@ -21,7 +21,7 @@ from att_msgs_py.qos import recorded_topics
 from helpers.regression_log import FIXTURE
 
 PER_CHUNK = 25                 # messages between flushes: one chunk each
-TOPICS = ("/spacecraft/state", "/actuator/command", "/clock", "/controller/status")   # types unchanged since
+TOPICS = ("/spacecraft/state", "/actuator/command", "/clock", "/controller/status")   # types as in the fixture
 
 
 def fixture_messages(n: int = 400) -> list:

@@ -13,7 +13,7 @@ from att_planner.methods.eigenaxis import plan_eigenaxis_smooth
 from att_planner.problem import ManeuverProblem
 from att_sim.models import rotations as rot
 from att_sim.models import scenario
-from att_sim.models.ephemeris import Sky
+from att_sim.models.ephemeris import Ephemeris
 from att_sim.models.orbit import CircularOrbit
 from att_sim.truth.simulation import Simulation
 from helpers.signed_plans import context, issue
@@ -159,7 +159,7 @@ def test_feedback_margin_covers_the_zones_at_their_true_position_now():
     """The cone, an Earth-limb keep-in and a Sun keep-out zone, checked by hand from the sky at the
     state's time (the maneuver starts 30 s into the sim, the plan's epoch says 0 s: the truth wins)."""
     s = scenario.load("swift_demo")
-    sky = Sky(EPOCH, CircularOrbit(s.orbit))
+    sky = Ephemeris(EPOCH, CircularOrbit(s.orbit))
     cone = Cone([0.0, 0.0, -1.0], 0.5, "cone")
     sun, limb = Zone("sun", "sun", [1.0, 0, 0], 0.3), Zone("limb", "earth_limb", [0, 0, 1.0], 0.05, True)
     plan = plan_eigenaxis_smooth(ManeuverProblem(s.spacecraft, rot.IDENTITY, GOAL), samples=101)
@@ -174,7 +174,7 @@ def test_feedback_margin_covers_the_zones_at_their_true_position_now():
         outputs = fly(sim, core, 2.0, states=states)
         flown[name] = [(o.feedback, x) for o, x in zip(outputs, states) if o.feedback is not None]
     for (fb, state), (fb_none, _) in zip(flown["sky"], flown["none"]):
-        b = rot.dcm(state.q)
+        b = rot.dcm_NB(state.q)
         cone_m = math.acos(np.dot(b[:, 0], cone.direction)) - cone.half_angle
         sun_m = math.acos(np.dot(b[:, 0], sky.sun_direction(state.t))) - sun.half_angle
         limb_m = sky.earth_angular_radius(state.t) + limb.half_angle - math.acos(np.dot(b[:, 2], sky.nadir(state.t)))

@@ -11,7 +11,7 @@ import pytest
 
 from att_msgs_py.types import ControlMode, PointingMode
 from att_planner.guidance import reference
-from att_planner.guidance.laws import BlendedLaw, Sky
+from att_planner.guidance.laws import BlendedLaw, PointingGeometry
 from att_planner.guidance.modes import law_of
 from att_planner.methods.eigenaxis import plan_eigenaxis_smooth
 from att_planner.problem import ManeuverProblem
@@ -24,22 +24,23 @@ SWIFT = scen.load("swift_demo")
 
 
 def test_the_blend_starts_at_rest_on_the_law_and_joins_it():
-    law = law_of(PointingMode("nadir"), Sky.of(world.Environment.from_scenario(SWIFT)), 0.0, rot.IDENTITY)
+    law = law_of(PointingMode("nadir"), PointingGeometry.of(world.Environment.from_scenario(SWIFT)), 0.0, rot.IDENTITY)
     blended = BlendedLaw(law, 100.0, 60.0)
     start = reference(blended.attitude, 100.0, h=0.05)
-    assert rot.angle_between(start.q, law.attitude(100.0)) < 1e-12
-    assert np.linalg.norm(start.omega) < 0.05 * np.linalg.norm(reference(law.attitude, 100.0).omega)
+    assert rot.angle_between(start.q_RN, law.attitude(100.0)) < 1e-12
+    assert np.linalg.norm(start.omega_RN_R) < 0.05 * np.linalg.norm(reference(law.attitude, 100.0).omega_RN_R)
     for t in (160.0, 200.0):
         assert rot.angle_between(blended.attitude(t), law.attitude(t)) < 1e-12
     middle = reference(blended.attitude, 140.0)
-    assert np.linalg.norm(middle.omega) == pytest.approx(4 / 3 * SWIFT.orbit.mean_motion, rel=1e-3)
+    assert np.linalg.norm(middle.omega_RN_R) == pytest.approx(4 / 3 * SWIFT.orbit.mean_motion, rel=1e-3)
 
 
 @pytest.mark.slow
 def test_a_slew_onto_nadir_hands_over_without_a_jump():
     loop = ClosedLoop(SWIFT, overrides={"controller": {"state_source": "truth", "settle_time": 0.0}})
     loop.run(1.0)
-    law = law_of(PointingMode("nadir"), Sky.of(world.Environment.from_scenario(SWIFT)), loop.sim.t, rot.IDENTITY)
+    geometry = PointingGeometry.of(world.Environment.from_scenario(SWIFT))
+    law = law_of(PointingMode("nadir"), geometry, loop.sim.t, rot.IDENTITY)
     start, duration = loop.sim.t + 0.05, 100.0
     for _ in range(3):                   # aim at where nadir will be at the arrival
         plan = plan_eigenaxis_smooth(ManeuverProblem(SWIFT.spacecraft, loop.sim.x[:4], law.attitude(start + duration)))
@@ -63,7 +64,7 @@ def test_a_time_optimal_slew_ends_on_nadir_at_its_rate_and_hands_over_directly()
     was planned for, the controller takes the law itself (no blend): the error of the slew's end
     carries over without a jump and dies out."""
     s = scen.load("leo_momentum")
-    law = law_of(PointingMode("nadir"), Sky.of(world.Environment.from_scenario(s)), 0.0, rot.IDENTITY)
+    law = law_of(PointingMode("nadir"), PointingGeometry.of(world.Environment.from_scenario(s)), 0.0, rot.IDENTITY)
     q0 = rot.multiply(law.attitude(0.0), rot.from_axis_angle([1, 0, 0], math.radians(40)))
     loop = ClosedLoop(s, overrides={"controller": {"state_source": "truth", "momentum_dumping": False}}, q0=q0)
     loop.run(0.5)
@@ -74,8 +75,8 @@ def test_a_time_optimal_slew_ends_on_nadir_at_its_rate_and_hands_over_directly()
                            end_pointing=PointingMode("nadir"))
     end = t0 + plan.duration
     goal = reference(law.attitude, end)
-    assert rot.angle_between(plan.q[-1], goal.q) < 1e-5
-    assert np.linalg.norm(plan.omega[-1] - goal.omega) < 1e-6 < 0.5 * np.linalg.norm(goal.omega)
+    assert rot.angle_between(plan.q[-1], goal.q_RN) < 1e-5
+    assert np.linalg.norm(plan.omega[-1] - goal.omega_RN_R) < 1e-6 < 0.5 * np.linalg.norm(goal.omega_RN_R)
     assert loop.execute(plan, after=PointingMode("nadir")) is None
     loop.run(plan.duration + 120.0)
     assert loop.controller.pointing.name == "nadir" and not isinstance(loop.controller.pointing, BlendedLaw)

@@ -12,7 +12,7 @@ from att_msgs_py.types import ControlMode, PointingMode
 from att_planner.control import momentum, wheels
 from att_planner.control.controller import Controller, ControllerConfig
 from att_planner.control.plan_checks import PlanContext
-from att_planner.guidance.laws import Sky
+from att_planner.guidance.laws import PointingGeometry
 from att_sim.models import dynamics as dyn
 from att_sim.models import rotations as rot
 from att_sim.models import scenario as scen
@@ -66,7 +66,7 @@ def test_pointing_dumps_the_wheels_momentum_with_the_magnetorquers(dumping):
     swift = scen.load("swift_demo")
     sim = Simulation(SC, swift.orbit, wheel_speed0=np.array([40.0, 15.0, -30.0, 5.0]))
     h0 = float(np.linalg.norm(PYRAMID @ (SC.wheel_inertia * sim.x[7:])))
-    sky = Sky.of(world.Environment.circular(SC, swift.orbit))
+    sky = PointingGeometry.of(world.Environment.circular(SC, swift.orbit))
     config = ControllerConfig(control_period=0.5, tracking_kp=1.0, tracking_kd=25.0, dumping_gain=5e-3,
                               null_space_gain=0.02, null_space_speed=50.0)
     core = Controller(PlanContext(SC, "pyramid", "eci", KEY.public_key()), config, body_frame_id="body",

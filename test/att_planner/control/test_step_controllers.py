@@ -8,7 +8,7 @@ import pytest
 from att_msgs_py.types import ControlMode
 from att_planner.control import momentum, tracking, wheels
 from att_planner.control.controller import Controller, ControllerConfig, step_controllers
-from att_planner.control.reference import Reference
+from att_planner.guidance import Reference
 from att_planner.methods.eigenaxis import plan_eigenaxis_smooth
 from att_planner.problem import ManeuverProblem
 from att_sim.models import rotations as rot

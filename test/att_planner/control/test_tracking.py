@@ -6,7 +6,7 @@ import pytest
 
 from att_msgs_py.types import Command, ControlMode
 from att_planner.control import tracking, wheels
-from att_planner.control.reference import Reference
+from att_planner.guidance import Reference
 from att_planner.methods.eigenaxis import plan_eigenaxis, plan_eigenaxis_smooth
 from att_planner.problem import ManeuverProblem
 from att_sim.models import rotations as rot

@@ -24,7 +24,7 @@ def test_exact_vectors_give_the_attitude_to_rounding(angle):
     for _ in range(20):
         q = rot.from_axis_angle(random_unit(1)[0], angle)
         r = random_unit(4)
-        b = r @ rot.dcm(q)                      # rows R(q)ᵀ r: the body measurements
+        b = r @ rot.dcm_NB(q)                      # rows R(q)ᵀ r: the body measurements
         assert rot.angle_between(triad(b[0], b[1], r[0], r[1]), q) < 1e-7
         q_quest, _ = quest(b, r, np.ones(4))
         assert rot.angle_between(q_quest, q) < 1e-7
@@ -39,7 +39,7 @@ def test_quest_on_noisy_vectors_is_consistent_with_its_covariance():
         r = random_unit(3)
         b = []
         for ri, s in zip(r, sigmas):
-            v = rot.dcm(q).T @ ri + RNG.normal(0, s, 3)
+            v = rot.dcm_BN(q) @ ri + RNG.normal(0, s, 3)
             b.append(v / np.linalg.norm(v))
         b = np.array(b)
         q_hat, P = quest(b, r, 1.0 / sigmas**2)

@@ -42,7 +42,7 @@ SUN_N = np.array([0.6, 0.8, 0.0])
 FIELD_N = np.array([1e-5, -2e-5, 2.5e-5])
 
 
-class Sky:
+class FixedEnvironment:
     """A fixed sun and field: the onboard models the estimator asks."""
 
     def bodies(self, t):
@@ -51,7 +51,7 @@ class Sky:
 
 def estimator(**config) -> Estimator:
     base = dict(publish_period=0.05, arw=GYRO.arw, rrw=GYRO.rrw, initial_bias_sigma=GYRO.initial_bias)
-    return Estimator(SPECS, EstimatorConfig(**{**base, **config}), Sky(), "eci", "body")
+    return Estimator(SPECS, EstimatorConfig(**{**base, **config}), FixedEnvironment(), "eci", "body")
 
 
 def gyro(t, omega=(0.0, 0.0, 0.0)) -> GyroMeasurement:
@@ -102,7 +102,7 @@ def test_initialisation_from_the_first_tracker_or_from_quest_on_sun_and_field():
     # without a tracker: a sun vector and a field sample within the pair window
     est = estimator()
     est.on_gyro(gyro(0.0))
-    sun_B, field_B = rot.dcm(Q).T @ SUN_N, rot.dcm(Q).T @ FIELD_N
+    sun_B, field_B = rot.dcm_BN(Q) @ SUN_N, rot.dcm_BN(Q) @ FIELD_N
     values = np.maximum(np.vstack([np.eye(3), -np.eye(3)]) @ sun_B, 0.0)
     est.on_sun_sensors(SunSensorMeasurement(0.05, values, 0.0, "body"))
     est.on_magnetometer(MagnetometerMeasurement(0.05, field_B, np.eye(3), "body"))

@@ -84,7 +84,8 @@ def test_without_zones_it_is_the_smooth_eigenaxis_slew():
 
 
 def test_semi_free_goal_points_the_sensor_at_its_target():
-    problem = replace(benchmark_problem("swift"), sensor_target=rot.dcm(benchmark_problem("swift").q_final) @ [1, 0, 0])
+    swift = benchmark_problem("swift")
+    problem = replace(swift, sensor_target=rot.dcm_NB(swift.q_final) @ [1, 0, 0])
     plan = plan_graph_smooth(problem)
     ver = verify(problem, plan)
     assert rejection(ver) is None, rejection(ver)

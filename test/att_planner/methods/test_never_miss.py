@@ -1,4 +1,4 @@
-"""Never miss a feasible plan (issue 18): on random keep-out sets — the Swift cones plus three to ten
+"""Never miss a feasible plan: on random keep-out sets — the Swift cones plus three to ten
 8–20° cones near the eigenaxis path, start and goal clear — whenever a method finds a feasible path
 the smooth planners find a verified smooth plan too: the default method through the planner
 service (seeded with the first plan) and slepian_minimum_time on its own (which seeds itself with
@@ -35,8 +35,8 @@ def cone_set(seed: int):
     """The Swift problem with 3–10 extra cones of 8–20° scattered about its eigenaxis path (18° rms),
     none within 3° of the start or goal direction."""
     base = benchmark_problem("swift")
-    path = rot.dcm(rot.slerp(base.q_initial, base.q_final, np.linspace(0.1, 0.9, 50))) @ base.sensor_axis
-    ends = [rot.dcm(q) @ base.sensor_axis for q in (base.q_initial, base.q_final)]
+    path = rot.dcm_NB(rot.slerp(base.q_initial, base.q_final, np.linspace(0.1, 0.9, 50))) @ base.sensor_axis
+    ends = [rot.dcm_NB(q) @ base.sensor_axis for q in (base.q_initial, base.q_final)]
     rng = np.random.default_rng(seed)
     cones = list(base.cones)
     count = 3 + rng.integers(3, 11)

@@ -1,4 +1,4 @@
-"""Tests of the time-optimal wheel schedule (issue 5): model, order search, bounds, verification."""
+"""Tests of the time-optimal wheel schedule: model, order search, bounds, verification."""
 import itertools
 import time
 from dataclasses import replace

@@ -1,4 +1,4 @@
-"""Schedules that observe (issue 17): each target held at rest for its dwell, within its window and
+"""Schedules that observe: each target held at rest for its dwell, within its window and
 while no zone covers it; the order search checked against every order solved."""
 from dataclasses import replace
 
@@ -10,9 +10,9 @@ from att_planner.methods import schedule as sch
 from att_planner.methods.schedule.order_search import tour_bound, visibility
 from att_planner.methods.schedule.planner import zone_window
 from att_planner.reference import olivares_staffetti as ref
-from att_planner.verification import integrate, rejection
+from att_planner.verification import predict, rejection
 from att_sim.models import rotations as rot
-from helpers.skies import DescendingSky
+from helpers.skies import DescendingEphemeris
 
 GRID = 6
 TARGETS = ref.olivares_targets("A")
@@ -24,7 +24,7 @@ X = np.array([1.0, 0.0, 0.0])
 def _held(problem, plan):
     """Per observation: the largest attitude error (rad) and body rate (rad/s) of the integrated plan
     over its dwell."""
-    traj = integrate(problem, plan)
+    traj = predict(problem, plan)
     out = []
     for p in plan.passages:
         inside = (traj.t >= p.time + 1e-9) & (traj.t <= p.time + p.dwell)
@@ -108,7 +108,7 @@ def test_a_moving_zone_defers_an_observation_until_the_target_is_clear():
     210 s in: a target there is covered for a while, and its observation must avoid that time."""
     target = rot.from_axis_angle([0.0, 0.0, 1.0], np.deg2rad(45.0))
     problem = replace(ref.problem(targets={"sun side": target}), zones=[Zone("sun", "sun", X, np.deg2rad(15.0))],
-                      sky=DescendingSky(), target_dwell={"sun side": 120.0})
+                      sky=DescendingEphemeris(), target_dwell={"sun side": 120.0})
     zones = problem.zone_sky(zone_window(problem))
     visible = visibility(zones, target, (0.0, np.inf))
     assert len(visible) >= 2 and visible[0][0] == 0.0              # clear, covered, clear again (and so on:

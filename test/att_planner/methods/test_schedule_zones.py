@@ -1,4 +1,4 @@
-"""Schedules among zones that move (issue 13): every leg keeps every zone at its physical time along
+"""Schedules among zones that move: every leg keeps every zone at its physical time along
 the whole tour (a leg starts when the earlier legs end), checked by att_planner.verification at the
 zones' true positions."""
 from dataclasses import replace
@@ -9,9 +9,9 @@ import pytest
 from att_msgs_py.types import Cone, Status, Zone
 from att_planner.methods import schedule as sch
 from att_planner.reference import olivares_staffetti as ref
-from att_planner.verification import integrate, rejection, verify
+from att_planner.verification import predict, rejection, verify
 from att_sim.models import rotations as rot
-from helpers.skies import DescendingSky
+from helpers.skies import DescendingEphemeris
 
 GRID = 10
 X = np.array([1.0, 0.0, 0.0])
@@ -24,14 +24,14 @@ def tour():
     140 s each way. A 15° Sun zone descends through that plane at azimuth 45° about 210 s in (the
     return leg's middle) and is far above it during the outbound leg."""
     free = ref.problem(targets={"t": rot.from_axis_angle([0.0, 0.0, 1.0], np.deg2rad(90.0))})
-    moving = replace(free, zones=[Zone("sun", "sun", X, np.deg2rad(15.0))], sky=DescendingSky())
+    moving = replace(free, zones=[Zone("sun", "sun", X, np.deg2rad(15.0))], sky=DescendingEphemeris())
     options = {"search_intervals": GRID, "intervals": GRID}
     return moving, sch.plan_schedule(free, **options), sch.plan_schedule(moving, **options)
 
 
 def _leg_margins(problem, plan):
     """Smallest true zone margin (rad) on each leg of an integrated plan."""
-    traj = integrate(problem, plan)
+    traj = predict(problem, plan)
     m = problem.zone_sky().margins(traj.t, traj.q, true=True).min(axis=1)
     ends = [0.0, *(p.time for p in plan.passages), plan.duration]
     return [m[(traj.t >= a) & (traj.t <= b)].min() for a, b in zip(ends[:-1], ends[1:])]

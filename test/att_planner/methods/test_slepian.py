@@ -1,5 +1,5 @@
-"""Slepian smooth maneuver planner (issue 3): conventions, exact gradients, plans checked by the
-truth dynamics, smooth ends, refusals. Kept small (coarse N) so the file runs in well under 60 s."""
+"""Slepian smooth maneuver planner: conventions, exact gradients, plans checked by the
+prediction model, smooth ends, refusals. Kept small (coarse N) so the file runs in well under 60 s."""
 import time
 
 import numpy as np
@@ -12,7 +12,7 @@ from att_planner import methods
 from att_planner.methods import slepian as S
 from att_planner.problem import ManeuverProblem
 from att_planner.reference.celani_bruni import CASES, benchmark_problem
-from att_planner.verification import integrate, measure
+from att_planner.verification import measure, predict
 from att_sim.models import rotations as rot
 from att_sim.models.dynamics import Spacecraft
 
@@ -20,14 +20,14 @@ N_SMALL, W_SMALL = 120, 7.5 / 120      # same time-bandwidth product as the pape
 
 
 def _reference_tf(problem, alpha, N, W):
-    """The issue's conventions written out naively (loop, scipy expm), independent of the module."""
+    """The conventions of Celani & Bruni (2021) written out naively (loop, scipy expm), independent of the module."""
     alpha = np.asarray(alpha)
     V = dpss(N, N * W, Kmax=alpha.shape[1]).T
     w = V @ alpha.T
     J = problem.spacecraft.inertia
     dw = np.vstack([np.zeros(3), np.diff(w, axis=0) * N])
     T = dw @ J.T + np.cross(w, w @ J.T)
-    R = rot.dcm(problem.q_initial)
+    R = rot.dcm_NB(problem.q_initial)
     Rs = [R]
     for k in range(N):
         R = R @ expm(rot.hat(w[k] / N))
@@ -36,8 +36,8 @@ def _reference_tf(problem, alpha, N, W):
 
 
 def _verify(problem, plan):
-    traj = integrate(problem, plan, steps=4 * (len(plan.t) - 1))
-    trace = 3.0 - np.trace(rot.dcm(problem.q_final).T @ rot.dcm(traj.q[-1]))
+    traj = predict(problem, plan, steps=4 * (len(plan.t) - 1))
+    trace = 3.0 - np.trace(rot.dcm_BN(problem.q_final) @ rot.dcm_NB(traj.q[-1]))
     return measure(problem, plan, traj), trace
 
 
@@ -96,7 +96,7 @@ def test_evaluation_follows_the_issue_conventions():
 
 
 def test_minimum_time_plan_is_verified_smooth_and_reproducible():
-    """Arbitrary start attitude; torque ZOH from rest through the truth dynamics meets the goal,
+    """Arbitrary start attitude; torque ZOH from rest through the prediction model meets the goal,
     stays outside the cones on a dense grid, and starts/ends at (nearly) zero torque."""
     pb = benchmark_problem("swift")
     q0 = rot.from_axis_angle([0.0, 0.0, 1.0], -0.4)           # sensor still clear of the cones
@@ -112,7 +112,7 @@ def test_minimum_time_plan_is_verified_smooth_and_reproducible():
     tmax = pb.spacecraft.body_torque_max
     assert np.abs(plan.torque[[0, 1, -3, -2, -1]]).max() <= 2e-3 * tmax      # smooth ends
     assert np.abs(plan.torque).max() == pytest.approx(tmax, rel=1e-9)         # time-optimal: T* hits T̄
-    # the reported t_f and α reproduce each other under the issue's conventions
+    # the reported t_f and α reproduce each other under the conventions of Celani & Bruni (2021)
     tf_ref, _ = _reference_tf(pb, np.array(plan.stats["alpha"]), N_SMALL, W_SMALL)
     assert plan.duration == pytest.approx(tf_ref, rel=1e-9) == pytest.approx(plan.stats["tf"], rel=1e-9)
     # the references are the rigid-body response to the torque
@@ -145,7 +145,7 @@ def test_dfsp_never_worsens_a_feasible_start_and_respects_budget():
 
 def test_goal_inside_a_cone_is_refused_with_a_clear_message():
     pb = benchmark_problem("swift")
-    goal_boresight = rot.dcm(pb.q_final) @ pb.sensor_axis
+    goal_boresight = rot.dcm_NB(pb.q_final) @ pb.sensor_axis
     pb.cones = list(pb.cones) + [Cone(goal_boresight, np.radians(10.0), "star")]
     plan = S.plan_slepian(pb, N=N_SMALL, W=W_SMALL)
     assert plan.status == Status.FAILED

@@ -1,6 +1,6 @@
-"""Slepian methods against moving zones (issue 13): the zone rows at t_k = τ_k t_f and their exact
+"""Slepian methods against moving zones: the zone rows at t_k = τ_k t_f and their exact
 t_f derivative, a zone sweeping into the frozen plan's path, keep-in zones of another sensor, and
-cone-only problems planned exactly as before. A synthetic sky (known rates) keeps it fast."""
+cone-only problems planned exactly as the cone-only planner does. A synthetic sky (known rates) keeps it fast."""
 from dataclasses import replace
 
 import numpy as np
@@ -20,7 +20,7 @@ N_SMALL, W_SMALL = 120, 7.5 / 120      # same time-bandwidth product as the pape
 X, Y, Z = np.eye(3)
 
 
-class SweepSky:
+class SweepEphemeris:
     """A sky with known motion: the 'Sun' at azimuth 90° in the x-y plane's normal plane, its elevation
     ``elevation0 − rate·t`` (rotating about x); the 'Moon' 10° off +z precessing at 0.3 rad/s; the
     'Earth' along −x with an angular radius 0.5 + 0.05 sin(0.4 t) rad."""
@@ -59,7 +59,7 @@ def _frozen(problem):
 def _sweep_problem(elevation0_deg, rate_deg, keep_in_deg=40.0):
     zones = [Zone("sun", "sun", X, np.radians(20.0)),
              Zone("antenna", "moon", Z, np.radians(keep_in_deg), keep_in=True)]
-    return _swift_problem(zones, SweepSky(elevation0_deg, rate_deg))
+    return _swift_problem(zones, SweepEphemeris(elevation0_deg, rate_deg))
 
 
 @pytest.fixture(scope="module")
@@ -67,7 +67,7 @@ def three_sensors():
     """Keep-out Sun on x, keep-in Moon on z, keep-out Earth limb (varying radius) on −y; M = 4, N = 60."""
     zones = [Zone("sun", "sun", X, np.radians(20.0)), Zone("antenna", "moon", Z, np.radians(40.0), keep_in=True),
              Zone("earth", "earth_limb", -Y, np.radians(5.0))]
-    pb = _swift_problem(zones, SweepSky(40.0, 12.0))
+    pb = _swift_problem(zones, SweepEphemeris(40.0, 12.0))
     return S.build_maneuver(pb, M=4, N=60, W=7.5 / 60, cone_margin=1e-3)
 
 
@@ -93,11 +93,11 @@ def test_zone_rows_and_their_tf_derivative_match_finite_differences(three_sensor
 
 
 def test_zone_rows_agree_with_the_zone_margins(three_sensors):
-    """c_kz ≤ 0 exactly where ZoneSky.margins ≥ 0 (keep-out and keep-in, three sensors)."""
+    """c_kz ≤ 0 exactly where FittedZones.margins ≥ 0 (keep-out and keep-in, three sensors)."""
     man = replace(three_sensors, zone_margin=0.0)
     alpha = np.random.default_rng(8).normal(size=12) * 15.0
     ev = S.evaluate(man, alpha, tf=3.0)
-    m = man.zone_sky.margins(np.linspace(0.0, 3.0, man.N + 1), rot.from_dcm(ev.R))
+    m = man.zone_sky.margins(np.linspace(0.0, 3.0, man.N + 1), rot.from_dcm_NB(ev.R))
     assert (m < 0).any() and (m > 0).any()
     np.testing.assert_array_equal(ev.cones <= 0, m >= 0)
 
@@ -146,7 +146,7 @@ def test_static_keep_in_zone_of_another_sensor_is_respected():
     minimum-time plan tilts it further)."""
     free = _swift_problem([], None)
     plan = S.plan_slepian(free, N=N_SMALL, W=W_SMALL, starts=3)
-    tilt = np.degrees(np.arccos(np.clip(rot.dcm(plan.q) @ Z @ Z, -1.0, 1.0))).max()
+    tilt = np.degrees(np.arccos(np.clip(rot.dcm_NB(plan.q) @ Z @ Z, -1.0, 1.0))).max()
     assert tilt > 3.0
     pb = _swift_problem([Zone("antenna", "inertial", Z, np.radians(3.0), keep_in=True, direction=Z)], None)
     plan = S.plan_slepian(pb, N=N_SMALL, W=W_SMALL, starts=3)
@@ -158,9 +158,9 @@ def test_static_keep_in_zone_of_another_sensor_is_respected():
     ("swift", "slepian_minimum_time", {"starts": 3}, 4.495894450757781),
     ("earth_obs", "mssa", {"restarts": 4}, 1176.7675894755068),
 ])
-def test_cone_only_plans_are_unchanged(case, method, options, tf):
-    """t_f as before issue 13 (pinned from that code, to the solvers' convergence: MSSA iterates t_f to
-    1e-7, and on another CPU its BLAS rounds differently: 1176.76759 on the machine that pinned it,
+def test_cone_only_plans_keep_their_pinned_t_f(case, method, options, tf):
+    """t_f of the cone-only planner (pinned from the planner without zones, to the solvers' convergence:
+    MSSA iterates t_f to 1e-7, and on another CPU its BLAS rounds differently: 1176.76759 on the machine that pinned it,
     1176.76731 on an AMD EPYC), and the cones given as inertial zones plan identically (bit for bit)."""
     pb = benchmark_problem(case)
     plan = S.plan_slepian(pb, method=method, N=N_SMALL, W=W_SMALL, **options)

@@ -1,6 +1,6 @@
-"""Time-optimal keep-out slews (issue 4): the collocation planner against its baselines.
+"""Time-optimal keep-out slews: the collocation planner against its baselines.
 
-Every plan is checked by integrating its torque through the truth dynamics (att_planner.verification).
+Every plan is checked by integrating its torque through the prediction model (att_planner.verification).
 """
 import time
 from dataclasses import replace
@@ -17,7 +17,7 @@ from att_planner.methods.time_optimal import mesh as meshes
 from att_planner.methods.time_optimal import model, plan_time_optimal
 from att_planner.reference.time_optimal_cases import case_problem
 from att_sim.models import rotations as rot
-from helpers.truth import truth_check
+from helpers.prediction import prediction_check
 
 VALID = (Status.OPTIMAL, Status.FEASIBLE)
 
@@ -30,7 +30,7 @@ def test_unconstrained_symmetric_slew_beats_eigenaxis_by_8_percent(bw_plans):
     assert eig.duration == pytest.approx(2 * np.sqrt(np.pi), rel=1e-9)
     assert plan.duration <= 0.92 * eig.duration
     assert plan.duration <= 3.25                    # literature ≈ 3.243 (Bilimoria & Wie)
-    ver, _ = truth_check(problem, plan)
+    ver, _ = prediction_check(problem, plan)
     assert plan.interpolation == "zoh"
     assert ver.final_attitude_error <= np.deg2rad(0.5) and ver.final_rate <= 1e-2
     assert ver.torque_ratio <= 1.0 + 1e-9
@@ -41,7 +41,7 @@ def test_unconstrained_symmetric_slew_beats_eigenaxis_by_8_percent(bw_plans):
 def test_cone_constraints_hold_on_a_dense_grid(swift_plan):
     problem, plan = swift_plan
     assert plan.status in VALID
-    ver, traj = truth_check(problem, plan)
+    ver, traj = prediction_check(problem, plan)
     assert ver.dense_samples >= 400
     assert ver.min_cone_margin >= 0.0
     assert ver.final_attitude_error <= np.deg2rad(0.5) and ver.final_rate <= 1e-2
@@ -55,12 +55,12 @@ def test_cone_constraints_hold_on_a_dense_grid(swift_plan):
 
 
 def test_swift_plan_is_within_half_a_percent_of_its_optimum_after_one_refinement(swift_plan):
-    """Issue 18: one refinement round in quarters (the default) instead of three bisections; t_f
+    """One refinement round in quarters (the default) instead of three bisections; t_f
     within 0.5 % of the 3.06648 TU those reached, and the plan verified."""
     problem, plan = swift_plan
     assert plan.duration == pytest.approx(3.06648, rel=5e-3) and plan.duration >= 3.06648 * (1 - 1e-4)
     assert [m["intervals"] for m in plan.stats["mesh"]][:1] == [16] and len(plan.stats["mesh"]) == 2
-    ver, _ = truth_check(problem, plan)
+    ver, _ = prediction_check(problem, plan)
     assert ver.min_cone_margin >= 0 and ver.final_attitude_error <= np.deg2rad(0.5)
 
 
@@ -85,26 +85,26 @@ def test_an_nlp_is_built_once_per_shape_and_shared(monkeypatch):
 @pytest.mark.parametrize("case", ["bilimoria_wie", "swift"])
 def test_semi_free_final_attitude_is_never_slower(case, bw_plans, swift_plan):
     problem, full = (bw_plans[0], bw_plans[1]) if case == "bilimoria_wie" else swift_plan
-    target = rot.dcm(problem.q_final) @ problem.sensor_axis
+    target = rot.dcm_NB(problem.q_final) @ problem.sensor_axis
     semi = plan_time_optimal(replace(problem, sensor_target=target))
     assert semi.status in VALID
     assert semi.duration <= full.duration + 1e-6
-    ver, traj = truth_check(problem, semi)
-    pointing = np.arccos(np.clip(rot.dcm(traj.q[-1]) @ problem.sensor_axis @ target, -1, 1))
+    ver, traj = prediction_check(problem, semi)
+    pointing = np.arccos(np.clip(rot.dcm_NB(traj.q[-1]) @ problem.sensor_axis @ target, -1, 1))
     assert pointing <= np.deg2rad(0.5) and ver.final_rate <= 1e-2 and ver.min_cone_margin >= 0
 
 
 def test_arbitrary_initial_attitude_gives_the_same_time(swift_plan):
     problem, plan = swift_plan
     frame = rot.from_axis_angle([0.3, -0.5, 0.8], 1.1)        # rotate the whole scene
-    R = rot.dcm(frame)
+    R = rot.dcm_NB(frame)
     moved = replace(problem, q_initial=rot.multiply(frame, problem.q_initial),
                     q_final=rot.multiply(frame, problem.q_final),
                     cones=[Cone(R @ c.direction, c.half_angle, c.name) for c in problem.cones])
     other = plan_time_optimal(moved)
     assert other.status in VALID
     assert other.duration == pytest.approx(plan.duration, rel=1e-3)
-    ver, _ = truth_check(moved, other)
+    ver, _ = prediction_check(moved, other)
     assert ver.min_cone_margin >= 0 and ver.final_attitude_error <= np.deg2rad(0.5)
 
 
@@ -113,7 +113,7 @@ def test_rate_and_wheel_momentum_bounds_hold_on_the_truth_trajectory_and_cost_ti
     bounded = replace(problem, rate_max=1.5, wheel_momentum_max=1.2)
     plan = plan_time_optimal(bounded, starts=1)
     assert plan.status in VALID
-    _, traj = truth_check(problem, plan)
+    _, traj = prediction_check(problem, plan)
     assert np.abs(traj.omega).max() <= 1.5                      # per-axis body rate
     assert np.abs(traj.omega @ problem.spacecraft.inertia).max() <= 1.2   # wheel momentum, G = I
     assert plan.duration > free.duration
@@ -149,7 +149,7 @@ def test_deadline_returns_quickly_with_a_status_that_says_so():
     assert time.monotonic() - t0 < 4.0
     assert plan.status in (Status.BUDGET_EXPIRED, Status.FAILED)
     if plan.status == Status.BUDGET_EXPIRED:
-        ver, _ = truth_check(problem, plan, dense_fraction=500)
+        ver, _ = prediction_check(problem, plan, dense_fraction=500)
         assert ver.min_cone_margin >= 0
 
 

@@ -1,4 +1,4 @@
-"""Time-optimal slews among zones that move, keep-in zones and several sensors (issue 13).
+"""Time-optimal slews among zones that move, keep-in zones and several sensors.
 
 The zones move in a synthetic sky (a "Sun" turning about the inertial z axis at a known rate), so
 the expected geometry is known by hand; every plan is judged by att_planner.verification, which
@@ -31,9 +31,9 @@ RATE = np.deg2rad(-40.0) / TU               # rad/s: the Sun's azimuth rate (−
 X = np.array([1.0, 0.0, 0.0])
 
 
-class TurningSky:
+class TurningEphemeris:
     """A sky whose Sun lies in the inertial xy-plane at azimuth ψ0 + RATE t (the zones' interface
-    of :class:`att_planner.zones.ZoneSky`; the Moon and the Earth are not used)."""
+    of :class:`att_planner.zones.FittedZones`; the Moon and the Earth are not used)."""
 
     def __init__(self, psi0: float):
         self.psi0 = psi0
@@ -58,7 +58,7 @@ def _sweep_problem() -> ManeuverProblem:
     sc = Spacecraft(TU**2 * np.eye(3), body_torque_max=1.0)
     sun = Zone("sun", "sun", X, np.deg2rad(25.0))
     return ManeuverProblem(sc, rot.IDENTITY.copy(), rot.from_axis_angle([0.0, 0.0, 1.0], np.deg2rad(135.0)), X,
-                           zones=[sun], sky=TurningSky(np.deg2rad(200.0)))
+                           zones=[sun], sky=TurningEphemeris(np.deg2rad(200.0)))
 
 
 @pytest.fixture(scope="module")
@@ -89,7 +89,7 @@ def test_the_frozen_plan_enters_the_moving_zone_and_the_moving_plan_clears_it(sw
 
 def test_zone_constraints_are_exact_functions_of_time():
     """The path function of a moving zone takes the normalised time t (t_f enters through
-    t = τ t_f): its value and its t-derivative are the ZoneSky's series and their exact rate."""
+    t = τ t_f): its value and its t-derivative are the FittedZones' series and their exact rate."""
     problem = _sweep_problem()
     s = scaling(problem)
     margin = np.deg2rad(0.05)
@@ -102,7 +102,7 @@ def test_zone_constraints_are_exact_functions_of_time():
     dgdt = ca.Function("dgdt", [x, u, t], [ca.jacobian(path(x, u, t, values), t)])
     zs = problem.zone_sky()
     q = rot.from_axis_angle([0.2, 0.3, 1.0], 1.1)
-    b = rot.dcm(q) @ X
+    b = rot.dcm_NB(q) @ X
     state = np.concatenate([q, np.zeros(3)])
     for tn in (0.0, 1.3, 2.9):
         ts = tn * s.tu
@@ -138,7 +138,7 @@ def test_keep_in_zone_of_a_second_sensor_is_kept(bw_plans):
 
 
 def test_inertial_zones_plan_like_the_cones(swift_plan):
-    """Today's cones given as inertial keep-out zones of the same sensor: the same NLP, the same plan."""
+    """The keep-out cones given as inertial keep-out zones of the same sensor: the same NLP, the same plan."""
     problem, plan = swift_plan
     as_zones = replace(problem, cones=[], zones=problem.zone_sky().zones)
     assert not as_zones.zone_sky().moving

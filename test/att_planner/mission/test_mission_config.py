@@ -31,7 +31,7 @@ def test_the_shipped_day_loads_with_its_targets_pointed():
     assert len(targets) == 16 and [z.name for z in m.zones] == ["sun", "moon", "earth"]
     for target in targets.values():
         assert not target.moving and target.dwell > 0
-        assert rot.dcm(target.attitude) @ m.sensor_axis == pytest.approx(target.direction, abs=1e-12)
+        assert rot.dcm_NB(target.attitude) @ m.sensor_axis == pytest.approx(target.direction, abs=1e-12)
 
 
 def test_the_shipped_earth_observation_day_tracks_its_sites_without_the_payload_earth_zone():
@@ -43,7 +43,7 @@ def test_the_shipped_earth_observation_day_tracks_its_sites_without_the_payload_
     t = np.array([6700.0, 6800.0])
     q = singapore.attitudes(t)
     for k in range(2):                           # the sensor on the line of sight, body +z nearest the velocity
-        assert rot.dcm(q[k]) @ m.sensor_axis == pytest.approx(singapore.direction_at(t[k]), abs=1e-9)
+        assert rot.dcm_NB(q[k]) @ m.sensor_axis == pytest.approx(singapore.direction_at(t[k]), abs=1e-9)
     assert singapore.track.mode.kind == "ground" and singapore.track.mode.latitude == pytest.approx(math.radians(1.35))
 
 

@@ -31,7 +31,7 @@ def test_the_attitude_points_the_sensor_and_keeps_the_roll_axis_nearest_the_refe
     sensor = np.asarray(sensor, float) / np.linalg.norm(sensor)
     for d in rng.normal(size=(50, 3)):
         d /= np.linalg.norm(d)
-        R = rot.dcm(tl.pointing_attitude(sensor, d))
+        R = rot.dcm_NB(tl.pointing_attitude(sensor, d))
         assert R @ sensor == pytest.approx(d, abs=1e-12)
         # the roll axis is the unit vector ⟂ d nearest north: its north component is |north ⟂ d|
         r_body = np.roll(np.eye(3), 1, axis=0)[int(np.argmax(np.abs(sensor)))]

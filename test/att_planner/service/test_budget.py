@@ -43,8 +43,8 @@ def sky(kind: str) -> list:
     if kind == "none":
         return []
     rng = np.random.default_rng(3)
-    ends = [SENSOR, rot.dcm(GOAL) @ SENSOR]
-    path = rot.dcm(rot.slerp(rot.IDENTITY, GOAL, np.linspace(0.15, 0.85, MAX_CONES))) @ SENSOR
+    ends = [SENSOR, rot.dcm_NB(GOAL) @ SENSOR]
+    path = rot.dcm_NB(rot.slerp(rot.IDENTITY, GOAL, np.linspace(0.15, 0.85, MAX_CONES))) @ SENSOR
     cones = []
     while len(cones) < MAX_CONES:
         d = path[len(cones)] if kind == "blocking" else rng.normal(size=3)

@@ -1,4 +1,4 @@
-"""Requests for a slew that ends on a pointing mode (issue 15): planned by time_optimal only, not
+"""Requests for a slew that ends on a pointing mode: planned by time_optimal only, not
 with a semi-free goal, the mode checked field by field; the goal's law is the controller's."""
 from __future__ import annotations
 
@@ -12,7 +12,7 @@ import pytest
 from att_msgs_py.errors import ErrorCode, RequestError
 from att_msgs_py.types import PointingMode, Stage
 from att_planner.guidance import reference
-from att_planner.guidance.laws import Sky
+from att_planner.guidance.laws import PointingGeometry
 from att_planner.guidance.modes import law_of
 from att_planner.service.moving_goal import goal_law
 from att_planner.service.planning import plan_maneuver
@@ -36,10 +36,10 @@ def validate(method="time_optimal", mode=NADIR, **fields):
 def test_the_goal_is_the_controllers_law_shifted_by_the_plans_epoch():
     later = LEO.epoch.replace(second=LEO.epoch.second + 30)
     motion = goal_law(PointingMode("nadir"), LEO, later, rot.IDENTITY)
-    law = law_of(PointingMode("nadir"), Sky.of(world.Environment.from_scenario(LEO)), 0.0, rot.IDENTITY)
+    law = law_of(PointingMode("nadir"), PointingGeometry.of(world.Environment.from_scenario(LEO)), 0.0, rot.IDENTITY)
     q, w = motion(100.0)
     ref = reference(law.attitude, 130.0)
-    assert rot.angle_between(q, ref.q) < 1e-12 and np.allclose(w, ref.omega, atol=1e-15)
+    assert rot.angle_between(q, ref.q_RN) < 1e-12 and np.allclose(w, ref.omega_RN_R, atol=1e-15)
 
 
 def test_a_valid_request_carries_the_moving_goal_and_a_first_guess_of_its_end():

@@ -108,7 +108,7 @@ def test_semi_free_plan_is_judged_on_the_integrated_boresight():
     outcome = plan_maneuver(valid, TOLERANCES, runner=run_method)
     assert outcome.code == ErrorCode.OK, outcome.message
     assert outcome.verification.final_attitude_error < math.radians(0.5)      # boresight error here
-    reached = rot.dcm(outcome.plan.q[-1]) @ np.array([1.0, 0, 0])
+    reached = rot.dcm_NB(outcome.plan.q[-1]) @ np.array([1.0, 0, 0])
     assert reached @ target > math.cos(math.radians(0.5))
 
 

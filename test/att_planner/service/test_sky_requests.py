@@ -1,6 +1,7 @@
 """The planner service in the real sky (no ROS): where a request's epoch and orbit come from, zones
 in the problem and through a solver child, the closed-sky test with moving zones and several
-sensors, zone padding, requests without a sky unchanged, and the review of a flown plan's zones."""
+sensors, zone padding, requests without a sky planned against their cones alone, and the review of
+a flown plan's zones."""
 from __future__ import annotations
 
 import math
@@ -20,10 +21,10 @@ from att_planner.service.worker import run_isolated, warm_up
 from att_planner.tools.review.figures import figure_sky
 from att_planner.tools.review.run import Run
 from att_planner.tools.review.summary import summary_of, zone_sky_for
-from att_planner.zones import ZoneSky
+from att_planner.zones import FittedZones
 from att_sim.models import rotations as rot
 from att_sim.models import scenario as scen
-from att_sim.models.ephemeris import Sky
+from att_sim.models.ephemeris import Ephemeris
 from att_sim.models.orbit import TLEOrbit
 from helpers.maneuver_requests import EARTH, SUN, request, validate
 
@@ -36,7 +37,7 @@ X, Y = np.array([1.0, 0.0, 0.0]), np.array([0.0, 1.0, 0.0])
 ZONES = [Zone("sun", "sun", X, math.radians(47)), Zone("moon", "moon", X, math.radians(23)),
          Zone("earth", "earth_limb", X, math.radians(10))]
 SUN_Y = Zone("sun", "sun", Y, math.radians(47))
-LEO_GOAL = rot.from_axis_angle([1, 0, 0], math.radians(135))      # the issue's earth_obs slew, sensor +y
+LEO_GOAL = rot.from_axis_angle([1, 0, 0], math.radians(135))      # the earth_obs slew of att-bench sky, sensor +y
 
 
 def sky_request(epoch=EPOCH, zones=ZONES, tle=TLE, **fields):
@@ -108,7 +109,7 @@ def test_moving_zones_relax_over_the_window_and_fixed_ones_do_not():
     assert theta0[2] - math.radians(38) < caps["earth"].half_angle < theta0[2] - math.radians(36)
     assert theta0[0] - math.radians(0.2) < caps["sun"].half_angle < theta0[0]      # the Sun barely moves
     assert caps["radiator"].keep_in and caps["radiator"].half_angle > theta0[3]
-    fixed = ZoneSky([Zone("c", "inertial", X, 0.4, direction=Y)], None, 600.0)
+    fixed = FittedZones([Zone("c", "inertial", X, 0.4, direction=Y)], None, 600.0)
     assert relaxed_caps(fixed, np.arange(1))[0].half_angle == 0.4
 
 
@@ -160,7 +161,7 @@ def test_the_review_places_moving_zones_where_the_simulator_flew_them(tmp_path):
                 verification=Verification(0.0, 0.0, 0.1, [0.1] * 3, 0.5, 0.0, 0.0, 10))
     run = _rest_run(t0, plan)
     zones, note = zone_sky_for(run, leo_scenario)
-    sky = Sky(leo_scenario.epoch, leo_scenario.orbit_model)          # sim time zero is the scenario's epoch
+    sky = Ephemeris(leo_scenario.epoch, leo_scenario.orbit_model)          # sim time zero is the scenario's epoch
     assert np.allclose(zones.true_axes(0.0)[1], sky.moon_direction(t0), atol=1e-9)
     limb = math.acos(sky.nadir(t0 + 50.0) @ Y) - sky.earth_angular_radius(t0 + 50.0) - math.radians(10)
     assert zones.margins(50.0, rot.IDENTITY, true=True)[0, 2] == pytest.approx(limb, abs=1e-9)

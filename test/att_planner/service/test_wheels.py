@@ -1,4 +1,4 @@
-"""Plans that respect the wheels (issue 15): the wheels' speeds along a body-torque plan from momentum
+"""Plans that respect the wheels: the wheels' speeds along a body-torque plan from momentum
 conservation, a plan that would saturate a wheel slowed in time and verified, one that saturates at
 any speed refused, and the request's wheel speeds checked."""
 from __future__ import annotations
@@ -13,7 +13,7 @@ from att_msgs_py.types import ControlKind
 from att_planner.problem import ManeuverProblem
 from att_planner.service.wheels import smallest_slowdown, time_scaled
 from att_planner.tools.closed_loop import plan_in_process
-from att_planner.verification import body_plan_wheel_speeds, integrate, verify
+from att_planner.verification import body_plan_wheel_speeds, predict, verify
 from att_sim.models import rotations as rot
 from att_sim.models import scenario as scen
 from helpers.own_rk4 import integrate as own_rk4
@@ -46,13 +46,13 @@ def test_the_wheels_of_a_body_torque_plan_conserve_the_total_momentum_and_keep_t
     speeds0 = np.linspace(-0.6, 0.7, sc.n_wheels) * sc.wheel_speed_max
     p = plan(name)
     problem = ManeuverProblem(sc, rot.IDENTITY, SLEW, wheel_speeds=speeds0)
-    traj = integrate(problem, p)
+    traj = predict(problem, p)
     stored, slew = body_plan_wheel_speeds(problem, traj.q, traj.omega)
     relative = stored + slew
     assert relative[0] == pytest.approx(speeds0, abs=1e-9)
     inertial = relative + traj.omega @ sc.wheel_axes
     H_B = traj.omega @ sc.inertia.T + inertial @ (sc.wheel_inertia * sc.wheel_axes.T)
-    H_N = np.einsum("kij,kj->ki", rot.dcm(traj.q), H_B)
+    H_N = np.einsum("kij,kj->ki", rot.dcm_NB(traj.q), H_B)
     assert np.abs(H_N - H_N[0]).max() <= 1e-9 * np.linalg.norm(H_N[0])
     assert np.abs(slew).max() > 10.0            # the slew moves the wheels: the check above means something
     if sc.n_wheels > 3:

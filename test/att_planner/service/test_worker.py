@@ -1,4 +1,4 @@
-"""The planner's solver workers (issue 18): warm before they serve; one that overruns is killed and
+"""The planner's solver workers: warm before they serve; one that overruns is killed and
 replaced by a warmed one."""
 import math
 import time

@@ -1,4 +1,4 @@
-"""att-bench observe (issue 17): the zones' cost on a tour of observatory sources, both tours
+"""att-bench observe: the zones' cost on a tour of observatory sources, both tours
 verified, the JSON complete enough to integrate the plans independently."""
 import json
 from types import SimpleNamespace

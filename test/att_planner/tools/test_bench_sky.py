@@ -1,4 +1,4 @@
-"""``att-bench sky`` (issue 13): an INDEPENDENT check of the committed benchmarks/sky_<case>.json,
+"""``att-bench sky``: an INDEPENDENT check of the committed benchmarks/sky_<case>.json,
 and the study's plumbing on a cheap method.
 
 The check uses nothing of the suite: it integrates each plan's ZOH body torque from rest at

@@ -1,4 +1,4 @@
-"""``att-bench speed`` (issue 18): an INDEPENDENT check of the committed benchmarks/speed.json, and the
+"""``att-bench speed``: an INDEPENDENT check of the committed benchmarks/speed.json, and the
 study's plumbing on one quick run.
 
 For every case and every plan of the JSON (the first, the best smooth and the time-optimal one) the

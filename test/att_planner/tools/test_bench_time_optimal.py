@@ -1,9 +1,9 @@
-"""``att-bench time-optimal --case {ba1,ba2,bp1,bp2}`` (issue 19): an INDEPENDENT check of the
+"""``att-bench time-optimal --case {ba1,ba2,bp1,bp2}``: an INDEPENDENT check of the
 committed benchmarks/time_optimal_<case>.json, and the study's plumbing.
 
 The check uses nothing of the suite: it integrates the plan's ZOH torque from rest at ``q_initial``
 with its own RK4 (:mod:`helpers.own_rk4`, 40 steps per interval: about 2000 over the plan) and
-measures the boresight against the JSON's cone itself. It confirms the issue's claims: the final
+measures the boresight against the JSON's cone itself. It confirms the benchmark's claims: the final
 boresight within 0.01° of ``sensor_target`` and at rest; for BA the boresight within 1e-4 rad of the
 cone's boundary at every sample; for BP margins ≥ −1e-6 rad within 0.01 rad of the path's ends (the
 boundary points; README "Errors and limits", 112) and ≥ 0 everywhere else; BP ≤ BA ≤ λ-rotation for
@@ -20,7 +20,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from helpers.own_rk4 import dcm, integrate
+from helpers.own_rk4 import dcm_NB, integrate
 
 BENCHMARKS = Path(os.environ.get("ATT_TO_BENCHMARKS", Path(__file__).resolve().parents[3] / "benchmarks"))
 CASES = ("ba1", "ba2", "bp1", "bp2")
@@ -36,7 +36,7 @@ def _checked(case: str):
     payload = json.loads((BENCHMARKS / f"time_optimal_{case}.json").read_text())
     times, states = integrate(payload["J"], np.asarray(payload["t"], float), payload["torque"],
                               payload["q_initial"], SUBSTEPS, dense=True)
-    b = dcm(states[:, :4]) @ np.asarray(payload["sensor_axis"], float)
+    b = dcm_NB(states[:, :4]) @ np.asarray(payload["sensor_axis"], float)
     cone = payload["cones"][0]
     margin = np.arccos(np.clip(b @ np.asarray(cone["direction"], float), -1.0, 1.0)) - cone["half_angle"]
     return payload, times, states, b, margin

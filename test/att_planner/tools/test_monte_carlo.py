@@ -1,4 +1,4 @@
-"""``att-mc`` (issue 16): a 20-run campaign on a local Dask cluster, its table reproduced run by run
+"""``att-mc``: a 20-run campaign on a local Dask cluster, its table reproduced run by run
 from the seeds alone in this process, the report's figures, an interrupted campaign's partial
 report, a run's full log, and bad input refused in one line (an unreachable scheduler within its
 timeout). The campaign is the shipped dispersions on a 1° slew (test/data), flown in about a second a run."""

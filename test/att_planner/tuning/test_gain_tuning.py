@@ -1,4 +1,4 @@
-"""Magnetorquer PD law, batch settling simulator and derivative-free min-max (issue 6)."""
+"""Magnetorquer PD law, batch settling simulator and derivative-free min-max."""
 import math
 
 import numpy as np
@@ -48,7 +48,7 @@ def test_law_matches_formula_saturates_and_is_pd_when_unsaturated():
 
 
 def test_batch_right_hand_side_equals_truth_dynamics():
-    """The batch RHS is the truth model's derivative with Inputs(dipole=m, field_body=B_b)."""
+    """The batch RHS is the dynamics model's derivative with Inputs(dipole=m, field_body=B_b)."""
     rng = np.random.default_rng(1)
     n = 12
     h = gt.H_LOWER + rng.random((n, 7)) * (gt.H_UPPER - gt.H_LOWER)
@@ -90,7 +90,7 @@ def test_published_ic20_figures_reproduce():
 
 def test_batch_integration_agrees_with_truth_dynamics_stepping():
     """Same gains and ICs through att_sim.models.dynamics.step with every input held over each 1 s step
-    (the simulator's scheme before the per-stage environment of issue 13) and through the batch RK4
+    (a zero-order hold of the environment over each step) and through the batch RK4
     (inputs evaluated at the RK4 stages): after
     400 s of tumbling the states differ only by the hold's first-order effect (< 0.3°)."""
     rng = np.random.default_rng(3)

@@ -1,5 +1,5 @@
 """Disturbance torques (att_sim.models.disturbances) and the exponential atmosphere (att_sim.models.atmosphere),
-each against a case computed by hand (issue 13)."""
+each against a case computed by hand."""
 import math
 
 import numpy as np

@@ -1,4 +1,4 @@
-"""Orbit, tilted-dipole field and gravity-gradient helpers of att_sim.models.environment (issue 6)."""
+"""Orbit, tilted-dipole field and gravity-gradient helpers of att_sim.models.environment."""
 import math
 
 import numpy as np
@@ -64,17 +64,17 @@ def test_field_body_is_C_of_q_times_field():
     bi = env.field_inertial(ORBIT, t)
     bb = env.field_body(ORBIT, t, q)
     for n in range(5):
-        np.testing.assert_allclose(bb[n], rot.dcm(q[n]).T @ bi[n], rtol=1e-12)
+        np.testing.assert_allclose(bb[n], rot.dcm_BN(q[n]) @ bi[n], rtol=1e-12)
         np.testing.assert_allclose(np.linalg.norm(bb[n]), np.linalg.norm(bi[n]), rtol=1e-12)
 
 
 def test_paper_attitude_matrix_is_dcm_transpose():
-    """C(q) = (q4² − q_vᵀq_v) I + 2 q_v q_vᵀ − 2 q4 q_v× (Bruni & Celani) equals dcm(q).T."""
+    """C(q) = (q4² − q_vᵀq_v) I + 2 q_v q_vᵀ − 2 q4 q_v× (Bruni & Celani) equals dcm_BN(q)."""
     rng = np.random.default_rng(1)
     for q in rot.normalize(rng.normal(size=(20, 4))):
         qv, q4 = q[:3], q[3]
         c = (q4**2 - qv @ qv) * np.eye(3) + 2 * np.outer(qv, qv) - 2 * q4 * rot.hat(qv)
-        np.testing.assert_allclose(c, rot.dcm(q).T, atol=1e-14)
+        np.testing.assert_allclose(c, rot.dcm_BN(q), atol=1e-14)
 
 
 def test_gravity_gradient_torque():
@@ -88,7 +88,7 @@ def test_gravity_gradient_torque():
     np.testing.assert_allclose(env.gravity_gradient_torque(ORBIT, t, q_aligned, j), 0.0, atol=1e-12)
     # general attitude: 3μ/R³ r_b × J r_b and perpendicular to r_b
     q = rot.normalize(np.array([0.2, -0.4, 0.1, 0.9]))
-    rb = rot.dcm(q).T @ r
+    rb = rot.dcm_BN(q) @ r
     tau = env.gravity_gradient_torque(ORBIT, t, q, j)
     np.testing.assert_allclose(tau, 3 * env.EARTH_MU / ORBIT.radius**3 * np.cross(rb, j @ rb), rtol=1e-12)
     assert abs(tau @ rb) < 1e-18

@@ -1,4 +1,4 @@
-"""The sky seen from the spacecraft (att_sim.models.ephemeris, issue 13): DE421 Sun and Moon, shadow."""
+"""The sky seen from the spacecraft (att_sim.models.ephemeris): DE421 Sun and Moon, shadow."""
 import math
 import pickle
 import time
@@ -19,7 +19,7 @@ SOLSTICE = 20 * 3600.0 + 50 * 60.0         # 2026-12-21T20:50Z, the December sol
 
 @pytest.fixture(scope="module")
 def sky():
-    return eph.Sky(EPOCH, ob.TLEOrbit(EPOCH, LINE1, LINE2))
+    return eph.Ephemeris(EPOCH, ob.TLEOrbit(EPOCH, LINE1, LINE2))
 
 
 def _angle(u, v):
@@ -60,17 +60,17 @@ def test_earth_directions_and_angular_radius(sky):
     np.testing.assert_allclose(sky.nadir(t), -r / np.linalg.norm(r, axis=-1, keepdims=True))
     rho = sky.earth_angular_radius(t)
     np.testing.assert_allclose(np.sin(rho), env.EARTH_RADIUS / np.linalg.norm(r, axis=-1))
-    assert math.degrees(float(np.mean(rho))) == pytest.approx(66.4, abs=0.6)   # the issue's ~66° limb at 580 km
+    assert math.degrees(float(np.mean(rho))) == pytest.approx(66.4, abs=0.6)   # a ~66° limb at 580 km
     np.testing.assert_allclose(sky.velocity(t), sky.orbit.state(t)[1])
 
 
 def test_sky_epoch_may_differ_from_the_orbits():
     orbit = ob.TLEOrbit(EPOCH, LINE1, LINE2)
-    later = eph.Sky("2026-12-21T00:10:00Z", orbit)
+    later = eph.Ephemeris("2026-12-21T00:10:00Z", orbit)
     assert later.orbit_offset == pytest.approx(600.0, abs=1e-6)
     np.testing.assert_allclose(later.position(5.0), orbit.position(605.0), atol=1e-6)
-    np.testing.assert_allclose(later.sun(0.0), eph.Sky(EPOCH, orbit).sun(600.0), rtol=1e-14)
-    circular = eph.Sky(EPOCH, ob.CircularOrbit(env.OrbitParams()))       # epoch-free: starts at the sky's epoch
+    np.testing.assert_allclose(later.sun(0.0), eph.Ephemeris(EPOCH, orbit).sun(600.0), rtol=1e-14)
+    circular = eph.Ephemeris(EPOCH, ob.CircularOrbit(env.OrbitParams()))       # epoch-free: starts at the sky's epoch
     assert circular.orbit_offset == 0.0
     np.testing.assert_array_equal(circular.position(10.0), env.position(env.OrbitParams(), 10.0))
 

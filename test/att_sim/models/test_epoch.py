@@ -1,4 +1,4 @@
-"""Epoch parsing, range and skyfield times (att_sim.models.epoch, issue 13)."""
+"""Epoch parsing, range and skyfield times (att_sim.models.epoch)."""
 from datetime import UTC, datetime, timedelta, timezone
 
 import numpy as np

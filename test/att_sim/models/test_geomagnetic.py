@@ -1,4 +1,4 @@
-"""IGRF-14 field, Earth rotation table and field track of att_sim.models.geomagnetic (issue 13)."""
+"""IGRF-14 field, Earth rotation table and field track of att_sim.models.geomagnetic."""
 import math
 import time
 from datetime import UTC, datetime

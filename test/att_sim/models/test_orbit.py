@@ -1,4 +1,4 @@
-"""Orbits of the real sky (att_sim.models.orbit, issue 13): circular, Kepler + J2, TLE/SGP4 to GCRS."""
+"""Orbits of the real sky (att_sim.models.orbit): circular, Kepler + J2, TLE/SGP4 to GCRS."""
 import importlib.resources
 import math
 import time
@@ -13,7 +13,7 @@ from att_sim.models import orbit as ob
 from att_sim.models.epoch import skyfield_times
 
 EPOCH = "2026-12-21T00:00:00Z"
-LINE1 = "1 28485U          26355.00000000  .00000000  00000-0  20000-4 0    07"   # the issue's TLE
+LINE1 = "1 28485U          26355.00000000  .00000000  00000-0  20000-4 0    07"   # a 580 km, 20.56° LEO
 LINE2 = "2 28485  20.5600  60.0000 0005000  90.0000  10.0000 14.95764766    08"
 
 
@@ -22,7 +22,7 @@ def fix_checksum(line: str) -> str:
 
 
 @pytest.fixture(scope="module")
-def issue_orbit():
+def leo_orbit():
     return ob.TLEOrbit(EPOCH, LINE1, LINE2)
 
 
@@ -109,8 +109,8 @@ def test_kepler_bad_elements(args, words):
 
 
 # ---------------------------------------------------------------- TLE text
-def test_issue_tle_parses_and_flies_at_580_km(issue_orbit):
-    o = issue_orbit
+def test_leo_tle_parses_and_flies_at_580_km(leo_orbit):
+    o = leo_orbit
     assert o.tle_epoch.isoformat() == "2026-12-21T00:00:00+00:00" and o.frame == "GCRS"
     t = np.linspace(0.0, o.period, 200)
     r = np.linalg.norm(o.position(t), axis=-1)
@@ -208,22 +208,22 @@ def test_sgp4_teme_matches_tcppver_and_tle_orbit_rotates_it_to_gcrs(sat):
     assert np.all(angle < math.radians(0.1))        # epochs 2000-2006: little precession yet
 
 
-def test_gcrs_differs_from_teme_by_precession_since_j2000(issue_orbit):
+def test_gcrs_differs_from_teme_by_precession_since_j2000(leo_orbit):
     t = np.linspace(0.0, 6000.0, 7)
     rot = TEME.rotation_at(skyfield_times(EPOCH, t))
     angle = np.degrees(np.arccos((np.trace(rot) - 1.0) / 2.0))
     # general precession 50.29"/yr × 26.97 yr = 0.377° (nutation adds at most ~0.005°)
     assert angle == pytest.approx(np.full(7, 0.377), abs=0.01)
-    e, r, _ = issue_orbit.satrec.sgp4_array(np.full(7, issue_orbit.satrec.jdsatepoch), t / 86400.0)
-    r_gcrs = issue_orbit.position(t)
+    e, r, _ = leo_orbit.satrec.sgp4_array(np.full(7, leo_orbit.satrec.jdsatepoch), t / 86400.0)
+    r_gcrs = leo_orbit.position(t)
     np.testing.assert_allclose(np.einsum("ijn,nj->ni", rot, r_gcrs) / 1e3, r, atol=1e-5)
     between = np.degrees(np.arccos(np.sum(r * 1e3 * r_gcrs, -1) / np.linalg.norm(r_gcrs, axis=-1) ** 2))
     assert np.all(between < 0.39) and np.max(between) > 0.1
 
 
 # ---------------------------------------------------------------- tabulation
-def test_table_matches_direct_evaluation(issue_orbit):
-    o = issue_orbit
+def test_table_matches_direct_evaluation(leo_orbit):
+    o = leo_orbit
     t = np.random.default_rng(1).uniform(-3000.0, 12000.0, 400)
     r, v = o.state(t)
     r_direct, v_sgp4 = o.direct_state(t)
@@ -238,9 +238,9 @@ def test_table_matches_direct_evaluation(issue_orbit):
     assert o.state(t.reshape(20, 20))[0].shape == (20, 20, 3)
 
 
-def test_speed_scalar_and_vector_calls(issue_orbit):
+def test_speed_scalar_and_vector_calls(leo_orbit):
     """common13: ≤ 50 µs a scalar call amortised, ≤ 20 ms for 2000 times (here with 2× slack for load)."""
-    orbits = [issue_orbit, ob.KeplerOrbit(EPOCH, 7000e3, 0.01, 1.7, 0.3, 0.5, 0.1),
+    orbits = [leo_orbit, ob.KeplerOrbit(EPOCH, 7000e3, 0.01, 1.7, 0.3, 0.5, 0.1),
               ob.CircularOrbit(env.OrbitParams())]
     t = np.linspace(0.0, 9000.0, 2000)
     for o in orbits:

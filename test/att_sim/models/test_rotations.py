@@ -13,14 +13,29 @@ def random_quaternions(n):
 
 def test_dcm_maps_body_to_inertial_and_composes_like_the_product():
     q = rot.from_axis_angle([0, 0, 1], np.pi / 2)
-    assert rot.dcm(q) @ np.array([1.0, 0, 0]) == pytest.approx([0, 1, 0], abs=1e-15)
+    assert rot.dcm_NB(q) @ np.array([1.0, 0, 0]) == pytest.approx([0, 1, 0], abs=1e-15)
     p, r = random_quaternions(2)
-    assert np.allclose(rot.dcm(rot.multiply(p, r)), rot.dcm(p) @ rot.dcm(r))
+    assert np.allclose(rot.dcm_NB(rot.multiply(p, r)), rot.dcm_NB(p) @ rot.dcm_NB(r))
+
+
+def test_dcm_BN_is_schaub_and_junkins_bn_and_the_transpose_of_dcm_NB():
+    """A body frame turned by θ about the inertial 3-axis: Schaub & Junkins' [BN] = M3(θ) =
+    [[c, s, 0], [−s, c, 0], [0, 0, 1]] (v_B = [BN] v_N), written out here."""
+    theta = 0.7
+    c, s = np.cos(theta), np.sin(theta)
+    q_BN = rot.from_axis_angle([0, 0, 1], theta)
+    np.testing.assert_allclose(rot.dcm_BN(q_BN), [[c, s, 0], [-s, c, 0], [0, 0, 1]], atol=1e-15)
+    qs = random_quaternions(5)
+    assert np.array_equal(rot.dcm_BN(qs), np.swapaxes(rot.dcm_NB(qs), -1, -2))
+    v_N = RNG.normal(size=3)
+    for q in qs:
+        assert np.array_equal(rot.dcm_BN(q), rot.dcm_NB(q).T)
+        np.testing.assert_allclose(rot.to_body(q.tolist(), v_N.tolist()), rot.dcm_BN(q) @ v_N, rtol=0, atol=1e-14)
 
 
 def test_from_dcm_inverts_dcm_up_to_sign():
     for q in random_quaternions(50):
-        back = rot.from_dcm(rot.dcm(q))
+        back = rot.from_dcm_NB(rot.dcm_NB(q))
         assert min(np.linalg.norm(back - q), np.linalg.norm(back + q)) < 1e-12
 
 
@@ -38,8 +53,8 @@ def test_kinematics_convention_q_dot_is_half_q_times_omega():
     numeric = (rot.propagate_constant_rate(q, w, dt) - q) / dt
     assert np.allclose(numeric, 0.5 * rot.multiply(q, np.append(w, 0)), atol=1e-6)
     # R_dot = R hat(omega)
-    R_dot = (rot.dcm(rot.propagate_constant_rate(q, w, dt)) - rot.dcm(q)) / dt
-    assert np.allclose(R_dot, rot.dcm(q) @ rot.hat(w), atol=1e-5)
+    R_dot = (rot.dcm_NB(rot.propagate_constant_rate(q, w, dt)) - rot.dcm_NB(q)) / dt
+    assert np.allclose(R_dot, rot.dcm_NB(q) @ rot.hat(w), atol=1e-5)
 
 
 def test_angle_between_is_sign_independent():
@@ -50,12 +65,12 @@ def test_angle_between_is_sign_independent():
 
 
 def test_one_quaternion_fast_paths_agree_with_the_stacked_forms():
-    """dcm, exp_map and to_axis_angle take Python-float paths for one quaternion or vector (the
+    """dcm_NB, exp_map and to_axis_angle take Python-float paths for one quaternion or vector (the
     loops' hot path); each row of a stack goes through numpy's: the same values to the last ulps."""
     qs = random_quaternions(20)
-    stacked = rot.dcm(qs)
+    stacked = rot.dcm_NB(qs)
     for q, R in zip(qs, stacked):
-        assert np.array_equal(rot.dcm(q), R)
+        assert np.array_equal(rot.dcm_NB(q), R)
     phis = np.vstack([RNG.normal(size=(10, 3)), RNG.normal(size=(5, 3)) * 1e-9, np.zeros((1, 3))])
     for phi, q in zip(phis, rot.exp_map(phis)):
         assert np.allclose(rot.exp_map(phi), q, rtol=4e-16, atol=1e-300)

@@ -1,4 +1,4 @@
-"""The 3D view's geometry (issue 17): cones at their zones' half-angles about the zones' current
+"""The 3D view's geometry: cones at their zones' half-angles about the zones' current
 axes (the planner's definition), boresights and paths through the attitude convention, frames."""
 import math
 
@@ -8,11 +8,11 @@ from scipy.spatial.transform import Rotation
 
 from att_msgs_py import markers
 from att_msgs_py.types import ShapeKind, Zone
-from att_planner.zones import ZoneSky
+from att_planner.zones import FittedZones
 from att_sim.models import rotations as rot
 from att_sim.models import scenario as scen
 from att_sim.models import scene
-from att_sim.models.ephemeris import Sky
+from att_sim.models.ephemeris import Ephemeris
 from att_sim.models.world import Environment
 
 
@@ -43,7 +43,7 @@ def test_the_tf_transform_rotates_body_vectors_into_the_inertial_frame_as_the_st
     r = msg.transform.rotation
     as_tf = Rotation.from_quat([r.x, r.y, r.z, r.w])          # tf: v_parent = R v_child, scalar last
     v_B = np.array([[1.0, 0, 0], [0, 1.0, 0], [0.2, -0.4, 0.9]])
-    assert np.allclose(as_tf.apply(v_B), (rot.dcm(q_BN) @ v_B.T).T, atol=1e-12)
+    assert np.allclose(as_tf.apply(v_B), (rot.dcm_NB(q_BN) @ v_B.T).T, atol=1e-12)
     t = msg.transform.translation
     assert (t.x, t.y, t.z) == (0.0, 0.0, 0.0)                 # the view is centred on the spacecraft
     # the boresight arrow drawn in the body frame lands where the plan path (inertial) puts it
@@ -66,7 +66,7 @@ def test_zones_are_drawn_where_the_planner_says_they_are_now():
     sc = scen.load("leo_observatory")
     zones = sc.zones + [Zone("target", "inertial", [0, 1, 0], math.radians(20), True, [0.0, 0.6, 0.8])]
     env = Environment.from_scenario(sc)
-    truth = ZoneSky(zones, Sky(sc.epoch, sc.orbit_model), window=4000.0)
+    truth = FittedZones(zones, Ephemeris(sc.epoch, sc.orbit_model), window=4000.0)
     for t in (0.0, 1234.5, 3600.0):
         views = scene.zone_views(zones, env.bodies(t))
         assert [v.name for v in views] == ["sun", "moon", "earth", "target"]
@@ -114,7 +114,7 @@ def test_zone_margins_are_the_planners_truth_margins():
     sc = scen.load("leo_observatory")
     zones = sc.zones + [Zone("target", "inertial", [0, 0, 1], math.radians(20), True, [0.0, 0.6, 0.8])]
     env = Environment.from_scenario(sc)
-    truth = ZoneSky(zones, Sky(sc.epoch, sc.orbit_model), window=4000.0)
+    truth = FittedZones(zones, Ephemeris(sc.epoch, sc.orbit_model), window=4000.0)
     for t, q in ((0.0, rot.IDENTITY), (2000.0, rot.from_axis_angle([1, 2, 3], 2.0))):
         mine = scene.zone_margins(zones, scene.zone_views(zones, env.bodies(t)), q)
         assert np.allclose(mine, truth.margins(np.array([t]), q[None], true=True).reshape(-1), atol=1e-9)

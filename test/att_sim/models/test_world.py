@@ -1,4 +1,4 @@
-"""The simulator's world (issue 13): today's scenarios unchanged, the real sky composed from the
+"""The simulator's world: scenarios without the real sky's keys fly the circular world, the real sky composed from the
 scenario, the field and position published at the published state, the real-sky scenario keys checked."""
 import math
 import time
@@ -26,8 +26,8 @@ def leo():
     return scenario.load("leo_observatory")
 
 
-# ------------------------------------------------------------------- today's scenarios unchanged
-def test_a_scenario_without_the_real_sky_keys_is_todays_world():
+# ------------------------------------------------------------------- scenarios without the real sky
+def test_a_scenario_without_the_real_sky_keys_is_the_circular_world():
     s = scenario.load("swift_demo")
     assert s.epoch is None and s.field_model == "dipole" and s.zones == []
     assert isinstance(s.orbit_model, CircularOrbit) and s.orbit_model.params == s.orbit
@@ -107,7 +107,7 @@ def test_each_torque_is_its_model_at_the_stage_state(leo):
     assert set(tq) == {"gravity_gradient", "solar_pressure", "drag", "residual_dipole"}
     facets = leo.environment["facets"]
     sun = e.sky.sun(t) - r
-    b_body = rot.dcm(Q).T @ e.field.field_inertial(t, r)
+    b_body = rot.dcm_BN(Q) @ e.field.field_inertial(t, r)
     v_rel = v - np.cross([0.0, 0.0, 7.292115e-5], r)           # the air co-rotates
     rho = atmosphere.density(np.linalg.norm(r) - env.EARTH_RADIUS)
     expected = {
