@@ -1,6 +1,6 @@
 """The environment the simulator integrates: orbit, geomagnetic field, Sun and shadow, disturbance torques.
 
-:class:`Environment` composes the models of the real sky (issue 13) for one spacecraft:
+:class:`Environment` composes the models of the real sky for one spacecraft:
 
 * orbit: any :class:`att_sim.models.orbit.Orbit` (circular, Kepler + J2, TLE/SGP4), GCRS, t past the epoch;
 * field: :class:`att_sim.models.geomagnetic.GeomagneticField` (``dipole`` or ``igrf14``), in body axes
@@ -21,8 +21,11 @@
 cached — the two middle stages share a time and the last stage's time is the next step's first — so
 a step costs two time evaluations and four attitude evaluations.
 
-A scenario without the real sky's keys (:func:`Environment.from_scenario`) is today's world: the
+A scenario without the real sky's keys (:func:`Environment.from_scenario`) is the simple world: the
 circular orbit, the tilted dipole and optionally the gravity gradient, nothing else.
+
+:func:`stages` evaluates the environments of many runs at one stage on rows (one state per run); the
+time-only part is computed once when the runs' environments share it (:meth:`Environment.share_time_part`).
 """
 from __future__ import annotations
 
@@ -107,7 +110,7 @@ class Environment:
 
     @classmethod
     def circular(cls, spacecraft: Spacecraft, orbit: OrbitParams, gravity_gradient: bool = False) -> Environment:
-        """Today's world: circular orbit, tilted dipole, optional gravity gradient, no epoch."""
+        """The simple world: circular orbit, tilted dipole, optional gravity gradient, no epoch."""
         return cls(None, CircularOrbit(orbit), GeomagneticField("dipole"), None, spacecraft,
                    flags=Flags(gravity_gradient=gravity_gradient))
 
@@ -202,11 +205,12 @@ class Environment:
         return out
 
     def stage(self, t: float, x: np.ndarray) -> tuple[np.ndarray, np.ndarray | None]:
-        """``(B_b, τ_env)`` at one RK4 stage (:data:`att_sim.models.dynamics.StageEnvironment`); ``τ_env``
-        is None when no disturbance is active."""
-        q = x[:4]
-        field_b = np.array(rot.to_body(q.tolist(), self.field_inertial(t).tolist()))
-        return field_b, self.disturbance(t, q, field_b)
+        """``(B_b, τ_env)`` at one RK4 stage (:data:`att_sim.models.dynamics.StageEnvironment`) of one
+        state (7 + N,) or of rows of states, all in this environment; ``τ_env`` is None when no
+        disturbance is active."""
+        x = np.asarray(x, float)
+        field_b, tau = stages([self] * (len(x) if x.ndim == 2 else 1), t, x if x.ndim == 2 else x[None])
+        return (field_b, tau) if x.ndim == 2 else (field_b[0], None if tau is None else tau[0])
 
     def share_time_part(self, other: Environment) -> None:
         """Keep the time-only part (:class:`_Now`, field tracks) in one cache with ``other``'s, when
@@ -241,9 +245,26 @@ class Environment:
 
     def sample(self, t: float, q: np.ndarray) -> Sample:
         """Field, total disturbance torque, position and shadow at time ``t`` and attitude ``q``."""
-        return self.sample_of(t, *self.stage(t, np.asarray(q, float)))
+        field_b, tau = stages([self], t, np.asarray(q, float)[None])
+        return self.sample_of(t, field_b[0], None if tau is None else tau[0])
 
     def sample_of(self, t: float, field_b: np.ndarray, torque: np.ndarray | None) -> Sample:
         """:meth:`sample` of the attitude whose :meth:`stage` values at ``t`` are ``field_b``, ``torque``."""
         now = self._now(t)
         return Sample(field_b, np.zeros(3) if torque is None else torque, now.r.copy(), now.shadow)
+
+
+def stages(environments: list[Environment], t: float, x: np.ndarray) -> tuple[np.ndarray, np.ndarray | None]:
+    """``(B_b, τ_env)`` of each run at time ``t``: the field in body axes (n, 3) and the sum of the
+    disturbance torques (n, 3; None when no run is disturbed) of the run of each row of ``x`` (rows
+    whose first four entries are the attitude) in its environment."""
+    first = environments[0]
+    if all(e._cache is first._cache for e in environments):
+        field_N = first.field_inertial(t)
+    else:
+        field_N = np.array([e.field_inertial(t) for e in environments])
+    field_b = rot.to_body(x[:, :4], field_N)
+    if not any(e.disturbed for e in environments):
+        return field_b, None
+    torques = [e.disturbance(t, x[i, :4], field_b[i]) for i, e in enumerate(environments)]
+    return field_b, np.array([np.zeros(3) if tau is None else tau for tau in torques])

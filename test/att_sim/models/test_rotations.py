@@ -65,7 +65,7 @@ def test_one_quaternion_fast_paths_agree_with_the_stacked_forms():
 
 
 def test_log_map_of_rows_gives_each_row_its_bits_alone():
-    """The lockstep's gyros take the rotations of all runs as rows: each row is the one quaternion's
+    """A batch's gyros take the rotations of all runs as rows: each row is the one quaternion's
     log map bit for bit — small and zero rotations, w < 0, unnormalised, zero and non-finite rows."""
     qs = np.vstack([random_quaternions(200) * RNG.uniform(1e-3, 1e3, (200, 1)),
                     [[1e-12, -2e-13, 3e-14, -1.0], [0.0, 0.0, 0.0, 1.0], [0.0, 0.0, 0.0, 0.0],

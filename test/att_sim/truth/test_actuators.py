@@ -54,7 +54,7 @@ def test_a_power_limited_motor_cannot_speed_a_fast_wheel_up_with_full_torque():
     u = np.array([0.12, 0.12, -0.12, 0.12])
     speed = np.array([100.0, 600.0, 600.0, -600.0])
     # slow wheel: full torque; fast wheel sped up: 60 W / 600 rad/s; braking: full torque
-    assert np.allclose(drive.motor(u.tolist(), speed.tolist()), [0.12, 0.1, -0.12, 0.12])
+    assert np.allclose(drive.motor(u, speed), [0.12, 0.1, -0.12, 0.12])
     sim = simulation(WheelDriveSpec(power_max=60.0), wheel_speed0=(600.0, 0.0, 0.0))
     sim.set_command(Command(mode=ControlMode.PLAN_TRACKING, wheel_torques=np.array([0.12, 0.12, 0.0])))
     sim.advance(0.05)

@@ -32,6 +32,7 @@ from att_sim.truth.sensors.magnetometer import Magnetometer
 from att_sim.truth.sensors.star_tracker import StarTracker
 from att_sim.truth.sensors.sun_sensors import SunSensors
 from att_sim.truth.sensors.tachometer import Tachometer
+from att_sim.truth.sensors.tachometer import measure as measure_tachometers
 
 ARW = 0.01 * DEG / math.sqrt(HOUR)           # 0.01 deg/sqrt(h)
 BIAS_INSTABILITY = 0.05 * DEG / HOUR          # 0.05 deg/h
@@ -158,7 +159,7 @@ def test_sun_sensors_follow_the_cosine_law_their_field_of_view_and_the_shadow():
 
 def test_tachometer_noise_and_quantisation():
     tach = Tachometer(TachometerSpec(noise=0.01, quantization=0.005), np.random.default_rng(9))
-    speeds = np.array([tach.measure(0.0, np.array([100.0, -3.0, 0.0])).speeds for _ in range(4000)])
+    speeds = np.array([measure_tachometers([tach], np.array([[100.0, -3.0, 0.0]]))[0] for _ in range(4000)])
     assert np.allclose(np.round(speeds / 0.005) * 0.005, speeds)
     assert np.allclose(speeds.mean(axis=0), [100.0, -3.0, 0.0], atol=0.002)
     assert np.all(np.abs(speeds.std(axis=0) / math.hypot(0.01, 0.005 / math.sqrt(12)) - 1) < 0.08)
