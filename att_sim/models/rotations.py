@@ -24,16 +24,15 @@ import numpy as np
 IDENTITY = np.array([0.0, 0.0, 0.0, 1.0])
 
 
-_NEXT_AXIS = (1, 2, 0)
-_PREV_AXIS = (2, 0, 1)
+_NEXT_AXIS = np.array([1, 2, 0])
+_PREV_AXIS = np.array([2, 0, 1])
 
 
 def cross(a: np.ndarray, b: np.ndarray, axis: int = -1) -> np.ndarray:
     """``a × b`` along ``axis``, broadcasting: single vectors, rows of runs ``(n, 3)`` and
     component-first batches alike (cheaper than ``np.cross`` on small stacks)."""
-    a1, a2 = np.take(a, _NEXT_AXIS, axis), np.take(a, _PREV_AXIS, axis)
-    b1, b2 = np.take(b, _NEXT_AXIS, axis), np.take(b, _PREV_AXIS, axis)
-    return a1 * b2 - a2 * b1
+    a, b = np.asarray(a, float), np.asarray(b, float)
+    return a.take(_NEXT_AXIS, axis) * b.take(_PREV_AXIS, axis) - a.take(_PREV_AXIS, axis) * b.take(_NEXT_AXIS, axis)
 
 
 def hat(v: np.ndarray) -> np.ndarray:

@@ -150,15 +150,18 @@ class Gyros:
         dt, a, sigma, walk_sigma, noise_sigma = self._of_intervals(tuple(dts))
         k = rotation.shape[1]
         flicker, last = self._flicker(a, sigma, k)
-        walk = np.array([g.walk for g in gyros])[:, None, :] + np.cumsum(
+        walk = np.array([g.walk for g in gyros])[:, None, :] + np.add.accumulate(
             np.array([g.rng.standard_normal((k, 3)) for g in gyros]) * walk_sigma, axis=1)
         bias = self.turn_on + flicker + walk
         rate = rotation @ self.transfer_T / dt + bias
         rate = rate + np.array([g.rng.standard_normal((k, 3)) for g in gyros]) * noise_sigma
         rate = np.minimum(np.maximum(rate, -self.limit), self.limit)
-        total = np.array([g.carry for g in gyros])[:, None, :] + np.cumsum(rate * dt, axis=1)
+        total = np.array([g.carry for g in gyros])[:, None, :] + np.add.accumulate(rate * dt, axis=1)
         counted = quantize(total, self.lsb)
-        rate = np.diff(counted, axis=1, prepend=0.0) / dt
+        counts = counted.copy()                     # each sample's counts: the difference of the totals
+        counts[:, 1:] -= counted[:, :-1]
+        carry = total[:, -1] - counted[:, -1]
         for i, g in enumerate(gyros):
-            g.flicker, g.walk, g.bias, g.carry = last[i], walk[i, -1], bias[i, -1], total[i, -1] - counted[i, -1]
+            g.flicker, g.walk, g.bias, g.carry = last[i], walk[i, -1], bias[i, -1], carry[i]
+        rate = counts / dt
         return rate
