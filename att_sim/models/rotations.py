@@ -104,12 +104,14 @@ def dcm(q: np.ndarray) -> np.ndarray:
 
 
 def to_body(q: np.ndarray, v: np.ndarray) -> np.ndarray:
-    """``dcm(q)ᵀ v``, inertial vectors in body axes, on rows: ``q`` (n, 4), ``v`` (n, 3) or one
-    (3,) for every row; (n, 3). The matrix is the quadratic form of :func:`dcm` (for a quaternion
-    off unit norm too, as at an RK4 stage): ``dcm(q)ᵀ = I + T(q qᵀ)`` with ``T`` linear."""
+    """``dcm(q)ᵀ v``, inertial vectors in body axes: ``q`` (..., 4) (rows of runs, or one), ``v``
+    (..., 3) broadcasting against them (one vector for every row, or one per row). The matrix is
+    the quadratic form of :func:`dcm` (for a quaternion off unit norm too, as at an RK4 stage):
+    ``dcm(q)ᵀ = I + T(q qᵀ)`` with ``T`` linear."""
     q, v = np.asarray(q, float), np.asarray(v, float)
-    outer = (q[:, :, None] * q[:, None, :]).reshape(len(q), 1, 16)
-    quadratic = (outer @ _TO_BODY).reshape(len(q), 3, 3)
+    lead = q.shape[:-1]
+    outer = (q[..., :, None] * q[..., None, :]).reshape(lead + (1, 16))
+    quadratic = (outer @ _TO_BODY).reshape(lead + (3, 3))
     return v + (quadratic @ v[..., None])[..., 0]
 
 

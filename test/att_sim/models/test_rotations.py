@@ -78,9 +78,12 @@ def test_log_map_of_rows_gives_each_row_its_bits_alone():
 
 def test_to_body_on_rows_is_the_transposed_dcm_of_each_row():
     """Rows of quaternions, unit or not (an RK4 stage's), each against ``dcm(q)ᵀ v`` computed alone;
-    one vector for every row or one per row."""
+    one vector for every row or one per row; one quaternion; a stack of rows."""
     qs = random_quaternions(50) * RNG.uniform(0.9, 1.1, (50, 1))
     vs = RNG.normal(size=(50, 3))
     for v, rows in ((vs, rot.to_body(qs, vs)), (vs[0], rot.to_body(qs, vs[0]))):
         for i, (q, row) in enumerate(zip(qs, rows)):
             np.testing.assert_allclose(row, rot.dcm(q).T @ (v if v.ndim == 1 else v[i]), rtol=0, atol=1e-15)
+    np.testing.assert_allclose(rot.to_body(qs[3], vs[3]), rot.dcm(qs[3]).T @ vs[3], rtol=0, atol=1e-15)
+    stacked = rot.to_body(qs.reshape(5, 10, 4), vs.reshape(5, 10, 3))
+    np.testing.assert_array_equal(stacked.reshape(50, 3), rot.to_body(qs, vs))

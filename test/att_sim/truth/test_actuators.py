@@ -1,4 +1,4 @@
-"""Imperfect actuators of the truth (issue 14): wheel friction is internal (the momentum of body and
+"""Imperfect actuators of the truth: wheel friction is internal (the momentum of body and
 wheels is kept) and slows a free wheel as its law says; the drive quantises, adds noise, and a
 power-limited motor cannot speed a fast wheel up with full torque; magnetorquers quantise and are
 misaligned; every hostile datasheet value is refused naming the field."""

@@ -1,4 +1,4 @@
-"""Monte Carlo dispersions (issue 16): the draws follow the declared distributions, a run is
+"""Monte Carlo dispersions: the draws follow the declared distributions, a run is
 reproduced by its seed alone, the dispersed truth carries exactly the drawn values, and every bad
 campaign is refused in one sentence naming the field (or the seed of a non-physical draw)."""
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""Sensor models against their statistics (issue 14): the gyro's Allan deviation recovers its ARW and
+"""Sensor models against their statistics: the gyro's Allan deviation recovers its ARW and
 bias instability, the star tracker's noise its σ about each sensor axis, exclusions blind it; the
 magnetometer, sun sensors and tachometers as their datasheets say; every stream reproducible from
 the seed."""
