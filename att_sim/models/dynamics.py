@@ -397,7 +397,7 @@ def simulate_profile(
     duration; every interval gets at least one step). Returns the state at every substep. Body
     torques take the compiled stepper (:func:`_body_torque_stepper`: the same RK4 of the same
     equations, the wheels' momentum held, as :func:`step` without motor torques), motor torques
-    :func:`step`'s loop.
+    :func:`rk4` of :func:`rates` on a row of one.
     """
     t_knots = np.asarray(t_knots, float)
     values = np.asarray(values, float).reshape(len(t_knots), -1)
@@ -422,10 +422,11 @@ def simulate_profile(
     if kind == ControlKind.BODY_TORQUE:
         X = np.vstack([x, _body_torque_steps(sc, x, u, slope, h)])
     else:
-        X = [x.copy()]
+        stack, row, u, slope = sc.stacked, x[None], u[:, None], slope[:, None]      # motor torques: rows of one
+        X = [x]
         for u_i, du_i, h_i in zip(u, slope, h):
-            x = renormalised(rk4(lambda tau, s, u_i=u_i, du_i=du_i:
-                                 derivative(sc, s, Inputs(**{kind: u_i + du_i * tau})), 0.0, x, h_i))
-            X.append(x.copy())
+            row = rk4(lambda tau, s, u_i=u_i, du_i=du_i: rates(stack, s, _ZERO3, u_i + du_i * tau), 0.0, row, h_i)
+            renormalised(row.T)
+            X.append(row[0])
         X = np.array(X)
     return Trajectory(np.concatenate([grid[:1], t0 + h]), X[:, :4], X[:, 4:7], X[:, 7:])
