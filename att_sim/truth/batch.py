@@ -61,7 +61,7 @@ class SimulationBatch:
         self.coiled = [i for i, s in enumerate(sims) if s.magnetorquers is not None]
         coils = [sims[i].magnetorquers for i in self.coiled]
         self.coils = None if not coils else coils[0] if len(coils) == 1 else Magnetorquers.stack(coils)
-        self.gyros: tuple[list, Gyros] | None = None   # the runs whose gyros were due, and their model
+        self.gyros: tuple[list, Gyros] | None = None   # the gyros that were due, and their model on rows
 
     def advance(self, dt: float) -> None:
         """One RK4 step of every simulation, the actuator inputs held and each environment evaluated at
@@ -144,8 +144,10 @@ class SimulationBatch:
             taken[i].gyro_interval = sims[i].gyro_interval(rotations.get(i))
         due = [i for i in suites if taken[i].gyro_interval is not None]
         if due:
-            if self.gyros is None or self.gyros[0] != due:
-                self.gyros = (due, Gyros([sims[i].sensors.gyro for i in due]))
+            units = [sims[i].sensors.gyro for i in due]
+            if self.gyros is None or len(self.gyros[0]) != len(units) \
+                    or any(a is not b for a, b in zip(self.gyros[0], units)):
+                self.gyros = (units, Gyros(units))
             rotation = np.array([taken[i].gyro_interval[0] for i in due])[:, None, :]
             rates = self.gyros[1].measure(rotation, [taken[i].gyro_interval[1] for i in due])
             for i, rate in zip(due, rates):
