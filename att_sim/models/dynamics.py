@@ -205,12 +205,6 @@ def rk4_mean(k1, k2, k3, k4) -> np.ndarray:
     return (k1 + 2 * k2 + 2 * k3 + k4) / 6.0
 
 
-def mean_external_torque(inputs: Inputs, stages: list) -> np.ndarray:
-    """The RK4-weighted mean of :func:`external_torque` over a step's four ``stages`` (N m, body
-    axes): the body torque a step applied."""
-    return rk4_mean(*(external_torque(inputs, s) for s in stages))
-
-
 def rates(sc: SpacecraftStack, x: np.ndarray, torque: np.ndarray, u: np.ndarray | None = None,
           drive: Callable | None = None) -> np.ndarray:
     """Time derivative of the states ``x`` (n, 7 + N), one row per spacecraft of the stack, for

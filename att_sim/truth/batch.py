@@ -74,12 +74,11 @@ class SimulationBatch:
         """:meth:`advance` from the states ``x`` (rows) with the step's inputs already taken (:meth:`inputs`)."""
         sims, sc = self.sims, self.spacecraft
         environments = [s.environment for s in sims]
-        stages = []
+        torques = []                    # the external torque of each stage: the step's mean is applied
 
         def f(t, state):
-            stage = world.stages(environments, t, state)
-            stages.append(stage)
-            return dyn.rates(sc, state, dyn.external_torque(inputs, stage), inputs.wheel_torque, self.drives)
+            torques.append(dyn.external_torque(inputs, world.stages(environments, t, state)))
+            return dyn.rates(sc, state, torques[-1], inputs.wheel_torque, self.drives)
         try:
             x_new = dyn.rk4(f, sims[0].t, x, dt)
         except ValueError as err:       # some run's environment failed: each run alone, as it would be
@@ -95,8 +94,7 @@ class SimulationBatch:
         if self.drives is not None:     # at the step's start: motor torque, and less friction
             speed = dyn.relative_wheel_speed(sc, x[:, 7:], x[:, 4:7])
             u, net = self.drives.motor(u, speed), self.drives(u, speed)
-        body = dyn.rk4_mean(*(dyn.external_torque(inputs, stage) for stage in stages)) \
-            - (sc.wheel_axes @ net[:, :, None])[:, :, 0]
+        body = dyn.rk4_mean(*torques) - (sc.wheel_axes @ net[:, :, None])[:, :, 0]
         samples = self._samples(sims[0].t + dt, x_new)
         for i, s in enumerate(sims):
             s.finish_step(x_new[i], dt, Applied(u[i], inputs.dipole[i], body[i]), samples[i])
