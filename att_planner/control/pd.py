@@ -25,10 +25,7 @@ def relative_attitude(q_BN, q_RN) -> np.ndarray:
 
 def to_body(q_BR, v_R) -> np.ndarray:
     """``[BR] v_R``: a vector given in R's axes, in B's axes (``q_BR`` from :func:`relative_attitude`)."""
-    q_BR, v_R = np.asarray(q_BR, float), np.asarray(v_R, float)
-    if q_BR.ndim == 1:
-        return np.array(rot.to_body(q_BR.tolist(), v_R.tolist()))
-    return np.stack(rot.to_body(np.moveaxis(q_BR, -1, 0), np.moveaxis(v_R, -1, 0)), axis=-1)
+    return rot.to_body(q_BR, v_R)
 
 
 def attitude_feedback(q_BR, kp) -> np.ndarray:

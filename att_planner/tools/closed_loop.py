@@ -55,8 +55,8 @@ class Trace:
     _ROW = ("t", "x", "q_est", "attitude_covariance", "bias_est", "bias_true", "health", "tracker_status",
             "wheel_torques", "dipole", "mode", "attitude_error")
 
-    def __init__(self, wheel_axes: np.ndarray):
-        self.axes_T = np.asarray(wheel_axes, float).T      # wheels x 3: relative speeds ν = Ω − Gᵀω
+    def __init__(self, sc: dyn.Spacecraft):
+        self.sc = sc                    # its wheel axes: relative speeds ν = Ω − Gᵀω
         self.rows: list[tuple] = []
 
     def append(self, t: float, x: np.ndarray, q_est: np.ndarray, attitude_covariance: np.ndarray,
@@ -69,9 +69,9 @@ class Trace:
     def arrays(self, *names: str) -> dict[str, np.ndarray]:
         """The fields ``names`` (default every one of :data:`FIELDS`) as arrays, one row per instant."""
         columns = dict(zip(self._ROW, zip(*self.rows))) if self.rows else {}
-        x = np.array(columns.get("x", ()), float).reshape(-1, 7 + len(self.axes_T))
+        x = np.array(columns.get("x", ()), float).reshape(-1, 7 + self.sc.n_wheels)
         derived = {"q_true": lambda: x[:, :4], "omega_true": lambda: x[:, 4:7],
-                   "wheel_speeds": lambda: dyn.relative_wheel_speeds(self.axes_T, x)}
+                   "wheel_speeds": lambda: dyn.relative_wheel_speed(self.sc, x[:, 7:], x[:, 4:7])}
         return {k: derived[k]() if k in derived else np.asarray(columns.get(k, ())) for k in names or self.FIELDS}
 
 
@@ -100,7 +100,7 @@ class ClosedLoop:
         self.sim = simulation or Simulation.for_scenario(
             scenario, q0=q0, omega0=omega0, wheel_speed0=wheel_speed0, seed=seed,
             checks=Checks(body_frame_id=scenario.body_frame_id))
-        self.trace = Trace(self.sim.sc.wheel_axes)
+        self.trace = Trace(self.sim.sc)
         self.tracker_status = 0                 # of the latest tracker measurement (TrackerStatus)
         self.refusals: list[RequestError] = []
         self.next_state = 0.0
@@ -141,7 +141,7 @@ class ClosedLoop:
         """:meth:`exchange` as a generator: it yields each :class:`Reprocessing` the estimator needs
         before the exchange goes on (:meth:`Estimator.reprocess
         <att_planner.estimation.estimator.Estimator.reprocess>`), which the caller does — at once,
-        or for many loops together (:func:`~att_planner.tools.monte_carlo.run.fly_together`, which
+        or for many loops together (:func:`~att_planner.tools.monte_carlo.run.fly_batch`, which
         also senses for them: ``readings``, the simulation's now) — and the controller when it is
         about to step, to which the caller may send its :class:`StepOutput
         <att_planner.control.controller.StepOutput>`

@@ -34,13 +34,15 @@ class WheelDriveSpec:
     torque_scale: tuple = ()            # per wheel: delivered/commanded torque (a campaign's dispersion); (): 1
 
     def friction(self, speed: np.ndarray) -> np.ndarray:
-        """Friction torques opposing relative wheel speeds ``speed`` (N m)."""
-        speed = np.asarray(speed, float)
-        return np.array([self.friction_at(v) for v in speed.ravel().tolist()]).reshape(speed.shape)
+        """Friction torques opposing relative wheel speeds ``speed`` (N m): :func:`friction_torque`."""
+        return friction_torque(self.coulomb_friction, self.viscous_friction, self.friction_speed,
+                               np.asarray(speed, float))
 
-    def friction_at(self, speed: float) -> float:
-        """Friction torque opposing one relative wheel speed (N m): ``c tanh(ν/ν_s) + b ν``."""
-        return self.coulomb_friction * math.tanh(speed / self.friction_speed) + self.viscous_friction * speed
+
+def friction_torque(coulomb, viscous, friction_speed, speed: np.ndarray) -> np.ndarray:
+    """Friction torque opposing relative wheel speeds ``ν`` (N m): ``c tanh(ν/ν_s) + b ν`` (Bialke 1998);
+    the parameters numbers or columns of runs (rows of ``speed``)."""
+    return coulomb * np.tanh(speed / friction_speed) + viscous * speed
 
 
 @dataclass(frozen=True)

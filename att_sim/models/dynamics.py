@@ -26,6 +26,10 @@ axes and the external torques — is a function of ``(t, x)`` evaluated at every
 (:data:`StageEnvironment`), so a magnetorquer run is fourth-order accurate in the step. Holding the
 field fixed in body axes over a step instead (``Inputs.field_body``, kept for callers that evaluate
 it themselves) is only first-order accurate: the body turns under the held field.
+
+Every function works on a leading run axis: the states of n spacecraft as rows (n, 7 + N) and their
+parameters stacked (:class:`SpacecraftStack`; n = 1 for one simulation, n runs for a Monte Carlo
+batch, :mod:`att_sim.truth.batch`), each run's row computed by the same operations whatever n is.
 """
 from __future__ import annotations
 
@@ -34,7 +38,6 @@ import hashlib
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from functools import cached_property
-from operator import mul
 
 import numpy as np
 
@@ -68,9 +71,9 @@ class Spacecraft:
         return np.linalg.inv(self.inertia)
 
     @cached_property
-    def rows(self) -> tuple[list, list, list]:
-        """``(J, J⁻¹, G)`` as nested lists of Python floats (:func:`derivative`'s arithmetic)."""
-        return self.inertia.tolist(), self.inertia_inv.tolist(), self.wheel_axes.tolist()
+    def stacked(self) -> SpacecraftStack:
+        """This spacecraft as a :class:`SpacecraftStack` of one (n = 1: :func:`rates`' run axis)."""
+        return stack([self])
 
     @cached_property
     def wheel_axes_pinv(self) -> np.ndarray:
@@ -89,23 +92,70 @@ class Spacecraft:
         return h.hexdigest()
 
 
+@dataclass(frozen=True, eq=False)
+class SpacecraftStack:
+    """The parameters of n spacecraft with the same number of wheels N on a leading run axis (the
+    runs of a batch; n = 1: one spacecraft): the arrays :func:`rates` works on. Limits are columns
+    (n, 1), so they broadcast over the wheels or axes of each row."""
+
+    inertia: np.ndarray            # (n, 3, 3) kg m², J
+    inertia_inv: np.ndarray        # (n, 3, 3)
+    wheel_axes: np.ndarray         # (n, 3, N) G
+    wheel_inertia: np.ndarray      # (n, 1) kg m², I_w
+    wheel_torque_max: np.ndarray   # (n, 1) N m
+    wheel_speed_max: np.ndarray    # (n, 1) rad/s
+    body_torque_max: np.ndarray    # (n, 1) N m
+    dipole_max: np.ndarray         # (n, 1) A m²
+    momentum_map: np.ndarray       # (n, 3, 3 + N): h_B = [J, I_w G] [ω; Ω]
+    spinning: bool                 # the wheels have inertia (all rows alike)
+
+    @property
+    def n(self) -> int:
+        return len(self.inertia)
+
+    @property
+    def n_wheels(self) -> int:
+        return self.wheel_axes.shape[2]
+
+
+def stack(spacecraft: list[Spacecraft]) -> SpacecraftStack:
+    """The :class:`SpacecraftStack` of ``spacecraft`` (ValueError unless they have the same number of
+    wheels, and all spinning wheels or none)."""
+    if not spacecraft:
+        raise ValueError("a stack needs at least one spacecraft")
+    if len({sc.n_wheels for sc in spacecraft}) != 1 or len({sc.wheel_inertia > 0 for sc in spacecraft}) != 1:
+        raise ValueError("stacked spacecraft share their number of wheels, and have all spinning wheels or none")
+    G = np.array([sc.wheel_axes for sc in spacecraft])
+    J = np.array([sc.inertia for sc in spacecraft])
+
+    def column(name):
+        return np.array([[float(getattr(sc, name))] for sc in spacecraft])
+    wheel_inertia = column("wheel_inertia")
+    return SpacecraftStack(J, np.array([sc.inertia_inv for sc in spacecraft]), G, wheel_inertia,
+                           column("wheel_torque_max"), column("wheel_speed_max"), column("body_torque_max"),
+                           column("dipole_max"), np.concatenate([J, wheel_inertia[:, :, None] * G], axis=2),
+                           spacecraft[0].wheel_inertia > 0)
+
+
 @dataclass
 class Inputs:
-    """Actuator inputs held over one integration step (zero-order hold). ``field_body`` and
-    ``gravity_gradient`` are the held-environment form; a :data:`StageEnvironment` replaces both."""
+    """Actuator inputs held over one integration step (zero-order hold), one row per run (or one
+    vector: a run of one). ``field_body`` and ``gravity_gradient`` are the held-environment form; a
+    :data:`StageEnvironment` replaces both."""
 
-    wheel_torque: np.ndarray | None = None   # (N,) motor torques u
-    body_torque: np.ndarray | None = None    # (3,) direct body torque, body axes
-    dipole: np.ndarray | None = None         # (3,) A m², body axes
-    field_body: np.ndarray | None = None     # (3,) T, body axes (needed with dipole), held
-    gravity_gradient: np.ndarray | None = None  # (3,) N m, body axes, precomputed, held
-    wheel_drive: Callable | None = None      # (u, ν) -> net wheel torques at relative speeds ν (friction,
+    wheel_torque: np.ndarray | None = None   # (n, N) motor torques u
+    body_torque: np.ndarray | None = None    # (n, 3) direct body torque, body axes
+    dipole: np.ndarray | None = None         # (n, 3) A m², body axes
+    field_body: np.ndarray | None = None     # (n, 3) T, body axes (needed with dipole), held
+    gravity_gradient: np.ndarray | None = None  # (n, 3) N m, body axes, precomputed, held
+    wheel_drive: Callable | None = None      # (u, ν) -> net wheel torques at relative speeds ν, rows (friction,
                                              # envelope: att_sim.truth.actuators.WheelDrive); None: ideal motors
 
 
-StageEnvironment = Callable[[float, np.ndarray], tuple[np.ndarray, np.ndarray]]
+StageEnvironment = Callable[[float, np.ndarray], tuple[np.ndarray, np.ndarray | None]]
 """``(t, x) -> (B_b, τ_env)``: the geomagnetic field in body axes (T) and the external environment
-torque (N m, body axes) at one RK4 stage's time and state (e.g. :meth:`att_sim.models.world.Environment.stage`)."""
+torque (N m, body axes; None: none) at one RK4 stage's time and states (rows, e.g.
+:meth:`att_sim.models.world.Environment.stage`)."""
 
 
 def initial_state(sc: Spacecraft, q=rot.IDENTITY, omega=(0.0, 0.0, 0.0), wheel_speed=None) -> np.ndarray:
@@ -113,124 +163,87 @@ def initial_state(sc: Spacecraft, q=rot.IDENTITY, omega=(0.0, 0.0, 0.0), wheel_s
     return np.concatenate([rot.normalize(np.asarray(q, float)), np.asarray(omega, float), ws])
 
 
-def relative_wheel_speed(sc: Spacecraft, wheel_speed: np.ndarray, omega: np.ndarray) -> np.ndarray:
-    """The wheels' speeds relative to the body ``Ω − Gᵀω`` (rad/s): what a wheel drive measures and limits."""
-    return np.asarray(wheel_speed, float) - sc.wheel_axes.T @ np.asarray(omega, float)
+def relative_wheel_speed(sc: Spacecraft | SpacecraftStack, wheel_speed: np.ndarray, omega: np.ndarray) -> np.ndarray:
+    """The wheels' speeds relative to the body ``Ω − Gᵀω`` (rad/s): what a wheel drive measures and
+    limits. One spacecraft's vectors, or rows of runs (``omega`` (n, 3), ``wheel_speed`` (n, N)) of
+    one spacecraft or of a :class:`SpacecraftStack`."""
+    omega = np.asarray(omega, float)
+    return np.asarray(wheel_speed, float) - (omega[..., None, :] @ sc.wheel_axes)[..., 0, :]
 
 
-def relative_wheel_speeds(axes_T: np.ndarray, x: np.ndarray) -> np.ndarray:
-    """:func:`relative_wheel_speed` of each row of states ``x`` (rows of [q, ω, Ω]); ``axes_T``: the
-    wheels × 3 matrix ``Gᵀ`` of all rows, or one per row (stacked products: each row's bits alone)."""
-    return x[:, 7:] - np.matmul(axes_T, x[:, 4:7, None])[:, :, 0]
-
-
-def relative_speeds(G, w, ws) -> list:
-    """``Ω − Gᵀω`` component by component (:func:`rates`' arithmetic): ``G`` rows of components,
-    ``w`` the body rate's, ``ws`` the wheels'."""
-    w0, w1, w2 = w
-    return [s - (a * w0 + b * w1 + c * w2) for s, a, b, c in zip(ws, *G)]
-
-
-def through_wheels(G, u) -> list:
-    """``G u``, the body vector of wheel quantities ``u``, component by component."""
-    return [sum(map(mul, row, u)) for row in G]
-
-
-def effective_wheel_torque(sc: Spacecraft, wheel_speed: np.ndarray, u: np.ndarray, omega: np.ndarray) -> np.ndarray:
-    """Clip motor torques to their limit and cut those that would push a wheel beyond
-    ``wheel_speed_max`` *relative to the body* (``Ω − Gᵀω``, ``Ω`` the state's inertial spin rate,
-    ``ω`` the body rate) further."""
-    relative = relative_wheel_speed(sc, wheel_speed, omega)
-    return np.array(_limited(sc, np.asarray(u, float).tolist(), relative.tolist()))
-
-
-def _limited(sc: Spacecraft, u: list, relative: list) -> list:
-    """Torques ``u`` clipped to the limit, those pushing a wheel at its limit speed ``relative``
-    further cut (u ν > 0: the same sign, neither zero); Python floats."""
+def limited(sc: Spacecraft | SpacecraftStack, u: np.ndarray, relative: np.ndarray) -> np.ndarray:
+    """Motor torques ``u`` clipped to ``wheel_torque_max``, those that would push a wheel at its
+    limit speed (``|ν| ≥ wheel_speed_max`` for the relative speed ``ν``) further cut (``u ν > 0``)."""
     limit, speed_max = sc.wheel_torque_max, sc.wheel_speed_max
-    return [0.0 if abs(v) >= speed_max and u_k * v > 0 else u_k
-            for u_k, v in zip((min(max(u_k, -limit), limit) for u_k in u), relative)]
+    u = np.minimum(np.maximum(u, -limit), limit)
+    return np.where((np.abs(relative) >= speed_max) & (u * relative > 0), 0.0, u)
 
 
-def limited_runs(limit, speed_max, u: list, relative: list) -> list:
-    """:func:`_limited` of several runs at once: ``u`` and ``relative`` one array of runs per wheel
-    (the same operations, so the same bits run by run)."""
-    clipped = (np.minimum(np.maximum(u_k, -limit), limit) for u_k in u)
-    return [np.where((np.abs(v) >= speed_max) & (u_k * v > 0), 0.0, u_k) for u_k, v in zip(clipped, relative)]
+def effective_wheel_torque(sc: Spacecraft | SpacecraftStack, wheel_speed: np.ndarray, u: np.ndarray,
+                           omega: np.ndarray) -> np.ndarray:
+    """:func:`limited` at the state's relative wheel speeds ``Ω − Gᵀω`` (``Ω`` the state's inertial
+    spin rates, ``ω`` the body rate): vectors of one spacecraft or rows of runs."""
+    return limited(sc, np.asarray(u, float), relative_wheel_speed(sc, wheel_speed, omega))
 
 
-def torque_sum(tau_body, dipole, field_b, tau_env) -> list:
-    """``τ_body + m × B_b + τ_env`` component by component (each a Python float, or an array of
-    runs); ``dipole`` / ``field_b`` / ``tau_env`` None: absent."""
-    tau = [0.0, 0.0, 0.0] if tau_body is None else list(tau_body)
-    if dipole is not None and field_b is not None:
-        tau = [a + b for a, b in zip(tau, rot.cross_floats(dipole, field_b))]
-    if tau_env is not None:
-        tau = [a + b for a, b in zip(tau, tau_env)]
-    return tau
-
-
-def _floats(v):
-    return None if v is None else np.asarray(v, float).tolist()
-
-
-def external_torque(inputs: Inputs, stage: tuple | None = None) -> list:
-    """Body torque ``τ_body + m × B_b + τ_env`` (N m, body axes; three Python floats): ``stage`` =
-    ``(B_b, τ_env)`` of a :data:`StageEnvironment`, else the held ``inputs.field_body`` and
-    ``inputs.gravity_gradient``."""
+def external_torque(inputs: Inputs, stage: tuple | None = None) -> np.ndarray:
+    """Body torque ``τ_body + m × B_b + τ_env`` (N m, body axes; rows, or (3,) when every input is one
+    vector): ``stage`` = ``(B_b, τ_env)`` of a :data:`StageEnvironment`, else the held
+    ``inputs.field_body`` and ``inputs.gravity_gradient``."""
     field_b, tau_env = (inputs.field_body, inputs.gravity_gradient) if stage is None else stage
-    return torque_sum(_floats(inputs.body_torque), _floats(inputs.dipole), _floats(field_b), _floats(tau_env))
+    tau = _ZERO3 if inputs.body_torque is None else inputs.body_torque
+    if inputs.dipole is not None and field_b is not None:
+        tau = tau + rot.cross(inputs.dipole, field_b)
+    return tau if tau_env is None else tau + tau_env
 
 
-def rk4_mean(t1, t2, t3, t4) -> list:
-    """The RK4-weighted mean ``(a + 2b + 2c + d)/6`` of four stages' values, component by component."""
-    return [(a + 2 * b + 2 * c + d) / 6.0 for a, b, c, d in zip(t1, t2, t3, t4)]
+_ZERO3 = np.zeros(3)
 
 
-def mean_external_torque(inputs: Inputs, stages: list) -> np.ndarray:
-    """The RK4-weighted mean of :func:`external_torque` over a step's four ``stages`` (N m, body
-    axes): the body torque a step applied."""
-    return np.array(rk4_mean(*(external_torque(inputs, s) for s in stages)))
+def rk4_mean(k1, k2, k3, k4) -> np.ndarray:
+    """The RK4-weighted mean ``(a + 2b + 2c + d)/6`` of four stages' values."""
+    return (k1 + 2 * k2 + 2 * k3 + k4) / 6.0
 
 
-def derivative(sc: Spacecraft, x: np.ndarray, inputs: Inputs, stage: tuple | None = None) -> np.ndarray:
-    """Time derivative of one state for actuator inputs held constant (see module docstring);
-    ``stage``: the environment ``(B_b, τ_env)`` at this state (:func:`external_torque`). Evaluated
-    on Python floats: on 3-vectors numpy's cost is its per-call overhead (the simulator's hot path)."""
+def rates(sc: SpacecraftStack, x: np.ndarray, torque: np.ndarray, u: np.ndarray | None = None,
+          drive: Callable | None = None) -> np.ndarray:
+    """Time derivative of the states ``x`` (n, 7 + N), one row per spacecraft of the stack, for
+    inputs held constant (see module docstring): ``torque`` the external body torque (rows, or one
+    (3,) for all), ``u`` the held motor torques (n, N) (None: no motor input), cut at the speed
+    limit (:func:`limited`) and, with ``drive(u, ν)``, made the imperfect drives' net torques."""
+    out = np.empty_like(x)
+    w = x[:, 4:7]
+    out.T[:4] = quaternion_rate(x.T[:4], w.T)
+    h = (sc.momentum_map @ x[:, 4:, None])[:, :, 0]
+    if u is not None and sc.n_wheels:
+        relative = relative_wheel_speed(sc, x[:, 7:], w)
+        u = limited(sc, u, relative)
+        if drive is not None:
+            u = drive(u, relative)
+        torque = torque - (sc.wheel_axes @ u[:, :, None])[:, :, 0]
+        out[:, 7:] = u / sc.wheel_inertia if sc.spinning else 0.0
+    else:
+        out[:, 7:] = 0.0
+    out[:, 4:7] = (sc.inertia_inv @ (torque - rot.cross(w, h))[:, :, None])[:, :, 0]
+    return out
+
+
+def derivative(sc: Spacecraft | SpacecraftStack, x: np.ndarray, inputs: Inputs,
+               stage: tuple | None = None) -> np.ndarray:
+    """:func:`rates` of one spacecraft's state (7 + N,) or of a stack's rows, the inputs' ``wheel_torque``
+    one vector or rows; ``stage``: the environment ``(B_b, τ_env)`` there (:func:`external_torque`)."""
+    x = np.asarray(x, float)
     u = inputs.wheel_torque
-    return np.array(rates(sc.rows, sc.wheel_inertia, x[:4].tolist(), x[4:7].tolist(), x[7:].tolist(),
-                          external_torque(inputs, stage), None if u is None else _floats(u),
-                          lambda v, nu: _limited(sc, v, nu), inputs.wheel_drive, sc.wheel_inertia > 0))
-
-
-def rates(rows: tuple, wheel_inertia, q, w, ws, torque, u, limited, drive, spinning: bool) -> list:
-    """The state derivative component by component — each component a Python float (one run) or an
-    array of runs, with the same operations either way: ``rows`` = (J, J⁻¹, G) nested sequences of
-    such components, ``torque`` the external body torque, ``u`` the held motor torques (None: no
-    motor input), ``limited(u, ν)`` the speed-limit cut (:func:`_limited`), ``drive(u, ν)`` the
-    imperfect drives' net torques (None: ideal), ``spinning``: the wheels have inertia."""
-    J, J_inv, G = rows
-    w0, w1, w2 = w
-    h = [r[0] * w0 + r[1] * w1 + r[2] * w2 for r in J]
-    wheel_rates = [0.0] * len(ws)
-    if ws:
-        spin = [wheel_inertia * s for s in ws]
-        h = [h_i + s for h_i, s in zip(h, through_wheels(G, spin))]
-        if u is not None:
-            relative = relative_speeds(G, w, ws)
-            u = limited(u, relative)
-            if drive is not None:
-                u = drive(u, relative)
-            torque = [t - g for t, g in zip(torque, through_wheels(G, u))]
-            if spinning:
-                wheel_rates = [u_k / wheel_inertia for u_k in u]
-    net = [t - c for t, c in zip(torque, rot.cross_floats(w, h))]
-    w_dot = [r[0] * net[0] + r[1] * net[1] + r[2] * net[2] for r in J_inv]
-    return [*quaternion_rate(q, w), *w_dot, *wheel_rates]
+    if u is not None:
+        u = np.asarray(u, float)
+        u = u if u.ndim == 2 else u[None]
+    out = rates(sc.stacked if isinstance(sc, Spacecraft) else sc, x if x.ndim == 2 else x[None],
+                external_torque(inputs, stage), u, inputs.wheel_drive)
+    return out if x.ndim == 2 else out[0]
 
 
 def quaternion_rate(q, w) -> tuple:
-    """``q̇ = ½ q ⊗ [ω, 0]`` component by component, for floats and CasADi scalars alike."""
+    """``q̇ = ½ q ⊗ [ω, 0]`` component by component, for floats, arrays of runs and CasADi scalars alike."""
     qx, qy, qz, qw = q
     wx, wy, wz = w
     return (0.5 * (qw * wx + qy * wz - qz * wy), 0.5 * (qw * wy + qz * wx - qx * wz),
@@ -262,19 +275,24 @@ def rk4(f: Callable, t, x, dt, work: tuple | None = None):
 
 
 def renormalised(x: np.ndarray) -> np.ndarray:
-    """The state with its quaternion (first four rows) scaled back to unit norm, in place."""
+    """The state with its quaternion (first four entries; of each column of states whose components
+    are rows, e.g. the transpose of rows of runs) scaled back to unit norm, in place."""
     x[:4] /= np.linalg.norm(x[:4], axis=0)
     return x
 
 
-def step(sc: Spacecraft, x: np.ndarray, inputs: Inputs, dt: float,
+def step(sc: Spacecraft | SpacecraftStack, x: np.ndarray, inputs: Inputs, dt: float,
          environment: StageEnvironment | None = None, t: float = 0.0) -> np.ndarray:
-    """Advance the state from time ``t`` by ``dt`` with the actuator inputs held (ZOH): RK4, then the
-    quaternion renormalised. ``environment(t, x)`` is evaluated at each of the four stages (the
-    stage's time and state); without it the field and torque held in ``inputs`` act over the step."""
+    """Advance the state (or the rows of a stack's states) from time ``t`` by ``dt`` with the actuator
+    inputs held (ZOH): RK4, then the quaternions renormalised. ``environment(t, x)`` is evaluated at
+    each of the four stages (the stage's time and states); without it the field and torque held in
+    ``inputs`` act over the step."""
     if environment is None:
-        return renormalised(rk4(lambda _t, s: derivative(sc, s, inputs), t, x, dt))
-    return renormalised(rk4(lambda tt, s: derivative(sc, s, inputs, environment(tt, s)), t, x, dt))
+        x_new = rk4(lambda _t, s: derivative(sc, s, inputs), t, x, dt)
+    else:
+        x_new = rk4(lambda tt, s: derivative(sc, s, inputs, environment(tt, s)), t, x, dt)
+    renormalised(x_new.T)
+    return x_new
 
 
 def angular_momentum_inertial(sc: Spacecraft, x: np.ndarray) -> np.ndarray:
@@ -373,7 +391,7 @@ def simulate_profile(
     duration; every interval gets at least one step). Returns the state at every substep. Body
     torques take the compiled stepper (:func:`_body_torque_stepper`: the same RK4 of the same
     equations, the wheels' momentum held, as :func:`step` without motor torques), motor torques
-    :func:`step`'s loop.
+    :func:`rk4` of :func:`rates` on a row of one.
     """
     t_knots = np.asarray(t_knots, float)
     values = np.asarray(values, float).reshape(len(t_knots), -1)
@@ -398,10 +416,11 @@ def simulate_profile(
     if kind == ControlKind.BODY_TORQUE:
         X = np.vstack([x, _body_torque_steps(sc, x, u, slope, h)])
     else:
-        X = [x.copy()]
+        stack, row, u, slope = sc.stacked, x[None], u[:, None], slope[:, None]      # motor torques: rows of one
+        X = [x]
         for u_i, du_i, h_i in zip(u, slope, h):
-            x = renormalised(rk4(lambda tau, s, u_i=u_i, du_i=du_i:
-                                 derivative(sc, s, Inputs(**{kind: u_i + du_i * tau})), 0.0, x, h_i))
-            X.append(x.copy())
+            row = rk4(lambda tau, s, u_i=u_i, du_i=du_i: rates(stack, s, _ZERO3, u_i + du_i * tau), 0.0, row, h_i)
+            renormalised(row.T)
+            X.append(row[0])
         X = np.array(X)
     return Trajectory(np.concatenate([grid[:1], t0 + h]), X[:, :4], X[:, 4:7], X[:, 7:])

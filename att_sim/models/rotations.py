@@ -27,25 +27,15 @@ import numpy as np
 IDENTITY = np.array([0.0, 0.0, 0.0, 1.0])
 
 
-_NEXT_AXIS = (1, 2, 0)
-_PREV_AXIS = (2, 0, 1)
+_NEXT_AXIS = np.array([1, 2, 0])
+_PREV_AXIS = np.array([2, 0, 1])
 
 
 def cross(a: np.ndarray, b: np.ndarray, axis: int = -1) -> np.ndarray:
-    """``a × b`` along ``axis``, broadcasting (cheaper than ``np.cross`` on small stacks and on
-    component-first batches; two single vectors take the scalar formula, the dynamics' hot path)."""
-    if len(np.shape(a)) == 1 and len(np.shape(b)) == 1:
-        return np.array(cross_floats(np.asarray(a, float).tolist(), np.asarray(b, float).tolist()))
-    a1, a2 = np.take(a, _NEXT_AXIS, axis), np.take(a, _PREV_AXIS, axis)
-    b1, b2 = np.take(b, _NEXT_AXIS, axis), np.take(b, _PREV_AXIS, axis)
-    return a1 * b2 - a2 * b1
-
-
-def cross_floats(a, b) -> tuple[float, float, float]:
-    """``a × b`` of two 3-sequences of Python floats (the formula of :func:`cross` for one pair), or
-    of arrays of runs, component by component (:mod:`att_sim.truth.lockstep`)."""
-    (a0, a1, a2), (b0, b1, b2) = a, b
-    return a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0
+    """``a × b`` along ``axis``, broadcasting: single vectors, rows of runs ``(n, 3)`` and
+    component-first batches alike (cheaper than ``np.cross`` on small stacks)."""
+    a, b = np.asarray(a, float), np.asarray(b, float)
+    return a.take(_NEXT_AXIS, axis) * b.take(_PREV_AXIS, axis) - a.take(_PREV_AXIS, axis) * b.take(_NEXT_AXIS, axis)
 
 
 def hat(v: np.ndarray) -> np.ndarray:
@@ -123,15 +113,33 @@ def dcm_BN(q_BN: np.ndarray) -> np.ndarray:
     return np.swapaxes(dcm_NB(q_BN), -1, -2)
 
 
-def to_body(q_BN, v_N) -> list:
-    """``v_B = [BN] v_N``, an inertial vector in body axes, component by component: ``q_BN`` and
-    ``v_N`` are sequences of Python floats (one vector) or of arrays (a batch, one array per
-    component); the same operations either way."""
-    x, y, z, w = q_BN
-    v0, v1, v2 = v_N
-    return [(1 - 2 * (y * y + z * z)) * v0 + 2 * (x * y + z * w) * v1 + 2 * (x * z - y * w) * v2,
-            2 * (x * y - z * w) * v0 + (1 - 2 * (x * x + z * z)) * v1 + 2 * (y * z + x * w) * v2,
-            2 * (x * z + y * w) * v0 + 2 * (y * z - x * w) * v1 + (1 - 2 * (x * x + y * y)) * v2]
+def to_body(q_BN: np.ndarray, v_N: np.ndarray) -> np.ndarray:
+    """``v_B = [BN] v_N``, inertial vectors in body axes: ``q_BN`` (..., 4) (rows of runs, or one),
+    ``v_N`` (..., 3) broadcasting against them (one vector for every row, or one per row). The
+    matrix is the quadratic form of :func:`dcm_BN` (for a quaternion off unit norm too, as at an
+    RK4 stage): ``[BN] = I + T(q qᵀ)`` with ``T`` linear."""
+    q, v = np.asarray(q_BN, float), np.asarray(v_N, float)
+    lead = q.shape[:-1]
+    outer = (q[..., :, None] * q[..., None, :]).reshape(lead + (1, 16))
+    quadratic = (outer @ _TO_BODY).reshape(lead + (3, 3))
+    return v + (quadratic @ v[..., None])[..., 0]
+
+
+def _to_body_form() -> np.ndarray:
+    """``T`` of :func:`to_body` as a (16, 9) matrix: the entries of ``[BN] − I`` (row-major)
+    as combinations of the products ``q_i q_j`` (row ``4 i + j``)."""
+    x, y, z, w = range(4)
+    form = np.zeros((16, 9))
+    terms = {(0, 0): [(-2, y, y), (-2, z, z)], (0, 1): [(2, x, y), (2, z, w)], (0, 2): [(2, x, z), (-2, y, w)],
+             (1, 0): [(2, x, y), (-2, z, w)], (1, 1): [(-2, x, x), (-2, z, z)], (1, 2): [(2, y, z), (2, x, w)],
+             (2, 0): [(2, x, z), (2, y, w)], (2, 1): [(2, y, z), (-2, x, w)], (2, 2): [(-2, x, x), (-2, y, y)]}
+    for (row, col), products in terms.items():
+        for factor, i, j in products:
+            form[4 * i + j, 3 * row + col] += factor
+    return form
+
+
+_TO_BODY = _to_body_form()
 
 
 def from_dcm_NB(dcm_NB: np.ndarray) -> np.ndarray:

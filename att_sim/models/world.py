@@ -23,6 +23,9 @@ a step costs two time evaluations and four attitude evaluations.
 
 A scenario without the real sky's keys (:func:`Environment.from_scenario`) has the circular world
 (:meth:`Environment.circular`): the circular orbit, the tilted dipole and optionally the gravity gradient, nothing else.
+
+:func:`stages` evaluates the environments of many runs at one stage on rows (one state per run); the
+time-only part is computed once when the runs' environments share it (:meth:`Environment.share_time_part`).
 """
 from __future__ import annotations
 
@@ -202,11 +205,12 @@ class Environment:
         return out
 
     def stage(self, t: float, x: np.ndarray) -> tuple[np.ndarray, np.ndarray | None]:
-        """``(B_b, τ_env)`` at one RK4 stage (:data:`att_sim.models.dynamics.StageEnvironment`); ``τ_env``
-        is None when no disturbance is active."""
-        q = x[:4]
-        field_b = np.array(rot.to_body(q.tolist(), self.field_inertial(t).tolist()))
-        return field_b, self.disturbance(t, q, field_b)
+        """``(B_b, τ_env)`` at one RK4 stage (:data:`att_sim.models.dynamics.StageEnvironment`) of one
+        state (7 + N,) or of rows of states, all in this environment; ``τ_env`` is None when no
+        disturbance is active."""
+        x = np.asarray(x, float)
+        field_b, tau = stages([self] * (len(x) if x.ndim == 2 else 1), t, x if x.ndim == 2 else x[None])
+        return (field_b, tau) if x.ndim == 2 else (field_b[0], None if tau is None else tau[0])
 
     def share_time_part(self, other: Environment) -> None:
         """Keep the time-only part (:class:`_Now`, field tracks) in one cache with ``other``'s, when
@@ -241,9 +245,26 @@ class Environment:
 
     def sample(self, t: float, q_BN: np.ndarray) -> Sample:
         """Field, total disturbance torque, position and shadow at time ``t`` and attitude ``q_BN``."""
-        return self.sample_of(t, *self.stage(t, np.asarray(q_BN, float)))
+        field_B, tau = stages([self], t, np.asarray(q_BN, float)[None])
+        return self.sample_of(t, field_B[0], None if tau is None else tau[0])
 
     def sample_of(self, t: float, field_b: np.ndarray, torque: np.ndarray | None) -> Sample:
         """:meth:`sample` of the attitude whose :meth:`stage` values at ``t`` are ``field_b``, ``torque``."""
         now = self._now(t)
         return Sample(field_b, np.zeros(3) if torque is None else torque, now.r.copy(), now.shadow)
+
+
+def stages(environments: list[Environment], t: float, x: np.ndarray) -> tuple[np.ndarray, np.ndarray | None]:
+    """``(B_b, τ_env)`` of each run at time ``t``: the field in body axes (n, 3) and the sum of the
+    disturbance torques (n, 3; None when no run is disturbed) of the run of each row of ``x`` (rows
+    whose first four entries are the attitude) in its environment."""
+    first = environments[0]
+    if all(e._cache is first._cache for e in environments):
+        field_N = first.field_inertial(t)
+    else:
+        field_N = np.array([e.field_inertial(t) for e in environments])
+    field_b = rot.to_body(x[:, :4], field_N)
+    if not any(e.disturbed for e in environments):
+        return field_b, None
+    torques = [e.disturbance(t, x[i, :4], field_b[i]) for i, e in enumerate(environments)]
+    return field_b, np.array([np.zeros(3) if tau is None else tau for tau in torques])

@@ -18,11 +18,11 @@ once (six small off-diagonal angles) and quantisation ``Q``.
 """
 from __future__ import annotations
 
-import math
+from functools import cached_property
 
 import numpy as np
 
-from att_sim.models.actuator_specs import MagnetorquerSpec, WheelDriveSpec
+from att_sim.models.actuator_specs import MagnetorquerSpec, WheelDriveSpec, friction_torque
 from att_sim.models.rotations import small_error_matrix
 
 
@@ -35,104 +35,79 @@ def quantize(value: np.ndarray, lsb) -> np.ndarray:
     return np.where(lsb > 0, lsb * np.rint(value / np.where(lsb > 0, lsb, 1.0)), value)
 
 
-def _clip(value: float, limit: float) -> float:
-    return min(max(value, -limit), limit)
-
-
 class WheelDrive:
-    """The wheel drives of one spacecraft (see module docstring)."""
+    """The wheel drives of one spacecraft (see module docstring), or of the n runs of a batch stacked
+    (:meth:`stack`): every method works on rows of runs (n, N) (one vector: a run of one), each
+    run's parameters a row of columns, its noise from its own stream."""
 
-    def __init__(self, spec: WheelDriveSpec, rng: np.random.Generator):
-        self.spec, self.rng = spec, rng
+    def __init__(self, spec: WheelDriveSpec, rng: np.random.Generator, n_wheels: int | None = None):
+        width = n_wheels or len(spec.torque_scale) or 1
+        self.rngs = [rng]
+        self.lsb = np.array([[spec.torque_quantization]])
+        self.scale = np.array([spec.torque_scale or (1.0,) * width], float)
+        self.noise = np.array([[spec.torque_noise]])
+        self.power = np.array([[spec.power_max]])
+        self.friction_columns = tuple(np.array([[v]]) for v in (spec.coulomb_friction, spec.viscous_friction,
+                                                                spec.friction_speed))
 
-    def hold(self, u: np.ndarray) -> np.ndarray:
-        """The motor torques a command becomes for one step: quantised, scaled, with the drive's noise."""
-        u = quantize(u, self.spec.torque_quantization)
-        if self.spec.torque_scale:
-            u = u * np.asarray(self.spec.torque_scale)
-        return u + self.rng.standard_normal(len(u)) * self.spec.torque_noise
+    @classmethod
+    def stack(cls, drives: list[WheelDrive]) -> WheelDrive:
+        """The drives of several runs as one (their rows in order; each keeps its own stream)."""
+        out = cls.__new__(cls)
+        out.rngs = [rng for d in drives for rng in d.rngs]
+        for name in ("lsb", "scale", "noise", "power"):
+            setattr(out, name, np.concatenate([getattr(d, name) for d in drives]))
+        out.friction_columns = tuple(np.concatenate(c) for c in zip(*(d.friction_columns for d in drives)))
+        return out
 
-    def motor(self, u: list, speed: list) -> list:
-        """Held torques ``u`` within the envelope at relative speeds ``speed`` (lists of floats:
-        :func:`att_sim.models.dynamics.derivative` works on Python floats)."""
-        power = self.spec.power_max
-        if math.isinf(power):
-            return list(u)
-        return [_clip(u_k, power / max(abs(v), 1e-12)) if u_k * v > 0 else u_k for u_k, v in zip(u, speed)]
+    @cached_property
+    def unlimited(self) -> bool:
+        """No drive is power-limited (:meth:`motor` clips nothing)."""
+        return bool(np.all(np.isinf(self.power)))
 
-    def __call__(self, u: list, speed: list) -> list:
+    def hold(self, u: np.ndarray, active=None) -> np.ndarray:
+        """The motor torques commands ``u`` become for one step: quantised, scaled, plus each drive's
+        noise — for the runs whose watchdog is not tripped (``active``, one bool per row; None: all);
+        the others' ``u`` unchanged, nothing drawn from their streams."""
+        u = np.asarray(u, float)
+        width = u.shape[-1]
+        if active is None:
+            noise = np.array([rng.standard_normal(width) for rng in self.rngs])
+            return quantize(u, self.lsb) * self.scale + noise * self.noise
+        noise = np.array([rng.standard_normal(width) if on else np.zeros(width) for rng, on in zip(self.rngs, active)])
+        return np.where(np.asarray(active)[:, None], quantize(u, self.lsb) * self.scale + noise * self.noise, u)
+
+    def motor(self, u: np.ndarray, speed: np.ndarray) -> np.ndarray:
+        """Held torques ``u`` within each drive's envelope at relative speeds ``speed``: a motor speeding
+        its wheel up (``u ν > 0``) delivers at most ``P_max/|ν|``."""
+        if self.unlimited:
+            return u
+        limit = self.power / np.maximum(np.abs(speed), 1e-12)
+        return np.where(u * speed > 0, np.minimum(np.maximum(u, -limit), limit), u)
+
+    def __call__(self, u: np.ndarray, speed: np.ndarray) -> np.ndarray:
         """Net torques on the wheels (motor minus friction) at relative speeds ``speed``: what
-        :func:`att_sim.models.dynamics.derivative` applies at each stage."""
-        return [m - self.spec.friction_at(v) for m, v in zip(self.motor(u, speed), speed)]
+        :func:`att_sim.models.dynamics.rates` applies at each stage."""
+        return self.motor(u, speed) - friction_torque(*self.friction_columns, speed)
 
 
 class Magnetorquers:
+    """The coils of one spacecraft, or of the n runs of a batch stacked (:meth:`stack`), on rows (n, 3)."""
+
     def __init__(self, spec: MagnetorquerSpec, rng: np.random.Generator):
-        self.spec = spec
-        self.transfer = small_error_matrix(rng, 0.0, spec.misalignment)
+        self.lsb = np.array([[spec.quantization]])
+        self.scale = np.array([spec.scale or (1.0, 1.0, 1.0)], float)
+        self.transfer = small_error_matrix(rng, 0.0, spec.misalignment)[None]
 
-    def __call__(self, m: np.ndarray) -> np.ndarray:
-        """The dipole the coils produce for the (saturated) command ``m``."""
-        m = quantize(m, self.spec.quantization)
-        return self.transfer @ (m * np.asarray(self.spec.scale) if self.spec.scale else m)
-
-
-class MagnetorquersOfRuns:
-    """:class:`Magnetorquers` of several runs on rows of runs (R × 3), the same operations per run
-    (the transfer matrices as one stack: each run's product has its own bits)."""
-
-    def __init__(self, coils: list[Magnetorquers]):
-        self.lsb = np.array([[c.spec.quantization] for c in coils])
-        self.scale = _per_run([c.spec.scale for c in coils], 1.0, 3)
-        self.transfer = np.array([c.transfer for c in coils])
-
-    def __call__(self, m: np.ndarray) -> np.ndarray:
-        return (self.transfer @ (quantize(m, self.lsb) * self.scale)[:, :, None])[:, :, 0]
-
-
-def _per_run(values: list, default: float, width: int) -> np.ndarray:
-    """Rows of runs (R × width) of per-run tuples, ``default`` for an empty one."""
-    return np.array([v if v else (default,) * width for v in values], float)
-
-
-class DrivesOfRuns:
-    """The wheel drives of several runs acting at once (:class:`att_sim.truth.lockstep.Lockstep`): the
-    torques of :class:`WheelDrive` on arrays of runs — :meth:`hold` on rows of runs (R × wheels),
-    the others one array per wheel — by the same operations element by element (the friction's
-    ``tanh`` is ``math.tanh``, as one run's; a missing scale is a product by 1), so every run gets
-    the bits its own drive gives it."""
-
-    def __init__(self, drives: list[WheelDrive], n_wheels: int):
-        specs = [d.spec for d in drives]
-        self.rngs = [d.rng for d in drives]
-        self.lsb = np.array([[s.torque_quantization] for s in specs])
-        self.scale = _per_run([s.torque_scale for s in specs], 1.0, n_wheels)
-        self.noise = np.array([[s.torque_noise] for s in specs])
-        self.power = np.array([s.power_max for s in specs])
-        self.unlimited = bool(np.all(np.isinf(self.power)))
-        self.coulomb = np.array([s.coulomb_friction for s in specs])
-        self.viscous = np.array([s.viscous_friction for s in specs])
-        self.friction_speed = np.array([s.friction_speed for s in specs])
-
-    def hold(self, u: np.ndarray, active: list[bool]) -> np.ndarray:
-        """:meth:`WheelDrive.hold` of the runs whose watchdog is not tripped (``active``; the others'
-        ``u`` unchanged, nothing drawn from their streams): quantised, scaled, plus each drive's noise."""
-        noise = np.array([rng.standard_normal(u.shape[1]) if on else np.zeros(u.shape[1])
-                          for rng, on in zip(self.rngs, active)])
-        return np.where(np.array(active)[:, None], quantize(u, self.lsb) * self.scale + noise * self.noise, u)
-
-    def motor(self, u: list, speed: list) -> list:
-        """:meth:`WheelDrive.motor`: held torques within each run's envelope (an infinite power limit
-        clips nothing)."""
-        if self.unlimited:
-            return list(u)
-        out = []
-        for u_k, v in zip(u, speed):
-            limit = self.power / np.maximum(np.abs(v), 1e-12)
-            out.append(np.where(u_k * v > 0, np.minimum(np.maximum(u_k, -limit), limit), u_k))
+    @classmethod
+    def stack(cls, coils: list[Magnetorquers]) -> Magnetorquers:
+        """The coils of several runs as one (their rows in order)."""
+        out = cls.__new__(cls)
+        for name in ("lsb", "scale", "transfer"):
+            setattr(out, name, np.concatenate([getattr(c, name) for c in coils]))
         return out
 
-    def __call__(self, u: list, speed: list) -> list:
-        """:meth:`WheelDrive.__call__`: net torques on the wheels, motor minus friction."""
-        return [m - (self.coulomb * np.array([math.tanh(a) for a in (v / self.friction_speed).tolist()])
-                     + self.viscous * v) for m, v in zip(self.motor(u, speed), speed)]
+    def __call__(self, m: np.ndarray) -> np.ndarray:
+        """The dipoles the coils produce for the (saturated) commands ``m`` (rows)."""
+        m = np.asarray(m, float).reshape(-1, 3)
+        return (self.transfer @ (quantize(m, self.lsb) * self.scale)[:, :, None])[:, :, 0]

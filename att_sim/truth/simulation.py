@@ -4,8 +4,9 @@
 command and the environment of :mod:`att_sim.models.world` (orbit, field, Sun, disturbances), which is
 evaluated at every RK4 stage; the actuator command is held over a step. The published state carries
 the field and position *at the published state* (its time and attitude). The simulator node is a
-thin adapter around it; tests drive it directly; :class:`att_sim.truth.lockstep.Lockstep` advances the
-simulations of many Monte Carlo runs in one step, each to the bits :meth:`Simulation.advance` gives it.
+thin adapter around it; tests drive it directly. Its step and its sensor readings are those of a
+:class:`att_sim.truth.batch.SimulationBatch` of one: the same functions advance the simulations of
+many Monte Carlo runs in one step.
 
 Every command and reset is checked field by field first (:class:`Checks`); a refused one changes
 nothing and comes back as a :class:`Refusal` (an :class:`~att_msgs_py.errors.ErrorCode` and a
@@ -15,7 +16,7 @@ clamped to the limit (saturation); beyond it, it is a fault and refused.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import NamedTuple
 
 import numpy as np
@@ -31,6 +32,7 @@ from att_sim.models.actuator_specs import ActuatorSpecs
 from att_sim.models.orbit import CircularOrbit
 from att_sim.models.sensor_specs import SensorSpecs
 from att_sim.truth.actuators import Magnetorquers, WheelDrive
+from att_sim.truth.batch import Applied, SimulationBatch
 from att_sim.truth.sensors import Readings, SensorSuite, Taken, rng
 
 DEFAULT_STEP = 0.05             # s: the simulator's RK4 step unless its parameter says otherwise
@@ -56,15 +58,6 @@ class Checks:
     stamp_age: float = math.inf         # s: one stamped before t − stamp_age is refused (node: command_timeout)
 
 
-@dataclass
-class Applied:
-    """What actually acted on the body during the last step (after limits)."""
-
-    wheel_torque: np.ndarray
-    dipole: np.ndarray = field(default_factory=lambda: np.zeros(3))
-    body_torque: np.ndarray = field(default_factory=lambda: np.zeros(3))   # total torque on the body, step mean
-
-
 def _numbers(value, name: str, code: ErrorCode, shape: tuple) -> np.ndarray:
     """``value`` as a finite float array of ``shape`` (RequestError otherwise)."""
     try:
@@ -86,9 +79,9 @@ def _number(value, name: str, code: ErrorCode, low: float = -math.inf, high: flo
 
 
 class Simulation:
-    """Truth state, held actuator command and environment. Give ``orbit`` (today's circular orbit
-    with the tilted dipole and optional ``gravity_gradient``) or a :class:`att_sim.models.world.Environment`
-    (:meth:`for_scenario` builds the scenario's). ``sensors`` and ``actuators`` (issue 14): the
+    """Truth state, held actuator command and environment. Give ``orbit`` (a circular orbit with the
+    tilted dipole and optional ``gravity_gradient``) or a :class:`att_sim.models.world.Environment`
+    (:meth:`for_scenario` builds the scenario's). ``sensors`` and ``actuators``: the
     datasheets of the sensors :meth:`sense` samples and of the imperfect wheel drives and
     magnetorquers; ``seed`` (default: the sensors' ``seed``) makes every random stream of the run."""
 
@@ -115,9 +108,11 @@ class Simulation:
         sensors, actuators = sensors or SensorSpecs(), actuators or ActuatorSpecs()
         self.seed = sensors.seed if seed is None else int(seed)
         self.sensors = SensorSuite(sensors, self.seed, frame_id, body_frame_id) if sensors else None
-        self.wheel_drive = WheelDrive(actuators.wheels, rng(self.seed, "wheel_drive")) if actuators.wheels else None
+        self.wheel_drive = (WheelDrive(actuators.wheels, rng(self.seed, "wheel_drive"), sc.n_wheels)
+                            if actuators.wheels else None)
         self.magnetorquers = (Magnetorquers(actuators.magnetorquers, rng(self.seed, "magnetorquers"))
                               if actuators.magnetorquers else None)
+        self._batch: tuple[tuple, SimulationBatch] | None = None
 
     def _arg0(self) -> float | None:
         """A circular orbit's argument of latitude at t = 0 (rad; None for an orbit of elements or a TLE)."""
@@ -253,31 +248,30 @@ class Simulation:
                      applied_torque=a.body_torque, position=self.now.position.copy(),
                      command_timeout=self.command_timeout, frame_id=frame_id, body_frame_id=body_frame_id)
 
-    def inputs(self) -> dyn.Inputs:
-        """Actuator inputs for the next step: limits applied, zero while the command watchdog is
-        tripped; through the imperfect drives and coils when the scenario has them."""
-        w, ws = self.x[4:7], self.x[7:]
-        active = not self.command_timeout
-        u = self.wheel_cmd if active else np.zeros_like(self.wheel_cmd)
-        if self.wheel_drive is not None and active:      # the watchdog disables the drives: no torque at all
-            u = self.wheel_drive.hold(u)
-        u = dyn.effective_wheel_torque(self.sc, ws, u, w)
-        m = np.minimum(np.maximum(self.dipole_cmd, -self.sc.dipole_max), self.sc.dipole_max) if active else np.zeros(3)
-        if self.magnetorquers is not None:
-            m = self.magnetorquers(m)
-        tau = (np.minimum(np.maximum(self.body_cmd, -self.sc.body_torque_max), self.sc.body_torque_max) if active
-               else np.zeros(3))
-        return dyn.Inputs(wheel_torque=u, body_torque=tau, dipole=m, wheel_drive=self.wheel_drive)
+    def batch(self) -> SimulationBatch:
+        """This simulation as a :class:`~att_sim.truth.batch.SimulationBatch` of one (kept while its
+        spacecraft, drives and coils are the same objects)."""
+        key = (self.sc, self.wheel_drive, self.magnetorquers)
+        if self._batch is None or any(a is not b for a, b in zip(self._batch[0], key)):
+            self._batch = (key, SimulationBatch([self]))
+        return self._batch[1]
 
-    def sense(self, taken: Taken | None = None) -> Readings:
-        """What the sensors output now (nothing without sensors): see :class:`att_sim.truth.sensors.SensorSuite`
-        (``taken``: its :meth:`~att_sim.truth.sensors.SensorSuite.sample`'s, the gyro's and tachometer's
-        measurements taken already)."""
+    def inputs(self) -> dyn.Inputs:
+        """Actuator inputs for the next step (rows of one run): limits applied, zero while the command
+        watchdog is tripped; through the imperfect drives and coils when the scenario has them."""
+        return self.batch().inputs(self.x[None])
+
+    def sense(self) -> Readings:
+        """What the sensors output now (nothing without sensors): see :class:`att_sim.truth.sensors.SensorSuite`."""
+        return self.batch().sense()[0]
+
+    def sense_taken(self, taken: Taken) -> Readings:
+        """:meth:`sense` with the gyro's and tachometer's measurements taken already
+        (:meth:`SimulationBatch.sense <att_sim.truth.batch.SimulationBatch.sense>`)."""
         if self.sensors is None:
             return Readings()
         x = self.x
-        relative = None if taken is not None else dyn.relative_wheel_speed(self.sc, x[7:], x[4:7])
-        return self.sensors.sample(self.t, x[:4], x[4:7], relative, self.now.field_B, self.applied.dipole,
+        return self.sensors.sample(self.t, x[:4], x[4:7], None, self.now.field_B, self.applied.dipole,
                                    lambda: self.environment.bodies(self.t), taken)
 
     def gyro_interval(self, rotation: np.ndarray | None = None) -> tuple[np.ndarray, float] | None:
@@ -289,28 +283,7 @@ class Simulation:
         """One RK4 step, the actuator inputs held and the environment evaluated at every stage; a
         non-finite result or an environment that cannot be evaluated (e.g. a decayed TLE) halts the
         simulation. The applied body torque reported is the step's RK4-weighted mean."""
-        self.advance_with(self.inputs(), dt)
-
-    def advance_with(self, inp: dyn.Inputs, dt: float) -> None:
-        """:meth:`advance` with the step's inputs already taken (:meth:`inputs`)."""
-        stages = []
-
-        def stage(t, x):
-            got = self.environment.stage(t, x)
-            stages.append(got)
-            return got
-        try:
-            x_new = dyn.step(self.sc, self.x, inp, dt, stage, self.t)
-        except ValueError as err:
-            self.halt_environment(err)
-            return
-        u, G = inp.wheel_torque.tolist(), self.sc.rows[2]
-        motor = net = u
-        if self.wheel_drive is not None:        # at the step's start: motor torque, and less friction
-            speed = dyn.relative_speeds(G, self.x[4:7].tolist(), self.x[7:].tolist())
-            motor, net = self.wheel_drive.motor(u, speed), self.wheel_drive(u, speed)
-        body = [m - g for m, g in zip(dyn.mean_external_torque(inp, stages).tolist(), dyn.through_wheels(G, net))]
-        self.finish_step(x_new, dt, Applied(np.array(motor, float), inp.dipole, np.array(body)))
+        self.batch().advance(dt)
 
     def finish_step(self, x_new: np.ndarray, dt: float, applied: Applied, sample: world.Sample | None = None) -> None:
         """Take the state ``x_new`` a step of ``dt`` reached and what acted over it, or halt: a

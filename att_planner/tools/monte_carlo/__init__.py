@@ -1,4 +1,4 @@
-"""``att-mc``: Monte Carlo campaigns — how a plan fares when the model is wrong (issue 16).
+"""``att-mc``: Monte Carlo campaigns — how a plan fares when the model is wrong.
 
     att-mc campaigns/swift_demo.yaml --runs 1000 --json mc.json          # local Dask cluster, a core each
     att-mc campaigns/swift_demo.yaml --scheduler tcp://host:8786 --json mc.json

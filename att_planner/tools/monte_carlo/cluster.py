@@ -12,7 +12,7 @@ import os
 from collections.abc import Iterator
 from contextlib import contextmanager
 
-from att_planner.tools.monte_carlo.run import Setup, fly_together
+from att_planner.tools.monte_carlo.run import Setup, fly_batch
 
 # The local cluster's housekeeping, slowed: the runs keep every core busy, and Dask's defaults wake
 # its processes every 10-500 ms (the event-loop watchdog's tick, the system monitor, the nannies'
@@ -55,8 +55,8 @@ def client_for(scheduler: str | None, workers: int, timeout: float):
 
 
 def fly_chunk(setup: Setup, seeds: list[tuple[int, int]]) -> list[dict]:
-    """The rows of ``(run, seed)`` pairs, flown together in this worker (:func:`fly_together`)."""
-    return fly_together(setup, seeds)
+    """The rows of ``(run, seed)`` pairs, flown as one batch in this worker (:func:`fly_batch`)."""
+    return fly_batch(setup, seeds)
 
 
 def stream(client, setup: Setup, runs: list[tuple[int, int]], chunk: int) -> Iterator[list[dict]]:

@@ -9,10 +9,11 @@ ticks until the estimate is CONVERGED (at most the campaign's ``converge_timeout
 waits before it sends a goal; then the controller flies the plan and holds its end for
 ``settle_time``. The outcomes are taken at every control instant of the flown truth.
 
-The runs of a task fly in lockstep (:func:`fly_together`): each run's flight software steps on its
+The runs of a task fly as a batch (:func:`fly_batch`): each run's flight software steps on its
 own, the heavy numerics of a step are done for all the runs at once — the estimators' propagations,
-the plan's reference and the tracking law, one RK4 step of every simulation — and each run gets the bits it gets alone:
-a run's row does not depend on the runs it flew with, so a run is reproduced alone from its seed.
+the plan's reference and the tracking law, one RK4 step of every simulation — each run's row by the
+operations it gets alone: a run's row does not depend on the runs it flew with (to rounding), and a
+run is reproduced from its seed alone.
 """
 from __future__ import annotations
 
@@ -33,8 +34,8 @@ from att_planner.verification import rejection
 from att_sim.models import rotations as rot
 from att_sim.models import scenario as scen
 from att_sim.truth import dispersions as disp
+from att_sim.truth.batch import SimulationBatch
 from att_sim.truth.dispersions import DEG
-from att_sim.truth.lockstep import Lockstep
 from att_sim.truth.simulation import Checks, Simulation
 
 OUTCOMES = ("success", "code", "final_error_deg", "final_rate", "min_margin_deg", "peak_wheel_ratio",
@@ -100,7 +101,7 @@ def loop_for(setup: Setup, truth: disp.Truth, key: Ed25519PrivateKey | None = No
 
 @dataclass
 class _Flight:
-    """One run of :func:`fly_together`: converging, then flying its plan (``deadline``: of the phase)."""
+    """One run of :func:`fly_batch`: converging, then flying its plan (``deadline``: of the phase)."""
 
     setup: Setup
     loop: ClosedLoop
@@ -138,17 +139,17 @@ class _Flight:
         return False
 
 
-def fly_together(setup: Setup, runs: list[tuple[int, int]], tap=None) -> list[dict]:
-    """The rows of ``(run, seed)`` pairs (applied values and outcomes, :data:`OUTCOMES`), flown in
-    lockstep: each run converges, then flies the plan, as it would alone; at each step the runs'
-    gyros measure together (:meth:`Lockstep.sense <att_sim.truth.lockstep.Lockstep.sense>`), their
-    estimators reprocess together (:func:`~att_planner.estimation.estimator.replay`:
+def fly_batch(setup: Setup, runs: list[tuple[int, int]], tap=None) -> list[dict]:
+    """The rows of ``(run, seed)`` pairs (applied values and outcomes, :data:`OUTCOMES`), flown as one
+    batch: each run converges, then flies the plan, as it would alone; at each step the runs'
+    sensors are read on rows (:meth:`SimulationBatch.sense <att_sim.truth.batch.SimulationBatch.sense>`),
+    their estimators reprocess together (:func:`~att_planner.estimation.estimator.replay`:
     their propagations as one stack), their controllers share the plan's reference (one plan object,
     issued once with the loops' one key: :class:`~att_planner.control.tracking.ReferenceMemo`) and
     compute its tracking law as rows (:func:`~att_planner.control.controller.step_controllers`), and
-    the simulations of the runs still going advance together (:class:`att_sim.truth.lockstep.Lockstep`) —
-    every run to the bits it reaches alone. ``cpu_seconds``: the group's CPU time shared equally.
-    ``tap``: see :attr:`ClosedLoop.tap` (a full log; one run)."""
+    the simulations of the runs still going advance as one batch (:class:`att_sim.truth.batch.SimulationBatch`).
+    ``cpu_seconds``: the group's CPU time shared equally. ``tap``: see :attr:`ClosedLoop.tap` (a full
+    log; one run)."""
     cpu = time.process_time()
     flights, key, references, issued = [], Ed25519PrivateKey.generate(), ReferenceMemo(), None
     for run, seed in runs:
@@ -158,13 +159,13 @@ def fly_together(setup: Setup, runs: list[tuple[int, int]], tap=None) -> list[di
         issued = issued or loop.issue(setup.plan)
         flights.append(_Flight(setup, loop, {"run": run, "seed": seed, **applied_columns(values, loop)},
                                loop.sim.t + setup.campaign.converge_timeout, issued))
-    going, lockstep = flights, None
+    going, batch = flights, None
     while going:
         still = [f for f in going if f.going()]
-        if len(still) != len(going) or lockstep is None:
-            lockstep = Lockstep([f.loop.sim for f in still]) if len(still) > 1 else None
+        if len(still) != len(going) or batch is None:
+            batch = SimulationBatch([f.loop.sim for f in still]) if still else None
         going = still
-        readings = lockstep.sense() if lockstep is not None else [None] * len(going)
+        readings = batch.sense() if batch is not None else []
         exchanges = [f.loop.exchange_steps(r) for f, r in zip(going, readings)]
         outputs = {}
         while exchanges:                # each turn: every exchange to its next job, those of a kind done together
@@ -174,10 +175,8 @@ def fly_together(setup: Setup, runs: list[tuple[int, int]], tap=None) -> list[di
             for (steps, _), out in zip(stepping, step_controllers([job for _, job in stepping])):
                 outputs[steps] = out
             exchanges = [steps for steps, job in turn if job is not None]
-        if lockstep is not None:
-            lockstep.advance(going[0].loop.step)
-        elif going:
-            going[0].loop.sim.advance(going[0].loop.step)
+        if batch is not None:
+            batch.advance(going[0].loop.step)
     share = (time.process_time() - cpu) / max(len(flights), 1)
     return [{**f.row, "cpu_seconds": share} for f in flights]
 
@@ -191,8 +190,8 @@ def _resume(steps, value):
 
 
 def fly(setup: Setup, seed: int, run: int = -1, tap=None) -> dict:
-    """The row of the run of seed ``seed`` (``run``: its index in the campaign), alone: :func:`fly_together`."""
-    return fly_together(setup, [(run, seed)], tap)[0]
+    """The row of the run of seed ``seed`` (``run``: its index in the campaign), alone: :func:`fly_batch`."""
+    return fly_batch(setup, [(run, seed)], tap)[0]
 
 
 def settling_time(t: np.ndarray, error: np.ndarray, t_end: float, tolerance: float) -> float:

@@ -31,6 +31,7 @@ from att_sim.truth.sensors.magnetometer import Magnetometer
 from att_sim.truth.sensors.star_tracker import StarTracker
 from att_sim.truth.sensors.sun_sensors import SunSensors
 from att_sim.truth.sensors.tachometer import Tachometer
+from att_sim.truth.sensors.tachometer import measure as measure_tachometers
 
 STREAMS = {"gyro": 0, "magnetometer": 1, "sun_sensors": 2, "tachometer": 3, "wheel_drive": 4, "magnetorquers": 5,
            "star_tracker": 16}      # star tracker i: 16 + i
@@ -55,9 +56,9 @@ class Readings:
 
 @dataclass
 class Taken:
-    """What was measured for a suite already, its schedules asked (:class:`att_sim.truth.lockstep.Lockstep`
-    measures the runs' gyros and tachometers together): the gyro's interval (None: not due) and
-    rate, the tachometer's sample (None: not due)."""
+    """What was measured for a suite already, its schedules asked (:meth:`att_sim.truth.batch.SimulationBatch.sense`
+    measures the gyros and tachometers of its runs on rows): the gyro's interval (None: not due)
+    and rate, the tachometer's sample (None: not due)."""
 
     gyro_interval: tuple[np.ndarray, float] | None = None
     gyro_rate: np.ndarray | None = None
@@ -124,15 +125,19 @@ class SensorSuite:
         measures the rotation since its previous sample (at its first sample: ``omega`` over one
         period); a tracker's measurement of ``t`` comes out at the first call at or after ``t`` + its
         latency. ``taken``: the gyro's and the tachometer's measurements when they were taken already
-        (:meth:`gyro_interval` and :meth:`tachometer_due` asked: :class:`Taken`; then
-        ``relative_wheel_speed`` is not used)."""
+        on rows of runs (:meth:`att_sim.truth.batch.SimulationBatch.sense`; then
+        ``relative_wheel_speed`` is not used); else this suite takes them, a row of one."""
+        if taken is None:
+            taken = Taken(self.gyro_interval(t, q, omega))
+            if taken.gyro_interval is not None:
+                taken.gyro_rate = self.gyro.measure(*taken.gyro_interval)
+            if self.tachometer_due(t):
+                speeds = measure_tachometers([self.tachometer], np.asarray(relative_wheel_speed, float)[None])[0]
+                taken.wheel_speeds = WheelSpeedMeasurement(t, speeds, self.body_frame_id)
         out = Readings()
         body = self.body_frame_id
-        interval, rate = (self.gyro_interval(t, q, omega), None) if taken is None else \
-            (taken.gyro_interval, taken.gyro_rate)
-        if interval is not None:
-            out.gyro = GyroMeasurement(t, self.gyro.measure(*interval) if rate is None else rate,
-                                       self.gyro.noise_covariance(interval[1]), body)
+        if taken.gyro_interval is not None:
+            out.gyro = GyroMeasurement(t, taken.gyro_rate, self.gyro.noise_covariance(taken.gyro_interval[1]), body)
             out.truth = SensorTruth(t, self.gyro.bias.copy(), self._magnetometer_bias(), body)
         sky = None
         for tracker, schedule in zip(self.trackers, self.tracker_schedules):
@@ -142,10 +147,7 @@ class SensorSuite:
         if self.pending:
             out.star_trackers = [m for release, m in self.pending if release <= t + 1e-9]
             self.pending = [(release, m) for release, m in self.pending if release > t + 1e-9]
-        if taken is not None:
-            out.wheel_speeds = taken.wheel_speeds
-        elif self.tachometer_due(t):
-            out.wheel_speeds = self.tachometer.measure(t, relative_wheel_speed, body)
+        out.wheel_speeds = taken.wheel_speeds
         if self.magnetometer is not None and self.schedules["magnetometer"].due(t):
             out.magnetometer = self.magnetometer.measure(t, field_B, dipole_applied, body)
         if self.sun_sensors is not None and self.schedules["sun_sensors"].due(t):

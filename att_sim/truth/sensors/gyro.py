@@ -42,7 +42,8 @@ def flicker_times() -> np.ndarray:
 
 
 class Gyro:
-    """One gyro unit: its drawn errors and the state of its noise (see module docstring)."""
+    """One gyro unit: its drawn errors and the state of its noise (see module docstring); it measures
+    through :class:`Gyros` (itself alone)."""
 
     def __init__(self, spec: GyroSpec, rng: np.random.Generator):
         self.spec, self.rng = spec, rng
@@ -54,9 +55,8 @@ class Gyro:
         self.walk = np.zeros(3)
         self.carry = np.zeros(3)          # rad: angle not yet output by the quantiser
         self.bias = self.turn_on + self.flicker.sum(axis=0)
-        self._banks: dict[float, tuple[np.ndarray, np.ndarray]] = {}    # dt -> (a, σ√(1 − a²)) of each process
         self._covariances: dict[float, np.ndarray] = {}                 # dt -> the sample's noise covariance
-        self._alone: GyrosOfRuns | None = None                         # this gyro's one-sample path
+        self._alone: Gyros | None = None
 
     def noise_sigma(self, dt: float) -> float:
         """1σ of the white rate noise of one sample (rad/s)."""
@@ -73,123 +73,95 @@ class Gyro:
             covariance.flags.writeable = False
         return covariance
 
-    def _bank(self, dt: float) -> tuple[np.ndarray, np.ndarray]:
-        """Each flicker process's step over ``dt``: its factor ``a = exp(−Δt/τ)`` and the drive's 1σ
-        (columns), kept for the few intervals a simulator's clock makes."""
-        bank = self._banks.get(dt)
-        if bank is None:
-            if len(self._banks) >= 64:
-                self._banks.clear()
-            a = np.exp(-dt / self.times)[:, None]
-            bank = self._banks[dt] = (a, self.flicker_sigma * np.sqrt(1.0 - a * a))
-        return bank
-
-    def _bias(self, n: int, dt: float) -> np.ndarray:
-        """The bias at the end of each of ``n`` intervals (n, 3); advances the noise state. Each
-        flicker process is ``x_k = a x_(k-1) + w_k``: a batch (n > 1) through ``scipy.signal.lfilter``
-        (imported then: it costs a node seconds at start); one interval is :class:`GyrosOfRuns`'s."""
-        flicker = np.zeros((n, 3))
-        if self.flicker_sigma > 0:
-            for j, tau in enumerate(self.times):
-                a = math.exp(-dt / tau)
-                drive = self.rng.standard_normal((n, 3)) * (self.flicker_sigma * math.sqrt(1.0 - a * a))
-                from scipy.signal import lfilter
-
-                path, _ = lfilter([1.0], [1.0, -a], drive, axis=0, zi=(a * self.flicker[j])[None, :])
-                flicker += path
-                self.flicker[j] = path[-1]
-        walk = self.walk + np.cumsum(self.rng.standard_normal((n, 3)) * (self.spec.rrw * math.sqrt(dt)), axis=0)
-        self.walk = walk[-1]
-        bias = self.turn_on + flicker + walk
-        self.bias = bias[-1]
-        return bias
-
     def measure(self, rotation: np.ndarray, dt: float) -> np.ndarray:
         """Measured rates for consecutive intervals of ``dt`` s whose true rotation vectors are the
-        rows of ``rotation`` ((n, 3), or (3,) for one sample: then the result is (3,))."""
-        increments = np.atleast_2d(np.asarray(rotation, float))
-        n = len(increments)
-        if n == 1:                        # the simulator's case
-            self._alone = self._alone or GyrosOfRuns([self])
-            rate = self._alone.measure([(increments[0], dt)])[0]
-            return rate if np.ndim(rotation) == 1 else rate[None, :]
-        rate = increments @ self.transfer.T / dt + self._bias(n, dt)
-        rate += self.rng.standard_normal((n, 3)) * self.noise_sigma(dt)
-        rate = np.minimum(np.maximum(rate, -self.spec.range), self.spec.range)
-        lsb = self.spec.quantization
-        if lsb > 0:
-            total = self.carry + np.cumsum(rate * dt, axis=0)
-            counted = quantize(total, lsb)
-            self.carry = total[-1] - counted[-1]
-            rate = np.diff(counted, axis=0, prepend=0.0) / dt     # the counts of each sample
-        return rate
+        rows of ``rotation`` ((k, 3), or (3,) for one sample: then the result is (3,))."""
+        self._alone = self._alone or Gyros([self])
+        increments = np.asarray(rotation, float)
+        rate = self._alone.measure(increments.reshape(1, -1, 3), (dt,))[0]
+        return rate[0] if increments.ndim == 1 else rate
 
 
 def _column(values) -> np.ndarray:
-    """One value per gyro, as a column (R × 1)."""
+    """One value per gyro, as a column (n × 1)."""
     return np.array([[v] for v in values], float)
 
 
-class GyrosOfRuns:
-    """Gyros sampled together — one gyro's sample in the simulator, or the gyros of a lockstep's runs
-    at once: the whole flicker bank in one step, then the rate random walk, the white noise (each
-    gyro's draws from its own stream, in that order), the arithmetic on rows of gyros (element by
-    element; the stacked bank sums and products give each row the bits it gets alone). The gyros'
-    constants are stacked once, their factors for an interval kept for the few intervals a clock
-    makes. Gyros unlike in their noise's form (a bank or none, a quantiser or none) measure one by one."""
+class Gyros:
+    """The gyro model on rows of units: one unit alone (:meth:`Gyro.measure`) or the gyros of a
+    batch's runs at once, each over k consecutive intervals. In order per unit: the flicker bank
+    (each process ``x_k = a x_(k−1) + w_k``: one step computed directly, many by
+    ``scipy.signal.lfilter``, imported then: it costs a node seconds at start), the rate random
+    walk, the white noise (each unit's draws from its own stream), then the arithmetic on rows of
+    units. The units' constants are stacked once, their factors for an interval kept for the few
+    intervals a clock makes; each unit's noise state is read and written back."""
 
     def __init__(self, gyros: list[Gyro]):
-        self.gyros, first = gyros, gyros[0]
-        self.banked, self.quantized = first.flicker_sigma > 0, first.spec.quantization > 0
-        self.alike = all((g.flicker_sigma > 0) == self.banked and (g.spec.quantization > 0) == self.quantized
-                         and g.flicker.shape == first.flicker.shape for g in gyros)
-        if self.alike:
-            self.transfer_T = np.array([g.transfer.T for g in gyros])
-            self.turn_on = np.array([g.turn_on for g in gyros])
-            self.limit = _column([g.spec.range for g in gyros])
-            self.lsb = _column([g.spec.quantization for g in gyros])
+        self.gyros = gyros
+        self.banked = [g.flicker_sigma > 0 for g in gyros]
+        self.transfer_T = np.array([g.transfer.T for g in gyros])
+        self.turn_on = np.array([g.turn_on for g in gyros])[:, None, :]
+        self.limit = _column([g.spec.range for g in gyros])[:, :, None]
+        self.lsb = _column([g.spec.quantization for g in gyros])[:, :, None]
         self._factors: dict[tuple, tuple] = {}
 
     def _of_intervals(self, dts: tuple) -> tuple:
-        """For the intervals ``dts`` (one per gyro): their column, the bank's factors and drives' 1σ,
-        the rate walk's and the white noise's 1σ (columns)."""
+        """For the intervals ``dts`` (one per unit): their column, each flicker process's factor
+        ``a = exp(−Δt/τ)`` and drive's 1σ ``σ√(1 − a²)``, the rate walk's and the white noise's 1σ."""
         factors = self._factors.get(dts)
         if factors is None:
             if len(self._factors) >= 64:
                 self._factors.clear()
             gyros = self.gyros
-            banks = [g._bank(h) for g, h in zip(gyros, dts)] if self.banked else []
+            a = np.array([np.exp(-h / g.times) for g, h in zip(gyros, dts)])[:, :, None]          # n × m × 1
+            sigma = np.array([[g.flicker_sigma] for g in gyros])[:, :, None] * np.sqrt(1.0 - a * a)
             factors = self._factors[dts] = (
-                _column(dts), np.array([a for a, _ in banks]), np.array([s for _, s in banks]),
-                _column([g.spec.rrw * math.sqrt(h) for g, h in zip(gyros, dts)]),
-                _column([g.noise_sigma(h) for g, h in zip(gyros, dts)]))
+                _column(dts)[:, :, None], a, sigma[:, :, None, :],
+                _column([g.spec.rrw * math.sqrt(h) for g, h in zip(gyros, dts)])[:, :, None],
+                _column([g.noise_sigma(h) for g, h in zip(gyros, dts)])[:, :, None])
         return factors
 
-    def measure(self, intervals: list[tuple[np.ndarray, float]]) -> list[np.ndarray]:
-        """The rate each gyro measures over its interval ``(rotation, dt)`` (the gyros' order)."""
+    def _flicker(self, a: np.ndarray, sigma: np.ndarray, k: int) -> tuple[np.ndarray, np.ndarray]:
+        """The flicker bank over k intervals: the sum of its processes (n × k × 3) and each
+        process's last value (n × m × 3); draws a unit's drives process by process (a bank without
+        variance draws nothing)."""
         gyros = self.gyros
-        if not self.alike:
-            return [g.measure(*interval) for g, interval in zip(gyros, intervals)]
-        dt, a, sigma, walk_sigma, noise_sigma = self._of_intervals(tuple(h for _, h in intervals))
-        flicker_sum = np.zeros((len(gyros), 3))
-        if self.banked:
-            flicker = a * np.array([g.flicker for g in gyros]) \
-                + np.array([g.rng.standard_normal(g.flicker.shape) for g in gyros]) * sigma
-            flicker_sum = flicker.sum(axis=1)
-            for g, row in zip(gyros, flicker):
-                g.flicker = row
-        walk = np.array([g.walk for g in gyros]) + np.array([g.rng.standard_normal(3) for g in gyros]) * walk_sigma
-        bias = self.turn_on + flicker_sum + walk
-        rotation = np.array([r for r, _ in intervals])[:, None, :]
-        rate = (rotation @ self.transfer_T)[:, 0, :] / dt + bias
-        rate = rate + np.array([g.rng.standard_normal(3) for g in gyros]) * noise_sigma
+        state = np.array([g.flicker for g in gyros])                                             # n × m × 3
+        if k == 1:
+            drives = np.array([g.rng.standard_normal(g.flicker.shape) if banked else np.zeros(g.flicker.shape)
+                               for g, banked in zip(gyros, self.banked)])
+            last = a * state + drives * sigma[:, :, 0, :]
+            return last.sum(axis=1)[:, None, :], last
+        from scipy.signal import lfilter
+
+        total, last = np.zeros((len(gyros), k, 3)), state.copy()
+        for i, (g, banked) in enumerate(zip(gyros, self.banked)):
+            for j in range(len(g.times)) if banked else ():
+                path, _ = lfilter([1.0], [1.0, -a[i, j, 0]], g.rng.standard_normal((k, 3)) * sigma[i, j, 0],
+                                  axis=0, zi=(a[i, j, 0] * state[i, j])[None, :])
+                total[i] += path
+                last[i, j] = path[-1]
+        return total, last
+
+    def measure(self, rotation: np.ndarray, dts) -> np.ndarray:
+        """The rates each unit measures over k consecutive intervals of its ``dts`` entry, whose true
+        rotation vectors are ``rotation`` (n × k × 3); n × k × 3."""
+        gyros = self.gyros
+        dt, a, sigma, walk_sigma, noise_sigma = self._of_intervals(tuple(dts))
+        k = rotation.shape[1]
+        flicker, last = self._flicker(a, sigma, k)
+        walk = np.array([g.walk for g in gyros])[:, None, :] + np.add.accumulate(
+            np.array([g.rng.standard_normal((k, 3)) for g in gyros]) * walk_sigma, axis=1)
+        bias = self.turn_on + flicker + walk
+        rate = rotation @ self.transfer_T / dt + bias
+        rate = rate + np.array([g.rng.standard_normal((k, 3)) for g in gyros]) * noise_sigma
         rate = np.minimum(np.maximum(rate, -self.limit), self.limit)
-        if self.quantized:
-            total = np.array([g.carry for g in gyros]) + rate * dt
-            counted = quantize(total, self.lsb)
-            rate = counted / dt
-            for g, row in zip(gyros, total - counted):
-                g.carry = row
-        for g, w, b in zip(gyros, walk, bias):
-            g.walk, g.bias = w, b
-        return list(rate)
+        total = np.array([g.carry for g in gyros])[:, None, :] + np.add.accumulate(rate * dt, axis=1)
+        counted = quantize(total, self.lsb)
+        counts = counted.copy()                     # each sample's counts: the difference of the totals
+        counts[:, 1:] -= counted[:, :-1]
+        carry = total[:, -1] - counted[:, -1]
+        for i, g in enumerate(gyros):
+            g.flicker, g.walk, g.bias, g.carry = last[i], walk[i, -1], bias[i, -1], carry[i]
+        rate = counts / dt
+        return rate

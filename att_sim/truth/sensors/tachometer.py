@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import numpy as np
 
-from att_msgs_py.types import WheelSpeedMeasurement
 from att_sim.models.sensor_specs import TachometerSpec
 from att_sim.truth.actuators import quantize
 
@@ -13,15 +12,10 @@ class Tachometer:
     def __init__(self, spec: TachometerSpec, rng: np.random.Generator):
         self.spec, self.rng = spec, rng
 
-    def measure(self, t: float, relative_speed: np.ndarray, frame_id: str = "") -> WheelSpeedMeasurement:
-        speeds = measure_together([self], np.asarray(relative_speed, float)[None])[0]
-        return WheelSpeedMeasurement(t=t, speeds=speeds, frame_id=frame_id)
 
-
-def measure_together(tachometers: list[Tachometer], relative_speeds: np.ndarray) -> np.ndarray:
-    """The speeds each tachometer measures (a row of ``relative_speeds`` each: the runs of a
-    lockstep), each one's noise from its own stream, the arithmetic on rows (element by element:
-    each row's bits alone)."""
+def measure(tachometers: list[Tachometer], relative_speeds: np.ndarray) -> np.ndarray:
+    """The speeds each tachometer measures, a row of ``relative_speeds`` (n × N) each (one
+    spacecraft's, or the runs of a batch), each one's noise from its own stream."""
     noise = np.array([[tach.spec.noise] for tach in tachometers])
     lsb = np.array([[tach.spec.quantization] for tach in tachometers])
     n = relative_speeds.shape[1]

@@ -152,3 +152,51 @@ def test_compiled_body_torque_profile_is_the_step_loop(interpolation):
     np.testing.assert_allclose(traj.q, states[:, :4], rtol=0, atol=1e-13)
     np.testing.assert_allclose(traj.omega, states[:, 4:7], rtol=0, atol=1e-13)
     np.testing.assert_array_equal(traj.wheel_speed, states[:, 7:])
+
+
+def _stack_case():
+    """Three unlike spacecraft (inertia, wheel axes, wheel inertia, limits) and a state each, one
+    wheel at its speed limit pushed further, one motor torque beyond its limit."""
+    rng = np.random.default_rng(5)
+    scs = []
+    for k in range(3):
+        a = rng.normal(size=(3, 3))
+        axes = np.eye(3) + 0.05 * rng.normal(size=(3, 3))
+        scs.append(dyn.Spacecraft(inertia=np.diag([10.0, 12.0, 14.0]) * (1 + 0.1 * k) + 0.3 * (a + a.T),
+                                  wheel_axes=axes / np.linalg.norm(axes, axis=0), wheel_inertia=0.05 * (1 + k),
+                                  wheel_torque_max=0.1 + 0.02 * k, wheel_speed_max=300.0 - 10 * k))
+    x = np.array([dyn.initial_state(sc, rng.normal(size=4), rng.normal(0, 0.02, 3), rng.uniform(-100, 100, 3))
+                  for sc in scs])
+    x[0, :4] *= 1.01                                        # a stage's quaternion is off unit norm
+    x[1, 7] = scs[1].wheel_speed_max + scs[1].wheel_axes[:, 0] @ x[1, 4:7]     # relative speed at its limit
+    u = rng.uniform(-0.08, 0.08, (3, 3))
+    u[1, 0] = 0.05                                          # pushes the limited wheel further: cut
+    u[2, 1] = 1.0                                           # beyond the torque limit: clipped
+    return scs, x, u, rng.normal(0, 1e-3, (3, 3))
+
+
+def test_rates_of_a_stack_are_each_spacecraft_s_equations():
+    """:func:`dyn.rates` on rows of three unlike spacecraft against the equations written out per
+    spacecraft with numpy's own products (q̇ = ½ q ⊗ [ω, 0], J ω̇ = τ − G u − ω × (J ω + G I_w Ω),
+    I_w Ω̇ = u), and against the derivative of each spacecraft alone."""
+    scs, x, u, tau = _stack_case()
+    got = dyn.rates(dyn.stack(scs), x, tau, u)
+    for sc, xi, ui, ti, row in zip(scs, x, u, tau, got):
+        q, w, ws = xi[:4], xi[4:7], xi[7:]
+        G = sc.wheel_axes
+        nu = ws - G.T @ w
+        ui = np.clip(ui, -sc.wheel_torque_max, sc.wheel_torque_max)
+        ui = np.where((np.abs(nu) >= sc.wheel_speed_max) & (ui * nu > 0), 0.0, ui)
+        h = sc.inertia @ w + G @ (sc.wheel_inertia * ws)
+        w_dot = np.linalg.solve(sc.inertia, ti - G @ ui - np.cross(w, h))
+        qv, qw = q[:3], q[3]
+        q_dot = 0.5 * np.concatenate([qw * w + np.cross(qv, w), [-qv @ w]])
+        np.testing.assert_allclose(row, np.concatenate([q_dot, w_dot, ui / sc.wheel_inertia]), rtol=1e-10, atol=1e-15)
+        np.testing.assert_allclose(row, dyn.derivative(sc, xi, dyn.Inputs(wheel_torque=ui, body_torque=ti)),
+                                   rtol=1e-12, atol=1e-18)
+    assert got[1, 7] == 0.0 and got[2, 8] == pytest.approx(scs[2].wheel_torque_max / scs[2].wheel_inertia)
+
+
+def test_a_stack_refuses_unlike_wheel_counts():
+    with pytest.raises(ValueError, match="number of wheels"):
+        dyn.stack([dyn.Spacecraft(inertia=np.eye(3)), dyn.Spacecraft(inertia=np.eye(3), wheel_axes=np.eye(3)[:, :2])])

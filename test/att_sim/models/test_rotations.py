@@ -80,7 +80,7 @@ def test_one_quaternion_fast_paths_agree_with_the_stacked_forms():
 
 
 def test_log_map_of_rows_gives_each_row_its_bits_alone():
-    """The lockstep's gyros take the rotations of all runs as rows: each row is the one quaternion's
+    """A batch's gyros take the rotations of all runs as rows: each row is the one quaternion's
     log map bit for bit — small and zero rotations, w < 0, unnormalised, zero and non-finite rows."""
     qs = np.vstack([random_quaternions(200) * RNG.uniform(1e-3, 1e3, (200, 1)),
                     [[1e-12, -2e-13, 3e-14, -1.0], [0.0, 0.0, 0.0, 1.0], [0.0, 0.0, 0.0, 0.0],
@@ -89,3 +89,16 @@ def test_log_map_of_rows_gives_each_row_its_bits_alone():
     for q, row in zip(qs, rows):
         assert rot.log_map(q).tobytes() == row.tobytes()
     assert np.allclose(rot.exp_map(rows[:200]), rot.normalize(qs[:200]) * np.sign(qs[:200, 3:]), atol=1e-12)
+
+
+def test_to_body_on_rows_is_the_transposed_dcm_of_each_row():
+    """Rows of quaternions, unit or not (an RK4 stage's), each against ``dcm(q)ᵀ v`` computed alone;
+    one vector for every row or one per row; one quaternion; a stack of rows."""
+    qs = random_quaternions(50) * RNG.uniform(0.9, 1.1, (50, 1))
+    vs = RNG.normal(size=(50, 3))
+    for v, rows in ((vs, rot.to_body(qs, vs)), (vs[0], rot.to_body(qs, vs[0]))):
+        for i, (q, row) in enumerate(zip(qs, rows)):
+            np.testing.assert_allclose(row, rot.dcm_BN(q) @ (v if v.ndim == 1 else v[i]), rtol=0, atol=1e-15)
+    np.testing.assert_allclose(rot.to_body(qs[3], vs[3]), rot.dcm_BN(qs[3]) @ vs[3], rtol=0, atol=1e-15)
+    stacked = rot.to_body(qs.reshape(5, 10, 4), vs.reshape(5, 10, 3))
+    np.testing.assert_array_equal(stacked.reshape(50, 3), rot.to_body(qs, vs))

@@ -54,7 +54,7 @@ def test_a_power_limited_motor_cannot_speed_a_fast_wheel_up_with_full_torque():
     u = np.array([0.12, 0.12, -0.12, 0.12])
     speed = np.array([100.0, 600.0, 600.0, -600.0])
     # slow wheel: full torque; fast wheel sped up: 60 W / 600 rad/s; braking: full torque
-    assert np.allclose(drive.motor(u.tolist(), speed.tolist()), [0.12, 0.1, -0.12, 0.12])
+    assert np.allclose(drive.motor(u, speed), [0.12, 0.1, -0.12, 0.12])
     sim = simulation(WheelDriveSpec(power_max=60.0), wheel_speed0=(600.0, 0.0, 0.0))
     sim.set_command(Command(mode=ControlMode.PLAN_TRACKING, wheel_torques=np.array([0.12, 0.12, 0.0])))
     sim.advance(0.05)
@@ -99,3 +99,34 @@ def test_a_bad_actuator_datasheet_is_refused_naming_the_field(values, field):
     with pytest.raises(ValueError) as err:
         actuators_from_params(values)
     assert field in str(err.value)
+
+
+def test_stacked_drives_and_coils_give_each_run_what_it_gets_alone():
+    """The drives and coils of three runs stacked (a batch) against each one alone, built again from
+    the same streams: held torques (one run's watchdog tripped: its command unchanged, nothing
+    drawn), the power envelope and the friction law per run, the dipoles."""
+    specs = [WheelDriveSpec(coulomb_friction=0.002 * (1 + k), viscous_friction=1e-5, friction_speed=0.5,
+                            torque_quantization=1e-4, torque_noise=2e-4, power_max=(60.0, math.inf, 40.0)[k],
+                            torque_scale=(1.0 + 0.1 * k, 1.0, 0.9)) for k in range(3)]
+    coil_specs = [MagnetorquerSpec(quantization=0.01 * (k + 1), misalignment=math.radians(0.5)) for k in range(3)]
+
+    def units():
+        return ([WheelDrive(s, np.random.default_rng(k), 3) for k, s in enumerate(specs)],
+                [Magnetorquers(s, np.random.default_rng(10 + k)) for k, s in enumerate(coil_specs)])
+    drives, coils = units()
+    alone_drives, alone_coils = units()
+    rng = np.random.default_rng(3)
+    u, speed, m = rng.uniform(-0.12, 0.12, (3, 3)), rng.uniform(-600, 600, (3, 3)), rng.uniform(-5, 5, (3, 3))
+    u[0, 0], speed[0, 0] = 0.12, 600.0              # run 0 speeds a fast wheel up: 60 W / 600 rad/s
+    stacked = WheelDrive.stack(drives)
+    held = stacked.hold(u, [True, False, True])
+    net = stacked(held, speed)
+    dipoles = Magnetorquers.stack(coils)(m)
+    for i, (drive, coil) in enumerate(zip(alone_drives, alone_coils)):
+        one = drive.hold(u[i:i + 1]) if i != 1 else u[i:i + 1]
+        np.testing.assert_allclose(held[i], one[0], rtol=1e-12, atol=0)
+        motor = drive.motor(one, speed[i:i + 1])[0]
+        expected = motor - specs[i].friction(speed[i])
+        np.testing.assert_allclose(net[i], expected, rtol=1e-12, atol=1e-18)
+        np.testing.assert_allclose(dipoles[i], coil(m[i:i + 1])[0], rtol=1e-12, atol=1e-18)
+    assert stacked.motor(held, speed)[0, 0] == pytest.approx(0.1)     # the envelope clipped it

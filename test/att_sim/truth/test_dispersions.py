@@ -98,7 +98,7 @@ def test_the_drives_deliver_the_scaled_torque():
     ideal = replace(SWIFT, actuators=replace(SWIFT.actuators, wheels=None))
     truth, v = disp.seed_truth(c, ideal, 5)
     sim = Simulation.for_scenario(truth.scenario)
-    held = sim.wheel_drive.hold(np.array([0.1, -0.1, 0.05]))
+    held = sim.wheel_drive.hold(np.array([[0.1, -0.1, 0.05]]))[0]       # one run's row
     assert held == pytest.approx(np.array([0.1, -0.1, 0.05]) * (1 + v["wheel_torque_scale"]), rel=1e-12)
 
 
@@ -155,7 +155,7 @@ def test_the_coils_deliver_the_scaled_dipole():
     truth, v = disp.seed_truth(c, ideal, 5)
     coils = Simulation.for_scenario(truth.scenario).magnetorquers
     m = np.array([2.0, -1.0, 0.5])
-    assert coils(m) == pytest.approx(m * (1 + v["magnetorquer_scale"]), rel=1e-12)
+    assert coils(m[None])[0] == pytest.approx(m * (1 + v["magnetorquer_scale"]), rel=1e-12)
 
 
 def test_an_epoch_offset_moves_the_truths_orbit_and_sky():

@@ -27,11 +27,12 @@ from att_sim.models.sensor_specs import (
 )
 from att_sim.models.world import Bodies
 from att_sim.truth.sensors import SensorSuite
-from att_sim.truth.sensors.gyro import Gyro
+from att_sim.truth.sensors.gyro import Gyro, Gyros
 from att_sim.truth.sensors.magnetometer import Magnetometer
 from att_sim.truth.sensors.star_tracker import StarTracker
 from att_sim.truth.sensors.sun_sensors import SunSensors
 from att_sim.truth.sensors.tachometer import Tachometer
+from att_sim.truth.sensors.tachometer import measure as measure_tachometers
 
 ARW = 0.01 * DEG / math.sqrt(HOUR)           # 0.01 deg/sqrt(h)
 BIAS_INSTABILITY = 0.05 * DEG / HOUR          # 0.05 deg/h
@@ -158,7 +159,7 @@ def test_sun_sensors_follow_the_cosine_law_their_field_of_view_and_the_shadow():
 
 def test_tachometer_noise_and_quantisation():
     tach = Tachometer(TachometerSpec(noise=0.01, quantization=0.005), np.random.default_rng(9))
-    speeds = np.array([tach.measure(0.0, np.array([100.0, -3.0, 0.0])).speeds for _ in range(4000)])
+    speeds = np.array([measure_tachometers([tach], np.array([[100.0, -3.0, 0.0]]))[0] for _ in range(4000)])
     assert np.allclose(np.round(speeds / 0.005) * 0.005, speeds)
     assert np.allclose(speeds.mean(axis=0), [100.0, -3.0, 0.0], atol=0.002)
     assert np.all(np.abs(speeds.std(axis=0) / math.hypot(0.01, 0.005 / math.sqrt(12)) - 1) < 0.08)
@@ -242,3 +243,38 @@ def test_datasheet_units_are_converted_once():
     assert g.misalignment == pytest.approx(math.radians(20 / 3600)) and g.range == pytest.approx(math.radians(10))
     assert specs.star_trackers[0].cross_boresight == pytest.approx(math.radians(3 / 3600))
     assert specs.magnetometer.noise == pytest.approx(50e-9)
+
+
+def _gyro_spec(quantization: float = 0.0) -> GyroSpec:
+    return GyroSpec(rate=20.0, arw=ARW, bias_instability=BIAS_INSTABILITY, rrw=1e-9, initial_bias=1e-5,
+                    scale_factor=1e-4, misalignment=1e-4, quantization=quantization, range=0.2)
+
+
+def test_gyros_on_rows_give_each_unit_its_own_rates():
+    """Three unlike gyros measured on rows (a batch's) against each one alone from the same stream,
+    over intervals of their own; the noise state each one keeps goes on alike."""
+    specs = [_gyro_spec(), _gyro_spec(1e-7), replace(_gyro_spec(), bias_instability=0.0)]
+    rows = Gyros([Gyro(s, np.random.default_rng(k)) for k, s in enumerate(specs)])
+    alone = [Gyro(s, np.random.default_rng(k)) for k, s in enumerate(specs)]
+    rng = np.random.default_rng(4)
+    for _ in range(5):
+        rotation, dts = rng.normal(0, 1e-3, (3, 3)), (0.05, 0.1, 0.05)
+        rates = rows.measure(rotation[:, None, :], dts)[:, 0]
+        for g, r, dt, got, unit in zip(alone, rotation, dts, rates, rows.gyros):
+            np.testing.assert_allclose(got, g.measure(r, dt), rtol=1e-12, atol=1e-18)
+            np.testing.assert_allclose(unit.bias, g.bias, rtol=1e-12, atol=1e-20)
+
+
+def test_a_gyro_measures_many_intervals_at_once_as_one_after_the_other():
+    """k consecutive intervals in one call give the rates of k single calls, to rounding: the errors
+    drawn once (turn-on bias, scale factor, misalignment), saturation and the quantiser's carried
+    remainder (the noise streams are drawn in another order, so the noise is off here)."""
+    spec = replace(_gyro_spec(1e-6), arw=0.0, bias_instability=0.0, rrw=0.0)
+    batch, single = Gyro(spec, np.random.default_rng(8)), Gyro(spec, np.random.default_rng(8))
+    rotation = np.random.default_rng(9).normal(0, 1e-3, (50, 3))
+    rotation[7] = [0.05, 0.0, 0.0]                  # 1 rad/s: saturated
+    together = batch.measure(rotation, 0.05)
+    one_by_one = np.array([single.measure(r, 0.05) for r in rotation])
+    np.testing.assert_allclose(together, one_by_one, rtol=1e-9, atol=1e-15)
+    np.testing.assert_allclose(batch.carry, single.carry, rtol=0, atol=1e-15)
+    assert together[7, 0] == pytest.approx(0.2, abs=1e-6 / 0.05) and np.any(single.carry != 0)
