@@ -55,7 +55,7 @@ from att_msgs_py.node_runner import (
     subscribe_when_heard,
 )
 from att_msgs_py.types import ManeuverResult
-from att_planner.control.from_scenario import controller_from_scenario, public_key
+from att_planner.control.controller_from_scenario import controller_from_scenario, public_key
 from att_planner.estimation.inputs import Sources
 from att_sim.models import scenario as scen
 

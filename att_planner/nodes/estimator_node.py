@@ -24,7 +24,7 @@ from att_msgs.msg import ActuatorCommand, AttitudeEstimate, CoarseSunSensors, St
 from att_msgs_py import convert, qos, topics
 from att_msgs_py.errors import RequestError, clip
 from att_msgs_py.node_runner import RefusalLog, parameter_reader, publisher_of, run_node, subscribe_when_heard
-from att_planner.estimation.from_scenario import estimator_from_scenario
+from att_planner.estimation.estimator_from_scenario import estimator_from_scenario
 from att_planner.estimation.inputs import Sources
 from att_sim.models import scenario as scen
 from att_sim.models.sensor_specs import DEG, HOUR

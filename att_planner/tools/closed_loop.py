@@ -3,8 +3,8 @@
 :class:`ClosedLoop` runs :class:`att_sim.truth.simulation.Simulation`, the
 :class:`~att_planner.estimation.estimator.Estimator` and the
 :class:`~att_planner.control.controller.Controller` of a scenario — built by the same functions as
-the nodes (:func:`~att_planner.control.from_scenario.controller_from_scenario`,
-:func:`~att_planner.estimation.from_scenario.estimator_from_scenario`) from the scenario's sections, with
+the nodes (:func:`~att_planner.control.controller_from_scenario.controller_from_scenario`,
+:func:`~att_planner.estimation.estimator_from_scenario.estimator_from_scenario`) from the scenario's sections, with
 ``overrides`` on top — and passes what the nodes would publish, in the order the simulator publishes
 it: each step the sensors' readings, then the state; the estimator's estimate (or the truth state)
 to the controller; its command, at each control instant, back to the simulator. No DDS: tests, the
@@ -25,9 +25,9 @@ from att_msgs_py import convert, signing, topics
 from att_msgs_py.errors import RequestError
 from att_msgs_py.parameters import SectionReader
 from att_msgs_py.types import Health, ManeuverResult, Plan, PointingMode
-from att_planner.control.from_scenario import controller_from_scenario
+from att_planner.control.controller_from_scenario import controller_from_scenario
 from att_planner.estimation.estimator import Estimator
-from att_planner.estimation.from_scenario import estimator_from_scenario
+from att_planner.estimation.estimator_from_scenario import estimator_from_scenario
 from att_sim.models import dynamics as dyn
 from att_sim.models import rotations as rot
 from att_sim.models.scenario import Scenario

@@ -1,4 +1,4 @@
-"""Monte Carlo campaigns (issue 16): the dispersed truth of one run, drawn from its seed.
+"""Monte Carlo campaigns: the dispersed truth of one run, drawn from its seed.
 
 A campaign file (YAML, ``yaml.safe_load``; one mapping ``campaign:``) names a scenario and declares
 how the truth departs from the model the plan was made with::

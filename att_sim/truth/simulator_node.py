@@ -6,12 +6,12 @@ no lock or cross-thread wake-up sits in the control loop.
 
 Subscribes ``/actuator/command`` (ActuatorCommand), publishes ``/spacecraft/state``
 (SpacecraftState) at ``publish_rate`` and ``/clock`` at ``clock_rate`` (Hz of sim time), serves
-``/simulator/reset``. The 3D view (issue 17, :mod:`att_sim.models.scene`): ``/tf`` (tf2_msgs/TFMessage: the
+``/simulator/reset``. The 3D view (:mod:`att_sim.models.scene`): ``/tf`` (tf2_msgs/TFMessage: the
 body frame ``body_frame_id`` under the inertial ``frame_id``, attitude only, the view centred on the
 spacecraft) and ``/simulator/zone_margins`` (att_msgs/ZoneMargins: each zone's truth margin) at
 ``tf_rate``, and ``/simulator/markers`` (visualization_msgs/MarkerArray: the zones as
 cones where they are now, the sensor boresights, the Sun/Moon/Earth directions) at ``marker_rate``;
-a rate of 0 switches either off. With the scenario's sensors (issue 14) it also publishes what they measure,
+a rate of 0 switches either off. With the scenario's sensors it also publishes what they measure,
 each at its own rate (:class:`att_sim.truth.sensors.SensorSuite`): ``/sensors/imu`` (sensor_msgs/Imu),
 ``/sensors/star_tracker`` (att_msgs/StarTracker), ``/sensors/magnetometer``
 (sensor_msgs/MagneticField), ``/sensors/sun_sensors`` (att_msgs/CoarseSunSensors),

@@ -1,4 +1,4 @@
-"""``att-bench``: the one entry point for the figures the issues ask for.
+"""``att-bench``: the one entry point for the suite's benchmark figures.
 
 ``att-bench <study> [options] --json PATH`` runs a study, prints a table and writes its JSON.
 Each study is a module of this package providing ``configure(parser)`` and ``run(args) -> dict``
