@@ -31,7 +31,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from att_sim.models import rotations as rot
-from att_sim.models.environment import EARTH_MU, to_body
+from att_sim.models.environment import EARTH_MU
 
 SOLAR_PRESSURE_1AU = 4.56e-6          # N/m², solar flux 1367 W/m² over c (Wertz §17.2)
 ASTRONOMICAL_UNIT = 1.495978707e11    # m (IAU 2012)
@@ -121,17 +121,9 @@ def facets_from_params(params, field: str = "environment.facets") -> list[Facet]
 
 
 def _body(q_BN, v_N) -> tuple:
-    """``v_B = [BN] v_N`` as three components: floats for one attitude and one vector (the
-    simulator's per-stage path), arrays for stacks (:func:`att_sim.models.rotations.dcm_BN`)."""
-    q, v = np.asarray(q_BN, float), np.asarray(v_N, float)
-    if q.shape != (4,) or v.shape != (3,):
-        b = to_body(q, v)
-        return b[..., 0], b[..., 1], b[..., 2]
-    x, y, z, w = q.tolist()
-    a, b, c = v.tolist()
-    return ((1 - 2 * (y * y + z * z)) * a + 2 * (x * y + z * w) * b + 2 * (x * z - y * w) * c,
-            2 * (x * y - z * w) * a + (1 - 2 * (x * x + z * z)) * b + 2 * (y * z + x * w) * c,
-            2 * (x * z + y * w) * a + 2 * (y * z - x * w) * b + (1 - 2 * (x * x + y * y)) * c)
+    """``v_B = [BN] v_N`` (:func:`att_sim.models.rotations.to_body`) as its three components."""
+    b = rot.to_body(q_BN, v_N)
+    return b[..., 0], b[..., 1], b[..., 2]
 
 
 def _vector_out(tx, ty, tz, like) -> np.ndarray:

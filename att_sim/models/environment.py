@@ -133,19 +133,14 @@ def field_inertial(orbit: OrbitParams, t, arg0=None, dipole: DipoleModel = DEFAU
     return np.stack(np.broadcast_arrays(*dipole_field_components(orbit, r_hat, m_hat, dipole)), -1)
 
 
-def to_body(q_BN, v_N) -> np.ndarray:
-    """``v_B = C(q) v_N = [BN] v_N``: an inertial vector in body axes (stacks broadcast)."""
-    return np.einsum("...ji,...j->...i", rot.dcm_NB(q_BN), np.asarray(v_N, float))
-
-
 def field_body(orbit: OrbitParams, t, q_BN, arg0=None, dipole: DipoleModel = DEFAULT_DIPOLE) -> np.ndarray:
     """``B_b = C(q_BN) B_i(t)`` (T)."""
-    return to_body(q_BN, field_inertial(orbit, t, arg0, dipole))
+    return rot.to_body(q_BN, field_inertial(orbit, t, arg0, dipole))
 
 
 def gravity_gradient_torque(orbit: OrbitParams, t, q_BN, inertia, arg0=None) -> np.ndarray:
     """Gravity-gradient torque in body axes (N m): ``(3μ/R³) r̂_b × (J r̂_b)``."""
     r = position(orbit, t, arg0)
-    r_b = to_body(q_BN, r / orbit.radius)
+    r_b = rot.to_body(q_BN, r / orbit.radius)
     j_r = np.einsum("ij,...j->...i", np.asarray(inertia, float), r_b)
     return 3.0 * EARTH_MU / orbit.radius**3 * np.cross(r_b, j_r)
