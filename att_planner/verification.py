@@ -98,16 +98,16 @@ def measure(problem: ManeuverProblem, plan: Plan, traj: dyn.Trajectory) -> Verif
     applied = controls[:-1] if plan.interpolation == Interpolation.ZOH and len(controls) > 1 else controls
     limit = sc.wheel_torque_max if wheels else sc.body_torque_max
     zone_sky = problem.zone_sky()
-    m = clearances(problem, traj.t, traj.q)
-    final_rate = float(np.linalg.norm(traj.omega[-1]))
+    m = clearances(problem, traj.t, traj.q_BN)
+    final_rate = float(np.linalg.norm(traj.omega_BN_B[-1]))
     if problem.goal_motion is not None:            # the moving goal where and as fast as it is at t_f
         q_goal, omega_goal = problem.goal_motion(float(traj.t[-1]))
-        final_error = float(rot.angle_between(traj.q[-1], q_goal))
-        final_rate = float(np.linalg.norm(traj.omega[-1] - omega_goal))
+        final_error = float(rot.angle_between(traj.q_BN[-1], q_goal))
+        final_rate = float(np.linalg.norm(traj.omega_BN_B[-1] - omega_goal))
     elif problem.sensor_target is None:
-        final_error = float(rot.angle_between(traj.q[-1], problem.q_final))
+        final_error = float(rot.angle_between(traj.q_BN[-1], problem.q_final))
     else:
-        reached = rot.dcm_NB(traj.q[-1]) @ np.asarray(problem.sensor_axis, float)
+        reached = rot.dcm_NB(traj.q_BN[-1]) @ np.asarray(problem.sensor_axis, float)
         target = np.asarray(problem.sensor_target, float)
         final_error = float(np.arccos(np.clip(reached @ target / np.linalg.norm(target), -1.0, 1.0)))
     passage_errors, passage_rates = [], []
@@ -115,8 +115,8 @@ def measure(problem: ManeuverProblem, plan: Plan, traj: dyn.Trajectory) -> Verif
         k = int(np.argmin(np.abs(traj.t - passage.time)))
         held = np.flatnonzero((traj.t >= traj.t[k]) & (traj.t <= passage.time + passage.dwell)) \
             if passage.dwell > 0 else np.array([k])
-        passage_errors.append(float(max(rot.angle_between(traj.q[i], passage.attitude) for i in held)))
-        rates = np.linalg.norm(traj.omega[held], axis=1) if passage.dwell > 0 else np.abs(traj.omega[held, 2])
+        passage_errors.append(float(max(rot.angle_between(traj.q_BN[i], passage.attitude) for i in held)))
+        rates = np.linalg.norm(traj.omega_BN_B[held], axis=1) if passage.dwell > 0 else np.abs(traj.omega_BN_B[held, 2])
         passage_rates.append(float(rates.max()))
     return Verification(
         final_attitude_error=final_error,
@@ -125,10 +125,10 @@ def measure(problem: ManeuverProblem, plan: Plan, traj: dyn.Trajectory) -> Verif
         cone_margins=[float(v) for v in m.min(axis=0)] if m.size else [],
         torque_ratio=_ratio(peak_magnitude(applied), limit),
         wheel_speed_ratio=_ratio(peak_magnitude(wheel_speeds_along(problem, plan, traj)), sc.wheel_speed_max),
-        rate_max=float(np.linalg.norm(traj.omega, axis=1).max()),
+        rate_max=float(np.linalg.norm(traj.omega_BN_B, axis=1).max()),
         dense_samples=len(traj.t),
         duration=plan.duration,
-        body_rate_ratio=_ratio(peak_magnitude(traj.omega), problem.rate_max),
+        body_rate_ratio=_ratio(peak_magnitude(traj.omega_BN_B), problem.rate_max),
         wheel_momentum_ratio=_ratio(peak_magnitude(_wheel_momentum(sc, traj, wheels)), problem.wheel_momentum_max),
         passage_attitude_errors=passage_errors,
         passage_rates_z=passage_rates,
@@ -190,7 +190,7 @@ def _wheel_momentum(sc: dyn.Spacecraft, traj: dyn.Trajectory, wheels: bool) -> n
     momentum ``G⁺ J ω`` the wheels would hold producing the body torque with zero total momentum."""
     if wheels:
         return sc.wheel_inertia * traj.wheel_speed
-    return traj.omega @ (sc.wheel_axes_pinv @ sc.inertia).T
+    return traj.omega_BN_B @ (sc.wheel_axes_pinv @ sc.inertia).T
 
 
 def wheel_speeds_along(problem: ManeuverProblem, plan: Plan, traj: dyn.Trajectory) -> np.ndarray:
@@ -199,8 +199,8 @@ def wheel_speeds_along(problem: ManeuverProblem, plan: Plan, traj: dyn.Trajector
     predicts its wheels; a body-torque plan's are :func:`body_plan_wheel_speeds` (the two parts summed)."""
     sc = prediction_model(problem)
     if plan.control_kind == ControlKind.WHEEL_TORQUE:
-        return traj.wheel_speed - traj.omega @ sc.wheel_axes
-    stored, slew = body_plan_wheel_speeds(problem, traj.q, traj.omega)
+        return traj.wheel_speed - traj.omega_BN_B @ sc.wheel_axes
+    stored, slew = body_plan_wheel_speeds(problem, traj.q_BN, traj.omega_BN_B)
     return stored + slew
 
 

@@ -63,9 +63,9 @@ def main(start=0.0, stop=5800.0, step=100.0):
             continue
         traj = predict(prob, plan)
         ax0, h0 = sky(off)
-        b = np.einsum("kij,j->ki", rot.dcm_NB(traj.q), base.sensor_axis)
+        b = np.einsum("kij,j->ki", rot.dcm_NB(traj.q_BN), base.sensor_axis)
         frozen = np.arccos(np.clip(b @ ax0[0].T, -1, 1)) - h0[0]
-        true = margins(off + traj.t, traj.q)
+        true = margins(off + traj.t, traj.q_BN)
         end_true = margins(off + plan.duration, base.q_final[None])
         print(f"{off:7.0f}  tf {plan.duration:6.1f}  {plan.wall_time:4.1f}s  frozen min "
               f"{np.degrees(frozen.min(axis=0)).round(3)}  true min {np.degrees(true.min(axis=0)).round(3)}  "

@@ -53,7 +53,7 @@ def slow_for_wheels(problem: ManeuverProblem, plan: Plan) -> tuple[Plan | None, 
     if problem.goal_motion is not None:
         return None, "a plan that ends on a moving goal is not slowed (it would miss the goal)"
     traj = predict(problem, plan)
-    stored, slew = body_plan_wheel_speeds(problem, traj.q, traj.omega)
+    stored, slew = body_plan_wheel_speeds(problem, traj.q_BN, traj.omega_BN_B)
     c = smallest_slowdown(stored, slew, sc.wheel_speed_max * (1.0 - LIMIT_MARGIN))
     if not math.isfinite(c):
         k, i = np.unravel_index(int(np.argmax(np.abs(stored))), stored.shape)

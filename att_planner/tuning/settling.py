@@ -342,7 +342,7 @@ def truth_settling_time(case: MagnetorquerCase, kp: float, kd: float, h, *, dt: 
         return env.field_body(case.orbit, tt, s[:4], psi[0], case.dipole), None
     for k in range(1, int(math.ceil(settings.cap_orbits * period / dt)) + 1):
         m = dipole_command(x[:4], x[4:7], field(t, x)[0], kp, kd, case.m_max)
-        x = dyn.step(sc, x, dyn.Inputs(dipole=m), dt, field, t)
+        x = dyn.step(sc, x, dyn.Inputs(dipole_B=m), dt, field, t)
         t = k * dt
         qmax = np.max(np.abs(x[:3]))
         if qmax > case.nu:

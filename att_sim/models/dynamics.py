@@ -2,30 +2,32 @@
 
 This is the truth model of the simulator *and* the model the planner uses to verify every plan.
 
-State ``x = [q (4, xyzw body-to-inertial), omega (3, rad/s body), wheel_speed (N, rad/s)]``.
-Momentum model (Olivares & Staffetti 2018, generalised to a mounting matrix ``G`` (3×N) whose
-columns are the wheel spin axes in body axes)::
+Frames (Basilisk's names): N inertial, B body. State ``x = [q_BN (4, xyzw: B relative to N),
+omega_BN_B (3, rad/s: rate of B relative to N in B axes), wheel_speed (N, rad/s: the wheels' spin
+rates Ω in inertial space, one scalar per wheel about its spin axis)]``. Momentum model (Olivares &
+Staffetti 2018, generalised to a mounting matrix ``G`` (3×N) whose columns are the wheel spin axes
+in B axes; ``ω`` is ``omega_BN_B``)::
 
-    H_b   = J ω + G I_w Ω                       (J: I_s, everything but the wheels' spin inertia;
-                                                 Ω: wheel spin rates in inertial space)
-    J ω̇  = −ω × (J ω + G I_w Ω) − G u + τ_ext   (u: wheel motor torques, reaction on the body −G u)
+    h_B   = J ω + G I_w Ω                       (J: I_s about the centre of mass in B axes, everything
+                                                 but the wheels' spin inertia)
+    J ω̇  = −ω × (J ω + G I_w Ω) − G u + τ_B     (u: wheel motor torques, reaction on the body −G u)
     I_w Ω̇ = u
-    q̇    = ½ q ⊗ [ω, 0]
+    q̇_BN = ½ q_BN ⊗ [ω, 0]
 
 A wheel at its speed limit cannot accelerate further: the motor torque pushing it beyond
 ``wheel_speed_max`` is cut (the same thing a wheel drive does). The limit applies to the speed the
 drive sees, the wheel's speed *relative to the body* ``Ω − Gᵀω`` (Basilisk's ``Omega`` and
 ``Omega_max`` are relative speeds too), not to the inertial spin rate ``Ω`` of the state.
-``τ_ext`` adds the direct body torque input, magnetorquer torque ``m × B_b`` and the
+``τ_B`` (B axes) adds the direct body torque input, magnetorquer torque ``m_B × B_B`` and the
 environment's torques (gravity gradient, solar pressure, drag, residual dipole).
 
 Integration: classic RK4 (:func:`rk4`, the suite's one Runge–Kutta step) with quaternion
 renormalisation after every step, see :func:`step`. Actuator inputs are held over a step
-(zero-order hold: that is what a sampled controller commands); the environment — the field in body
+(zero-order hold: that is what a sampled controller commands); the environment — the field in B
 axes and the external torques — is a function of ``(t, x)`` evaluated at every RK4 stage
 (:data:`StageEnvironment`), so a magnetorquer run is fourth-order accurate in the step. Holding the
-field fixed in body axes over a step instead (``Inputs.field_body``, kept for callers that evaluate
-it themselves) is only first-order accurate: the body turns under the held field.
+field fixed in B axes over a step instead (``Inputs.field_B``, for callers that evaluate the field
+themselves) is only first-order accurate: the body turns under the held field.
 
 Every function works on a leading run axis: the states of n spacecraft as rows (n, 7 + N) and their
 parameters stacked (:class:`SpacecraftStack`; n = 1 for one simulation, n runs for a Monte Carlo
@@ -47,14 +49,17 @@ from att_sim.models import rotations as rot
 
 @dataclass(frozen=True)
 class Spacecraft:
-    """Mass properties and actuator limits (SI units)."""
+    """Mass properties and actuator limits (SI units), in body (B) axes: the parameters a scenario
+    file writes, by the same names. ``inertia`` is ``J`` (= I_s, see the module docstring) about the
+    centre of mass in B axes, ``wheel_axes`` the mounting matrix ``G`` whose columns are the wheels'
+    unit spin axes in B axes, ``body_torque_max`` the direct torque limit per B axis."""
 
-    inertia: np.ndarray                                   # (3, 3) kg m², I_s (see module docstring)
-    wheel_axes: np.ndarray = field(default_factory=lambda: np.eye(3))  # (3, N) unit spin axes
+    inertia: np.ndarray                                   # (3, 3) kg m², J about the centre of mass, B axes
+    wheel_axes: np.ndarray = field(default_factory=lambda: np.eye(3))  # (3, N) unit spin axes in B axes, G
     wheel_inertia: float = 0.0                            # kg m² about each spin axis
     wheel_torque_max: float = np.inf                      # N m per wheel
     wheel_speed_max: float = np.inf                       # rad/s per wheel
-    body_torque_max: float = np.inf                       # N m per body axis (direct torque input)
+    body_torque_max: float = np.inf                       # N m per B axis (direct torque input)
     dipole_max: float = np.inf                            # A m² per magnetorquer
 
     def __post_init__(self):
@@ -77,7 +82,7 @@ class Spacecraft:
 
     @cached_property
     def wheel_axes_pinv(self) -> np.ndarray:
-        """``G⁺`` (N, 3): the least-norm wheel quantities that produce a body vector."""
+        """``G⁺`` (N, 3): the least-norm wheel quantities that produce a vector in B axes."""
         return np.linalg.pinv(self.wheel_axes)
 
     @cached_property
@@ -96,17 +101,18 @@ class Spacecraft:
 class SpacecraftStack:
     """The parameters of n spacecraft with the same number of wheels N on a leading run axis (the
     runs of a batch; n = 1: one spacecraft): the arrays :func:`rates` works on. Limits are columns
-    (n, 1), so they broadcast over the wheels or axes of each row."""
+    (n, 1), so they broadcast over the wheels or axes of each row. Frames as in :class:`Spacecraft`
+    (B axes), whose field names these are."""
 
-    inertia: np.ndarray            # (n, 3, 3) kg m², J
+    inertia: np.ndarray            # (n, 3, 3) kg m², J about the centre of mass, B axes
     inertia_inv: np.ndarray        # (n, 3, 3)
-    wheel_axes: np.ndarray         # (n, 3, N) G
+    wheel_axes: np.ndarray         # (n, 3, N) G, spin axes in B axes
     wheel_inertia: np.ndarray      # (n, 1) kg m², I_w
     wheel_torque_max: np.ndarray   # (n, 1) N m
     wheel_speed_max: np.ndarray    # (n, 1) rad/s
     body_torque_max: np.ndarray    # (n, 1) N m
     dipole_max: np.ndarray         # (n, 1) A m²
-    momentum_map: np.ndarray       # (n, 3, 3 + N): h_B = [J, I_w G] [ω; Ω]
+    momentum_map: np.ndarray       # (n, 3, 3 + N): h_B = [J, I_w G] [omega_BN_B; Ω]
     spinning: bool                 # the wheels have inertia (all rows alike)
 
     @property
@@ -140,35 +146,39 @@ def stack(spacecraft: list[Spacecraft]) -> SpacecraftStack:
 @dataclass
 class Inputs:
     """Actuator inputs held over one integration step (zero-order hold), one row per run (or one
-    vector: a run of one). ``field_body`` and ``gravity_gradient`` are the held-environment form; a
+    vector (a run of one). ``field_B`` and ``gravity_gradient_B`` are the held-environment form; a
     :data:`StageEnvironment` replaces both."""
 
-    wheel_torque: np.ndarray | None = None   # (n, N) motor torques u
-    body_torque: np.ndarray | None = None    # (n, 3) direct body torque, body axes
-    dipole: np.ndarray | None = None         # (n, 3) A m², body axes
-    field_body: np.ndarray | None = None     # (n, 3) T, body axes (needed with dipole), held
-    gravity_gradient: np.ndarray | None = None  # (n, 3) N m, body axes, precomputed, held
+    wheel_torque: np.ndarray | None = None   # (n, N) motor torques u, one scalar per wheel
+    torque_B: np.ndarray | None = None       # (n, 3) N m, direct body torque, B axes
+    dipole_B: np.ndarray | None = None       # (n, 3) A m², magnetorquer dipole, B axes
+    field_B: np.ndarray | None = None        # (n, 3) T, geomagnetic field, B axes (needed with dipole_B), held
+    gravity_gradient_B: np.ndarray | None = None  # (n, 3) N m, environment torque, B axes, precomputed, held
     wheel_drive: Callable | None = None      # (u, ν) -> net wheel torques at relative speeds ν, rows (friction,
                                              # envelope: att_sim.truth.actuators.WheelDrive); None: ideal motors
 
 
 StageEnvironment = Callable[[float, np.ndarray], tuple[np.ndarray, np.ndarray | None]]
-"""``(t, x) -> (B_b, τ_env)``: the geomagnetic field in body axes (T) and the external environment
-torque (N m, body axes; None: none) at one RK4 stage's time and states (rows, e.g.
+"""``(t, x) -> (B_B, τ_env_B)``: the geomagnetic field in B axes (T) and the external environment
+torque (N m, B axes; None: none) at one RK4 stage's time and states (rows, e.g.
 :meth:`att_sim.models.world.Environment.stage`)."""
 
 
-def initial_state(sc: Spacecraft, q=rot.IDENTITY, omega=(0.0, 0.0, 0.0), wheel_speed=None) -> np.ndarray:
+def initial_state(sc: Spacecraft, q_BN=rot.IDENTITY, omega_BN_B=(0.0, 0.0, 0.0), wheel_speed=None) -> np.ndarray:
+    """The state ``[q_BN, omega_BN_B, wheel_speed]`` (7 + N,): the attitude normalised, the wheels'
+    inertial spin rates ``Ω`` (rad/s; None: at rest in inertial space)."""
     ws = np.zeros(sc.n_wheels) if wheel_speed is None else np.asarray(wheel_speed, float)
-    return np.concatenate([rot.normalize(np.asarray(q, float)), np.asarray(omega, float), ws])
+    return np.concatenate([rot.normalize(np.asarray(q_BN, float)), np.asarray(omega_BN_B, float), ws])
 
 
-def relative_wheel_speed(sc: Spacecraft | SpacecraftStack, wheel_speed: np.ndarray, omega: np.ndarray) -> np.ndarray:
-    """The wheels' speeds relative to the body ``Ω − Gᵀω`` (rad/s): what a wheel drive measures and
-    limits. One spacecraft's vectors, or rows of runs (``omega`` (n, 3), ``wheel_speed`` (n, N)) of
-    one spacecraft or of a :class:`SpacecraftStack`."""
-    omega = np.asarray(omega, float)
-    return np.asarray(wheel_speed, float) - (omega[..., None, :] @ sc.wheel_axes)[..., 0, :]
+def relative_wheel_speed(sc: Spacecraft | SpacecraftStack, wheel_speed: np.ndarray,
+                         omega_BN_B: np.ndarray) -> np.ndarray:
+    """The wheels' speeds relative to the body ``Ω − Gᵀω`` (rad/s; ``Ω`` the inertial spin rates
+    ``wheel_speed``, ``ω`` = ``omega_BN_B``): what a wheel drive measures and limits. One
+    spacecraft's vectors, or rows of runs (``omega_BN_B`` (n, 3), ``wheel_speed`` (n, N)) of one
+    spacecraft or of a :class:`SpacecraftStack`."""
+    omega_BN_B = np.asarray(omega_BN_B, float)
+    return np.asarray(wheel_speed, float) - (omega_BN_B[..., None, :] @ sc.wheel_axes)[..., 0, :]
 
 
 def limited(sc: Spacecraft | SpacecraftStack, u: np.ndarray, relative: np.ndarray) -> np.ndarray:
@@ -180,21 +190,21 @@ def limited(sc: Spacecraft | SpacecraftStack, u: np.ndarray, relative: np.ndarra
 
 
 def effective_wheel_torque(sc: Spacecraft | SpacecraftStack, wheel_speed: np.ndarray, u: np.ndarray,
-                           omega: np.ndarray) -> np.ndarray:
+                           omega_BN_B: np.ndarray) -> np.ndarray:
     """:func:`limited` at the state's relative wheel speeds ``Ω − Gᵀω`` (``Ω`` the state's inertial
-    spin rates, ``ω`` the body rate): vectors of one spacecraft or rows of runs."""
-    return limited(sc, np.asarray(u, float), relative_wheel_speed(sc, wheel_speed, omega))
+    spin rates, ``ω`` = ``omega_BN_B`` the body rate): vectors of one spacecraft or rows of runs."""
+    return limited(sc, np.asarray(u, float), relative_wheel_speed(sc, wheel_speed, omega_BN_B))
 
 
 def external_torque(inputs: Inputs, stage: tuple | None = None) -> np.ndarray:
-    """Body torque ``τ_body + m × B_b + τ_env`` (N m, body axes; rows, or (3,) when every input is one
-    vector): ``stage`` = ``(B_b, τ_env)`` of a :data:`StageEnvironment`, else the held
-    ``inputs.field_body`` and ``inputs.gravity_gradient``."""
-    field_b, tau_env = (inputs.field_body, inputs.gravity_gradient) if stage is None else stage
-    tau = _ZERO3 if inputs.body_torque is None else inputs.body_torque
-    if inputs.dipole is not None and field_b is not None:
-        tau = tau + rot.cross(inputs.dipole, field_b)
-    return tau if tau_env is None else tau + tau_env
+    """The external torque ``τ_B = torque_B + m_B × B_B + τ_env_B`` (N m, B axes; rows, or (3,) when
+    every input is one vector): ``stage`` = ``(B_B, τ_env_B)`` of a :data:`StageEnvironment`, else the
+    held ``inputs.field_B`` and ``inputs.gravity_gradient_B``."""
+    field_B, tau_env_B = (inputs.field_B, inputs.gravity_gradient_B) if stage is None else stage
+    tau = _ZERO3 if inputs.torque_B is None else inputs.torque_B
+    if inputs.dipole_B is not None and field_B is not None:
+        tau = tau + rot.cross(inputs.dipole_B, field_B)
+    return tau if tau_env_B is None else tau + tau_env_B
 
 
 _ZERO3 = np.zeros(3)
@@ -205,11 +215,11 @@ def rk4_mean(k1, k2, k3, k4) -> np.ndarray:
     return (k1 + 2 * k2 + 2 * k3 + k4) / 6.0
 
 
-def rates(sc: SpacecraftStack, x: np.ndarray, torque: np.ndarray, u: np.ndarray | None = None,
+def rates(sc: SpacecraftStack, x: np.ndarray, torque_B: np.ndarray, u: np.ndarray | None = None,
           drive: Callable | None = None) -> np.ndarray:
     """Time derivative of the states ``x`` (n, 7 + N), one row per spacecraft of the stack, for
-    inputs held constant (see module docstring): ``torque`` the external body torque (rows, or one
-    (3,) for all), ``u`` the held motor torques (n, N) (None: no motor input), cut at the speed
+    inputs held constant (see module docstring): ``torque_B`` the external torque in B axes (rows, or
+    one (3,) for all), ``u`` the held motor torques (n, N) (None: no motor input), cut at the speed
     limit (:func:`limited`) and, with ``drive(u, ν)``, made the imperfect drives' net torques."""
     out = np.empty_like(x)
     w = x[:, 4:7]
@@ -220,18 +230,18 @@ def rates(sc: SpacecraftStack, x: np.ndarray, torque: np.ndarray, u: np.ndarray 
         u = limited(sc, u, relative)
         if drive is not None:
             u = drive(u, relative)
-        torque = torque - (sc.wheel_axes @ u[:, :, None])[:, :, 0]
+        torque_B = torque_B - (sc.wheel_axes @ u[:, :, None])[:, :, 0]
         out[:, 7:] = u / sc.wheel_inertia if sc.spinning else 0.0
     else:
         out[:, 7:] = 0.0
-    out[:, 4:7] = (sc.inertia_inv @ (torque - rot.cross(w, h))[:, :, None])[:, :, 0]
+    out[:, 4:7] = (sc.inertia_inv @ (torque_B - rot.cross(w, h))[:, :, None])[:, :, 0]
     return out
 
 
 def derivative(sc: Spacecraft | SpacecraftStack, x: np.ndarray, inputs: Inputs,
                stage: tuple | None = None) -> np.ndarray:
     """:func:`rates` of one spacecraft's state (7 + N,) or of a stack's rows, the inputs' ``wheel_torque``
-    one vector or rows; ``stage``: the environment ``(B_b, τ_env)`` there (:func:`external_torque`)."""
+    one vector or rows; ``stage``: the environment ``(B_B, τ_env_B)`` there (:func:`external_torque`)."""
     x = np.asarray(x, float)
     u = inputs.wheel_torque
     if u is not None:
@@ -242,10 +252,11 @@ def derivative(sc: Spacecraft | SpacecraftStack, x: np.ndarray, inputs: Inputs,
     return out if x.ndim == 2 else out[0]
 
 
-def quaternion_rate(q, w) -> tuple:
-    """``q̇ = ½ q ⊗ [ω, 0]`` component by component, for floats, arrays of runs and CasADi scalars alike."""
-    qx, qy, qz, qw = q
-    wx, wy, wz = w
+def quaternion_rate(q_BN, omega_BN_B) -> tuple:
+    """``q̇_BN = ½ q_BN ⊗ [omega_BN_B, 0]`` component by component, for floats, arrays of runs and CasADi
+    scalars alike."""
+    qx, qy, qz, qw = q_BN
+    wx, wy, wz = omega_BN_B
     return (0.5 * (qw * wx + qy * wz - qz * wy), 0.5 * (qw * wy + qz * wx - qx * wz),
             0.5 * (qw * wz + qx * wy - qy * wx), -0.5 * (qx * wx + qy * wy + qz * wz))
 
@@ -295,14 +306,17 @@ def step(sc: Spacecraft | SpacecraftStack, x: np.ndarray, inputs: Inputs, dt: fl
     return x_new
 
 
-def angular_momentum_inertial(sc: Spacecraft, x: np.ndarray) -> np.ndarray:
-    h_b = sc.inertia @ x[4:7] + sc.wheel_axes @ (sc.wheel_inertia * x[7:])
-    return rot.dcm_NB(x[:4]) @ h_b
+def angular_momentum_N(sc: Spacecraft, x: np.ndarray) -> np.ndarray:
+    """``h_N = [NB] h_B``, ``h_B = J omega_BN_B + G I_w Ω``: the angular momentum of body and wheels in
+    N axes (N m s), conserved when no external torque acts."""
+    h_B = sc.inertia @ x[4:7] + sc.wheel_axes @ (sc.wheel_inertia * x[7:])
+    return rot.dcm_NB(x[:4]) @ h_B
 
 
 def kinetic_energy(sc: Spacecraft, x: np.ndarray) -> float:
-    """Rotational kinetic energy ``½ ωᵀ J ω + ½ I_w |Ω|²`` of body and wheels (Ω measured in
-    inertial space, as in the momentum model); conserved when no torque acts and motors are idle."""
+    """Rotational kinetic energy ``½ ωᵀ J ω + ½ I_w |Ω|²`` of body and wheels (``ω`` = ``omega_BN_B``,
+    Ω measured in inertial space, as in the momentum model); conserved when no torque acts and motors
+    are idle."""
     w, ws = x[4:7], x[7:]
     return 0.5 * w @ sc.inertia @ w + 0.5 * sc.wheel_inertia * ws @ ws
 
@@ -313,10 +327,12 @@ def kinetic_energy(sc: Spacecraft, x: np.ndarray) -> float:
 
 @dataclass
 class Trajectory:
-    t: np.ndarray          # (K,)
-    q: np.ndarray          # (K, 4)
-    omega: np.ndarray      # (K, 3)
-    wheel_speed: np.ndarray  # (K, N)
+    """The states along an integrated profile, one row per time."""
+
+    t: np.ndarray            # (K,) s
+    q_BN: np.ndarray         # (K, 4) attitude of B relative to N, xyzw
+    omega_BN_B: np.ndarray   # (K, 3) rad/s, rate of B relative to N in B axes
+    wheel_speed: np.ndarray  # (K, N) rad/s, the wheels' inertial spin rates Ω
 
 
 STEPS_PER_CALL = 2048      # RK4 steps per call of the compiled body-torque stepper (a verification: one)
@@ -324,11 +340,12 @@ STEPS_PER_CALL = 2048      # RK4 steps per call of the compiled body-torque step
 
 @functools.cache
 def _body_torque_stepper():
-    """``(x0, U, dU, h, p) -> X``: :data:`STEPS_PER_CALL` RK4 steps of the rigid body from ``x0`` = (q, ω)
-    under the body torque ``U_i + dU_i τ`` (τ from the step's start: ZOH with ``dU = 0``, linear
-    interpolation), step ``h_i`` (0: the state is kept), quaternion renormalised after each step, as
-    :func:`step` does; ``p`` = (J, J⁻¹, G I_w Ω) column-major, the wheels' momentum constant (no motor
-    torque). CasADi code, compiled once into the cache (:mod:`att_sim.models.codegen`)."""
+    """``(x0, U, dU, h, p) -> X``: :data:`STEPS_PER_CALL` RK4 steps of the rigid body from ``x0`` =
+    (q_BN, omega_BN_B) under the body torque (B axes) ``U_i + dU_i τ`` (τ from the step's start: ZOH
+    with ``dU = 0``, linear interpolation), step ``h_i`` (0: the state is kept), quaternion
+    renormalised after each step, as :func:`step` does; ``p`` = (J, J⁻¹, G I_w Ω) column-major, the
+    wheels' momentum constant (no motor torque). CasADi code, compiled once into the cache
+    (:mod:`att_sim.models.codegen`)."""
     import casadi as ca
 
     from att_sim.models.codegen import compiled
@@ -385,8 +402,8 @@ def simulate_profile(
 ) -> Trajectory:
     """Integrate a sampled control history through :func:`derivative`.
 
-    ``kind`` is 'body_torque' (values are body torques, (K, 3)) or 'wheel_torque' (motor torques,
-    (K, N)). ZOH profiles are integrated with steps aligned to the knots (exact input switching);
+    ``kind`` is 'body_torque' (values are body torques in B axes, (K, 3)) or 'wheel_torque' (motor
+    torques, (K, N)). ZOH profiles are integrated with steps aligned to the knots (exact input switching);
     each knot interval is split into substeps no longer than ``max_step`` (default: 1/400 of the
     duration; every interval gets at least one step). Returns the state at every substep. Body
     torques take the compiled stepper (:func:`_body_torque_stepper`: the same RK4 of the same
@@ -402,7 +419,7 @@ def simulate_profile(
         max_step = max((grid[-1] - grid[0]) / 400.0, 1e-6) if len(dts) else 1.0
     if interpolation not in tuple(Interpolation):
         raise ValueError(f"unknown interpolation '{interpolation}' (use 'zoh' or 'linear')")
-    kind = str(ControlKind(kind))           # the Inputs field the values go to
+    kind = str(ControlKind(kind))           # body torques (B axes) or motor torques
     n = np.maximum(1, np.ceil(np.diff(grid) / max_step - 1e-9).astype(int))      # steps per knot interval
     h = np.repeat(np.diff(grid) / n, n)
     t0 = np.repeat(grid[:-1], n) + (np.arange(n.sum()) - np.repeat(np.cumsum(n) - n, n)) * h   # each step's start

@@ -97,7 +97,7 @@ class SimulationBatch:
         body = dyn.rk4_mean(*torques) - (sc.wheel_axes @ net[:, :, None])[:, :, 0]
         samples = self._samples(sims[0].t + dt, x_new)
         for i, s in enumerate(sims):
-            s.finish_step(x_new[i], dt, Applied(u[i], inputs.dipole[i], body[i]), samples[i])
+            s.finish_step(x_new[i], dt, Applied(u[i], inputs.dipole_B[i], body[i]), samples[i])
 
     def inputs(self, x: np.ndarray) -> dyn.Inputs:
         """Every run's actuator inputs for the next step at its state (a row of ``x``), on rows: the
@@ -117,7 +117,7 @@ class SimulationBatch:
             m[self.coiled] = self.coils(m[self.coiled])
         limit = sc.body_torque_max
         tau = np.where(on, np.minimum(np.maximum(np.array([s.body_cmd for s in sims]), -limit), limit), 0.0)
-        return dyn.Inputs(wheel_torque=u, body_torque=tau, dipole=m, wheel_drive=self.drives)
+        return dyn.Inputs(wheel_torque=u, torque_B=tau, dipole_B=m, wheel_drive=self.drives)
 
     def _samples(self, t: float, x: np.ndarray) -> list:
         """Each run's :meth:`Environment.sample <att_sim.models.world.Environment.sample>` at ``t`` and its
@@ -176,5 +176,5 @@ def inputs_row(inputs: dyn.Inputs, i: int, drive: WheelDrive | None) -> dyn.Inpu
     """Run ``i``'s inputs of a batch's (rows ``i:i+1``), its drive ``drive``."""
     def row(v):
         return None if v is None else v[i:i + 1]
-    return dyn.Inputs(wheel_torque=row(inputs.wheel_torque), body_torque=row(inputs.body_torque),
-                      dipole=row(inputs.dipole), wheel_drive=drive)
+    return dyn.Inputs(wheel_torque=row(inputs.wheel_torque), torque_B=row(inputs.torque_B),
+                      dipole_B=row(inputs.dipole_B), wheel_drive=drive)

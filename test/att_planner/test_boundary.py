@@ -113,7 +113,7 @@ def test_a_forced_boundary_arc_is_planned_and_stays_on_the_boundary(method):
     assert outcome.code == ErrorCode.OK and outcome.plan.method == method, outcome.message
     assert outcome.verification.boundary_arc == "moon"
     ver, traj = prediction_check(valid.problem, outcome.plan, dense_fraction=2000)
-    b = rot.dcm_NB(traj.q) @ valid.problem.sensor_axis
+    b = rot.dcm_NB(traj.q_BN) @ valid.problem.sensor_axis
     off = np.abs(np.arccos(np.clip(b @ valid.problem.cones[0].direction, -1, 1)) - valid.problem.cones[0].half_angle)
     assert off.max() <= ARC_TOLERANCE and ver.final_attitude_error <= math.radians(0.5)
 

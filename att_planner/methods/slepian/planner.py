@@ -235,7 +235,7 @@ def physical_profile(man: SmoothManeuver, alpha: np.ndarray, spacecraft: Spacecr
         x0 = dyn.initial_state(spacecraft, rot.from_dcm_NB(man.R_initial))
         traj = dyn.simulate_profile(spacecraft, x0, t, torque, kind=ControlKind.BODY_TORQUE,
                                     interpolation=Interpolation.ZOH, max_step=tf / N)
-        q, omega = traj.q, traj.omega
+        q, omega = traj.q_BN, traj.omega_BN_B
     return {"t": t, "torque": torque, "q": q, "omega": omega, "tf": tf, "evaluation": ev}
 
 

@@ -203,7 +203,7 @@ class _Incumbent:
 def _truth_violation_intervals(traj, sol: col.PhaseSolution, s: Scaling, problem) -> np.ndarray:
     """Mesh intervals containing dense truth samples below a zone's clearance floor
     (:func:`att_planner.verification.clearances`: each zone at the sample's time)."""
-    m = clearances(problem, traj.t, traj.q, true=False)
+    m = clearances(problem, traj.t, traj.q_BN, true=False)
     if not m.size:
         return np.array([], int)
     bad_t = traj.t[m.min(axis=1) < 0] / s.tu / sol.duration

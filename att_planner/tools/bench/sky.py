@@ -175,7 +175,7 @@ def verification(problem: ManeuverProblem, planned: ManeuverProblem, plan) -> di
     margins = dict(zip(ver.zone_names, ver.cone_margins))
     worst = min(margins, key=margins.get) if margins else None
     traj = predict(problem, plan)
-    own = planned.zone_sky().margins(traj.t, traj.q).min(axis=0)
+    own = planned.zone_sky().margins(traj.t, traj.q_BN).min(axis=0)
     return dict(asdict(ver), passes=why is None, rejection=why, zone_margins_vs_motion=margins,
                 entered=worst if worst is not None and margins[worst] < 0 else None,
                 entered_by=-margins[worst] if worst is not None and margins[worst] < 0 else 0.0,

@@ -51,7 +51,8 @@ def verification(problem, plan) -> dict:
     why = rejection(ver)
     applied = np.abs(plan.torque[:-1]).max(axis=1)
     tmax = problem.spacecraft.body_torque_max
-    return dict(asdict(ver), trace_residual=float(3.0 - np.trace(rot.dcm_BN(problem.q_final) @ rot.dcm_NB(traj.q[-1]))),
+    residual = float(3.0 - np.trace(rot.dcm_BN(problem.q_final) @ rot.dcm_NB(traj.q_BN[-1])))
+    return dict(asdict(ver), trace_residual=residual,
                 start_torque_ratio=float(applied[0] / tmax), end_torque_ratio=float(applied[-1] / tmax),
                 passes=why is None, rejection=why)
 

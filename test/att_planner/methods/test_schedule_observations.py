@@ -28,8 +28,8 @@ def _held(problem, plan):
     out = []
     for p in plan.passages:
         inside = (traj.t >= p.time + 1e-9) & (traj.t <= p.time + p.dwell)
-        out.append((max(rot.angle_between(q, p.attitude) for q in traj.q[inside]),
-                    np.linalg.norm(traj.omega[inside], axis=1).max()))
+        out.append((max(rot.angle_between(q, p.attitude) for q in traj.q_BN[inside]),
+                    np.linalg.norm(traj.omega_BN_B[inside], axis=1).max()))
     return out
 
 

@@ -32,7 +32,7 @@ def tour():
 def _leg_margins(problem, plan):
     """Smallest true zone margin (rad) on each leg of an integrated plan."""
     traj = predict(problem, plan)
-    m = problem.zone_sky().margins(traj.t, traj.q, true=True).min(axis=1)
+    m = problem.zone_sky().margins(traj.t, traj.q_BN, true=True).min(axis=1)
     ends = [0.0, *(p.time for p in plan.passages), plan.duration]
     return [m[(traj.t >= a) & (traj.t <= b)].min() for a, b in zip(ends[:-1], ends[1:])]
 

@@ -37,7 +37,7 @@ def _reference_tf(problem, alpha, N, W):
 
 def _verify(problem, plan):
     traj = predict(problem, plan, steps=4 * (len(plan.t) - 1))
-    trace = 3.0 - np.trace(rot.dcm_BN(problem.q_final) @ rot.dcm_NB(traj.q[-1]))
+    trace = 3.0 - np.trace(rot.dcm_BN(problem.q_final) @ rot.dcm_NB(traj.q_BN[-1]))
     return measure(problem, plan, traj), trace
 
 

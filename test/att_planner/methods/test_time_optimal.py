@@ -90,7 +90,7 @@ def test_semi_free_final_attitude_is_never_slower(case, bw_plans, swift_plan):
     assert semi.status in VALID
     assert semi.duration <= full.duration + 1e-6
     ver, traj = prediction_check(problem, semi)
-    pointing = np.arccos(np.clip(rot.dcm_NB(traj.q[-1]) @ problem.sensor_axis @ target, -1, 1))
+    pointing = np.arccos(np.clip(rot.dcm_NB(traj.q_BN[-1]) @ problem.sensor_axis @ target, -1, 1))
     assert pointing <= np.deg2rad(0.5) and ver.final_rate <= 1e-2 and ver.min_cone_margin >= 0
 
 
@@ -114,8 +114,8 @@ def test_rate_and_wheel_momentum_bounds_hold_on_the_truth_trajectory_and_cost_ti
     plan = plan_time_optimal(bounded, starts=1)
     assert plan.status in VALID
     _, traj = prediction_check(problem, plan)
-    assert np.abs(traj.omega).max() <= 1.5                      # per-axis body rate
-    assert np.abs(traj.omega @ problem.spacecraft.inertia).max() <= 1.2   # wheel momentum, G = I
+    assert np.abs(traj.omega_BN_B).max() <= 1.5                      # per-axis body rate
+    assert np.abs(traj.omega_BN_B @ problem.spacecraft.inertia).max() <= 1.2   # wheel momentum, G = I
     assert plan.duration > free.duration
     assert plan.verification.wheel_momentum_ratio <= 1.0
 

@@ -47,12 +47,12 @@ def test_the_wheels_of_a_body_torque_plan_conserve_the_total_momentum_and_keep_t
     p = plan(name)
     problem = ManeuverProblem(sc, rot.IDENTITY, SLEW, wheel_speeds=speeds0)
     traj = predict(problem, p)
-    stored, slew = body_plan_wheel_speeds(problem, traj.q, traj.omega)
+    stored, slew = body_plan_wheel_speeds(problem, traj.q_BN, traj.omega_BN_B)
     relative = stored + slew
     assert relative[0] == pytest.approx(speeds0, abs=1e-9)
-    inertial = relative + traj.omega @ sc.wheel_axes
-    H_B = traj.omega @ sc.inertia.T + inertial @ (sc.wheel_inertia * sc.wheel_axes.T)
-    H_N = np.einsum("kij,kj->ki", rot.dcm_NB(traj.q), H_B)
+    inertial = relative + traj.omega_BN_B @ sc.wheel_axes
+    H_B = traj.omega_BN_B @ sc.inertia.T + inertial @ (sc.wheel_inertia * sc.wheel_axes.T)
+    H_N = np.einsum("kij,kj->ki", rot.dcm_NB(traj.q_BN), H_B)
     assert np.abs(H_N - H_N[0]).max() <= 1e-9 * np.linalg.norm(H_N[0])
     assert np.abs(slew).max() > 10.0            # the slew moves the wheels: the check above means something
     if sc.n_wheels > 3:

@@ -48,7 +48,7 @@ def test_law_matches_formula_saturates_and_is_pd_when_unsaturated():
 
 
 def test_batch_right_hand_side_equals_truth_dynamics():
-    """The batch RHS is the dynamics model's derivative with Inputs(dipole=m, field_body=B_b)."""
+    """The batch RHS is the dynamics model's derivative with Inputs(dipole_B=m, field_B=B_b)."""
     rng = np.random.default_rng(1)
     n = 12
     h = gt.H_LOWER + rng.random((n, 7)) * (gt.H_UPPER - gt.H_LOWER)
@@ -63,7 +63,7 @@ def test_batch_right_hand_side_equals_truth_dynamics():
     for j in range(n):
         b_body = env.field_body(orbit, t, q0[j], psi[j])
         m = dipole_command(q0[j], w0[j], b_body, kp[j], kd[j], CASE.m_max)
-        ref = dyn.derivative(sc, dyn.initial_state(sc, q0[j], w0[j]), dyn.Inputs(dipole=m, field_body=b_body))
+        ref = dyn.derivative(sc, dyn.initial_state(sc, q0[j], w0[j]), dyn.Inputs(dipole_B=m, field_B=b_body))
         np.testing.assert_allclose(d[:, j], ref[:7], rtol=1e-9, atol=1e-15)
 
 
@@ -104,7 +104,7 @@ def test_batch_integration_agrees_with_truth_dynamics_stepping():
         for k in range(400):
             b_body = env.field_body(CASE.orbit, float(k), x[:4], psi[j])
             m = dipole_command(x[:4], x[4:7], b_body, kp, kd, CASE.m_max)
-            x = dyn.step(sc, x, dyn.Inputs(dipole=m, field_body=b_body), 1.0)
+            x = dyn.step(sc, x, dyn.Inputs(dipole_B=m, field_B=b_body), 1.0)
         assert rot.angle_between(x[:4], batch[j, :4]) < 5e-3
         np.testing.assert_allclose(x[4:7], batch[j, 4:7], atol=5e-5)
 
