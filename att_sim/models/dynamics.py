@@ -1,6 +1,7 @@
 """Rigid-body attitude dynamics with reaction wheels, magnetorquers and external torques.
 
-This is the truth model of the simulator *and* the model the planner uses to verify every plan.
+The one model of the motion, shared: the truth simulation integrates it with the dispersed spacecraft,
+the planner's verification (its prediction model) with the nominal one.
 
 Frames (Basilisk's names): N inertial, B body. State ``x = [q_BN (4, xyzw: B relative to N),
 omega_BN_B (3, rad/s: rate of B relative to N in B axes), wheel_speed (N, rad/s: the wheels' spin
