@@ -59,8 +59,8 @@ class PlanRefused(ExecutiveEvent):
 
 
 @dataclass(frozen=True, kw_only=True)
-class ManeuverEnded(ExecutiveEvent):
-    """The controller's result of the maneuver started by request ``request``."""
+class ControllerAnswer(ExecutiveEvent):
+    """The controller's answer to request ``request``: success, or an error code and message."""
 
     request: int
     success: bool
@@ -69,13 +69,13 @@ class ManeuverEnded(ExecutiveEvent):
 
 
 @dataclass(frozen=True, kw_only=True)
-class PointingSet(ExecutiveEvent):
-    """The controller's answer to the hold asked by request ``request``."""
+class ManeuverEnded(ControllerAnswer):
+    """The controller's result of the maneuver started by request ``request``."""
 
-    request: int
-    success: bool
-    code: int = 0
-    message: str = ""
+
+@dataclass(frozen=True, kw_only=True)
+class PointingSet(ControllerAnswer):
+    """The controller's answer to the hold asked by request ``request``."""
 
 
 # ---- actions (what to do) ----
