@@ -59,6 +59,7 @@ from att_msgs_py.node_runner import (
 from att_msgs_py.types import ManeuverResult
 from att_planner.control.controller_from_scenario import controller_from_scenario, public_key
 from att_planner.control.mode_authentication import MAX_AHEAD, ModeAuthentication, default_sequence_path
+from att_planner.control.plan_checks import check_message
 from att_planner.estimation.inputs import Sources
 from att_sim.models import scenario as scen
 
@@ -176,7 +177,7 @@ class ControllerNode(Node):
                 self.finish(out.result)
 
     def on_plan(self, msg: ManeuverPlan):
-        refused = self._core.receive_plan(convert.plan_from_msg(msg), signing.payload(msg))
+        refused = check_message(msg) or self._core.receive_plan(convert.plan_from_msg(msg), signing.payload(msg))
         if refused is not None:
             self._refusals("published plan", refused)
 
@@ -210,8 +211,11 @@ class ControllerNode(Node):
         """Start tracking and wait (without blocking the executor) until the control loop ends
         the maneuver; feedback and cancellation are handled by the control loop."""
         goal = goal_handle.request
-        inline = convert.plan_from_msg(goal.plan) if goal.use_inline_plan else None
-        plan, refused = self._core.resolve(goal.plan_id, inline, signing.payload(goal.plan) if inline else b"")
+        refused = check_message(goal.plan) if goal.use_inline_plan else None
+        plan = None
+        if refused is None:
+            inline = convert.plan_from_msg(goal.plan) if goal.use_inline_plan else None
+            plan, refused = self._core.resolve(goal.plan_id, inline, signing.payload(goal.plan) if inline else b"")
         if plan is not None:
             refused = self._core.start(plan, convert.pointing_from_msg(goal.pointing_after) if goal.point_after
                                        else None)
