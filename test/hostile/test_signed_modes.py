@@ -38,3 +38,18 @@ def test_with_signed_modes_required_only_the_ground_key_changes_the_mode(ros_sui
         assert refused.error_code == ErrorCode.MODE_NOT_AUTHENTIC and "ahead" in refused.message
         assert record.exists()
         assert client.set_mode(ControlMode.IDLE).success                 # default key file: signed
+
+
+def test_an_accepted_request_replayed_after_a_controller_restart_is_refused(ros_suite, tmp_path):
+    params = {"controller": {"require_signed_modes": True, "state_source": "truth",
+                             "mode_sequence_file": str(tmp_path / "mode_sequences.json")}}
+    recorded = SetControllerMode.Request(mode=ControlMode.SAFE, sequence=time.time_ns())
+    signing.sign(recorded, signing.load_private_key(signing.default_key_dir() / signing.PRIVATE_NAME))
+    with ros_suite("swift_demo", nodes=("controller",), name="signed_modes_before", params=params) as s:
+        assert s.client.mode_client.wait_for_service(timeout_sec=30)
+        assert s.client._call(s.client.mode_client, recorded, 10).success
+    with ros_suite("swift_demo", nodes=("controller",), name="signed_modes_after", params=params) as s:
+        assert s.client.mode_client.wait_for_service(timeout_sec=30)
+        replayed = s.client._call(s.client.mode_client, recorded, 10)
+        assert replayed.error_code == ErrorCode.MODE_NOT_AUTHENTIC and "replayed" in replayed.message
+        assert s.client.set_mode(ControlMode.IDLE).success              # a fresh request still works
