@@ -1,7 +1,8 @@
 """What the controller checks before it keeps or flies a plan (no ROS).
 
 :func:`check_plan` looks at every field of a received plan (cached from ``/planner/plans`` or
-inline in an ``ExecuteManeuver`` goal): sizes and lengths against each other, finiteness, unit
+inline in an ``ExecuteManeuver`` goal), and :func:`check_message` at the message's ``duration``
+before conversion: sizes and lengths against each other, finiteness, unit
 quaternions, times from 0 strictly increasing and bounded, controls within the spacecraft's
 limits, known vocabularies, bounded strings, its zones (:func:`att_msgs_py.validation.zone`: known
 body, unit axes, half-angle range, an inertial zone's direction) and its epoch (within
@@ -31,6 +32,7 @@ from att_sim.models.dynamics import Spacecraft
 LIMIT_TOLERANCE = 1e-6       # relative: plan controls may touch their limit, not exceed it
 MAX_PLAN_RATE = 10.0         # rad/s, any body axis: beyond it a plan is not a slew
 MAX_CONES = 16
+DURATION_TOLERANCE = 1e-9   # relative: a plan's stated duration against the span of its times
 MAX_ZONES = 16               # zones besides the cones: the planner service's cap (att_planner.service.real_sky)
 
 
@@ -77,6 +79,7 @@ def _fields(plan: Plan, sc: Spacecraft, frame_id: str) -> Plan:
     for name, a in (("attitudes", plan.q), ("rates", plan.omega), ("torques", plan.torque)):
         if len(a) != k:
             raise RequestError(code, f"plan.{name} has {len(a)} entries for {k} times")
+    validation.number(plan.wall_time, "plan.solve_seconds", code, 0.0)
     t = validation.finite_array(plan.t, "plan.times", code, (-1,))
     if t[0] != 0.0:
         raise RequestError(code, f"plan.times[0] = {t[0]!r}; a plan starts at 0")
@@ -133,6 +136,24 @@ def _zones(plan: Plan) -> tuple[list, datetime | None]:
         raise RequestError(code, f"plan.zones[{moving}] ('{zones[moving].name}') moves with the sky (body "
                                  f"{zones[moving].body}) but plan.epoch is zero: a moving zone needs the epoch")
     return zones, epoch
+
+
+def check_message(msg) -> RequestError | None:
+    """Why a ``ManeuverPlan`` message (published or inline) contradicts itself in a field that
+    :class:`~att_msgs_py.types.Plan` does not carry: its ``duration`` must be finite and equal to
+    ``times[-1] - times[0]`` (relative tolerance :data:`DURATION_TOLERANCE`). Checked before the
+    message is converted; :func:`check_plan` checks the rest."""
+    times = msg.times
+    if not 0 < len(times) <= validation.MAX_PLAN_SAMPLES:
+        return None                                   # check_plan refuses the sample count
+    span = float(times[-1]) - float(times[0])
+    stated = float(msg.duration)
+    if not (math.isfinite(stated) and math.isfinite(span)
+            and abs(stated - span) <= DURATION_TOLERANCE * max(1.0, abs(span))):
+        return RequestError(ErrorCode.INVALID_PLAN,
+                            f"plan.duration = {stated!r} s contradicts plan.times, which span {span!r} s "
+                            f"(from {float(times[0])!r} to {float(times[-1])!r})")
+    return None
 
 
 def check_plan(plan: Plan, payload: bytes, ctx: PlanContext) -> RequestError | None:

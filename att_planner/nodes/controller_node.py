@@ -12,7 +12,9 @@ Nothing received is trusted (the core's checks, :mod:`att_planner.control.plan_c
 :mod:`att_planner.control.state_gate`): a refused state or plan is logged (at most once a second
 per kind, clipped, with a running count) and changes nothing. Plans must verify against the
 Ed25519 public key ``plan_public_key`` (:mod:`att_msgs_py.signing`); with ``require_signed_modes``
-mode requests must verify against ``mode_public_key`` and carry an increasing sequence number.
+mode requests must verify against ``mode_public_key`` and carry an increasing sequence number
+(the signer's wall clock in ns, at most ``mode_sequence_ahead`` s ahead of the controller's), the
+last accepted one kept in ``mode_sequence_file`` (:mod:`att_planner.control.mode_authentication`).
 
 Sim time comes from the states' stamps. ``/clock`` is read by the node itself, not through
 rclpy's ``use_sim_time`` (whose time source raises on a negative stamp, so one hostile message
@@ -56,6 +58,8 @@ from att_msgs_py.node_runner import (
 )
 from att_msgs_py.types import ManeuverResult
 from att_planner.control.controller_from_scenario import controller_from_scenario, public_key
+from att_planner.control.mode_authentication import MAX_AHEAD, ModeAuthentication, default_sequence_path
+from att_planner.control.plan_checks import check_message
 from att_planner.estimation.inputs import Sources
 from att_sim.models import scenario as scen
 
@@ -70,8 +74,13 @@ class ControllerNode(Node):
         wait_for_subscribers = param("wait_for_subscribers", 0, 0, 1000)
         start_timeout = param("start_timeout", 60.0, 0.0, 3600.0, low_open=True)
         if param("require_signed_modes", False):
-            self._core.mode_key = public_key(param, "mode_public_key")
+            self._core.authentication = ModeAuthentication(
+                public_key(param, "mode_public_key"),
+                param("mode_sequence_file", str(default_sequence_path())),
+                param("mode_sequence_ahead", MAX_AHEAD, 0.0, 86_400.0, low_open=True))
         param.refuse_unknown()
+        if self._core.authentication.warning:
+            self.get_logger().warning(self._core.authentication.warning)
         self._state_wall = time.monotonic()   # no "no state" warning before wall_timeout has passed
         self._stale = False
         self._refusals = RefusalLog(self.get_logger())   # refused inputs, logged once a second per kind
@@ -168,7 +177,7 @@ class ControllerNode(Node):
                 self.finish(out.result)
 
     def on_plan(self, msg: ManeuverPlan):
-        refused = self._core.receive_plan(convert.plan_from_msg(msg), signing.payload(msg))
+        refused = check_message(msg) or self._core.receive_plan(convert.plan_from_msg(msg), signing.payload(msg))
         if refused is not None:
             self._refusals("published plan", refused)
 
@@ -202,8 +211,11 @@ class ControllerNode(Node):
         """Start tracking and wait (without blocking the executor) until the control loop ends
         the maneuver; feedback and cancellation are handled by the control loop."""
         goal = goal_handle.request
-        inline = convert.plan_from_msg(goal.plan) if goal.use_inline_plan else None
-        plan, refused = self._core.resolve(goal.plan_id, inline, signing.payload(goal.plan) if inline else b"")
+        refused = check_message(goal.plan) if goal.use_inline_plan else None
+        plan = None
+        if refused is None:
+            inline = convert.plan_from_msg(goal.plan) if goal.use_inline_plan else None
+            plan, refused = self._core.resolve(goal.plan_id, inline, signing.payload(goal.plan) if inline else b"")
         if plan is not None:
             refused = self._core.start(plan, convert.pointing_from_msg(goal.pointing_after) if goal.point_after
                                        else None)

@@ -46,6 +46,33 @@ class Refusal(NamedTuple):
     message: str
 
 
+class CommandSource:
+    """The publisher whose actuator commands are applied, held as the controller holds the
+    publisher of its states: the first one accepted is kept while it lives, and a command from
+    another publisher is refused until the held one has sent no accepted command for ``timeout``
+    s of sim time (gone: its inputs are zeroed by then), never merely because it is late.
+    ``None`` sources (a middleware that does not say) are not compared."""
+
+    def __init__(self, timeout: float):
+        self.timeout = timeout
+        self.source: bytes | None = None   # the held publisher
+        self.last_t = -math.inf             # sim time of its last accepted command
+
+    def check(self, source: bytes | None, t: float) -> Refusal | None:
+        """Why a command from ``source`` at sim time ``t`` may not be applied (None: it may)."""
+        if source is None or self.source is None or source == self.source or t - self.last_t > self.timeout:
+            return None
+        return Refusal(ErrorCode.INVALID_COMMAND,
+                       f"command from a second publisher while the first one is alive (its last command accepted "
+                       f"{t - self.last_t:.3g} s ago, at most command_timeout = {self.timeout:g} s); ignored")
+
+    def accept(self, source: bytes | None, t: float) -> None:
+        """Remember an applied command from ``source`` at sim time ``t``."""
+        if source is not None:
+            self.source = source
+        self.last_t = t
+
+
 @dataclass(frozen=True)
 class Checks:
     """What a command or reset must satisfy. The simulator node sets every field from its

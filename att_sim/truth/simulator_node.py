@@ -30,7 +30,9 @@ each is type- and range-checked, and a bad one stops the node with one line on s
 
 Safety: every command and reset is checked by :class:`~att_sim.truth.simulation.Simulation` (sizes,
 NaN/Inf, magnitude against ``command_limit_factor`` × the limits, stamp, frame, text); a refused one
-is never integrated and is logged at most once a second with the running count. When no valid
+is never integrated and is logged at most once a second with the running count. Commands are held
+to their publisher (:class:`~att_sim.truth.simulation.CommandSource`): one from a second publisher
+is refused while the first one has had a command accepted within ``command_timeout`` s of sim time. When no valid
 command arrived for ``command_timeout`` s of sim time the actuator inputs are zeroed and the state
 says so. In lockstep, a state that no command answers within ``lockstep_timeout`` s of wall time
 ends the waiting: the simulator free-runs at its real-time factor with zero inputs
@@ -62,7 +64,7 @@ from att_msgs_py.node_runner import parameter_reader, publisher_of, run_node, sp
 from att_sim.models import scenario as scen
 from att_sim.models import scene
 from att_sim.truth import dispersions
-from att_sim.truth.simulation import DEFAULT_STEP, Checks, Refusal, Simulation
+from att_sim.truth.simulation import DEFAULT_STEP, Checks, CommandSource, Refusal, Simulation
 
 FREE_RUN_PACE = 1.0        # real-time factor of a free-running simulator whose real_time_factor is 0 (max)
 
@@ -75,7 +77,6 @@ class SimulatorNode(Node):
         self.answered = False
         self.awaited_stamp = 0.0
         self.free_running = False      # lockstep suspended: no command answered a state in time
-        self.command_source = None     # publisher of the last accepted command
         self.pace = (0.0, 0.0)         # (wall, sim) time the real-time pacing counts from
         self.last_command_time = -np.inf
         self.refused = {"command": 0, "reset": 0}
@@ -87,6 +88,7 @@ class SimulatorNode(Node):
                 checks=Checks(command_limit_factor=param["command_limit_factor"],
                               max_reset_rate=param["max_reset_rate"], body_frame_id=self.scenario.body_frame_id,
                               stamp_ahead=self.step, stamp_age=self.command_timeout), seed=truth.seed)
+            self.commands = CommandSource(self.command_timeout)   # the publisher whose commands are applied
         except ValueError as err:        # the environment cannot start (e.g. a TLE that fails at t = 0)
             raise ConfigError(ErrorCode.INVALID_CONFIG, f"scenario '{self.scenario.name}': {clip(err, 300)}") from None
 
@@ -201,17 +203,17 @@ class SimulatorNode(Node):
     def on_command(self, msg: ActuatorCommand, info: dict):
         command = convert.command_from_msg(msg)
         source = publisher_of(info)
-        refusal = self.sim.set_command(command)
+        refusal = self.commands.check(source, self.sim.t) or self.sim.set_command(command)
         if refusal is not None:
             self.report("command", refusal)
-            if self.free_running and source is not None and source == self.command_source and \
+            if self.free_running and source is not None and source == self.commands.source and \
                     self.sim.late_only(command):
                 self.free_running = False        # the controller lives but lags: wait for it to catch up
                 self.get_logger().info(f"a late command (t = {command.t:.3f} s) from the controller at t = "
                                        f"{self.sim.t:.3f} s: waiting for it to catch up", throttle_duration_sec=1.0)
             return
         self.last_command_time = self.sim.t
-        self.command_source = source
+        self.commands.accept(source, self.sim.t)
         if command.t >= self.awaited_stamp - 1e-9:
             self.answered = True
         if self.free_running:
