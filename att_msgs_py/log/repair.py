@@ -29,6 +29,7 @@ from mcap.records import (
     Channel,
     Chunk,
     ChunkIndex,
+    DataEnd,
     Footer,
     Header,
     Message,
@@ -47,6 +48,10 @@ DAMAGE = (McapError, ValueError, EOFError, struct.error, zstandard.ZstdError, Ru
           KeyError, IndexError)
 KEPT = (Header, Schema, Channel, Message, Attachment, Metadata)
 _OPCODES = frozenset(int(o) for o in Opcode)
+# what the summary section (after the data end) may hold; a data record there is a damaged opcode
+_SUMMARY_OPCODES = frozenset(int(o) for o in (Opcode.SCHEMA, Opcode.CHANNEL, Opcode.CHUNK_INDEX,
+                                               Opcode.ATTACHMENT_INDEX, Opcode.METADATA_INDEX, Opcode.STATISTICS,
+                                               Opcode.SUMMARY_OFFSET, Opcode.FOOTER))
 
 
 class LogFileError(ValueError):
@@ -86,12 +91,20 @@ class Scan:
 
 
 class _StrictReader(StreamReader):
-    """mcap's stream reader that refuses a record of an unknown opcode instead of skipping it."""
+    """mcap's stream reader that refuses a record of an unknown opcode instead of skipping it, and
+    after the data end any record the summary section cannot hold (a flipped opcode there would
+    turn a summary's channel into a message outside any CRC)."""
+
+    _in_summary = False
 
     def _read_record(self, opcode: int, length: int):
         if opcode not in _OPCODES:
             raise ValueError(f"record of unknown opcode 0x{opcode:02x}")
-        return super()._read_record(opcode, length)
+        if self._in_summary and opcode not in _SUMMARY_OPCODES:
+            raise ValueError(f"a {Opcode(opcode).name.lower()} record after the data end")
+        record = super()._read_record(opcode, length)
+        self._in_summary = self._in_summary or isinstance(record, DataEnd)
+        return record
 
 
 class _Bounded:
@@ -155,6 +168,15 @@ def _check_channels(scan: Scan, records: list) -> None:
             raise KeyError(f"message on channel {r.channel_id}, which no channel record defines")
 
 
+def _check_summary_copy(scan: Scan, record) -> None:
+    """ValueError for a summary's schema or channel that differs from the data section's record of
+    its id (the summary has no CRC the reader checks before it is used; a difference is a damaged
+    byte). One of an id the data section lacks (a writer that wrote no chunk holding it) is kept."""
+    known = scan.schemas if isinstance(record, Schema) else scan.channels
+    if record.id in known and known[record.id] != record:
+        raise ValueError(f"the summary's {type(record).__name__.lower()} {record.id} differs from the data section's")
+
+
 def _take(scan: Scan, record) -> bool:
     """Account for one record; True when it is to be passed on."""
     if isinstance(record, Header):
@@ -190,8 +212,8 @@ def scan_records(path: str | Path, scan: Scan | None = None) -> Iterator:
     scan.path, scan.size, scan.good_bytes = path, size, len(MAGIC)
     with open(path, "rb") as fh:
         view = _Bounded(fh, size)
-        records = _StrictReader(view, emit_chunks=True, record_size_limit=None).records
-        footer, start = False, len(MAGIC)
+        records = _StrictReader(view, emit_chunks=True, validate_crcs=True, record_size_limit=None).records
+        footer, summary, start = False, False, len(MAGIC)
         while True:
             try:
                 record = next(records)
@@ -199,6 +221,8 @@ def scan_records(path: str | Path, scan: Scan | None = None) -> Iterator:
                     raise ValueError(f"the first record is a {type(record).__name__}, not a header")
                 inner = _chunk_records(record) if isinstance(record, Chunk) else [record]
                 _check_channels(scan, inner)
+                if summary and isinstance(record, (Schema, Channel)):
+                    _check_summary_copy(scan, record)
             except StopIteration:
                 scan.complete, scan.good_bytes = footer, view.pos
                 return
@@ -208,6 +232,7 @@ def scan_records(path: str | Path, scan: Scan | None = None) -> Iterator:
             passed = [r for r in inner if _take(scan, r)]
             scan.chunks += isinstance(record, Chunk)
             footer = footer or isinstance(record, Footer)
+            summary = summary or isinstance(record, DataEnd)
             start = scan.good_bytes = view.pos
             yield from passed
 
