@@ -2,7 +2,8 @@
 
 Like ``ros2 bag play`` (not available from PyPI): every recorded message is republished as its
 raw CDR bytes (rclpy ``Publisher.publish`` takes serialized bytes), with its original type
-(``topics.message_class`` of the channel's schema name) and the recorded QoS
+(``topics.message_class`` of the channel's schema name, resolved only for the suite's interface
+packages: :func:`interface_type`) and the recorded QoS
 (reliability and durability; the history depth is raised to the topic's message count, at least
 1000: a keep-last writer overwrites what a slow reliable reader has not acknowledged, and at
 ``--rate 0`` on a loaded machine a depth of 1000 lost 19 of 1547 wheel-speed messages).
