@@ -289,14 +289,25 @@ HOSTILE_NAMES = ["/a\x1b[2J\x1b]0;pwned\x07", "/b\r\n/fake 1", "/c\x00\x7f\x9b31
 @pytest.mark.parametrize("topic", HOSTILE_NAMES)
 def test_file_provided_names_reach_the_terminal_escaped(tmp_path, capsys, topic):
     """Topic, type, profile and library strings of a file are printed with their control characters
-    escaped by ``att-log info``, and ``att-replay`` refuses such a topic naming it escaped."""
+    escaped by ``att-log info``, ``att-replay`` refuses such a topic naming it escaped, and neither
+    ``att-log repair`` nor ``att-review`` prints them raw."""
     from att_msgs_py.log import replay
     from att_msgs_py.log.cli import main as att_log
+    from att_planner.tools.review import main as att_review
+
+    def assert_escaped(text: str) -> None:
+        assert not any((ord(c) < 0x20 and c != "\n") or 0x7f <= ord(c) < 0xa0 for c in text), repr(text)
 
     path = hostile_log(tmp_path / "names.mcap", topic=topic, type_name="std_msgs/msg/Empty\x1b[1m")
     assert att_log(["info", str(path)]) in (0, 1)
+    printed = capsys.readouterr()
+    assert_escaped(printed.out + printed.err)
+    assert "\\x1b" in printed.out
     assert replay.main([str(path), "--wait", "0", "--linger", "0"]) == 2
     printed = capsys.readouterr()
-    for text in (printed.out, printed.err):
-        assert not any((ord(c) < 0x20 and c != "\n") or 0x7f <= ord(c) < 0xa0 for c in text), repr(text)
-    assert "\\x1b" in printed.out and printed.err.count("\n") == 1
+    assert_escaped(printed.out + printed.err)
+    assert printed.err.count("\n") == 1 and "is not a ROS topic name" in printed.err, printed.err
+    assert att_log(["repair", str(path), "-o", str(tmp_path / "out.mcap")]) == 0
+    assert att_review([str(path), "--out", str(tmp_path / "review")]) == 1     # no state to review
+    printed = capsys.readouterr()
+    assert_escaped(printed.out + printed.err)
