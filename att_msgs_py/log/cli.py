@@ -10,8 +10,10 @@ schemas, channels (with their QoS metadata) and every message that was whole on 
 byte, with its log time, publish time and sequence (see :mod:`att_msgs_py.log.repair`). The default
 output is ``IN.repaired.mcap``; the input is never overwritten except with ``--in-place``, and every
 output is written to a temporary file and renamed once it reads back whole. A complete input is
-copied without loss and reported as complete. Exit 0 when the output was written, 2 when the input
-is not MCAP or holds nothing to recover.
+copied without loss and reported as complete. Exit 0 when the output was written, 1 when it was
+written but the input held a damaged record (named on stderr with its byte offset: what follows it
+is lost), 2 when the input is not MCAP or holds nothing to recover. Strings from the file (topic,
+type, profile, library) are printed with their control characters escaped.
 """
 from __future__ import annotations
 
@@ -19,7 +21,7 @@ import argparse
 import sys
 from datetime import UTC, datetime
 
-from att_msgs_py.log.repair import LogFileError, Scan, repair, scan_records
+from att_msgs_py.log.repair import LogFileError, Scan, printable, repair, scan_records
 
 
 def _stamp(ns: int) -> str:
@@ -43,14 +45,16 @@ def status(scan: Scan) -> str:
 
 
 def info_lines(scan: Scan) -> list[str]:
-    lines = [f"{scan.path}: {scan.size} bytes, profile '{scan.profile}', library '{scan.library}'",
+    lines = [f"{scan.path}: {scan.size} bytes, profile '{printable(scan.profile)}', "
+             f"library '{printable(scan.library)}'",
              f"status    {status(scan)}",
              f"messages  {scan.messages} on {len(scan.channels)} channels, {time_range(scan)}"]
-    width = max((len(c.topic) for c in scan.channels.values()), default=0)
+    topics = {cid: printable(c.topic) for cid, c in scan.channels.items()}
+    width = max((len(t) for t in topics.values()), default=0)
     for cid, channel in scan.channels.items():
         schema = scan.schemas.get(channel.schema_id)
-        type_name = schema.name if schema is not None else "(no schema)"
-        lines.append(f"  {channel.topic:<{width}}  {type_name:<40} {scan.counts[cid]:>8}")
+        type_name = printable(schema.name) if schema is not None else "(no schema)"
+        lines.append(f"  {topics[cid]:<{width}}  {type_name:<40} {scan.counts[cid]:>8}")
     return lines
 
 
@@ -61,6 +65,8 @@ def info(path: str) -> int:
     if not scan.header:
         raise LogFileError(f"{path}: {scan.problem}; nothing to recover")
     print("\n".join(info_lines(scan)))
+    if scan.damaged:
+        print(f"att-log: {path}: {scan.problem}", file=sys.stderr)
     return 0 if scan.indexed else 1
 
 
@@ -71,9 +77,13 @@ def repair_command(path: str, output: str | None, in_place: bool) -> int:
     if src.indexed:
         print(f"{path} was complete and indexed: copied {topics} to {done.output}")
     else:
-        print(f"{path} was {'complete but not indexed' if src.complete else 'incomplete: ' + src.problem}")
+        print(f"{path} was {'complete but not indexed' if src.complete else 'incomplete: ' + printable(src.problem)}")
         print(f"recovered {topics}; {src.dropped_bytes} bytes after the last whole record dropped")
         print(f"wrote {done.output}: {status(out)}")
+    if src.damaged:
+        print(f"att-log: {path}: {src.problem}; the {out.messages} messages before it were recovered",
+              file=sys.stderr)
+        return 1
     return 0
 
 

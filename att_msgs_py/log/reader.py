@@ -11,11 +11,10 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
-from mcap.reader import make_reader
 from mcap_ros2.decoder import DecoderFactory
 
 from att_msgs_py import topics as suite_topics
-from att_msgs_py.log.repair import DAMAGE, salvaged_messages
+from att_msgs_py.log.repair import LogFileError, Scan, printable, salvaged_messages
 
 
 @dataclass
@@ -79,20 +78,20 @@ def _stack(values: list):
 
 
 def iter_records(path: str | Path):
-    """(schema, channel, message) of every message, in log-time order for a complete, indexed file;
-    a file whose writer was killed is read in file order up to its last whole record
-    (:func:`~att_msgs_py.log.repair.salvaged_messages`)."""
-    with open(path, "rb") as fh:
-        try:
-            reader = make_reader(fh)
-            summary = reader.get_summary()
-            indexed = summary is not None and bool(summary.chunk_indexes)
-        except DAMAGE:
-            indexed = False
-        if indexed:
-            yield from reader.iter_messages(log_time_order=True)
-            return
-    yield from salvaged_messages(path)
+    """(schema, channel, message) of every message, in log-time order for a complete file; a file
+    whose writer was killed is read in file order up to its last whole record. Every file is read by
+    :func:`~att_msgs_py.log.repair.salvaged_messages` (CRCs checked, decompression bounded):
+    :class:`~att_msgs_py.log.repair.LogFileError` (one line: the problem and its byte offset) for a
+    file that is not MCAP, holds no whole header, or has a damaged record before its end."""
+    scan = Scan(Path(path), 0)
+    records = list(salvaged_messages(path, scan))
+    if not scan.header:
+        raise LogFileError(f"{printable(path)}: {scan.problem or 'no header record'}; nothing to read")
+    if scan.damaged:
+        raise LogFileError(f"{printable(path)}: {scan.problem}")
+    if scan.complete:
+        records.sort(key=lambda r: r[2].log_time)        # stable: the file order of equal times
+    yield from records
 
 
 def read_log(path: str | Path, topics: list[str] | None = None,

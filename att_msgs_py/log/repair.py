@@ -15,6 +15,7 @@ short is dropped: the recorder flushes a chunk at least every 0.5 s, so that is 
 """
 from __future__ import annotations
 
+import io
 import os
 import struct
 from collections.abc import Iterator
@@ -29,6 +30,7 @@ from mcap.records import (
     Channel,
     Chunk,
     ChunkIndex,
+    DataEnd,
     Footer,
     Header,
     Message,
@@ -41,16 +43,28 @@ from mcap.writer import CompressionType, Writer
 
 MAGIC = b"\x89MCAP0\r\n"
 CHUNK_SIZE = 256 * 1024
-MAX_CHUNK_BYTES = 1 << 30          # an uncompressed chunk claiming more is damaged
+MAX_CHUNK_BYTES = 64 << 20         # a chunk claiming or inflating to more is refused before it is inflated
 # what a cut or damaged record raises inside mcap's readers and decompressors
 DAMAGE = (McapError, ValueError, EOFError, struct.error, zstandard.ZstdError, RuntimeError, MemoryError,
-          KeyError, IndexError)
+          KeyError, IndexError, OverflowError)
 KEPT = (Header, Schema, Channel, Message, Attachment, Metadata)
 _OPCODES = frozenset(int(o) for o in Opcode)
+# what the summary section (after the data end) may hold; a data record there is a damaged opcode
+_SUMMARY_OPCODES = frozenset(int(o) for o in (Opcode.SCHEMA, Opcode.CHANNEL, Opcode.CHUNK_INDEX,
+                                               Opcode.ATTACHMENT_INDEX, Opcode.METADATA_INDEX, Opcode.STATISTICS,
+                                               Opcode.SUMMARY_OFFSET, Opcode.FOOTER))
 
 
 class LogFileError(ValueError):
     """A file that is not an MCAP log, or holds nothing that can be recovered."""
+
+
+def printable(text: str, limit: int = 200) -> str:
+    """``text`` safe to print to a terminal: control characters (C0, DEL, C1) and other
+    non-printable ones escaped as ``\\xNN``/``\\uNNNN``, at most ``limit`` characters kept."""
+    out = "".join(c if c.isprintable() else f"\\x{ord(c):02x}" if ord(c) < 0x100 else f"\\u{ord(c):04x}"
+                  for c in str(text)[:limit])
+    return out + ("..." if len(str(text)) > limit else "")
 
 
 @dataclass
@@ -76,6 +90,11 @@ class Scan:
     problem: str = ""            # why reading stopped before the end ("" when complete)
 
     @property
+    def damaged(self) -> bool:
+        """Reading stopped at a damaged or hostile record (not merely at a cut end)."""
+        return self.problem.startswith("damaged record")
+
+    @property
     def indexed(self) -> bool:
         """Complete with a summary: statistics, and a chunk index per chunk."""
         return self.complete and self.statistics is not None and self.chunk_indexes == self.chunks
@@ -86,12 +105,20 @@ class Scan:
 
 
 class _StrictReader(StreamReader):
-    """mcap's stream reader that refuses a record of an unknown opcode instead of skipping it."""
+    """mcap's stream reader that refuses a record of an unknown opcode instead of skipping it, and
+    after the data end any record the summary section cannot hold (a flipped opcode there would
+    turn a summary's channel into a message outside any CRC)."""
+
+    _in_summary = False
 
     def _read_record(self, opcode: int, length: int):
         if opcode not in _OPCODES:
             raise ValueError(f"record of unknown opcode 0x{opcode:02x}")
-        return super()._read_record(opcode, length)
+        if self._in_summary and opcode not in _SUMMARY_OPCODES:
+            raise ValueError(f"a {Opcode(opcode).name.lower()} record after the data end")
+        record = super()._read_record(opcode, length)
+        self._in_summary = self._in_summary or isinstance(record, DataEnd)
+        return record
 
 
 class _Bounded:
@@ -124,25 +151,58 @@ def check_magic(path: str | Path) -> int:
     return size
 
 
+def _inflate(chunk: Chunk) -> bytes:
+    """A chunk's records, decompressed into at most its claimed size (itself at most
+    :data:`MAX_CHUNK_BYTES`): a frame that claims or inflates to more is refused before, or as soon
+    as, it passes the claim, so a decompression bomb never allocates more than the bound."""
+    size = chunk.uncompressed_size
+    if size > MAX_CHUNK_BYTES:
+        raise ValueError(f"chunk claims {size} uncompressed bytes (at most {MAX_CHUNK_BYTES} are read)")
+    if chunk.compression == "":
+        data = chunk.data
+    elif chunk.compression == "zstd":
+        content = zstandard.frame_content_size(chunk.data)
+        if content not in (-1, size):
+            raise ValueError(f"zstd frame of {content} bytes in a chunk of {size}")
+        data = bytearray()
+        with zstandard.ZstdDecompressor().stream_reader(io.BytesIO(chunk.data)) as reader:
+            while len(data) <= size and (piece := reader.read(size + 1 - len(data))):
+                data += piece
+        data = bytes(data)
+    elif chunk.compression == "lz4":
+        import lz4.frame
+
+        inflater = lz4.frame.LZ4FrameDecompressor()
+        data = inflater.decompress(chunk.data, max_length=size + 1)
+    else:
+        raise ValueError(f"chunk compressed with '{printable(chunk.compression, 20)}', not zstd, lz4 or none")
+    if len(data) != size:
+        raise ValueError(f"chunk inflates to {'more than ' if len(data) > size else ''}{len(data)} bytes, "
+                         f"not the {size} it claims")
+    return data
+
+
 def _chunk_records(chunk: Chunk) -> list:
     """The records of a chunk, its CRC checked; DAMAGE for a chunk that does not decode."""
-    if chunk.uncompressed_size > MAX_CHUNK_BYTES:
-        raise ValueError(f"chunk claims {chunk.uncompressed_size} uncompressed bytes")
-    if chunk.compression == "zstd":
-        content = zstandard.frame_content_size(chunk.data)
-        if content not in (-1, chunk.uncompressed_size):
-            raise ValueError(f"zstd frame of {content} bytes in a chunk of {chunk.uncompressed_size}")
-    return breakup_chunk(chunk, validate_crc=True)
+    data = _inflate(chunk)
+    plain = Chunk(compression="", data=data, message_end_time=chunk.message_end_time,
+                  message_start_time=chunk.message_start_time, uncompressed_crc=chunk.uncompressed_crc,
+                  uncompressed_size=chunk.uncompressed_size)
+    return breakup_chunk(plain, validate_crc=True)
 
 
-def _problem(exc: Exception, start: int, end: int, size: int, footer: bool) -> str:
+def _problem(exc: Exception, start: int, end: int, size: int, footer: bool, whole: bool) -> str:
+    """Why reading stopped at the record starting at ``start``; ``whole``: the record was read to
+    its end (so it is damaged or hostile, not cut)."""
     if footer:
-        return f"the closing magic after the footer is missing or wrong ({exc})"
+        return f"the closing magic after the footer is missing or wrong ({printable(exc)})"
+    if whole:
+        return f"damaged record at byte {start}: {printable(exc)}"
     if start >= size:
         return "no data end, summary or footer after the last complete record (the writer did not finish)"
     if end >= size:
         return f"the last record (at byte {start}) is cut short: its writer was stopped while writing it"
-    return f"damaged record at byte {start}: {exc}"
+    return f"damaged record at byte {start}: {printable(exc)}"
 
 
 def _check_channels(scan: Scan, records: list) -> None:
@@ -153,6 +213,15 @@ def _check_channels(scan: Scan, records: list) -> None:
             known.add(r.id)
         elif isinstance(r, Message) and r.channel_id not in known:
             raise KeyError(f"message on channel {r.channel_id}, which no channel record defines")
+
+
+def _check_summary_copy(scan: Scan, record) -> None:
+    """ValueError for a summary's schema or channel that differs from the data section's record of
+    its id (the summary has no CRC the reader checks before it is used; a difference is a damaged
+    byte). One of an id the data section lacks (a writer that wrote no chunk holding it) is kept."""
+    known = scan.schemas if isinstance(record, Schema) else scan.channels
+    if record.id in known and known[record.id] != record:
+        raise ValueError(f"the summary's {type(record).__name__.lower()} {record.id} differs from the data section's")
 
 
 def _take(scan: Scan, record) -> bool:
@@ -190,31 +259,37 @@ def scan_records(path: str | Path, scan: Scan | None = None) -> Iterator:
     scan.path, scan.size, scan.good_bytes = path, size, len(MAGIC)
     with open(path, "rb") as fh:
         view = _Bounded(fh, size)
-        records = _StrictReader(view, emit_chunks=True, record_size_limit=None).records
-        footer, start = False, len(MAGIC)
+        records = _StrictReader(view, emit_chunks=True, validate_crcs=True, record_size_limit=None).records
+        footer, summary, start = False, False, len(MAGIC)
         while True:
+            whole = False
             try:
                 record = next(records)
+                whole = True
                 if not scan.header and not isinstance(record, Header):
                     raise ValueError(f"the first record is a {type(record).__name__}, not a header")
                 inner = _chunk_records(record) if isinstance(record, Chunk) else [record]
                 _check_channels(scan, inner)
+                if summary and isinstance(record, (Schema, Channel)):
+                    _check_summary_copy(scan, record)
             except StopIteration:
                 scan.complete, scan.good_bytes = footer, view.pos
                 return
             except DAMAGE as exc:
-                scan.problem = _problem(exc, start, view.pos, size, footer)
+                scan.problem = _problem(exc, start, view.pos, size, footer, whole)
                 return
             passed = [r for r in inner if _take(scan, r)]
             scan.chunks += isinstance(record, Chunk)
             footer = footer or isinstance(record, Footer)
+            summary = summary or isinstance(record, DataEnd)
             start = scan.good_bytes = view.pos
             yield from passed
 
 
-def salvaged_messages(path: str | Path) -> Iterator[tuple[Schema | None, Channel, Message]]:
-    """(schema, channel, message) of every message :func:`scan_records` reads, in file order."""
-    scan = Scan(Path(path), 0)
+def salvaged_messages(path: str | Path, scan: Scan | None = None) -> Iterator[tuple[Schema | None, Channel, Message]]:
+    """(schema, channel, message) of every message :func:`scan_records` reads, in file order;
+    ``scan`` is filled as the file is read."""
+    scan = scan if scan is not None else Scan(Path(path), 0)
     for record in scan_records(path, scan):
         if isinstance(record, Message):
             channel = scan.channels[record.channel_id]

@@ -2,7 +2,8 @@
 
 Like ``ros2 bag play`` (not available from PyPI): every recorded message is republished as its
 raw CDR bytes (rclpy ``Publisher.publish`` takes serialized bytes), with its original type
-(``topics.message_class`` of the channel's schema name) and the recorded QoS
+(``topics.message_class`` of the channel's schema name, resolved only for the suite's interface
+packages: :func:`interface_type`) and the recorded QoS
 (reliability and durability; the history depth is raised to the topic's message count, at least
 1000: a keep-last writer overwrites what a slow reliable reader has not acknowledged, and at
 ``--rate 0`` on a loaded machine a depth of 1000 lost 19 of 1547 wheel-speed messages).
@@ -34,6 +35,7 @@ from pathlib import Path
 
 from att_msgs_py import topics as suite_topics
 from att_msgs_py.log.reader import iter_records
+from att_msgs_py.log.repair import printable
 
 CLOCK = suite_topics.CLOCK
 CLOCK_TYPE = suite_topics.RECORDED[CLOCK]
@@ -43,6 +45,21 @@ MIN_DEPTH = 1000
 DISCOVERY_SETTLE = 2.0
 NAMESPACE = "/replay"
 NAMESPACE_PATTERN = re.compile(r"(/[A-Za-z][A-Za-z0-9_]*)+")
+TOPIC_PATTERN = re.compile(r"(/[A-Za-z_][A-Za-z0-9_]*)+")
+# the interface packages whose message types a log may name: the suite's own and the ROS ones it uses
+INTERFACE_PACKAGES = frozenset({"att_msgs", "std_msgs", "geometry_msgs", "sensor_msgs", "visualization_msgs",
+                                "tf2_msgs", "rosgraph_msgs", "builtin_interfaces"})
+TYPE_PATTERN = re.compile(r"([a-z][a-z0-9_]*)/msg/([A-Z][A-Za-z0-9]*)")
+
+
+def interface_type(topic: str, type_name: str) -> str:
+    """``type_name`` when it names a message of :data:`INTERFACE_PACKAGES` (``pkg/msg/Name``);
+    ValueError otherwise, before anything is imported: a log never chooses which module is loaded."""
+    match = TYPE_PATTERN.fullmatch(type_name)
+    if match is None or match[1] not in INTERFACE_PACKAGES:
+        raise ValueError(f"topic {printable(topic)}: type '{printable(type_name)}' is not one of the suite's "
+                         f"interface types ({', '.join(sorted(INTERFACE_PACKAGES))}/msg/...); refused")
+    return type_name
 
 
 def replayed_name(topic: str, namespace: str = NAMESPACE) -> str:
@@ -65,11 +82,17 @@ class NotDelivered(RuntimeError):
 
 
 def read_records(path: str | Path) -> tuple[list[Record], dict[str, tuple[str, str]]]:
-    """All cdr records in log-time order, and topic -> (type, QoS metadata)."""
+    """All cdr records in log-time order, and topic -> (type, QoS metadata); ValueError (one line,
+    file strings escaped) for a topic that is not a plain ROS name or a type outside the suite's
+    interface packages (:func:`interface_type`)."""
     records, channels = [], {}
     for schema, channel, message in iter_records(path):
         if schema is None or channel.message_encoding != "cdr":
             continue
+        if channel.topic not in channels:
+            if not TOPIC_PATTERN.fullmatch(channel.topic):
+                raise ValueError(f"topic '{printable(channel.topic)}' is not a ROS topic name; refused")
+            interface_type(channel.topic, schema.name)
         channels.setdefault(channel.topic, (schema.name, channel.metadata.get("offered_qos_profiles", "")))
         records.append(Record(message.log_time, channel.topic, bytes(message.data)))
     records.sort(key=lambda r: r.log_time_ns)      # stable: keeps the recorded order of equal times
@@ -209,6 +232,11 @@ def main(argv=None) -> int:
         print(f"att-replay: WARNING: --live publishes on the recorded topic names: every node on ROS_DOMAIN_ID "
               f"{os.environ.get('ROS_DOMAIN_ID', '0 (unset)')} acts on the replayed messages as if they were live",
               file=sys.stderr, flush=True)
+    try:
+        read_records(args.log)         # a damaged or hostile file is refused before ROS starts
+    except ValueError as err:
+        print(f"att-replay: {err}", file=sys.stderr)
+        return 2
     import rclpy
     from rclpy.executors import ExternalShutdownException
 

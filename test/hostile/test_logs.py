@@ -4,6 +4,7 @@ same path) makes it whole for both, every message decoded, at most a flush inter
 ``att-demo``'s domain: the user's ROS_DOMAIN_ID is honoured, a malformed one refused in one line."""
 from __future__ import annotations
 
+import ast
 import signal
 import subprocess
 import sys
@@ -144,3 +145,169 @@ def test_att_demo_refuses_a_scenario_it_cannot_run_in_one_line(tmp_path, capsys,
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and err.startswith("att-demo: ") and words in err, err
     assert list(tmp_path.iterdir()) == []                 # nothing started, nothing written
+
+
+# -- hostile and damaged files for the log tools -------------------------------------------------
+
+ATT_TOOLS = {name: Path(sys.executable).parent / name for name in ("att-log", "att-review", "att-replay")}
+BOMB_BYTES = 1 << 30                  # what the bomb chunk inflates to
+
+
+def hostile_log(path: Path, topic: str = "/a", type_name: str = "std_msgs/msg/Empty", chunk: bytes | None = None,
+                finish: bool = True) -> Path:
+    """A small MCAP (profile ros2, cdr) with one topic; ``chunk``: the raw content of a Chunk record
+    placed after the first chunk (a forged one), the file then ends there."""
+    from mcap.writer import Writer
+
+    with open(path, "wb") as fh:
+        writer = Writer(fh)
+        writer.start(profile="ros2", library="test")
+        channel = writer.register_channel(topic, "cdr", writer.register_schema(type_name, "ros2msg", b""))
+        for i in range(3):
+            writer.add_message(channel, log_time=i, data=b"\x00\x01\x00\x00\x00\x00\x00\x00", publish_time=i,
+                               sequence=i)
+        if chunk is None and finish:
+            writer.finish()
+            return path
+        writer.flush()                         # the chunk written now; no summary or footer
+    if chunk is not None:
+        with open(path, "ab") as fh:
+            fh.write(b"\x06" + len(chunk).to_bytes(8, "little") + chunk)
+    return path
+
+
+def chunk_content(data: bytes, uncompressed_size: int, compression: str) -> bytes:
+    """A Chunk record's content (times, uncompressed size, CRC 0, compression, records)."""
+    name = compression.encode()
+    return (bytes(16) + uncompressed_size.to_bytes(8, "little") + bytes(4) + len(name).to_bytes(4, "little") + name
+            + len(data).to_bytes(8, "little") + data)
+
+
+@pytest.fixture(scope="module")
+def zstd_bomb() -> bytes:
+    """A zstd frame of 1 GiB of zeros (a few tens of kB), its content size written in the frame."""
+    import zstandard
+
+    cctx = zstandard.ZstdCompressor(level=1)
+    out = bytearray()
+    zeros = bytes(1 << 24)
+    chunker = cctx.chunker(size=BOMB_BYTES, chunk_size=1 << 20)
+    for _ in range(BOMB_BYTES // len(zeros)):
+        for piece in chunker.compress(zeros):
+            out += piece
+    for piece in chunker.finish():
+        out += piece
+    return bytes(out)
+
+
+def unsized_zstd_bomb(size: int = 1 << 28) -> bytes:
+    """A zstd frame of ``size`` zeros that does not say its content size (only inflating tells)."""
+    import zstandard
+
+    writer = zstandard.ZstdCompressor(level=1, write_content_size=False).compressobj()
+    zeros = bytes(1 << 24)
+    return b"".join(writer.compress(zeros) for _ in range(size // len(zeros))) + writer.flush()
+
+
+@pytest.fixture(scope="module")
+def damaged_logs(tmp_path_factory, zstd_bomb) -> dict[str, Path]:
+    import lz4.frame
+
+    from helpers.regression_log import FIXTURE
+
+    where = tmp_path_factory.mktemp("hostile")
+    fixture = FIXTURE.read_bytes()
+    files = {"cut after 9 bytes": fixture[:9]}
+    with open(FIXTURE, "rb") as fh:
+        chunks = sorted(make_reader(fh).get_summary().chunk_indexes, key=lambda c: c.chunk_start_offset)
+    flipped = bytearray(fixture)
+    middle = chunks[len(chunks) // 2]
+    for i in range(16):
+        flipped[middle.chunk_start_offset + 9 + i * max(1, middle.chunk_length // 17)] ^= 0x5A
+    files["16 flipped bytes in a chunk"] = bytes(flipped)
+    out = {name: where / f"{i}.mcap" for i, name in enumerate(files)}
+    for name, data in files.items():
+        out[name].write_bytes(data)
+    lz4_bomb = lz4.frame.LZ4FrameCompressor(content_checksum=False)
+    frame = lz4_bomb.begin(source_size=BOMB_BYTES) + b"".join(lz4_bomb.compress(bytes(1 << 24)) for _ in range(64))
+    frame += lz4_bomb.flush()
+    for name, chunk in (("zstd bomb claimed", chunk_content(zstd_bomb, BOMB_BYTES, "zstd")),
+                        ("zstd bomb unclaimed", chunk_content(zstd_bomb, 4096, "zstd")),
+                        ("zstd bomb unsized", chunk_content(unsized_zstd_bomb(), 4096, "zstd")),
+                        ("lz4 bomb", chunk_content(frame, 4096, "lz4"))):
+        out[name] = hostile_log(where / f"{name.replace(' ', '_')}.mcap", chunk=chunk)
+    return out
+
+
+TOOL_COMMANDS = {
+    "att-log info": lambda p, out: [str(ATT_TOOLS["att-log"]), "info", str(p)],
+    "att-log repair": lambda p, out: [str(ATT_TOOLS["att-log"]), "repair", str(p), "-o", str(out / "r.mcap")],
+    "att-review": lambda p, out: [str(ATT_TOOLS["att-review"]), str(p), "--out", str(out)],
+    "att-replay": lambda p, out: [str(ATT_TOOLS["att-replay"]), str(p), "--wait", "0", "--linger", "0"],
+}
+
+
+@pytest.mark.parametrize("tool", TOOL_COMMANDS)
+@pytest.mark.parametrize("damage", ["cut after 9 bytes", "16 flipped bytes in a chunk", "zstd bomb claimed",
+                                    "zstd bomb unclaimed", "zstd bomb unsized", "lz4 bomb"])
+def test_log_tools_answer_a_damaged_or_hostile_file_in_one_line(damaged_logs, tmp_path, tool, damage):
+    """Each tool answers a cut, flipped or decompression-bomb file with one line naming the problem
+    and its byte offset, exit 1 or 2, no traceback, within 2 s and 256 MB of resident memory (the
+    tool's peak RSS, measured by a parent that runs only it)."""
+    path = damaged_logs[damage]
+    argv = TOOL_COMMANDS[tool](path, tmp_path)
+    probe = ("import resource, subprocess, sys, time; t = time.monotonic(); "
+             "r = subprocess.run(sys.argv[1:], capture_output=True, text=True, timeout=30); "
+             "print(repr((r.returncode, r.stdout, r.stderr, time.monotonic() - t, "
+             "resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss)))")
+    probed = subprocess.run([sys.executable, "-c", probe, *argv], capture_output=True, text=True, timeout=60)
+    code, out, err, elapsed, maxrss_kb = ast.literal_eval(probed.stdout)
+    assert code in (1, 2), (code, out, err)
+    assert "Traceback" not in err and err.count("\n") == 1, err
+    assert "byte" in err or "bytes" in err, err
+    assert elapsed < 2.0, f"{tool} took {elapsed:.2f} s"
+    assert maxrss_kb < 256 * 1024, f"{tool} grew to {maxrss_kb / 1024:.0f} MB"
+
+
+def test_a_log_never_chooses_which_module_is_imported(tmp_path, capsys):
+    """A schema named ``this/msg/x`` must not import the module ``this``: only the suite's interface
+    packages are resolved, anything else refused in one line before any import."""
+    from att_msgs_py.log import replay
+
+    assert "this" not in sys.modules
+    for type_name in ("this/msg/x", "os/msg/Path", "std_msgs/msg/../../os", "att_msgs/srv/Plan", "antigravity"):
+        path = hostile_log(tmp_path / "named.mcap", type_name=type_name)
+        assert replay.main([str(path), "--wait", "0", "--linger", "0"]) == 2
+        err = capsys.readouterr().err
+        assert err.count("\n") == 1 and "not one of the suite's interface types" in err, err
+        assert "this" not in sys.modules and "antigravity" not in sys.modules
+
+
+HOSTILE_NAMES = ["/a\x1b[2J\x1b]0;pwned\x07", "/b\r\n/fake 1", "/c\x00\x7f\x9b31m"]
+
+
+@pytest.mark.parametrize("topic", HOSTILE_NAMES)
+def test_file_provided_names_reach_the_terminal_escaped(tmp_path, capsys, topic):
+    """Topic, type, profile and library strings of a file are printed with their control characters
+    escaped by ``att-log info``, ``att-replay`` refuses such a topic naming it escaped, and neither
+    ``att-log repair`` nor ``att-review`` prints them raw."""
+    from att_msgs_py.log import replay
+    from att_msgs_py.log.cli import main as att_log
+    from att_planner.tools.review import main as att_review
+
+    def assert_escaped(text: str) -> None:
+        assert not any((ord(c) < 0x20 and c != "\n") or 0x7f <= ord(c) < 0xa0 for c in text), repr(text)
+
+    path = hostile_log(tmp_path / "names.mcap", topic=topic, type_name="std_msgs/msg/Empty\x1b[1m")
+    assert att_log(["info", str(path)]) in (0, 1)
+    printed = capsys.readouterr()
+    assert_escaped(printed.out + printed.err)
+    assert "\\x1b" in printed.out
+    assert replay.main([str(path), "--wait", "0", "--linger", "0"]) == 2
+    printed = capsys.readouterr()
+    assert_escaped(printed.out + printed.err)
+    assert printed.err.count("\n") == 1 and "is not a ROS topic name" in printed.err, printed.err
+    assert att_log(["repair", str(path), "-o", str(tmp_path / "out.mcap")]) == 0
+    assert att_review([str(path), "--out", str(tmp_path / "review")]) == 1     # no state to review
+    printed = capsys.readouterr()
+    assert_escaped(printed.out + printed.err)

@@ -8,7 +8,7 @@ import shutil
 from pathlib import Path
 
 import pytest
-from hypothesis import HealthCheck, given, settings
+from hypothesis import HealthCheck, example, given, settings
 from hypothesis import strategies as st
 from mcap.exceptions import McapError
 from mcap.reader import make_reader
@@ -110,6 +110,7 @@ def test_a_file_cut_at_any_offset_is_repaired_to_exactly_its_whole_chunks(finish
 
 @settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
 @given(cut=st.floats(0.05, 1.0), flips=st.lists(st.tuples(st.floats(0.0, 1.0), st.integers(1, 255)), max_size=3))
+@example(cut=0.616557717681738, flips=[(0.3897591234523544, 6)])
 def test_a_cut_and_damaged_file_repairs_to_a_prefix_of_its_messages(finished, tmp_path, cut, flips):
     """Bytes flipped anywhere and the end cut: whatever is recovered is a prefix of the original
     messages (a damaged chunk fails its CRC and ends the recovery), and the output is valid."""
@@ -126,6 +127,64 @@ def test_a_cut_and_damaged_file_repairs_to_a_prefix_of_its_messages(finished, tm
         return
     got = records_of(done.output)
     assert got == original[:len(got)]
+
+
+def record_ranges(data: bytes) -> dict[str, list[tuple[int, int]]]:
+    """Byte ranges [start, end) of every record of a finished MCAP file by kind, found by walking
+    its framing (opcode, 8-byte length, content) from the magic to the footer; a chunk is split
+    into its header (opcode to records length) and its compressed payload. The suite's writer puts
+    schemas and channels inside chunks (under the chunk CRC); the ones outside a CRC'd chunk are the
+    summary's copies, listed as "schema" and "channel"; data end, chunk indexes, statistics, summary
+    offsets and footer are "summary"."""
+    kinds = {0x01: "header", 0x07: "message index"}
+    out: dict[str, list[tuple[int, int]]] = {}
+    pos, data_end = 8, False
+    while pos < len(data) - 8:
+        opcode, length = data[pos], int.from_bytes(data[pos + 1:pos + 9], "little")
+        end = pos + 9 + length
+        if opcode == 0x06:
+            name_len = int.from_bytes(data[pos + 9 + 28:pos + 9 + 32], "little")
+            payload = pos + 9 + 32 + name_len + 8
+            out.setdefault("chunk header", []).append((pos, payload))
+            out.setdefault("chunk payload", []).append((payload, end))
+        else:
+            data_end = data_end or opcode == 0x0F
+            kind = {0x03: "schema", 0x04: "channel"}.get(opcode, "summary") if data_end else kinds[opcode]
+            out.setdefault(kind, []).append((pos, end))
+        pos = end
+    assert pos == len(data) - 8 and data[pos:] == b"\x89MCAP0\r\n"
+    return out
+
+
+RECORD_KINDS = ("header", "schema", "channel", "chunk header", "chunk payload", "message index", "summary")
+
+
+@settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(kind=st.sampled_from(RECORD_KINDS), which=st.floats(0.0, 1.0), cut=st.floats(0.05, 1.0),
+       flips=st.lists(st.tuples(st.floats(0.0, 1.0), st.integers(1, 255)), min_size=1, max_size=4))
+def test_flips_inside_any_record_kind_repair_to_a_prefix_of_its_messages(finished, tmp_path, kind, which, cut,
+                                                                           flips):
+    """Bytes flipped inside one record of a chosen kind (header, schema, channel, chunk header, chunk
+    payload, message index, summary) and the end perhaps cut: what is recovered is a prefix of the
+    recorded messages, byte for byte, or nothing."""
+    path, original = finished
+    data = bytearray(path.read_bytes())
+    ranges = record_ranges(bytes(data))
+    assert all(ranges.get(k) for k in RECORD_KINDS), sorted(ranges)
+    start, end = ranges[kind][min(int(which * len(ranges[kind])), len(ranges[kind]) - 1)]
+    for where, xor in flips:
+        data[start + min(int(where * (end - start)), end - start - 1)] ^= xor
+    if cut < 1.0:
+        data = data[:max(end, int(cut * len(data)))]
+    damaged = tmp_path / "damaged.mcap"
+    damaged.write_bytes(bytes(data))
+    try:
+        done = repair(damaged, tmp_path / "out.mcap")
+    except LogFileError as err:
+        assert "nothing to recover" in str(err)
+        return
+    got = records_of(done.output)
+    assert got == original[:len(got)], (kind, start, end, flips)
 
 
 @pytest.mark.parametrize("opcode", [0x00, 0x10, 0x80, 0xFF])
