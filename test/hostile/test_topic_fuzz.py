@@ -258,6 +258,7 @@ def test_random_sensor_readings_and_estimates(fuzzed, topic, data):
     publish(fuzzed, topic, data.draw(SENSOR_FUZZ[topic][1]()))
 
 
+@pytest.mark.slow                                   # 23 s on the 2-core machine
 def test_nothing_died_nothing_stalled_and_the_maneuver_got_an_answer(fuzzed):
     s, monitor, client = fuzzed["suite"], fuzzed["monitor"], fuzzed["suite"].client
     end = time.monotonic()
