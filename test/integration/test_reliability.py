@@ -11,7 +11,7 @@ import numpy as np
 import psutil
 import pytest
 import rclpy
-from hypothesis import HealthCheck, given, settings
+from hypothesis import given, settings
 from hypothesis import strategies as st
 from mcap.reader import make_reader
 from rclpy.executors import MultiThreadedExecutor
@@ -69,7 +69,7 @@ def malformed_requests(draw):
     return req
 
 
-@settings(max_examples=40, deadline=None, suppress_health_check=list(HealthCheck))
+@settings(max_examples=40, deadline=None)
 @given(request=malformed_requests())
 def test_random_malformed_requests_all_get_an_answer(suite, request):
     s, client, _ = suite
