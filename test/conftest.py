@@ -51,6 +51,19 @@ def wait_for_converged_estimate(client: SuiteClient, timeout: float = 30.0) -> N
     assert any(converged), f"the estimate did not converge within {timeout:g} s"
 
 
+# pytest-timeout's deadline for a `ros` or `slow` test (pyproject.toml's `timeout` is the unit-test one):
+# the slowest of a full run took 121 s of module setup (a mission flown) on the 2-core machine.
+ROS_OR_SLOW_TIMEOUT = 600
+
+
+def pytest_collection_modifyitems(config, items):
+    """Give every `ros` or `slow` test without its own ``timeout`` mark the larger deadline."""
+    for item in items:
+        if item.get_closest_marker("timeout") is None and (
+                item.get_closest_marker("ros") or item.get_closest_marker("slow")):
+            item.add_marker(pytest.mark.timeout(ROS_OR_SLOW_TIMEOUT))
+
+
 @pytest.fixture(scope="session", autouse=True)
 def isolated_ros_domain():
     """Every test process talks on its own random domain, localhost only."""

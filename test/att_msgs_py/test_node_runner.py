@@ -38,7 +38,7 @@ NODE_SCRIPT = textwrap.dedent("""
             self.pub = self.create_publisher(String, "busy", 10)
 
         def close(self):
-            time.sleep(0.3)                 # a signal must not cut this short
+            time.sleep(0.3)                 # wait-ok: a close that takes time, which a signal must not cut short
             print("closed", flush=True)
 
     def loop(node, executor):
@@ -67,7 +67,7 @@ def test_signal_stops_node_cleanly(loop, signum, delay, from_thread):
     try:
         assert proc.stdout.readline().strip() == "running"
         if not from_thread:
-            time.sleep(delay)
+            time.sleep(delay)               # wait-ok: the signal's moment in the node's life is the parameter
             proc.send_signal(signum)
         out, _ = proc.communicate(timeout=20)
     finally:

@@ -62,7 +62,7 @@ def main() -> int:
                 result = client.execute(response.plan.plan_id)
                 if result.error_code not in (ErrorCode.NO_STATE, ErrorCode.ESTIMATE_UNHEALTHY):   # not yet
                     break
-                time.sleep(0.25)
+                time.sleep(0.25)    # wait-ok: retry period of a goal refused while the state is missing (40 tries)
             plan = response.plan
             print(f"plan {plan.plan_id} ({plan.method}, {plan.duration:.1f} s): {result.message}")
             if not result.success:

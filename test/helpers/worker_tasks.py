@@ -16,7 +16,7 @@ def pid_and_warmth() -> tuple[int, bool]:
 
 
 def sleep_then_pid(seconds: float) -> int:
-    time.sleep(seconds)
+    time.sleep(seconds)     # wait-ok: a task that takes time (or hangs), on purpose
     return os.getpid()
 
 

@@ -355,7 +355,7 @@ def test_good_values_start_the_simulator(tmp_path):
         for proc, log, (_, words) in zip(procs, logs, cases):
             end = time.monotonic() + 40
             while words not in log.read_text() and time.monotonic() < end and proc.poll() is None:
-                time.sleep(0.2)
+                time.sleep(0.2)     # wait-ok: poll period of a wait on the log's words or the node's exit (40 s)
             assert words in log.read_text(), f"exit {proc.poll()}: {log.read_text()}"
     finally:
         for proc in procs:

@@ -53,6 +53,7 @@ def rate_of(msg) -> float:
     return float(np.linalg.norm(convert.state_from_msg(msg).omega))
 
 
+@pytest.mark.slow                                   # 36 s on the 2-core machine
 def test_killed_controller_then_restarted_controller_damps_the_coasting_spacecraft(ros_suite):
     with ros_suite("swift_demo", nodes=("simulator", "controller"), name="restart_test",
                    params={"simulator": {"real_time_factor": RTF}, "controller": {"state_source": "truth"}}) as s:

@@ -264,13 +264,9 @@ def test_a_sky_that_is_open_however_narrowly_is_not_refused(name):
     assert len(valid.problem.cones) == len(OPEN_SKIES[name])
 
 
-def test_the_closed_sky_check_costs_milliseconds():
-    validate(request(cones=ring(X)[:-1]))                # lattice built, imports done
-    start = time.perf_counter()
-    for _ in range(5):
-        with pytest.raises(RequestError):
-            validate(request(cones=ring(X) + ring(-X)))       # 16 overlapping cones: the full check
-    assert (time.perf_counter() - start) / 5 < 0.1
+def test_a_sky_closed_by_16_overlapping_cones_is_refused():
+    with pytest.raises(RequestError):
+        validate(request(cones=ring(X) + ring(-X)))           # 16 overlapping cones: the full check
 
 
 @pytest.mark.parametrize("method", ["eigenaxis", "constrained_axis", "time_optimal"])

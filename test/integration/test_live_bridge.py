@@ -17,6 +17,7 @@ import pytest
 import rclpy
 from mcap.records import Schema
 from mcap_ros2.decoder import DecoderFactory
+from rclpy.duration import Duration
 from rclpy.serialization import deserialize_message
 from visualization_msgs.msg import Marker, MarkerArray
 from websockets.exceptions import InvalidStatus
@@ -75,7 +76,8 @@ def publish_latched_path(client) -> None:
     while pub.get_subscription_count() < 1 and time.monotonic() < end:
         rclpy.spin_once(client, timeout_sec=0.05)
     assert pub.get_subscription_count() == 1, "the bridge did not subscribe to the plan path"
-    time.sleep(1.0)
+    # reliable QoS: acknowledged once the bridge's reader holds the path (before any Foxglove client connects)
+    assert pub.wait_for_all_acked(Duration(seconds=10)), "the bridge did not acknowledge the plan path"
 
 
 def test_a_foxglove_client_receives_the_suite_live(ros_suite):

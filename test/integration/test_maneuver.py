@@ -63,6 +63,7 @@ def test_a_quick_answer_is_the_first_stage_and_every_stage_is_reported(suite):
     assert method.duration == pytest.approx(best.plan.duration) and method.duration < first.duration
 
 
+@pytest.mark.slow                                   # 22 s on the 2-core machine
 def test_maneuver_is_planned_executed_and_recorded(suite):
     client = suite.client
     response = client.plan(maneuver_request(rot.IDENTITY, GOAL, SENSOR, CONES, time_budget=60))

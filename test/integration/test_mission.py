@@ -21,7 +21,7 @@ from att_sim.models import scenario as scen
 from att_sim.models.ephemeris import Ephemeris
 from helpers.missions import fly_written
 
-pytestmark = pytest.mark.ros
+pytestmark = [pytest.mark.ros, pytest.mark.slow]     # flies 2400 s of sim time: 121 s of module setup
 SOURCES = {"polaris": 60.0, "cas_a": 60.0}         # visible at the epoch for 1870 s, from 1070 s on (1 deg margin)
 
 

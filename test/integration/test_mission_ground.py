@@ -17,7 +17,7 @@ from att_sim.models import rotations as rot
 from helpers.independent import site_sight
 from helpers.missions import fly_written
 
-pytestmark = pytest.mark.ros
+pytestmark = [pytest.mark.ros, pytest.mark.slow]     # the module's flight: 85 s of setup
 SITE = {"name": "new_guinea", "lat_deg": -4.0, "lon_deg": 145.0, "alt_m": 0.0, "dwell_s": 30.0}
 
 

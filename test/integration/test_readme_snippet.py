@@ -9,7 +9,7 @@ from pathlib import Path
 
 import pytest
 
-pytestmark = pytest.mark.ros
+pytestmark = [pytest.mark.ros, pytest.mark.slow]     # 33 s on the 2-core machine
 
 README = Path(__file__).resolve().parents[2] / "README.md"
 

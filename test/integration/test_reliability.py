@@ -8,9 +8,10 @@ import threading
 import time
 
 import numpy as np
+import psutil
 import pytest
 import rclpy
-from hypothesis import HealthCheck, given, settings
+from hypothesis import given, settings
 from hypothesis import strategies as st
 from mcap.reader import make_reader
 from rclpy.executors import MultiThreadedExecutor
@@ -26,16 +27,17 @@ from att_msgs_py.types import ControlMode
 from att_planner.nodes.client import SuiteClient, maneuver_request
 from att_planner.tools.launch import Suite, isolated_env
 from att_sim.models import rotations as rot
+from helpers.waiting import wait_until
 
 pytestmark = pytest.mark.ros
 
 GOAL = rot.from_axis_angle([0, 0, 1], 0.4)
+SUITE_PARAMS = {"simulator": {"real_time_factor": 4.0}, "controller": {"state_source": "truth"}}
 
 
 @pytest.fixture(scope="module")
 def suite(ros_suite):
-    with ros_suite("swift_demo", nodes=("simulator", "controller", "planner"),
-                   params={"simulator": {"real_time_factor": 4.0}, "controller": {"state_source": "truth"}},
+    with ros_suite("swift_demo", nodes=("simulator", "controller", "planner"), params=SUITE_PARAMS,
                    name="reliability_test") as s:
         yield s.suite, s.client, s.mcap.parent
 
@@ -67,7 +69,7 @@ def malformed_requests(draw):
     return req
 
 
-@settings(max_examples=40, deadline=None, suppress_health_check=list(HealthCheck))
+@settings(max_examples=40, deadline=None)
 @given(request=malformed_requests())
 def test_random_malformed_requests_all_get_an_answer(suite, request):
     s, client, _ = suite
@@ -96,10 +98,7 @@ def test_hundred_concurrent_requests_from_several_clients(suite):
             req = maneuver_request(rot.IDENTITY, rot.from_axis_angle([0, 0, 1], angle), [1, 0, 0], [],
                                    method="eigenaxis_smooth")
             futures.append((angle, clients[i % 4].plan_client.call_async(req)))
-        deadline = time.monotonic() + 120
-        while time.monotonic() < deadline and not all(f.done() for _, f in futures):
-            time.sleep(0.1)
-        assert all(f.done() for _, f in futures), "some requests got no answer"
+        wait_until(lambda: all(f.done() for _, f in futures), 120, "an answer to each of 100 requests")
         for angle, f in futures:
             r = f.result()
             assert r.success, r.message
@@ -124,8 +123,11 @@ def test_long_solve_does_not_block_a_quick_request(suite):
     slow_req = maneuver_request(rot.IDENTITY, rot.from_axis_angle([0, 0, 1], math.radians(135)), [1, 0, 0], [],
                                 method="time_optimal", time_budget=60, options=slow_options)
     slow_req.cones = swift_cones
+    planner = psutil.Process(s.procs["planner"].pid)
+    cpu_before = cpu_seconds(planner)
     slow = client.plan_client.call_async(slow_req)
-    time.sleep(2.0)
+    # the slow request is being solved (1 s of the planner's and its workers' CPU) before the quick one goes
+    wait_until(lambda: cpu_seconds(planner) - cpu_before > 1.0, 60, "the planner working on the slow request")
     start = time.monotonic()
     quick = client.plan(maneuver_request(rot.IDENTITY, GOAL, [1, 0, 0], [], method="eigenaxis_smooth"), timeout=30)
     latency = time.monotonic() - start
@@ -145,7 +147,11 @@ def test_controller_refuses_unknown_plan_and_mode_change_mid_maneuver(suite):
     rclpy.spin_until_future_complete(client, goal, timeout_sec=20)
     handle = goal.result()
     assert handle.accepted
-    time.sleep(1.0)
+    statuses = []
+    sub = client.create_subscription(ControllerStatus, topics.CONTROLLER_STATUS, statuses.append, qos.STREAM_QOS)
+    wait_until(lambda: any(m.plan_id == plan.plan_id for m in statuses), 30, "the controller tracking the plan",
+               node=client)
+    client.destroy_subscription(sub)
     refused = client.set_mode(ControlMode.MAGNETORQUER_PD)
     assert refused.error_code == ErrorCode.BUSY and "executing" in refused.message
     done = handle.get_result_async()
@@ -173,6 +179,18 @@ def test_simulator_rejects_nan_commands_and_state_stays_finite(suite):
         client.destroy_publisher(pub)
 
 
+def cpu_seconds(proc: psutil.Process) -> float:
+    """CPU time (user + system) of a process, its live descendants and the children they reaped."""
+    total = 0.0
+    for p in (proc, *proc.children(recursive=True)):
+        try:
+            t = p.cpu_times()
+        except psutil.NoSuchProcess:
+            continue
+        total += t.user + t.system + t.children_user + t.children_system
+    return total
+
+
 def wait_for(client, predicate, messages, timeout):
     end = time.monotonic() + timeout
     while time.monotonic() < end:
@@ -182,22 +200,23 @@ def wait_for(client, predicate, messages, timeout):
     return False
 
 
-def test_watchdogs_report_silence(suite):
-    """Runs last in this module: it stops the controller and then the simulator."""
-    s, client, _ = suite
-    states, statuses = [], []
-    client.create_subscription(SpacecraftState, topics.STATE, states.append, qos.STREAM_QOS)
-    client.create_subscription(ControllerStatus, topics.CONTROLLER_STATUS, statuses.append, qos.STREAM_QOS)
-    controller = s.procs["controller"]
-    controller.send_signal(signal.SIGSTOP)          # commands stop arriving
-    try:
-        assert wait_for(client, lambda m: m.command_timeout, states, 60), "simulator did not zero its inputs"
-    finally:
-        controller.send_signal(signal.SIGCONT)
-    s.procs["simulator"].send_signal(signal.SIGINT)  # states stop arriving
-    s.procs["simulator"].wait(10)
-    statuses.clear()
-    assert wait_for(client, lambda m: m.state_stale, statuses, 60), "controller did not report stale state"
+def test_watchdogs_report_silence(ros_suite):
+    """On a suite of its own (it stops the controller and then the simulator): any order of the module holds."""
+    with ros_suite("swift_demo", nodes=("simulator", "controller"), params=SUITE_PARAMS, name="watchdog_test") as r:
+        s, client = r.suite, r.client
+        states, statuses = [], []
+        client.create_subscription(SpacecraftState, topics.STATE, states.append, qos.STREAM_QOS)
+        client.create_subscription(ControllerStatus, topics.CONTROLLER_STATUS, statuses.append, qos.STREAM_QOS)
+        controller = s.procs["controller"]
+        controller.send_signal(signal.SIGSTOP)          # commands stop arriving
+        try:
+            assert wait_for(client, lambda m: m.command_timeout, states, 60), "simulator did not zero its inputs"
+        finally:
+            controller.send_signal(signal.SIGCONT)
+        s.procs["simulator"].send_signal(signal.SIGINT)  # states stop arriving
+        s.procs["simulator"].wait(10)
+        statuses.clear()
+        assert wait_for(client, lambda m: m.state_stale, statuses, 60), "controller did not report stale state"
 
 
 def messages_on_disk(path) -> int:
@@ -211,13 +230,22 @@ def messages_on_disk(path) -> int:
     return scan.messages
 
 
+def states_on_disk(path) -> int:
+    """States in the flushed chunks of a log still being written (0 while none is readable)."""
+    try:
+        return len(read_log(path, topics=["/spacecraft/state"]).get("/spacecraft/state", ()))
+    except (LogFileError, OSError, ValueError):
+        return 0
+
+
 def test_recorder_killed_leaves_a_readable_log_and_clean_stop_writes_the_index(tmp_path):
     env = isolated_env()
     suite = Suite(env, tmp_path)
     suite.start("recorder", {"output": str(tmp_path / "killed.mcap")})
     suite.start("simulator", {"scenario": "swift_demo", "lockstep": False, "real_time_factor": 2.0})
     try:
-        time.sleep(8.0)
+        wait_until(lambda: states_on_disk(tmp_path / "killed.mcap") > 20, 60, "21 states flushed by the recorder",
+                   period=0.5)
         suite.procs["recorder"].send_signal(signal.SIGKILL)
         killed_at = time.time()
         suite.procs["recorder"].wait(10)
@@ -228,9 +256,8 @@ def test_recorder_killed_leaves_a_readable_log_and_clean_stop_writes_the_index(t
         suite.start("recorder", {"output": str(tmp_path / "clean.mcap")})
         # on a loaded machine the new recorder takes seconds to start and match: wait for its messages
         assert suite.wait_for_output("recorder", "recording", 60), suite.log_text("recorder")
-        deadline = time.monotonic() + 30.0
-        while messages_on_disk(tmp_path / "clean.mcap") <= 20 and time.monotonic() < deadline:
-            time.sleep(0.5)
+        wait_until(lambda: messages_on_disk(tmp_path / "clean.mcap") > 20, 30,
+                   "21 messages flushed by the new recorder")
         assert suite.alive()["simulator"], suite.log_text("simulator")[-2000:]
     finally:
         codes = suite.stop()

@@ -3,7 +3,6 @@ recorded; the log, decoded by rosbags from its own definitions, holds /tf with t
 the inertial one (the state's attitude) and the Earth-fixed frame (skyfield's ITRS, at -r), the
 zones' cones where the sky puts them, their margins, and the plan's boresight path."""
 import math
-import time
 from datetime import timedelta
 
 import numpy as np
@@ -16,6 +15,7 @@ from att_planner.nodes.client import maneuver_request
 from att_sim.models import rotations as rot
 from att_sim.models import scenario as scen
 from att_sim.models.world import Environment
+from helpers.waiting import wait_until
 
 SCENARIO = "leo_observatory"                    # GCRS, TLE orbit, Sun/Moon/Earth-limb keep-out zones on +y
 END = 6.0                                       # s of sim time
@@ -36,19 +36,13 @@ def decode(path):
     return out, types
 
 
-def recorded(path, topic: str, timeout: float) -> bool:
+def recorded(path, topic: str) -> bool:
     """Whether the recorder has written a message of ``topic`` to ``path`` (it flushes every 0.5 s;
-    read while it writes) within ``timeout`` s: the planner's latched markers reach it whenever its
-    executor gets to them, which under load can be after a fast simulator's end."""
-    deadline = time.monotonic() + timeout
-    while time.monotonic() < deadline:
-        try:
-            if len(read_log(path, topics=[topic]).get(topic, ())):
-                return True
-        except (OSError, ValueError):
-            pass                    # not written yet, or a chunk half written: try again
-        time.sleep(0.2)
-    return False
+    read while it writes)."""
+    try:
+        return bool(len(read_log(path, topics=[topic]).get(topic, ())))
+    except (OSError, ValueError):
+        return False                # not written yet, or a chunk half written: look again
 
 
 def stamp(msg) -> float:
@@ -64,7 +58,9 @@ def test_a_recorded_real_sky_run_holds_tf_markers_and_the_plan_path(ros_suite):
                                                   time_budget=10.0, frame_id="gcrs"))
         assert response.success, response.message
         assert s.suite.wait_for_output("simulator", "end_time reached", timeout=120)
-        assert recorded(s.mcap, topics.PLAN_MARKERS, timeout=60)     # the simulator may end before it arrives
+        # the planner's latched markers reach the recorder whenever its executor gets to them, which
+        # under load can be after a fast simulator's end
+        wait_until(lambda: recorded(s.mcap, topics.PLAN_MARKERS), 60, "the plan's markers in the log", period=0.2)
         s.stop()
     log, types = decode(s.mcap)
     assert types[topics.TF] == "tf2_msgs/msg/TFMessage"

@@ -106,7 +106,7 @@ def test_a_plan_above_the_sample_cap_is_refused_before_verification():
 
 def test_a_plan_too_late_to_verify_is_replaced_by_the_first_plan(monkeypatch):
     def late(method, problem, options, wait):
-        time.sleep(max(0.0, problem.deadline - time.monotonic()) + 0.4)       # past the request's budget
+        time.sleep(max(0.0, problem.deadline - time.monotonic()) + 0.4)       # wait-ok: a method past its budget
         # the verification cost is estimated from measured steps: pin it (1 ms a step, 6 s for this plan)
         # so the plan is too late on a fast idle machine as on a busy one (the first plan was verified)
         monkeypatch.setattr(planning, "_step_seconds", 1e-3)

@@ -9,6 +9,7 @@ from att_planner.service import worker
 from att_planner.service.warm import warm, warm_requests
 from att_planner.verification import TOLERANCES
 from helpers import worker_tasks
+from helpers.waiting import wait_until
 
 
 def on_death(message):
@@ -44,9 +45,7 @@ def test_a_worker_that_overruns_is_killed_and_replaced_by_a_warmed_one():
     assert worker.call_isolated(worker_tasks.sleep_then_pid, (3600.0,), {}, 0.1, on_death=on_death) is None
     pooled.join(10.0)
     assert not pooled.is_alive()
-    deadline = time.monotonic() + 60.0
-    while not worker.idle_workers() and time.monotonic() < deadline:
-        time.sleep(0.1)
+    wait_until(worker.idle_workers, 60.0, "a warmed worker in place of the killed one")
     pid, warmed = worker.call_isolated(worker_tasks.pid_and_warmth, (), {}, 10.0, on_death=on_death)
     assert warmed and pid != pooled.pid
 
