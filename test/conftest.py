@@ -72,6 +72,14 @@ def isolated_ros_domain():
     yield
 
 
+@pytest.fixture(scope="session", autouse=True)
+def isolated_state_dir(tmp_path_factory):
+    """The nodes' kept state (the controller's last accepted mode sequences) in a folder of this run,
+    never the user's: a test run neither reads nor leaves state behind."""
+    os.environ["ATT_STATE_DIR"] = str(tmp_path_factory.mktemp("att_state"))
+    yield
+
+
 @dataclass
 class RosSuite:
     """Nodes started by :func:`ros_suite`, a client joined to their domain, the run's log."""
