@@ -49,8 +49,8 @@ def record_and_kill(suite: Suite, path: Path) -> float:
     assert suite.wait_for_output("recorder", "recording", 30), suite.log_text("recorder")
     deadline = time.monotonic() + 30
     while not (path.is_file() and path.stat().st_size > 1000) and time.monotonic() < deadline:
-        time.sleep(0.1)
-    time.sleep(KILL_AFTER)
+        time.sleep(0.1)                # wait-ok: the poll period of a wait with a deadline
+    time.sleep(KILL_AFTER)             # wait-ok: how long the recorder runs before the kill is the test's parameter
     suite.procs["recorder"].send_signal(signal.SIGKILL)
     killed_at = time.time()
     assert suite.procs["recorder"].wait(10) == -signal.SIGKILL
