@@ -96,7 +96,7 @@ def test_a_second_publishers_command_is_not_applied_while_the_controller_answers
 
         def intruder_only():
             intruder.publish(command(latest[0], 0.12))
-            time.sleep(0.005)  # pacing of the intruder's publications, not a wait on a condition
+            time.sleep(0.005)  # wait-ok: pacing of the intruder's publications, not a wait
 
         assert spin_until(client, lambda: any(abs(m.wheel_torques[0] - 0.12) < 2e-3 for m in states), 20.0,
                           intruder_only), "a new publisher was never followed once the held one had gone"
