@@ -32,12 +32,12 @@ from helpers.waiting import wait_until
 pytestmark = pytest.mark.ros
 
 GOAL = rot.from_axis_angle([0, 0, 1], 0.4)
-SUITE_PARAMS = {"simulator": {"real_time_factor": 4.0}, "controller": {"state_source": "truth"}}
 
 
 @pytest.fixture(scope="module")
 def suite(ros_suite):
-    with ros_suite("swift_demo", nodes=("simulator", "controller", "planner"), params=SUITE_PARAMS,
+    with ros_suite("swift_demo", nodes=("simulator", "controller", "planner"),
+                   params={"simulator": {"real_time_factor": 4.0}, "controller": {"state_source": "truth"}},
                    name="reliability_test") as s:
         yield s.suite, s.client, s.mcap.parent
 
@@ -200,23 +200,22 @@ def wait_for(client, predicate, messages, timeout):
     return False
 
 
-def test_watchdogs_report_silence(ros_suite):
-    """On a suite of its own (it stops the controller and then the simulator): any order of the module holds."""
-    with ros_suite("swift_demo", nodes=("simulator", "controller"), params=SUITE_PARAMS, name="watchdog_test") as r:
-        s, client = r.suite, r.client
-        states, statuses = [], []
-        client.create_subscription(SpacecraftState, topics.STATE, states.append, qos.STREAM_QOS)
-        client.create_subscription(ControllerStatus, topics.CONTROLLER_STATUS, statuses.append, qos.STREAM_QOS)
-        controller = s.procs["controller"]
-        controller.send_signal(signal.SIGSTOP)          # commands stop arriving
-        try:
-            assert wait_for(client, lambda m: m.command_timeout, states, 60), "simulator did not zero its inputs"
-        finally:
-            controller.send_signal(signal.SIGCONT)
-        s.procs["simulator"].send_signal(signal.SIGINT)  # states stop arriving
-        s.procs["simulator"].wait(10)
-        statuses.clear()
-        assert wait_for(client, lambda m: m.state_stale, statuses, 60), "controller did not report stale state"
+def test_watchdogs_report_silence(suite):
+    """Runs last in this module: it stops the controller and then the simulator."""
+    s, client, _ = suite
+    states, statuses = [], []
+    client.create_subscription(SpacecraftState, topics.STATE, states.append, qos.STREAM_QOS)
+    client.create_subscription(ControllerStatus, topics.CONTROLLER_STATUS, statuses.append, qos.STREAM_QOS)
+    controller = s.procs["controller"]
+    controller.send_signal(signal.SIGSTOP)          # commands stop arriving
+    try:
+        assert wait_for(client, lambda m: m.command_timeout, states, 60), "simulator did not zero its inputs"
+    finally:
+        controller.send_signal(signal.SIGCONT)
+    s.procs["simulator"].send_signal(signal.SIGINT)  # states stop arriving
+    s.procs["simulator"].wait(10)
+    statuses.clear()
+    assert wait_for(client, lambda m: m.state_stale, statuses, 60), "controller did not report stale state"
 
 
 def messages_on_disk(path) -> int:
