@@ -126,19 +126,22 @@ def default_nodes(scenario: str) -> tuple[str, ...]:
 
 
 def start_suite(scenario: str, mcap_path: str | Path, log_dir: str | Path, *, env: dict | None = None,
-                nodes=None, params: dict | None = None) -> Suite:
+                nodes=None, params: dict | None = None, state_listeners: int = 0) -> Suite:
     """Start ``nodes`` (default: :func:`default_nodes`) for ``scenario``; ``params`` maps node name ->
-    extra ROS parameters.
+    extra ROS parameters; ``state_listeners``: the caller's own nodes that will subscribe to the
+    state (a mission driver), which the simulator counts among its subscribers too.
 
     The simulator holds sim time at zero until the recorder, the controller and the estimator
-    (those started) subscribe to its state or sensors; the controller and the estimator subscribe
-    only once their outputs are heard (commands by the simulator and the recorder, the estimate by
-    the recorder), so every run is recorded and controlled from t = 0.
+    (those started), and the caller's ``state_listeners``, subscribe to its state or sensors; the
+    controller and the estimator subscribe only once their outputs are heard (commands by the
+    simulator and the recorder, the estimate by the recorder), so every run is recorded and
+    controlled from t = 0 (without ``state_listeners``, a caller's early subscription would stand in
+    for a late recorder).
     """
     nodes = default_nodes(scenario) if nodes is None else nodes
     suite = Suite(env or isolated_env(), Path(log_dir))
     recorder = "recorder" in nodes
-    listeners = {"simulator": sum(n in nodes for n in ("recorder", "controller", "estimator")),
+    listeners = {"simulator": sum(n in nodes for n in ("recorder", "controller", "estimator")) + state_listeners,
                  "controller": ("simulator" in nodes) + int(recorder),
                  "estimator": int(recorder)}
     for name in nodes:

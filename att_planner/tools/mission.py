@@ -173,7 +173,8 @@ def fly_mission(mission: mission_config.MissionConfig, out: Path, log=print) -> 
                              "handover_blend": mission.handover_blend},
               "estimator": {"publish_rate": rate}}
     name = mission.scenario.name
-    suite = start_suite(name, mcap_path, run_dir, env=env, nodes=default_nodes(name), params=params)
+    # the driver's telemetry listens to the state: one more subscriber for the simulator to wait for
+    suite = start_suite(name, mcap_path, run_dir, env=env, nodes=default_nodes(name), params=params, state_listeners=1)
     wall = time.monotonic()
     try:
         with client_session("mission") as client:
