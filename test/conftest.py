@@ -3,7 +3,6 @@ starts the suite's nodes as processes and tears them down (:func:`ros_suite`).""
 from __future__ import annotations
 
 import os
-import random
 import time
 from contextlib import contextmanager
 from dataclasses import dataclass, field
@@ -12,7 +11,7 @@ from pathlib import Path
 import pytest
 
 from att_planner.nodes.client import SuiteClient, client_session
-from att_planner.tools.launch import Suite, default_nodes, isolated_env, join_env, start_suite
+from att_planner.tools.launch import Suite, default_nodes, fresh_domain_id, isolated_env, join_env, start_suite
 
 
 def wait_for_controller_step(client: SuiteClient, timeout: float = 30.0) -> None:
@@ -67,7 +66,7 @@ def pytest_collection_modifyitems(config, items):
 @pytest.fixture(scope="session", autouse=True)
 def isolated_ros_domain():
     """Every test process talks on its own random domain, localhost only."""
-    os.environ["ROS_DOMAIN_ID"] = str(random.randint(1, 200))
+    os.environ["ROS_DOMAIN_ID"] = str(fresh_domain_id())
     os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
     yield
 

@@ -32,6 +32,17 @@ MAX_DOMAIN_ID = 232            # the largest ROS_DOMAIN_ID that maps to valid DD
 DISCOVERY_RANGES = ("OFF", "LOCALHOST", "SUBNET", "SYSTEM_DEFAULT")
 
 
+_DOMAINS_HANDED_OUT: set[int] = set()
+
+
+def fresh_domain_id() -> int:
+    """A random ROS domain in 1..200 not yet handed out by this process (any when all were)."""
+    free = sorted(set(range(1, 201)) - _DOMAINS_HANDED_OUT) or list(range(1, 201))
+    domain = random.SystemRandom().choice(free)
+    _DOMAINS_HANDED_OUT.add(domain)
+    return domain
+
+
 def isolated_env(domain_id: int | None = None, base: dict | None = None, *, inherit: bool = False) -> dict:
     """``base`` (default: this process's environment) on ``domain_id`` (default: random 1..200) with
     localhost-only discovery. ``inherit``: a ``ROS_DOMAIN_ID`` / ``ROS_AUTOMATIC_DISCOVERY_RANGE``
@@ -44,7 +55,7 @@ def isolated_env(domain_id: int | None = None, base: dict | None = None, *, inhe
                              "(or unset it for a random free domain)")
         env["ROS_DOMAIN_ID"] = str(int(user_domain))
     else:
-        env["ROS_DOMAIN_ID"] = str(domain_id if domain_id is not None else random.randint(1, 200))
+        env["ROS_DOMAIN_ID"] = str(domain_id if domain_id is not None else fresh_domain_id())
     user_range = env.get("ROS_AUTOMATIC_DISCOVERY_RANGE", "").strip() if inherit else ""
     if user_range and user_range not in DISCOVERY_RANGES:
         raise ValueError(f"ROS_AUTOMATIC_DISCOVERY_RANGE is '{user_range[:40]}': expected one of "

@@ -3,7 +3,6 @@ subscriber on the live names hears nothing), on the live names only with ``--liv
 it builds when a log has none."""
 from __future__ import annotations
 
-import random
 import subprocess
 import sys
 import threading
@@ -14,6 +13,7 @@ import numpy as np
 import pytest
 
 from att_msgs_py.log import read_log
+from att_planner.tools.launch import fresh_domain_id
 from helpers.regression_log import FIXTURE, TOPIC_TYPES
 
 pytestmark = pytest.mark.ros
@@ -35,7 +35,7 @@ def listening(prefixes: tuple[str, ...]):
 
     from att_msgs_py.topics import message_class
 
-    domain = random.randint(1, 200)
+    domain = fresh_domain_id()
     context = rclpy.Context()
     rclpy.init(context=context, domain_id=domain)
     node = Node("replay_test", context=context)
