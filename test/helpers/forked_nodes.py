@@ -7,6 +7,7 @@ from __future__ import annotations
 import importlib
 import multiprocessing
 import os
+import subprocess
 import sys
 
 NODE_MODULES = ("att_sim.truth.simulator_node", "att_planner.nodes.controller_node", "att_planner.nodes.estimator_node",
@@ -23,18 +24,11 @@ def _run(module: str, args: list, env: dict, output_path: str) -> None:
     os.environ.update(env)
     mod = importlib.import_module(module)
     sys.argv = [mod.__file__, "--ros-args", *args]
-    code = 1                            # an exception escaping main(): the interpreter's exit status
     try:
         mod.main()
-        code = 0
-    except SystemExit as exc:
-        code = exc.code if isinstance(exc.code, int) else 0 if exc.code is None else 1
-        raise
     finally:
         sys.stdout.flush()
         sys.stderr.flush()
-        with open(output_path + ".exit", "w", encoding="utf-8") as fh:
-            fh.write(str(code))
 
 
 def context() -> multiprocessing.context.BaseContext:
@@ -46,9 +40,10 @@ def context() -> multiprocessing.context.BaseContext:
 def run_case(ctx, module: str, args: list, env: dict, output_path: str,
              timeout: float = 30.0) -> tuple[int | None, str]:
     """Exit code (None: still running after ``timeout`` s, then killed) and the output. The exit
-    code is the forkserver's report; where it reports 255, its "status lost" (CPython's
-    ``popen_forkserver.poll`` when the status pipe gives EOF: seen once under load, the node's one
-    line printed), the code the child recorded as ``main()`` ended is taken."""
+    code is the forkserver's report. Where it reports 255 — also its "status lost" (CPython's
+    ``popen_forkserver.poll`` when the status pipe gives EOF, seen once under load) — the case is run
+    again as ``python -m MODULE --ros-args ...`` and that process's own exit status and output are
+    taken: no status the child reports about itself is trusted."""
     proc = ctx.Process(target=_run, args=(module, args, env, output_path))
     proc.start()
     proc.join(timeout)
@@ -56,8 +51,18 @@ def run_case(ctx, module: str, args: list, env: dict, output_path: str,
     if code is None:
         proc.kill()
         proc.join()
-    elif code == 255 and os.path.exists(output_path + ".exit"):
-        with open(output_path + ".exit", encoding="utf-8") as fh:
-            code = int(fh.read())
+    elif code == 255:
+        code = _run_as_process(module, args, env, output_path, timeout)
     with open(output_path, encoding="utf-8", errors="replace") as fh:
         return code, fh.read()
+
+
+def _run_as_process(module: str, args: list, env: dict, output_path: str, timeout: float) -> int | None:
+    """Exit code of ``python -m module --ros-args *args`` (None: killed after ``timeout`` s), its
+    output in ``output_path``."""
+    with open(output_path, "wb") as out:
+        try:
+            return subprocess.run([sys.executable, "-m", module, "--ros-args", *args], env=env, stdout=out,
+                                  stderr=subprocess.STDOUT, timeout=timeout).returncode
+        except subprocess.TimeoutExpired:
+            return None

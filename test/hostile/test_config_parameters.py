@@ -344,6 +344,26 @@ def test_a_node_with_a_hostile_parameter_prints_one_line_and_exits_2(node_result
     assert len(lines[0]) <= 450
 
 
+@pytest.mark.ros
+def test_a_status_the_forkserver_lost_is_taken_from_a_real_run_never_from_the_child(tmp_path):
+    """Where the forkserver reports 255 ("status lost"), the harness runs the case as ``python -m``
+    and takes that process's exit status and output."""
+    class Lost:                                    # a forked child whose status pipe gave EOF
+        exitcode = 255
+
+        def start(self):
+            pass
+
+        def join(self, timeout=None):
+            pass
+
+    ctx = type("LostContext", (), {"Process": staticmethod(lambda **_: Lost())})()
+    node, args, code_name, words = NODE_CASES["real_time_factor text"]
+    exit_code, output = forked_nodes.run_case(ctx, NODE_MODULES[node], args, isolated_env(), str(tmp_path / "case.log"))
+    assert exit_code == 2, f"exit {exit_code}:\n{output}"
+    assert code_name in output and all(w in output for w in words), output
+
+
 def test_there_are_enough_distinct_hostile_configurations():
     assert len(BAD_SCENARIOS) + len(NODE_CASES) >= 70
 
