@@ -16,7 +16,7 @@ from att_msgs_py.types import Cone
 from att_planner.methods.slepian import plan_slepian
 from att_planner.reference.celani_bruni import benchmark_problem
 from att_planner.verification import predict
-from att_sim import rotations as rot
+from att_sim.models import rotations as rot
 
 L1 = "1 28485U          26355.00000000  .00000000  00000-0  20000-4 0    07"
 L2 = "2 28485  20.5600  60.0000 0005000  90.0000  10.0000 14.95764766    08"
