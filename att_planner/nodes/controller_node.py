@@ -93,7 +93,8 @@ class ControllerNode(Node):
         self._refusals = RefusalLog(self.get_logger())   # refused inputs, logged once a second per kind
         self._goal = None                     # the goal handle of the running maneuver
         self._waiting = None                  # (estimate, source) that came before any wheel speed
-        self._sources = Sources(self._core.gate.config.resync_timeout)   # one publisher per measurement
+        self._sources = Sources({"wheel speed measurement": live_publishers(self, topics.WHEEL_SPEEDS),
+                                 "magnetometer measurement": live_publishers(self, topics.MAGNETOMETER)})
         self._done: Future | None = None
 
         self._cmd_pub = self.create_publisher(ActuatorCommand, topics.COMMAND, qos.STREAM_QOS)
@@ -142,8 +143,8 @@ class ControllerNode(Node):
 
     def on_wheel_speeds(self, msg: JointState, info: dict):
         try:
-            self._sources.admit("wheel speed measurement", publisher_of(info), time.monotonic())
-            self._core.measured.on_wheel_speeds(convert.wheel_speeds_from_msg(msg))
+            self._sources.guarded("wheel speed measurement", publisher_of(info), self._core.measured.on_wheel_speeds,
+                                  convert.wheel_speeds_from_msg(msg))
         except RequestError as err:
             self._refusals("wheel speed measurement", err)
             return
@@ -153,8 +154,8 @@ class ControllerNode(Node):
 
     def on_magnetometer(self, msg: MagneticField, info: dict):
         try:
-            self._sources.admit("magnetometer measurement", publisher_of(info), time.monotonic())
-            self._core.measured.on_magnetometer(convert.magnetometer_from_msg(msg))
+            self._sources.guarded("magnetometer measurement", publisher_of(info), self._core.measured.on_magnetometer,
+                                  convert.magnetometer_from_msg(msg))
         except RequestError as err:
             self._refusals("magnetometer measurement", err)
 
