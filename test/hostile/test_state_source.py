@@ -77,3 +77,24 @@ def test_a_spoofer_cannot_take_the_state_input_while_the_simulator_pauses_and_th
         acted = [t for t in commanded if off_grid(t)]
         assert not acted, f"the controller acted on {len(acted)} intruder states (stamps {acted[:3]})"
         assert "second publisher" in s.suite.log_text("controller")
+
+
+def test_a_restarted_simulator_is_followed_as_a_new_timeline(ros_suite):
+    """The held publisher leaves the graph (the simulator stopped) and a new one appears whose stamps
+    start again at 0: the controller takes it (a new timeline, logged) and commands on its states."""
+    with ros_suite("swift_demo", nodes=("simulator", "controller"), name="state_source_restart",
+                   params={"simulator": {"real_time_factor": 2.0},
+                           "controller": {"state_source": "truth"}}) as s:
+        client, commanded = s.client, []
+        client.create_subscription(ActuatorCommand, topics.COMMAND,
+                                   lambda m: commanded.append(convert.from_time(m.header.stamp)), qos.STREAM_QOS)
+        wait_until(lambda: commanded and commanded[-1] > 5.0, 30, "the controller commanding past t = 5 s",
+                   node=client)
+        simulator = s.suite.procs["simulator"]
+        simulator.send_signal(signal.SIGINT)
+        assert simulator.wait(10) == 0
+        before = len(commanded)
+        s.suite.start("simulator", {"scenario": "swift_demo", "real_time_factor": 2.0})
+        wait_until(lambda: sum(t < 5.0 for t in commanded[before:]) > 10, 30,
+                   "the controller commanding on the restarted simulator's states", node=client)
+        assert "timeline restarted" in s.suite.log_text("controller")
