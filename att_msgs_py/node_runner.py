@@ -96,6 +96,13 @@ def publisher_of(info) -> bytes | None:
     return bytes(gid["data"]) if isinstance(gid, dict) and gid.get("data") is not None else None
 
 
+def live_publishers(node, topic: str) -> Callable[[], list[bytes]]:
+    """The GIDs of the publishers of ``topic`` (as ``node`` resolves it) now in the ROS graph, as
+    a callable: the evidence a :class:`~att_msgs_py.source_hold.SourceHold` releases a publisher on."""
+    name = node.resolve_topic_name(topic)
+    return lambda: [bytes(i.endpoint_gid) for i in node.get_publishers_info_by_topic(name)]
+
+
 def participant_of(gid: bytes | None) -> bytes | None:
     """The DDS participant of a publisher GID (its 12-byte GUID prefix): one per node process."""
     return None if gid is None else gid[:12]

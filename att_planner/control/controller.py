@@ -172,6 +172,8 @@ class Controller:
         out = StateOutcome()
         if admission.resynced:
             out.note = f"state timeline restarted: {admission.previous_t:.3f} s then {state.t:.3f} s"
+            if admission.handover:
+                out.note += " (the held publisher left the ROS graph: a new source)"
             if self.maneuver is not None:
                 out.ended = self.abort(f"aborted: {out.note}")
             self.next_control = -math.inf

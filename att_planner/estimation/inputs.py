@@ -10,11 +10,13 @@ from __future__ import annotations
 
 import math
 from collections import deque
+from collections.abc import Callable, Mapping
 
 import numpy as np
 
 from att_msgs_py import validation
 from att_msgs_py.errors import ErrorCode, RequestError
+from att_msgs_py.source_hold import Live, SourceHold
 from att_msgs_py.types import GyroMeasurement, MagnetometerMeasurement, StarTrackerMeasurement, SunSensorMeasurement
 from att_sim.models.sensor_specs import SensorSpecs
 
@@ -109,19 +111,27 @@ class DipoleLog:
 
 
 class Sources:
-    """One publisher per input: a message from a second publisher of the same kind is refused while
-    the first was heard within ``timeout`` s of wall time (then the newcomer takes over: a restarted
-    sensor or simulator)."""
+    """One publisher per input kind (:class:`~att_msgs_py.source_hold.SourceHold`): a message from
+    a publisher other than the held one of its kind is refused while the held one is in the ROS graph,
+    however long it is silent; once it has left the graph the next accepted one is held (a
+    restarted sensor or simulator). ``live`` maps each kind to its topic's publishers in the graph."""
 
-    def __init__(self, timeout: float = 1.0):
-        self.timeout = timeout
-        self.known: dict[str, tuple[bytes, float]] = {}          # kind -> (publisher, wall time last heard)
+    def __init__(self, live: Mapping[str, Live] | None = None):
+        self.live = dict(live or {})
+        self.holds: dict[str, SourceHold] = {}
 
-    def admit(self, kind: str, source: bytes | None, wall: float) -> None:
-        """RequestError (320) for a second publisher of ``kind`` while the first one is alive."""
-        if source is None:
-            return
-        known = self.known.get(kind)
-        if known is not None and known[0] != source and wall - known[1] <= self.timeout:
-            raise RequestError(BAD, f"{kind} from a second publisher while the first one is alive; ignored")
-        self.known[kind] = (source, wall)
+    def hold(self, kind: str) -> SourceHold:
+        if kind not in self.holds:
+            self.holds[kind] = SourceHold(self.live.get(kind))
+        return self.holds[kind]
+
+    def guarded(self, kind: str, source: bytes | None, call: Callable, *args):
+        """``call(*args)`` (a core input that raises RequestError when it refuses) if ``source`` may
+        give ``kind``; ``source`` is held once the call accepted it. RequestError (320) for a
+        second publisher while the held one is in the graph."""
+        hold = self.hold(kind)
+        if not hold.check(source).admitted:
+            raise RequestError(BAD, hold.refusal(kind))
+        result = call(*args)
+        hold.take(source)
+        return result

@@ -18,8 +18,12 @@ last accepted one kept in ``mode_sequence_file`` (:mod:`att_planner.control.mode
 
 Sim time comes from the states' stamps. ``/clock`` is read by the node itself, not through
 rclpy's ``use_sim_time`` (whose time source raises on a negative stamp, so one hostile message
-would kill the node): only clock messages from the participant that publishes the accepted states
-count, and they only serve the state gate's skew check.
+would kill the node): the latest clock of each participant is kept, and a state is compared with
+the clock of its own participant only (the state gate's skew check).
+
+The states (or estimates) are held to one publisher: another one is ignored while the held one is
+in the ROS graph (:class:`att_msgs_py.source_hold.SourceHold`), so neither pausing nor starving the
+real source hands the loop to an intruder; a silent source is stale input (the watchdog below).
 
 Watchdog: when no state came for ``wall_timeout`` s of wall time the controller commands zero
 and reports ``state_stale`` until states flow again.
@@ -50,6 +54,7 @@ from att_msgs_py import convert, qos, signing, topics
 from att_msgs_py.errors import ErrorCode, RequestError
 from att_msgs_py.node_runner import (
     RefusalLog,
+    live_publishers,
     parameter_reader,
     participant_of,
     publisher_of,
@@ -70,6 +75,8 @@ class ControllerNode(Node):
         self._scenario = scen.load_checked(parameter_reader(self, {})("scenario", "swift_demo"))
         param = parameter_reader(self, self._scenario.node_params.get("controller", {}), str(self._scenario.path))
         self._core = controller_from_scenario(param, self._scenario)
+        self._core.gate.hold.live = live_publishers(self, topics.STATE if self._core.measured is None
+                                                    else topics.ESTIMATE)
         self._wall_timeout = param("wall_timeout", 2.0, 0.0, 3600.0, low_open=True)
         wait_for_subscribers = param("wait_for_subscribers", 0, 0, 1000)
         start_timeout = param("start_timeout", 60.0, 0.0, 3600.0, low_open=True)
@@ -84,10 +91,10 @@ class ControllerNode(Node):
         self._state_wall = time.monotonic()   # no "no state" warning before wall_timeout has passed
         self._stale = False
         self._refusals = RefusalLog(self.get_logger())   # refused inputs, logged once a second per kind
-        self._sim_clock: tuple[bytes, float] | None = None   # (participant, s): its latest /clock
         self._goal = None                     # the goal handle of the running maneuver
         self._waiting = None                  # (estimate, source) that came before any wheel speed
-        self._sources = Sources(self._core.gate.config.resync_timeout)   # one publisher per measurement
+        self._sources = Sources({"wheel speed measurement": live_publishers(self, topics.WHEEL_SPEEDS),
+                                 "magnetometer measurement": live_publishers(self, topics.MAGNETOMETER)})
         self._done: Future | None = None
 
         self._cmd_pub = self.create_publisher(ActuatorCommand, topics.COMMAND, qos.STREAM_QOS)
@@ -118,14 +125,12 @@ class ControllerNode(Node):
 
     # (``info`` has no default: rclpy passes the message info only to two-argument callbacks)
     def on_clock(self, msg: ClockMsg, info: dict):
-        sender = participant_of(publisher_of(info))
-        if sender is not None and sender == participant_of(self._core.gate.source):
-            if msg.clock.sec >= 0 and msg.clock.nanosec < 1_000_000_000:
-                self._sim_clock = (sender, convert.from_time(msg.clock))
+        if msg.clock.sec >= 0 and msg.clock.nanosec < 1_000_000_000:
+            self._core.gate.clocks.hear(participant_of(publisher_of(info)), convert.from_time(msg.clock))
 
     def on_state(self, msg: SpacecraftState, info: dict):
         source = publisher_of(info)
-        clock = self._sim_clock[1] if self._sim_clock and self._sim_clock[0] == participant_of(source) else None
+        clock = self._core.gate.clocks.of(participant_of(source))
         self._step(self._core.accept_state(convert.state_from_msg(msg), time.monotonic(), clock, source), "state")
 
     def on_estimate(self, msg: AttitudeEstimate, info: dict):
@@ -138,8 +143,8 @@ class ControllerNode(Node):
 
     def on_wheel_speeds(self, msg: JointState, info: dict):
         try:
-            self._sources.admit("wheel speed measurement", publisher_of(info), time.monotonic())
-            self._core.measured.on_wheel_speeds(convert.wheel_speeds_from_msg(msg))
+            self._sources.guarded("wheel speed measurement", publisher_of(info), self._core.measured.on_wheel_speeds,
+                                  convert.wheel_speeds_from_msg(msg))
         except RequestError as err:
             self._refusals("wheel speed measurement", err)
             return
@@ -149,8 +154,8 @@ class ControllerNode(Node):
 
     def on_magnetometer(self, msg: MagneticField, info: dict):
         try:
-            self._sources.admit("magnetometer measurement", publisher_of(info), time.monotonic())
-            self._core.measured.on_magnetometer(convert.magnetometer_from_msg(msg))
+            self._sources.guarded("magnetometer measurement", publisher_of(info), self._core.measured.on_magnetometer,
+                                  convert.magnetometer_from_msg(msg))
         except RequestError as err:
             self._refusals("magnetometer measurement", err)
 

@@ -8,7 +8,8 @@ datasheets are the scenario's ``sensors`` group (nominal mountings and noise, ne
 simulator drew); its tuning is this node's parameters, defaulting to values derived from them.
 
 Nothing received is trusted: a refused measurement (320 INVALID_MEASUREMENT, 321
-STALE_MEASUREMENT; a second publisher of an input while the first is alive, too) changes nothing
+STALE_MEASUREMENT; a second publisher of an input while the held one is in the ROS graph, too:
+:class:`att_planner.estimation.inputs.Sources`) changes nothing
 and is logged at most once a second per kind with the running count, as are measurements rejected
 by the innovation gate and the filter's notes (initialised, diverged, gyro saturated).
 """
@@ -23,11 +24,22 @@ from sensor_msgs.msg import Imu, MagneticField
 from att_msgs.msg import ActuatorCommand, AttitudeEstimate, CoarseSunSensors, StarTracker
 from att_msgs_py import convert, qos, topics
 from att_msgs_py.errors import RequestError, clip
-from att_msgs_py.node_runner import RefusalLog, parameter_reader, publisher_of, run_node, subscribe_when_heard
+from att_msgs_py.node_runner import (
+    RefusalLog,
+    live_publishers,
+    parameter_reader,
+    publisher_of,
+    run_node,
+    subscribe_when_heard,
+)
 from att_planner.estimation.estimator_from_scenario import estimator_from_scenario
 from att_planner.estimation.inputs import Sources
 from att_sim.models import scenario as scen
 from att_sim.models.sensor_specs import DEG, HOUR
+
+INPUTS = {"gyro sample": topics.IMU, "star tracker measurement": topics.STAR_TRACKER,
+          "magnetometer measurement": topics.MAGNETOMETER, "sun sensor measurement": topics.SUN_SENSORS,
+          "actuator command": topics.COMMAND}      # each input's topic, by the name its refusals give
 
 
 class EstimatorNode(Node):
@@ -40,7 +52,7 @@ class EstimatorNode(Node):
         start_timeout = param("start_timeout", 60.0, 0.0, 3600.0, low_open=True)
         param.refuse_unknown()
         self._refusals = RefusalLog(self.get_logger())
-        self._sources = Sources(self._core.config.resync_timeout)
+        self._sources = Sources({what: live_publishers(self, topic) for what, topic in INPUTS.items()})
         self._pub = self.create_publisher(AttitudeEstimate, topics.ESTIMATE, qos.STREAM_QOS)
         subscribe_when_heard(self, self._pub, wait_for_subscribers, start_timeout, self._subscribe_sensors)
         c = self._core.config
@@ -61,8 +73,7 @@ class EstimatorNode(Node):
         """Run ``call(*args)`` (a core input) if its publisher is the one of ``what``, logging a
         refusal; its result otherwise."""
         try:
-            self._sources.admit(what, publisher_of(info), time.monotonic())
-            return call(*args)
+            return self._sources.guarded(what, publisher_of(info), call, *args)
         except RequestError as err:
             self._refusals(what, err)
             return None

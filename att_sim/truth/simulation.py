@@ -10,8 +10,11 @@ many Monte Carlo runs in one step.
 
 Every command and reset is checked field by field first (:class:`Checks`); a refused one changes
 nothing and comes back as a :class:`Refusal` (an :class:`~att_msgs_py.errors.ErrorCode` and a
-sentence naming the field). A command within ``command_limit_factor`` × an actuator limit is
-clamped to the limit (saturation); beyond it, it is a fault and refused.
+sentence naming the field). Commands are held to their publisher
+(:class:`~att_msgs_py.source_hold.SourceHold`, :attr:`Simulation.command_source`): one from another
+publisher is refused while the held one is in the ROS graph, however long it is silent. A command
+within ``command_limit_factor`` × an actuator limit is clamped to the limit (saturation); beyond
+it, it is a fault and refused.
 """
 from __future__ import annotations
 
@@ -23,6 +26,7 @@ import numpy as np
 
 from att_msgs_py import validation
 from att_msgs_py.errors import ErrorCode, RequestError, clip
+from att_msgs_py.source_hold import SourceHold
 from att_msgs_py.types import CONTROL_MODES, Command, ControlMode, State
 from att_sim.models import dynamics as dyn
 from att_sim.models import environment as env
@@ -44,33 +48,6 @@ class Refusal(NamedTuple):
 
     code: ErrorCode
     message: str
-
-
-class CommandSource:
-    """The publisher whose actuator commands are applied, held as the controller holds the
-    publisher of its states: the first one accepted is kept while it lives, and a command from
-    another publisher is refused until the held one has sent no accepted command for ``timeout``
-    s of sim time (gone: its inputs are zeroed by then), never merely because it is late.
-    ``None`` sources (a middleware that does not say) are not compared."""
-
-    def __init__(self, timeout: float):
-        self.timeout = timeout
-        self.source: bytes | None = None   # the held publisher
-        self.last_t = -math.inf             # sim time of its last accepted command
-
-    def check(self, source: bytes | None, t: float) -> Refusal | None:
-        """Why a command from ``source`` at sim time ``t`` may not be applied (None: it may)."""
-        if source is None or self.source is None or source == self.source or t - self.last_t > self.timeout:
-            return None
-        return Refusal(ErrorCode.INVALID_COMMAND,
-                       f"command from a second publisher while the first one is alive (its last command accepted "
-                       f"{t - self.last_t:.3g} s ago, at most command_timeout = {self.timeout:g} s); ignored")
-
-    def accept(self, source: bytes | None, t: float) -> None:
-        """Remember an applied command from ``source`` at sim time ``t``."""
-        if source is not None:
-            self.source = source
-        self.last_t = t
 
 
 @dataclass(frozen=True)
@@ -128,6 +105,7 @@ class Simulation:
         self.dipole_cmd = np.zeros(3)
         self.body_cmd = np.zeros(3)
         self.command_timeout = False
+        self.command_source = SourceHold()     # the publisher whose commands are applied (the node gives the graph)
         self.halted, self.halt_reason = False, ""
         self.applied = Applied(np.zeros(sc.n_wheels))
         self.now = self.environment.sample(self.t, self.x[:4])
@@ -157,12 +135,16 @@ class Simulation:
                    sensors=scenario.sensors, actuators=scenario.actuators, seed=seed, frame_id=scenario.frame_id,
                    body_frame_id=scenario.body_frame_id)
 
-    def set_command(self, command: Command) -> Refusal | None:
-        """Accept a command (None) or say why it is refused; a refused command changes nothing."""
+    def set_command(self, command: Command, source: bytes | None = None) -> Refusal | None:
+        """Accept a command from publisher ``source`` (None: unnamed) or say why it is refused; a
+        refused command changes nothing."""
+        if not self.command_source.check(source).admitted:
+            return Refusal(ErrorCode.INVALID_COMMAND, self.command_source.refusal("command"))
         try:
             wheel_torque, dipole, body_torque = self.check_command(command)
         except RequestError as err:
             return Refusal(err.code, err.message)
+        self.command_source.take(source)
         idle = command.mode == ControlMode.IDLE
         self.wheel_cmd = np.zeros(self.sc.n_wheels) if idle or wheel_torque.size == 0 else wheel_torque
         self.dipole_cmd = np.zeros(3) if idle else dipole

@@ -31,8 +31,10 @@ each is type- and range-checked, and a bad one stops the node with one line on s
 Safety: every command and reset is checked by :class:`~att_sim.truth.simulation.Simulation` (sizes,
 NaN/Inf, magnitude against ``command_limit_factor`` × the limits, stamp, frame, text); a refused one
 is never integrated and is logged at most once a second with the running count. Commands are held
-to their publisher (:class:`~att_sim.truth.simulation.CommandSource`): one from a second publisher
-is refused while the first one has had a command accepted within ``command_timeout`` s of sim time. When no valid
+to their publisher (:class:`~att_msgs_py.source_hold.SourceHold`): one from a second publisher is
+refused while the held one is in the ROS graph, however long it is silent; a restarted controller
+is followed once the old one has left the graph (at once after a clean stop, when its DDS lease
+expires after a crash). When no valid
 command arrived for ``command_timeout`` s of sim time the actuator inputs are zeroed and the state
 says so. In lockstep, a state that no command answers within ``lockstep_timeout`` s of wall time
 ends the waiting: the simulator free-runs at its real-time factor with zero inputs
@@ -60,11 +62,11 @@ from att_msgs.msg import ActuatorCommand, CoarseSunSensors, SensorTruth, Spacecr
 from att_msgs.srv import ResetSimulator
 from att_msgs_py import convert, markers, qos, topics, validation
 from att_msgs_py.errors import ConfigError, ErrorCode, RequestError, clip
-from att_msgs_py.node_runner import parameter_reader, publisher_of, run_node, spin_until_shutdown
+from att_msgs_py.node_runner import live_publishers, parameter_reader, publisher_of, run_node, spin_until_shutdown
 from att_sim.models import scenario as scen
 from att_sim.models import scene
 from att_sim.truth import dispersions
-from att_sim.truth.simulation import DEFAULT_STEP, Checks, CommandSource, Refusal, Simulation
+from att_sim.truth.simulation import DEFAULT_STEP, Checks, Refusal, Simulation
 
 FREE_RUN_PACE = 1.0        # real-time factor of a free-running simulator whose real_time_factor is 0 (max)
 
@@ -88,7 +90,6 @@ class SimulatorNode(Node):
                 checks=Checks(command_limit_factor=param["command_limit_factor"],
                               max_reset_rate=param["max_reset_rate"], body_frame_id=self.scenario.body_frame_id,
                               stamp_ahead=self.step, stamp_age=self.command_timeout), seed=truth.seed)
-            self.commands = CommandSource(self.command_timeout)   # the publisher whose commands are applied
         except ValueError as err:        # the environment cannot start (e.g. a TLE that fails at t = 0)
             raise ConfigError(ErrorCode.INVALID_CONFIG, f"scenario '{self.scenario.name}': {clip(err, 300)}") from None
 
@@ -100,6 +101,7 @@ class SimulatorNode(Node):
         self.marker_pub = (self.create_publisher(MarkerArray, topics.SIM_MARKERS, qos.STREAM_QOS)
                            if self.marker_rate else None)
         self.sensor_pubs = self.sensor_publishers()
+        self.sim.command_source.live = live_publishers(self, topics.COMMAND)
         self.create_subscription(ActuatorCommand, topics.COMMAND, self.on_command, qos.STREAM_QOS)
         self.create_service(ResetSimulator, topics.RESET_SIMULATOR, self.on_reset)
         e = self.sim.environment
@@ -203,17 +205,16 @@ class SimulatorNode(Node):
     def on_command(self, msg: ActuatorCommand, info: dict):
         command = convert.command_from_msg(msg)
         source = publisher_of(info)
-        refusal = self.commands.check(source, self.sim.t) or self.sim.set_command(command)
+        refusal = self.sim.set_command(command, source)
         if refusal is not None:
             self.report("command", refusal)
-            if self.free_running and source is not None and source == self.commands.source and \
+            if self.free_running and source is not None and source == self.sim.command_source.held and \
                     self.sim.late_only(command):
                 self.free_running = False        # the controller lives but lags: wait for it to catch up
                 self.get_logger().info(f"a late command (t = {command.t:.3f} s) from the controller at t = "
                                        f"{self.sim.t:.3f} s: waiting for it to catch up", throttle_duration_sec=1.0)
             return
         self.last_command_time = self.sim.t
-        self.commands.accept(source, self.sim.t)
         if command.t >= self.awaited_stamp - 1e-9:
             self.answered = True
         if self.free_running:

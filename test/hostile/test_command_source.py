@@ -1,6 +1,6 @@
 """Actuator commands are held to their source: a valid-looking command from a second publisher is
-not applied while the controller lives, and the simulator follows a new publisher only once the
-held one is gone (no accepted command for ``command_timeout`` s of sim time)."""
+not applied while the held publisher (the controller) is in the ROS graph, however long it is
+silent, and the simulator follows a new publisher only once the held one has left the graph."""
 from __future__ import annotations
 
 import time
@@ -13,40 +13,60 @@ from att_msgs.msg import ActuatorCommand, SpacecraftState
 from att_msgs_py import convert, qos, topics
 from att_msgs_py.errors import ErrorCode
 from att_msgs_py.types import Command, ControlMode
-from att_sim.truth.simulation import CommandSource
+from att_sim.models import scenario
+from att_sim.truth.simulation import Simulation
 
 CONTROLLER, INTRUDER = b"controller-gid", b"intruder-gid"
+SWIFT = scenario.load("swift_demo")
 
 
-def test_a_second_publisher_is_refused_while_the_first_lives():
-    held = CommandSource(timeout=1.0)
-    assert held.check(CONTROLLER, 0.0) is None
-    held.accept(CONTROLLER, 0.0)
-    for t in (0.0, 0.5, 1.0):
-        refused = held.check(INTRUDER, t)
+def simulation(*publishers):
+    """A simulation whose command topic lists ``publishers`` in the graph (a set to edit)."""
+    sim = Simulation(SWIFT.spacecraft, SWIFT.orbit)
+    live = set(publishers)
+    sim.command_source.live = lambda: live
+    return sim, live
+
+
+def torque(sim, wheel_x: float) -> Command:
+    return Command(t=sim.t, mode=ControlMode.PLAN_TRACKING, wheel_torques=np.array([wheel_x, 0.0, 0.0]),
+                   dipole=np.zeros(3), body_torque=np.zeros(3))
+
+
+def test_a_second_publisher_is_refused_while_the_first_is_in_the_graph_however_long_it_is_silent():
+    sim, _ = simulation(CONTROLLER, INTRUDER)
+    assert sim.set_command(torque(sim, 0.0), CONTROLLER) is None
+    for _ in range(100):                                      # the controller paused 5 s of sim time
+        sim.advance(0.05)
+        refused = sim.set_command(torque(sim, 0.12), INTRUDER)
         assert refused.code == ErrorCode.INVALID_COMMAND and "second publisher" in refused.message
-    assert held.check(CONTROLLER, 0.9) is None
-    held.accept(CONTROLLER, 0.9)
-    assert held.check(INTRUDER, 1.5) is not None              # 0.6 s after the controller's last command
+    assert np.all(sim.wheel_cmd == 0.0)
+    assert sim.set_command(torque(sim, 0.01), CONTROLLER) is None and sim.wheel_cmd[0] == 0.01
 
 
-def test_a_new_publisher_is_followed_once_the_held_one_is_gone():
-    held = CommandSource(timeout=1.0)
-    held.accept(CONTROLLER, 2.0)
-    assert held.check(INTRUDER, 3.01) is None                  # silent for more than the timeout: gone
-    held.accept(INTRUDER, 3.01)
-    assert held.source == INTRUDER
-    assert held.check(CONTROLLER, 3.5).code == ErrorCode.INVALID_COMMAND   # and now the new one is held
+def test_a_new_publisher_is_followed_once_the_held_one_has_left_the_graph():
+    sim, live = simulation(CONTROLLER, INTRUDER)
+    sim.set_command(torque(sim, 0.0), CONTROLLER)
+    live.discard(CONTROLLER)                                  # the controller stopped (or restarted)
+    assert sim.set_command(torque(sim, 0.02), INTRUDER) is None and sim.wheel_cmd[0] == 0.02
+    assert sim.command_source.held == INTRUDER
+    live.add(CONTROLLER)
+    assert sim.set_command(torque(sim, 0.0), CONTROLLER).code == ErrorCode.INVALID_COMMAND   # now the new one is held
+
+
+def test_a_refused_command_never_takes_the_hold():
+    sim, _ = simulation(CONTROLLER, INTRUDER)
+    bad = torque(sim, float("nan"))
+    assert sim.set_command(bad, INTRUDER).code == ErrorCode.INVALID_COMMAND
+    assert sim.command_source.held is None
+    assert sim.set_command(torque(sim, 0.0), CONTROLLER) is None and sim.command_source.held == CONTROLLER
 
 
 def test_sources_the_middleware_does_not_name_are_not_compared():
-    held = CommandSource(timeout=1.0)
-    held.accept(None, 0.0)
-    assert held.source is None and held.check(INTRUDER, 0.1) is None
-    held.accept(INTRUDER, 0.1)
-    assert held.check(None, 0.2) is None
-    held.accept(None, 0.2)
-    assert held.source == INTRUDER and held.last_t == 0.2
+    sim, _ = simulation(INTRUDER)
+    assert sim.set_command(torque(sim, 0.0), None) is None and sim.command_source.held is None
+    assert sim.set_command(torque(sim, 0.0), INTRUDER) is None
+    assert sim.set_command(torque(sim, 0.0), None) is None and sim.command_source.held == INTRUDER
 
 
 def command(t: float, wheel_x: float) -> ActuatorCommand:
@@ -92,11 +112,16 @@ def test_a_second_publishers_command_is_not_applied_while_the_controller_answers
         applied = [m for m in states if not m.command_timeout]
         assert max(abs(m.wheel_torques[0]) for m in applied) < 0.01, "the intruder's torque was applied"
         assert "second publisher" in s.suite.log_text("simulator")
-        states.clear()                                         # the controller stops: gone after command_timeout
 
         def intruder_only():
             intruder.publish(command(latest[0], 0.12))
             time.sleep(0.005)  # wait-ok: pacing of the intruder's publications, not a wait
 
+        states.clear()                                         # the controller silent, still in the graph
+        assert spin_until(client, lambda: len(states) > 60, 30.0, intruder_only)
+        assert all(m.command_timeout and m.wheel_torques[0] == 0.0 for m in states[20:]), \
+            "a silent controller's input was handed to the intruder"
+        client.destroy_publisher(controller)                   # the controller stops: it leaves the graph
+        states.clear()
         assert spin_until(client, lambda: any(abs(m.wheel_torques[0] - 0.12) < 2e-3 for m in states), 20.0,
                           intruder_only), "a new publisher was never followed once the held one had gone"

@@ -91,29 +91,83 @@ def test_without_a_clock_the_previous_state_bounds_a_forward_jump(loop):
     assert out.refused.code == ErrorCode.STATE_TIME_JUMP and "at most 5 s" in out.refused.message
 
 
-def test_a_second_publisher_is_ignored_while_the_first_is_alive_then_may_take_over(loop):
+def graph(core, *gids):
+    """Give the core's state gate a ROS graph listing ``gids`` as the state's publishers (a set to edit)."""
+    live = set(gids)
+    core.gate.hold.live = lambda: live
+    return live
+
+
+def test_a_second_publisher_is_ignored_while_the_first_is_in_the_graph_however_long_it_is_silent(loop):
     core, sim = loop
+    graph(core, SIM_A, SIM_B)
     out = core.accept_state(base(sim), wall=sim.t, clock=sim.t, source=SIM_B)
     assert out.refused.code == ErrorCode.INVALID_STATE and "second publisher" in out.refused.message
-    sim.advance(3.0)                        # the first publisher fell silent for longer than resync_timeout
-    assert core.accept_state(base(sim), wall=sim.t, clock=sim.t, source=SIM_B).refused is None
-    assert core.gate.source == SIM_B
+    sim.advance(30.0)                       # the first publisher silent (paused) for 30 s: still in the graph
+    assert core.accept_state(base(sim), wall=sim.t, clock=sim.t, source=SIM_B).refused.code == \
+        ErrorCode.INVALID_STATE
+    assert core.state.t == pytest.approx(1.0) and core.gate.hold.held == SIM_A
 
 
-def test_a_hand_published_far_stamp_before_the_clock_runs_stalls_nothing_for_long():
+def test_a_second_publisher_takes_over_once_the_first_has_left_the_graph(loop):
+    core, sim = loop
+    live = graph(core, SIM_A, SIM_B)
+    live.discard(SIM_A)                     # the first publisher stopped
+    out = core.accept_state(base(sim), wall=sim.t, clock=sim.t, source=SIM_B)
+    assert out.refused is None and "new source" in out.note
+    assert core.gate.hold.held == SIM_B
+
+
+def test_a_spoofer_flooding_while_the_real_source_pauses_is_never_acted_on_and_the_real_one_goes_on(loop):
+    """The real simulator paused 3 s while an intruder publishes plausible states at 1 kHz (current
+    attitude, stamps following the sim clock, a small body rate) and its own, then frozen, /clock:
+    nothing of the intruder is taken, and the real source's next state is."""
+    core, sim = loop
+    live = graph(core, SIM_A, SIM_B)
+    clock_A, clock_B = SIM_A[:12], SIM_B[:12]
+    core.gate.clocks.hear(clock_A, sim.t)
+    for k in range(3000):
+        wall = sim.t + 0.001 * (k + 1)
+        fake = replace(base(sim), t=sim.t + 0.001 * (k + 1), omega=np.array([0.002, 0.0, 0.0]))
+        core.gate.clocks.hear(clock_B, 1.0)                   # the intruder's clock, frozen
+        out = core.accept_state(fake, wall=wall, clock=core.gate.clocks.of(clock_B), source=SIM_B)
+        assert out.refused is not None and "second publisher" in out.refused.message
+    live.discard(SIM_B)                                       # the intruder stops
+    sim.advance(0.05)
+    core.gate.clocks.hear(clock_A, sim.t)
+    out = core.accept_state(base(sim), wall=sim.t + 3.0, clock=core.gate.clocks.of(clock_A), source=SIM_A)
+    assert out.refused is None and out.note is None          # the same timeline, no restart
+    assert core.state.t == pytest.approx(sim.t) and not np.any(core.state.omega == 0.002)
+
+
+def test_another_participants_clock_never_fails_the_held_sources_states(loop):
+    core, sim = loop
+    core.gate.clocks.hear(SIM_A[:12], sim.t)
+    core.gate.clocks.hear(SIM_B[:12], 500.0)                 # a hostile clock from another participant
+    assert core.gate.clocks.of(SIM_A[:12]) == pytest.approx(sim.t)
+    assert core.accept_state(base(sim), wall=sim.t, clock=core.gate.clocks.of(SIM_A[:12]),
+                             source=SIM_A).refused is None
+    for k in range(40):                                      # a flood of participants forgets the oldest only
+        core.gate.clocks.hear(bytes([k]) * 12, 1.0)
+    assert core.gate.clocks.of(SIM_A[:12]) is None and len(core.gate.clocks.latest) == 16
+
+
+def test_the_held_source_whose_stamps_jump_after_a_starved_while_starts_a_new_timeline(loop):
+    core, sim = loop
+    sim.advance(8.0)                                         # the controller was busy 2.5 s; the simulator ran on
+    out = core.accept_state(base(sim), wall=1.0 + 2.5, clock=sim.t, source=SIM_A)
+    assert out.refused is None and "timeline restarted" in out.note and core.gate.hold.held == SIM_A
+
+
+def test_a_hand_published_far_stamp_before_the_clock_runs_stalls_nothing_once_its_publisher_is_gone():
     core = Controller(context(), ControllerConfig(), body_frame_id="body")
+    live = graph(core, SIM_B, SIM_A)
     sim = Simulation(SWIFT.spacecraft, SWIFT.orbit)
     assert core.accept_state(replace(base(sim), t=1e6), wall=0.0, source=SIM_B).refused is None  # the first one
-    refused_until = None
-    for k in range(60):                      # the simulator's states, 20 Hz of wall time
-        wall = 0.05 * (k + 1)
-        out = core.accept_state(base(sim), wall=wall, source=SIM_A)
-        if out.refused is None:
-            refused_until = wall
-            assert "timeline restarted" in out.note
-            break
-        sim.advance(0.05)
-    assert refused_until is not None and refused_until <= core.gate.config.resync_timeout + 0.1
+    assert core.accept_state(base(sim), wall=0.05, source=SIM_A).refused is not None
+    live.discard(SIM_B)                      # `ros2 topic pub --once` ends
+    out = core.accept_state(base(sim), wall=0.1, source=SIM_A)
+    assert out.refused is None and "timeline restarted" in out.note
 
 
 def test_a_new_timeline_aborts_the_running_maneuver(loop):
@@ -122,7 +176,8 @@ def test_a_new_timeline_aborts_the_running_maneuver(loop):
                                                                 rot.from_axis_angle([0, 0, 1], 0.5))), core.context)
     assert core.start(core.resolve("", plan, payload)[0]) is None
     restarted = Simulation(SWIFT.spacecraft, SWIFT.orbit)          # a restarted simulator: t = 0 again
-    out = core.accept_state(base(restarted), wall=sim.t + 5.0, clock=0.0, source=SIM_B)
+    graph(core, SIM_B)                                              # the first one has left the graph
+    out = core.accept_state(base(restarted), wall=sim.t + 0.05, clock=0.0, source=SIM_B)
     assert out.refused is None and "timeline restarted" in out.note
     assert out.ended.error_code == ErrorCode.ABORTED and core.maneuver is None and core.mode == ControlMode.SAFE
 

@@ -146,3 +146,22 @@ def test_expected_friction_is_added_to_every_wheel_command():
     difference = compensating.step().command.wheel_torques - plain.step().command.wheel_torques
     relative = np.array([100.0, -50.0, 0.0])
     assert np.allclose(difference, friction(relative), atol=1e-15) and difference[0] > 0 > difference[1]
+
+
+def test_an_intruders_estimates_while_the_estimator_pauses_are_never_flown():
+    """The estimator paused (in the graph, silent) while an intruder publishes converged estimates of
+    a rate that does not exist, at 1 kHz for 3 s: the controller never composes a state from them
+    (no safe-mode damping of a phantom rate); the estimator's next estimate is flown."""
+    estimator, intruder = b"estimator-gid", b"intruder-gid"
+    core = controller()
+    core.gate.hold.live = lambda: {estimator, intruder}
+    core.measured.on_wheel_speeds(wheels(0.0, (0.0, 0.0, 0.0)))
+    assert core.accept_estimate(estimate(0.0), wall=0.0, source=estimator).refused is None
+    core.step()
+    for k in range(3000):
+        outcome = core.accept_estimate(estimate(0.001 * (k + 1), omega=(0.02, 0.0, 0.0)), wall=0.001 * (k + 1),
+                                       source=intruder)
+        assert outcome.refused is not None and "second publisher" in outcome.refused.message
+    assert core.state.t == 0.0 and not np.any(core.state.omega)
+    assert core.accept_estimate(estimate(0.05), wall=3.1, source=estimator).refused is None
+    assert core.due() and np.allclose(core.step().command.wheel_torques, 0.0) and core.mode == ControlMode.IDLE

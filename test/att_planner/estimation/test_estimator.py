@@ -246,16 +246,33 @@ def test_no_single_gyro_sample_can_steer_the_filters_clock_but_a_restarted_timel
     assert est.on_gyro(gyro(3.05), wall=102.05).health == Health.CONVERGED
 
 
-def test_a_second_publisher_of_an_input_is_refused_while_the_first_is_alive():
-    sources = Sources(timeout=1.0)
-    sources.admit("gyro sample", b"a", 0.0)
-    with pytest.raises(RequestError) as err:
-        sources.admit("gyro sample", b"b", 0.5)
-    assert err.value.code == ErrorCode.INVALID_MEASUREMENT
-    sources.admit("star tracker measurement", b"b", 0.5)             # another input: its own publisher
-    sources.admit("gyro sample", b"b", 1.6)                          # the first fell silent: the newcomer takes over
+def test_a_second_publisher_of_an_input_is_refused_while_the_first_is_in_the_graph_however_long_it_is_silent():
+    gyros, trackers = {b"a", b"b"}, {b"b"}
+    sources = Sources({"gyro sample": lambda: gyros, "star tracker measurement": lambda: trackers})
+    taken = []
+    assert sources.guarded("gyro sample", b"a", taken.append, 1) is None and taken == [1]
+    for _ in range(1000):                                             # the first one paused, another floods
+        with pytest.raises(RequestError) as err:
+            sources.guarded("gyro sample", b"b", taken.append, 2)
+        assert err.value.code == ErrorCode.INVALID_MEASUREMENT and "second publisher" in err.value.message
+    assert taken == [1]
+    sources.guarded("star tracker measurement", b"b", taken.append, 3)   # another input: its own publisher
+    gyros.discard(b"a")                                               # the first one left the graph: taken over
+    sources.guarded("gyro sample", b"b", taken.append, 4)
+    gyros.add(b"a")
     with pytest.raises(RequestError):
-        sources.admit("gyro sample", b"a", 1.7)
+        sources.guarded("gyro sample", b"a", taken.append, 5)
+    assert taken == [1, 3, 4]
+
+
+def test_a_publisher_whose_message_the_estimator_refuses_never_takes_an_input():
+    est = estimator()
+    sources = Sources({"gyro sample": lambda: {b"intruder", b"real"}})
+    with pytest.raises(RequestError):                                 # the intruder came first, with a NaN rate
+        sources.guarded("gyro sample", b"intruder", est.on_gyro, gyro(0.0, omega=np.array([np.nan, 0, 0])))
+    assert sources.hold("gyro sample").held is None
+    sources.guarded("gyro sample", b"real", est.on_gyro, gyro(0.0))
+    assert sources.hold("gyro sample").held == b"real"
 
 
 def test_a_covariance_that_stops_being_positive_definite_loses_the_estimate_which_reinitialises():
