@@ -24,6 +24,7 @@ STUDIES = {
     "observe": "att_planner.tools.bench.observe",
     "day": "att_planner.tools.bench.day",
     "timing": "att_planner.tools.bench.timing",
+    "logtools": "att_planner.tools.bench.logtools",
 }
 
 
