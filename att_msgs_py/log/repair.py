@@ -143,7 +143,7 @@ def check_magic(path: str | Path) -> int:
     with open(path, "rb") as fh:
         start = fh.read(len(MAGIC))
     if size == 0:
-        raise LogFileError(f"{path}: the file is empty (its writer stopped before writing anything)")
+        raise LogFileError(f"{path}: the file is empty (0 bytes: its writer stopped before writing anything)")
     if start != MAGIC[:len(start)]:
         raise LogFileError(f"{path}: not an MCAP file (it does not start with the MCAP magic bytes)")
     if len(start) < len(MAGIC):
@@ -199,7 +199,8 @@ def _problem(exc: Exception, start: int, end: int, size: int, footer: bool, whol
     if whole:
         return f"damaged record at byte {start}: {printable(exc)}"
     if start >= size:
-        return "no data end, summary or footer after the last complete record (the writer did not finish)"
+        return (f"no data end, summary or footer after the last complete record, which ends at byte {start} "
+                "(the writer did not finish)")
     if end >= size:
         return f"the last record (at byte {start}) is cut short: its writer was stopped while writing it"
     return f"damaged record at byte {start}: {printable(exc)}"

@@ -309,6 +309,8 @@ def test_what_is_not_an_mcap_log_is_refused_in_one_line(tmp_path, capsys, name):
         err = capsys.readouterr().err
         assert err.count("\n") == 1 and err.startswith(f"att-log: {path}: "), err
         assert "Traceback" not in err
+        if name in ("empty", "half magic", "magic only", "magic and cut header", "no header first"):
+            assert "byte" in err, err          # where the file ends or what is at its start
     assert sorted(p.name for p in tmp_path.iterdir()) == ([] if name == "missing" else ["in.mcap"])
 
 
