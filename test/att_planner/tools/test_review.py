@@ -239,3 +239,29 @@ def test_a_log_without_goal_or_plan_is_reviewed_without_a_warning(tmp_path):
         warnings.simplefilter("error")
         done = review(path, tmp_path / "review")
     assert done.summary["kind"] != "maneuver" and (tmp_path / "review" / "time_histories.png").stat().st_size > 10_000
+
+
+def test_the_reviewed_topics_cover_every_part_of_the_review():
+    from att_msgs_py.topics import COMMAND, CONTROLLER_STATUS, PLANS, STATE
+    from att_planner.tools.review import REVIEWED_TOPICS
+    from att_planner.tools.review.estimation import TOPICS as ESTIMATION_TOPICS
+    from att_planner.tools.review.mission import TOPICS as MISSION_TOPICS
+
+    assert REVIEWED_TOPICS == sorted({STATE, COMMAND, PLANS, CONTROLLER_STATUS, *ESTIMATION_TOPICS, *MISSION_TOPICS})
+
+
+def test_a_damaged_log_is_refused_before_the_figures_and_models_are_imported(tmp_path):
+    """att-review answers a file it cannot read after importing only the reader: matplotlib, scipy
+    and the planner's models (seconds on a loaded machine) are imported once there is a log to review."""
+    import subprocess
+    import sys
+
+    damaged = tmp_path / "cut.mcap"
+    damaged.write_bytes(FIXTURE.read_bytes()[:9])
+    heavy = ("matplotlib", "scipy", "att_planner.zones", "att_planner.tools.review.figures")
+    probe = ("import sys; from att_planner.tools.review import main; code = main([sys.argv[1]]); "
+             f"print(code, sorted(m for m in {heavy!r} if m in sys.modules))")
+    done = subprocess.run([sys.executable, "-c", probe, str(damaged)], capture_output=True, text=True, timeout=120)
+    assert done.stdout.strip() == "1 []", done.stdout + done.stderr
+    assert done.stderr.count("\n") == 1 and "at byte 8" in done.stderr, done.stderr
+    assert not (tmp_path / "review").exists()
