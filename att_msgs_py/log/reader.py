@@ -94,6 +94,22 @@ def iter_records(path: str | Path):
     yield from records
 
 
+def _decoder(factory: DecoderFactory, path, channel, schema):
+    """The decoder of ``schema`` (a ros2msg text named ``pkg/msg/Name``, parsed by ``mcap_ros2``
+    without importing anything); :class:`LogFileError` (one line) for a schema that does not parse:
+    its name and text come from the file, so whatever the parser raises is the file's fault."""
+    try:
+        decoder = factory.decoder_for(channel.message_encoding, schema)
+    except Exception as err:
+        decoder, why = None, f"{type(err).__name__}: {printable(err)}"
+    else:
+        why = f"no decoder for encoding '{printable(channel.message_encoding)}'"
+    if decoder is None:
+        raise LogFileError(f"{printable(path)}: topic '{printable(channel.topic)}': schema '{printable(schema.name)}' "
+                           f"does not decode ({why})")
+    return decoder
+
+
 def read_log(path: str | Path, topics: list[str] | None = None,
              keep_messages: bool | Collection[str] = (suite_topics.PLANS,)) -> dict[str, TopicLog]:
     """Read an MCAP log into ``{topic: TopicLog}``: the replay library of tools and tests.
@@ -107,16 +123,24 @@ def read_log(path: str | Path, topics: list[str] | None = None,
     limits the topics read; the decoded message objects are kept too (``TopicLog.messages``) for
     the topics in ``keep_messages`` (True: all; default: the plans, which tools turn into
     :class:`~att_msgs_py.types.Plan` with :func:`att_msgs_py.convert.plan_from_msg`). A file whose
-    writer was killed is read up to its last complete chunk.
+    writer was killed is read up to its last complete chunk. :class:`LogFileError` (one line) for a
+    read topic whose schema does not parse or whose message does not decode.
     """
     factory = DecoderFactory()
     decoders, rows = {}, {}
     for schema, channel, message in iter_records(path):
         if topics is not None and channel.topic not in topics:
             continue
+        if schema is None:
+            raise LogFileError(f"{printable(path)}: topic '{printable(channel.topic)}' has no schema to decode it")
         if schema.id not in decoders:
-            decoders[schema.id] = factory.decoder_for(channel.message_encoding, schema)
-        decoded = decoders[schema.id](message.data)
+            decoders[schema.id] = _decoder(factory, path, channel, schema)
+        try:
+            decoded = decoders[schema.id](message.data)
+        except Exception as err:      # the bytes come from the file: whatever their decoding raises
+            raise LogFileError(f"{printable(path)}: message {message.sequence} of topic '{printable(channel.topic)}' "
+                               f"does not decode as '{printable(schema.name)}' ({type(err).__name__}: "
+                               f"{printable(err)})") from None
         entry = rows.setdefault(channel.topic, (schema.name, [], [], []))
         entry[1].append(message.log_time * 1e-9)
         entry[2].append(flatten(decoded))

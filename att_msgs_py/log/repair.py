@@ -7,7 +7,11 @@ perhaps with its last chunk cut short; ``rosbags`` and ``mcap``'s seeking reader
 bounded by what is left of the file, so a damaged length field cannot allocate more) and stops
 at the first record that is cut, fails its CRC or has an opcode the MCAP specification does not
 define (the specification lets a reader skip such a record; a suite log holds none, so one is a
-damaged byte: a chunk's opcode flipped would otherwise drop that chunk and go on after it).
+damaged byte: a chunk's opcode flipped would otherwise drop that chunk and go on after it). Every
+CRC of the file is checked: each chunk's (a chunk whose CRC reads 0 is refused: nothing could tell
+its damaged payload from the recorded one), the data section's in the data end (the header and the
+message indexes, which no chunk CRC covers) and the summary's in the footer (the summary's
+statistics, indexes and offsets, and the footer's summary start).
 :func:`repair` writes every record read before that point (header, schemas, channels with their
 metadata, messages byte for byte with their log time, publish time and sequence, attachments,
 metadata) through ``mcap``'s Writer, which adds the index and the summary. A chunk the kill cut
@@ -18,6 +22,7 @@ from __future__ import annotations
 import io
 import os
 import struct
+import zlib
 from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -143,7 +148,7 @@ def check_magic(path: str | Path) -> int:
     with open(path, "rb") as fh:
         start = fh.read(len(MAGIC))
     if size == 0:
-        raise LogFileError(f"{path}: the file is empty (its writer stopped before writing anything)")
+        raise LogFileError(f"{path}: the file is empty (0 bytes: its writer stopped before writing anything)")
     if start != MAGIC[:len(start)]:
         raise LogFileError(f"{path}: not an MCAP file (it does not start with the MCAP magic bytes)")
     if len(start) < len(MAGIC):
@@ -183,8 +188,12 @@ def _inflate(chunk: Chunk) -> bytes:
 
 
 def _chunk_records(chunk: Chunk) -> list:
-    """The records of a chunk, its CRC checked; DAMAGE for a chunk that does not decode."""
+    """The records of a chunk, its CRC checked; DAMAGE for a chunk that does not decode or has no
+    CRC (0: the MCAP specification's "not computed"; every writer the suite reads computes one, so
+    a 0 is a damaged field, and nothing would tell a damaged payload from the recorded one)."""
     data = _inflate(chunk)
+    if chunk.uncompressed_crc == 0:
+        raise ValueError("chunk without a CRC (its CRC field reads 0): its records cannot be checked")
     plain = Chunk(compression="", data=data, message_end_time=chunk.message_end_time,
                   message_start_time=chunk.message_start_time, uncompressed_crc=chunk.uncompressed_crc,
                   uncompressed_size=chunk.uncompressed_size)
@@ -193,13 +202,18 @@ def _chunk_records(chunk: Chunk) -> list:
 
 def _problem(exc: Exception, start: int, end: int, size: int, footer: bool, whole: bool) -> str:
     """Why reading stopped at the record starting at ``start``; ``whole``: the record was read to
-    its end (so it is damaged or hostile, not cut)."""
+    its end, or its length field says it ends within the file (so it is damaged or hostile, not cut:
+    a flipped opcode or inner length would otherwise read on to the end and pass for a cut)."""
     if footer:
         return f"the closing magic after the footer is missing or wrong ({printable(exc)})"
+    if isinstance(getattr(exc, "record", None), DataEnd):
+        return (f"damaged record at byte {start}: the data end's CRC of the data section does not match its bytes "
+                "(a byte of the header or of a message index is damaged: every chunk's own CRC matched)")
     if whole:
         return f"damaged record at byte {start}: {printable(exc)}"
     if start >= size:
-        return "no data end, summary or footer after the last complete record (the writer did not finish)"
+        return (f"no data end, summary or footer after the last complete record, which ends at byte {start} "
+                "(the writer did not finish)")
     if end >= size:
         return f"the last record (at byte {start}) is cut short: its writer was stopped while writing it"
     return f"damaged record at byte {start}: {printable(exc)}"
@@ -222,6 +236,38 @@ def _check_summary_copy(scan: Scan, record) -> None:
     known = scan.schemas if isinstance(record, Schema) else scan.channels
     if record.id in known and known[record.id] != record:
         raise ValueError(f"the summary's {type(record).__name__.lower()} {record.id} differs from the data section's")
+
+
+def _declared_end(fh, start: int) -> int:
+    """Where the record starting at ``start`` ends by its own length field (read without moving ``fh``)."""
+    return start + 9 + int.from_bytes(os.pread(fh.fileno(), 8, start + 1).ljust(8, b"\0"), "little")
+
+
+def _summary_crc(fh, start: int, end: int) -> int:
+    """CRC32 of the file's bytes ``[start, end)``, read in pieces without moving ``fh``."""
+    crc, pos = 0, start
+    while pos < end:
+        piece = os.pread(fh.fileno(), min(1 << 20, end - pos), pos)
+        if not piece:
+            break
+        crc, pos = zlib.crc32(piece, crc), pos + len(piece)
+    return crc
+
+
+def _check_footer(fh, footer: Footer, start: int, summary_start: int | None) -> None:
+    """ValueError for a footer whose summary start or summary CRC (over the summary section and the
+    footer's first two fields, as the MCAP specification defines it) disagrees with the file."""
+    if summary_start is None:
+        raise ValueError("a footer without a data end before it")
+    has_summary = start > summary_start
+    if footer.summary_start != (summary_start if has_summary else 0):
+        raise ValueError(f"the footer's summary start {footer.summary_start} is not where the summary is "
+                         f"({summary_start if has_summary else 'none'})")
+    if footer.summary_crc != 0:
+        crc = _summary_crc(fh, summary_start, start + 1 + 8 + 8 + 8)
+        if crc != footer.summary_crc:
+            raise ValueError(f"summary CRC mismatch (footer says {footer.summary_crc:#010x}, the summary's bytes "
+                             f"{crc:#010x})")
 
 
 def _take(scan: Scan, record) -> bool:
@@ -260,22 +306,27 @@ def scan_records(path: str | Path, scan: Scan | None = None) -> Iterator:
     with open(path, "rb") as fh:
         view = _Bounded(fh, size)
         records = _StrictReader(view, emit_chunks=True, validate_crcs=True, record_size_limit=None).records
-        footer, summary, start = False, False, len(MAGIC)
+        footer, summary, start, summary_start = False, False, len(MAGIC), None
         while True:
             whole = False
             try:
                 record = next(records)
                 whole = True
+                if _declared_end(fh, start) > size:
+                    raise ValueError(f"its length field runs past the end of the file ({size} bytes)")
                 if not scan.header and not isinstance(record, Header):
                     raise ValueError(f"the first record is a {type(record).__name__}, not a header")
                 inner = _chunk_records(record) if isinstance(record, Chunk) else [record]
                 _check_channels(scan, inner)
                 if summary and isinstance(record, (Schema, Channel)):
                     _check_summary_copy(scan, record)
+                if isinstance(record, Footer):
+                    _check_footer(fh, record, start, summary_start)
             except StopIteration:
                 scan.complete, scan.good_bytes = footer, view.pos
                 return
             except DAMAGE as exc:
+                whole = whole or (size - start >= 9 and _declared_end(fh, start) <= size)
                 scan.problem = _problem(exc, start, view.pos, size, footer, whole)
                 return
             passed = [r for r in inner if _take(scan, r)]
@@ -283,6 +334,8 @@ def scan_records(path: str | Path, scan: Scan | None = None) -> Iterator:
             footer = footer or isinstance(record, Footer)
             summary = summary or isinstance(record, DataEnd)
             start = scan.good_bytes = view.pos
+            if isinstance(record, DataEnd):
+                summary_start = view.pos
             yield from passed
 
 
@@ -318,7 +371,7 @@ def _copy(src: Path, stream) -> Scan:
     writer, schemas, channels = None, {}, {}
     for r in scan_records(src, scan):
         if isinstance(r, Header):
-            writer = Writer(stream, chunk_size=CHUNK_SIZE, compression=CompressionType.ZSTD)
+            writer = Writer(stream, chunk_size=CHUNK_SIZE, compression=CompressionType.ZSTD, enable_data_crcs=True)
             writer.start(profile=r.profile, library=r.library)
         elif isinstance(r, Schema):
             schemas[r.id] = writer.register_schema(name=r.name, encoding=r.encoding, data=r.data)

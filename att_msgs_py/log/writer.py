@@ -1,8 +1,11 @@
 """MCAP logs exactly as rosbag2 writes them.
 
 ``ros2`` profile, one ``ros2msg`` schema per type (:func:`~att_msgs_py.log.definitions.message_definition`),
-``cdr`` channels with the ``offered_qos_profiles`` metadata. Chunks are closed and flushed at least
-every ``flush_period`` seconds so a killed recorder loses at most that much.
+``cdr`` channels with the ``offered_qos_profiles`` metadata. Every CRC MCAP defines is written: each
+chunk's, the data section's (in the data end: it covers the header and the message indexes, which
+no chunk CRC does) and the summary's (in the footer), so a reader can tell a damaged byte anywhere.
+Chunks are closed and flushed at least every ``flush_period`` seconds so a killed recorder loses at
+most that much.
 """
 from __future__ import annotations
 
@@ -21,7 +24,8 @@ class LogWriter:
         self.path = Path(path)
         self.path.parent.mkdir(parents=True, exist_ok=True)
         self._stream = open(self.path, "wb")
-        self._writer = Writer(self._stream, chunk_size=chunk_size, compression=CompressionType.ZSTD)
+        self._writer = Writer(self._stream, chunk_size=chunk_size, compression=CompressionType.ZSTD,
+                              enable_data_crcs=True)
         self._writer.start(profile="ros2", library="att_suite")
         self._schemas: dict[str, int] = {}
         self._channels: dict[str, int] = {}

@@ -2,7 +2,8 @@
 
 ``att-bench <study> [options] --json PATH`` runs a study, prints a table and writes its JSON.
 Each study is a module of this package providing ``configure(parser)`` and ``run(args) -> dict``
-(``run`` prints the table and returns the JSON payload).
+(``run`` prints the table and returns the JSON payload). The exit status is 1 when the payload
+says ``"passed": false`` (a study that states a criterion and found it failed), 0 otherwise.
 """
 from __future__ import annotations
 
@@ -22,6 +23,8 @@ STUDIES = {
     "momentum": "att_planner.tools.bench.momentum",
     "observe": "att_planner.tools.bench.observe",
     "day": "att_planner.tools.bench.day",
+    "timing": "att_planner.tools.bench.timing",
+    "logtools": "att_planner.tools.bench.logtools",
 }
 
 
@@ -49,4 +52,4 @@ def main(argv: list[str] | None = None) -> int:
         with open(args.json, "w") as fh:
             json.dump(payload, fh, indent=1, default=_json_default)
         print(f"JSON: {args.json}")
-    return 0
+    return 0 if payload.get("passed", True) else 1

@@ -52,17 +52,36 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from att_msgs_py.log import read_log
-from att_msgs_py.topics import COMMAND, CONTROLLER_STATUS, MISSION_EVENTS, PLANS, STATE
-from att_planner.tools.review.estimation import TOPICS as ESTIMATION_TOPICS
-from att_planner.tools.review.estimation import estimation_of, estimation_summary, figure_estimation
-from att_planner.tools.review.figures import figure_overview, figure_sky, figure_time_histories
-from att_planner.tools.review.mission import TOPICS as MISSION_TOPICS
-from att_planner.tools.review.mission import figure_mission, figure_mission_sky, mission_of, mission_summary
-from att_planner.tools.review.pointing import figure_pointing, pointing_of, pointing_summary
-from att_planner.tools.review.run import extract_run, settling_time
-from att_planner.tools.review.summary import format_summary, notes, scenario_for, summarize, summary_of, zone_sky_for
+from att_msgs_py.topics import (
+    COMMAND,
+    CONTROLLER_STATUS,
+    ESTIMATE,
+    IMU,
+    MAGNETOMETER,
+    MISSION_EVENTS,
+    PLANS,
+    SENSOR_TRUTH,
+    STAR_TRACKER,
+    STATE,
+)
 
 __all__ = ["Review", "extract_run", "format_summary", "main", "review", "settling_time", "summarize"]
+
+# the topics a review reads: the run's, and those of :mod:`.estimation` and :mod:`.mission` (their
+# ``TOPICS``); named here so that a log is read, and a damaged one refused, before the figures and
+# the models are imported (a second or more on a loaded machine)
+REVIEWED_TOPICS = sorted({STATE, COMMAND, PLANS, CONTROLLER_STATUS, ESTIMATE, SENSOR_TRUTH, STAR_TRACKER, IMU,
+                          MAGNETOMETER, MISSION_EVENTS})
+_LAZY = {"extract_run": "run", "settling_time": "run", "format_summary": "summary", "summarize": "summary"}
+
+
+def __getattr__(name: str):
+    """The package's exports from :mod:`.run` and :mod:`.summary`, imported when first used."""
+    if name in _LAZY:
+        import importlib
+
+        return getattr(importlib.import_module(f"{__name__}.{_LAZY[name]}"), name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
 @dataclass
@@ -91,11 +110,17 @@ def review(log_path: str | Path, out_dir: str | Path | None = None, *, plan_id: 
            scenario: str | None = None) -> Review:
     """Read ``log_path`` and write figures, summary and HTML page into ``out_dir``."""
     log_path = Path(log_path)
+    log = read_log(log_path, topics=REVIEWED_TOPICS, keep_messages=(PLANS, MISSION_EVENTS))
+    from att_planner.tools.review.estimation import estimation_of, estimation_summary, figure_estimation
+    from att_planner.tools.review.figures import figure_overview, figure_sky, figure_time_histories
+    from att_planner.tools.review.mission import figure_mission, figure_mission_sky, mission_of, mission_summary
+    from att_planner.tools.review.pointing import figure_pointing, pointing_of, pointing_summary
+    from att_planner.tools.review.run import extract_run
+    from att_planner.tools.review.summary import format_summary, notes, scenario_for, summary_of, zone_sky_for
+
     out = Path(out_dir) if out_dir is not None else log_path.parent / "review"
-    out.mkdir(parents=True, exist_ok=True)
-    log = read_log(log_path, topics=sorted({STATE, COMMAND, PLANS, CONTROLLER_STATUS, *ESTIMATION_TOPICS,
-                                            *MISSION_TOPICS}), keep_messages=(PLANS, MISSION_EVENTS))
     run = extract_run(log, plan_id)
+    out.mkdir(parents=True, exist_ok=True)
     found = scenario_for(run, scenario)
     sc = found.spacecraft if found is not None else None
     zones, zones_note = zone_sky_for(run, found)

@@ -195,7 +195,11 @@ def plot_attitude_error(ax, run: Run) -> None:
     if run.kind == "maneuver":
         ax.semilogy(run.t, np.maximum(np.degrees(reference_error(run)), 1e-6), label="to plan reference")
     ax.set_ylabel("attitude error [deg]")
-    ax.legend(loc="upper right", fontsize=7)
+    if ax.get_legend_handles_labels()[0]:
+        ax.legend(loc="upper right", fontsize=7)
+    else:
+        ax.text(0.5, 0.5, "no goal and no plan in the reviewed segment", transform=ax.transAxes, ha="center",
+                va="center", fontsize=8, color="0.4")
 
 
 def plot_rates(ax, run: Run) -> None:

@@ -84,3 +84,51 @@ def test_rosbags_decodes_a_log_written_by_the_current_writer(tmp_path, log):
     assert {t: len(v) for t, v in decoded.items()} == {t: len(v) for t, v in log.items()}
     again = read_log(out)
     assert np.array_equal(again["/spacecraft/state"]["attitude"], log["/spacecraft/state"]["attitude"])
+
+
+def _log_with(path: Path, schema_name: str, definition: bytes, data: bytes) -> Path:
+    """One topic, /controller/status, of the given schema name and text, holding one message."""
+    from mcap.writer import Writer
+
+    with open(path, "wb") as fh:
+        writer = Writer(fh)
+        writer.start(profile="ros2", library="test")
+        schema = writer.register_schema(schema_name, "ros2msg", definition)
+        channel = writer.register_channel("/controller/status", "cdr", schema)
+        writer.add_message(channel, log_time=1, data=data, publish_time=1, sequence=7)
+        writer.finish()
+    return path
+
+
+@pytest.mark.parametrize("schema_name", ["this/msg/x", "os/msg/Path", "x", "att_msgs/msg/\x1b[2J"])
+def test_a_schema_the_reader_cannot_parse_is_refused_in_one_line_without_an_import(tmp_path, schema_name):
+    """A schema whose name the ros2msg parser refuses (or whose message then does not decode) is the
+    file's fault: read_log answers with one line naming the topic and the schema (escaped), and
+    nothing named by the file is imported."""
+    import sys
+
+    from att_msgs_py.log.definitions import message_definition
+    from att_msgs_py.log.repair import LogFileError, printable
+
+    definition = message_definition("att_msgs/msg/ControllerStatus").encode()
+    path = _log_with(tmp_path / "named.mcap", schema_name, definition, b"\x00\x01\x00\x00")
+    with pytest.raises(LogFileError) as refused:
+        read_log(path)
+    message = str(refused.value)
+    assert "\n" not in message and "\x1b" not in message, message
+    assert "topic '/controller/status'" in message and "does not decode" in message, message
+    assert f"'{printable(schema_name)}'" in message, message
+    assert "this" not in sys.modules and "os.msg" not in sys.modules
+
+
+def test_a_message_that_does_not_decode_as_its_schema_is_refused_in_one_line(tmp_path):
+    from att_msgs_py.log.definitions import message_definition
+    from att_msgs_py.log.repair import LogFileError
+
+    type_name = "att_msgs/msg/ControllerStatus"
+    definition = message_definition(type_name).encode()
+    path = _log_with(tmp_path / "short.mcap", type_name, definition, b"\x00\x01\x00\x00\x07")
+    with pytest.raises(LogFileError, match=r"message 7 of topic '/controller/status' does not decode as "
+                                           r"'att_msgs/msg/ControllerStatus' \(") as refused:
+        read_log(path)
+    assert "\n" not in str(refused.value)

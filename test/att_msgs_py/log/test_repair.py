@@ -309,6 +309,8 @@ def test_what_is_not_an_mcap_log_is_refused_in_one_line(tmp_path, capsys, name):
         err = capsys.readouterr().err
         assert err.count("\n") == 1 and err.startswith(f"att-log: {path}: "), err
         assert "Traceback" not in err
+        if name in ("empty", "half magic", "magic only", "magic and cut header", "no header first"):
+            assert "byte" in err, err          # where the file ends or what is at its start
     assert sorted(p.name for p in tmp_path.iterdir()) == ([] if name == "missing" else ["in.mcap"])
 
 
@@ -351,3 +353,71 @@ def test_an_unchunked_log_cut_anywhere_keeps_a_growing_prefix(tmp_path):
         assert got == original[:len(got)] and len(got) >= last
         last = len(got)
     assert last == len(original)
+
+
+def test_the_writer_writes_every_crc_mcap_defines(finished):
+    """Chunk CRCs, the data section's CRC (data end) and the summary's (footer), all non-zero and
+    each equal to an independent CRC32 of the bytes the MCAP specification says it covers."""
+    import zlib
+
+    path, _ = finished
+    data = path.read_bytes()
+    ranges = record_ranges(data)
+    data_end = next(pos for pos, _ in ranges["summary"] if data[pos] == 0x0F)
+    footer = next(pos for pos, _ in ranges["summary"] if data[pos] == 0x02)
+    assert int.from_bytes(data[data_end + 9:data_end + 13], "little") == zlib.crc32(data[:data_end]) != 0
+    summary_start = int.from_bytes(data[footer + 9:footer + 17], "little")
+    assert summary_start == data_end + 13
+    assert int.from_bytes(data[footer + 25:footer + 29], "little") == zlib.crc32(data[summary_start:footer + 25]) != 0
+    for pos, _ in ranges["chunk header"]:
+        assert int.from_bytes(data[pos + 9 + 24:pos + 9 + 28], "little") != 0
+
+
+def damage_is_noticed(path: Path, tmp_path: Path, capsys) -> str:
+    """The problem scan_records names for ``path``, after checking that att-log info and repair
+    report it as damaged (exit 1, one line) and that what repair recovers is whole."""
+    scan = Scan(path, 0)
+    for _ in scan_records(path, scan):
+        pass
+    assert scan.damaged and not scan.indexed, scan.problem
+    nothing = not scan.header               # the header itself damaged: nothing to recover (exit 2)
+    assert att_log(["info", str(path)]) == 1 + nothing
+    assert capsys.readouterr().err.count("\n") == 1
+    assert att_log(["repair", str(path), "-o", str(tmp_path / "out.mcap")]) == 1 + nothing
+    assert capsys.readouterr().err.count("\n") == 1
+    return scan.problem
+
+
+@pytest.mark.parametrize("kind", RECORD_KINDS)
+@pytest.mark.parametrize("where", [0.0, 0.5, 1.0])
+def test_one_flipped_byte_in_any_record_of_a_suite_log_is_noticed(finished, tmp_path, capsys, kind, where):
+    """Every byte of a suite log is under a CRC: a chunk's payload under the chunk's, the header,
+    chunk headers and message indexes under the data section's, the summary under the footer's."""
+    path, original = finished
+    data = bytearray(path.read_bytes())
+    start, end = record_ranges(bytes(data))[kind][1 if kind in ("chunk header", "chunk payload") else 0]
+    data[start + min(int(where * (end - start)), end - start - 1)] ^= 0x01
+    damaged = tmp_path / "damaged.mcap"
+    damaged.write_bytes(bytes(data))
+    assert damage_is_noticed(damaged, tmp_path, capsys).startswith("damaged record at byte ")
+    if (tmp_path / "out.mcap").exists():
+        got = records_of(tmp_path / "out.mcap")
+        assert got == original[:len(got)]
+
+
+@pytest.mark.parametrize("field, value", [("crc", bytes(4)), ("crc and payload", bytes(4))])
+def test_a_chunk_whose_crc_reads_0_ends_the_recovery_before_it(finished, tmp_path, capsys, field, value):
+    """CRC 0 means "not computed" in MCAP: such a chunk cannot be told from a damaged one (its
+    payload flipped too, a decoder may still inflate it into other bytes), so it is refused."""
+    path, original = finished
+    data = bytearray(path.read_bytes())
+    start, _ = record_ranges(bytes(data))["chunk header"][2]
+    data[start + 9 + 24:start + 9 + 28] = value
+    if field == "crc and payload":
+        payload, end = record_ranges(bytes(data))["chunk payload"][2]
+        data[(payload + end) // 2] ^= 0x01
+    damaged = tmp_path / "damaged.mcap"
+    damaged.write_bytes(bytes(data))
+    problem = damage_is_noticed(damaged, tmp_path, capsys)
+    assert problem.startswith(f"damaged record at byte {start}: chunk without a CRC"), problem
+    assert records_of(tmp_path / "out.mcap") == original[:2 * PER_CHUNK]

@@ -212,3 +212,56 @@ def test_the_timeline_ends_a_refused_slew_at_its_refusal():
     bars = [(e.target, e.event, start, end) for e, start, end in timeline_bars(events)]
     assert bars == [("vega", Kind.PARK, 40.0, 285.6), ("polaris", Kind.SLEW, 285.6, 747.8),
                     ("polaris", Kind.DWELL, 808.0, 868.0), ("cas_a", Kind.SLEW, 988.0, 1200.0)]
+
+
+def test_review_refuses_a_schema_it_cannot_parse_in_one_line(tmp_path, capsys):
+    """The regression log with its controller status schema named ``this/msg/x``: one line naming the
+    topic and the schema, exit 1, no traceback (the ros2msg parser's exception is the file's fault)."""
+    from att_planner.tools.bench.hostile_logs import renamed
+
+    path = tmp_path / "named.mcap"
+    renamed(schemas={"att_msgs/msg/ControllerStatus": "this/msg/x"})(FIXTURE.read_bytes(), [], path)
+    assert review_main([str(path), "--out", str(tmp_path / "review")]) == 1
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and err.startswith("att-review: ") and "schema 'this/msg/x' does not decode" in err, err
+
+
+def test_a_log_without_goal_or_plan_is_reviewed_without_a_warning(tmp_path):
+    """2 s of the in-process closed loop holding its attitude (no plan, no goal): the review is
+    written and matplotlib warns of nothing (a warning is a second line on the terminal)."""
+    import warnings
+
+    from att_planner.tools.bench.hostile_logs import recorded_log
+    from att_planner.tools.review import review
+
+    path = recorded_log(tmp_path / "hold.mcap", seconds=2.0)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        done = review(path, tmp_path / "review")
+    assert done.summary["kind"] != "maneuver" and (tmp_path / "review" / "time_histories.png").stat().st_size > 10_000
+
+
+def test_the_reviewed_topics_cover_every_part_of_the_review():
+    from att_msgs_py.topics import COMMAND, CONTROLLER_STATUS, PLANS, STATE
+    from att_planner.tools.review import REVIEWED_TOPICS
+    from att_planner.tools.review.estimation import TOPICS as ESTIMATION_TOPICS
+    from att_planner.tools.review.mission import TOPICS as MISSION_TOPICS
+
+    assert REVIEWED_TOPICS == sorted({STATE, COMMAND, PLANS, CONTROLLER_STATUS, *ESTIMATION_TOPICS, *MISSION_TOPICS})
+
+
+def test_a_damaged_log_is_refused_before_the_figures_and_models_are_imported(tmp_path):
+    """att-review answers a file it cannot read after importing only the reader: matplotlib, scipy
+    and the planner's models (seconds on a loaded machine) are imported once there is a log to review."""
+    import subprocess
+    import sys
+
+    damaged = tmp_path / "cut.mcap"
+    damaged.write_bytes(FIXTURE.read_bytes()[:9])
+    heavy = ("matplotlib", "scipy", "att_planner.zones", "att_planner.tools.review.figures")
+    probe = ("import sys; from att_planner.tools.review import main; code = main([sys.argv[1]]); "
+             f"print(code, sorted(m for m in {heavy!r} if m in sys.modules))")
+    done = subprocess.run([sys.executable, "-c", probe, str(damaged)], capture_output=True, text=True, timeout=120)
+    assert done.stdout.strip() == "1 []", done.stdout + done.stderr
+    assert done.stderr.count("\n") == 1 and "at byte 8" in done.stderr, done.stderr
+    assert not (tmp_path / "review").exists()
