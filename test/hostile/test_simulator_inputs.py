@@ -29,6 +29,7 @@ from att_msgs_py.types import Command, ControlMode
 from att_sim.models import rotations as rot
 from att_sim.models import scenario
 from att_sim.truth.simulation import Checks, Simulation
+from helpers.waiting import wait_until
 
 SWIFT = scenario.load("swift_demo")
 SC = SWIFT.spacecraft
@@ -220,10 +221,11 @@ def test_there_are_enough_distinct_hostile_simulator_inputs():
 RTF = 4.0
 
 
-@pytest.fixture(scope="module")
+@pytest.fixture
 def lonely_sim(ros_suite):
-    """The simulator alone (RTF 4, lockstep on): no controller answers its states. Yields the
-    suite, the states received as (wall time, message) and a function giving the latest stamp."""
+    """A simulator of the test's own, alone (RTF 4, lockstep on): no controller answers its states
+    (each test sees a simulator no other test has commanded, in any order). Yields the suite, the
+    states received as (wall time, message) and a function giving the latest stamp."""
     with ros_suite("swift_demo", nodes=("simulator",), params={"simulator": {"real_time_factor": RTF}},
                    name="sim_inputs") as s:
         states, latest = [], [0.0]
@@ -244,6 +246,12 @@ def spin_for(client, seconds: float, each=None, period: float = 0.0) -> None:
             each()
             due = time.monotonic() + period
         rclpy.spin_once(client, timeout_sec=0.002)
+
+
+def free_running(s) -> None:
+    """Wait (spinning the client) until the lone simulator has given up waiting for a controller."""
+    wait_until(lambda: "free-running" in s.suite.log_text("simulator"), 60,
+               "the simulator going free-running without a controller", node=s.client)
 
 
 def command_msg(t: float, **fields) -> ActuatorCommand:
@@ -268,6 +276,7 @@ def test_hostile_commands_are_refused_states_flow_and_refusals_are_throttled(lon
     """A flood of refused commands (a valid torque each time, one field hostile): none is applied,
     none satisfies the lockstep (the stamp 1e6 one included), the states keep flowing."""
     s, states, now = lonely_sim
+    free_running(s)
     pub = s.client.create_publisher(ActuatorCommand, topics.COMMAND, qos.STREAM_QOS)
     spin_for(s.client, 1.0)                                     # discovery
     hostile = [lambda: command_msg(1e6), lambda: command_msg(now() + 10.0),
@@ -301,6 +310,7 @@ def test_hostile_commands_are_refused_states_flow_and_refusals_are_throttled(lon
 @pytest.mark.ros
 def test_a_command_answering_a_state_resumes_the_lockstep(lonely_sim):
     s, states, now = lonely_sim
+    free_running(s)
     pub = s.client.create_publisher(ActuatorCommand, topics.COMMAND, qos.STREAM_QOS)
     spin_for(s.client, 1.0)
     answered = set()
@@ -325,6 +335,7 @@ def test_a_late_command_of_the_controller_makes_the_simulator_wait_for_it(lonely
     """A controller that lives but lags (its commands too old to apply) is waited for, not drowned:
     its late command puts the free-running simulator back to waiting; another publisher's is ignored."""
     s, states, now = lonely_sim
+    free_running(s)
     pub = s.client.create_publisher(ActuatorCommand, topics.COMMAND, qos.STREAM_QOS)
     stranger = s.client.create_publisher(ActuatorCommand, topics.COMMAND, qos.STREAM_QOS)
     spin_for(s.client, 1.0)
