@@ -28,8 +28,10 @@ from helpers.own_rk4 import integrate
 BENCHMARKS = Path(os.environ.get("ATT_SKY_BENCHMARKS", Path(__file__).resolve().parents[3] / "benchmarks"))
 CASES = ("rising_limb", "leo_observatory", "moon_parallax")
 # the method and interpolation of each committed JSON
-METHODS = {"rising_limb": ("smooth_collocation", "linear"), "leo_observatory": ("slepian_minimum_time", "zoh"),
-           "moon_parallax": ("slepian_minimum_time", "zoh")}
+METHODS = dict.fromkeys(CASES, ("smooth_collocation", "linear"))
+# the cases whose frozen plan enters a true zone with the default method (leo_observatory's start,
+# found for the Slepian method, no longer shows it: both of its plans clear every true zone)
+ENTERS = ("rising_limb", "moon_parallax")
 HEADLINE_DEPTH = math.radians(5.0)     # the frozen plan of the headline case enters the true limb by more
 TOL = math.radians(0.01)
 SUBSTEPS = 4                  # RK4 steps per ZOH interval (500 intervals: 2000 steps); the sky at the knots
@@ -89,9 +91,12 @@ def test_torque_reproduces_each_plan(checked):
 def test_frozen_plan_enters_a_zone_and_the_moving_one_does_not(checked):
     payload, own = checked
     frozen = min(m.min() for m in own["frozen"][2].values())
-    assert frozen < -TOL, f"frozen plan's smallest true margin {math.degrees(frozen):.4f} deg"
-    entered = payload["plans"]["frozen"]["verification"]["entered"]
-    assert own["frozen"][2][entered].min() < -TOL
+    if payload["case"] in ENTERS:
+        assert frozen < -TOL, f"frozen plan's smallest true margin {math.degrees(frozen):.4f} deg"
+        entered = payload["plans"]["frozen"]["verification"]["entered"]
+        assert own["frozen"][2][entered].min() < -TOL
+    else:
+        assert frozen >= -TOL, f"frozen plan's smallest true margin {math.degrees(frozen):.4f} deg"
     moving = min(m.min() for m in own["moving"][2].values())
     assert moving >= -TOL, f"moving plan's smallest true margin {math.degrees(moving):.4f} deg"
 
