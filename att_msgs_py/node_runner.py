@@ -178,10 +178,12 @@ def _check_params_files(args) -> None:
 def run_node(make_node: Callable, args=None, make_executor: Callable[[], Executor] = SingleThreadedExecutor,
              loop: Callable | None = None) -> None:
     """Create node and executor after ``rclpy.init`` and run ``loop(node, executor)`` (default:
-    :func:`spin_until_shutdown`); the C allocator set to give large blocks back (:func:`memory.configure`)."""
+    :func:`spin_until_shutdown`); the C allocator and the middleware set to give large blocks back
+    (:func:`memory.configure`, :func:`memory.middleware_env`)."""
     for signum in (signal.SIGINT, signal.SIGTERM):
         signal.signal(signum, _stop_requested)      # before rclpy.init, which chains to it
     memory.configure()                              # large blocks go back to the system when freed
+    memory.middleware_env()                         # and the middleware's payloads too
     node, exit_code = None, 0
     try:
         _check_params_files(args)

@@ -47,7 +47,7 @@ from sensor_msgs.msg import JointState, MagneticField
 from att_msgs.action import ExecuteManeuver
 from att_msgs.msg import ActuatorCommand, AttitudeEstimate, ControllerStatus, ManeuverPlan, SpacecraftState
 from att_msgs.srv import SetControllerMode
-from att_msgs_py import convert, limits, qos, signing, topics
+from att_msgs_py import convert, limits, memory, qos, signing, topics
 from att_msgs_py.errors import ErrorCode, RequestError
 from att_msgs_py.node_runner import (
     RefusalLog,
@@ -261,6 +261,7 @@ class ControllerNode(Node):
 
 
 def main(args=None):
+    memory.reexec_with_c_allocator()
     run_node(ControllerNode, args)
 
 

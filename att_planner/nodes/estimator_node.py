@@ -22,7 +22,7 @@ from rclpy.node import Node
 from sensor_msgs.msg import Imu, MagneticField
 
 from att_msgs.msg import ActuatorCommand, AttitudeEstimate, CoarseSunSensors, StarTracker
-from att_msgs_py import convert, limits, qos, topics
+from att_msgs_py import convert, limits, memory, qos, topics
 from att_msgs_py.errors import RequestError, clip
 from att_msgs_py.node_runner import RefusalLog, parameter_reader, publisher_of, run_node, subscribe_when_heard
 from att_planner.estimation.estimator_from_scenario import estimator_from_scenario
@@ -114,6 +114,7 @@ class EstimatorNode(Node):
 
 
 def main(args=None):
+    memory.reexec_with_c_allocator()
     run_node(EstimatorNode, args)
 
 

@@ -221,6 +221,7 @@ def maneuver_from_msg(request) -> ManeuverRequest:
 
 
 def main(args=None):
+    memory.reexec_with_c_allocator()
     # waiting requests hold a thread, not a core: many threads so quick requests never queue
     run_node(PlannerNode, args, make_executor=lambda: MultiThreadedExecutor(num_threads=16))
 

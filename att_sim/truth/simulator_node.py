@@ -372,6 +372,7 @@ class SimulatorNode(Node):
 
 
 def main(args=None):
+    memory.reexec_with_c_allocator()
     run_node(SimulatorNode, args, loop=lambda node, executor: node.run(executor))
 
 

@@ -57,3 +57,45 @@ def test_freed_blocks_go_back_with_a_fixed_threshold_or_a_trim():
     assert kept_default > 30                     # 50 MB of 256 KiB blocks stayed in the heap
     assert after_trim < 10                       # malloc_trim gave them back
     assert kept_configured < 10                  # a fixed threshold never kept them
+
+
+def test_the_middleware_is_pointed_at_the_suite_profiles_unless_the_user_chose():
+    env = {}
+    assert memory.middleware_env(env)
+    assert env == {"RMW_FASTRTPS_USE_QOS_FROM_XML": "1", "FASTDDS_DEFAULT_PROFILES_FILE": str(memory.PROFILES)}
+    text = memory.PROFILES.read_text()
+    assert text.count("<historyMemoryPolicy>DYNAMIC</historyMemoryPolicy>") == 2 and "ASYNCHRONOUS" in text
+    mine = {"FASTDDS_DEFAULT_PROFILES_FILE": "/my/profiles.xml"}
+    assert not memory.middleware_env(mine) and mine == {"FASTDDS_DEFAULT_PROFILES_FILE": "/my/profiles.xml"}
+    other = {"RMW_IMPLEMENTATION": "rmw_cyclonedds_cpp"}
+    assert not memory.middleware_env(other) and len(other) == 1
+
+
+REEXEC = """
+import os, sys
+from att_msgs_py import memory
+print(os.getpid(), os.environ.get("PYTHONMALLOC", ""), sys.argv[1:], flush=True)
+memory.reexec_with_c_allocator()
+"""
+
+
+@glibc
+def test_a_node_runs_itself_again_with_the_c_allocator_once_keeping_pid_and_arguments(tmp_path):
+    script = tmp_path / "node.py"
+    script.write_text(REEXEC)
+    env = {k: v for k, v in os.environ.items() if k != "PYTHONMALLOC"}
+    out = subprocess.run([sys.executable, str(script), "--ros-args", "-p", "x:=1"], env=env, capture_output=True,
+                         text=True, check=True, timeout=60).stdout.splitlines()
+    first, second = (line.split(" ", 2) for line in out)
+    assert first[0] == second[0] and (first[1], second[1]) == ("", "malloc")
+    assert first[2] == second[2] == "['--ros-args', '-p', 'x:=1']"
+    kept = subprocess.run([sys.executable, str(script)], env={**env, "PYTHONMALLOC": "pymalloc"},
+                          capture_output=True, text=True, check=True, timeout=60).stdout.splitlines()
+    assert len(kept) == 1 and kept[0].split(" ")[1] == "pymalloc"      # the user's choice: no re-run
+
+
+def test_the_launch_environment_starts_nodes_with_the_c_allocator():
+    from att_planner.tools.launch import isolated_env
+
+    assert isolated_env(base={})["PYTHONMALLOC"] == "malloc"
+    assert isolated_env(base={"PYTHONMALLOC": "debug"})["PYTHONMALLOC"] == "debug"
