@@ -22,6 +22,7 @@ STUDIES = {
     "momentum": "att_planner.tools.bench.momentum",
     "observe": "att_planner.tools.bench.observe",
     "day": "att_planner.tools.bench.day",
+    "flood": "att_planner.tools.bench.flood",
 }
 
 
