@@ -13,6 +13,7 @@ setup(
     name=PACKAGE,
     version="0.1.0",
     packages=find_packages(include=["att_planner*", "att_sim*", "att_msgs_py*"]),
+    package_data={"att_msgs_py": ["fastdds_profiles.xml"]},
     data_files=[
         ("share/ament_index/resource_index/packages", ["resource/" + PACKAGE]),
         ("share/" + PACKAGE, ["package.xml"]),

@@ -29,6 +29,7 @@ from rcl_interfaces.msg import ParameterDescriptor
 from rclpy.clock import Clock, ClockType
 from rclpy.executors import Executor, ExternalShutdownException, SingleThreadedExecutor
 
+from att_msgs_py import memory
 from att_msgs_py.errors import ConfigError, ErrorCode, RequestError, clip
 from att_msgs_py.parameters import checked, coerce
 
@@ -111,7 +112,9 @@ def participant_of(gid: bytes | None) -> bytes | None:
 class RefusalLog:
     """A node's refused inputs: counted per kind and logged at most once a second *per kind* (so a
     flood of one kind cannot hide another; rclpy's own throttling is per call site), clipped, with
-    the running count: ``state refused (55 so far) [311 STATE_TIME_JUMP]: ...``."""
+    the running count: ``state refused (55 so far) [311 STATE_TIME_JUMP]: ...``. After a message
+    refused for its size (SIZE_LIMIT) the memory its deserialised copy took is handed back
+    (:func:`att_msgs_py.memory.trim`, a few ms: less than deserialising it cost)."""
 
     def __init__(self, logger, period: float = 1.0):
         self.logger, self.period = logger, period
@@ -120,6 +123,8 @@ class RefusalLog:
 
     def __call__(self, what: str, err: RequestError) -> None:
         self.counts[what] = self.counts.get(what, 0) + 1
+        if err.code == ErrorCode.SIZE_LIMIT:
+            memory.trim()
         now = time.monotonic()
         if now - self.logged.get(what, -math.inf) >= self.period:
             self.logged[what] = now
@@ -180,9 +185,12 @@ def _check_params_files(args) -> None:
 def run_node(make_node: Callable, args=None, make_executor: Callable[[], Executor] = SingleThreadedExecutor,
              loop: Callable | None = None) -> None:
     """Create node and executor after ``rclpy.init`` and run ``loop(node, executor)`` (default:
-    :func:`spin_until_shutdown`)."""
+    :func:`spin_until_shutdown`); the C allocator and the middleware set to give large blocks back
+    (:func:`memory.configure`, :func:`memory.middleware_env`)."""
     for signum in (signal.SIGINT, signal.SIGTERM):
         signal.signal(signum, _stop_requested)      # before rclpy.init, which chains to it
+    memory.configure()                              # large blocks go back to the system when freed
+    memory.middleware_env()                         # and the middleware's payloads too
     node, exit_code = None, 0
     try:
         _check_params_files(args)

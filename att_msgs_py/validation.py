@@ -15,13 +15,13 @@ from operator import mul
 import numpy as np
 
 from att_msgs_py.errors import ErrorCode, RequestError
+from att_msgs_py.limits import MAX_NAME_LENGTH
+from att_msgs_py.limits import MAX_PLAN_BYTES as MAX_PLAN_BYTES  # the caps, declared in one place
+from att_msgs_py.limits import MAX_PLAN_SAMPLES as MAX_PLAN_SAMPLES
+from att_msgs_py.limits import MAX_TEXT_LENGTH as MAX_TEXT_LENGTH
 from att_msgs_py.types import ZONE_BODIES, Zone
 
 UNIT_TOLERANCE = 1e-3          # |‖q‖ − 1| (and unit vectors) accepted and normalised below this
-MAX_NAME_LENGTH = 128          # names, ids and frames
-MAX_TEXT_LENGTH = 1000         # free text (plan messages)
-MAX_PLAN_SAMPLES = 20_000      # knots of a plan (about 1.8 MB on the wire)
-MAX_PLAN_BYTES = 4 * 1024 * 1024   # serialized ManeuverPlan
 MAX_PLAN_DURATION = 86_400.0   # s
 UNIX_EPOCH = datetime(1970, 1, 1, tzinfo=UTC)
 WIRE_EPOCH_MIN = UNIX_EPOCH + timedelta(seconds=-2**31)       # builtin_interfaces/Time has int32 seconds:

@@ -21,7 +21,7 @@ from foxglove.websocket import ServerListener
 from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy
 
-from att_msgs_py import qos, topics
+from att_msgs_py import memory, qos, topics
 from att_msgs_py.errors import ConfigError, ErrorCode, clip
 from att_msgs_py.log.definitions import message_definition
 from att_msgs_py.node_runner import parameter_reader, run_node
@@ -92,6 +92,7 @@ class BridgeNode(Node):
 
 
 def main(args=None):
+    memory.reexec_with_c_allocator()
     run_node(BridgeNode, args)
 
 

@@ -16,7 +16,7 @@ from pathlib import Path
 
 from rclpy.node import Node
 
-from att_msgs_py import qos, topics
+from att_msgs_py import memory, qos, topics
 from att_msgs_py.log.repair import LogFileError, Scan, repair, scan_records
 from att_msgs_py.log.writer import LogWriter
 from att_msgs_py.node_runner import run_node
@@ -65,6 +65,7 @@ class RecorderNode(Node):
 
 
 def main(args=None):
+    memory.reexec_with_c_allocator()
     run_node(RecorderNode, args)
 
 

@@ -23,6 +23,7 @@ import numpy as np
 
 from att_msgs_py import signing, validation
 from att_msgs_py.errors import ErrorCode, RequestError
+from att_msgs_py.limits import MAX_CONES, MAX_ZONES
 from att_msgs_py.types import ControlKind, Interpolation, Plan, State, Status
 from att_planner.control import pd
 from att_sim.models import epoch as epochs
@@ -31,9 +32,7 @@ from att_sim.models.dynamics import Spacecraft
 
 LIMIT_TOLERANCE = 1e-6       # relative: plan controls may touch their limit, not exceed it
 MAX_PLAN_RATE = 10.0         # rad/s, any body axis: beyond it a plan is not a slew
-MAX_CONES = 16
 DURATION_TOLERANCE = 1e-9   # relative: a plan's stated duration against the span of its times
-MAX_ZONES = 16               # zones besides the cones: the planner service's cap (att_planner.service.real_sky)
 
 
 @dataclass(frozen=True)
@@ -165,7 +164,7 @@ def check_plan(plan: Plan, payload: bytes, ctx: PlanContext) -> RequestError | N
     try:
         _fields(plan, ctx.spacecraft, ctx.frame_id)
     except RequestError as err:
-        return err
+        return err.with_traceback(None)          # its frames hold the refused plan's arrays
     if plan.spacecraft != ctx.spacecraft_name or plan.spacecraft_digest != ctx.spacecraft.digest:
         which = "name" if plan.spacecraft != ctx.spacecraft_name else "physical parameters (digest)"
         return RequestError(ErrorCode.WRONG_SPACECRAFT,

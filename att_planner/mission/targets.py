@@ -30,6 +30,7 @@ from pathlib import Path
 import numpy as np
 
 from att_msgs_py.errors import ConfigError, ErrorCode, clip
+from att_msgs_py.limits import MAX_TARGETS  # as a PlanSchedule request
 from att_sim.models import rotations as rot
 from att_sim.models import scenario as scen
 
@@ -37,7 +38,6 @@ KINDS = {"inertial": ("name", "ra_deg", "dec_deg", "dwell_s"),
          "ground": ("name", "lat_deg", "lon_deg", "alt_m", "dwell_s")}
 FILE_KEYS = {"inertial": ("kind", "scenario", "roll_reference", "targets"),
              "ground": ("kind", "scenario", "min_elevation_deg", "targets")}
-MAX_TARGETS = 20                    # as a PlanSchedule request
 MAX_DWELL = 86_400.0                # s
 CELESTIAL_NORTH = np.array([0.0, 0.0, 1.0])
 

@@ -8,7 +8,8 @@ time (the simulator waits for it before it advances); serves ``/controller/set_m
 ``settle_time`` and reports progress as feedback (the zone margins of the feedback are taken
 on the scenario's sky: its epoch and orbit).
 
-Nothing received is trusted (the core's checks, :mod:`att_planner.control.plan_checks` and
+Nothing received is trusted (the size caps of :mod:`att_msgs_py.limits`, checked before a message is
+read, SIZE_LIMIT; the core's checks, :mod:`att_planner.control.plan_checks` and
 :mod:`att_planner.control.state_gate`): a refused state or plan is logged (at most once a second
 per kind, clipped, with a running count) and changes nothing. Plans must verify against the
 Ed25519 public key ``plan_public_key`` (:mod:`att_msgs_py.signing`); with ``require_signed_modes``
@@ -50,7 +51,7 @@ from sensor_msgs.msg import JointState, MagneticField
 from att_msgs.action import ExecuteManeuver
 from att_msgs.msg import ActuatorCommand, AttitudeEstimate, ControllerStatus, ManeuverPlan, SpacecraftState
 from att_msgs.srv import SetControllerMode
-from att_msgs_py import convert, qos, signing, topics
+from att_msgs_py import convert, limits, memory, qos, signing, topics
 from att_msgs_py.errors import ErrorCode, RequestError
 from att_msgs_py.node_runner import (
     RefusalLog,
@@ -129,11 +130,15 @@ class ControllerNode(Node):
             self._core.gate.clocks.hear(participant_of(publisher_of(info)), convert.from_time(msg.clock))
 
     def on_state(self, msg: SpacecraftState, info: dict):
+        if (oversized := limits.issue(msg, limits.SPACECRAFT_STATE, "state")) is not None:
+            return self._refusals("state", oversized)
         source = publisher_of(info)
         clock = self._core.gate.clocks.of(participant_of(source))
         self._step(self._core.accept_state(convert.state_from_msg(msg), time.monotonic(), clock, source), "state")
 
     def on_estimate(self, msg: AttitudeEstimate, info: dict):
+        if (oversized := limits.issue(msg, limits.ATTITUDE_ESTIMATE, "estimate")) is not None:
+            return self._refusals("attitude estimate", oversized)
         estimate, source = convert.estimate_from_msg(msg), publisher_of(info)
         outcome = self._core.accept_estimate(estimate, time.monotonic(), source)
         if outcome.refused is not None and outcome.refused.code == ErrorCode.NO_STATE:
@@ -143,6 +148,7 @@ class ControllerNode(Node):
 
     def on_wheel_speeds(self, msg: JointState, info: dict):
         try:
+            limits.check(msg, limits.JOINT_STATE, "wheel_speeds")
             self._sources.guarded("wheel speed measurement", publisher_of(info), self._core.measured.on_wheel_speeds,
                                   convert.wheel_speeds_from_msg(msg))
         except RequestError as err:
@@ -154,6 +160,7 @@ class ControllerNode(Node):
 
     def on_magnetometer(self, msg: MagneticField, info: dict):
         try:
+            limits.check(msg, limits.HEADER_ONLY, "magnetometer")
             self._sources.guarded("magnetometer measurement", publisher_of(info), self._core.measured.on_magnetometer,
                                   convert.magnetometer_from_msg(msg))
         except RequestError as err:
@@ -182,13 +189,14 @@ class ControllerNode(Node):
                 self.finish(out.result)
 
     def on_plan(self, msg: ManeuverPlan):
-        refused = check_message(msg) or self._core.receive_plan(convert.plan_from_msg(msg), signing.payload(msg))
+        refused = (limits.issue(msg, limits.MANEUVER_PLAN, "plan") or check_message(msg)
+                   or self._core.receive_plan(convert.plan_from_msg(msg), signing.payload(msg)))
         if refused is not None:
             self._refusals("published plan", refused)
 
     def on_set_mode(self, request, response):
-        refused = self._core.authorize_mode(signing.payload(request), bytes(request.signature), request.key_id,
-                                            int(request.sequence))
+        refused = limits.issue(request, limits.SET_CONTROLLER_MODE) or self._core.authorize_mode(
+            signing.payload(request), bytes(request.signature), request.key_id, int(request.sequence))
         if refused is not None:
             self._refusals("mode request", refused)
             response.success, response.error_code, response.message = False, int(refused.code), refused.message
@@ -216,11 +224,13 @@ class ControllerNode(Node):
         """Start tracking and wait (without blocking the executor) until the control loop ends
         the maneuver; feedback and cancellation are handled by the control loop."""
         goal = goal_handle.request
-        refused = check_message(goal.plan) if goal.use_inline_plan else None
+        caps = limits.inline_plan() if goal.use_inline_plan else limits.EXECUTE_MANEUVER
+        refused = limits.issue(goal, caps) or (check_message(goal.plan) if goal.use_inline_plan else None)
         plan = None
         if refused is None:
             inline = convert.plan_from_msg(goal.plan) if goal.use_inline_plan else None
             plan, refused = self._core.resolve(goal.plan_id, inline, signing.payload(goal.plan) if inline else b"")
+        goal.plan = ManeuverPlan()       # read or refused: the goal handle, kept until its result expires, drops it
         if plan is not None:
             refused = self._core.start(plan, convert.pointing_from_msg(goal.pointing_after) if goal.point_after
                                        else None)
@@ -256,6 +266,7 @@ class ControllerNode(Node):
 
 
 def main(args=None):
+    memory.reexec_with_c_allocator()
     run_node(ControllerNode, args)
 
 

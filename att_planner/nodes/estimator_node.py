@@ -7,7 +7,8 @@ commands, for the magnetometer's blanking); publishes ``/estimator/attitude``
 datasheets are the scenario's ``sensors`` group (nominal mountings and noise, never the errors the
 simulator drew); its tuning is this node's parameters, defaulting to values derived from them.
 
-Nothing received is trusted: a refused measurement (320 INVALID_MEASUREMENT, 321
+Nothing received is trusted: a message above its size caps (:mod:`att_msgs_py.limits`, 132
+SIZE_LIMIT) is refused before it is read; a refused measurement (320 INVALID_MEASUREMENT, 321
 STALE_MEASUREMENT; a second publisher of an input while the held one is in the ROS graph, too:
 :class:`att_planner.estimation.inputs.Sources`) changes nothing
 and is logged at most once a second per kind with the running count, as are measurements rejected
@@ -22,7 +23,7 @@ from rclpy.node import Node
 from sensor_msgs.msg import Imu, MagneticField
 
 from att_msgs.msg import ActuatorCommand, AttitudeEstimate, CoarseSunSensors, StarTracker
-from att_msgs_py import convert, qos, topics
+from att_msgs_py import convert, limits, memory, qos, topics
 from att_msgs_py.errors import RequestError, clip
 from att_msgs_py.node_runner import (
     RefusalLog,
@@ -80,7 +81,17 @@ class EstimatorNode(Node):
 
     # -- callbacks: translate messages to Estimator calls -------------------------------------------
     # (``info`` has no default: rclpy passes the message info only to two-argument callbacks)
+    def _oversized(self, msg, caps: dict, what: str, name: str) -> bool:
+        """Whether ``msg`` (its fields named ``name.field``) is above its size caps
+        (:mod:`att_msgs_py.limits`): refused as ``what`` before it is read."""
+        err = limits.issue(msg, caps, name)
+        if err is not None:
+            self._refusals(what, err)
+        return err is not None
+
     def on_imu(self, msg: Imu, info: dict):
+        if self._oversized(msg, limits.HEADER_ONLY, "gyro sample", "imu"):
+            return
         estimate = self._guarded("gyro sample", info, self._core.on_gyro, convert.gyro_from_msg(msg),
                                  time.monotonic())
         report = self._core.take_report()
@@ -90,22 +101,31 @@ class EstimatorNode(Node):
             self._pub.publish(convert.estimate_msg(estimate))
 
     def on_star_tracker(self, msg: StarTracker, info: dict):
+        if self._oversized(msg, limits.STAR_TRACKER, "star tracker measurement", "star_tracker"):
+            return
         self._guarded("star tracker measurement", info, self._core.on_star_tracker, convert.star_tracker_from_msg(msg))
 
     def on_magnetometer(self, msg: MagneticField, info: dict):
+        if self._oversized(msg, limits.HEADER_ONLY, "magnetometer measurement", "magnetometer"):
+            return
         self._guarded("magnetometer measurement", info, self._core.on_magnetometer,
                       convert.magnetometer_from_msg(msg))
 
     def on_sun_sensors(self, msg: CoarseSunSensors, info: dict):
+        if self._oversized(msg, limits.SUN_SENSORS, "sun sensor measurement", "sun_sensors"):
+            return
         self._guarded("sun sensor measurement", info, self._core.on_sun_sensors, convert.sun_sensors_from_msg(msg))
 
     def on_command(self, msg: ActuatorCommand, info: dict):
+        if self._oversized(msg, limits.ACTUATOR_COMMAND, "actuator command", "command"):
+            return
         command = convert.command_from_msg(msg)
         if math.isfinite(command.t) and all(math.isfinite(v) for v in command.dipole):   # else: blanks nothing
             self._guarded("actuator command", info, self._core.on_dipole_command, command.t, command.dipole)
 
 
 def main(args=None):
+    memory.reexec_with_c_allocator()
     run_node(EstimatorNode, args)
 
 

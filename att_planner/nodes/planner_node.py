@@ -17,7 +17,9 @@ but the read-only method registry.
 Every plan it issues is signed with the Ed25519 private key ``signing_key``
 (:mod:`att_msgs_py.signing`) after its last field is set, and names the spacecraft configuration
 it was made for (``spacecraft_digest``); the response and the published plan are the same message.
-Refusals and log lines are clipped (:func:`att_msgs_py.errors.clip`).
+Refusals and log lines are clipped (:func:`att_msgs_py.errors.clip`). A request is first held to
+the size caps of :mod:`att_msgs_py.limits` (SIZE_LIMIT, before any field is converted), and after
+each answer the node hands the memory it freed back to the system (:func:`att_msgs_py.memory.trim`).
 """
 from __future__ import annotations
 
@@ -31,7 +33,7 @@ from visualization_msgs.msg import MarkerArray
 
 from att_msgs.msg import ManeuverPlan
 from att_msgs.srv import PlanManeuver, PlanSchedule
-from att_msgs_py import convert, markers, qos, signing, topics
+from att_msgs_py import convert, limits, markers, memory, qos, signing, topics
 from att_msgs_py.errors import ConfigError, ErrorCode, RequestError, clip
 from att_msgs_py.node_runner import parameter_reader, run_node
 from att_msgs_py.types import Plan
@@ -108,22 +110,9 @@ class PlannerNode(Node):
 
     def on_plan_maneuver(self, request: PlanManeuver.Request, response: PlanManeuver.Response):
         try:
-            valid = validate_maneuver(
-                ManeuverRequest(
-                    frame_id=request.header.frame_id,
-                    q_initial=convert.from_quaternion(request.initial_attitude),
-                    q_final=convert.from_quaternion(request.final_attitude),
-                    sensor_axis=convert.from_vector3(request.sensor_axis),
-                    cones=[convert.cone_parts(c) for c in request.cones],
-                    method=request.method, time_budget=request.time_budget, spacecraft=request.spacecraft,
-                    option_names=list(request.option_names), option_values=list(request.option_values),
-                    semi_free=request.semi_free, sensor_target=convert.from_vector3(request.sensor_target),
-                    epoch=convert.epoch_parts(request.epoch), zones=[convert.zone_from_msg(z) for z in request.zones],
-                    tle_line1=request.tle_line1, tle_line2=request.tle_line2,
-                    wheel_speeds=list(request.wheel_speeds),
-                    end_pointing=convert.pointing_from_msg(request.end_pointing)),
-                frame_id=self._frame_id, default_spacecraft=self._scenario_name,
-                default_method=self._default_method, default_budget=self._default_budget)
+            valid = validate_maneuver(maneuver_from_msg(request), frame_id=self._frame_id,
+                                      default_spacecraft=self._scenario_name, default_method=self._default_method,
+                                      default_budget=self._default_budget)
         except RequestError as err:
             return self.refuse(response, err, "request")
         runner = run_method if valid.method.cheap else run_isolated
@@ -141,6 +130,7 @@ class PlannerNode(Node):
 
     def on_plan_schedule(self, request: PlanSchedule.Request, response: PlanSchedule.Response):
         try:
+            limits.check(request, limits.PLAN_SCHEDULE)
             valid = validate_schedule(
                 list(request.target_names), [convert.from_quaternion(q) for q in request.targets],
                 convert.from_quaternion(request.start_attitude),
@@ -178,6 +168,7 @@ class PlannerNode(Node):
     def refuse(self, response, err: RequestError, what: str):
         self.get_logger().warning(clip(f"{what} rejected [{int(err.code)} {err.code.name}]: {err.message}"))
         response.success, response.error_code, response.message = False, int(err.code), clip(err.message)
+        memory.trim()
         return response
 
     def answer(self, response, outcome: PlanOutcome, spacecraft: str, what: str, **context):
@@ -206,9 +197,31 @@ class PlannerNode(Node):
                 self._marker_pub.publish(markers.marker_array(shapes, t, self._frame_id))
         else:
             self.get_logger().warning(clip(f"{what} failed (code {response.error_code}): {outcome.message}"))
+        memory.trim()            # what the request's checks and verification took goes back to the system
+
+
+def maneuver_from_msg(request) -> ManeuverRequest:
+    """The fields of a PlanManeuver request as a :class:`ManeuverRequest`, after its sizes are
+    checked (:data:`att_msgs_py.limits.PLAN_MANEUVER`): an oversized request is refused (SIZE_LIMIT)
+    before any field is converted."""
+    limits.check(request, limits.PLAN_MANEUVER)
+    return ManeuverRequest(
+        frame_id=request.header.frame_id,
+        q_initial=convert.from_quaternion(request.initial_attitude),
+        q_final=convert.from_quaternion(request.final_attitude),
+        sensor_axis=convert.from_vector3(request.sensor_axis),
+        cones=[convert.cone_parts(c) for c in request.cones],
+        method=request.method, time_budget=request.time_budget, spacecraft=request.spacecraft,
+        option_names=list(request.option_names), option_values=list(request.option_values),
+        semi_free=request.semi_free, sensor_target=convert.from_vector3(request.sensor_target),
+        epoch=convert.epoch_parts(request.epoch), zones=[convert.zone_from_msg(z) for z in request.zones],
+        tle_line1=request.tle_line1, tle_line2=request.tle_line2,
+        wheel_speeds=list(request.wheel_speeds),
+        end_pointing=convert.pointing_from_msg(request.end_pointing))
 
 
 def main(args=None):
+    memory.reexec_with_c_allocator()
     # waiting requests hold a thread, not a core: many threads so quick requests never queue
     run_node(PlannerNode, args, make_executor=lambda: MultiThreadedExecutor(num_threads=16))
 

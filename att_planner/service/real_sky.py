@@ -20,14 +20,13 @@ from datetime import datetime
 
 from att_msgs_py import validation
 from att_msgs_py.errors import ErrorCode, RequestError
+from att_msgs_py.limits import MAX_TLE_LENGTH, MAX_ZONES
 from att_msgs_py.types import Zone
 from att_sim.models import epoch as epochs
 from att_sim.models import orbit as orbits
 from att_sim.models.ephemeris import Ephemeris
 from att_sim.models.scenario import Scenario
 
-MAX_ZONES = 16                 # zones of one request (besides its cones): each is a constraint at every sample
-MAX_TLE_LENGTH = 80            # characters of a TLE line (69 are used; trailing blanks are dropped)
 MIN_ALTITUDE = 150e3           # m (att_sim.models.orbit.check_altitude's default)
 
 

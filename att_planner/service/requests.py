@@ -22,6 +22,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from att_msgs_py.errors import ErrorCode, RequestError
+from att_msgs_py.limits import MAX_CONES, MAX_OPTIONS, MAX_TARGETS
 from att_msgs_py.types import Cone, PointingMode
 from att_msgs_py.validation import MAX_NAME_LENGTH, finite_array, text, unit_quaternion, unit_vector
 from att_planner import methods
@@ -35,10 +36,7 @@ from att_sim.models import rotations as rot
 from att_sim.models import scenario as scen
 from att_sim.models.dynamics import Spacecraft
 
-MAX_CONES = 16
-MAX_OPTIONS = 16
 MAX_TIME_BUDGET = 600.0        # s
-MAX_TARGETS = 20               # schedule targets (the order search is exponential in their number)
 MAX_DWELL = 86_400.0           # s: a schedule target's observation, at most a day
 MAX_WINDOW = 7 * 86_400.0      # s: a schedule target's window opens within a week of the start
 SAME_TARGET = 1e-6             # rad: schedule targets closer than this are one attitude (q and -q too)

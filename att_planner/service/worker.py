@@ -20,6 +20,11 @@ more (a solve then takes a fraction of that), so:
 A worker that dies is replaced. At most ``max_parallel`` solve at once (the rest wait, within their
 own budget).
 
+Memory comes back: a worker hands its allocator's free pages back after every task
+(:func:`att_msgs_py.memory.trim`; IPOPT's and CasADi's work arrays are freed, not returned, otherwise),
+and one whose resident set is still above :data:`MAX_WORKER_RSS` after a task is retired and replaced
+by a warmed one, so what a solver keeps between problems cannot accumulate without bound.
+
 A problem with a sky crosses to the child as it is: :class:`att_sim.models.ephemeris.Ephemeris` and
 :class:`att_sim.models.orbit.TLEOrbit` pickle as their recipes (epoch and orbit, epoch and lines), since
 skyfield's and SGP4's objects do not; the child rebuilds their tables as it needs them.
@@ -31,6 +36,7 @@ import os
 import threading
 import time
 
+from att_msgs_py import memory
 from att_msgs_py.types import Plan, Status
 from att_planner.methods import Method
 from att_planner.problem import ManeuverProblem
@@ -40,6 +46,7 @@ _CONTEXT = multiprocessing.get_context("forkserver")
 _CONTEXT.set_forkserver_preload(["att_planner.service.planning", "numpy", "scipy.optimize", "att_sim.models.ephemeris",
                                  "skyfield.api", "sgp4.api", "casadi", "att_planner.methods.time_optimal.smooth"])
 _SLOTS = threading.BoundedSemaphore(max(1, os.cpu_count() or 1))
+MAX_WORKER_RSS = 640 * 1024 * 1024    # bytes: a worker above it after a task is recycled (a warm one holds ~200 MB)
 KILL_GRACE = 0.5            # s after the wait before the child is terminated
 WARM_UP_TIMEOUT = 300.0     # s a worker's warm-up may take before the worker is given up (the node serves anyway)
 
@@ -64,13 +71,18 @@ _POOL_SIZE = 0                  # workers kept warm (start_pool)
 
 def _serve(conn) -> None:
     """A worker: run each ``(function, args, kwargs)`` received and send its result back, until the
-    pipe closes."""
+    pipe closes; after each, the memory the task freed goes back to the system."""
+    memory.configure()
     while True:
         try:
             function, args, kwargs = conn.recv()
         except EOFError:
             return
-        conn.send(function(*args, **kwargs))
+        result = function(*args, **kwargs)
+        del function, args, kwargs
+        memory.trim()                     # before the answer: the resident set the caller reads is trimmed
+        conn.send(result)
+        del result
 
 
 def _spawn():
@@ -168,9 +180,10 @@ def call_isolated(function, args: tuple, kwargs: dict, wait: float | None, *, on
             conn.send((function, args, kwargs))
             if conn.poll(None if remaining is None else remaining + KILL_GRACE):
                 result = conn.recv()
-                with _IDLE_LOCK:
-                    _IDLE.append((process, conn))
-                process = None            # kept for the next task
+                if (memory.rss_bytes(process.pid) or 0) <= MAX_WORKER_RSS:
+                    with _IDLE_LOCK:
+                        _IDLE.append((process, conn))
+                    process = None        # kept for the next task; else retired and replaced (finally)
                 return result
             if not process.is_alive():
                 return on_death(f"solver process died (exit code {process.exitcode})")

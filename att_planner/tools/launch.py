@@ -18,6 +18,8 @@ import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from att_msgs_py import memory
+
 NODE_MODULES = {
     "simulator": "att_sim.truth.simulator_node",
     "controller": "att_planner.nodes.controller_node",
@@ -62,6 +64,8 @@ def isolated_env(domain_id: int | None = None, base: dict | None = None, *, inhe
                          f"{', '.join(DISCOVERY_RANGES)}")
     env["ROS_AUTOMATIC_DISCOVERY_RANGE"] = user_range or "LOCALHOST"
     env.setdefault("RCUTILS_COLORIZED_OUTPUT", "0")
+    for key, value in memory.C_ALLOCATOR.items():          # freed memory goes back (att_msgs_py.memory)
+        env.setdefault(key, value)
     env["PYTHONUNBUFFERED"] = "1"
     return env
 

@@ -28,7 +28,8 @@ orbit, field model, disturbances, epoch = sim time zero); the state's position i
 Parameters come from the scenario file (``scenario`` parameter), overridable by ROS parameters;
 each is type- and range-checked, and a bad one stops the node with one line on stderr (exit 2).
 
-Safety: every command and reset is checked by :class:`~att_sim.truth.simulation.Simulation` (sizes,
+Safety: a command or reset above the size caps of :mod:`att_msgs_py.limits` is refused (SIZE_LIMIT)
+before it is read; every command and reset is checked by :class:`~att_sim.truth.simulation.Simulation` (sizes,
 NaN/Inf, magnitude against ``command_limit_factor`` × the limits, stamp, frame, text); a refused one
 is never integrated and is logged at most once a second with the running count. Commands are held
 to their publisher (:class:`~att_msgs_py.source_hold.SourceHold`): one from a second publisher is
@@ -60,7 +61,7 @@ from visualization_msgs.msg import MarkerArray
 
 from att_msgs.msg import ActuatorCommand, CoarseSunSensors, SensorTruth, SpacecraftState, StarTracker, ZoneMargins
 from att_msgs.srv import ResetSimulator
-from att_msgs_py import convert, markers, qos, topics, validation
+from att_msgs_py import convert, limits, markers, memory, qos, topics, validation
 from att_msgs_py.errors import ConfigError, ErrorCode, RequestError, clip
 from att_msgs_py.node_runner import live_publishers, parameter_reader, publisher_of, run_node, spin_until_shutdown
 from att_sim.models import scenario as scen
@@ -203,6 +204,8 @@ class SimulatorNode(Node):
     # -- callbacks: translate messages to Simulation calls -------------------------------------
     # (``info`` has no default: rclpy passes the message info only to two-argument callbacks)
     def on_command(self, msg: ActuatorCommand, info: dict):
+        if (oversized := limits.issue(msg, limits.ACTUATOR_COMMAND)) is not None:
+            return self.report("command", Refusal(oversized.code, oversized.message))
         command = convert.command_from_msg(msg)
         source = publisher_of(info)
         refusal = self.sim.set_command(command, source)
@@ -223,9 +226,13 @@ class SimulatorNode(Node):
                                    throttle_duration_sec=1.0)
 
     def on_reset(self, request: ResetSimulator.Request, response: ResetSimulator.Response):
-        q = convert.from_quaternion(request.attitude)
-        w = convert.from_vector3(request.body_rate)
-        refusal = self.sim.reset(q, w, np.asarray(request.wheel_speeds, float), request.orbit_phase)
+        refusal = limits.issue(request, limits.RESET_SIMULATOR)
+        if refusal is None:
+            q = convert.from_quaternion(request.attitude)
+            w = convert.from_vector3(request.body_rate)
+            refusal = self.sim.reset(q, w, np.asarray(request.wheel_speeds, float), request.orbit_phase)
+        else:
+            refusal = Refusal(refusal.code, refusal.message)
         if refusal is not None:
             self.report("reset", refusal)
         response.success = refusal is None
@@ -237,6 +244,8 @@ class SimulatorNode(Node):
         """Log a refused command or reset: at most one line a second for each (a flood of commands
         cannot hide a refused reset), with the running count."""
         self.refused[what] += 1
+        if refusal.code == ErrorCode.SIZE_LIMIT:
+            memory.trim()                # the refused message's deserialised copy goes back to the system
         line = clip(f"{'actuator command' if what == 'command' else 'reset'} rejected [{int(refusal.code)} "
                     f"{refusal.code.name}] ({self.refused[what]} so far): {refusal.message}")
         if what == "command":            # two call sites: rclpy throttles each call site separately
@@ -364,6 +373,7 @@ class SimulatorNode(Node):
 
 
 def main(args=None):
+    memory.reexec_with_c_allocator()
     run_node(SimulatorNode, args, loop=lambda node, executor: node.run(executor))
 
 

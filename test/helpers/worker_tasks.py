@@ -24,3 +24,24 @@ def built_nlps() -> int:
     """NLPs the collocation methods have built in this worker."""
     from att_planner.methods.time_optimal import model
     return len(model._NLPS)
+
+
+_KEPT = []
+
+
+def allocate_then_rss(megabytes: int, keep: bool) -> tuple[int, int]:
+    """Touch ``megabytes`` MB in 64 KiB blocks from the heap, each followed by a 1 KiB block kept for
+    good (so the heap cannot shrink from its top), free the large ones unless ``keep``; the worker's
+    pid and the resident set it reads of itself before answering."""
+    from att_msgs_py import memory
+
+    blocks = []
+    for _ in range(16 * megabytes):
+        block = bytearray(64 * 1024)
+        block[::4096] = b"x" * len(block[::4096])
+        blocks.append(block)
+        _KEPT.append(bytearray(1024))
+    if keep:
+        _KEPT.extend(blocks)
+    del blocks
+    return os.getpid(), memory.rss_bytes()

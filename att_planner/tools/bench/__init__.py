@@ -25,6 +25,7 @@ STUDIES = {
     "day": "att_planner.tools.bench.day",
     "timing": "att_planner.tools.bench.timing",
     "logtools": "att_planner.tools.bench.logtools",
+    "flood": "att_planner.tools.bench.flood",
 }
 
 

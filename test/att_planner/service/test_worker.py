@@ -50,6 +50,24 @@ def test_a_worker_that_overruns_is_killed_and_replaced_by_a_warmed_one():
     assert warmed and pid != pooled.pid
 
 
+def test_a_worker_hands_back_what_a_task_freed():
+    pid, before = worker.call_isolated(worker_tasks.allocate_then_rss, (0, False), {}, 30.0, on_death=on_death)
+    same, _ = worker.call_isolated(worker_tasks.allocate_then_rss, (200, False), {}, 30.0, on_death=on_death)
+    rss = worker.memory.rss_bytes(pid)
+    assert same == pid and rss - before < 30 * 2**20        # 200 MB touched and freed: not kept
+
+
+def test_a_worker_above_its_resident_bound_after_a_task_is_recycled(monkeypatch):
+    first, rss = worker.call_isolated(worker_tasks.allocate_then_rss, (0, True), {}, 30.0, on_death=on_death)
+    monkeypatch.setattr(worker, "MAX_WORKER_RSS", rss + 100 * 2**20)
+    assert worker.call_isolated(worker_tasks.allocate_then_rss, (10, True), {}, 30.0, on_death=on_death)[0] == first
+    assert worker.idle_workers() == 1                       # below the bound: kept
+    held, rss = worker.call_isolated(worker_tasks.allocate_then_rss, (200, True), {}, 30.0, on_death=on_death)
+    assert held == first and rss > worker.MAX_WORKER_RSS and worker.idle_workers() == 0   # above: retired
+    fresh, _ = worker.call_isolated(worker_tasks.allocate_then_rss, (0, False), {}, 30.0, on_death=on_death)
+    assert fresh != first
+
+
 def test_a_worker_whose_warm_up_hangs_is_given_up(monkeypatch):
     monkeypatch.setattr(worker, "WARM_UP_TIMEOUT", 0.5)
     worker.set_warm_up(worker_tasks.sleep_then_pid, (3600.0,))
