@@ -1,13 +1,14 @@
 """Random valid messages with extreme field values on every subscribed topic while a maneuver runs.
 
 The whole suite runs (recorder, simulator, estimator, controller, planner: the controller flies on
-the estimate); a maneuver is executing; for each message type hypothesis publishes random,
-well-formed CDR messages (NaN, ±Inf, ±1e308, denormals, huge and empty arrays, control characters,
-any stamp) on the topics the nodes subscribe to, the sensors' and the estimate's included. Each
-fuzz test then asserts its own outcome (it runs alone and in any order): no node died, no loop
-stalled for more than a second (the state, estimate and controller-status streams kept flowing, and
-each delivered a message after the fuzzing); the last one, that the maneuver ended with an answer:
-completed, or aborted with a code. Hypothesis's health checks are all on.
+the estimate); a maneuver is executing (each test starts one when none flies); for each message
+type hypothesis publishes random, well-formed CDR messages (NaN, ±Inf, ±1e308, denormals, huge and
+empty arrays, control characters, any stamp) on the topics the nodes subscribe to, the sensors' and
+the estimate's included. Each fuzz test then asserts its own outcome (it runs alone and in any
+order): no node died, no loop stalled for more than a second (the state, estimate and
+controller-status streams kept flowing, and each delivered a message after the fuzzing); the last
+fuzzes every topic until the maneuver in flight ends with an answer: completed, or aborted with a
+code. Hypothesis's health checks are all on.
 """
 from __future__ import annotations
 
@@ -37,8 +38,9 @@ from att_msgs.msg import (
     SpacecraftState,
     StarTracker,
 )
-from att_msgs_py import qos, topics
+from att_msgs_py import convert, qos, topics
 from att_msgs_py.errors import ErrorCode
+from att_msgs_py.node_runner import publisher_of
 from att_planner.nodes.client import maneuver_request
 from att_sim.models import rotations as rot
 from helpers.waiting import wait_until
@@ -171,12 +173,15 @@ SENSOR_FUZZ = {topics.IMU: (Imu, imus), topics.STAR_TRACKER: (StarTracker, star_
 
 
 class Monitor(Node):
-    """Wall-clock arrival times of the state and controller-status streams."""
+    """Wall-clock arrival times of the state, estimate and controller-status streams, and the latest
+    state the simulator published (the fuzzer's states on the same topic set aside by publisher)."""
 
     def __init__(self):
         super().__init__("fuzz_monitor")
         self.arrivals = {topics.STATE: [], topics.CONTROLLER_STATUS: [], topics.ESTIMATE: []}
-        self.create_subscription(SpacecraftState, topics.STATE, lambda _: self.arrived(topics.STATE), qos.STREAM_QOS)
+        self.simulator_state = None
+        self.publishers_seen: dict[bytes, bool] = {}      # publisher GID: whether it is the simulator
+        self.create_subscription(SpacecraftState, topics.STATE, self.on_state, qos.STREAM_QOS)
         self.create_subscription(AttitudeEstimate, topics.ESTIMATE, lambda _: self.arrived(topics.ESTIMATE),
                                  qos.STREAM_QOS)
         self.create_subscription(ControllerStatus, topics.CONTROLLER_STATUS,
@@ -185,9 +190,23 @@ class Monitor(Node):
     def arrived(self, topic):
         self.arrivals[topic].append(time.monotonic())
 
+    def on_state(self, msg, info):
+        self.arrived(topics.STATE)
+        gid = publisher_of(info)
+        if gid not in self.publishers_seen:
+            simulator = {bytes(i.endpoint_gid) for i in self.get_publishers_info_by_topic(topics.STATE)
+                         if i.node_name == "simulator"}
+            self.publishers_seen[gid] = gid in simulator
+        if self.publishers_seen[gid]:
+            self.simulator_state = msg
+
     def largest_gap(self, topic, start, end) -> float:
+        return self.gap_at(topic, start, end)[0]
+
+    def gap_at(self, topic, start, end) -> tuple[float, float]:
+        """The largest gap between two arrivals (or ``start``/``end``) and when it began."""
         t = [start] + [a for a in self.arrivals[topic] if start <= a <= end] + [end]
-        return max(b - a for a, b in zip(t, t[1:]))
+        return max((b - a, a) for a, b in zip(t, t[1:]))
 
 
 @pytest.fixture(scope="module")
@@ -199,22 +218,44 @@ def fuzzed(ros_suite):
         spinner = threading.Thread(target=executor.spin, daemon=True)
         spinner.start()
         client = s.client
-        response = client.plan(maneuver_request(rot.IDENTITY, rot.from_axis_angle([0, 0, 1], 1.2), [1, 0, 0], [],
-                                                method="eigenaxis_smooth"))
-        assert response.success, response.message
-        send = client.execute_client.send_goal_async(ExecuteManeuver.Goal(plan_id=response.plan.plan_id))
-        rclpy.spin_until_future_complete(client, send, timeout_sec=20)
-        assert send.result().accepted
         kinds = [(topics.STATE, SpacecraftState), (topics.PLANS, ManeuverPlan), (topics.COMMAND, ActuatorCommand),
                  (topics.CLOCK, Clock), (topics.CONTROLLER_STATUS, ControllerStatus),
                  *((t, cls) for t, (cls, _) in SENSOR_FUZZ.items())]
         publishers = {t: client.create_publisher(cls, t, qos.LATCHED_QOS if t == topics.PLANS else qos.STREAM_QOS)
                       for t, cls in kinds}
-        state = {"suite": s, "monitor": monitor, "goal": send.result(), "pubs": publishers,
+        state = {"suite": s, "monitor": monitor, "goal": None, "pubs": publishers,
                  "start": time.monotonic(), "published": 0}
         yield state
         executor.shutdown()
         monitor.destroy_node()
+
+
+def in_flight(fuzzed):
+    """The goal of a maneuver the controller is flying and its answer's future: the one running, or
+    (none yet, or the last one answered) a new 1.2 rad slew from the simulator's latest state, sent
+    and fed back on."""
+    client, monitor = fuzzed["suite"].client, fuzzed["monitor"]
+    if fuzzed["goal"] is not None:
+        goal, answer = fuzzed["goal"]
+        rclpy.spin_until_future_complete(client, answer, timeout_sec=0.2)     # an answer already sent is taken
+        if not answer.done():
+            return goal, answer
+    wait_until(lambda: monitor.simulator_state is not None, 10, "a state from the simulator")
+    q0 = convert.state_from_msg(monitor.simulator_state).q
+    response = client.plan(maneuver_request(q0, rot.multiply(q0, rot.from_axis_angle([0, 0, 1], 1.2)), [1, 0, 0],
+                                            [], method="eigenaxis_smooth"))
+    assert response.success, response.message
+    fed_back = []
+    send = client.execute_client.send_goal_async(ExecuteManeuver.Goal(plan_id=response.plan.plan_id),
+                                                 feedback_callback=fed_back.append)
+    rclpy.spin_until_future_complete(client, send, timeout_sec=20)
+    goal = send.result()
+    assert goal is not None and goal.accepted
+    answer = goal.get_result_async()
+    wait_until(lambda: fed_back or answer.done(), 30, "feedback on the maneuver", node=client)
+    assert fed_back, f"the maneuver was answered before it flew: {answer.result().result.message}"
+    fuzzed["goal"] = goal, answer
+    return goal, answer
 
 
 def publish(fuzzed, topic, msg):
@@ -242,7 +283,9 @@ def assert_survived(fuzzed, start: float, published_before: int) -> None:
 
 
 def fuzz(fuzzed, publish_examples, *args) -> None:
-    """Run one hypothesis fuzzer against the running suite, then assert what it must leave."""
+    """Run one hypothesis fuzzer against the running suite while a maneuver flies, then assert what
+    it must leave."""
+    in_flight(fuzzed)
     start, before = time.monotonic(), fuzzed["published"]
     publish_examples(fuzzed, *args)
     assert_survived(fuzzed, start, before)
@@ -309,17 +352,38 @@ def test_random_sensor_readings_and_estimates(fuzzed, topic):
     fuzz(fuzzed, publish_sensor_readings, topic)
 
 
+@EXAMPLES
+@given(data=st.data())
+def publish_anything(fuzzed, data):
+    topic = data.draw(st.sampled_from(sorted(FUZZERS)))
+    publish(fuzzed, topic, data.draw(FUZZERS[topic]()))
+
+
+FUZZERS = {topics.STATE: states, topics.PLANS: plans, topics.COMMAND: commands,
+           topics.CLOCK: lambda: st.builds(Clock, clock=stamps()), topics.CONTROLLER_STATUS: statuses,
+           **{t: strategy for t, (_, strategy) in SENSOR_FUZZ.items()}}
+
+
 @pytest.mark.slow                                   # 23 s on the 2-core machine
 def test_nothing_died_nothing_stalled_and_the_maneuver_got_an_answer(fuzzed):
+    """The maneuver in flight (a new one when none flies) fuzzed on every topic until its answer,
+    whatever ran before: no node died, no stream stalled since the suite started, and the maneuver
+    ended completed or aborted with a code."""
     s, monitor, client = fuzzed["suite"], fuzzed["monitor"], fuzzed["suite"].client
+    began = time.monotonic()
+    _, done = in_flight(fuzzed)
+    deadline = time.monotonic() + 120
+    while not done.done() and time.monotonic() < deadline:
+        publish_anything(fuzzed)
+        rclpy.spin_once(client, timeout_sec=0.05)
+    rclpy.spin_until_future_complete(client, done, timeout_sec=max(0.0, deadline - time.monotonic()))
+    assert done.done(), "the maneuver was never answered"
     end = time.monotonic()
     assert all(s.suite.alive().values()), s.suite.alive()
     for topic in (topics.STATE, topics.CONTROLLER_STATUS, topics.ESTIMATE):
-        gap = monitor.largest_gap(topic, fuzzed["start"] + 0.5, end)
-        assert gap < 1.0, f"{topic} stalled for {gap:.2f} s while fuzzing"
-    done = fuzzed["goal"].get_result_async()
-    rclpy.spin_until_future_complete(client, done, timeout_sec=120)
-    assert done.done(), "the maneuver was never answered"
+        gap, at = monitor.gap_at(topic, fuzzed["start"] + 0.5, end)
+        assert gap < 1.0, (f"{topic} stalled for {gap:.2f} s while fuzzing, from {at - fuzzed['start']:.1f} s "
+                           f"after the suite started (this test ran from {began - fuzzed['start']:.1f} s)")
     result = done.result().result
     assert result.success or result.error_code in (ErrorCode.ABORTED, ErrorCode.STATE_TIME_JUMP), result.message
     assert "estimator" in s.suite.procs

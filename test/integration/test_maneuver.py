@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import math
+from contextlib import ExitStack
 from pathlib import Path
 
 import numpy as np
@@ -27,10 +28,37 @@ GOAL = rot.from_axis_angle([0, 0, 1], math.radians(135))
 LAYOUT = Path(__file__).parents[2] / "docs" / "foxglove_layout.json"
 
 
+class RunningSuite:
+    """The module's nodes, started again for the next test when one stopped them (the recorded test
+    stops them to read the finalised log): every test finds them running, in whatever order."""
+
+    def __init__(self, ros_suite):
+        self.ros_suite, self.stack, self.current = ros_suite, None, None
+
+    def get(self):
+        if self.current is None or self.current.exit_codes:
+            self.close()
+            self.stack = ExitStack()
+            self.current = self.stack.enter_context(
+                self.ros_suite("swift_demo", params={"simulator": {"real_time_factor": 0.0}}, name="integration_test"))
+        return self.current
+
+    def close(self) -> None:
+        if self.stack is not None:
+            self.stack, self.current, stack = None, None, self.stack
+            stack.close()
+
+
 @pytest.fixture(scope="module")
-def suite(ros_suite):
-    with ros_suite("swift_demo", params={"simulator": {"real_time_factor": 0.0}}, name="integration_test") as s:
-        yield s
+def running(ros_suite):
+    nodes = RunningSuite(ros_suite)
+    yield nodes
+    nodes.close()
+
+
+@pytest.fixture
+def suite(running):
+    return running.get()
 
 
 def test_bad_request_is_refused_and_the_next_good_one_is_served(suite):
