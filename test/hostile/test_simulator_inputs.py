@@ -336,18 +336,31 @@ def test_a_late_command_of_the_controller_makes_the_simulator_wait_for_it(lonely
     its late command puts the free-running simulator back to waiting; another publisher's is ignored."""
     s, states, now = lonely_sim
     free_running(s)
+    log = lambda: s.suite.log_text("simulator")      # noqa: E731
     pub = s.client.create_publisher(ActuatorCommand, topics.COMMAND, qos.STREAM_QOS)
     stranger = s.client.create_publisher(ActuatorCommand, topics.COMMAND, qos.STREAM_QOS)
-    spin_for(s.client, 1.0)
-    pub.publish(command_msg(now()))                      # the controller: its last accepted command
-    spin_for(s.client, 2.0)                              # then silent: free-running again
-    assert s.suite.log_text("simulator").count("waiting for it to catch up") == 0
+    answered = set()
+
+    def answer_latest():                             # the controller: commands accepted, so it is held
+        if now() not in answered:
+            answered.add(now())
+            pub.publish(command_msg(now()))
+
+    deadline = time.monotonic() + 60
+    while "lockstep resumed" not in log():
+        assert time.monotonic() < deadline, "no command of the controller was accepted within 60 s"
+        spin_for(s.client, 0.1, answer_latest)
+    # then silent: the simulator free-runs again (its log line is throttled in sim time, so the event is
+    # the sim clock running on past the last answered state without an answer, as lockstep never does)
+    last = max(answered)
+    wait_until(lambda: now() > last + 2.0, 60, "the simulator free-running again once the controller fell silent",
+               node=s.client)
     stranger.publish(command_msg(now() - 5.0))
-    spin_for(s.client, 1.0)
-    assert s.suite.log_text("simulator").count("waiting for it to catch up") == 0
-    pub.publish(command_msg(now() - 5.0))                # late, from the controller
-    spin_for(s.client, 1.0)
-    assert "waiting for it to catch up" in s.suite.log_text("simulator")
+    spin_for(s.client, 1.0)                          # wait-ok: an interval in which nothing may happen
+    assert log().count("waiting for it to catch up") == 0, "a stranger's late command was waited for"
+    pub.publish(command_msg(now() - 5.0))            # late, from the controller
+    wait_until(lambda: "waiting for it to catch up" in log(), 30,
+               "the simulator waiting for the controller's late command", node=s.client)
     s.client.destroy_publisher(pub)
     s.client.destroy_publisher(stranger)
 
