@@ -18,9 +18,9 @@ more (a solve then takes a fraction of that), so:
   budget.)
 * a replacement warms in the background at a lower priority (:data:`BACKGROUND_NICENESS`, its
   warm-up thread only, :func:`at_low_priority`): the seconds of CPU it takes to build its NLPs
-  otherwise compete with what the node answers meanwhile (on 2 cores, a request of 100,000 zones
-  that rclpy converts for 0.9 s of CPU was answered 2.1 s past its 0.5 s budget while a worker
-  warmed). The workers of :func:`start_pool` warm at full priority: nothing is served before them.
+  otherwise compete with what the node answers meanwhile (on 2 cores, rclpy's 0.9 s of CPU
+  converting a request of 100,000 zones takes 2.4 s of wall time beside a warming worker). The
+  workers of :func:`start_pool` warm at full priority: nothing is served before them.
 
 A worker that dies is replaced. At most ``max_parallel`` solve at once (the rest wait, within their
 own budget).
