@@ -13,9 +13,17 @@ before ``rclpy.init`` has installed rclpy's handler: the node then stops right a
 An error raised after the context is shut down is the stop itself, not a fault. The node's
 ``close()`` (e.g. the recorder finalising its log) then runs before the node is destroyed, and the
 process exits 0.
+
+Once the node is built, what it holds from its start-up (imported modules, its scenario, a planner's
+pool) is moved out of the cyclic garbage collector's reach (:func:`freeze_start_up`): rclpy converts
+a received message into Python objects before any callback can look at it (100,000 zones of an
+oversized request are some 300,000 objects), and each full collection those allocations trigger
+would otherwise walk the whole start-up heap too (a planner's 100,000 objects: 1.08 s of CPU for that
+request's take instead of 0.78 s). The frozen objects stay freed by their reference counts.
 """
 from __future__ import annotations
 
+import gc
 import math
 import signal
 import sys
@@ -41,6 +49,15 @@ def _stop_requested(_signum, _frame) -> None:
     rclpy has already shut the context down; before it, only this flag knows."""
     global _stop_signalled
     _stop_signalled = True
+
+
+def freeze_start_up() -> int:
+    """Collect the garbage of the start-up, then move every object that survives it to the collector's
+    permanent generation (``gc.freeze``), which its later collections do not walk (module docstring);
+    the number of objects frozen."""
+    gc.collect()
+    gc.freeze()
+    return gc.get_freeze_count()
 
 
 def spin_until_shutdown(executor: Executor, poll: float = 0.2) -> None:
@@ -203,6 +220,7 @@ def run_node(make_node: Callable, args=None, make_executor: Callable[[], Executo
         node = make_node()
         executor = make_executor()
         executor.add_node(node)
+        freeze_start_up()
         if loop is None:
             spin_until_shutdown(executor)
         else:

@@ -16,6 +16,11 @@ more (a solve then takes a fraction of that), so:
   build instead, holding its slot for up to 5 s, starved the answers of concurrent requests on
   this 2-core machine: the budget test's most expensive requests came 1.6-1.9 s after a 0.5 s
   budget.)
+* a replacement warms in the background at a lower priority (:data:`BACKGROUND_NICENESS`, its
+  warm-up thread only, :func:`at_low_priority`): the seconds of CPU it takes to build its NLPs
+  otherwise compete with what the node answers meanwhile (on 2 cores, rclpy's 0.9 s of CPU
+  converting a request of 100,000 zones takes 2.4 s of wall time beside a warming worker). The
+  workers of :func:`start_pool` warm at full priority: nothing is served before them.
 
 A worker that dies is replaced. At most ``max_parallel`` solve at once (the rest wait, within their
 own budget).
@@ -33,6 +38,7 @@ from __future__ import annotations
 
 import multiprocessing
 import os
+import sys
 import threading
 import time
 
@@ -48,6 +54,7 @@ _CONTEXT.set_forkserver_preload(["att_planner.service.planning", "numpy", "scipy
 _SLOTS = threading.BoundedSemaphore(max(1, os.cpu_count() or 1))
 MAX_WORKER_RSS = 640 * 1024 * 1024    # bytes: a worker above it after a task is recycled (a warm one holds ~200 MB)
 KILL_GRACE = 0.5            # s after the wait before the child is terminated
+BACKGROUND_NICENESS = 10    # nice(2) increment of a replacement worker's warm-up thread (Linux: per thread)
 WARM_UP_TIMEOUT = 300.0     # s a worker's warm-up may take before the worker is given up (the node serves anyway)
 
 
@@ -101,13 +108,40 @@ def set_warm_up(function, args: tuple = ()) -> None:
     _WARM_UP = (function, tuple(args))
 
 
-def _warm_worker() -> bool:
-    """Start a worker, run the warm-up in it and add it to the idle ones; False if it died or its
-    warm-up overran :data:`WARM_UP_TIMEOUT`."""
+def at_low_priority(function, args: tuple):
+    """``function(*args)`` run in a thread of this process whose niceness is raised by
+    :data:`BACKGROUND_NICENESS` (on Linux niceness is per thread: the caller's thread, which later
+    solves, keeps its own); its result, or its exception raised again here. Elsewhere it runs at the
+    caller's priority."""
+    outcome: list = []
+
+    def run():
+        try:
+            if sys.platform == "linux":
+                tid = threading.get_native_id()
+                os.setpriority(os.PRIO_PROCESS, tid, os.getpriority(os.PRIO_PROCESS, tid) + BACKGROUND_NICENESS)
+            outcome.append((True, function(*args)))
+        except BaseException as exc:       # handed to the calling thread
+            outcome.append((False, exc))
+
+    thread = threading.Thread(target=run, name="warm-up")
+    thread.start()
+    thread.join()
+    ok, value = outcome[0]
+    if not ok:
+        raise value
+    return value
+
+
+def _warm_worker(background: bool = False) -> bool:
+    """Start a worker, run the warm-up in it (at a low priority when ``background``,
+    :func:`at_low_priority`) and add it to the idle ones; False if it died or its warm-up overran
+    :data:`WARM_UP_TIMEOUT`."""
     process, conn = _spawn()
     if _WARM_UP is not None:
         try:
-            conn.send((_WARM_UP[0], _WARM_UP[1], {}))
+            task = (at_low_priority, (_WARM_UP[0], _WARM_UP[1]), {}) if background else (_WARM_UP[0], _WARM_UP[1], {})
+            conn.send(task)
             if not conn.poll(WARM_UP_TIMEOUT):
                 raise TimeoutError
             conn.recv()
@@ -161,7 +195,7 @@ def _retire(process, conn) -> None:
 def _replace() -> None:
     """A warmed worker in the background for one retired, while the pool is short of its size."""
     if idle_workers() < _POOL_SIZE:
-        threading.Thread(target=_warm_worker, daemon=True).start()
+        threading.Thread(target=_warm_worker, args=(True,), daemon=True).start()
 
 
 def call_isolated(function, args: tuple, kwargs: dict, wait: float | None, *, on_death):

@@ -97,3 +97,36 @@ def test_refusals_are_logged_once_a_second_per_kind_with_their_count():
     assert Logger.lines[0] == "state refused (1 so far) [311 STATE_TIME_JUMP]: stamp jumps"
     assert len(Logger.lines) == 2 and Logger.lines[1].startswith("published plan refused (1 so far) [306 ")
     assert len(Logger.lines[1]) <= 400 and log.counts == {"state": 1001, "published plan": 1}
+
+
+FREEZE_SCRIPT = textwrap.dedent("""
+    import gc
+    import rclpy
+    from rclpy.node import Node
+    from att_msgs_py.node_runner import run_node
+
+    held = []
+
+    class Holder(Node):
+        def __init__(self):
+            super().__init__("holder")
+            held.append([{"start-up": i} for i in range(1000)])     # what a node keeps from its start-up
+
+    def loop(node, executor):
+        young = [[] for _ in range(10)]                              # made after the start-up
+        tracked = {id(o) for o in gc.get_objects()}
+        frozen = gc.get_freeze_count()
+        print(frozen >= 1000, id(held[0]) in tracked, id(held[0][0]) in tracked, id(young[0]) in tracked,
+              flush=True)
+
+    run_node(Holder, loop=loop)
+""")
+
+
+def test_a_node_start_up_heap_is_out_of_the_collector_reach():
+    """What the node built before it spins is frozen (gc.get_objects, which lists what collections
+    walk, no longer holds it); what it makes later is still collected."""
+    out = subprocess.run([sys.executable, "-c", FREEZE_SCRIPT], env=isolated_env(), capture_output=True, text=True,
+                         timeout=60)
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.split() == ["True", "False", "False", "True"], out.stdout

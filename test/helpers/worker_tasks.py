@@ -45,3 +45,19 @@ def allocate_then_rss(megabytes: int, keep: bool) -> tuple[int, int]:
         _KEPT.extend(blocks)
     del blocks
     return os.getpid(), memory.rss_bytes()
+
+
+WARM_NICENESS = None
+
+
+def warm_recording_niceness() -> None:
+    """A warm-up that records the niceness of the thread it runs in."""
+    import threading
+    global WARM_NICENESS
+    WARM_NICENESS = os.getpriority(os.PRIO_PROCESS, threading.get_native_id())
+
+
+def niceness() -> tuple[int | None, int]:
+    """The niceness the warm-up ran at and the niceness of the thread serving this task."""
+    import threading
+    return WARM_NICENESS, os.getpriority(os.PRIO_PROCESS, threading.get_native_id())

@@ -50,6 +50,32 @@ def test_a_worker_that_overruns_is_killed_and_replaced_by_a_warmed_one():
     assert warmed and pid != pooled.pid
 
 
+@pytest.mark.skipif(worker.sys.platform != "linux", reason="niceness is per thread on Linux only")
+def test_a_replacement_warms_at_a_low_priority_and_serves_at_the_node_priority():
+    """The pool's first workers warm at the node's priority; one warmed in place of a killed one
+    warms BACKGROUND_NICENESS lower, in its warm-up thread only, and serves at the node's again."""
+    base = worker.os.getpriority(worker.os.PRIO_PROCESS, 0)
+    worker.set_warm_up(worker_tasks.warm_recording_niceness)
+    worker.start_pool(1)
+    assert worker.call_isolated(worker_tasks.niceness, (), {}, 10.0, on_death=on_death) == (base, base)
+    assert worker.call_isolated(worker_tasks.sleep_then_pid, (3600.0,), {}, 0.1, on_death=on_death) is None
+    wait_until(worker.idle_workers, 60.0, "a warmed worker in place of the killed one")
+    expected = min(19, base + worker.BACKGROUND_NICENESS)
+    assert worker.call_isolated(worker_tasks.niceness, (), {}, 10.0, on_death=on_death) == (expected, base)
+
+
+def test_a_low_priority_call_returns_its_result_and_raises_its_error():
+    assert worker.at_low_priority(divmod, (7, 2)) == (3, 1)
+    with pytest.raises(ZeroDivisionError):
+        worker.at_low_priority(divmod, (7, 0))
+    os = worker.os
+    before = os.getpriority(os.PRIO_PROCESS, 0)                 # on Linux: this thread's
+    ran_at = worker.at_low_priority(os.getpriority, (os.PRIO_PROCESS, 0))
+    if worker.sys.platform == "linux":
+        assert ran_at == min(19, before + worker.BACKGROUND_NICENESS)
+    assert os.getpriority(os.PRIO_PROCESS, 0) == before         # the caller's thread keeps its niceness
+
+
 def test_a_worker_hands_back_what_a_task_freed():
     pid, before = worker.call_isolated(worker_tasks.allocate_then_rss, (0, False), {}, 30.0, on_death=on_death)
     same, _ = worker.call_isolated(worker_tasks.allocate_then_rss, (200, False), {}, 30.0, on_death=on_death)
