@@ -28,7 +28,7 @@ leave tens of MB per topic for good (+40 MB in an estimator that refused 60 of t
 topics). :func:`middleware_env` points Fast DDS at :data:`PROFILES` (payloads allocated per sample
 and freed when released; rmw_fastrtps's other defaults kept, QoS still from the code): the same
 refusals then leave the estimator at its start-up size.
-:func:`rss_bytes` reads a process's resident set (``VmRSS`` of ``/proc/PID/status``).
+:func:`rss_bytes` reads a process's resident set (``Rss`` of ``/proc/PID/smaps_rollup``).
 """
 from __future__ import annotations
 
@@ -101,12 +101,14 @@ def reexec_with_c_allocator() -> None:
 
 
 def rss_bytes(pid: int | str = "self") -> int | None:
-    """The resident set of process ``pid`` in bytes (``VmRSS``), None when it has none to read
-    (exited, or no ``/proc``)."""
+    """The resident set of process ``pid`` in bytes, None when it has none to read (exited, or no
+    ``/proc``). Read from ``/proc/PID/smaps_rollup``, which counts the mapped pages as they are:
+    ``VmRSS`` of ``/proc/PID/status`` is the kernel's cached counter, which can lag by tens of MB in a
+    process of many threads (a touched 64 MB array once left it unchanged)."""
     try:
-        with open(f"/proc/{pid}/status") as fh:
+        with open(f"/proc/{pid}/smaps_rollup") as fh:
             for line in fh:
-                if line.startswith("VmRSS:"):
+                if line.startswith("Rss:"):
                     return int(line.split()[1]) * 1024
     except OSError:
         return None

@@ -3,7 +3,7 @@
 Starts the simulator, estimator, controller and planner of ``--scenario`` as processes
 (:func:`att_planner.tools.launch.start_suite`, on a random ``ROS_DOMAIN_ID`` with localhost
 discovery; no recorder: it would write every oversized message to disk), reads each node's RSS
-(``VmRSS``, :func:`att_msgs_py.memory.rss_bytes`; the planner's solver workers separately, as the sum
+(``Rss`` of ``smaps_rollup``, :func:`att_msgs_py.memory.rss_bytes`; the planner's solver workers separately, as the sum
 over its descendant processes) once all serve and their resident sets have settled (:func:`settled`),
 then sends ``--messages`` messages cycling through
 :data:`KINDS`: large valid planning requests (16 moving zones, time-optimal with 200 intervals),
