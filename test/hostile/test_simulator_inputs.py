@@ -295,8 +295,12 @@ def test_hostile_commands_are_refused_states_flow_and_refusals_are_throttled(lon
     spin_for(s.client, 4.0, publish_one, period=0.01)
     elapsed = time.monotonic() - start
     assert all(s.suite.alive().values())
+    # the simulator's flow, read from the stamps: the client may drop states of its shallow queue while
+    # it publishes the flood, so their count says how fast the test process is, not the simulator
     gaps = np.diff([w for w, _ in states])
-    assert len(states) > 100 and gaps.max() < 1.0, "states stopped flowing"
+    advanced = convert.from_time(states[-1][1].header.stamp) - convert.from_time(states[0][1].header.stamp)
+    assert len(states) > 10 and gaps.max() < 1.0, "states stopped flowing"
+    assert advanced >= 0.5 * RTF * elapsed, f"sim time advanced {advanced:.2f} s in {elapsed:.2f} s (RTF {RTF})"
     assert all(m.command_timeout and not np.any(m.wheel_torques) for _, m in states), \
         "a refused command was applied or satisfied the lockstep"
     lines = [ln for ln in s.suite.log_text("simulator").splitlines() if "actuator command rejected" in ln]
