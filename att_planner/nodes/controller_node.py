@@ -43,6 +43,7 @@ import time
 
 from rclpy.action import ActionServer, CancelResponse, GoalResponse
 from rclpy.clock import Clock, ClockType
+from rclpy.impl.implementation_singleton import rclpy_implementation as _rclpy
 from rclpy.node import Node
 from rclpy.task import Future
 from rosgraph_msgs.msg import Clock as ClockMsg
@@ -184,7 +185,7 @@ class ControllerNode(Node):
             self._cmd_pub.publish(convert.command_msg(out.command))
             self._status_pub.publish(convert.controller_status_msg(out.status))
             if out.feedback is not None and self._goal is not None:
-                self._goal.publish_feedback(convert.feedback_msg(out.feedback))
+                self._to_client("feedback", self._goal.publish_feedback, convert.feedback_msg(out.feedback))
             if out.result is not None:
                 self.finish(out.result)
 
@@ -236,18 +237,24 @@ class ControllerNode(Node):
                                        else None)
         if refused is not None:
             self._refusals("execute goal", refused)
-            goal_handle.abort()
+            self._to_client("goal status", goal_handle.abort)
             return convert.result_msg(ManeuverResult(False, int(refused.code), refused.message))
         self._goal, self._done = goal_handle, Future(executor=self.executor)
         self.get_logger().info(f"executing plan '{plan.plan_id}' ({plan.method}, {plan.duration:.1f} s)")
         result = await self._done
-        if goal_handle.is_cancel_requested:
-            goal_handle.canceled()
-        elif result.success:
-            goal_handle.succeed()
-        else:
-            goal_handle.abort()
+        end = (goal_handle.canceled if goal_handle.is_cancel_requested else
+               goal_handle.succeed if result.success else goal_handle.abort)
+        self._to_client("goal status", end)
         return convert.result_msg(result)
+
+    def _to_client(self, what: str, send, *args) -> None:
+        """Send the action client ``what`` (a goal's feedback or its terminal status). The goal's
+        state changes before the status is published, so a publication the middleware refuses
+        loses only that message, never the goal's result: logged, and the node goes on."""
+        try:
+            send(*args)
+        except _rclpy.RCLError as err:
+            self.get_logger().warning(f"{what} not published: {err}")
 
     def finish(self, result: ManeuverResult):
         """Hand the result of the maneuver that ended to the waiting action callback."""

@@ -11,6 +11,7 @@ import math
 
 import pytest
 import rclpy
+from action_msgs.msg import GoalStatus
 
 from att_msgs.action import ExecuteManeuver
 from att_msgs_py import convert, signing
@@ -90,5 +91,6 @@ def test_the_controller_node_refuses_an_inline_plan_whose_duration_contradicts_i
             rclpy.spin_until_future_complete(client, done, timeout_sec=20)
             assert done.done(), "the goal was never answered"
             result = done.result().result
+            assert done.result().status == GoalStatus.STATUS_ABORTED, (done.result().status, result.message)
             assert not result.success and result.error_code == ErrorCode.INVALID_PLAN, result.message
             assert "plan.duration" in result.message
