@@ -137,7 +137,8 @@ def json_lines(notes: list[str]) -> list[dict]:
                 command = (f"att-mc campaigns/swift_demo.yaml --runs {payload.get('requested')} --workers "
                            f"{payload.get('workers')} --no-figures --json {path}   # at {ab['code']}")
             if kept and path in TEXT_LOAD:
-                source = f"the JSON; load {TEXT_LOAD[path]} from BENCHMARKS.md at {TEXT_AT}"
+                load, section = TEXT_LOAD[path].split(" (", 1)
+                source = f"the JSON; load {load} from BENCHMARKS.md at {TEXT_AT} ({section}"
             try:
                 row = hist.line(payload, case=case, json_path=path if kept else None, command=command,
                                 date=date, commit=commit, source=source)

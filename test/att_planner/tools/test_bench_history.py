@@ -138,3 +138,36 @@ def test_a_study_json_without_a_machine_gets_one(tmp_path, monkeypatch):
     assert machine["cores"] >= 1 and machine["load_1min"] >= 0.0
     datetime.strptime(machine["date"], "%Y-%m-%dT%H:%M:%SZ")
     assert set(machine) == {"cores", "python", "load_1min", "omp_num_threads", "date", "commit"}
+
+
+def test_benchmarks_md_tables_are_the_historys(tmp_path, capsys):
+    """BENCHMARKS.md's summary table and each study's table are what ``att-bench summary`` renders from
+    the committed history; a changed figure or a missing row is found."""
+    from att_planner.tools.bench import summary
+
+    rows = hist.read(BENCHMARKS / "history.jsonl")
+    blocks = summary.render(rows)
+    page = (ROOT / "BENCHMARKS.md").read_text()
+    assert page.index(summary.begin(summary.SUMMARY)) < page.index("\n## ", page.index("## Summary") + 1)
+    for name, block in blocks.items():
+        assert block in page, f"BENCHMARKS.md's {name} table differs from `att-bench summary` (run it with --write)"
+    assert summary.differing(page, blocks) == []
+    for study, case in summary.ROWS:
+        assert f"| {study}, {case} |" in blocks[summary.SUMMARY]
+
+    changed = [dict(r) for r in rows]
+    changed[-1]["value"] = changed[-1]["value"] + 1.0
+    history, md = tmp_path / "history.jsonl", tmp_path / "BENCHMARKS.md"
+    for row in changed:
+        hist.append(row, history)
+    md.write_text(page)
+    assert main(["summary", "--history", str(history), "--markdown", str(md), "--check"]) == 1
+    assert "differs" in capsys.readouterr().out
+    assert main(["summary", "--history", str(history), "--markdown", str(md), "--write"]) == 0
+    assert main(["summary", "--history", str(history), "--markdown", str(md), "--check"]) == 0
+    assert md.read_text().count("\n## ") == page.count("\n## ")
+
+    with pytest.raises(hist.HistoryError, match="no line for smooth swift"):
+        summary.render([r for r in rows if (r["study"], r["case"]) != ("smooth", "swift")])
+    md.write_text("# no tables\n")
+    assert main(["summary", "--history", str(history), "--markdown", str(md), "--write"]) == 2
