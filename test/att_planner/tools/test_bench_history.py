@@ -2,7 +2,6 @@
 inputs refused with a sentence, and the committed history's latest lines equal to the kept JSONs."""
 import json
 import math
-import re
 import shutil
 from datetime import datetime
 from pathlib import Path
@@ -15,7 +14,6 @@ from att_planner.tools.bench import main
 ROOT = Path(__file__).resolve().parents[3]
 BENCHMARKS = ROOT / "benchmarks"
 NOT_STUDY_RUNS = {"sky_search.json"}        # the sky case search's output
-AB = re.compile(r"monte_carlo_ab_[0-9a-f]+_\d+\.json")   # per-commit A/B runs: history lines only
 
 
 def _lines(path: Path) -> list[dict]:
@@ -104,8 +102,7 @@ def test_the_committed_history_holds_each_kept_json_as_its_latest_line():
     rows = hist.read(BENCHMARKS / "history.jsonl")
     latest = hist.latest(rows)
     kept = {row["json"]: row for row in latest.values() if row["json"]}
-    on_disk = {f"benchmarks/{p.name}" for p in BENCHMARKS.glob("*.json") if p.name not in NOT_STUDY_RUNS
-               and not AB.fullmatch(p.name)}
+    on_disk = {f"benchmarks/{p.name}" for p in BENCHMARKS.glob("*.json") if p.name not in NOT_STUDY_RUNS}
     assert set(kept) == on_disk
     for path, row in kept.items():
         again = hist.line(hist.load_json(ROOT / path), case=row["case"], json_path=path, command=row["command"],
