@@ -6,9 +6,9 @@ campaign), recognises the study from its keys (or takes ``--study``), and append
 
 ``study``, ``case``, ``metric`` (the headline figure's name), ``value`` and ``unit``, ``target`` (the
 criterion in words) and ``met`` (``true``/``false``, ``null`` where the study states none),
-``metrics`` (the other figures of the run), ``date`` (UTC), ``commit``, ``machine`` and
-``load_1min`` (from the JSON when it holds them), ``command``, ``json`` (the file, when it is kept
-in the repository) and ``source`` (where the figures were read).
+``metrics`` (the other figures of the run), ``date`` (UTC) and ``commit`` (the run's, see :func:`run`),
+``machine`` and ``load_1min`` (from the JSON when it holds them), ``command``, ``json`` (the file,
+when it is kept in the repository) and ``source`` (where the figures were read).
 
 Every figure of a line is read from the JSON; the criterion of each study is written once, in
 :data:`STUDIES`. ``att-bench summary`` renders BENCHMARKS.md's summary table from the latest line of
@@ -18,8 +18,6 @@ from __future__ import annotations
 
 import json
 import math
-import os
-import platform
 import subprocess
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -27,6 +25,7 @@ from datetime import UTC, datetime
 from pathlib import Path
 
 HISTORY = Path("benchmarks") / "history.jsonl"
+DATE_FORMAT = "%Y-%m-%dT%H:%M:%SZ"
 FIELDS = ("study", "case", "metric", "value", "unit", "target", "met", "metrics", "date", "commit", "machine",
           "load_1min", "command", "json", "source")
 
@@ -439,14 +438,24 @@ def configure(parser) -> None:
 
 
 def run(args) -> int:
-    """Append the summary line of ``args.append`` to ``args.history``; 2 with a sentence when refused."""
+    """Append the summary line of ``args.append`` to ``args.history``; 2 with a sentence when refused.
+
+    The line's date and commit are the run's when its JSON names them (``machine.date``,
+    ``machine.commit``, written by ``att-bench``), else the time of the append and the checkout's HEAD.
+    """
     try:
         payload = load_json(args.append)
+        ran = payload.get("machine") if isinstance(payload.get("machine"), dict) else {}
+        date = ran.get("date")
+        if date is not None:
+            try:
+                datetime.strptime(date, DATE_FORMAT)
+            except (TypeError, ValueError):
+                raise HistoryError(f"'machine.date' must be a UTC time like 2026-12-05T01:26:04Z, "
+                                   f"found {date!r}") from None
         row = line(payload, study=args.study, case=args.case, json_path=None if args.no_json else args.append,
-                   command=args.command, date=datetime.now(UTC).strftime("%Y-%m-%dT%H:%M:%SZ"),
-                   commit=head_commit(), source="json",
-                   machine={"cores": os.cpu_count(), "python": platform.python_version()},
-                   load_1min=None)
+                   command=args.command, date=date or datetime.now(UTC).strftime(DATE_FORMAT),
+                   commit=ran.get("commit") or head_commit(), source="json")
         append(row, args.history)
     except (HistoryError, ValueError) as exc:
         print(f"att-bench history: {exc}")

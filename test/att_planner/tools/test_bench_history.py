@@ -39,6 +39,7 @@ def test_append_writes_the_study_line_from_its_json(tmp_path, capsys):
     assert list(row) == list(hist.FIELDS)
 
     payload["tf"] = 6.0
+    payload["machine"].update(date="2026-12-05T01:02:03Z", commit="abc1234")
     run.write_text(json.dumps(payload))
     assert main(["history", "--append", str(run), "--history", str(history), "--case", "swift",
                  "--command", "by hand", "--no-json"]) == 0
@@ -46,6 +47,7 @@ def test_append_writes_the_study_line_from_its_json(tmp_path, capsys):
     first, second = _lines(history)
     assert first == row and second["value"] == 6.0 and second["met"] is False
     assert second["json"] is None and second["command"] == "by hand"
+    assert second["date"] == "2026-12-05T01:02:03Z" and second["commit"] == "abc1234"   # the run's, not the append's
     assert hist.latest(_lines(history))[("smooth", "swift")] == second
 
 
@@ -56,12 +58,17 @@ def test_append_writes_the_study_line_from_its_json(tmp_path, capsys):
     ("nan.json", None, "'tf' must be a finite number, found nan"),
     ("missing.json", None, "has no 'published.dfsp'"),
     ("absent.json", "", "cannot be read"),
+    ("date.json", None, "'machine.date' must be a UTC time"),
 ])
 def test_a_hostile_json_is_refused_and_nothing_appended(tmp_path, capsys, name, text, says):
     path = tmp_path / name
     if name == "nan.json":
         payload = json.loads((BENCHMARKS / "smooth_swift.json").read_text())
         payload["tf"] = math.nan
+        path.write_text(json.dumps(payload))
+    elif name == "date.json":
+        payload = json.loads((BENCHMARKS / "smooth_swift.json").read_text())
+        payload["machine"]["date"] = "yesterday"
         path.write_text(json.dumps(payload))
     elif name == "missing.json":
         payload = json.loads((BENCHMARKS / "smooth_swift.json").read_text())
