@@ -1,0 +1,34 @@
+"""The documentation builds with Sphinx and MyST with every warning an error, and its generated pages
+hold what the code declares (error codes, planning methods, node topics)."""
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+DOCS = ROOT / "docs"
+
+
+def build(out: Path) -> subprocess.CompletedProcess:
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(ROOT), os.environ.get("PYTHONPATH", "")])}
+    return subprocess.run([sys.executable, "-m", "sphinx", "-W", "--keep-going", "-b", "html", "-q", "-E",
+                           "-d", str(out / "doctrees"), str(DOCS), str(out / "html")],
+                          cwd=ROOT, env=env, capture_output=True, text=True, timeout=240)
+
+
+def test_the_documentation_builds_without_a_warning(tmp_path):
+    run = build(tmp_path)
+    assert run.returncode == 0, run.stdout[-3000:] + run.stderr[-3000:]
+    html = (tmp_path / "html" / "errors.html").read_text()
+    from att_msgs_py.errors import ErrorCode
+    for code in ErrorCode:                      # every code of the enum is on the generated page
+        assert f"<td><p>{int(code)}</p></td>" in html and code.name in html, code
+
+
+def test_every_error_code_has_a_meaning():
+    from att_msgs_py.error_meanings import MEANINGS
+    from att_msgs_py.errors import ErrorCode
+    assert set(MEANINGS) == set(ErrorCode)
+    assert all(text.strip() for text in MEANINGS.values())
