@@ -25,6 +25,16 @@ def test_the_documentation_builds_without_a_warning(tmp_path):
     from att_msgs_py.errors import ErrorCode
     for code in ErrorCode:                      # every code of the enum is on the generated page
         assert f"<td><p>{int(code)}</p></td>" in html and code.name in html, code
+    from att_planner.methods import REGISTRY
+    methods = (tmp_path / "html" / "planning-methods.html").read_text()
+    for method in REGISTRY:                     # every registered method and each of its options
+        assert f'id="{method.name.replace("_", "-")}"' in methods, method.name
+        assert all(f"<code class=\"docutils literal notranslate\"><span class=\"pre\">{o}</span></code>" in methods
+                   for o in method.options), method.name
+    from att_msgs_py import topics
+    nodes = "".join(page.read_text() for page in (tmp_path / "html" / "nodes").glob("*.html"))
+    for name in topics.ABOUT:                   # every topic, service and action is on a node's page
+        assert f"<span class=\"pre\">{name}</span>" in nodes, name
 
 
 def test_every_error_code_has_a_meaning():
