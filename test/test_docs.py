@@ -42,3 +42,21 @@ def test_every_error_code_has_a_meaning():
     from att_msgs_py.errors import ErrorCode
     assert set(MEANINGS) == set(ErrorCode)
     assert all(text.strip() for text in MEANINGS.values())
+
+
+def test_node_pages_read_each_node_s_endpoints_from_its_source():
+    sys.path.insert(0, str(DOCS / "_ext"))
+    try:
+        import att_docs
+    finally:
+        sys.path.remove(str(DOCS / "_ext"))
+    from att_planner.tools.launch import NODE_MODULES
+    rows = {node: {(r[0], r[1].strip("`"), r[2].strip("`")) for r in att_docs.node_interfaces(NODE_MODULES[node])}
+            for node in att_docs.NODES}
+    assert ("serves (action)", "/controller/execute", "att_msgs/action/ExecuteManeuver") in rows["controller"]
+    assert ("serves (service)", "/simulator/reset", "att_msgs/srv/ResetSimulator") in rows["simulator"]
+    # the simulator publishes a sensor's topic only when the scenario has that sensor
+    assert ("publishes (when configured)", "/sensors/imu", "sensor_msgs/msg/Imu") in rows["simulator"]
+    assert ("publishes", "/estimator/attitude", "att_msgs/msg/AttitudeEstimate") in rows["estimator"]
+    from att_msgs_py.topics import RECORDED
+    assert {r[1] for r in rows["recorder"]} == set(RECORDED)

@@ -145,21 +145,38 @@ def _qos_text(name: str | None, kind: str) -> str:
             f"keep last {profile.depth}")
 
 
+def _conditional(call: ast.Call, parents: dict) -> bool:
+    """Whether ``call`` runs only under a condition of its own: ``x if c else y``, a comprehension's
+    ``if``, or an ``if`` block of the function (the node's configuration decides)."""
+    node = call
+    while node in parents and not isinstance(node, ast.FunctionDef):
+        parent = parents[node]
+        if isinstance(parent, (ast.IfExp, ast.If)) and node is not parent.test:
+            return True
+        if isinstance(parent, (ast.ListComp, ast.DictComp, ast.SetComp, ast.GeneratorExp)) and any(
+                g.ifs for g in parent.generators):
+            return True
+        node = parent
+    return False
+
+
 def node_interfaces(module: str) -> list[list[str]]:
     """Rows (role, name, type, QoS, what) of one node, from its source."""
     from att_msgs_py import qos, topics
     tree = ast.parse(_source(module).read_text())
     types = _imports(tree)
     rows = []
+    parents = {child: node for node in ast.walk(tree) for child in ast.iter_child_nodes(node)}
     functions = [n for n in ast.walk(tree) if isinstance(n, ast.FunctionDef)]
     for function in functions:
         for call in (n for n in ast.walk(function) if isinstance(n, ast.Call)):
             kind = _call_name(call)
             if kind not in _CALLS:
                 continue
+            role = _CALLS[kind] + (" (when configured)" if _conditional(call, parents) else "")
             for type_name, attr, qos_name in _endpoints(function, call, kind):
                 name = getattr(topics, attr)
-                rows.append([_CALLS[kind], f"`{name}`", f"`{types.get(type_name, type_name)}`",
+                rows.append([role, f"`{name}`", f"`{types.get(type_name, type_name)}`",
                              _qos_text(qos_name, _CALLS[kind]), topics.ABOUT.get(name, "")])
     if "recorded_topics()" in _source(module).read_text():
         for name, (type_name, profile) in qos.recorded_topics().items():
