@@ -5,7 +5,7 @@ from att_msgs_py.parameters import Parameter, ParameterTable
 
 RECORDER = ParameterTable("recorder", (
     Parameter("output", str, None, "MCAP file the run is recorded to (an unfinished one there is first repaired "
-                                   "aside)", default_rule="runs/run_<UTC date>_<time>.mcap"),
+                                   "aside)", default_rule="runs/run_YYYYmmdd_HHMMSS.mcap (UTC start time)"),
     Parameter("flush_period", float, 0.5, "longest time between flushes to disk (a killed recorder loses at most "
                                           "this)", "s", 0.0, 3600.0, low_open=True),
 ), "writes every suite topic to one rosbag2-compatible MCAP file per run")

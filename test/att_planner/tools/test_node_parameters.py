@@ -1,13 +1,16 @@
 """Every node's parameter declarations (ROS-free): complete, with units that match their names,
-defaults that are the cores' own, and the in-process cores refusing what a node refuses in the
-same words."""
+defaults that are the cores' own, the in-process cores refusing what a node refuses in the same
+words, and a Markdown reference that lists every declared parameter."""
 from __future__ import annotations
 
 import dataclasses
+import math
+import re
 
 import pytest
 
 from att_msgs_py.errors import ConfigError, ErrorCode
+from att_msgs_py.parameter_docs import COLUMNS, TYPE_NAMES, markdown
 from att_msgs_py.parameters import SectionReader
 from att_planner.control.controller_config import ControllerConfig
 from att_planner.control.controller_from_scenario import controller_config, gate_config
@@ -18,7 +21,7 @@ from att_planner.estimation.estimator_from_scenario import estimator_config
 from att_planner.estimation.estimator_parameters import ESTIMATOR
 from att_planner.tools.closed_loop import ClosedLoop
 from att_planner.tools.launch import NODE_MODULES
-from att_planner.tools.node_parameters import NODE_PARAMETERS, declared
+from att_planner.tools.node_parameters import NODE_PARAMETERS, declared, reference
 from att_sim.models import scenario as scen
 
 SWIFT = scen.load("swift_demo")
@@ -80,3 +83,32 @@ def test_the_in_process_loop_refuses_what_a_node_refuses_in_the_same_words(overr
 def test_an_integer_for_a_double_runs_in_process():
     loop = ClosedLoop(SWIFT, overrides={"controller": {"control_rate": 20, "state_source": "truth"}})
     assert loop.controller.config.control_period == pytest.approx(0.05)
+
+
+def rows(text: str) -> list[list[str]]:
+    return [[c.strip() for c in re.split(r"(?<!\\)\|", line)[1:-1]] for line in text.splitlines()
+            if line.startswith("| ")]
+
+
+@pytest.mark.parametrize("node", NODE_PARAMETERS)
+def test_the_markdown_reference_lists_every_declared_parameter(node):
+    table = declared(node)
+    text = markdown(table)
+    header, *body = rows(text)
+    assert header == list(COLUMNS) and text.startswith(f"## {node}\n")
+    assert [r[0] for r in body] == [f"`{spec.name}`" for spec in table]
+    for r, spec in zip(body, table):
+        assert len(r) == len(COLUMNS)
+        assert r[1] == TYPE_NAMES[spec.kind] and r[4] == spec.unit and r[5].startswith(spec.description[:20])
+        assert (r[2] == f"`{spec.default_text()}`") if spec.default is not None else r[2] == spec.default_rule
+        if spec.bounded and not spec.refusal:
+            assert spec.interval() in r[3]
+
+
+def test_the_reference_has_every_node_and_writes_numbers_as_a_parameter_file_does():
+    text = reference()
+    assert all(f"## {node}\n" in text for node in NODE_PARAMETERS)
+    assert "| `step` | double | `0.05` | in (0, 1] | s |" in text
+    assert "| `schedule_rate_max` | double | `.inf` |" in text
+    assert "| `initial_attitude` | double[] | `[0.0, 0.0, 0.0, 1.0]` |" in text
+    assert math.isclose(CONTROLLER["control_rate"].default, 1.0 / ControllerConfig().control_period)
