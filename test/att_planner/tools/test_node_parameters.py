@@ -8,6 +8,7 @@ import math
 import re
 
 import pytest
+import yaml
 
 from att_msgs_py.errors import ConfigError, ErrorCode
 from att_msgs_py.parameter_docs import COLUMNS, TYPE_NAMES, markdown
@@ -112,3 +113,27 @@ def test_the_reference_has_every_node_and_writes_numbers_as_a_parameter_file_doe
     assert "| `schedule_rate_max` | double | `.inf` |" in text
     assert "| `initial_attitude` | double[] | `[0.0, 0.0, 0.0, 1.0]` |" in text
     assert math.isclose(CONTROLLER["control_rate"].default, 1.0 / ControllerConfig().control_period)
+
+
+def node_sections(name: str) -> tuple[str, dict]:
+    """The node sections of shipped file ``name``: a scenario's, or a plain ROS parameter file's."""
+    try:
+        s = scen.load(name)
+    except ConfigError:                                   # a --params-file (controller_gains)
+        path = scen.find(name)
+        return str(path), {k: v["ros__parameters"] for k, v in yaml.safe_load(path.read_text()).items()}
+    return str(s.path), s.node_params
+
+
+@pytest.mark.parametrize("name", scen.available())
+def test_every_shipped_file_sets_only_declared_node_parameters_to_accepted_values(name):
+    """A shipped file's node sections pass the checks a node makes of them."""
+    path, sections = node_sections(name)
+    assert sections
+    for node, section in sections.items():
+        if node not in NODE_PARAMETERS:                   # the demo maneuver, the shared /** keys
+            continue
+        table = NODE_PARAMETERS[node]
+        assert set(section) <= set(table.parameters), (node, set(section) - set(table.parameters))
+        for key, value in section.items():
+            table[key].check(value, f" (from {path})")
