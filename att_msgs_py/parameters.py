@@ -3,10 +3,10 @@ naming the bad one.
 
 Each node's parameters are a :class:`ParameterTable` of :class:`Parameter` declarations (name, type,
 default, range, length, choices, unit, description). :class:`att_msgs_py.node_runner.ParameterReader`
-declares them as ROS parameters with full descriptors and checks every value with :func:`checked`;
-:class:`SectionReader` reads the same table over a scenario file's section for the in-process cores
-(the closed loop of :mod:`att_planner.tools.closed_loop`), so a value a node would refuse is refused
-there too, in the same words. Both are called ``read(name)`` (the table's default) or
+declares them as ROS parameters with full descriptors and checks every value with
+:meth:`Parameter.check`; :class:`SectionReader` reads the same table over a scenario file's section
+for the in-process cores (the closed loop of :mod:`att_planner.tools.closed_loop`), so a value a
+node would refuse is refused there too, in the same words. Both are called ``read(name)`` (the table's default) or
 ``read(name, default)`` for a default the node finds at start-up (``default_rule`` says how), and
 ``high=`` for an upper bound found at start-up (``high_rule``).
 """
@@ -60,6 +60,8 @@ class Parameter:
             raise TypeError(f"parameter '{self.name}': kind {self.kind!r} is not one of {KINDS}")
         if not self.description:
             raise ValueError(f"parameter '{self.name}' has no description")
+        if self.kind is list and self.default is not None and not isinstance(self.default, tuple):
+            raise TypeError(f"parameter '{self.name}': a list's default is a tuple (a declaration is immutable)")
         if self.default is None and not self.default_rule:
             raise ValueError(f"parameter '{self.name}': a default found at start-up needs its default_rule")
         if self.default is not None:
@@ -99,8 +101,8 @@ class Parameter:
         return ".inf" if self.default == math.inf else _number(self.default)
 
     def constraints(self) -> str:
-        """Every constraint in words: the range (with its unit), the list's length, the choices, the
-        node's own further check (``refusal``), the hint."""
+        """Every constraint in words: the range (or the ``refusal`` sentence that replaces it), the
+        list's length, the choices, the hint."""
         parts = []
         if self.refusal:
             parts.append(self.refusal.removeprefix("expected "))
