@@ -20,15 +20,21 @@ def row(spec: Parameter) -> tuple[str, ...]:
             spec.constraints(), spec.unit, spec.description + ("" if spec.read_only else " (settable at run time)"))
 
 
+def markdown_table(table: ParameterTable) -> str:
+    """``table`` as a Markdown table alone: a header, then one row per parameter, in declaration
+    order (for a page that has its own heading)."""
+    lines = ["| " + " | ".join(COLUMNS) + " |", "|" + "---|" * len(COLUMNS)]
+    lines += ["| " + " | ".join(_cell(c) for c in row(spec)) + " |" for spec in table]
+    return "\n".join(lines) + "\n"
+
+
 def markdown(table: ParameterTable, heading: str | None = None, level: int = 2) -> str:
-    """``table`` as a Markdown section: a heading (default: the node's name), its summary, then one
-    row per parameter, in declaration order."""
+    """``table`` as a Markdown section: a heading (default: the node's name), its summary, then
+    :func:`markdown_table`."""
     lines = [f"{'#' * level} {heading or table.node}", ""]
     if table.summary:
         lines += [table.summary[0].upper() + table.summary[1:] + ".", ""]
-    lines += ["| " + " | ".join(COLUMNS) + " |", "|" + "---|" * len(COLUMNS)]
-    lines += ["| " + " | ".join(_cell(c) for c in row(spec)) + " |" for spec in table]
-    return "\n".join(lines) + "\n"
+    return "\n".join(lines) + "\n" + markdown_table(table)
 
 
 def markdown_all(tables: dict[str, ParameterTable], level: int = 2) -> str:

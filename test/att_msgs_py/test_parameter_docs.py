@@ -1,7 +1,7 @@
 """The Markdown table of a node's parameters: one row per declaration, cells that stay cells."""
 from __future__ import annotations
 
-from att_msgs_py.parameter_docs import COLUMNS, markdown
+from att_msgs_py.parameter_docs import COLUMNS, markdown, markdown_table
 from att_msgs_py.parameters import Parameter, ParameterTable
 
 TABLE = ParameterTable("demo", (
@@ -17,3 +17,9 @@ def test_a_table_has_a_heading_its_summary_and_one_row_per_declaration():
     assert lines[6] == "| `gain` | double | `0.5` | in [0, 1) | 1/s | a gain \\| with a pipe and a &lt;tag> |"
     assert lines[7] == "| `path` | string | a_file_in the state directory |  |  | a file |"
     assert len(lines) == 8
+
+
+def test_the_table_alone_is_the_sections_table():
+    alone = markdown_table(TABLE)
+    assert markdown(TABLE).endswith("\n\n" + alone) and alone.startswith("| parameter |")
+    assert len(alone.splitlines()) == 2 + len(TABLE)
