@@ -118,6 +118,28 @@ class Parameter:
             parts.append(self.hint.strip(" ()"))
         return "; ".join(parts)
 
+    def json_schema(self) -> dict:
+        """This declaration as a JSON Schema property (see :meth:`ParameterTable.json_schema`)."""
+        number = {float: "number", int: "integer"}.get(self.kind, "number")
+        bounds = {}
+        for key, bound, is_open in (("Minimum", self.low, self.low_open), ("Maximum", self.high, self.high_open)):
+            if bound is not None and not math.isinf(bound) and not (key == "Maximum" and self.high_rule):
+                bounds[f"exclusive{key}" if is_open else key.lower()] = bound
+        if self.kind is list:
+            out = {"type": "array", "items": {"type": "number", **bounds}}
+            if self.length is not None:
+                out["minItems"] = out["maxItems"] = self.length
+        else:
+            out = {"type": {bool: "boolean", str: "string"}.get(self.kind, number)}
+            if self.kind in (float, int):
+                out.update(bounds)
+        out["description"] = self.summary() + (f" ({self.constraints()})" if self.constraints() else "")
+        if self.choices is not None:
+            out["enum"] = list(self.choices)
+        if self.default is not None and not (isinstance(self.default, float) and math.isinf(self.default)):
+            out["default"] = list(self.default) if isinstance(self.default, tuple) else self.default
+        return out
+
     def check(self, value, where: str = "", high: float | None = None):
         """``value`` checked against this declaration (``high``: a tighter upper bound found at
         start-up); ConfigError naming the parameter, ``where`` the value came from and what is expected."""
@@ -177,6 +199,33 @@ class ParameterTable:
 
     def __add__(self, other: ParameterTable) -> ParameterTable:
         return ParameterTable(self.node, (*self, *other), self.summary)
+
+    def problems(self, values: dict, where: str = "", allowed=()) -> list[ConfigError]:
+        """Every problem of a node section ``values`` (a scenario's or a ``--params-file``'s) at once,
+        each a ConfigError naming its parameter: an undeclared name (a typo; ``allowed``: names a node
+        shares, such as ``use_sim_time``), a value its declaration refuses. A bound found at start-up
+        (``high_rule``) is not checked here: the node checks it."""
+        out = []
+        unknown = sorted(set(values) - set(self.parameters) - set(allowed))
+        if unknown:
+            out.append(ConfigError(ErrorCode.INVALID_PARAMETER,
+                                   f"unknown {self.node} parameter(s) {clip(', '.join(unknown), 120)}{where}; "
+                                   f"known: {clip(', '.join(self.parameters), 160)}"))
+        for name, value in values.items():
+            if name in self.parameters:
+                try:
+                    self.parameters[name].check(value, where)
+                except ConfigError as err:
+                    out.append(err)
+        return out
+
+    def json_schema(self) -> dict:
+        """The JSON Schema (draft 2020-12) of this node's ``ros__parameters`` mapping: each declaration's
+        type, description with its unit, default, range, length and choices; no other key. An open
+        bound is ``exclusiveMinimum``/``exclusiveMaximum``; a bound found at start-up is left to the
+        node; NaN and Inf, which JSON cannot write, are refused by the node."""
+        return {"type": "object", "additionalProperties": False, "title": f"{self.node} parameters",
+                "description": self.summary, "properties": {p.name: p.json_schema() for p in self}}
 
 
 def coerce(name: str, value, default, where: str):

@@ -146,3 +146,29 @@ def test_the_ros_descriptor_says_what_the_declaration_says():
     assert a.additional_constraints == "each number in [-1, 1]; 3 numbers"
     m = descriptor(MODE)
     assert m.type == ParameterType.PARAMETER_STRING and m.additional_constraints == "one of 'a', 'b'"
+
+
+def test_a_section_is_checked_whole_with_every_problem_at_once():
+    problems = TABLE.problems({"rate": 0.0, "count": "many", "raet": 1.0, "use_sim_time": True, "mode": "b"},
+                              " (from demo.yaml)", allowed=("use_sim_time",))
+    assert [p.message for p in problems] == [
+        "unknown demo parameter(s) raet (from demo.yaml); known: rate, count, axis, mode, bound, found",
+        "parameter 'rate' (from demo.yaml) = 0.0 is outside (0, 100] (a hint)",
+        "parameter 'count' (from demo.yaml): expected an integer, got str 'many'"]
+    assert all(p.code == ErrorCode.INVALID_PARAMETER for p in problems)
+    assert TABLE.problems({"rate": 5, "axis": [0, 0, 1]}) == []
+
+
+def test_the_json_schema_says_what_the_declaration_says():
+    schema = TABLE.json_schema()
+    assert schema["type"] == "object" and schema["additionalProperties"] is False
+    assert list(schema["properties"]) == list(TABLE.parameters)
+    p = schema["properties"]
+    assert p["rate"] == {"type": "number", "exclusiveMinimum": 0.0, "maximum": 100.0, "default": 10.0,
+                         "description": "a rate [Hz] (in (0, 100]; a hint)"}
+    assert p["count"]["type"] == "integer" and (p["count"]["minimum"], p["count"]["maximum"]) == (1, 10)
+    assert p["axis"]["items"] == {"type": "number", "minimum": -1.0, "maximum": 1.0}
+    assert p["axis"]["minItems"] == p["axis"]["maxItems"] == 3 and p["axis"]["default"] == [0.0, 0.0, 1.0]
+    assert p["mode"]["enum"] == ["a", "b"] and p["mode"]["type"] == "string"
+    assert "default" not in p["bound"] and "maximum" not in p["bound"]          # .inf: JSON cannot write it
+    assert p["found"]["exclusiveMaximum"] == 5.0 and "default" not in p["found"]

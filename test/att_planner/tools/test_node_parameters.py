@@ -4,6 +4,7 @@ words, and a Markdown reference that lists every declared parameter."""
 from __future__ import annotations
 
 import dataclasses
+import json
 import math
 import re
 
@@ -133,7 +134,15 @@ def test_every_shipped_file_sets_only_declared_node_parameters_to_accepted_value
     for node, section in sections.items():
         if node not in NODE_PARAMETERS:                   # the demo maneuver, the shared /** keys
             continue
-        table = NODE_PARAMETERS[node]
-        assert set(section) <= set(table.parameters), (node, set(section) - set(table.parameters))
-        for key, value in section.items():
-            table[key].check(value, f" (from {path})")
+        assert NODE_PARAMETERS[node].problems(section, f" (from {path})") == []
+
+
+@pytest.mark.parametrize("node", NODE_PARAMETERS)
+def test_each_nodes_json_schema_is_json_and_has_every_declaration(node):
+    schema = json.loads(json.dumps(NODE_PARAMETERS[node].json_schema(), allow_nan=False))
+    assert list(schema["properties"]) == list(NODE_PARAMETERS[node].parameters)
+    for spec in NODE_PARAMETERS[node]:
+        prop = schema["properties"][spec.name]
+        assert prop["description"].startswith(spec.summary())
+        if spec.bounded and spec.kind is not list and spec.low is not None and not math.isinf(spec.low):
+            assert prop["exclusiveMinimum" if spec.low_open else "minimum"] == spec.low
