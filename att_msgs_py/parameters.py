@@ -33,8 +33,9 @@ class Parameter:
     (``low_open``/``high_open`` exclude a bound; a bounded number is finite, NaN and Inf never pass),
     applied to each number of a list; ``high_rule``: an upper bound found at start-up, in words.
     ``length``: the list's length. ``choices``: the allowed values. ``unit``: SI or the unit in the
-    name. ``hint``: words added to every refusal. ``refusal``: the sentence of a range refusal
-    instead of the interval (``allow_inf`` then lets +Inf through: a bound that can be "none").
+    name. ``hint``: words added to every refusal. ``refusal``: the sentence of a range or choice
+    refusal instead of the interval or the list of choices (``allow_inf`` then lets +Inf through: a
+    bound that can be "none").
     ``read_only``: the node takes the value at start only."""
 
     name: str
@@ -112,7 +113,7 @@ class Parameter:
             parts.append(f"each number in {self.interval()}" if self.kind is list else f"in {self.interval()}")
         if self.length is not None:
             parts.append(f"{self.length} numbers")
-        if self.choices is not None:
+        if self.choices is not None and not self.refusal:
             parts.append(f"one of {', '.join(repr(c) if isinstance(c, str) else str(c) for c in self.choices)}")
         if self.hint and not self.high_rule:
             parts.append(self.hint.strip(" ()"))
@@ -148,9 +149,11 @@ class Parameter:
         try:
             if self.refusal:
                 value = coerce(self.name, value, PROTOTYPES[self.kind], where)
-                if not _within(value, self.low, top, self.low_open, self.high_open, self.allow_inf):
-                    raise ConfigError(ErrorCode.INVALID_PARAMETER, f"{label}: {self.refusal}, got {value!r}")
-                return checked(self.name, value, value, where, length=self.length, choices=self.choices)
+                if (self.bounded and not _within(value, self.low, top, self.low_open, self.high_open, self.allow_inf)
+                        or self.choices is not None and value not in self.choices):
+                    raise ConfigError(ErrorCode.INVALID_PARAMETER, f"{label}: {self.refusal}, got "
+                                                                   f"{clip(repr(value), 80)}")
+                return checked(self.name, value, value, where, length=self.length)
             return checked(self.name, value, PROTOTYPES[self.kind], where, self.low, top, low_open=self.low_open,
                            high_open=self.high_open, length=self.length, choices=self.choices)
         except ConfigError as err:

@@ -57,10 +57,6 @@ class PlannerNode(Node):
         param = ParameterReader(self, PLANNER, scenario.node_params.get("planner", {}), str(scenario.path))
         self._frame_id = scenario.frame_id
         self._default_method = param("default_method") or methods.REGISTRY[0].name
-        if self._default_method not in methods.METHODS:
-            raise ConfigError(ErrorCode.INVALID_PARAMETER, f"parameter 'default_method': expected '' (the best) or one "
-                                                           f"of {', '.join(methods.METHODS)}, got "
-                                                           f"'{clip(self._default_method, 80)}'")
         self._default_budget = param("time_budget")
         self._tolerances = Tolerances(attitude=math.radians(param("accept_attitude_error_deg")),
                                       rate=param("accept_final_rate"),

@@ -66,6 +66,14 @@ def test_a_refusal_sentence_replaces_the_interval_and_may_let_inf_through():
         assert refusal(BOUND, bad) == f"parameter 'bound': expected a bound > 0 rad/s (.inf: none), got {bad!r}"
 
 
+def test_a_refusal_sentence_replaces_the_list_of_choices():
+    method = Parameter("method", str, "", "a method ('': the best)", choices=("", "fast", "slow"),
+                       refusal="expected '' (the best) or one of fast, slow")
+    assert method.check("slow") == "slow" and method.constraints() == "'' (the best) or one of fast, slow"
+    assert refusal(method, "magic") == "parameter 'method': expected '' (the best) or one of fast, slow, got 'magic'"
+    assert "expected a string" in refusal(method, 5)
+
+
 def test_a_section_reader_takes_the_override_then_the_file_then_the_default():
     read = SectionReader(TABLE, {"rate": 20.0, "count": 4}, "demo.yaml", {"count": 5})
     assert read("rate") == 20.0 and read("count") == 5 and read("mode") == "a" and read("axis") == [0.0, 0.0, 1.0]
