@@ -33,13 +33,16 @@ from pathlib import Path
 
 import rclpy
 import yaml
-from rcl_interfaces.msg import ParameterDescriptor
+from rcl_interfaces.msg import FloatingPointRange, IntegerRange, ParameterDescriptor
 from rclpy.clock import Clock, ClockType
+from rclpy.exceptions import InvalidParameterTypeException, InvalidParameterValueException
 from rclpy.executors import Executor, ExternalShutdownException, SingleThreadedExecutor
+from rclpy.parameter import Parameter
 
 from att_msgs_py import memory
 from att_msgs_py.errors import ConfigError, ErrorCode, RequestError, clip
-from att_msgs_py.parameters import checked, coerce
+from att_msgs_py.parameters import SCENARIO_TABLE, ParameterTable, Reader
+from att_msgs_py.parameters import Parameter as Declaration
 
 _stop_signalled = False
 
@@ -68,44 +71,95 @@ def spin_until_shutdown(executor: Executor, poll: float = 0.2) -> None:
 
 SHARED_PARAMETERS = ("scenario", "use_sim_time", "frame_id", "body_frame_id")
 SHARED_PREFIXES = ("spacecraft.", "orbit.", "qos_overrides.", "sensors.", "actuators.", "environment.")
+USE_SIM_TIME = "use_sim_time"
+_ROS_TYPES = {float: Parameter.Type.DOUBLE, int: Parameter.Type.INTEGER, bool: Parameter.Type.BOOL,
+              str: Parameter.Type.STRING, list: Parameter.Type.DOUBLE_ARRAY}
+_INT64 = (-2**63, 2**63 - 1)
+_FROM_THE_COMMAND_LINE = " (from the command line or a --params-file)"
 
 
-class ParameterReader:
-    """``read(name, default, low=, high=, low_open=, length=, choices=)`` for a node: declares ROS
-    parameter ``name`` with the value of its scenario-file section (``scenario_values``) or else
-    ``default``, so ``-p`` and ``--params-file`` overrides win over both, and returns the value
-    checked against the type of ``default`` (an integer is accepted for a float), the range
-    [``low``, ``high``] (``(low, high]`` with ``low_open``; NaN and Inf never pass for a bounded
-    number), the list ``length`` and the ``choices``. Anything else raises :class:`ConfigError`
-    with one line naming the parameter, where it came from and what is expected.
-    :meth:`refuse_unknown` then refuses every parameter given that no ``read`` asked for (a typo)."""
+def descriptor(spec: Declaration, high: float | None = None) -> ParameterDescriptor:
+    """The ROS descriptor of ``spec``: its type, its description with the unit, its range (ROS
+    ranges are closed: an open bound is enforced by :meth:`Declaration.check`; an absent bound is
+    the largest finite number, as a bounded number is finite), its other constraints in words and
+    ``read_only``. ``high``: an upper bound found at start-up, tighter than the declared one."""
+    d = ParameterDescriptor(name=spec.name, type=_ROS_TYPES[spec.kind].value, description=spec.summary(),
+                            additional_constraints=spec.constraints(), read_only=spec.read_only)
+    if spec.bounded and spec.kind is float:
+        top = spec.high if high is None else high
+        d.floating_point_range = [FloatingPointRange(
+            from_value=-sys.float_info.max if spec.low is None else float(spec.low),
+            to_value=(math.inf if spec.allow_inf else sys.float_info.max) if top is None else float(top), step=0.0)]
+    elif spec.bounded and spec.kind is int:
+        d.integer_range = [IntegerRange(from_value=_INT64[0] if spec.low is None else int(spec.low),
+                                        to_value=_INT64[1] if spec.high is None else int(spec.high), step=1)]
+    return d
 
-    def __init__(self, node, scenario_values: dict, source: str = ""):
+
+class ParameterReader(Reader):
+    """``read(name)`` or ``read(name, default)`` (a default found at start-up) for a node: declares ROS
+    parameter ``name`` of ``table`` with its full :func:`descriptor` and the value of its
+    scenario-file section (``scenario_values``) or else the default, so ``-p`` and ``--params-file``
+    overrides win over both, and returns the value checked against its declaration
+    (:meth:`att_msgs_py.parameters.Parameter.check`; an integer is accepted for a float, and handed to
+    rclpy as a float). Anything else raises :class:`ConfigError` with one line naming the parameter,
+    where it came from and what is expected. :meth:`refuse_unknown` then refuses every parameter
+    given that the table does not declare (a typo) and declares the ones not read."""
+
+    def __init__(self, node, table: ParameterTable, scenario_values: dict, source: str = ""):
+        super().__init__(table)
         self.node, self.values, self.source = node, scenario_values, source
-        self.used: set[str] = set()
 
-    def __call__(self, name: str, default, low: float | None = None, high: float | None = None, *,
-                 low_open: bool = False, length: int | None = None, choices=None):
-        self.used.add(name)
-        in_file = name in self.values
-        where = f" (from {self.source})" if in_file and self.source else ""
-        initial = coerce(name, self.values[name], default, where) if in_file else default
-        value = self.node.declare_parameter(name, initial, ParameterDescriptor(dynamic_typing=True)).value
-        if value != initial or type(value) is not type(initial):
-            where = " (from the command line or a --params-file)"
-        return checked(name, value, default, where, low, high, low_open=low_open, length=length, choices=choices)
+    def _given(self, spec: Declaration, default, high):
+        """The value given for ``spec`` (an override, the scenario file's, else ``default``) checked,
+        with the override rclpy will take replaced by that value in the declared type."""
+        overrides = self.node._parameter_overrides          # -p and --params-file values, by name
+        if spec.name in overrides:
+            value = spec.check(overrides[spec.name].value, _FROM_THE_COMMAND_LINE, high)
+            overrides[spec.name] = Parameter(spec.name, _ROS_TYPES[spec.kind], value)
+            return value
+        if spec.name in self.values:
+            return spec.check(self.values[spec.name], f" (from {self.source})" if self.source else "", high)
+        return spec.check(default, "", high)
+
+    def _source(self, spec: Declaration, default, high):
+        value = self._given(spec, default, high)
+        try:
+            self.node.declare_parameter(spec.name, value, descriptor(spec, high))
+        except (InvalidParameterTypeException, InvalidParameterValueException) as exc:
+            raise ConfigError(ErrorCode.INVALID_PARAMETER, f"parameter '{spec.name}': {clip(exc, 200)}") from None
+        return value
 
     def refuse_unknown(self) -> None:
-        """A parameter of this node in the scenario file or on the command line that nothing
-        read (a typo) is an error, not silently ignored; the shared ``/**`` ones are allowed."""
-        overrides = set(getattr(self.node, "_parameter_overrides", {}))     # -p and --params-file values
+        """A parameter of this node in the scenario file or on the command line that the table does
+        not declare (a typo) is an error, not silently ignored; the shared ``/**`` ones are allowed.
+        The declared parameters the node did not read (they do not apply in its configuration) are
+        then read too, so a ROS user sees every one and a value given for one is still checked.
+        ``use_sim_time`` (rclpy's) is described."""
+        overrides = set(self.node._parameter_overrides)
+        known = set(self.table.parameters) | set(SHARED_PARAMETERS)
         for where, names in ((self.source or "the scenario file", set(self.values)),
                              ("the command line or a --params-file", overrides)):
-            unknown = sorted(n for n in names - self.used - set(SHARED_PARAMETERS) if not n.startswith(SHARED_PREFIXES))
+            unknown = sorted(n for n in names - known if not n.startswith(SHARED_PREFIXES))
             if unknown:
                 raise ConfigError(ErrorCode.INVALID_PARAMETER,
                                   f"unknown {self.node.get_name()} parameter(s) {clip(', '.join(unknown), 120)} "
-                                  f"(from {where}); known: {', '.join(sorted(self.used))}")
+                                  f"(from {where}); known: {clip(', '.join(self.table.parameters), 160)}")
+        for spec in self.table:
+            if spec.name not in self.used:
+                if spec.default is None:        # a node reads these: only it knows the default
+                    raise TypeError(f"{self.node.get_name()} did not read parameter '{spec.name}', whose default "
+                                    "it finds at start-up")
+                self(spec.name)
+        if self.node.has_parameter(USE_SIM_TIME) and not self.node.describe_parameter(USE_SIM_TIME).description:
+            self.node.set_descriptor(USE_SIM_TIME, ParameterDescriptor(
+                type=Parameter.Type.BOOL.value, description="take the time from /clock (sim time) instead of the "
+                                                            "system clock (rclpy's parameter)"))
+
+
+def read_scenario(node) -> str:
+    """The node's ``scenario`` parameter, declared and checked."""
+    return ParameterReader(node, SCENARIO_TABLE, {})("scenario")
 
 
 def publisher_of(info) -> bytes | None:
@@ -170,10 +224,6 @@ def subscribe_when_heard(node, publisher, count: int, timeout: float, subscribe:
         subscribe()
 
     timer = node.create_timer(0.05, check, clock=Clock(clock_type=ClockType.STEADY_TIME))
-
-
-def parameter_reader(node, scenario_values: dict, source: str = "") -> ParameterReader:
-    return ParameterReader(node, scenario_values, source)
 
 
 def _check_params_files(args) -> None:

@@ -24,7 +24,8 @@ from rclpy.qos import DurabilityPolicy
 from att_msgs_py import memory, qos, topics
 from att_msgs_py.errors import ConfigError, ErrorCode, clip
 from att_msgs_py.log.definitions import message_definition
-from att_msgs_py.node_runner import parameter_reader, run_node
+from att_msgs_py.log.log_parameters import BRIDGE
+from att_msgs_py.node_runner import ParameterReader, run_node
 
 
 class Latch(ServerListener):
@@ -57,9 +58,9 @@ class Latch(ServerListener):
 class BridgeNode(Node):
     def __init__(self):
         super().__init__("bridge")
-        param = parameter_reader(self, {})
-        host = param("host", "127.0.0.1")
-        port = param("port", 8765, 0, 65535)
+        param = ParameterReader(self, BRIDGE, {})
+        host = param("host")
+        port = param("port")
         param.refuse_unknown()
         self.sinks = foxglove.Context()        # the node's own channels, not the SDK's global ones
         self.latch = Latch()

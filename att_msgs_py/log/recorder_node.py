@@ -17,17 +17,20 @@ from pathlib import Path
 from rclpy.node import Node
 
 from att_msgs_py import memory, qos, topics
+from att_msgs_py.log.log_parameters import RECORDER
 from att_msgs_py.log.repair import LogFileError, Scan, repair, scan_records
 from att_msgs_py.log.writer import LogWriter
-from att_msgs_py.node_runner import run_node
+from att_msgs_py.node_runner import ParameterReader, run_node
 
 
 class RecorderNode(Node):
     def __init__(self):
         super().__init__("recorder")
         stamp = datetime.now(UTC).strftime("%Y%m%d_%H%M%S")
-        output = self.declare_parameter("output", f"runs/run_{stamp}.mcap").value
-        flush_period = float(self.declare_parameter("flush_period", 0.5).value)
+        param = ParameterReader(self, RECORDER, {})
+        output = param("output", f"runs/run_{stamp}.mcap")
+        flush_period = param("flush_period")
+        param.refuse_unknown()
         if Path(output).is_file():
             self.keep_leftover(Path(output))
         self.log = LogWriter(output, flush_period=flush_period)

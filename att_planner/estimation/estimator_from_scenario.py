@@ -12,33 +12,26 @@ from att_sim.models.sensor_specs import ARCSEC, DEG, HOUR, NANOTESLA
 
 
 def estimator_config(param, s: Scenario) -> EstimatorConfig:
-    """The filter's tuning: parameters in datasheet units, defaulting to :meth:`Estimator.default_config`."""
+    """The filter's tuning from the parameters of
+    :data:`~att_planner.estimation.estimator_parameters.ESTIMATOR` (datasheet units), defaulting to
+    :meth:`Estimator.default_config`."""
     d = Estimator.default_config(s.sensors, 1.0 / s.sensors.gyro.rate)
-    rate = param("publish_rate", 1.0 / d.publish_period, 0.0, s.sensors.gyro.rate, low_open=True)
+    rate = param("publish_rate", 1.0 / d.publish_period, high=s.sensors.gyro.rate)
     return EstimatorConfig(
         publish_period=1.0 / rate,
-        arw=param("arw_deg_per_sqrt_h", d.arw * math.sqrt(HOUR) / DEG, 0.0, 100.0, low_open=True)
-        * DEG / math.sqrt(HOUR),
-        rrw=param("rrw_deg_per_h_per_sqrt_h", d.rrw * HOUR * math.sqrt(HOUR) / DEG, 0.0, 1e4, low_open=True)
-        * DEG / HOUR / math.sqrt(HOUR),
-        initial_bias_sigma=param("initial_bias_sigma_deg_per_h", d.initial_bias_sigma * HOUR / DEG, 0.0, 1e5,
-                                 low_open=True) * DEG / HOUR,
-        scale_factor_sigma=param("consider_scale_factor_ppm", d.scale_factor_sigma * 1e6, 0.0, 1e5) * 1e-6,
-        misalignment_sigma=param("consider_misalignment_arcsec", d.misalignment_sigma / ARCSEC, 0.0, 3600.0) * ARCSEC,
-        gate_probability=param("gate_probability", d.gate_probability, 0.5, 1.0 - 1e-12),
-        converged_attitude_sigma=param("converged_attitude_sigma_arcsec", d.converged_attitude_sigma / ARCSEC,
-                                       0.0, 648000.0, low_open=True) * ARCSEC,
-        propagate_timeout=param("propagate_timeout", d.propagate_timeout, 0.0, 3600.0, low_open=True),
-        history=param("history", d.history, 0.0, 60.0, low_open=True),
-        lost_after=param("lost_after", d.lost_after, 1, 1000),
-        vector_fallback_after=param("vector_fallback_after", d.vector_fallback_after, 0.0, 3600.0),
-        magnetometer_sigma=param("magnetometer_sigma_nT", d.magnetometer_sigma / NANOTESLA, 0.0, 1e5,
-                                 low_open=True) * NANOTESLA,
-        sun_sigma=param("sun_sigma_deg", d.sun_sigma / DEG, 0.0, 90.0, low_open=True) * DEG,
-        sun_threshold=param("sun_threshold", d.sun_threshold, 0.0, 1.0),
-        pair_window=param("pair_window", d.pair_window, 0.0, 60.0),
-        max_gyro_gap=param("max_gyro_gap", d.max_gyro_gap, 0.0, 3600.0, low_open=True),
-        resync_timeout=param("resync_timeout", d.resync_timeout, 0.0, 3600.0, low_open=True))
+        arw=param("arw_deg_per_sqrt_h", d.arw * math.sqrt(HOUR) / DEG) * DEG / math.sqrt(HOUR),
+        rrw=param("rrw_deg_per_h_per_sqrt_h", d.rrw * HOUR * math.sqrt(HOUR) / DEG) * DEG / HOUR / math.sqrt(HOUR),
+        initial_bias_sigma=param("initial_bias_sigma_deg_per_h", d.initial_bias_sigma * HOUR / DEG) * DEG / HOUR,
+        scale_factor_sigma=param("consider_scale_factor_ppm", d.scale_factor_sigma * 1e6) * 1e-6,
+        misalignment_sigma=param("consider_misalignment_arcsec", d.misalignment_sigma / ARCSEC) * ARCSEC,
+        gate_probability=param("gate_probability"),
+        converged_attitude_sigma=param("converged_attitude_sigma_arcsec", d.converged_attitude_sigma / ARCSEC)
+        * ARCSEC,
+        propagate_timeout=param("propagate_timeout"), history=param("history"), lost_after=param("lost_after"),
+        vector_fallback_after=param("vector_fallback_after"),
+        magnetometer_sigma=param("magnetometer_sigma_nT") * NANOTESLA, sun_sigma=param("sun_sigma_deg") * DEG,
+        sun_threshold=param("sun_threshold"), pair_window=param("pair_window"), max_gyro_gap=param("max_gyro_gap"),
+        resync_timeout=param("resync_timeout"))
 
 
 def estimator_from_scenario(param, s: Scenario) -> Estimator:

@@ -55,17 +55,19 @@ from att_msgs.srv import SetControllerMode
 from att_msgs_py import convert, limits, memory, qos, signing, topics
 from att_msgs_py.errors import ErrorCode, RequestError
 from att_msgs_py.node_runner import (
+    ParameterReader,
     RefusalLog,
     live_publishers,
-    parameter_reader,
     participant_of,
     publisher_of,
+    read_scenario,
     run_node,
     subscribe_when_heard,
 )
 from att_msgs_py.types import ManeuverResult
 from att_planner.control.controller_from_scenario import controller_from_scenario, public_key
-from att_planner.control.mode_authentication import MAX_AHEAD, ModeAuthentication, default_sequence_path
+from att_planner.control.controller_parameters import CONTROLLER
+from att_planner.control.mode_authentication import ModeAuthentication, default_sequence_path
 from att_planner.control.plan_checks import check_message
 from att_planner.estimation.inputs import Sources
 from att_sim.models import scenario as scen
@@ -74,19 +76,21 @@ from att_sim.models import scenario as scen
 class ControllerNode(Node):
     def __init__(self):
         super().__init__("controller")
-        self._scenario = scen.load_checked(parameter_reader(self, {})("scenario", "swift_demo"))
-        param = parameter_reader(self, self._scenario.node_params.get("controller", {}), str(self._scenario.path))
+        self._scenario = scen.load_checked(read_scenario(self))
+        param = ParameterReader(self, CONTROLLER, self._scenario.node_params.get("controller", {}),
+                                str(self._scenario.path))
         self._core = controller_from_scenario(param, self._scenario)
         self._core.gate.hold.live = live_publishers(self, topics.STATE if self._core.measured is None
                                                     else topics.ESTIMATE)
-        self._wall_timeout = param("wall_timeout", 2.0, 0.0, 3600.0, low_open=True)
-        wait_for_subscribers = param("wait_for_subscribers", 0, 0, 1000)
-        start_timeout = param("start_timeout", 60.0, 0.0, 3600.0, low_open=True)
-        if param("require_signed_modes", False):
-            self._core.authentication = ModeAuthentication(
-                public_key(param, "mode_public_key"),
-                param("mode_sequence_file", str(default_sequence_path())),
-                param("mode_sequence_ahead", MAX_AHEAD, 0.0, 86_400.0, low_open=True))
+        self._wall_timeout = param("wall_timeout")
+        wait_for_subscribers = param("wait_for_subscribers")
+        start_timeout = param("start_timeout")
+        signed = param("require_signed_modes")
+        mode_key = public_key(param, "mode_public_key", load=signed)
+        sequences = param("mode_sequence_file", str(default_sequence_path()))
+        ahead = param("mode_sequence_ahead")
+        if signed:
+            self._core.authentication = ModeAuthentication(mode_key, sequences, ahead)
         param.refuse_unknown()
         if self._core.authentication.warning:
             self.get_logger().warning(self._core.authentication.warning)

@@ -26,14 +26,16 @@ from att_msgs.msg import ActuatorCommand, AttitudeEstimate, CoarseSunSensors, St
 from att_msgs_py import convert, limits, memory, qos, topics
 from att_msgs_py.errors import RequestError, clip
 from att_msgs_py.node_runner import (
+    ParameterReader,
     RefusalLog,
     live_publishers,
-    parameter_reader,
     publisher_of,
+    read_scenario,
     run_node,
     subscribe_when_heard,
 )
 from att_planner.estimation.estimator_from_scenario import estimator_from_scenario
+from att_planner.estimation.estimator_parameters import ESTIMATOR
 from att_planner.estimation.inputs import Sources
 from att_sim.models import scenario as scen
 from att_sim.models.sensor_specs import DEG, HOUR
@@ -46,11 +48,11 @@ INPUTS = {"gyro sample": topics.IMU, "star tracker measurement": topics.STAR_TRA
 class EstimatorNode(Node):
     def __init__(self):
         super().__init__("estimator")
-        s = scen.load_checked(parameter_reader(self, {})("scenario", "swift_demo"))
-        param = parameter_reader(self, s.node_params.get("estimator", {}), str(s.path))
+        s = scen.load_checked(read_scenario(self))
+        param = ParameterReader(self, ESTIMATOR, s.node_params.get("estimator", {}), str(s.path))
         self._core = estimator_from_scenario(param, s)
-        wait_for_subscribers = param("wait_for_subscribers", 0, 0, 1000)
-        start_timeout = param("start_timeout", 60.0, 0.0, 3600.0, low_open=True)
+        wait_for_subscribers = param("wait_for_subscribers")
+        start_timeout = param("start_timeout")
         param.refuse_unknown()
         self._refusals = RefusalLog(self.get_logger())
         self._sources = Sources({what: live_publishers(self, topic) for what, topic in INPUTS.items()})

@@ -35,15 +35,16 @@ from att_msgs.msg import ManeuverPlan
 from att_msgs.srv import PlanManeuver, PlanSchedule
 from att_msgs_py import convert, limits, markers, memory, qos, signing, topics
 from att_msgs_py.errors import ConfigError, ErrorCode, RequestError, clip
-from att_msgs_py.node_runner import parameter_reader, run_node
+from att_msgs_py.node_runner import ParameterReader, read_scenario, run_node
 from att_msgs_py.types import Plan
 from att_planner import methods
 from att_planner.methods.schedule import plan_schedule
+from att_planner.service.planner_parameters import PLANNER
 from att_planner.service.planning import PlanOutcome, plan_maneuver, plan_schedule_request, prepare, run_method
-from att_planner.service.requests import MAX_TIME_BUDGET, ManeuverRequest, validate_maneuver, validate_schedule
+from att_planner.service.requests import ManeuverRequest, validate_maneuver, validate_schedule
 from att_planner.service.warm import warm, warm_requests
 from att_planner.service.worker import call_isolated, run_isolated, set_max_parallel, set_warm_up, start_pool, warm_up
-from att_planner.verification import TOLERANCES, Tolerances
+from att_planner.verification import Tolerances
 from att_sim.models import scenario as scen
 from att_sim.models import scene
 
@@ -51,32 +52,22 @@ from att_sim.models import scene
 class PlannerNode(Node):
     def __init__(self):
         super().__init__("planner")
-        scenario = scen.load_checked(parameter_reader(self, {})("scenario", "swift_demo"))
+        scenario = scen.load_checked(read_scenario(self))
         self._scenario_name = scenario.name
-        param = parameter_reader(self, scenario.node_params.get("planner", {}), str(scenario.path))
+        param = ParameterReader(self, PLANNER, scenario.node_params.get("planner", {}), str(scenario.path))
         self._frame_id = scenario.frame_id
-        self._default_method = param("default_method", "") or methods.REGISTRY[0].name
-        if self._default_method not in methods.METHODS:
-            raise ConfigError(ErrorCode.INVALID_PARAMETER, f"parameter 'default_method': expected '' (the best) or one "
-                                                           f"of {', '.join(methods.METHODS)}, got "
-                                                           f"'{clip(self._default_method, 80)}'")
-        self._default_budget = param("time_budget", 20.0, 0.0, MAX_TIME_BUDGET, low_open=True)
-        self._tolerances = Tolerances(
-            attitude=math.radians(param("accept_attitude_error_deg", math.degrees(TOLERANCES.attitude), 0.0, 180.0,
-                                        low_open=True)),
-            rate=param("accept_final_rate", TOLERANCES.rate, 0.0, 10.0, low_open=True),
-            cone_penetration=math.radians(param("accept_cone_penetration_deg",
-                                                math.degrees(TOLERANCES.cone_penetration), 0.0, 10.0)))
-        self._cone_padding = math.radians(param("cone_padding_deg", 1.0, 0.0, 10.0))
-        self._schedule_rate_max = param("schedule_rate_max", math.inf)
-        if not self._schedule_rate_max > 0:        # .inf: no bound; NaN, 0 and negatives are refused
-            raise ConfigError(ErrorCode.INVALID_PARAMETER, "parameter 'schedule_rate_max': expected a body-rate bound "
-                                                           f"> 0 rad/s (.inf: none), got {self._schedule_rate_max!r}")
+        self._default_method = param("default_method") or methods.REGISTRY[0].name
+        self._default_budget = param("time_budget")
+        self._tolerances = Tolerances(attitude=math.radians(param("accept_attitude_error_deg")),
+                                      rate=param("accept_final_rate"),
+                                      cone_penetration=math.radians(param("accept_cone_penetration_deg")))
+        self._cone_padding = math.radians(param("cone_padding_deg"))
+        self._schedule_rate_max = param("schedule_rate_max")        # .inf: no bound
         key_path = param("signing_key", str(signing.default_key_dir() / signing.PRIVATE_NAME))
         self._signing_key = self._load_signing_key(key_path)
-        parallel = param("max_parallel_solves", 2, 1, 64)
+        parallel = param("max_parallel_solves")
         set_max_parallel(parallel)
-        show_plans = param("plan_markers", True)
+        show_plans = param("plan_markers")
         # every worker plans these scenarios' demo maneuvers before it serves (its NLPs built)
         names = [n.strip() for n in param("warm_up_scenarios", scenario.name).split(",") if n.strip()]
         param.refuse_unknown()

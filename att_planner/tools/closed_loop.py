@@ -22,17 +22,21 @@ import numpy as np
 from cryptography.hazmat.primitives.asymmetric.ed25519 import Ed25519PrivateKey
 
 from att_msgs_py import convert, signing, topics
-from att_msgs_py.errors import RequestError
+from att_msgs_py.errors import ConfigError, ErrorCode, RequestError
 from att_msgs_py.parameters import SectionReader
 from att_msgs_py.types import Health, ManeuverResult, Plan, PointingMode
 from att_planner.control.controller_from_scenario import controller_from_scenario
+from att_planner.control.controller_parameters import CONTROLLER
 from att_planner.estimation.estimator import Estimator
 from att_planner.estimation.estimator_from_scenario import estimator_from_scenario
+from att_planner.estimation.estimator_parameters import ESTIMATOR
+from att_planner.service.planner_parameters import PLANNER
 from att_sim.models import dynamics as dyn
 from att_sim.models import rotations as rot
 from att_sim.models.scenario import Scenario
 from att_sim.truth.sensors import Readings
-from att_sim.truth.simulation import DEFAULT_STEP, Checks, Simulation
+from att_sim.truth.simulation import Checks, Simulation
+from att_sim.truth.simulator_parameters import SIMULATOR
 
 
 class Reprocessing(NamedTuple):
@@ -84,18 +88,27 @@ class ClosedLoop:
         seed (default the scenario's); ``simulation``: a prepared one (e.g. a dispersed truth);
         ``key``: the plan-signing key (default a new one; loops sharing one can share issued plans)."""
         overrides = overrides or {}
+        unknown = sorted(set(overrides) - {"simulator", "controller", "estimator"})
+        if unknown:
+            raise ConfigError(ErrorCode.INVALID_PARAMETER, f"overrides of unknown node(s) {', '.join(unknown)}; "
+                                                           "known: simulator, controller, estimator")
         sections = scenario.node_params
-        sim_param = SectionReader(sections.get("simulator", {}), str(scenario.path), overrides.get("simulator"))
-        self.step = sim_param("step", DEFAULT_STEP, 0.0, 1.0, low_open=True)
-        self.publish_period = 1.0 / sim_param("publish_rate", min(10.0, 1.0 / self.step), 0.0,
-                                              (1 + 1e-9) / self.step, low_open=True)
+        sim_param = SectionReader(SIMULATOR, sections.get("simulator", {}), str(scenario.path),
+                                  overrides.get("simulator"))
+        self.step = sim_param("step")
+        self.publish_period = 1.0 / sim_param("publish_rate", min(10.0, 1.0 / self.step), high=(1 + 1e-9) / self.step)
+        sim_param.refuse_unknown()
         self.key = key or Ed25519PrivateKey.generate()
-        ctl_param = SectionReader(sections.get("controller", {}), str(scenario.path), overrides.get("controller"))
+        ctl_param = SectionReader(CONTROLLER, sections.get("controller", {}), str(scenario.path),
+                                  overrides.get("controller"))
         self.controller = controller_from_scenario(ctl_param, scenario, key=self.key.public_key())
+        ctl_param.refuse_unknown()
         self.estimator = None
         if self.controller.measured is not None:
-            est_param = SectionReader(sections.get("estimator", {}), str(scenario.path), overrides.get("estimator"))
+            est_param = SectionReader(ESTIMATOR, sections.get("estimator", {}), str(scenario.path),
+                                      overrides.get("estimator"))
             self.estimator = estimator_from_scenario(est_param, scenario)
+            est_param.refuse_unknown()
         self.scenario = scenario
         self.sim = simulation or Simulation.for_scenario(
             scenario, q0=q0, omega0=omega0, wheel_speed0=wheel_speed0, seed=seed,
@@ -260,16 +273,16 @@ def plan_in_process(scenario: Scenario, q0, qf, sensor_axis, cones=(), zones=(),
     from att_planner.service.planning import plan_maneuver
     from att_planner.service.requests import ManeuverRequest, validate_maneuver
 
-    planner = SectionReader(scenario.node_params.get("planner", {}), str(scenario.path))
+    planner = SectionReader(PLANNER, scenario.node_params.get("planner", {}), str(scenario.path))
     request = ManeuverRequest(scenario.frame_id, np.asarray(q0, float), np.asarray(qf, float),
                               np.asarray(sensor_axis, float),
                               [(c.direction, c.half_angle, c.name) for c in cones], method=method,
                               time_budget=time_budget, spacecraft=scenario.name, epoch=epoch, zones=list(zones),
                               wheel_speeds=list(wheel_speeds), end_pointing=end_pointing)
     valid = validate_maneuver(request, frame_id=scenario.frame_id, default_spacecraft=scenario.name,
-                              default_method=planner("default_method", "") or methods.REGISTRY[0].name,
+                              default_method=planner("default_method") or methods.REGISTRY[0].name,
                               default_budget=time_budget)
-    outcome = plan_maneuver(valid, cone_padding=math.radians(planner("cone_padding_deg", 1.0, 0.0, 10.0)))
+    outcome = plan_maneuver(valid, cone_padding=math.radians(planner("cone_padding_deg")))
     if outcome.code != 0:
         raise RequestError(outcome.code, outcome.message)
     return outcome.plan

@@ -48,7 +48,6 @@ state stops the propagation (reported, the node stays up).
 """
 from __future__ import annotations
 
-import math
 import time
 
 import numpy as np
@@ -63,11 +62,19 @@ from att_msgs.msg import ActuatorCommand, CoarseSunSensors, SensorTruth, Spacecr
 from att_msgs.srv import ResetSimulator
 from att_msgs_py import convert, limits, markers, memory, qos, topics, validation
 from att_msgs_py.errors import ConfigError, ErrorCode, RequestError, clip
-from att_msgs_py.node_runner import live_publishers, parameter_reader, publisher_of, run_node, spin_until_shutdown
+from att_msgs_py.node_runner import (
+    ParameterReader,
+    live_publishers,
+    publisher_of,
+    read_scenario,
+    run_node,
+    spin_until_shutdown,
+)
 from att_sim.models import scenario as scen
 from att_sim.models import scene
 from att_sim.truth import dispersions
-from att_sim.truth.simulation import DEFAULT_STEP, Checks, Refusal, Simulation
+from att_sim.truth.simulation import Checks, Refusal, Simulation
+from att_sim.truth.simulator_parameters import SIMULATOR
 
 FREE_RUN_PACE = 1.0        # real-time factor of a free-running simulator whose real_time_factor is 0 (max)
 
@@ -75,7 +82,7 @@ FREE_RUN_PACE = 1.0        # real-time factor of a free-running simulator whose 
 class SimulatorNode(Node):
     def __init__(self):
         super().__init__("simulator")
-        self.scenario = scen.load_checked(parameter_reader(self, {})("scenario", "swift_demo"))
+        self.scenario = scen.load_checked(read_scenario(self))
         param = self.read_parameters()
         self.answered = False
         self.awaited_stamp = 0.0
@@ -116,45 +123,29 @@ class SimulatorNode(Node):
         """Read and check every parameter (ConfigError naming the first bad one); the timing ones
         become attributes, the rest (initial state, checks) are returned."""
         section = self.scenario.node_params.get("simulator", {})
-        read = parameter_reader(self, section, source=str(self.scenario.path))
-
-        def param(name, default, *args, hint="", **kwargs):
-            try:
-                return read(name, default, *args, **kwargs)
-            except ConfigError as err:
-                raise ConfigError(err.code, err.message + hint) from None
-
-        inf = math.inf
-        self.step = param("step", DEFAULT_STEP, 0.0, 1.0, low_open=True)
-        per_step = dict(hint=" (at most 1/step: one per integration step)", low_open=True)
+        param = ParameterReader(self, SIMULATOR, section, source=str(self.scenario.path))
+        self.step = param("step")
         top = (1 + 1e-9) / self.step
-        self.publish_period = 1.0 / param("publish_rate", min(10.0, 1.0 / self.step), 0.0, top, **per_step)
-        self.clock_period = 1.0 / param("clock_rate", min(50.0, 1.0 / self.step), 0.0, top, **per_step)
+        self.publish_period = 1.0 / param("publish_rate", min(10.0, 1.0 / self.step), high=top)
+        self.clock_period = 1.0 / param("clock_rate", min(50.0, 1.0 / self.step), high=top)
         # the 3D view: /tf (default: with every state) and the markers, in Hz of sim time; 0: off
-        off = dict(hint=" (at most 1/step: one per integration step; 0: off)")
-        self.tf_rate = param("tf_rate", 1.0 / self.publish_period, 0.0, top, **off)
-        self.marker_rate = param("marker_rate", min(1.0, 1.0 / self.step), 0.0, top, **off)
-        self.real_time_factor = param("real_time_factor", 1.0, 0.0, inf)
-        self.command_timeout = param("command_timeout", 1.0, 0.0, inf, low_open=True)
-        self.end_time = param("end_time", 0.0, 0.0, inf)      # s of sim time; 0: run until stopped
+        self.tf_rate = param("tf_rate", 1.0 / self.publish_period, high=top)
+        self.marker_rate = param("marker_rate", min(1.0, 1.0 / self.step), high=top)
+        self.real_time_factor = param("real_time_factor")
+        self.command_timeout = param("command_timeout")
+        self.end_time = param("end_time")      # s of sim time; 0: run until stopped
         # Hold sim time at zero until this many subscribers (recorder, controller) see the state,
         # so that no run starts before it is recorded and controlled; at most start_timeout s.
-        self.wait_for_subscribers = param("wait_for_subscribers", 0, 0, 1000)
-        self.start_timeout = param("start_timeout", 60.0, 0.0, inf, low_open=True)
+        self.wait_for_subscribers = param("wait_for_subscribers")
+        self.start_timeout = param("start_timeout")
         # Lockstep: after each published state, wait (up to lockstep_timeout s of wall time) for
         # the command that answers it, so the loop stays closed at any speed and under CPU load.
-        self.lockstep = param("lockstep", True)
-        self.lockstep_timeout = param("lockstep_timeout", 0.5, 0.0, inf, low_open=True)
-        values = {
-            "command_limit_factor": param("command_limit_factor", 2.0, 1.0, inf),
-            "max_reset_rate": param("max_reset_rate", 1.0, 0.0, inf, low_open=True),
-            # default: the scenario's environment.gravity_gradient (false without it)
-            "gravity_gradient": param("gravity_gradient", bool(self.scenario.environment.get("gravity_gradient"))),
-            "initial_attitude": param("initial_attitude", [0.0, 0.0, 0.0, 1.0], -inf, inf, length=4),
-            "initial_rate": param("initial_rate", [0.0, 0.0, 0.0], -inf, inf, length=3),
-            "seed": param("seed", self.scenario.sensors.seed, 0, 2**63 - 1),
-            "campaign": param("campaign", ""),
-            "run_seed": param("run_seed", -1, -1, 2**32 - 1)}
+        self.lockstep = param("lockstep")
+        self.lockstep_timeout = param("lockstep_timeout")
+        values = {name: param(name) for name in ("command_limit_factor", "max_reset_rate", "initial_attitude",
+                                                 "initial_rate", "campaign", "run_seed")}
+        values["gravity_gradient"] = param("gravity_gradient", bool(self.scenario.environment.get("gravity_gradient")))
+        values["seed"] = param("seed", self.scenario.sensors.seed)
         try:
             values["initial_attitude"] = validation.unit_quaternion(
                 values["initial_attitude"], "parameter 'initial_attitude'", ErrorCode.INVALID_PARAMETER)
@@ -164,7 +155,7 @@ class SimulatorNode(Node):
         if rate > values["max_reset_rate"]:
             raise ConfigError(ErrorCode.INVALID_PARAMETER, f"parameter 'initial_rate' has norm {rate:g} rad/s, above "
                                                            f"max_reset_rate = {values['max_reset_rate']:g} rad/s")
-        read.refuse_unknown()
+        param.refuse_unknown()
         values["truth"] = self.dispersed_truth(values)
         return values
 

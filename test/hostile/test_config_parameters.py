@@ -270,6 +270,14 @@ NODE_CASES = {
     "bridge: host not this machine's": ("bridge", ["-p", "host:=192.0.2.1", "-p", "port:=0"], P,
                                         ["'host'", "192.0.2.1", "cannot serve", "Cannot assign"]),
     "bridge: unknown parameter (typo)": ("bridge", ["-p", "prot:=8765"], P, ["prot"]),
+    # every declared parameter is checked, the recorder's too
+    "recorder: flush_period zero": ("recorder", ["-p", "flush_period:=0.0"], P, ["'flush_period'", "(0, 3600]"]),
+    "recorder: flush_period text": ("recorder", ["-p", "flush_period:=often"], P, ["'flush_period'", "a number"]),
+    "recorder: unknown parameter (typo)": ("recorder", ["-p", "outptu:=run.mcap"], P, ["outptu"]),
+    "controller: m_max zero": ("controller", ["-p", "m_max:=0.0"], P, ["'m_max'", "dipole > 0"]),
+    "planner: default_method unknown": ("planner", ["-p", "default_method:=magic"], P,
+                                        ["'default_method'", "(the best)", "magic"]),
+    "simulator: step an integer out of range": (SIM, ["-p", "step:=2"], P, ["'step'", "(0, 1]"]),
 }
 RCL_PARSE_ERROR = re.compile(r"^\[ERROR\] \[[\d.]+\] \[rcl\]: Failed to parse global arguments$")
 REFUSAL = re.compile(r"^(\w+)\.py: \[(\d+) (\w+)\] (.+)$")
