@@ -46,6 +46,7 @@ setup(
             "att-log = att_msgs_py.log.cli:main",
             "att-mc = att_planner.tools.monte_carlo:main",
             "att-mission = att_planner.tools.mission:main",
+            "att-config = att_planner.tools.config_cli:main",
         ],
     },
 )

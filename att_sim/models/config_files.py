@@ -383,5 +383,11 @@ def renamed_text(text: str, problems: Iterable[Problem]) -> str:
     for p in problems:
         if p.rename and p.line and 0 < p.line <= len(lines):
             old, new = p.rename
-            lines[p.line - 1] = re.sub(rf"(?<![\w.]){re.escape(old)}(?=\s*:)", new, lines[p.line - 1], count=1)
+            line = re.sub(rf"(?<![\w.]){re.escape(old)}(?=\s*:)", new, lines[p.line - 1], count=1)
+            if line != lines[p.line - 1]:            # keep a trailing comment in its column where room allows
+                gap = re.search(r"\S( {3,})#", line)
+                if gap:
+                    spaces = " " * max(2, len(gap[1]) - len(new) + len(old))
+                    line = line[:gap.start(1)] + spaces + line[gap.end(1):]
+            lines[p.line - 1] = line
     return "".join(lines)

@@ -432,3 +432,10 @@ class ScenarioFile(Schema):
     __pydantic_extra__: dict[str, NodeSection] = Field(init=False)
 
     shared: SharedSection = Field(alias="/**", description="the spacecraft and its sky, read by every node")
+
+
+class ParametersFile(Schema):
+    """A plain ROS 2 parameter file (``--params-file``): one ``ros__parameters`` mapping per node."""
+
+    model_config = ConfigDict(extra="allow", frozen=True, strict=True)
+    __pydantic_extra__: dict[str, NodeSection] = Field(init=False)

@@ -109,6 +109,8 @@ def test_renamed_text_rewrites_old_keys_only(tmp_path):
     err = refused(tmp_path, text)
     fixed = cf.renamed_text(text, err.problems)
     assert fixed == text.replace("{torque_max:", "{torque_max_Nm:")
+    one = cf.Problem("f", 1, "torque_max", "", "", ("torque_max", "torque_max_Nm"))
+    assert cf.renamed_text("torque_max: 1      # N m\n", [one]) == "torque_max_Nm: 1   # N m\n"
     path = tmp_path / "fixed.yaml"
     path.write_text(fixed)
     assert cf.load_file(path, Craft).model.wheels[0].torque_max_Nm == 0.2
