@@ -124,6 +124,11 @@ class _NoAliasLoader(yaml.SafeLoader):
         return super().compose_node(parent, index)
 
 
+# YAML 1.2's floats with an unsigned exponent (7.0e6, 1e-3 already resolves): PyYAML's YAML 1.1 reads them as text
+_NoAliasLoader.add_implicit_resolver("tag:yaml.org,2002:float",
+                                     re.compile(r"^[-+]?[0-9][0-9_]*(?:\.[0-9_]*)?[eE][-+]?[0-9]+$"),
+                                     list("-+0123456789"))
+
 _STANDARD_TAGS = {f"tag:yaml.org,2002:{t}" for t in ("str", "int", "float", "bool", "null", "map", "seq",
                                                      "timestamp")}
 
@@ -352,6 +357,13 @@ def problems_of(exc: ValidationError, root: type[BaseModel], data: dict, lines: 
             out.append(Problem(name, _line(lines, path), field_path(path), "this key (required)", "nothing"))
             continue
         found = err.get("input")
+        if err["type"] == "union_tag_invalid" and isinstance(found, dict):
+            tag = err["ctx"]["tag"]
+            key = next((k for k, v in found.items() if str(v) == tag), None)
+            path = (*path, key) if key is not None else path
+            out.append(Problem(name, _line(lines, path), field_path(path), f"one of {err['ctx']['expected_tags']}",
+                               shown(tag)))
+            continue
         out.append(Problem(name, _line(lines, path), field_path(path), _expected(err),
                            shown(found) if not (isinstance(found, float) and math.isnan(found)) else "nan"))
     return sorted(set(out), key=lambda p: (p.line or 0, p.field, p.expected))

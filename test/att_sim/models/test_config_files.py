@@ -118,3 +118,12 @@ def test_renamed_text_rewrites_old_keys_only(tmp_path):
 
 def test_field_path():
     assert cf.field_path(("a", "b", 2, "c")) == "a.b[2].c" and cf.field_path(()) == ""
+
+
+def test_yaml_12_exponents_are_numbers(tmp_path):
+    path = tmp_path / "e.yaml"
+    path.write_text("name: x\nmass_kg: 7.0e6\n")
+    assert cf.load_file(path, Craft).model.mass_kg == 7.0e6
+    path.write_text("name: 1e3\n")
+    with pytest.raises(cf.ConfigFileError, match="name: expected a valid string; found 1000.0"):
+        cf.load_file(path, Craft)
