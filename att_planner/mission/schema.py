@@ -47,7 +47,8 @@ Secondary = Literal[tuple(k for k in SECONDARY_KINDS if k != "inertial")]
 class Mission(Schema):
     """How a day of observations is flown."""
 
-    targets: Name = Field(description="the target list (a file stem under config/targets/)")
+    targets: Annotated[str, Field(min_length=1, max_length=4096)] = Field(
+        description="the target list: a file stem under config/targets/, or a path to a *.yaml file")
     sensor_axis: UnitAxis = Field(description="body axis put on each target")
     horizon_s: float = number(ge=60.0, le=7 * 86_400.0, unit="s", meaning="sim time from the scenario's epoch")
     margin_deg: float = number(1.0, ge=0.0, le=30.0, unit="deg", meaning="visible this far outside every zone")

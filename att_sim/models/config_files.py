@@ -346,7 +346,7 @@ def problems_of(exc: ValidationError, root: type[BaseModel], data: dict, lines: 
         hint = f" (did you mean '{close[0]}'?)" if close else ""
         out.append(Problem(name, _line(lines, path), field_path(path),
                            f"one of the keys {', '.join(known)}{hint}" if known else "no such key",
-                           f"the unknown key '{key}'"))
+                           f"unknown key(s) {key}"))
     for err in errors:
         if err["type"] == "extra_forbidden":
             continue
