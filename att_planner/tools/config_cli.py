@@ -5,9 +5,10 @@
   ``--kind``), and the names it refers to (a mission's target list, a target list's or campaign's
   scenario) resolved. Exit 0 when every file is valid; else 2, after printing every problem of every
   file, one per line: ``file:line: field.path: expected ...; found ...``.
-- ``att-config schema [KIND]``: the JSON Schema of a kind (without KIND: of every kind, by name), for
-  editors: a YAML file whose first line is ``# yaml-language-server: $schema=<path or URL>`` is
-  completed and checked as it is typed.
+- ``att-config schema [KIND] [--out DIR]``: the JSON Schema of a kind (without KIND: of every kind, by
+  name), or ``DIR/KIND.schema.json`` files, for editors: a YAML file whose first line is
+  ``# yaml-language-server: $schema=<path or URL>`` is completed and checked as it is typed (the
+  shipped schemas are under ``config/schemas/``).
 - ``att-config show SCENARIO``: the resolved scenario (a name as ``-p scenario:=NAME`` takes it, or a
   path), one line per value, with where the value came from: ``file:line`` or ``default``.
 - ``att-config migrate FILE...``: each old key name written under its new name, in place (comments
@@ -104,6 +105,11 @@ def schema(kind: str | None = None) -> dict:
     out.setdefault("title", kind)
     out["$schema"] = "https://json-schema.org/draft/2020-12/schema"
     return out
+
+
+def schema_text(kind: str) -> str:
+    """The JSON Schema of ``kind`` as the text of its file (``config/schemas/KIND.schema.json``)."""
+    return json.dumps(schema(kind), indent=2, allow_nan=False) + "\n"
 
 
 def _finite_defaults(node):
@@ -204,6 +210,7 @@ def main(argv=None) -> int:
     kinds = sub.add_parser("schema", help="print the JSON Schema of a kind of file")
     kinds.add_argument("kind", nargs="?", choices=sorted(KINDS), metavar="KIND",
                        help=f"one of {', '.join(KINDS)} (default: every kind)")
+    kinds.add_argument("--out", metavar="DIR", help="write KIND.schema.json (every kind without KIND) into DIR")
     shown = sub.add_parser("show", help="print a scenario resolved, with where each value came from")
     shown.add_argument("scenario", metavar="SCENARIO", help="a scenario name or a path to its file")
     migrate = sub.add_parser("migrate", help="write old key names under their new names, in place")
@@ -213,6 +220,12 @@ def main(argv=None) -> int:
     if args.command == "check":
         return _check(args)
     if args.command == "schema":
+        if args.out:
+            for kind in [args.kind] if args.kind else KINDS:
+                path = Path(args.out) / f"{kind}.schema.json"
+                path.write_text(schema_text(kind), encoding="utf-8")
+                print(path)
+            return 0
         print(json.dumps(schema(args.kind), indent=2, allow_nan=False))
         return 0
     if args.command == "show":

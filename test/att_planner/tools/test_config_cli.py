@@ -88,3 +88,23 @@ def test_migrate_renames_in_place_and_keeps_comments(tmp_path, capsys):
     path.write_text("# campaign\ncampaign:\n  scenario: swift_demo\n  seed: 1\n  converge_timeout: 3.0   # s\n")
     assert config_cli.main(["migrate", str(path)]) == 0
     assert path.read_text().splitlines()[-1] == "  converge_timeout_s: 3.0  # s"
+
+
+@pytest.mark.parametrize("kind", sorted(config_cli.KINDS))
+def test_shipped_schemas_are_current(kind):
+    """config/schemas/KIND.schema.json is what `att-config schema KIND --out config/schemas` writes."""
+    assert (ROOT / "config" / "schemas" / f"{kind}.schema.json").read_text() == config_cli.schema_text(kind)
+
+
+def test_schema_header_names_the_schema_of_the_files_kind():
+    headed = [p for p in SHIPPED if p.read_text().startswith("# yaml-language-server: $schema=")]
+    assert {p.parent.name for p in headed} >= {"missions", "targets"}
+    for path in headed:
+        target = path.read_text().splitlines()[0].split("$schema=", 1)[1].strip()
+        kind, _ = config_cli.check_file(path)
+        assert (path.parent / target).resolve() == (ROOT / "config" / "schemas" / f"{kind}.schema.json").resolve()
+
+
+def test_schema_out_writes_one_file_per_kind(tmp_path, capsys):
+    assert config_cli.main(["schema", "--out", str(tmp_path)]) == 0
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted(f"{k}.schema.json" for k in config_cli.KINDS)
