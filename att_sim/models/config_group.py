@@ -55,6 +55,17 @@ class Group:
             raise ValueError(f"{self.field(key)} must be a number in {span}, got {_clip(v)}")
         return x
 
+    def declared(self, model, key: str) -> float:
+        """The number ``key`` with the default and range the pydantic ``model`` declares for it (the
+        one place they are written; a field without a default is required)."""
+        info = model.model_fields[key]
+        bounds = {name: getattr(m, name) for m in info.metadata for name in ("ge", "gt", "le", "lt")
+                  if getattr(m, name, None) is not None}
+        default = None if info.is_required() else info.default
+        return self.number(key, default, bounds.get("ge", bounds.get("gt", -math.inf)),
+                           bounds.get("le", bounds.get("lt", math.inf)), low_open="gt" in bounds,
+                           high_open="lt" in bounds)
+
     def numbers(self, key: str, default=None, size: int | None = None, multiple: int | None = None) -> np.ndarray:
         """A list of finite numbers (``size`` of them, or a multiple of ``multiple``)."""
         v = self.raw(key, default)

@@ -30,6 +30,7 @@ import yaml
 from att_msgs_py import validation
 from att_msgs_py.errors import ConfigError, ErrorCode, RequestError, clip
 from att_msgs_py.types import ZONE_BODIES, Zone
+from att_sim.models import config_schema as schema
 from att_sim.models import disturbances
 from att_sim.models import epoch as epochs
 from att_sim.models import orbit as orbits
@@ -95,7 +96,7 @@ FIELD_MODELS = ("dipole", "igrf14")
 ENVIRONMENT_KEYS = ("gravity_gradient", "solar_pressure", "drag", "drag_coefficient", "residual_dipole", "facets")
 ZONE_KEYS = ("name", "body", "sensor_axis", "half_angle_deg", "keep_in", "direction")
 UNIT_TOLERANCE = 1e-3          # |‖v‖ − 1| accepted for a unit vector of a file (then normalised)
-DEFAULT_DRAG_COEFFICIENT = 2.2
+DEFAULT_DRAG_COEFFICIENT = schema.Environment.model_fields["drag_coefficient"].default
 MAX_FILE_BYTES = 1_000_000     # a scenario file is a few kB
 
 
@@ -367,10 +368,12 @@ def spacecraft_from_params(p: dict) -> Spacecraft:
 
 
 def orbit_from_params(p: dict) -> OrbitParams:
-    return OrbitParams(altitude=float(p.get("altitude", 450e3)),
-                       inclination=math.radians(float(p.get("inclination_deg", 87.0))),
-                       raan=math.radians(float(p.get("raan_deg", 0.0))),
-                       arg0=float(p.get("arg0", 0.0)))
+    """The circular orbit of an ``orbit`` group, defaults from :class:`att_sim.models.config_schema.CircularOrbit`."""
+    d = {key: info.default for key, info in schema.CircularOrbit.model_fields.items()}
+    return OrbitParams(altitude=float(p.get("altitude", d["altitude_m"])),
+                       inclination=math.radians(float(p.get("inclination_deg", d["inclination_deg"]))),
+                       raan=math.radians(float(p.get("raan_deg", d["raan_deg"]))),
+                       arg0=float(p.get("arg0", d["arg0_rad"])))
 
 
 def read_document(path: Path):

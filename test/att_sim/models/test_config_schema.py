@@ -95,3 +95,17 @@ def test_json_schema_has_units_and_ranges():
     gyro = schema["$defs"]["Gyro"]["properties"]["arw_deg_per_sqrt_h"]
     assert gyro["minimum"] == 0.0 and gyro["maximum"] == 100.0
     assert "/**" in schema["properties"]
+
+
+def test_the_readers_take_defaults_and_ranges_from_the_models():
+    from att_sim.models.actuator_specs import actuators_from_params
+    from att_sim.models.sensor_specs import ARCSEC, sensors_from_params
+    specs = sensors_from_params({"gyro": {}, "star_trackers": [{"name": "a"}]}, epoch_known=False)
+    assert specs.gyro.rate == cs.Gyro.model_fields["rate_hz"].default
+    about = cs.StarTracker(name="a").about_boresight_arcsec
+    assert specs.star_trackers[0].about_boresight == pytest.approx(about * ARCSEC)
+    with pytest.raises(ValueError, match=r"sensors.gyro.rate_hz must be a number in \(0, 1000\]"):
+        sensors_from_params({"gyro": {"rate_hz": 1000.5}}, epoch_known=False)
+    with pytest.raises(ValueError, match=r"actuators.wheels.friction_speed_rad_s must be a number in \(0, 1000\]"):
+        actuators_from_params({"wheels": {"friction_speed_rad_s": 0.0}})
+    assert actuators_from_params({"wheels": {}}).wheels.power_max == math.inf
