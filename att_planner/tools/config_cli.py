@@ -10,7 +10,8 @@
   ``# yaml-language-server: $schema=<path or URL>`` is completed and checked as it is typed (the
   shipped schemas are under ``config/schemas/``).
 - ``att-config show SCENARIO``: the resolved scenario (a name as ``-p scenario:=NAME`` takes it, or a
-  path), one line per value, with where the value came from: ``file:line`` or ``default``.
+  path), one line per value, with where the value came from: ``file:line`` or ``default``. A file
+  whose only problems are old key names is shown under the new names (with a note to migrate it).
 - ``att-config migrate FILE...``: each old key name written under its new name, in place (comments
   and layout kept); the file is then checked.
 """
@@ -177,12 +178,26 @@ def _show(args) -> int:
         print(f"att-config: {err.args[0]}", file=sys.stderr)
         return 2
     try:
-        loaded = cf.load_file(path, cs.ScenarioFile)
+        loaded = _loaded_renamed(path)
     except cf.ConfigFileError as err:
         print(err.message)
         return 2
     print("\n".join(show(loaded)))
     return 0
+
+
+def _loaded_renamed(path: Path) -> cf.Loaded:
+    """The scenario at ``path``; a file whose only problems are old key names read under the new names
+    (the file itself left as it is, a note on stderr)."""
+    try:
+        return cf.load_file(path, cs.ScenarioFile)
+    except cf.ConfigFileError as err:
+        if not all(p.rename for p in err.problems):
+            raise
+        print(f"att-config: {path} uses {len(err.problems)} old key name(s) (att-config migrate {path} renames "
+              f"them); shown under the new names", file=sys.stderr)
+        data, lines = cf.parse_yaml(cf.renamed_text(path.read_text(encoding="utf-8"), err.problems), str(path))
+        return cf.Loaded(path, cf.validate(path, cs.ScenarioFile, data, lines), data, lines)
 
 
 def _migrate(args) -> int:

@@ -192,6 +192,16 @@ def read_yaml(path: Path, max_bytes: int = MAX_FILE_BYTES) -> tuple[dict, dict]:
     except UnicodeDecodeError as exc:
         raise refuse(raw[: exc.start].count(b"\n") + 1, "", "UTF-8 text",
                      f"the byte 0x{raw[exc.start]:02x} at offset {exc.start}") from None
+    return parse_yaml(text, name)
+
+
+def parse_yaml(text: str, name: str) -> tuple[dict, dict]:
+    """The root mapping of the YAML ``text`` (of the file ``name``) and the line of each field path
+    in it; :class:`ConfigFileError` as :func:`read_yaml`."""
+
+    def refuse(line, fld, expected, found):
+        return ConfigFileError([Problem(name, line, fld, expected, found)])
+
     if not text.strip() or all(not ln.strip() or ln.lstrip().startswith("#") for ln in text.splitlines()):
         raise refuse(1, "", "a mapping of keys", "an empty file")
     loader = _NoAliasLoader(text)

@@ -108,3 +108,25 @@ def test_schema_header_names_the_schema_of_the_files_kind():
 def test_schema_out_writes_one_file_per_kind(tmp_path, capsys):
     assert config_cli.main(["schema", "--out", str(tmp_path)]) == 0
     assert sorted(p.name for p in tmp_path.iterdir()) == sorted(f"{k}.schema.json" for k in config_cli.KINDS)
+
+
+def test_show_a_shipped_scenario_with_old_key_names(capsys):
+    """A file whose only problems are old names is shown under the new names, the file untouched."""
+    path = ROOT / "config" / "swift_demo.yaml"
+    before = path.read_text()
+    assert config_cli.main(["show", "swift_demo"]) == 0
+    captured = capsys.readouterr()
+    lines = captured.out.splitlines()
+    assert path.read_text() == before
+    torque = next(line for line in lines if ".spacecraft.torque_max_Nm = " in line)
+    number = next(i + 1 for i, text in enumerate(before.splitlines()) if "torque_max:" in text and "wheel" not in text)
+    assert torque == f"/**.ros__parameters.spacecraft.torque_max_Nm = 0.1  ({path}:{number})"
+    assert "old key name" in captured.err and "att-config migrate" in captured.err
+    assert any(line.startswith("demo.ros__parameters.method = ") for line in lines)
+
+
+def test_show_refuses_a_scenario_with_real_problems(tmp_path, capsys):
+    path = tmp_path / "bad.yaml"
+    path.write_text("/**:\n  ros__parameters:\n    spacecraft:\n      inertia: [1, 1, 5]\n")
+    assert config_cli.main(["show", str(path)]) == 2
+    assert "triangle inequality" in capsys.readouterr().out
