@@ -13,6 +13,8 @@ from collections.abc import Mapping
 
 import numpy as np
 
+from att_sim.models.config_schema import declared
+
 UNIT_TOLERANCE = 1e-3          # |‖v‖ − 1| accepted for a unit vector or quaternion (then normalised)
 
 
@@ -55,16 +57,11 @@ class Group:
             raise ValueError(f"{self.field(key)} must be a number in {span}, got {_clip(v)}")
         return x
 
-    def declared(self, model, key: str) -> float:
-        """The number ``key`` with the default and range the pydantic ``model`` declares for it (the
-        one place they are written; a field without a default is required)."""
-        info = model.model_fields[key]
-        bounds = {name: getattr(m, name) for m in info.metadata for name in ("ge", "gt", "le", "lt")
-                  if getattr(m, name, None) is not None}
-        default = None if info.is_required() else info.default
-        return self.number(key, default, bounds.get("ge", bounds.get("gt", -math.inf)),
-                           bounds.get("le", bounds.get("lt", math.inf)), low_open="gt" in bounds,
-                           high_open="lt" in bounds)
+    def declared(self, model, key: str, field: str | None = None) -> float:
+        """The number ``key`` with the default and range the pydantic ``model`` declares for its field
+        ``field`` (default: ``key``): :func:`att_sim.models.config_schema.declared`."""
+        default, low, high, low_open, high_open = declared(model, field or key)
+        return self.number(key, default, low, high, low_open=low_open, high_open=high_open)
 
     def numbers(self, key: str, default=None, size: int | None = None, multiple: int | None = None) -> np.ndarray:
         """A list of finite numbers (``size`` of them, or a multiple of ``multiple``)."""
