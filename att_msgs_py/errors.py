@@ -1,4 +1,4 @@
-"""Error codes of every suite service and action (listed in README "Errors and limits").
+"""Error codes of every suite service and action (their meanings: :mod:`att_msgs_py.error_meanings`).
 
 A rejected request carries one of these codes and a sentence naming the field and the reason.
 """

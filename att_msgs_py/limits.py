@@ -1,6 +1,6 @@
 """The size caps of everything the suite receives, and their check on a message before it is read.
 
-Every array and string a node receives has a declared cap here (README, "Errors and limits"); the
+Every array and string a node receives has a declared cap here (docs/limits.md); the
 field checks of the receivers (:mod:`att_msgs_py.validation`, the planner's request checks, the
 controller's plan checks, the simulator's command checks) use these same constants.
 :func:`check` compares the element counts of a message's fields with a table of caps (the tables

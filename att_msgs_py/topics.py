@@ -50,6 +50,39 @@ RECORDED = {
 }
 
 
+# What each topic, service and action carries (the documentation's node pages are generated from this).
+ABOUT = {
+    STATE: "the truth state at `publish_rate` (sim time): attitude, rate, wheel speeds, field, position, "
+           "`command_timeout`",
+    CLOCK: "sim time (the controller reads it itself, for its clock-skew check)",
+    COMMAND: "wheel torques, dipole or body torque, and the mode",
+    CONTROLLER_STATUS: "mode, plan progress, guidance law, reference, attitude error, dumping, watchdog state",
+    PLANS: "every plan returned (latched), for the controller and the log",
+    IMU: "gyro: mean body rate over the sample interval and its covariance; orientation and acceleration "
+         "not provided (covariance[0] = -1)",
+    STAR_TRACKER: "sensor-frame attitude, validity and status (Sun, Earth, Moon, excluded, rate), covariance; "
+                  "stamped at the instant measured",
+    MAGNETOMETER: "field in body axes (T) and its covariance",
+    SUN_SENSORS: "the coarse sun sensors' cosine detector outputs",
+    WHEEL_SPEEDS: "tachometers: `wheel_i` velocity relative to the body",
+    SENSOR_TRUTH: "the gyro's and magnetometer's actual biases, for evaluation only (no flight node reads it)",
+    ESTIMATE: "attitude, rate, gyro bias, their covariances, health",
+    TF: "the body frame under the inertial frame (rotation: the truth attitude, no translation) at `tf_rate`; "
+        "with an epoch also the Earth-fixed frame `itrs`",
+    SIM_MARKERS: "the zones as cones at their current directions (keep-out red, keep-in green), the sensor "
+                 "boresights, Sun, Moon and Earth directions, at `marker_rate`",
+    ZONE_MARGINS: "each scenario zone's truth margin (rad, >= 0 clear) and the smallest, at `tf_rate`",
+    PLAN_MARKERS: "the latest plan's boresight path (inertial frame, latched)",
+    MISSION_EVENTS: "a mission's decisions, slews, dwells, parks and missed targets with why (latched)",
+    PLAN_MANEUVER: "plan a rest-to-rest maneuver (or one ending on a pointing law), verified and signed",
+    PLAN_SCHEDULE: "the fastest tour through target attitudes, each flown through or observed (held for its "
+                   "dwell, within its window, never while a zone covers it)",
+    SET_CONTROLLER_MODE: "idle, magnetorquer PD, safe or pointing (a `PointingMode`); momentum dumping on or off",
+    RESET_SIMULATOR: "reset attitude, rate, wheel speeds and orbit phase",
+    EXECUTE_MANEUVER: "execute a plan (by id or inline), with feedback while it runs",
+}
+
+
 def message_class(type_name: str):
     """Message class of ``pkg/msg/Type``."""
     pkg, kind, name = type_name.split("/")

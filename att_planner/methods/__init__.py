@@ -49,6 +49,7 @@ class Method:
     # combinations the method cannot run: check(options with ``fixed``) -> why, of the ``combined`` options
     check: Callable[[dict], str | None] | None = None
     combined: tuple = ()
+    paper: str = ""                               # the publication the method follows or reproduces
 
     def load(self) -> Callable:
         return getattr(importlib.import_module(self.module), self.function)
@@ -101,9 +102,10 @@ def _time_optimal_check(options: dict) -> str | None:
     return option_problem(options)
 
 
-def _slepian(variant: str, description: str, seeded: bool = False) -> Method:
+def _slepian(variant: str, description: str, paper: str, seeded: bool = False) -> Method:
     return Method(variant, "att_planner.methods.slepian.planner", "plan_slepian", description, SLEPIAN_OPTIONS,
-                  fixed={"method": variant}, check=_slepian_check, combined=("M", "N", "W"), seeded=seeded)
+                  fixed={"method": variant}, check=_slepian_check, combined=("M", "N", "W"), seeded=seeded,
+                  paper=paper)
 
 
 # Bounds of the maneuver the collocation methods take as options.
@@ -112,6 +114,12 @@ _MOMENTUM_MAX = Option(1e-6, 1e4, limit=True, doc="N m s per wheel")
 # Basis size, DPSS length and half-bandwidth of the Slepian methods.
 SLEPIAN_OPTIONS = {"M": Option(2, 12, True, doc="basis size"), "N": Option(50, 2000, True, doc="samples"),
                    "W": Option(1e-4, 0.25, doc="half-bandwidth")}
+# Collocation: mesh intervals, and the tightening of every zone at the collocation points.
+_INTERVALS = Option(4, 200, True, doc="collocation intervals")
+_CONE_MARGIN = Option(0.0, 5.0, doc="zone tightening at the collocation points, deg")
+_CELANI_BRUNI = "Celani & Bruni (2021), smooth keep-out maneuvers on a Slepian basis"
+_MELTON = "Melton (2012), time-optimal constrained reorientation by direct collocation"
+
 
 # The forced boundary arc: the index of the request's cone whose boundary the sensor rides
 # (at most 16 cones per request); a bound of the maneuver, checked against the cones by the service.
@@ -122,23 +130,27 @@ REGISTRY = [
     Method("smooth_collocation", "att_planner.methods.time_optimal.smooth", "plan_smooth_collocation",
            "minimum time with a C1 torque (its second derivative bounded; torque and its rate zero at both ends) "
            "by Hermite-Simpson collocation with IPOPT, started from the first plan; zone-aware",
-           {"intervals": Option(4, 200, True), "torque_accel": Option(1.0, 1e4, doc="|d2T/dt2| in T/tu^2"),
-            "cone_margin_deg": Option(0.0, 5.0), "rate_max": _RATE_MAX, "wheel_momentum_max": _MOMENTUM_MAX},
-           seeded=True),
+           {"intervals": _INTERVALS, "torque_accel": Option(1.0, 1e4, doc="|d2T/dt2| in T/tu^2"),
+            "cone_margin_deg": _CONE_MARGIN, "rate_max": _RATE_MAX, "wheel_momentum_max": _MOMENTUM_MAX},
+           seeded=True, paper=_MELTON + ", with the torque a C1 state"),
     _slepian("slepian_minimum_time", "smooth torque on a Slepian basis, t_f minimised exactly; zone-aware",
-             seeded=True),
+             _CELANI_BRUNI + " (their basis and conventions)", seeded=True),
     Method("time_optimal", "att_planner.methods.time_optimal.planner", "plan_time_optimal",
            "minimum-time bang-bang slew by direct collocation with IPOPT (Melton 2012); zone-aware",
-           {"intervals": Option(4, 200, True), "max_intervals": Option(4, 400, True), "starts": Option(1, 20, True),
-            "refine_rounds": Option(0, 6, True), "refine_split": Option(2, 8, True, doc="parts per refined interval"),
-            "cone_margin_deg": Option(0.0, 5.0), "rate_max": _RATE_MAX, "wheel_momentum_max": _MOMENTUM_MAX,
-            "smooth_warm_start": Option(0, 1, True), "global_stage": Option(0, 1, True, doc="particle swarm first"),
+           {"intervals": _INTERVALS, "max_intervals": Option(4, 400, True, doc="intervals after mesh refinement"),
+            "starts": Option(1, 20, True, doc="initial guesses solved"),
+            "refine_rounds": Option(0, 6, True, doc="mesh refinement rounds"),
+            "refine_split": Option(2, 8, True, doc="parts per refined interval"),
+            "cone_margin_deg": _CONE_MARGIN, "rate_max": _RATE_MAX, "wheel_momentum_max": _MOMENTUM_MAX,
+            "smooth_warm_start": Option(0, 1, True, doc="the smooth Slepian plan among the starts"),
+            "global_stage": Option(0, 1, True, doc="particle swarm first"),
             "parallel_starts": Option(0, 1, True, doc="the starts on two cores (a forked child)"),
             "boundary_cone": BOUNDARY_CONE}, check=_time_optimal_check,
-           combined=("intervals", "max_intervals"), seeded=True),
+           combined=("intervals", "max_intervals"), seeded=True, paper=_MELTON),
     Method("constrained_axis", "att_planner.methods.constrained_axis", "plan_constrained_axis",
            "eigenaxis bang-bang, or lambda-rotations riding a zone boundary when the path is blocked",
-           {"ride_margin_deg": Option(0.0, 10.0), "boundary_cone": BOUNDARY_CONE}, cheap=True),
+           {"ride_margin_deg": Option(0.0, 10.0, doc="how far outside a zone boundary the sensor rides, deg"),
+            "boundary_cone": BOUNDARY_CONE}, cheap=True),
     Method("graph_smooth", "att_planner.methods.graph_smooth", "plan_graph_smooth",
            "the constructive first plan: the quickest rest-to-rest legs round the zones on a graph of sensor "
            "directions (exact checks on every leg), C1 torque zero at every leg's ends; zone-aware", cheap=True),
@@ -148,8 +160,10 @@ REGISTRY = [
            {"samples": Option(61, 5000, True, doc="knots of the linear torque profile")}, cheap=True),
     Method("eigenaxis", "att_planner.methods.eigenaxis", "plan_eigenaxis",
            "eigenaxis bang-bang slew with the largest torque the per-axis limits allow; ignores zones", cheap=True),
-    _slepian("mssa", "Slepian basis, minimum sum of squared coefficients (Celani & Lucarelli); zone-aware"),
-    _slepian("dfsp", "Slepian basis, derivative-free sequential penalty on t_f (Celani & Bruni); zone-aware, slow"),
+    _slepian("mssa", "Slepian basis, minimum sum of squared coefficients (Celani & Lucarelli); zone-aware",
+             "Celani & Lucarelli, the MSSA method"),
+    _slepian("dfsp", "Slepian basis, derivative-free sequential penalty on t_f (Celani & Bruni); zone-aware, slow",
+             _CELANI_BRUNI + ", the DFSP method"),
 ]
 METHODS = {m.name: m for m in REGISTRY}
 

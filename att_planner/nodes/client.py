@@ -28,6 +28,7 @@ from rclpy.action import ActionClient
 from rclpy.node import Node
 
 from att_msgs.action import ExecuteManeuver
+from att_msgs.msg import AttitudeEstimate
 from att_msgs.srv import PlanManeuver, PlanSchedule, SetControllerMode
 from att_msgs_py import convert, qos, signing, topics
 from att_msgs_py.errors import ErrorCode, RequestError
@@ -107,7 +108,11 @@ class SuiteClient(Node):
         self.mode_client = self.create_client(SetControllerMode, topics.SET_CONTROLLER_MODE)
         self.execute_client = ActionClient(self, ExecuteManeuver, topics.EXECUTE_MANEUVER)
 
-    def wait_for_servers(self, timeout: float = 30.0, schedule: bool = False) -> None:
+    def wait_for_servers(self, timeout: float = 30.0, schedule: bool = False, estimate: bool = False) -> None:
+        """Wait for the planner's and the controller's services and action (``schedule``: the schedule
+        service too; ``estimate``: then for a CONVERGED attitude estimate, without which a controller
+        flying on the estimate refuses a maneuver with 313 ESTIMATE_UNHEALTHY); TimeoutError after
+        ``timeout`` s in all."""
         deadline = time.monotonic() + timeout
         clients = [self.plan_client, self.mode_client] + ([self.schedule_client] if schedule else [])
         for client in clients:
@@ -115,6 +120,22 @@ class SuiteClient(Node):
                 raise TimeoutError(f"service {client.srv_name} not available after {timeout} s")
         if not self.execute_client.wait_for_server(timeout_sec=max(0.1, deadline - time.monotonic())):
             raise TimeoutError(f"action {topics.EXECUTE_MANEUVER} not available after {timeout} s")
+        if estimate:
+            self.wait_for_estimate(max(0.0, deadline - time.monotonic()))
+
+    def wait_for_estimate(self, timeout: float = 30.0) -> None:
+        """Spin until the estimator publishes a CONVERGED attitude estimate; TimeoutError after ``timeout`` s."""
+        converged = []
+        sub = self.create_subscription(AttitudeEstimate, topics.ESTIMATE,
+                                       lambda m: converged.append(m.health == m.HEALTH_CONVERGED), qos.STREAM_QOS)
+        try:
+            deadline = time.monotonic() + timeout
+            while not any(converged):
+                if time.monotonic() > deadline:
+                    raise TimeoutError(f"no converged estimate on {topics.ESTIMATE} within {timeout:.3g} s")
+                rclpy.spin_once(self, timeout_sec=0.05)
+        finally:
+            self.destroy_subscription(sub)
 
     def _servers(self, client) -> frozenset:
         """The servers of ``client``'s service as this node's graph lists them: the GIDs of their

@@ -3,7 +3,7 @@
 :func:`validate_maneuver` and :func:`validate_schedule` turn the raw fields of a ``PlanManeuver``
 or ``PlanSchedule`` request into a :class:`~att_planner.problem.ManeuverProblem`, or raise
 :class:`RequestError` with a code and a sentence naming the field and the reason. Documented
-tolerances and caps are the constants below (README, "Errors and limits"); method options are
+tolerances and caps are the constants below (docs/limits.md); method options are
 checked by the registry (:mod:`att_planner.methods`). Field checks are the shared ones of
 :mod:`att_msgs_py.validation` (``unit_quaternion`` and ``unit_vector`` are re-exported here): every
 string is free of control characters (INVALID_TEXT) and at most ``MAX_NAME_LENGTH`` characters

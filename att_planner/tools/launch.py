@@ -82,10 +82,16 @@ class Suite:
     log_dir: Path
     procs: dict = field(default_factory=dict)
 
+    def __enter__(self) -> Suite:
+        return self
+
+    def __exit__(self, *exc) -> None:
+        """Leaving a ``with`` block stops every node (:meth:`stop`), whatever happened in it."""
+        self.stop()
+
     def start(self, name: str, params: dict | None = None, params_files: tuple = ()) -> subprocess.Popen:
         """Start node ``name`` with ``-p key:=value`` parameters and ``--params-file`` files
-        (both override the scenario defaults; between them rcl's rule applies, see README "Starting
-        nodes by hand")."""
+        (both override the scenario defaults; between them rcl's rule applies, see docs/running.md)."""
         args = [sys.executable, "-m", NODE_MODULES[name], "--ros-args"]
         for path in params_files:
             args += ["--params-file", str(path)]

@@ -68,7 +68,7 @@ def initial_states(h: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
 
 @dataclass(frozen=True)
 class SimSettings:
-    """Integration and settling-detection settings (see BENCHMARKS.md, gains, for the studies).
+    """Integration and settling-detection settings (docs/decisions/settling-simulator-settings.md).
 
     ``dt``: fixed RK4 step (s). Convergence study (64 random ICs of H, published robust gains,
     against dt = 1.25 s): median |Δt_s| 0.0009 / 0.0035 / 0.011 / 0.081 orbits at dt = 2.5 / 5 /

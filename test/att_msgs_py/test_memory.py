@@ -69,7 +69,10 @@ def test_the_middleware_is_pointed_at_the_suite_profiles_unless_the_user_chose()
     assert memory.middleware_env(env)
     assert env == {"RMW_FASTRTPS_USE_QOS_FROM_XML": "1", "FASTDDS_DEFAULT_PROFILES_FILE": str(memory.PROFILES)}
     text = memory.PROFILES.read_text()
-    assert text.count("<historyMemoryPolicy>DYNAMIC</historyMemoryPolicy>") == 2 and "ASYNCHRONOUS" in text
+    assert text.count("<historyMemoryPolicy>DYNAMIC</historyMemoryPolicy>") == 2
+    # synchronous, as rmw_fastrtps publishes without a profile: an asynchronous depth-1 writer (an action
+    # server's goal status) refuses a second write while the first is queued
+    assert "<kind>SYNCHRONOUS</kind>" in text and "ASYNCHRONOUS" not in text
     mine = {"FASTDDS_DEFAULT_PROFILES_FILE": "/my/profiles.xml"}
     assert not memory.middleware_env(mine) and mine == {"FASTDDS_DEFAULT_PROFILES_FILE": "/my/profiles.xml"}
     other = {"RMW_IMPLEMENTATION": "rmw_cyclonedds_cpp"}

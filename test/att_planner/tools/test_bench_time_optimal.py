@@ -6,7 +6,7 @@ with its own RK4 (:mod:`helpers.own_rk4`, 40 steps per interval: about 2000 over
 measures the boresight against the JSON's cone itself. It confirms the benchmark's claims: the final
 boresight within 0.01° of ``sensor_target`` and at rest; for BA the boresight within 1e-4 rad of the
 cone's boundary at every sample; for BP margins ≥ −1e-6 rad within 0.01 rad of the path's ends (the
-boundary points; README "Errors and limits", 112) and ≥ 0 everywhere else; BP ≤ BA ≤ λ-rotation for
+boundary points; docs/errors.md, 112) and ≥ 0 everywhere else; BP ≤ BA ≤ λ-rotation for
 each cone. ``ATT_TO_BENCHMARKS=DIR`` checks the JSONs of another directory.
 """
 from __future__ import annotations
@@ -25,7 +25,7 @@ from helpers.own_rk4 import dcm_NB, integrate
 BENCHMARKS = Path(os.environ.get("ATT_TO_BENCHMARKS", Path(__file__).resolve().parents[3] / "benchmarks"))
 CASES = ("ba1", "ba2", "bp1", "bp2")
 SUBSTEPS = 40
-END_RADIUS = 0.01          # rad: the README's neighbourhood of an end direction
+END_RADIUS = 0.01          # rad: the documented neighbourhood of an end direction
 END_TOLERANCE = 1e-6       # rad: how far inside a boundary an end may lie
 ARC_TOLERANCE = 1e-4       # rad: a boundary arc's band
 

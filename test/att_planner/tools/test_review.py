@@ -99,7 +99,7 @@ def test_peak_body_torque_against_the_planning_and_the_actuator_limit(log):
 
 @pytest.mark.parametrize("peak, above", [(0.1027, False), (0.1199, False), (0.1201, True), (0.5, True)])
 def test_only_a_peak_above_the_actuator_limit_is_flagged(log, peak, above):
-    """The README run's 1.027 x torque_max is within the wheels' limit; past 0.12 N m it is flagged."""
+    """The documented run's 1.027 x torque_max is within the wheels' limit; past 0.12 N m it is flagged."""
     run = extract_run(log)
     inside = segment_states(log, run)
     state = log["/spacecraft/state"]

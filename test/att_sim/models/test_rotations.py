@@ -96,9 +96,17 @@ def test_to_body_on_rows_is_the_transposed_dcm_of_each_row():
     one vector for every row or one per row; one quaternion; a stack of rows."""
     qs = random_quaternions(50) * RNG.uniform(0.9, 1.1, (50, 1))
     vs = RNG.normal(size=(50, 3))
+
+    def rounding(q, v):
+        """The two evaluation orders of one sum differ by a few ulps of its largest term (|q|^2 |v|
+        per product, about 8 products per component, rounded at most twice each)."""
+        return 16 * np.finfo(float).eps * (1.0 + q @ q) * np.abs(v).sum()
+
     for v, rows in ((vs, rot.to_body(qs, vs)), (vs[0], rot.to_body(qs, vs[0]))):
         for i, (q, row) in enumerate(zip(qs, rows)):
-            np.testing.assert_allclose(row, rot.dcm_BN(q) @ (v if v.ndim == 1 else v[i]), rtol=0, atol=1e-15)
-    np.testing.assert_allclose(rot.to_body(qs[3], vs[3]), rot.dcm_BN(qs[3]) @ vs[3], rtol=0, atol=1e-15)
+            vi = v if v.ndim == 1 else v[i]
+            np.testing.assert_allclose(row, rot.dcm_BN(q) @ vi, rtol=0, atol=rounding(q, vi))
+    np.testing.assert_allclose(rot.to_body(qs[3], vs[3]), rot.dcm_BN(qs[3]) @ vs[3], rtol=0,
+                               atol=rounding(qs[3], vs[3]))
     stacked = rot.to_body(qs.reshape(5, 10, 4), vs.reshape(5, 10, 3))
     np.testing.assert_array_equal(stacked.reshape(50, 3), rot.to_body(qs, vs))

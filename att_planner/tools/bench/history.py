@@ -1,0 +1,465 @@
+"""history: one summary line per recorded run of a study, appended to ``benchmarks/history.jsonl``.
+
+``att-bench history --append PATH [--study NAME] [--case NAME] [--command CMD]`` reads the JSON a
+study wrote (``att-bench <study> --json PATH``, or ``att-mc ... --json PATH`` for the Monte Carlo
+campaign), recognises the study from its keys (or takes ``--study``), and appends one line:
+
+``study``, ``case``, ``metric`` (the headline figure's name), ``value`` and ``unit``, ``target`` (the
+criterion in words) and ``met`` (``true``/``false``, ``null`` where the study states none),
+``metrics`` (the other figures of the run), ``date`` (UTC) and ``commit`` (the run's, see :func:`run`),
+``machine`` and ``load_1min`` (from the JSON when it holds them), ``command``, ``json`` (the file,
+when it is kept in the repository) and ``source`` (where the figures were read).
+
+Every figure of a line is read from the JSON; the criterion of each study is written once, in
+:data:`STUDIES`. ``att-bench summary`` renders BENCHMARKS.md's summary table from the latest line of
+each study and case.
+"""
+from __future__ import annotations
+
+import json
+import math
+import subprocess
+from collections.abc import Callable
+from dataclasses import dataclass
+from datetime import UTC, datetime
+from pathlib import Path
+
+HISTORY = Path("benchmarks") / "history.jsonl"
+DATE_FORMAT = "%Y-%m-%dT%H:%M:%SZ"
+FIELDS = ("study", "case", "metric", "value", "unit", "target", "met", "metrics", "date", "commit", "machine",
+          "load_1min", "command", "json", "source")
+
+MC_TARGET_RUNS = 1000            # runs of the demo maneuver ...
+MC_TARGET_RUNS_PER_S = 3.3       # ... in 5 minutes on the 2-core machine
+SMOOTH_COMPUTE_S = 10.0          # compute of the default smooth plan
+SCHEDULE_TF_RATIO = 1.01         # t_f against the published schedule
+MOMENTUM_WHEEL_RATIO = 0.5       # peak wheel speed with dumping, fraction of the limit
+MOMENTUM_POINTING_DEG = 0.002    # pointing error rms bound
+GAINS_FIXED_TS_ORBITS = 1.78     # settling time at IC (20), fixed gains
+GAINS_FIXED_S = 60.0             # compute of the fixed-gains search
+GAINS_ROBUST_WORST_ORBITS = 4.086  # thorough worst case of the published robust gains
+GAINS_ROBUST_S = 600.0           # compute of the min-max search
+
+
+class HistoryError(ValueError):
+    """A JSON that cannot be summarised, or a history file that cannot be read."""
+
+
+@dataclass(frozen=True)
+class Summary:
+    """The figures of one run: the headline ``value`` of ``metric`` in ``unit``, judged against ``target``."""
+
+    case: str
+    metric: str
+    value: float
+    unit: str
+    target: str
+    met: bool | None
+    metrics: dict
+
+
+@dataclass(frozen=True)
+class Study:
+    """How a study's JSON is recognised (``detect``), summarised and re-made (``command``)."""
+
+    name: str
+    detect: Callable[[dict], bool]
+    summarise: Callable[[dict, str | None], Summary]
+    command: Callable[[dict, str], str]
+
+
+def _get(payload: dict, *keys):
+    """``payload[k0][k1]...``, or a :class:`HistoryError` naming the missing key."""
+    node = payload
+    for i, key in enumerate(keys):
+        if not isinstance(node, dict) or key not in node:
+            raise HistoryError(f"the JSON has no '{'.'.join(str(k) for k in keys[:i + 1])}' (expected for this study)")
+        node = node[key]
+    return node
+
+
+def _num(payload: dict, *keys) -> float:
+    value = _get(payload, *keys)
+    if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
+        raise HistoryError(f"'{'.'.join(str(k) for k in keys)}' must be a finite number, found {value!r}")
+    return float(value)
+
+
+def _passes(payload: dict) -> bool:
+    ver = _get(payload, "verification")
+    if not isinstance(ver, dict):
+        raise HistoryError(f"'verification' must be an object, found {ver!r}")
+    return bool(ver.get("passes", ver.get("passed", False)))
+
+
+# --- one summary per study -------------------------------------------------------------------------------------
+
+def _smooth(p: dict, case: str | None) -> Summary:
+    case = case or str(_get(p, "case"))
+    unit = "TU" if _get(p, "case") == "swift" else "s"
+    tf, secs, dfsp = _num(p, "tf"), _num(p, "solve_seconds"), _num(p, "published", "dfsp")
+    met = tf <= dfsp and secs <= SMOOTH_COMPUTE_S and _passes(p)
+    metrics = {"tf": tf, "solve_s": secs, "M": _get(p, "M"), "method": _get(p, "method"), "verified": _passes(p)}
+    for run in p.get("runs") or []:         # every method and basis size the study tabulates
+        if isinstance(run, dict) and {"method", "M", "tf"} <= run.keys():
+            metrics[f"tf_{run['method']}_M{run['M']}"] = run["tf"]
+    return Summary(case, "t_f, default smooth plan", tf, unit,
+                   f"≤ {dfsp:g} {unit} (published DFSP), ≤ {SMOOTH_COMPUTE_S:g} s compute, verified", met, metrics)
+
+
+def _time_optimal(p: dict, case: str | None) -> Summary:
+    case = case or str(_get(p, "case"))
+    tf = _num(p, "tf")
+    metrics = {"tf": tf, "solve_s": _num(p, "solve_seconds"), "method": _get(p, "method"), "verified": _passes(p)}
+    for name, plan in (p.get("plans") or {}).items():
+        if isinstance(plan, dict) and "tf" in plan:
+            metrics[f"tf_{name}"] = plan["tf"]
+    sweep = (p.get("sweep") or {}).get("summary") or {}
+    for name in ("bp", "ba", "lambda"):     # the orientation sweep: best and worst over the orientations
+        if isinstance(sweep.get(name), dict):
+            metrics[f"sweep_{name}_best_worst"] = [sweep[name]["best"], sweep[name]["worst"]]
+    return Summary(case, "t_f, time-optimal plan", tf, "TU", "a verified plan", _passes(p), metrics)
+
+
+def _schedule(p: dict, case: str | None) -> Summary:
+    experiment = str(_get(p, "experiment"))
+    case = case or f"experiment {experiment}"
+    tf, secs = _num(p, "tf"), _num(p, "solve_seconds")
+    published, published_s = _num(p, "published", "tf"), _num(p, "published", "solve_seconds")
+    stats = _get(p, "stats")
+    if case == f"experiment {experiment}":     # the fast run: the paper's t_f and compute
+        target = (f"≤ {SCHEDULE_TF_RATIO:g} × published t_f ({published:g} s), compute ≤ published "
+                  f"({published_s:g} s), verified")
+        met = tf <= SCHEDULE_TF_RATIO * published and secs <= published_s and _passes(p)
+    else:                                      # a proof of the order (--prove, --exhaustive)
+        target = f"order proven, ≤ {SCHEDULE_TF_RATIO:g} × published t_f ({published:g} s), verified"
+        met = bool(stats.get("order_proven")) and tf <= SCHEDULE_TF_RATIO * published and _passes(p)
+    metrics = {"tf": tf, "order": "".join(_get(p, "order")), "solve_s": secs, "published_solve_s": published_s,
+               "orders_solved": stats.get("orders_solved"), "order_proven": stats.get("order_proven"),
+               "verified": _passes(p), "rest_to_rest_ab_s": (p.get("rest_to_rest_ab") or {}).get("tf")}
+    if isinstance(p.get("published_order_here"), dict):     # the paper's order under this model
+        metrics["published_order_here_s"] = p["published_order_here"].get("tf")
+        metrics["stopping_at_every_target_s"] = p["published_order_here"].get("rest_to_rest_legs_tf")
+    if isinstance(p.get("grid_study"), list):
+        metrics["grid_intervals_tf_s"] = {str(g["intervals"]): g["tf"] for g in p["grid_study"]}
+    if isinstance(p.get("exhaustive"), dict):
+        e = p["exhaustive"]
+        metrics["orders"] = e.get("orders")
+        metrics["best_orders_s"] = e.get("best_pair_tf")
+        metrics["orders_above_their_reverse_0.1pct"] = e.get("orders_worse_than_their_reverse_by_0.1pct")
+        metrics["exhaustive_s"] = e.get("seconds")
+    return Summary(case, "t_f, schedule", tf, "s", target, met, metrics)
+
+
+def _sky(p: dict, case: str | None) -> Summary:
+    case = case or str(_get(p, "case"))
+    s = _get(p, "summary")
+    if "moving_true_margin" in s:
+        moving = math.degrees(_num(s, "moving_true_margin"))
+        frozen = math.degrees(_num(s, "frozen_true_margin"))
+        met = bool(_get(s, "moving_verified_vs_truth"))
+    else:       # the first sky JSONs: each plan verified against the true sky, margins in its verification
+        moving = math.degrees(_num(p, "plans", "moving", "verification", "min_cone_margin"))
+        frozen = math.degrees(_num(p, "plans", "frozen", "verification", "min_cone_margin"))
+        met = _passes(_get(p, "plans", "moving"))
+    return Summary(case, "moving plan's smallest true margin", moving, "deg",
+                   "moving plan clear of every true zone, verified", met,
+                   {"moving_margin_deg": moving, "frozen_margin_deg": frozen,
+                    "frozen_entered": s.get("frozen_entered"), "tf_moving": _num(p, "plans", "moving", "tf"),
+                    "tf_frozen": _num(p, "plans", "frozen", "tf"), "tf_ratio": s.get("tf_ratio")})
+
+
+def _speed(p: dict, case: str | None) -> Summary:
+    rows, goal = _get(p, "cases"), _get(p, "targets")
+    first = max(_num(r, "first", "solve_cpu_seconds") for r in rows)
+    best = max(_num(r, "best", "solve_seconds") for r in rows)
+    ratio = max(_num(r, "best_tf_ratio") for r in rows)
+    to = max(_num(r, "time_optimal_seconds") for r in rows)
+    met = (first <= _num(goal, "first_seconds") and best <= _num(goal, "best_seconds")
+           and ratio <= _num(goal, "best_tf_ratio") and to <= _num(goal, "time_optimal_seconds"))
+    return Summary(case or "/".join(str(_get(r, "case")) for r in rows), "time-optimal method stage, slowest case",
+                   to, "s", f"first plan ≤ {goal['first_seconds'] * 1e3:g} ms CPU; best ≤ {goal['best_seconds']:g} s "
+                   f"and ≤ {goal['best_tf_ratio']:g} × t_o; time-optimal ≤ {goal['time_optimal_seconds']:g} s", met,
+                   {"first_cpu_s": first, "best_s": best, "best_tf_ratio": ratio, "time_optimal_s": to})
+
+
+def _estimation(p: dict, case: str | None) -> Summary:
+    err = _num(p, "final_pointing_error_deg")
+    if "pointing_bound_deg" in p:
+        bound = _num(p, "pointing_bound_deg")
+        target, met = f"≤ 3σ of the star tracker ({bound:.4f}°), success", bool(_get(p, "success")) and err <= bound
+    else:       # a JSON without the bound: judged by the study's own success
+        target, met = "success", bool(_get(p, "success"))
+    truth = p.get("truth_loop") or {}
+    return Summary(case or "swift_demo", "final pointing error, flown on the estimate", err, "deg", target, met,
+                   {"final_pointing_error_deg": err, "attitude_error_rms_arcsec": _num(p, "attitude_error_rms_arcsec"),
+                    "nees_mean": _num(p, "nees_mean"), "min_cone_margin_deg": _num(p, "min_cone_margin_deg"),
+                    "truth_final_pointing_error_deg": truth.get("final_pointing_error_deg"),
+                    "truth_min_cone_margin_deg": truth.get("min_cone_margin_deg")})
+
+
+def _momentum(p: dict, case: str | None) -> Summary:
+    peak = _num(p, "dumping", "peak_wheel_speed_ratio")
+    rms = _num(p, "dumping", "pointing_error_rms_deg")
+    met = peak < MOMENTUM_WHEEL_RATIO and rms <= MOMENTUM_POINTING_DEG
+    return Summary(case or f"{_num(p, 'orbits'):g} orbits", "peak wheel speed with dumping", peak, "of the limit",
+                   f"< {MOMENTUM_WHEEL_RATIO:g} of the limit, pointing rms ≤ {MOMENTUM_POINTING_DEG:g}°", met,
+                   {"peak_wheel_ratio_dumping": peak, "pointing_error_rms_deg": rms,
+                    "peak_wheel_ratio_no_dumping": _num(p, "no_dumping", "peak_wheel_speed_ratio"),
+                    "saturation_time_s_no_dumping": _get(p, "no_dumping", "saturation_time_s")})
+
+
+def _observe(p: dict, case: str | None) -> Summary:
+    ratio = _num(p, "zone_cost_ratio")
+    met = bool(_get(p, "with_zones", "verified")) and bool(_get(p, "without_zones", "verified"))
+    return Summary(case or f"{len(_get(p, 'sources'))} sources", "tour t_f among the zones / without", ratio, "×",
+                   "both tours verified on the true sky", met,
+                   {"tf_with_zones": _num(p, "with_zones", "tf"), "tf_without_zones": _num(p, "without_zones", "tf"),
+                    "solve_s_with_zones": _num(p, "with_zones", "solve_seconds")})
+
+
+def _day(p: dict, case: str | None) -> Summary:
+    observed, missed = int(_num(p, "observed")), int(_num(p, "missed"))
+    margin = _num(p, "min_margin_deg")
+    return Summary(case or "observatory_day", "targets observed", observed, f"of {observed + missed}",
+                   "every zone kept (smallest margin ≥ 0)", margin >= 0.0,
+                   {"observed": observed, "missed": missed, "min_margin_deg": margin,
+                    "peak_wheel_ratio": _num(p, "peak_wheel_ratio"), "rtf": _num(p, "rtf"),
+                    "sim_s": _num(p, "sim_seconds")})
+
+
+def _timing(p: dict, case: str | None) -> Summary:
+    scalar = [_num(f, "scalar", "median_s") for group in ("sky", "orbit") for f in _get(p, group).values()]
+    vector = [_num(f, "vector", "median_s") for group in ("sky", "orbit") for f in _get(p, group).values()]
+    goal = _get(p, "targets")
+    return Summary(case or "sky, orbit, request checks", "slowest single call (median)", max(scalar) * 1e6, "µs",
+                   f"a call ≤ {_num(goal, 'scalar_s') * 1e6:g} µs; {_get(p, 'vector_times')} times ≤ "
+                   f"{_num(goal, 'vector_s') * 1e3:g} ms; 16-cone check ≤ {_num(goal, 'closed_sky_s') * 1e3:g} ms",
+                   bool(_get(p, "passed")),
+                   {"scalar_worst_us": max(scalar) * 1e6, "vector_worst_ms": max(vector) * 1e3,
+                    "closed_sky_ms": _num(p, "closed_sky", "median_s") * 1e3,
+                    "goal_in_cone_ms": _num(p, "goal_in_cone", "median_s") * 1e3})
+
+
+def _logtools(p: dict, case: str | None) -> Summary:
+    tools, limits = _get(p, "tools"), _get(p, "limits")
+    wall = max(_num(t, "worst_wall_s") for t in tools.values())
+    rss = max(_num(t, "worst_rss_mb") for t in tools.values())
+    return Summary(case or f"{_get(p, 'files')} files × {len(tools)} tools", "worst refusal time", wall, "s",
+                   f"one line, a documented exit, ≤ {_num(limits, 'wall_s'):g} s, ≤ {_num(limits, 'rss_mb'):g} MB",
+                   bool(_get(p, "passed")), {"worst_wall_s": wall, "worst_rss_mb": rss,
+                                             "failed": len(_get(p, "failed"))})
+
+
+def _flood(p: dict, case: str | None) -> Summary:
+    growth = _get(p, "growth_mib")
+    worst = max(_num(growth, k) for k in growth)
+    late = _get(p, "worst_past_budget")
+    return Summary(case or f"{int(_num(p, 'messages'))} messages", "largest RSS growth of a process", worst, "MiB",
+                   f"≤ {_num(p, 'growth_limit_mib'):g} MiB per process", bool(_get(p, "passed")),
+                   {"growth_mib": growth, "worst_past_budget_s": max(_num(late, k) for k in late),
+                    "flood_s": _num(p, "flood_seconds")})
+
+
+def _monte_carlo(p: dict, case: str | None) -> Summary:
+    runs, workers, rate = int(_num(p, "runs")), int(_num(p, "workers")), _num(p, "runs_per_second")
+    requested, success = int(_num(p, "requested")), _num(p, "success_rate")
+    if requested >= MC_TARGET_RUNS:
+        target = f"≥ {MC_TARGET_RUNS} runs at ≥ {MC_TARGET_RUNS_PER_S:g} runs/s, every run a success"
+        met = runs >= MC_TARGET_RUNS and rate >= MC_TARGET_RUNS_PER_S and success == 1.0
+    else:                                      # a scaling or A/B run: no target of its own
+        target, met = "none (a scaling or comparison run)", None
+    return Summary(case or f"{requested} runs, {workers} worker{'s' if workers > 1 else ''}",
+                   "closed-loop runs per second", rate, "runs/s", target, met,
+                   {"runs": runs, "workers": workers, "wall_s": _num(p, "wall_seconds"),
+                    "cpu_s_per_run": _num(p, "cpu_seconds_per_run", "mean"), "success_rate": success,
+                    "final_error_deg_p99": _num(p, "final_error_deg", "p99"),
+                    "final_error_deg_max": _num(p, "final_error_deg", "max"),
+                    "min_margin_deg_min": _num(p, "min_margin_deg", "min")})
+
+
+def _gains(p: dict, case: str | None) -> Summary:
+    mode, ts, secs = _get(p, "mode"), _num(p, "ts"), _num(p, "solve_seconds")
+    if mode == "fixed":
+        return Summary(case or "fixed", "t_s at IC (20), truth path", ts, "orbits",
+                       f"≤ {GAINS_FIXED_TS_ORBITS:g} orbits in ≤ {GAINS_FIXED_S:g} s",
+                       ts <= GAINS_FIXED_TS_ORBITS and secs <= GAINS_FIXED_S,
+                       {"kp": _num(p, "kp"), "kd": _num(p, "kd"), "ts_orbits": ts, "solve_s": secs})
+    return Summary(case or "robust", "thorough worst-case t_s", ts, "orbits",
+                   f"≤ {GAINS_ROBUST_WORST_ORBITS:g} orbits (published robust gains) in ≤ {GAINS_ROBUST_S:g} s",
+                   ts <= GAINS_ROBUST_WORST_ORBITS and secs <= GAINS_ROBUST_S,
+                   {"kp": _num(p, "kp"), "kd": _num(p, "kd"), "ts_orbits": ts, "solve_s": secs})
+
+
+def _soak(p: dict, case: str | None) -> Summary:
+    dropped = int(_num(p, "dropped_state"))
+    return Summary(case or f"{_num(p, 'orbits'):g} orbits", "state messages dropped", dropped, "",
+                   "none dropped, every process exits 0", dropped == 0 and not any(_get(p, "exit_codes").values()),
+                   {"rtf": _num(p, "real_time_factor"), "state_messages": _num(p, "state_messages"),
+                    "settling_orbits": p.get("settling_orbits")})
+
+
+def _cmd(template: str) -> Callable[[dict, str], str]:
+    return lambda p, path: template.format(path=path, **{k: v for k, v in p.items()
+                                                                                 if isinstance(v, str | int | float)})
+
+
+STUDIES: tuple[Study, ...] = (
+    Study("monte-carlo", lambda p: "runs_per_second" in p and "campaign" in p, _monte_carlo,
+          lambda p, path: f"att-mc {p['campaign']} --runs {p['requested']} --workers {p['workers']} "
+                          f"--json {path}"),
+    Study("smooth", lambda p: {"N", "W", "alpha"} <= p.keys(), _smooth,
+          _cmd("att-bench smooth --case {case} --json {path}")),
+    Study("schedule", lambda p: "experiment" in p, _schedule,
+          _cmd("att-bench schedule --experiment {experiment} --json {path}")),
+    Study("sky", lambda p: isinstance(p.get("plans"), dict) and {"frozen", "moving"} <= p["plans"].keys(), _sky,
+          _cmd("att-bench sky --case {case} --json {path}")),
+    Study("time-optimal", lambda p: {"case", "tf", "torque", "verification"} <= p.keys(), _time_optimal,
+          _cmd("att-bench time-optimal --case {case} --json {path}")),
+    Study("speed", lambda p: "cases" in p and "targets" in p, _speed, _cmd("att-bench speed --ros --json {path}")),
+    Study("estimation", lambda p: "nees_mean" in p, _estimation, _cmd("att-bench estimation --json {path}")),
+    Study("momentum", lambda p: "dumping" in p and "no_dumping" in p, _momentum,
+          _cmd("att-bench momentum --in-process --orbits {orbits:g} --json {path}")),
+    Study("observe", lambda p: "zone_cost_ratio" in p, _observe, _cmd("att-bench observe --json {path}")),
+    Study("day", lambda p: "observed" in p and "missed" in p, _day, _cmd("att-bench day --json {path}")),
+    Study("timing", lambda p: "closed_sky" in p, _timing, _cmd("att-bench timing --json {path}")),
+    Study("logtools", lambda p: "tools" in p and "allowed_exits" in p, _logtools,
+          _cmd("att-bench logtools --json {path}")),
+    Study("flood", lambda p: "growth_mib" in p, _flood, _cmd("att-bench flood --messages {messages} --json {path}")),
+    Study("gains", lambda p: p.get("mode") in ("fixed", "robust") and "kp" in p, _gains,
+          _cmd("att-bench gains --mode {mode} --json {path}")),
+    Study("soak", lambda p: "dropped_state" in p, _soak, _cmd("att-bench soak --json {path}")),
+)
+BY_NAME = {s.name: s for s in STUDIES}
+
+
+def detect(payload: dict) -> Study:
+    """The one study whose JSON ``payload`` is; a :class:`HistoryError` when none or several match."""
+    found = [s for s in STUDIES if s.detect(payload)]
+    if len(found) != 1:
+        what = "no study" if not found else "several studies (" + ", ".join(s.name for s in found) + ")"
+        raise HistoryError(f"the JSON matches {what}; name it with --study (one of {', '.join(BY_NAME)})")
+    return found[0]
+
+
+def load_json(path: str | Path) -> dict:
+    """A study's JSON object from ``path``, refused with a sentence when it is not one."""
+    try:
+        text = Path(path).read_text()
+    except OSError as exc:
+        raise HistoryError(f"{path}: cannot be read ({exc.strerror or exc})") from None
+    try:
+        payload = json.loads(text)
+    except json.JSONDecodeError as exc:
+        raise HistoryError(f"{path}: not JSON (line {exc.lineno}: {exc.msg})") from None
+    if not isinstance(payload, dict):
+        raise HistoryError(f"{path}: expected a JSON object, found {type(payload).__name__}")
+    return payload
+
+
+def machine_of(payload: dict) -> tuple[dict | None, float | None]:
+    """The machine a JSON names and its 1-min load (at the end of the run when both ends are recorded)."""
+    machine = payload.get("machine")
+    if not isinstance(machine, dict):
+        return None, None
+    load = machine.get("load_1min")
+    if load is None and isinstance(machine.get("load_after"), list) and machine["load_after"]:
+        load = machine["load_after"][0]
+    kept = {k: machine[k] for k in ("cores", "python", "omp_num_threads") if k in machine}
+    return kept or None, (float(load) if isinstance(load, int | float) else None)
+
+
+def line(payload: dict, *, study: str | None = None, case: str | None = None, json_path: str | None,
+         command: str | None = None, date: str, commit: str | None, source: str,
+         machine: dict | None = None, load_1min: float | None = None) -> dict:
+    """The history line of one run: ``payload`` (a study's JSON) summarised and its provenance."""
+    if study is not None and study not in BY_NAME:
+        raise HistoryError(f"unknown study '{study}': expected one of {', '.join(BY_NAME)}")
+    kind = BY_NAME[study] if study else detect(payload)
+    s = kind.summarise(payload, case)
+    json_machine, json_load = machine_of(payload)
+    return {"study": kind.name, "case": s.case, "metric": s.metric, "value": s.value, "unit": s.unit,
+            "target": s.target, "met": s.met, "metrics": s.metrics, "date": date, "commit": commit,
+            "machine": json_machine or machine, "load_1min": json_load if json_load is not None else load_1min,
+            "command": command or kind.command(payload, json_path or "PATH"), "json": json_path, "source": source}
+
+
+def read(path: str | Path = HISTORY) -> list[dict]:
+    """Every line of a history file, each checked to carry :data:`FIELDS`."""
+    rows = []
+    for n, text in enumerate(Path(path).read_text().splitlines(), 1):
+        if not text.strip():
+            continue
+        try:
+            row = json.loads(text)
+        except json.JSONDecodeError as exc:
+            raise HistoryError(f"{path}:{n}: not JSON ({exc.msg})") from None
+        missing = [f for f in FIELDS if not isinstance(row, dict) or f not in row]
+        if missing:
+            raise HistoryError(f"{path}:{n}: a history line needs {', '.join(missing)}")
+        rows.append(row)
+    return rows
+
+
+def append(row: dict, path: str | Path = HISTORY) -> None:
+    """Append ``row`` as one JSON line (keys in :data:`FIELDS` order; NaN and infinity refused)."""
+    text = json.dumps({k: row[k] for k in FIELDS}, ensure_ascii=False, allow_nan=False)
+    with open(path, "a") as fh:
+        fh.write(text + "\n")
+
+
+def latest(rows: list[dict]) -> dict[tuple[str, str], dict]:
+    """The last line of each (study, case), in the order the pairs first appear."""
+    out: dict[tuple[str, str], dict] = {}
+    for row in rows:
+        out[(row["study"], row["case"])] = row
+    return out
+
+
+def head_commit() -> str | None:
+    """The short hash of the checkout's HEAD (``+`` when the tree has changes), or ``None`` outside git."""
+    try:
+        commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True,
+                                check=True).stdout.strip()
+        dirty = subprocess.run(["git", "status", "--porcelain", "--untracked-files=no"], capture_output=True,
+                               text=True, check=True).stdout.strip()
+    except (OSError, subprocess.CalledProcessError):
+        return None
+    return commit + ("+" if dirty else "")
+
+
+def configure(parser) -> None:
+    parser.add_argument("--append", metavar="JSON", required=True, help="the JSON a study wrote")
+    parser.add_argument("--study", choices=sorted(BY_NAME), help="the study that wrote it (default: from its keys)")
+    parser.add_argument("--case", help="the case's name in the history (default: from the JSON)")
+    parser.add_argument("--command", help="the command that wrote the JSON (default: the study's usual one)")
+    parser.add_argument("--history", default=str(HISTORY), help="the history file (default: %(default)s)")
+    parser.add_argument("--no-json", action="store_true", help="the JSON is not kept in the repository")
+
+
+def run(args) -> int:
+    """Append the summary line of ``args.append`` to ``args.history``; 2 with a sentence when refused.
+
+    The line's date and commit are the run's when its JSON names them (``machine.date``,
+    ``machine.commit``, written by ``att-bench``), else the time of the append and the checkout's HEAD.
+    """
+    try:
+        payload = load_json(args.append)
+        ran = payload.get("machine") if isinstance(payload.get("machine"), dict) else {}
+        date = ran.get("date")
+        if date is not None:
+            try:
+                datetime.strptime(date, DATE_FORMAT)
+            except (TypeError, ValueError):
+                raise HistoryError(f"'machine.date' must be a UTC time like 2026-12-05T01:26:04Z, "
+                                   f"found {date!r}") from None
+        row = line(payload, study=args.study, case=args.case, json_path=None if args.no_json else args.append,
+                   command=args.command, date=date or datetime.now(UTC).strftime(DATE_FORMAT),
+                   commit=ran.get("commit") or head_commit(), source="json")
+        append(row, args.history)
+    except (HistoryError, ValueError) as exc:
+        print(f"att-bench history: {exc}")
+        return 2
+    met = {True: "met", False: "NOT met", None: "no target"}[row["met"]]
+    print(f"{row['study']} {row['case']}: {row['metric']} {row['value']:.6g} {row['unit']} ({met}) -> {args.history}")
+    return 0
