@@ -37,6 +37,7 @@ from att_msgs_py.errors import ConfigError, ErrorCode
 
 MAX_FILE_BYTES = 1_000_000     # a configuration file is a few kB
 MAX_DEPTH = 32                 # nesting of mappings and lists
+MAX_NODES = 100_000            # values of a file, aliases expanded
 MAX_PROBLEMS = 100             # problems reported for one file (then: "and N more")
 MAX_FOUND = 80                 # characters of a found value quoted in a problem
 
@@ -113,8 +114,12 @@ class _Refused(Exception):
 class _NoAliasLoader(yaml.SafeLoader):
     """PyYAML's safe loader that refuses anchors and aliases while it composes (before any expansion)."""
 
+    aliases = False            # True: anchors and aliases composed (shared nodes), their expansion bounded
+
     def compose_node(self, parent, index):
         event = self.peek_event()
+        if self.aliases:
+            return super().compose_node(parent, index)
         if isinstance(event, yaml.AliasEvent):
             raise _Refused(event.start_mark.line + 1, "", "no YAML aliases (write the value out)",
                            f"the alias *{event.anchor}")
@@ -139,9 +144,14 @@ class _Walk:
     def __init__(self, loader: yaml.SafeLoader):
         self.loader = loader
         self.lines: dict[tuple, int] = {}
+        self.visits = 0
 
     def value(self, node, path: tuple):
         line = node.start_mark.line + 1
+        self.visits += 1
+        if self.visits > MAX_NODES:            # aliases expanding into more values than a file holds: a bomb
+            raise _Refused(line, field_path(path), f"at most {MAX_NODES} values once aliases are expanded",
+                           "more (an alias bomb?)")
         self.lines.setdefault(path, line)
         if node.tag not in _STANDARD_TAGS:
             raise _Refused(line, field_path(path), "a plain YAML value (no tags)", f"the tag {node.tag}")
@@ -168,10 +178,12 @@ class _Walk:
         return self.loader.construct_object(node)
 
 
-def read_yaml(path: Path, max_bytes: int = MAX_FILE_BYTES) -> tuple[dict, dict]:
+def read_yaml(path: Path, max_bytes: int = MAX_FILE_BYTES, aliases: bool = False) -> tuple[dict, dict]:
     """The root mapping of the YAML file ``path`` and the line of each field path in it;
     :class:`ConfigFileError` for a file that cannot be read, is too large, is not UTF-8, is not
-    YAML, uses aliases, anchors, tags or duplicate keys, or whose root is not a mapping."""
+    YAML, uses anchors and aliases (unless ``aliases``: then accepted up to :data:`MAX_NODES` values
+    expanded, as ``yaml.safe_dump`` writes an object it meets twice), tags or duplicate keys, or whose
+    root is not a mapping."""
     name = str(path)
 
     def refuse(line, fld, expected, found):
@@ -192,10 +204,10 @@ def read_yaml(path: Path, max_bytes: int = MAX_FILE_BYTES) -> tuple[dict, dict]:
     except UnicodeDecodeError as exc:
         raise refuse(raw[: exc.start].count(b"\n") + 1, "", "UTF-8 text",
                      f"the byte 0x{raw[exc.start]:02x} at offset {exc.start}") from None
-    return parse_yaml(text, name)
+    return parse_yaml(text, name, aliases)
 
 
-def parse_yaml(text: str, name: str) -> tuple[dict, dict]:
+def parse_yaml(text: str, name: str, aliases: bool = False) -> tuple[dict, dict]:
     """The root mapping of the YAML ``text`` (of the file ``name``) and the line of each field path
     in it; :class:`ConfigFileError` as :func:`read_yaml`."""
 
@@ -205,6 +217,7 @@ def parse_yaml(text: str, name: str) -> tuple[dict, dict]:
     if not text.strip() or all(not ln.strip() or ln.lstrip().startswith("#") for ln in text.splitlines()):
         raise refuse(1, "", "a mapping of keys", "an empty file")
     loader = _NoAliasLoader(text)
+    loader.aliases = aliases
     try:
         node = loader.get_single_node()
         if node is None:

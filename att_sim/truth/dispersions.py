@@ -1,7 +1,8 @@
 """Monte Carlo campaigns: the dispersed truth of one run, drawn from its seed.
 
-A campaign file (YAML, ``yaml.safe_load``; one mapping ``campaign:``) names a scenario and declares
-how the truth departs from the model the plan was made with::
+A campaign file (YAML read by :func:`att_sim.models.config_files.read_yaml`; one mapping
+``campaign:``) names a scenario and declares how the truth departs from the model the plan was made
+with::
 
     campaign:
       scenario: swift_demo          # a scenario name: a file stem under config/ or $ATT_CONFIG_PATH
@@ -41,9 +42,9 @@ from datetime import timedelta
 from pathlib import Path
 
 import numpy as np
-import yaml
 from scipy.special import ndtr, ndtri
 
+from att_sim.models import config_files
 from att_sim.models import rotations as rot
 from att_sim.models import scenario as scen
 from att_sim.models.actuator_specs import MagnetorquerSpec, WheelDriveSpec
@@ -154,12 +155,13 @@ def load_campaign(path) -> Campaign:
     """The campaign file at ``path`` (ValueError: one sentence naming the file and the field)."""
     path = Path(path)
     try:
-        if path.stat().st_size > MAX_FILE_BYTES:
-            raise ValueError(f"{path.stat().st_size} bytes; a campaign file has at most {MAX_FILE_BYTES}")
-        with open(path, encoding="utf-8") as fh:
-            return campaign_from(yaml.safe_load(fh), path)
-    except (OSError, UnicodeDecodeError, yaml.YAMLError) as exc:
-        raise ValueError(f"campaign {path}: cannot be read ({' '.join(str(exc).split())[:200]})") from None
+        doc = config_files.read_yaml(path, MAX_FILE_BYTES, aliases=True)[0]
+    except config_files.ConfigFileError as err:
+        p = err.problems[0]
+        raise ValueError(f"campaign {path}: cannot be read ({f'line {p.line}: ' if p.line else ''}{p.expected} "
+                         f"expected, found {p.found[:200]})") from None
+    try:
+        return campaign_from(doc, path)
     except ValueError as exc:
         raise ValueError(f"campaign {path}: {exc}") from None
 

@@ -274,3 +274,22 @@ def test_all_problems_of_a_file_at_once(tmp_path):
     assert [(p.line, p.field) for p in problems] == [
         (6, f"{SC}.torque_max"), (10, f"{P}.orbit.altitude_m"), (20, f"{P}.sensors.seed"),
         (25, f"{P}.sensors.magnetometer.noise_nT")]
+
+
+def test_the_scenario_reader_refuses_duplicate_keys_and_alias_bombs(tmp_path):
+    """scenario.load reads through the same guards: a duplicate key or an alias bomb is a ConfigError
+    naming the file and the line, never a silent last value or gigabytes of memory."""
+    from att_msgs_py.errors import ConfigError
+    from att_sim.models import scenario
+    twice = tmp_path / "twice.yaml"
+    twice.write_text("/**:\n  ros__parameters:\n    frame_id: eci\n    frame_id: gcrs\n")
+    with pytest.raises(ConfigError, match=r"twice.yaml: line 4: /\*\*.ros__parameters.frame_id: expected each key "
+                                          r"once in a mapping"):
+        scenario.load(str(twice))
+    bomb = tmp_path / "bomb.yaml"
+    levels = "a: &a [" + ", ".join(["lol"] * 10) + "]\n"
+    for name, below in zip("bcdefgh", "abcdefg"):          # 10^8 values once expanded, 600 bytes written
+        levels += f"{name}: &{name} [" + ", ".join([f"*{below}"] * 10) + "]\n"
+    bomb.write_text(levels)
+    with pytest.raises(ConfigError, match="alias bomb"):
+        scenario.load(str(bomb))

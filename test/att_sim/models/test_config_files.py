@@ -127,3 +127,16 @@ def test_yaml_12_exponents_are_numbers(tmp_path):
     path.write_text("name: 1e3\n")
     with pytest.raises(cf.ConfigFileError, match="name: expected a valid string; found 1000.0"):
         cf.load_file(path, Craft)
+
+
+def test_aliases_when_asked_are_bounded(tmp_path):
+    """A reader of files written by yaml.safe_dump accepts its anchors; an alias bomb stays refused."""
+    path = tmp_path / "a.yaml"
+    path.write_text("a: &x [1, 2]\nb: *x\n")
+    assert cf.read_yaml(path, aliases=True)[0] == {"a": [1, 2], "b": [1, 2]}
+    bomb = "a: &a [" + ", ".join(["x"] * 10) + "]\n"
+    for name, below in zip("bcdefg", "abcdef"):
+        bomb += f"{name}: &{name} [" + ", ".join([f"*{below}"] * 10) + "]\n"
+    path.write_text(bomb)
+    with pytest.raises(cf.ConfigFileError, match="alias bomb"):
+        cf.read_yaml(path, aliases=True)
