@@ -254,6 +254,14 @@ def free_running(s) -> None:
                "the simulator going free-running without a controller", node=s.client)
 
 
+def commanding(s, states, *publishers) -> None:
+    """Wait until every command publisher is matched to the simulator and the client has received a
+    state: the hostile commands are stamped from the latest state's time, and before the first one
+    that time reads 0, so that ``now() + 10`` (meant to be ahead) would be a valid command at t = 10."""
+    wait_until(lambda: all(p.get_subscription_count() > 0 for p in publishers) and len(states) > 0, 30,
+               "the command publishers matched and a state received", node=s.client)
+
+
 def command_msg(t: float, **fields) -> ActuatorCommand:
     base = dict(t=t, dipole=np.zeros(3), wheel_torques=np.array([0.05, 0.0, 0.0]))
     return convert.command_msg(good_command(**{**base, **fields}))
@@ -278,7 +286,7 @@ def test_hostile_commands_are_refused_states_flow_and_refusals_are_throttled(lon
     s, states, now = lonely_sim
     free_running(s)
     pub = s.client.create_publisher(ActuatorCommand, topics.COMMAND, qos.STREAM_QOS)
-    spin_for(s.client, 1.0)                                     # discovery
+    commanding(s, states, pub)
     hostile = [lambda: command_msg(1e6), lambda: command_msg(now() + 10.0),
                lambda: command_msg(now(), frame_id="map"), lambda: command_msg(now(), wheel_torques=np.full(3, 1e30)),
                lambda: command_msg(now(), wheel_torques=np.zeros(7)), lambda: command_msg(now(), mode=42),
@@ -316,7 +324,7 @@ def test_a_command_answering_a_state_resumes_the_lockstep(lonely_sim):
     s, states, now = lonely_sim
     free_running(s)
     pub = s.client.create_publisher(ActuatorCommand, topics.COMMAND, qos.STREAM_QOS)
-    spin_for(s.client, 1.0)
+    commanding(s, states, pub)
     answered = set()
 
     def answer_latest():
@@ -343,6 +351,7 @@ def test_a_late_command_of_the_controller_makes_the_simulator_wait_for_it(lonely
     log = lambda: s.suite.log_text("simulator")      # noqa: E731
     pub = s.client.create_publisher(ActuatorCommand, topics.COMMAND, qos.STREAM_QOS)
     stranger = s.client.create_publisher(ActuatorCommand, topics.COMMAND, qos.STREAM_QOS)
+    commanding(s, states, pub, stranger)
     answered = set()
 
     def answer_latest():                             # the controller: commands accepted, so it is held

@@ -48,10 +48,26 @@ def client_for(scheduler: str | None, workers: int, timeout: float):
         return
     import dask
 
-    with dask.config.set(QUIET), LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
-                                              dashboard_address=None, silence_logs=40,
-                                              env={"OMP_NUM_THREADS": "1"}) as cluster, Client(cluster) as client:
+    with environment_kept(), dask.config.set(QUIET), \
+            LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None,
+                         silence_logs=40, env={"OMP_NUM_THREADS": "1"}) as cluster, Client(cluster) as client:
         yield client
+
+
+@contextmanager
+def environment_kept():
+    """This process's environment as it was on entry, put back on exit. A Dask nanny writes its
+    workers' ``distributed.nanny.pre-spawn-environ`` (``MALLOC_TRIM_THRESHOLD_=65536``,
+    ``OMP_NUM_THREADS``, ...) into its parent's ``os.environ`` before each spawn
+    (``distributed/nanny.py``), where every process started later (nodes, tools, tests) would
+    inherit settings meant for the workers."""
+    saved = dict(os.environ)
+    try:
+        yield
+    finally:
+        for name in set(os.environ) - set(saved):
+            del os.environ[name]
+        os.environ.update(saved)
 
 
 def fly_chunk(setup: Setup, seeds: list[tuple[int, int]]) -> list[dict]:

@@ -8,6 +8,7 @@ from __future__ import annotations
 import csv
 import json
 import math
+import os
 import socket
 import time
 from dataclasses import replace
@@ -64,9 +65,11 @@ def assert_same_row(row: dict, expected: dict) -> None:
 @pytest.mark.slow
 def test_a_20_run_campaign_on_a_local_dask_cluster_is_reproduced_from_its_seeds(tmp_path, setup, capsys):
     out = tmp_path / "mc"
+    environment = dict(os.environ)
     code = mc.main([str(CAMPAIGN), "--workers", "2", "--out", str(out), "--json", str(tmp_path / "mc.json"),
                     "--no-progress"])
     assert code == 0, capsys.readouterr().err
+    assert dict(os.environ) == environment        # the nannies' worker settings did not stay in this process
     summary = json.loads((tmp_path / "mc.json").read_text())
     assert summary["runs"] == summary["requested"] == 20 and summary["workers"] == 2 and not summary["interrupted"]
     assert summary["runs_per_second"] == pytest.approx(20 / summary["wall_seconds"])
