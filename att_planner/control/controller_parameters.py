@@ -26,7 +26,8 @@ _KEY_RULE = "plan_signing.pub in the suite's key directory ($ATT_KEY_DIR, see at
 
 CONTROLLER = ParameterTable("controller", (
     Parameter("state_source", str, None, "the state the controller flies on: the simulator's truth or the "
-                                         "estimator's estimate", choices=STATE_SOURCES,
+                                         "estimator's estimate (with wheels, estimate needs tachometers)",
+              choices=STATE_SOURCES,
               default_rule="estimate when the scenario has a gyro, else truth"),
     Parameter("friction_compensation", bool, None, "add the wheel drives' modelled friction to the wheel commands",
               default_rule="true when the scenario's wheels have friction"),
@@ -40,9 +41,12 @@ CONTROLLER = ParameterTable("controller", (
               0.0, INF),
     Parameter("tracking_kd", float, _C.tracking_kd, "rate feedback gain around the plan reference", "N m s/rad",
               0.0, INF),
-    Parameter("kp", float, _C.kp, "attitude gain of the magnetorquer PD-like law (Bruni & Celani)", "", 0.0, INF),
-    Parameter("kd", float, _C.kd, "rate gain of the magnetorquer PD-like law (Bruni & Celani)", "", 0.0, INF),
-    Parameter("m_max", float, None, "dipole limit per magnetorquer coil the laws command", "A m^2", 0.0,
+    Parameter("kp", float, _C.kp, "attitude gain of the magnetorquer PD-like law (Bruni & Celani)", "A m^2/T",
+              0.0, INF),
+    Parameter("kd", float, _C.kd, "rate gain of the magnetorquer PD-like law (Bruni & Celani)", "A m^2 s/(T rad)",
+              0.0, INF),
+    Parameter("m_max", float, None, "dipole limit per magnetorquer coil the laws command (capped at the "
+                                   "spacecraft's dipole_max)", "A m^2", 0.0,
               low_open=True, refusal="expected a dipole > 0 A m²", allow_inf=True,
               default_rule="the spacecraft's dipole_max"),
     Parameter("safe_kd", float, None, "rate damping gain of the safe mode", "N m s/rad", 0.0, INF,

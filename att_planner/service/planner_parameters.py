@@ -29,7 +29,7 @@ PLANNER = ParameterTable("planner", (
     Parameter("signing_key", str, None, "Ed25519 private key file the plans are signed with",
               default_rule="plan_signing.key in the suite's key directory ($ATT_KEY_DIR, see att-keygen)"),
     Parameter("max_parallel_solves", int, 2, "plans solved at once (worker processes)", "", 1, 64),
-    Parameter("plan_markers", bool, True, "publish each plan's path as markers for the 3D view"),
-    Parameter("warm_up_scenarios", str, None, "comma-separated scenarios whose demo maneuvers every worker plans "
-                                              "before it serves", default_rule="the scenario"),
+    Parameter("plan_markers", bool, True, "publish each plan's boresight path on /planner/plan_markers (the 3D view)"),
+    Parameter("warm_up_scenarios", str, None, "comma-separated scenarios whose demo maneuvers every worker "
+                                              "plans before the node serves ('': none)", default_rule="the scenario"),
 ), "the maneuver planner: the plan_maneuver and plan_schedule services")
