@@ -51,9 +51,9 @@ CONTROLLER = ParameterTable("controller", (
               default_rule="the spacecraft's dipole_max"),
     Parameter("safe_kd", float, None, "rate damping gain of the safe mode", "N m s/rad", 0.0, INF,
               default_rule="tracking_kd"),
-    Parameter("max_cached_plans", int, _C.max_cached_plans, "plans kept for execution", "", 1, 10_000),
-    Parameter("max_cache_mb", float, _C.max_cache_bytes / 2**20, "serialized plans kept, in total", "MiB",
-              0.0, 4096.0, low_open=True),
+    Parameter("max_cached_plans", int, _C.max_cached_plans, "most plans kept for execution", "", 1, 10_000),
+    Parameter("max_cache_mb", float, _C.max_cache_bytes / 2**20, "largest total size of the plans kept, serialized",
+              "MiB", 0.0, 4096.0, low_open=True),
     Parameter("safe_rate_threshold", float, _C.safe_rate_threshold, "body rate above which the controller, "
                                                                     "starting, damps it first (safe mode)", "rad/s",
               0.0, 10.0, low_open=True),
@@ -80,7 +80,8 @@ CONTROLLER = ParameterTable("controller", (
     Parameter("max_state_gap", float, _G.max_state_gap, "largest sim time between consecutive accepted states", "s",
               0.0, 3600.0, low_open=True),
     Parameter("max_clock_skew", float, _G.max_clock_skew, "largest difference between a state's stamp and the "
-                                                          "node's clock", "s", 0.0, 3600.0, low_open=True),
+                                                          "/clock of the state's publisher", "s", 0.0, 3600.0,
+              low_open=True),
     Parameter("resync_timeout", float, _G.resync_timeout, "wall time without an accepted state after which the "
                                                           "held publisher's stamps may jump", "s", 0.0, 3600.0,
               low_open=True),

@@ -13,8 +13,8 @@ PLANNER = ParameterTable("planner", (
     Parameter("default_method", str, "", "planning method of a request that names none ('': the best available)",
               choices=("", *methods.METHODS),
               refusal=f"expected '' (the best) or one of {', '.join(methods.METHODS)}"),
-    Parameter("time_budget", float, 20.0, "compute time of a request that gives 0", "s", 0.0, MAX_TIME_BUDGET,
-              low_open=True),
+    Parameter("time_budget", float, 20.0, "wall-time budget of a request whose time_budget is 0", "s",
+              0.0, MAX_TIME_BUDGET, low_open=True),
     Parameter("accept_attitude_error_deg", float, math.degrees(TOLERANCES.attitude), "largest final attitude error "
                                                                                      "of an accepted plan", "deg",
               0.0, 180.0, low_open=True),
