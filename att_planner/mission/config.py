@@ -24,8 +24,10 @@ a ground site is tracked through its dwell with the controller's ``ground`` poin
 list's) above it. An Earth-observation mission drops the scenario's Earth-limb zone of the payload
 (``zones``): its payload looks at the Earth.
 
-Every key is checked; a bad file is refused with a :class:`~att_msgs_py.errors.ConfigError` naming
-the file and the key.
+Every key is checked against :class:`att_planner.mission.schema.Mission` (its ranges and defaults)
+by :mod:`att_sim.models.config_files`; a bad file is refused with a
+:class:`~att_sim.models.config_files.ConfigFileError` naming the file, the line and the key of
+every problem; then the target list, its scenario and the zones named are resolved.
 """
 from __future__ import annotations
 
@@ -36,18 +38,13 @@ from pathlib import Path
 import numpy as np
 
 from att_msgs_py.errors import ConfigError, ErrorCode, clip
-from att_msgs_py.types import SECONDARY_KINDS
 from att_planner.mission import targets as target_lists
 from att_planner.mission.ground import GroundTrack, site_mode
 from att_planner.mission.scheduler import MissionTarget
+from att_planner.mission.schema import Mission
+from att_sim.models import config_files
 from att_sim.models import scenario as scen
 
-# key -> (default, low, high); None default: required
-NUMBERS = {"horizon_s": (None, 60.0, 7 * 86_400.0), "margin_deg": (1.0, 0.0, 30.0), "rate_hz": (5.0, 0.5, 50.0),
-           "start_lead_s": (240.0, 1.0, 3600.0), "time_budget_s": (10.0, 0.05, 600.0),
-           "pointing_tolerance_deg": (0.05, 1e-4, 10.0), "handover_blend_s": (60.0, 0.0, 3600.0)}
-KEYS = ("targets", "sensor_axis", "method", "momentum_dumping", "rate_max_deg_per_s", "zones", "secondary",
-        "secondary_axis", *NUMBERS)
 GYROSCOPIC_SHARE = 0.8        # of the wheels' torque margin over the planning limit the gyroscopic torque may take
 
 
@@ -111,74 +108,34 @@ def _invalid(path, message: str) -> ConfigError:
 
 
 def load(name: str) -> MissionConfig:
-    """The mission ``name`` (:func:`find`), every key checked (module docstring)."""
+    """The mission ``name`` (:func:`find`): the file checked against :class:`Mission`, then the names it
+    refers to resolved (module docstring)."""
     path = find(name)
-    doc = scen.read_document(path)
-    if not isinstance(doc, dict):
-        raise _invalid(path, f"the file is not a mapping of {', '.join(KEYS)}")
-    unknown = sorted(str(k) for k in set(doc) - set(KEYS))
-    if unknown:
-        raise _invalid(path, f"unknown key(s) {clip(', '.join(unknown), 120)} (known: {', '.join(KEYS)})")
-    numbers = {}
-    for key, (default, low, high) in NUMBERS.items():
-        value = doc.get(key, default)
-        ok = isinstance(value, (int, float)) and not isinstance(value, bool) and low <= value <= high
-        if not ok:
-            raise _invalid(path, f"{key} = {clip(repr(value), 60)} is not a number in [{low:g}, {high:g}]"
-                                 + (" (required)" if default is None and key not in doc else ""))
-        numbers[key] = float(value)
-    if not isinstance(doc.get("targets"), str):
-        raise _invalid(path, f"targets = {clip(repr(doc.get('targets')), 60)} is not the name of a target list")
+    m = config_files.load_file(path, Mission).model
     try:
-        target_list = target_lists.load(doc["targets"])
+        target_list = target_lists.load(m.targets)
     except KeyError as err:
         raise _invalid(path, f"targets: {err.args[0]}") from None
-    vec = _unit_axis(path, doc, "sensor_axis", doc.get("sensor_axis"))
-    second = _unit_axis(path, doc, "secondary_axis", doc.get("secondary_axis", target_lists.next_axis(vec).tolist()))
-    if np.linalg.norm(np.cross(vec, second)) < 1e-3:
-        raise _invalid(path, f"secondary_axis = {clip(repr(doc.get('secondary_axis')), 60)} is parallel to sensor_axis")
-    secondary = doc.get("secondary", "velocity")
-    if secondary not in SECONDARY_KINDS or secondary == "inertial":
-        raise _invalid(path, f"secondary = {clip(repr(secondary), 60)} is not one of "
-                             f"{', '.join(k for k in SECONDARY_KINDS if k != 'inertial')}")
-    method = doc.get("method", "")
-    if not isinstance(method, str) or not method.isprintable() or len(method) > 64:
-        raise _invalid(path, f"method = {clip(repr(method), 60)} is not a method name")
-    dumping = doc.get("momentum_dumping", True)
-    if not isinstance(dumping, bool):
-        raise _invalid(path, f"momentum_dumping = {clip(repr(dumping), 60)} is not true or false")
+    vec = np.asarray(m.sensor_axis, float)
+    second = (np.asarray(m.secondary_axis, float) if m.secondary_axis is not None
+              else target_lists.next_axis(vec))
     scenario = scen.load_checked(target_list.scenario)
-    rate = doc.get("rate_max_deg_per_s")
-    if rate is None:
-        rate_max = gyroscopic_rate_limit(scenario.spacecraft)
-    elif isinstance(rate, (int, float)) and not isinstance(rate, bool) and 1e-4 <= rate <= 10.0:
-        rate_max = math.radians(rate)
-    else:
-        raise _invalid(path, f"rate_max_deg_per_s = {clip(repr(rate), 60)} is not a number in [0.0001, 10]")
+    rate_max = (gyroscopic_rate_limit(scenario.spacecraft) if m.rate_max_deg_per_s is None
+                else math.radians(m.rate_max_deg_per_s))
     if scenario.epoch is None:
         raise _invalid(path, f"scenario '{scenario.name}' has no epoch: a mission flies the real sky")
-    return MissionConfig(path, target_list, scenario, vec, numbers["horizon_s"], math.radians(numbers["margin_deg"]),
-                         numbers["rate_hz"], numbers["start_lead_s"], numbers["time_budget_s"], method,
-                         math.radians(numbers["pointing_tolerance_deg"]), dumping, rate_max,
-                         _zones(path, doc, scenario), secondary, second, numbers["handover_blend_s"])
+    return MissionConfig(path, target_list, scenario, vec, m.horizon_s, math.radians(m.margin_deg), m.rate_hz,
+                         m.start_lead_s, m.time_budget_s, m.method, math.radians(m.pointing_tolerance_deg),
+                         m.momentum_dumping, rate_max, _zones(path, m.zones, scenario), m.secondary, second,
+                         m.handover_blend_s)
 
 
-def _unit_axis(path, doc: dict, key: str, axis) -> np.ndarray:
-    vec = np.asarray(axis, float) if isinstance(axis, list) and len(axis) == 3 and all(
-        isinstance(v, (int, float)) and not isinstance(v, bool) for v in axis) else None
-    if vec is None or not np.isfinite(vec).all() or abs(np.linalg.norm(vec) - 1.0) > 1e-6:
-        raise _invalid(path, f"{key} = {clip(repr(axis), 60)} is not a unit 3-vector (body axes)")
-    return vec
-
-
-def _zones(path, doc: dict, scenario) -> list:
-    """The scenario's zones named by ``zones`` (all of them without the key), each named once."""
-    names = doc.get("zones")
+def _zones(path, names: list | None, scenario) -> list:
+    """The scenario's zones named by ``zones`` (all of them without the key)."""
     known = [z.name for z in scenario.zones]
     if names is None:
         return list(scenario.zones)
-    if not isinstance(names, list) or not all(isinstance(n, str) and n in known for n in names) \
-            or len(set(names)) != len(names):
+    if not all(n in known for n in names):
         raise _invalid(path, f"zones = {clip(repr(names), 80)} is not a list of distinct zone names of scenario "
                              f"'{scenario.name}' ({', '.join(known) or 'none'})")
     return [z for z in scenario.zones if z.name in names]

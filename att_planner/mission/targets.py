@@ -31,14 +31,15 @@ import numpy as np
 
 from att_msgs_py.errors import ConfigError, ErrorCode, clip
 from att_msgs_py.limits import MAX_TARGETS  # as a PlanSchedule request
+from att_planner.mission import schema
 from att_sim.models import rotations as rot
 from att_sim.models import scenario as scen
+from att_sim.models.config_schema import declared
 
 KINDS = {"inertial": ("name", "ra_deg", "dec_deg", "dwell_s"),
          "ground": ("name", "lat_deg", "lon_deg", "alt_m", "dwell_s")}
 FILE_KEYS = {"inertial": ("kind", "scenario", "roll_reference", "targets"),
              "ground": ("kind", "scenario", "min_elevation_deg", "targets")}
-MAX_DWELL = 86_400.0                # s
 CELESTIAL_NORTH = np.array([0.0, 0.0, 1.0])
 
 
@@ -87,6 +88,12 @@ def _number(path, entry: dict, key: str, label: str, low: float, high: float) ->
     return number
 
 
+def _declared(path, entry: dict, key: str, label: str, model) -> float:
+    """``entry[key]`` (or the default ``model`` declares) checked against the range ``model`` declares."""
+    default, low, high = declared(model, key)[:3]
+    return _number(path, entry if default is None else {key: default, **entry}, key, label, low, high)
+
+
 def _target(path, kind: str, i: int, entry) -> Source | Site:
     label = f"targets[{i}]"
     if not isinstance(entry, dict):
@@ -101,16 +108,16 @@ def _target(path, kind: str, i: int, entry) -> Source | Site:
     if not isinstance(name, str) or not name or not name.isprintable() or len(name) > 128:
         raise _invalid(path, f"{label}.name = {clip(repr(name), 60)} is not a printable name of 1-128 characters")
     label = f"{label} ('{name}')"
-    dwell = _number(path, entry, "dwell_s", label, 0.0, MAX_DWELL)
+    model = schema.Source if kind == "inertial" else schema.Site
+
+    def number(key):
+        return _declared(path, entry, key, label, model)
+    dwell = number("dwell_s")
     if kind == "inertial":
-        ra = math.radians(_number(path, entry, "ra_deg", label, 0.0, 360.0))
-        dec = math.radians(_number(path, entry, "dec_deg", label, -90.0, 90.0))
+        ra, dec = math.radians(number("ra_deg")), math.radians(number("dec_deg"))
         return Source(name, np.array([math.cos(dec) * math.cos(ra), math.cos(dec) * math.sin(ra), math.sin(dec)]),
                       dwell)
-    lat = math.radians(_number(path, entry, "lat_deg", label, -90.0, 90.0))
-    lon = math.radians(_number(path, entry, "lon_deg", label, -180.0, 360.0))
-    alt = _number(path, {"alt_m": 0.0, **entry}, "alt_m", label, -500.0, 9000.0)
-    return Site(name, lat, lon, alt, dwell)
+    return Site(name, math.radians(number("lat_deg")), math.radians(number("lon_deg")), number("alt_m"), dwell)
 
 
 def config_file(folder: str, name: str, what: str) -> Path:
@@ -163,8 +170,7 @@ def load(name: str) -> TargetList:
             raise _invalid(path, f"roll_reference = {clip(repr(ref), 60)} is not a non-zero 3-vector")
         extra["roll_reference"] = vec / np.linalg.norm(vec)
     else:
-        extra["min_elevation"] = math.radians(_number(path, {"min_elevation_deg": 0.0, **doc}, "min_elevation_deg",
-                                                      "file", 0.0, 89.0))
+        extra["min_elevation"] = math.radians(_declared(path, doc, "min_elevation_deg", "file", schema.GroundTargets))
     return TargetList(path, kind, scenario, targets, **extra)
 
 

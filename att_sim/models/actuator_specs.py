@@ -18,6 +18,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from att_sim.models import config_schema as schema
 from att_sim.models.config_group import Group
 
 DEG = math.pi / 180.0
@@ -64,18 +65,14 @@ def actuators_from_params(values, label: str = "actuators") -> ActuatorSpecs:
     wheels = magnetorquers = None
     if "wheels" in g:
         w = g.group("wheels")
-        wheels = WheelDriveSpec(
-            coulomb_friction=w.number("coulomb_friction_Nm", 0.0, 0.0, 10.0),
-            viscous_friction=w.number("viscous_friction_Nm_s", 0.0, 0.0, 10.0),
-            friction_speed=w.number("friction_speed_rad_s", 1.0, 0.0, 1e3, low_open=True),
-            torque_quantization=w.number("torque_quantization_Nm", 0.0, 0.0, 10.0),
-            torque_noise=w.number("torque_noise_Nm", 0.0, 0.0, 10.0),
-            power_max=w.number("power_max_W", math.inf, 0.0, math.inf, low_open=True))
+        wheels = WheelDriveSpec(*(w.declared(schema.WheelDrives, key) for key in (
+            "coulomb_friction_Nm", "viscous_friction_Nm_s", "friction_speed_rad_s", "torque_quantization_Nm",
+            "torque_noise_Nm", "power_max_W")))
         w.done()
     if "magnetorquers" in g:
         m = g.group("magnetorquers")
-        magnetorquers = MagnetorquerSpec(quantization=m.number("quantization_Am2", 0.0, 0.0, 100.0),
-                                         misalignment=m.number("misalignment_deg", 0.0, 0.0, 10.0) * DEG)
+        magnetorquers = MagnetorquerSpec(quantization=m.declared(schema.Magnetorquers, "quantization_Am2"),
+                                         misalignment=m.declared(schema.Magnetorquers, "misalignment_deg") * DEG)
         m.done()
     g.read.update(("wheels", "magnetorquers"))
     g.done()

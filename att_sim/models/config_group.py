@@ -13,6 +13,8 @@ from collections.abc import Mapping
 
 import numpy as np
 
+from att_sim.models.config_schema import declared
+
 UNIT_TOLERANCE = 1e-3          # |‖v‖ − 1| accepted for a unit vector or quaternion (then normalised)
 
 
@@ -54,6 +56,12 @@ class Group:
         if math.isnan(x) or (math.isinf(x) and not (x > 0 and high == math.inf)) or not inside:
             raise ValueError(f"{self.field(key)} must be a number in {span}, got {_clip(v)}")
         return x
+
+    def declared(self, model, key: str, field: str | None = None) -> float:
+        """The number ``key`` with the default and range the pydantic ``model`` declares for its field
+        ``field`` (default: ``key``): :func:`att_sim.models.config_schema.declared`."""
+        default, low, high, low_open, high_open = declared(model, field or key)
+        return self.number(key, default, low, high, low_open=low_open, high_open=high_open)
 
     def numbers(self, key: str, default=None, size: int | None = None, multiple: int | None = None) -> np.ndarray:
         """A list of finite numbers (``size`` of them, or a multiple of ``multiple``)."""

@@ -4,7 +4,8 @@ A scenario file has a ``/**: ros__parameters:`` section shared by every node (th
 its orbit) and one section per node (``simulator``, ``controller``, ``planner``, ``recorder``); each
 node reads its section from the file named by its ``scenario`` parameter. This module reads the
 shared part without ROS, for the planner (which plans for any named spacecraft) and for tools.
-Files are read with ``yaml.safe_load`` only: nothing in them is ever evaluated.
+Files are read with :func:`att_sim.models.config_files.read_yaml` (PyYAML's safe loader: nothing in them
+is ever evaluated; tags, duplicate keys and alias bombs are refused).
 
 Keys of the shared part: ``frame_id``, ``body_frame_id``, ``spacecraft``, ``orbit`` and the real
 sky's (files without them fly the circular orbit and tilted dipole, the gravity gradient
@@ -30,7 +31,8 @@ import yaml
 from att_msgs_py import validation
 from att_msgs_py.errors import ConfigError, ErrorCode, RequestError, clip
 from att_msgs_py.types import ZONE_BODIES, Zone
-from att_sim.models import disturbances
+from att_sim.models import config_files, disturbances
+from att_sim.models import config_schema as schema
 from att_sim.models import epoch as epochs
 from att_sim.models import orbit as orbits
 from att_sim.models.actuator_specs import ActuatorSpecs, actuators_from_params
@@ -95,8 +97,8 @@ FIELD_MODELS = ("dipole", "igrf14")
 ENVIRONMENT_KEYS = ("gravity_gradient", "solar_pressure", "drag", "drag_coefficient", "residual_dipole", "facets")
 ZONE_KEYS = ("name", "body", "sensor_axis", "half_angle_deg", "keep_in", "direction")
 UNIT_TOLERANCE = 1e-3          # |‖v‖ − 1| accepted for a unit vector of a file (then normalised)
-DEFAULT_DRAG_COEFFICIENT = 2.2
-MAX_FILE_BYTES = 1_000_000     # a scenario file is a few kB
+DEFAULT_DRAG_COEFFICIENT = schema.Environment.model_fields["drag_coefficient"].default
+MAX_FILE_BYTES = config_files.MAX_FILE_BYTES
 
 
 def shared_params(doc: dict) -> dict:
@@ -367,23 +369,29 @@ def spacecraft_from_params(p: dict) -> Spacecraft:
 
 
 def orbit_from_params(p: dict) -> OrbitParams:
-    return OrbitParams(altitude=float(p.get("altitude", 450e3)),
-                       inclination=math.radians(float(p.get("inclination_deg", 87.0))),
-                       raan=math.radians(float(p.get("raan_deg", 0.0))),
-                       arg0=float(p.get("arg0", 0.0)))
+    """The circular orbit of an ``orbit`` group, defaults from :class:`att_sim.models.config_schema.CircularOrbit`."""
+    d = {key: info.default for key, info in schema.CircularOrbit.model_fields.items()}
+    return OrbitParams(altitude=float(p.get("altitude", d["altitude_m"])),
+                       inclination=math.radians(float(p.get("inclination_deg", d["inclination_deg"]))),
+                       raan=math.radians(float(p.get("raan_deg", d["raan_deg"]))),
+                       arg0=float(p.get("arg0", d["arg0_rad"])))
 
 
-def read_document(path: Path):
-    """The parsed YAML of a scenario file (ConfigError if it cannot be read or parsed)."""
+def read_document(path: Path) -> dict:
+    """The parsed YAML of a scenario file, read by :func:`att_sim.models.config_files.read_yaml` (size
+    cap before parsing; tags and duplicate keys refused; aliases as ``yaml.safe_dump`` writes them,
+    their expansion bounded); ConfigError if it cannot be read or parsed."""
     try:
-        if path.stat().st_size > MAX_FILE_BYTES:
-            raise _invalid(path, f"{path.stat().st_size} bytes; a scenario file has at most {MAX_FILE_BYTES}")
-        with open(path, encoding="utf-8") as fh:
-            return yaml.safe_load(fh)
-    except (OSError, UnicodeDecodeError) as exc:
-        raise _invalid(path, f"cannot be read ({clip(exc, 200)})") from None
-    except yaml.YAMLError as exc:
-        raise _invalid(path, f"is not valid YAML ({clip(' '.join(str(exc).split()), 200)})") from None
+        return config_files.read_yaml(Path(path), aliases=True)[0]
+    except config_files.ConfigFileError as err:
+        p = err.problems[0]
+        where = f"line {p.line}: " if p.line else ""
+        if p.expected == "valid YAML":
+            raise _invalid(path, f"is not valid YAML ({where}{clip(p.found, 200)})") from None
+        if p.expected in ("a readable file", "UTF-8 text"):
+            raise _invalid(path, f"cannot be read ({where}{p.expected} expected, found {clip(p.found, 120)})") from None
+        field = f"{p.field}: " if p.field else ""
+        raise _invalid(path, f"{where}{field}expected {p.expected}; found {clip(p.found, 120)}") from None
 
 
 def load(name: str) -> Scenario:

@@ -29,13 +29,13 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from att_msgs_py.types import ZONE_BODIES
+from att_sim.models import config_schema as schema
 from att_sim.models.config_group import Group
 
 DEG = math.pi / 180.0
 ARCSEC = DEG / 3600.0
 HOUR = 3600.0
 NANOTESLA = 1e-9
-MAX_SENSOR_RATE = 1000.0        # Hz
 SENSOR_KINDS = ("seed", "gyro", "star_trackers", "magnetometer", "sun_sensors", "wheel_tachometer")
 EXCLUSION_BODIES = tuple(b for b in ZONE_BODIES)
 
@@ -127,21 +127,16 @@ class SensorSpecs:
         return any((self.gyro, self.star_trackers, self.magnetometer, self.sun_sensors, self.tachometer))
 
 
-def _rate(g: Group, default: float) -> float:
-    return g.number("rate_hz", default, 0.0, MAX_SENSOR_RATE, low_open=True)
-
-
 def gyro_from_params(g: Group) -> GyroSpec:
+    def n(key):
+        return g.declared(schema.Gyro, key)
     out = GyroSpec(
-        rate=_rate(g, GyroSpec.rate),
-        arw=g.number("arw_deg_per_sqrt_h", 0.0, 0.0, 100.0) * DEG / math.sqrt(HOUR),
-        bias_instability=g.number("bias_instability_deg_per_h", 0.0, 0.0, 1e4) * DEG / HOUR,
-        rrw=g.number("rrw_deg_per_h_per_sqrt_h", 0.0, 0.0, 1e4) * DEG / HOUR / math.sqrt(HOUR),
-        initial_bias=g.number("initial_bias_deg_per_h", 0.0, 0.0, 1e5) * DEG / HOUR,
-        scale_factor=g.number("scale_factor_ppm", 0.0, 0.0, 1e5) * 1e-6,
-        misalignment=g.number("misalignment_arcsec", 0.0, 0.0, 3600.0) * ARCSEC,
-        quantization=g.number("quantization_arcsec", 0.0, 0.0, 3600.0) * ARCSEC,
-        range=g.number("range_deg_per_s", math.inf, 0.0, math.inf, low_open=True) * DEG)
+        rate=n("rate_hz"), arw=n("arw_deg_per_sqrt_h") * DEG / math.sqrt(HOUR),
+        bias_instability=n("bias_instability_deg_per_h") * DEG / HOUR,
+        rrw=n("rrw_deg_per_h_per_sqrt_h") * DEG / HOUR / math.sqrt(HOUR),
+        initial_bias=n("initial_bias_deg_per_h") * DEG / HOUR, scale_factor=n("scale_factor_ppm") * 1e-6,
+        misalignment=n("misalignment_arcsec") * ARCSEC, quantization=n("quantization_arcsec") * ARCSEC,
+        range=n("range_deg_per_s") * DEG)
     g.done()
     return out
 
@@ -160,26 +155,24 @@ def exclusion_from_params(g: Group, epoch_known: bool) -> Exclusion:
 
 
 def star_tracker_from_params(g: Group, epoch_known: bool) -> StarTrackerSpec:
-    d = StarTrackerSpec()
+    def n(key):
+        return g.declared(schema.StarTracker, key)
     out = StarTrackerSpec(
-        name=g.name("name"), mounting=g.quaternion("mounting", [0.0, 0.0, 0.0, 1.0]),
-        rate=_rate(g, d.rate), latency=g.number("latency_s", 0.0, 0.0, 10.0),
-        cross_boresight=g.number("cross_boresight_arcsec", 5.0, 0.0, 3600.0, low_open=True) * ARCSEC,
-        about_boresight=g.number("about_boresight_arcsec", 40.0, 0.0, 36000.0, low_open=True) * ARCSEC,
-        max_rate=g.number("max_rate_deg_per_s", math.inf, 0.0, math.inf, low_open=True) * DEG,
+        name=g.name("name"), mounting=g.quaternion("mounting", schema.StarTracker.model_fields["mounting"].default),
+        rate=n("rate_hz"), latency=n("latency_s"), cross_boresight=n("cross_boresight_arcsec") * ARCSEC,
+        about_boresight=n("about_boresight_arcsec") * ARCSEC, max_rate=n("max_rate_deg_per_s") * DEG,
         exclusions=tuple(exclusion_from_params(e, epoch_known) for e in g.items("exclusions")))
     g.done()
     return out
 
 
 def magnetometer_from_params(g: Group) -> MagnetometerSpec:
+    def n(key):
+        return g.declared(schema.Magnetometer, key)
     out = MagnetometerSpec(
-        rate=_rate(g, MagnetometerSpec.rate),
-        noise=g.number("noise_nT", 0.0, 0.0, 1e5) * NANOTESLA,
-        bias=g.number("bias_nT", 0.0, 0.0, 1e5) * NANOTESLA,
-        misalignment=g.number("misalignment_deg", 0.0, 0.0, 10.0) * DEG,
-        quantization=g.number("quantization_nT", 0.0, 0.0, 1e4) * NANOTESLA,
-        dipole_coupling=g.number("dipole_coupling_nT_per_Am2", 0.0, 0.0, 1e5) * NANOTESLA)
+        rate=n("rate_hz"), noise=n("noise_nT") * NANOTESLA, bias=n("bias_nT") * NANOTESLA,
+        misalignment=n("misalignment_deg") * DEG, quantization=n("quantization_nT") * NANOTESLA,
+        dipole_coupling=n("dipole_coupling_nT_per_Am2") * NANOTESLA)
     g.done()
     return out
 
@@ -187,17 +180,18 @@ def magnetometer_from_params(g: Group) -> MagnetometerSpec:
 def sun_sensors_from_params(g: Group, epoch_known: bool) -> SunSensorSpec:
     if not epoch_known:
         raise ValueError(f"{g.label} needs the scenario's epoch (the Sun's position and the Earth's shadow)")
-    d = SunSensorSpec()
-    out = SunSensorSpec(normals=g.unit_vectors("normals", d.normals.ravel().tolist()), rate=_rate(g, d.rate),
-                        fov=g.number("fov_deg", 80.0, 0.0, 90.0, low_open=True) * DEG,
-                        noise=g.number("noise", 0.0, 0.0, 1.0))
+    out = SunSensorSpec(normals=g.unit_vectors("normals", schema.SunSensors.model_fields["normals"].default),
+                        rate=g.declared(schema.SunSensors, "rate_hz"),
+                        fov=g.declared(schema.SunSensors, "fov_deg") * DEG,
+                        noise=g.declared(schema.SunSensors, "noise"))
     g.done()
     return out
 
 
 def tachometer_from_params(g: Group) -> TachometerSpec:
-    out = TachometerSpec(rate=_rate(g, TachometerSpec.rate), noise=g.number("noise_rad_per_s", 0.0, 0.0, 100.0),
-                         quantization=g.number("quantization_rad_per_s", 0.0, 0.0, 100.0))
+    out = TachometerSpec(rate=g.declared(schema.WheelTachometer, "rate_hz"),
+                         noise=g.declared(schema.WheelTachometer, "noise_rad_per_s"),
+                         quantization=g.declared(schema.WheelTachometer, "quantization_rad_per_s"))
     g.done()
     return out
 

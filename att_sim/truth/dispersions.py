@@ -1,7 +1,8 @@
 """Monte Carlo campaigns: the dispersed truth of one run, drawn from its seed.
 
-A campaign file (YAML, ``yaml.safe_load``; one mapping ``campaign:``) names a scenario and declares
-how the truth departs from the model the plan was made with::
+A campaign file (YAML read by :func:`att_sim.models.config_files.read_yaml`; one mapping
+``campaign:``) names a scenario and declares how the truth departs from the model the plan was made
+with::
 
     campaign:
       scenario: swift_demo          # a scenario name: a file stem under config/ or $ATT_CONFIG_PATH
@@ -41,17 +42,18 @@ from datetime import timedelta
 from pathlib import Path
 
 import numpy as np
-import yaml
 from scipy.special import ndtr, ndtri
 
+from att_sim.models import config_files
 from att_sim.models import rotations as rot
 from att_sim.models import scenario as scen
 from att_sim.models.actuator_specs import MagnetorquerSpec, WheelDriveSpec
 from att_sim.models.config_group import Group
+from att_sim.truth import campaign_schema as schema
 from att_sim.truth.sensors import STREAMS
 
 DISPERSION_STREAM = 1000 + len(STREAMS)     # spawn_key (DISPERSION_STREAM, k): clear of the sensors' streams
-MAX_RUNS = 10_000_000
+MAX_RUNS = schema.MAX_RUNS
 MAX_FILE_BYTES = 100_000
 DEG = math.pi / 180.0
 
@@ -120,8 +122,8 @@ def distribution_from(g: Group) -> Distribution:
     mean = g.number("mean", 0.0)
     if ("sigma" in g) == ("three_sigma" in g):
         raise ValueError(f"{g.label} needs exactly one of sigma, three_sigma")
-    sigma = g.number("sigma", low=0.0) if "sigma" in g else g.number("three_sigma", low=0.0) / 3.0
-    truncate = g.number("truncate", math.inf, 0.0, math.inf, low_open=True)
+    sigma = g.declared(schema.Normal, "sigma") if "sigma" in g else g.declared(schema.Normal, "three_sigma") / 3.0
+    truncate = g.declared(schema.Normal, "truncate")
     g.done()
     return Distribution(kind, mean, sigma, truncate)
 
@@ -133,12 +135,12 @@ def campaign_from(doc, path: Path) -> Campaign:
         raise ValueError(f"a campaign file holds one mapping 'campaign:', got {keys[:120]}")
     g = Group(doc["campaign"], "campaign")
     name = g.name("scenario")
-    seed = g.number("seed", low=0, high=2**63 - 1)
-    runs = g.number("runs", 100, 1, MAX_RUNS)
+    seed = g.declared(schema.Campaign, "seed")
+    runs = g.declared(schema.Campaign, "runs")
     if seed != int(seed) or runs != int(runs):
         raise ValueError("campaign.seed and campaign.runs must be integers")
-    settle = g.number("settle_tolerance_deg", 0.01, 0.0, 180.0, low_open=True) * DEG
-    converge = g.number("converge_timeout", 30.0, 0.0, 3600.0, low_open=True)
+    settle = g.declared(schema.Campaign, "settle_tolerance_deg") * DEG
+    converge = g.declared(schema.Campaign, "converge_timeout", "converge_timeout_s")
     d = g.group("dispersions")
     unknown = sorted(str(k) for k in d.values if k not in DISPERSIONS)
     if unknown:
@@ -153,12 +155,13 @@ def load_campaign(path) -> Campaign:
     """The campaign file at ``path`` (ValueError: one sentence naming the file and the field)."""
     path = Path(path)
     try:
-        if path.stat().st_size > MAX_FILE_BYTES:
-            raise ValueError(f"{path.stat().st_size} bytes; a campaign file has at most {MAX_FILE_BYTES}")
-        with open(path, encoding="utf-8") as fh:
-            return campaign_from(yaml.safe_load(fh), path)
-    except (OSError, UnicodeDecodeError, yaml.YAMLError) as exc:
-        raise ValueError(f"campaign {path}: cannot be read ({' '.join(str(exc).split())[:200]})") from None
+        doc = config_files.read_yaml(path, MAX_FILE_BYTES, aliases=True)[0]
+    except config_files.ConfigFileError as err:
+        p = err.problems[0]
+        raise ValueError(f"campaign {path}: cannot be read ({f'line {p.line}: ' if p.line else ''}{p.expected} "
+                         f"expected, found {p.found[:200]})") from None
+    try:
+        return campaign_from(doc, path)
     except ValueError as exc:
         raise ValueError(f"campaign {path}: {exc}") from None
 

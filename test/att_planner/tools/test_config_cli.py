@@ -1,0 +1,132 @@
+"""att-config: check (exit codes, every problem), schema (valid JSON Schema), show (origins), migrate."""
+from __future__ import annotations
+
+import json
+import shutil
+from pathlib import Path
+
+import pytest
+
+from att_planner.tools import config_cli
+
+ROOT = Path(config_cli.__file__).resolve().parents[2]
+SHIPPED = sorted([*ROOT.glob("config/*.yaml"), *ROOT.glob("config/*/*.yaml"), *ROOT.glob("campaigns/*.yaml")])
+
+
+def test_shipped_files_are_found():
+    assert len(SHIPPED) >= 11
+
+
+@pytest.mark.parametrize("path", SHIPPED, ids=lambda p: str(p.relative_to(ROOT)))
+def test_every_shipped_file_passes_check(path, tmp_path, capsys):
+    """Each shipped file is valid under its kind's schema once its old key names are migrated."""
+    copy = tmp_path / path.parent.name / path.name
+    copy.parent.mkdir()
+    shutil.copy(path, copy)
+    config_cli.main(["migrate", str(copy)])
+    kind, problems = config_cli.check_file(copy)
+    assert problems == [], "\n".join(map(str, problems))
+    assert kind == {"missions": "mission", "targets": "targets", "campaigns": "campaign"}.get(
+        path.parent.name, "parameters" if path.stem == "controller_gains" else "scenario")
+    assert config_cli.main(["check", str(copy)]) == 0
+
+
+def test_check_exit_2_with_every_problem_of_every_file(tmp_path, capsys):
+    a, b = tmp_path / "a.yaml", tmp_path / "b.yaml"
+    a.write_text("campaign:\n  scenario: swift_demo\n  seed: -1\n  runs: 0\n")
+    b.write_text("kind: inertial\nscenario: no_such_scenario\ntargets:\n  - {name: x, ra_deg: 400, dec_deg: 0, "
+                 "dwell_s: 1}\n")
+    assert config_cli.main(["check", str(a), str(b)]) == 2
+    out = capsys.readouterr().out.splitlines()
+    assert any(line.startswith(f"{a}:3: campaign.seed: expected greater than or equal to 0") for line in out), out
+    assert any(line.startswith(f"{a}:4: campaign.runs:") for line in out), out
+    assert any(line.startswith(f"{b}:4: targets[0].ra_deg:") for line in out), out
+    assert len(out) == 3
+
+
+def test_check_resolves_references(tmp_path, capsys):
+    mission = tmp_path / "missions" / "m.yaml"
+    mission.parent.mkdir()
+    mission.write_text("targets: nowhere\nsensor_axis: [0, 1, 0]\nhorizon_s: 600\n")
+    assert config_cli.main(["check", str(mission)]) == 2
+    out = capsys.readouterr().out
+    assert f"{mission}:1: targets: expected the name of a target list; found 'nowhere'" in out
+    assert "observatory" in out
+
+
+def test_schema_is_json_for_every_kind(capsys):
+    assert config_cli.main(["schema"]) == 0
+    every = json.loads(capsys.readouterr().out, parse_constant=lambda c: pytest.fail(f"non-JSON constant {c}"))
+    assert set(every) == set(config_cli.KINDS)
+    assert config_cli.main(["schema", "spacecraft"]) == 0
+    craft = json.loads(capsys.readouterr().out)
+    assert craft["required"] == ["inertia_kg_m2"] and craft["additionalProperties"] is False
+    assert craft["properties"]["torque_max_Nm"]["exclusiveMinimum"] == 0.0
+    assert {"inertial", "ground"} <= {s.get("title", "").replace("Targets", "").lower()
+                                      for s in every["targets"]["$defs"].values()}
+
+
+def test_show_names_file_line_or_default(tmp_path, capsys):
+    path = tmp_path / "mini.yaml"
+    path.write_text("/**:\n  ros__parameters:\n    spacecraft:\n      inertia_kg_m2: [2, 3, 4]\n"
+                    "      wheel_inertia_kg_m2: 0.01\nplanner:\n  ros__parameters:\n    time_budget: 5.0\n")
+    assert config_cli.main(["show", str(path)]) == 0
+    out = capsys.readouterr().out.splitlines()
+    assert f"/**.ros__parameters.spacecraft.inertia_kg_m2 = [2.0, 3.0, 4.0]  ({path}:4)" in out
+    assert "/**.ros__parameters.spacecraft.torque_max_Nm = .inf  (default)" in out
+    assert "/**.ros__parameters.orbit.altitude_m = 450000.0  (default)" in out
+    assert f"planner.ros__parameters.time_budget = 5.0  ({path}:8)" in out
+
+
+def test_show_unknown_scenario(capsys):
+    assert config_cli.main(["show", "no_such_scenario"]) == 2
+    assert "unknown spacecraft/scenario 'no_such_scenario'" in capsys.readouterr().err
+
+
+def test_migrate_renames_in_place_and_keeps_comments(tmp_path, capsys):
+    path = tmp_path / "c.yaml"
+    path.write_text("# campaign\ncampaign:\n  scenario: swift_demo\n  seed: 1\n  converge_timeout: 3.0   # s\n")
+    assert config_cli.main(["migrate", str(path)]) == 0
+    assert path.read_text().splitlines()[-1] == "  converge_timeout_s: 3.0  # s"
+
+
+@pytest.mark.parametrize("kind", sorted(config_cli.KINDS))
+def test_shipped_schemas_are_current(kind):
+    """config/schemas/KIND.schema.json is what `att-config schema KIND --out config/schemas` writes."""
+    assert (ROOT / "config" / "schemas" / f"{kind}.schema.json").read_text() == config_cli.schema_text(kind)
+
+
+def test_schema_header_names_the_schema_of_the_files_kind():
+    headed = [p for p in SHIPPED if p.read_text().startswith("# yaml-language-server: $schema=")]
+    assert {p.parent.name for p in headed} >= {"missions", "targets"}
+    for path in headed:
+        target = path.read_text().splitlines()[0].split("$schema=", 1)[1].strip()
+        kind, _ = config_cli.check_file(path)
+        assert (path.parent / target).resolve() == (ROOT / "config" / "schemas" / f"{kind}.schema.json").resolve()
+
+
+def test_schema_out_writes_one_file_per_kind(tmp_path, capsys):
+    assert config_cli.main(["schema", "--out", str(tmp_path)]) == 0
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted(f"{k}.schema.json" for k in config_cli.KINDS)
+
+
+def test_show_a_shipped_scenario_with_old_key_names(capsys):
+    """A file whose only problems are old names is shown under the new names, the file untouched."""
+    path = ROOT / "config" / "swift_demo.yaml"
+    before = path.read_text()
+    assert config_cli.main(["show", "swift_demo"]) == 0
+    captured = capsys.readouterr()
+    lines = captured.out.splitlines()
+    assert path.read_text() == before
+    torque = next(line for line in lines if ".spacecraft.torque_max_Nm = " in line)
+    number = next(i + 1 for i, text in enumerate(before.splitlines()) if "torque_max:" in text and "wheel" not in text)
+    assert torque == f"/**.ros__parameters.spacecraft.torque_max_Nm = 0.1  ({path}:{number})"
+    assert "old key name" in captured.err and "att-config migrate" in captured.err
+    assert any(line.startswith("demo.ros__parameters.method = ") for line in lines)
+
+
+def test_show_refuses_a_scenario_with_real_problems(tmp_path, capsys):
+    path = tmp_path / "bad.yaml"
+    path.write_text("/**:\n  ros__parameters:\n    spacecraft:\n      inertia: [1, 1, 5]\n")
+    assert config_cli.main(["show", str(path)]) == 2
+    assert "triangle inequality" in capsys.readouterr().out
