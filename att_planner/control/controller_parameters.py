@@ -46,9 +46,9 @@ CONTROLLER = ParameterTable("controller", (
     Parameter("kd", float, _C.kd, "rate gain of the magnetorquer PD-like law (Bruni & Celani)", "A m^2 s/(T rad)",
               0.0, INF),
     Parameter("m_max", float, None, "dipole limit per magnetorquer coil the laws command (capped at the "
-                                   "spacecraft's dipole_max)", "A m^2", 0.0,
+                                   "spacecraft's dipole_max_Am2)", "A m^2", 0.0,
               low_open=True, refusal="expected a dipole > 0 A m²", allow_inf=True,
-              default_rule="the spacecraft's dipole_max"),
+              default_rule="the spacecraft's dipole_max_Am2"),
     Parameter("safe_kd", float, None, "rate damping gain of the safe mode", "N m s/rad", 0.0, INF,
               default_rule="tracking_kd"),
     Parameter("max_cached_plans", int, _C.max_cached_plans, "most plans kept for execution", "", 1, 10_000),
