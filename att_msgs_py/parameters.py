@@ -81,8 +81,8 @@ class Parameter:
             return ""
         if self.low in (None, -math.inf) and self.high in (None, math.inf) and not self.high_rule:
             return "finite"
-        low = "-inf" if self.low is None else f"{self.low:.15g}"
-        high = self.high_rule or ("inf" if self.high is None else f"{self.high:.15g}")
+        low = "-inf" if self.low is None else _bound(self.low)
+        high = self.high_rule or ("inf" if self.high is None else _bound(self.high))
         return f"{'(' if self.low_open else '['}{low}, {high}{')' if self.high_open else ']'}"
 
     def summary(self) -> str:
@@ -166,6 +166,11 @@ def _number(x) -> str:
         return str(x)
     text = f"{x:.15g}"
     return text if any(c in text for c in ".en") else text + ".0"
+
+
+def _bound(x) -> str:
+    """A bound of a range: an integer in full (``2**63 - 1``, not ``9.2e+18``), a float to 15 digits."""
+    return str(x) if isinstance(x, int) else f"{x:.15g}"
 
 
 def _within(value, low, high, low_open: bool, high_open: bool, allow_inf: bool) -> bool:
@@ -323,6 +328,6 @@ class SectionReader(Reader):
                                                            f"known: {', '.join(self.table.parameters)}")
 
 
-SCENARIO = Parameter("scenario", str, "swift_demo", "the scenario: a name of a file in config/ (without .yaml) or "
-                                                    "a path to a scenario file")
+SCENARIO = Parameter("scenario", str, "swift_demo", "the scenario: a file name (without .yaml) in config/ or "
+                                                    "$ATT_CONFIG_PATH, or a path to a scenario file")
 SCENARIO_TABLE = ParameterTable("any", (SCENARIO,))

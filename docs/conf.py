@@ -19,5 +19,7 @@ root_doc = "index"
 exclude_patterns = ["_build", "_generated", "_ext"]
 myst_enable_extensions = ["dollarmath", "deflist"]
 myst_heading_anchors = 3
+# values, ranges and command lines are shown as typed: no curly quotes, no dashes for "--"
+smartquotes = False
 html_theme = "alabaster"
 html_title = "att_suite"

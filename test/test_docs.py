@@ -1,10 +1,11 @@
 """The documentation builds with Sphinx and MyST with every warning an error, and its generated pages
-hold what the code declares (error codes, planning methods, node topics)."""
+hold what the code declares (error codes, planning methods, node topics and parameters)."""
 from __future__ import annotations
 
 import os
 import subprocess
 import sys
+from html.parser import HTMLParser
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -35,6 +36,66 @@ def test_the_documentation_builds_without_a_warning(tmp_path):
     nodes = "".join(page.read_text() for page in (tmp_path / "html" / "nodes").glob("*.html"))
     for name in topics.ABOUT:                   # every topic, service and action is on a node's page
         assert f"<span class=\"pre\">{name}</span>" in nodes, name
+
+
+class _Tables(HTMLParser):
+    """The text of every cell of every table of an HTML page: tables -> rows -> cells."""
+
+    def __init__(self):
+        super().__init__(convert_charrefs=True)
+        self.tables: list[list[list[str]]] = []
+        self._cell: list[str] | None = None
+
+    def handle_starttag(self, tag, attrs):
+        if tag == "table":
+            self.tables.append([])
+        elif tag == "tr":
+            self.tables[-1].append([])
+        elif tag in ("td", "th"):
+            self._cell = []
+
+    def handle_endtag(self, tag):
+        if tag in ("td", "th") and self._cell is not None:
+            self.tables[-1][-1].append(" ".join("".join(self._cell).split()))
+            self._cell = None
+
+    def handle_data(self, data):
+        if self._cell is not None:
+            self._cell.append(data)
+
+
+def _parameter_rows(page: Path) -> dict[str, list[str]]:
+    """Parameter name -> its row's cells, from the parameter table of a built node page."""
+    from att_msgs_py.parameter_docs import COLUMNS
+    parser = _Tables()
+    parser.feed(page.read_text())
+    tables = [t for t in parser.tables if t and tuple(t[0]) == COLUMNS]
+    assert len(tables) == 1, f"{page.name}: {len(tables)} parameter tables"
+    return {row[0]: row for row in tables[0][1:]}
+
+
+def test_every_declared_parameter_is_on_its_node_s_page(tmp_path):
+    run = build(tmp_path)
+    assert run.returncode == 0, run.stdout[-3000:] + run.stderr[-3000:]
+    sys.path.insert(0, str(DOCS / "_ext"))
+    try:
+        import att_docs
+    finally:
+        sys.path.remove(str(DOCS / "_ext"))
+    from att_planner.tools.node_parameters import NODE_PARAMETERS, declared
+    assert set(att_docs.NODES) == set(NODE_PARAMETERS)
+    for node in att_docs.NODES:
+        rows = _parameter_rows(tmp_path / "html" / "nodes" / f"{node}.html")
+        table = declared(node)
+        assert list(rows) == [spec.name for spec in table], node      # every one, in order, none other
+        for spec in table:
+            _, kind, default, constraints, unit, description = rows[spec.name]
+            where = f"{node}.{spec.name}"
+            assert default == spec.default_text(), where
+            assert constraints == " ".join(spec.constraints().split()), where
+            assert unit == spec.unit and description.startswith(" ".join(spec.description.split())), where
+            if spec.bounded:                                            # its range, as the node checks it
+                assert spec.interval() in constraints or spec.refusal, where
 
 
 def test_every_error_code_has_a_meaning():

@@ -26,7 +26,8 @@ _KEY_RULE = "plan_signing.pub in the suite's key directory ($ATT_KEY_DIR, see at
 
 CONTROLLER = ParameterTable("controller", (
     Parameter("state_source", str, None, "the state the controller flies on: the simulator's truth or the "
-                                         "estimator's estimate", choices=STATE_SOURCES,
+                                         "estimator's estimate (with wheels, estimate needs tachometers)",
+              choices=STATE_SOURCES,
               default_rule="estimate when the scenario has a gyro, else truth"),
     Parameter("friction_compensation", bool, None, "add the wheel drives' modelled friction to the wheel commands",
               default_rule="true when the scenario's wheels have friction"),
@@ -40,16 +41,19 @@ CONTROLLER = ParameterTable("controller", (
               0.0, INF),
     Parameter("tracking_kd", float, _C.tracking_kd, "rate feedback gain around the plan reference", "N m s/rad",
               0.0, INF),
-    Parameter("kp", float, _C.kp, "attitude gain of the magnetorquer PD-like law (Bruni & Celani)", "", 0.0, INF),
-    Parameter("kd", float, _C.kd, "rate gain of the magnetorquer PD-like law (Bruni & Celani)", "", 0.0, INF),
-    Parameter("m_max", float, None, "dipole limit per magnetorquer coil the laws command", "A m^2", 0.0,
+    Parameter("kp", float, _C.kp, "attitude gain of the magnetorquer PD-like law (Bruni & Celani)", "A m^2/T",
+              0.0, INF),
+    Parameter("kd", float, _C.kd, "rate gain of the magnetorquer PD-like law (Bruni & Celani)", "A m^2 s/(T rad)",
+              0.0, INF),
+    Parameter("m_max", float, None, "dipole limit per magnetorquer coil the laws command (capped at the "
+                                   "spacecraft's dipole_max_Am2)", "A m^2", 0.0,
               low_open=True, refusal="expected a dipole > 0 A m²", allow_inf=True,
-              default_rule="the spacecraft's dipole_max"),
+              default_rule="the spacecraft's dipole_max_Am2"),
     Parameter("safe_kd", float, None, "rate damping gain of the safe mode", "N m s/rad", 0.0, INF,
               default_rule="tracking_kd"),
-    Parameter("max_cached_plans", int, _C.max_cached_plans, "plans kept for execution", "", 1, 10_000),
-    Parameter("max_cache_mb", float, _C.max_cache_bytes / 2**20, "serialized plans kept, in total", "MiB",
-              0.0, 4096.0, low_open=True),
+    Parameter("max_cached_plans", int, _C.max_cached_plans, "most plans kept for execution", "", 1, 10_000),
+    Parameter("max_cache_mb", float, _C.max_cache_bytes / 2**20, "largest total size of the plans kept, serialized",
+              "MiB", 0.0, 4096.0, low_open=True),
     Parameter("safe_rate_threshold", float, _C.safe_rate_threshold, "body rate above which the controller, "
                                                                     "starting, damps it first (safe mode)", "rad/s",
               0.0, 10.0, low_open=True),
@@ -76,7 +80,8 @@ CONTROLLER = ParameterTable("controller", (
     Parameter("max_state_gap", float, _G.max_state_gap, "largest sim time between consecutive accepted states", "s",
               0.0, 3600.0, low_open=True),
     Parameter("max_clock_skew", float, _G.max_clock_skew, "largest difference between a state's stamp and the "
-                                                          "node's clock", "s", 0.0, 3600.0, low_open=True),
+                                                          "/clock of the state's publisher", "s", 0.0, 3600.0,
+              low_open=True),
     Parameter("resync_timeout", float, _G.resync_timeout, "wall time without an accepted state after which the "
                                                           "held publisher's stamps may jump", "s", 0.0, 3600.0,
               low_open=True),

@@ -33,7 +33,7 @@ ESTIMATOR = ParameterTable("estimator", (
     Parameter("propagate_timeout", float, _E.propagate_timeout, "time without an accepted attitude measurement "
                                                                 "after which the estimate is PROPAGATING", "s",
               0.0, 3600.0, low_open=True),
-    Parameter("history", float, _E.history, "time of samples kept to apply late measurements", "s", 0.0, 60.0,
+    Parameter("history", float, _E.history, "span of samples kept to apply late measurements", "s", 0.0, 60.0,
               low_open=True),
     Parameter("lost_after", int, _E.lost_after, "tracker measurements rejected in a row after which the estimate is "
                                                 "DIVERGED", "", 1, 1000),

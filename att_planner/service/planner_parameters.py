@@ -13,8 +13,8 @@ PLANNER = ParameterTable("planner", (
     Parameter("default_method", str, "", "planning method of a request that names none ('': the best available)",
               choices=("", *methods.METHODS),
               refusal=f"expected '' (the best) or one of {', '.join(methods.METHODS)}"),
-    Parameter("time_budget", float, 20.0, "compute time of a request that gives 0", "s", 0.0, MAX_TIME_BUDGET,
-              low_open=True),
+    Parameter("time_budget", float, 20.0, "wall-time budget of a request whose time_budget is 0", "s",
+              0.0, MAX_TIME_BUDGET, low_open=True),
     Parameter("accept_attitude_error_deg", float, math.degrees(TOLERANCES.attitude), "largest final attitude error "
                                                                                      "of an accepted plan", "deg",
               0.0, 180.0, low_open=True),
@@ -29,7 +29,7 @@ PLANNER = ParameterTable("planner", (
     Parameter("signing_key", str, None, "Ed25519 private key file the plans are signed with",
               default_rule="plan_signing.key in the suite's key directory ($ATT_KEY_DIR, see att-keygen)"),
     Parameter("max_parallel_solves", int, 2, "plans solved at once (worker processes)", "", 1, 64),
-    Parameter("plan_markers", bool, True, "publish each plan's path as markers for the 3D view"),
-    Parameter("warm_up_scenarios", str, None, "comma-separated scenarios whose demo maneuvers every worker plans "
-                                              "before it serves", default_rule="the scenario"),
+    Parameter("plan_markers", bool, True, "publish each plan's boresight path on /planner/plan_markers (the 3D view)"),
+    Parameter("warm_up_scenarios", str, None, "comma-separated scenarios whose demo maneuvers every worker "
+                                              "plans before the node serves ('': none)", default_rule="the scenario"),
 ), "the maneuver planner: the plan_maneuver and plan_schedule services")

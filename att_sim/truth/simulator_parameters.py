@@ -15,16 +15,18 @@ SIMULATOR = ParameterTable("simulator", (
               0.0, INF, low_open=True, default_rule="min(10, 1/step)", high_rule="1/step", hint=PER_STEP),
     Parameter("clock_rate", float, None, "rate of /clock, in sim time", "Hz", 0.0, INF, low_open=True,
               default_rule="min(50, 1/step)", high_rule="1/step", hint=PER_STEP),
-    Parameter("tf_rate", float, None, "rate of /tf and of the zone margins, in sim time (0: off)", "Hz", 0.0, INF,
-              default_rule="publish_rate", high_rule="1/step", hint=PER_STEP_OR_OFF),
-    Parameter("marker_rate", float, None, "rate of the 3D view's markers, in sim time (0: off)", "Hz", 0.0, INF,
-              default_rule="min(1, 1/step)", high_rule="1/step", hint=PER_STEP_OR_OFF),
+    Parameter("tf_rate", float, None, "rate of /tf and /simulator/zone_margins, in sim time (0: off)", "Hz",
+              0.0, INF, default_rule="publish_rate", high_rule="1/step", hint=PER_STEP_OR_OFF),
+    Parameter("marker_rate", float, None, "rate of /simulator/markers (the 3D view), in sim time (0: off)", "Hz",
+              0.0, INF, default_rule="min(1, 1/step)", high_rule="1/step", hint=PER_STEP_OR_OFF),
     Parameter("real_time_factor", float, 1.0, "sim time per wall time (0: as fast as possible)", "", 0.0, INF),
-    Parameter("command_timeout", float, 1.0, "sim time without a command after which the actuator inputs are "
-                                             "zeroed", "s", 0.0, INF, low_open=True),
+    Parameter("command_timeout", float, 1.0, "sim time without a valid command after which the actuator "
+                                             "inputs are zeroed; also the largest age of a command's stamp", "s",
+              0.0, INF, low_open=True),
     Parameter("end_time", float, 0.0, "sim time at which the simulator stops (0: run until stopped)", "s", 0.0, INF),
-    Parameter("wait_for_subscribers", int, 0, "subscribers to the state (recorder, controller, estimator) that "
-                                              "must listen before sim time starts", "", 0, 1000),
+    Parameter("wait_for_subscribers", int, 0, "listeners that must be there before sim time starts: "
+                                              "subscriptions to the state, plus nodes that hear only the sensors",
+              "", 0, 1000),
     Parameter("start_timeout", float, 60.0, "wall time waited for those subscribers before starting anyway", "s",
               0.0, INF, low_open=True),
     Parameter("lockstep", bool, True, "wait for the command that answers each state (the loop stays closed at any "
@@ -37,11 +39,11 @@ SIMULATOR = ParameterTable("simulator", (
               "rad/s", 0.0, INF, low_open=True),
     Parameter("gravity_gradient", bool, None, "apply the gravity-gradient torque",
               default_rule="the scenario's environment.gravity_gradient (false without it)"),
-    Parameter("initial_attitude", list, (0.0, 0.0, 0.0, 1.0), "initial attitude q_BN [x, y, z, w] (unit norm)", "",
-              -INF, INF, length=4),
+    Parameter("initial_attitude", list, (0.0, 0.0, 0.0, 1.0), "initial attitude q_BN [x, y, z, w] (unit norm within "
+                                                              "1e-3)", "", -INF, INF, length=4),
     Parameter("initial_rate", list, (0.0, 0.0, 0.0), "initial body rate omega_BN_B (norm at most max_reset_rate)",
               "rad/s", -INF, INF, length=3),
-    Parameter("seed", int, None, "seed of the sensor noise", "", 0, 2**63 - 1,
+    Parameter("seed", int, None, "seed of every random stream of the sensors and actuators", "", 0, 2**63 - 1,
               default_rule="the scenario's sensors.seed"),
     Parameter("campaign", str, "", "Monte Carlo campaign file whose run run_seed is flown (dispersed truth; with "
                                    "run_seed)"),

@@ -10,7 +10,10 @@ hand-written pages include:
 - ``nodes/<node>.md``: the topics, services and actions of each node of
   :data:`att_planner.tools.launch.NODE_MODULES`, read from the node's source (the ``create_*`` calls and
   the action servers), with their types (the node's imports), QoS (:mod:`att_msgs_py.qos`) and what they
-  carry (:data:`att_msgs_py.topics.ABOUT`).
+  carry (:data:`att_msgs_py.topics.ABOUT`);
+- ``parameters/<node>.md``: the table of every parameter the node declares
+  (:func:`att_planner.tools.node_parameters.declared`, rendered by
+  :func:`att_msgs_py.parameter_docs.markdown_table`): type, default, range, unit and description.
 
 The node sources are parsed, not imported, so the build starts no ROS node.
 """
@@ -200,10 +203,18 @@ def node_page(node: str) -> str:
             + table(["role", "name", "type", "QoS", "what"], node_interfaces(module)))
 
 
+def parameters_page(node: str) -> str:
+    """The table of every parameter ``node`` declares, from its declarations."""
+    from att_msgs_py.parameter_docs import markdown_table
+    from att_planner.tools.node_parameters import declared
+    return markdown_table(declared(node))
+
+
 def generate(out: Path) -> list[Path]:
     """Write every generated page under ``out``; the paths written."""
     pages = {"errors.md": errors_page(), "methods.md": methods_page()}
     pages |= {f"nodes/{node}.md": node_page(node) for node in NODES}
+    pages |= {f"parameters/{node}.md": parameters_page(node) for node in NODES}
     written = []
     for name, text in pages.items():
         path = out / name

@@ -180,3 +180,11 @@ def test_the_json_schema_says_what_the_declaration_says():
     assert p["mode"]["enum"] == ["a", "b"] and p["mode"]["type"] == "string"
     assert "default" not in p["bound"] and "maximum" not in p["bound"]          # .inf: JSON cannot write it
     assert p["found"]["exclusiveMaximum"] == 5.0 and "default" not in p["found"]
+
+
+def test_an_integer_range_is_written_in_full():
+    seed = Parameter("seed", int, 0, "a seed", "", 0, 2**63 - 1)
+    assert seed.interval() == "[0, 9223372036854775807]"
+    assert seed.constraints() == "in [0, 9223372036854775807]"
+    step = Parameter("step", float, 0.05, "a step", "s", 0.0, 1.0, low_open=True)
+    assert step.interval() == "(0, 1]"
