@@ -23,8 +23,9 @@ $(VENV)/.stamp-venv:
 	$(PY) -m pip install --quiet --disable-pip-version-check pip==26.3
 	touch $@
 
+# --no-compile: the wheels' modules are compiled when first imported (36 s -> 13 s here; most are never imported)
 $(VENV)/.stamp-deps: requirements.txt $(VENV)/.stamp-venv
-	$(PY) -m pip install --quiet --disable-pip-version-check -r requirements.txt
+	$(PY) -m pip install --quiet --disable-pip-version-check --no-compile -r requirements.txt
 	touch $@
 
 # tf2_msgs (the /tf type: its standard TFMessage definition, no wheel on PyPI) first, then att_msgs
