@@ -33,10 +33,10 @@ from helpers import forked_nodes
 BASE = {
     "/**": {"ros__parameters": {
         "frame_id": "eci", "body_frame_id": "body",
-        "spacecraft": {"inertia": [10.0, 12.0, 14.0], "torque_max": 0.1,
-                       "wheel_axes": [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0], "wheel_inertia": 0.01,
-                       "wheel_torque_max": 0.1, "wheel_speed_max": 600.0, "dipole_max": 5.0},
-        "orbit": {"altitude": 500000.0, "inclination_deg": 97.0}}},
+        "spacecraft": {"inertia_kg_m2": [10.0, 12.0, 14.0], "torque_max_Nm": 0.1,
+                       "wheel_axes": [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0], "wheel_inertia_kg_m2": 0.01,
+                       "wheel_torque_max_Nm": 0.1, "wheel_speed_max_rad_s": 600.0, "dipole_max_Am2": 5.0},
+        "orbit": {"altitude_m": 500000.0, "inclination_deg": 97.0}}},
     "simulator": {"ros__parameters": {"step": 0.1, "publish_rate": 10.0}},
 }
 
@@ -62,43 +62,48 @@ BAD_SCENARIOS = {
     "a list": ("- 1\n- 2\n", "a mapping"),
     "a scalar": ("just some text\n", "a mapping"),
     "empty": ("", "an empty file"),
-    "broken YAML": ("/**: {ros__parameters: [\n", "not valid YAML"),
-    "tab indentation": ("/**:\n\tros__parameters: {}\n", "not valid YAML"),
-    "a gains file (no /**)": (GAINS, "not a scenario file"),
+    "broken YAML": ("/**: {ros__parameters: [\n", "expected valid YAML"),
+    "tab indentation": ("/**:\n\tros__parameters: {}\n", "expected valid YAML"),
+    "a gains file (no /**)": (GAINS, "/**: expected this key (required)"),
     "/** without ros__parameters": ("/**:\n  spacecraft: {inertia: [1, 1, 1]}\n", "ros__parameters"),
     "no spacecraft": (edited(spacecraft=...), "spacecraft"),
-    "spacecraft a list": (edited(spacecraft=[1, 2]), "mapping"),
-    "inertia missing": (edited(spacecraft__inertia=...), "spacecraft.inertia is missing"),
-    "inertia of 4 numbers": (edited(spacecraft__inertia=[1.0, 2.0, 3.0, 4.0]), "spacecraft.inertia"),
-    "inertia text": (edited(spacecraft__inertia="heavy"), "spacecraft.inertia"),
-    "inertia with a text entry": (edited(spacecraft__inertia=[1.0, "x", 1.0]), "spacecraft.inertia"),
-    "inertia NaN": (edited(spacecraft__inertia=[float("nan"), 1.0, 1.0]), "finite"),
-    "inertia a scalar": (edited(spacecraft__inertia=5.0), "spacecraft.inertia"),
-    "inertia nested lists": (edited(spacecraft__inertia=[[1, 0, 0], [0, 1, 0], [0, 0, 1]]), "spacecraft.inertia"),
-    "torque_max text": (edited(spacecraft__torque_max="fast"), "spacecraft.torque_max"),
-    "torque_max zero": (edited(spacecraft__torque_max=0.0), "spacecraft.torque_max"),
-    "torque_max negative": (edited(spacecraft__torque_max=-0.1), "positive"),
-    "dipole_max NaN": (edited(spacecraft__dipole_max=float("nan")), "spacecraft.dipole_max"),
-    "wheel_speed_max a bool": (edited(spacecraft__wheel_speed_max=True), "spacecraft.wheel_speed_max"),
-    "wheel_torque_max a list": (edited(spacecraft__wheel_torque_max=[0.1]), "spacecraft.wheel_torque_max"),
+    "spacecraft a list": (edited(spacecraft=[1, 2]), "spacecraft: expected a valid dictionary"),
+    "inertia missing": (edited(spacecraft__inertia_kg_m2=...),
+        "spacecraft.inertia_kg_m2: expected this key (required)"),
+    "inertia of 4 numbers": (edited(spacecraft__inertia_kg_m2=[1.0, 2.0, 3.0, 4.0]), "spacecraft.inertia"),
+    "inertia text": (edited(spacecraft__inertia_kg_m2="heavy"), "spacecraft.inertia"),
+    "inertia with a text entry": (edited(spacecraft__inertia_kg_m2=[1.0, "x", 1.0]), "spacecraft.inertia"),
+    "inertia NaN": (edited(spacecraft__inertia_kg_m2=[float("nan"), 1.0, 1.0]), "finite"),
+    "inertia a scalar": (edited(spacecraft__inertia_kg_m2=5.0), "spacecraft.inertia"),
+    "inertia nested lists": (edited(spacecraft__inertia_kg_m2=[[1, 0, 0], [0, 1, 0], [0, 0, 1]]), "spacecraft.inertia"),
+    "torque_max text": (edited(spacecraft__torque_max_Nm="fast"), "spacecraft.torque_max"),
+    "torque_max zero": (edited(spacecraft__torque_max_Nm=0.0), "spacecraft.torque_max"),
+    "torque_max negative": (edited(spacecraft__torque_max_Nm=-0.1),
+        "spacecraft.torque_max_Nm: expected greater than 0"),
+    "dipole_max NaN": (edited(spacecraft__dipole_max_Am2=float("nan")), "spacecraft.dipole_max"),
+    "wheel_speed_max a bool": (edited(spacecraft__wheel_speed_max_rad_s=True), "spacecraft.wheel_speed_max"),
+    "wheel_torque_max a list": (edited(spacecraft__wheel_torque_max_Nm=[0.1]), "spacecraft.wheel_torque_max"),
     "unknown spacecraft key (typo)": (edited(spacecraft__intertia=[1.0, 1.0, 1.0]), "unknown key(s) intertia"),
-    "wheel_axes of 4 numbers": (edited(spacecraft__wheel_axes=[1.0, 0.0, 0.0, 1.0]), "3 numbers per wheel"),
-    "wheel axis not unit": (edited(spacecraft__wheel_axes=[2.0, 0.0, 0.0]), "wheel_axes[0]"),
-    "wheels without inertia": (edited(spacecraft__wheel_inertia=0.0), "wheel_inertia"),
-    "wheel_inertia negative": (edited(spacecraft__wheel_inertia=-1.0), "wheel_inertia"),
+    "wheel_axes of 4 numbers": (edited(spacecraft__wheel_axes=[1.0, 0.0, 0.0, 1.0]),
+        "spacecraft.wheel_axes: expected 3 numbers per vector"),
+    "wheel axis not unit": (edited(spacecraft__wheel_axes=[2.0, 0.0, 0.0]),
+        "wheel_axes: expected 3 numbers per unit vector; vector 0"),
+    "wheels without inertia": (edited(spacecraft__wheel_inertia_kg_m2=0.0), "wheel_inertia"),
+    "wheel_inertia negative": (edited(spacecraft__wheel_inertia_kg_m2=-1.0), "wheel_inertia"),
     "unknown orbit key": (edited(orbit__eccentricity=0.1), "orbit"),
-    "orbit altitude text": (edited(orbit__altitude="high"), "orbit.altitude"),
-    "orbit altitude negative": (edited(orbit__altitude=-1.0), "orbit.altitude"),
+    "orbit altitude text": (edited(orbit__altitude_m="high"), "orbit.altitude"),
+    "orbit altitude negative": (edited(orbit__altitude_m=-1.0), "orbit.altitude"),
     "orbit a list": (edited(orbit=[1, 2]), "orbit"),
     "frame_id empty": (edited(frame_id=""), "frame_id"),
     "body_frame_id with a newline": (edited(body_frame_id="body\nx"), "body_frame_id"),
-    "node section not a mapping": (edited(simulator=5), "section 'simulator'"),
-    "node section without ros__parameters": (edited(simulator={"step": 0.1}), "section 'simulator'"),
+    "node section not a mapping": (edited(simulator=5), "simulator: expected a valid dictionary"),
+    "node section without ros__parameters": (edited(simulator={"step": 0.1}),
+        "simulator.ros__parameters: expected this key (required)"),
     "a file over 1 MB": ("# " + "x" * 1_100_000 + "\n" + yaml.safe_dump(BASE), "bytes"),
-    "not UTF-8": (b"\xff\xfe/**: \x00\x81", "cannot be read"),
+    "not UTF-8": (b"\xff\xfe/**: \x00\x81", "expected UTF-8 text"),
     # sensors and actuators
-    "sensors a list": (edited(sensors=[1, 2]), "sensors must be a mapping"),
-    "sensors unknown kind": (edited(sensors={"lidar": {}}), "sensors has unknown key(s) lidar"),
+    "sensors a list": (edited(sensors=[1, 2]), "sensors: expected a valid dictionary"),
+    "sensors unknown kind": (edited(sensors={"lidar": {}}), "sensors.lidar: expected one of the keys"),
     "gyro ARW negative": (edited(sensors={"gyro": {"arw_deg_per_sqrt_h": -0.1}}), "sensors.gyro.arw_deg_per_sqrt_h"),
     "gyro rate text": (edited(sensors={"gyro": {"rate_hz": "fast"}}), "sensors.gyro.rate_hz"),
     "gyro key typo": (edited(sensors={"gyro": {"arw_deg_per_sqrt_hr": 0.1}}), "unknown key(s) arw_deg_per_sqrt_hr"),
@@ -108,12 +113,13 @@ BAD_SCENARIOS = {
                                   "sensors.star_trackers[0].mounting"),
     "tracker Sun exclusion without an epoch": (
         edited(sensors={"star_trackers": [{"name": "a", "exclusions": [{"body": "sun", "half_angle_deg": 30}]}]}),
-        "needs the scenario's epoch"),
-    "sun sensors without an epoch": (edited(sensors={"sun_sensors": {}}), "sensors.sun_sensors needs"),
+        "expected an epoch (the Sun, Moon and Earth depend on the date) for star tracker a's sun exclusion"),
+    "sun sensors without an epoch": (edited(sensors={"sun_sensors": {}}),
+        "expected an epoch (the Sun, Moon and Earth depend on the date) for sun_sensors"),
     "seed text": (edited(sensors={"seed": "lucky"}), "sensors.seed"),
     "magnetometer noise NaN": (edited(sensors={"magnetometer": {"noise_nT": float("nan")}}),
                                "sensors.magnetometer.noise_nT"),
-    "actuators unknown kind": (edited(actuators={"thrusters": {}}), "actuators has unknown key(s) thrusters"),
+    "actuators unknown kind": (edited(actuators={"thrusters": {}}), "actuators.thrusters: expected one of the keys"),
     "wheel friction negative": (edited(actuators={"wheels": {"coulomb_friction_Nm": -1.0}}),
                                 "actuators.wheels.coulomb_friction_Nm"),
 }
@@ -127,7 +133,8 @@ def test_a_file_that_is_not_a_valid_scenario_is_a_config_error_naming_file_and_f
         scenario.load(str(path))
     assert isinstance(err.value, ValueError) and err.value.code == ErrorCode.INVALID_CONFIG
     assert "hostile_scenario.yaml" in err.value.message and words in err.value.message, err.value.message
-    assert len(err.value.message) <= 400
+    lines = err.value.message.splitlines()      # every problem, one bounded line each (the path aside)
+    assert 1 <= len(lines) <= 10 and all(len(line.replace(str(path), "")) <= 400 for line in lines), lines
 
 
 def test_the_base_scenario_of_these_cases_is_valid(tmp_path):
@@ -135,6 +142,7 @@ def test_the_base_scenario_of_these_cases_is_valid(tmp_path):
     path.write_text(yaml.safe_dump(BASE))
     s = scenario.load(str(path))
     assert s.spacecraft.n_wheels == 3 and s.node_params["simulator"]["step"] == 0.1
+    assert s.spacecraft.body_torque_max == 0.1 and s.orbit.altitude == 500000.0
 
 
 def test_unknown_names_stay_key_errors_and_the_planner_maps_both(tmp_path, monkeypatch):

@@ -110,11 +110,14 @@ def test_schema_out_writes_one_file_per_kind(tmp_path, capsys):
     assert sorted(p.name for p in tmp_path.iterdir()) == sorted(f"{k}.schema.json" for k in config_cli.KINDS)
 
 
-def test_show_a_shipped_scenario_with_old_key_names(capsys):
+def test_show_a_scenario_with_old_key_names(tmp_path, capsys):
     """A file whose only problems are old names is shown under the new names, the file untouched."""
-    path = ROOT / "config" / "swift_demo.yaml"
+    shipped = (ROOT / "config" / "swift_demo.yaml").read_text()
+    path = tmp_path / "old_names.yaml"
+    path.write_text(shipped.replace("torque_max_Nm:", "torque_max:")
+                    .replace("wheel_torque_max:", "wheel_torque_max_Nm:"))
     before = path.read_text()
-    assert config_cli.main(["show", "swift_demo"]) == 0
+    assert config_cli.main(["show", str(path)]) == 0
     captured = capsys.readouterr()
     lines = captured.out.splitlines()
     assert path.read_text() == before
@@ -125,8 +128,16 @@ def test_show_a_shipped_scenario_with_old_key_names(capsys):
     assert any(line.startswith("demo.ros__parameters.method = ") for line in lines)
 
 
+def test_show_a_shipped_scenario(capsys):
+    assert config_cli.main(["show", "swift_demo"]) == 0
+    captured = capsys.readouterr()
+    assert "old key name" not in captured.err
+    assert any(line.startswith("/**.ros__parameters.spacecraft.torque_max_Nm = 0.1  (") for line in
+               captured.out.splitlines())
+
+
 def test_show_refuses_a_scenario_with_real_problems(tmp_path, capsys):
     path = tmp_path / "bad.yaml"
-    path.write_text("/**:\n  ros__parameters:\n    spacecraft:\n      inertia: [1, 1, 5]\n")
+    path.write_text("/**:\n  ros__parameters:\n    spacecraft:\n      inertia_kg_m2: [1, 1, 5]\n")
     assert config_cli.main(["show", str(path)]) == 2
     assert "triangle inequality" in capsys.readouterr().out
