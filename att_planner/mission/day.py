@@ -95,7 +95,7 @@ def day_report(mcap_path: str | Path, scenario: scen.Scenario) -> dict:
                        window=max(1.0, float(t[-1] - t[0])))
     margins = zone_sky.margins(t, q, true=True)
     table = target_table(events, t, q, margins, scenario)
-    orbit = scen.read(scenario.path).model.shared.ros__parameters.orbit
+    orbit = scen.read(scenario.path).shared.orbit
     sc = scenario.spacecraft
     relative = np.asarray(state["wheel_speeds"], float) - np.asarray(state["body_rate"], float) @ sc.wheel_axes
     sensor_axis = next((e.sensor_axis for e in events if e.target), np.zeros(3))

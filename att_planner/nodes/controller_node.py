@@ -78,7 +78,7 @@ class ControllerNode(Node):
         super().__init__("controller")
         self._scenario = scen.load_checked(read_scenario(self))
         param = ParameterReader(self, CONTROLLER, self._scenario.node_params.get("controller", {}),
-                                str(self._scenario.path))
+                                str(self._scenario.node_params_path))
         self._core = controller_from_scenario(param, self._scenario)
         self._core.gate.hold.live = live_publishers(self, topics.STATE if self._core.measured is None
                                                     else topics.ESTIMATE)

@@ -1,18 +1,23 @@
-"""Scenario files: one YAML per spacecraft/scenario under ``config/``, in ROS 2 parameter-file form.
+"""Scenarios: a spacecraft in its sky, and the nodes' tuning, found by name.
 
-A scenario file has a ``/**: ros__parameters:`` section shared by every node (the spacecraft and
-its sky) and one section per node (``simulator``, ``controller``, ``planner``, ``recorder``); each
-node reads its section from the file named by its ``scenario`` parameter. This module reads the
-file without ROS, for the planner (which plans for any named spacecraft) and for tools.
+A scenario ``NAME`` is ``config/scenarios/NAME.yaml`` (:class:`~att_sim.models.config_schema.ScenarioSky`:
+the spacecraft it flies, by name, and its epoch, orbit, field model, environment switches and
+zones), the spacecraft file it names (``config/spacecraft/<name>.yaml``,
+:class:`~att_sim.models.config_schema.SpacecraftFile`: inertia, wheels, magnetorquers, surface,
+sensors, actuator imperfections), the nodes' tuning beside it (``NAME.params.yaml``, a plain ROS 2
+parameter file: one ``<node>: ros__parameters:`` section per node) and the demo maneuver
+(``NAME.demo.yaml``). Each node reads its section of the scenario named by its ``scenario``
+parameter; this module reads the files without ROS, for the nodes, the planner (which plans for any
+named spacecraft) and the tools. A self-contained file (a ``/**: ros__parameters:`` section with
+all of it, then the node sections; :class:`~att_sim.models.config_schema.ScenarioFile`) is read too.
 
-A file is read by the one configuration loader (:mod:`att_sim.models.config_files`: PyYAML's safe
-loader, nothing evaluated; tags, duplicate keys and alias bombs refused) and validated by the
-pydantic model :class:`att_sim.models.config_schema.ScenarioFile`, which holds every key, its
-default, range and unit; :func:`load` builds the :class:`Scenario` from that model. What the
-model cannot know — an orbit SGP4 cannot propagate or that dips below 150 km, a date outside
-IGRF-14's span — is refused in the same words, ``file:line: field.path: expected ...; found ...``.
-``facets`` and ``zones`` are lists of mappings, which rcl's parameter-file parser refuses: such a
-scenario is read by the nodes through ``-p scenario:=NAME`` only, never as a ``--params-file``.
+Every file is read by the one configuration loader (:mod:`att_sim.models.config_files`: PyYAML's
+safe loader, nothing evaluated; tags, duplicate keys and alias bombs refused) and validated by its
+pydantic model, which holds every key, its default, range and unit; the scenario and its spacecraft
+resolve into :class:`~att_sim.models.config_schema.Shared`, and :func:`load` builds the
+:class:`Scenario` from it. What the models cannot know — an orbit SGP4 cannot propagate or that dips
+below 150 km, a date outside IGRF-14's span — is refused in the same words,
+``file:line: field.path: expected ...; found ...``.
 """
 from __future__ import annotations
 
@@ -24,6 +29,7 @@ from pathlib import Path
 
 import numpy as np
 import yaml
+from pydantic import ValidationError
 
 from att_msgs_py import validation
 from att_msgs_py.errors import ConfigError, ErrorCode, RequestError, clip
@@ -51,19 +57,41 @@ def config_dirs() -> list[Path]:
     return [d for d in dirs if d.is_dir()]
 
 
+SCENARIOS, SPACECRAFT = "scenarios", "spacecraft"      # the folders of a configuration directory
+PARAMS_SUFFIX, DEMO_SUFFIX = ".params.yaml", ".demo.yaml"
+
+
+def _stems(folder: Path) -> set[str]:
+    return {p.name[:-len(".yaml")] for p in folder.glob("*.yaml") if "." not in p.name[:-len(".yaml")]}
+
+
 def available() -> list[str]:
-    return sorted({p.stem for d in config_dirs() for p in d.glob("*.yaml")})
+    """The scenario names: ``scenarios/NAME.yaml`` and the self-contained ``NAME.yaml`` of each config directory."""
+    return sorted({n for d in config_dirs() for n in _stems(d / SCENARIOS) | _stems(d)})
 
 
 def find(name: str) -> Path:
-    """Path of scenario ``name`` (a file stem) or of an explicit ``*.yaml`` path."""
+    """Path of scenario ``name`` (``scenarios/NAME.yaml``, else a self-contained ``NAME.yaml``, of the
+    first config directory holding one) or of an explicit ``*.yaml`` path."""
     if name.endswith(".yaml") and Path(name).is_file():
         return Path(name)
     for d in config_dirs():
-        p = d / f"{name}.yaml"
+        for p in (d / SCENARIOS / f"{name}.yaml", d / f"{name}.yaml"):
+            if p.is_file():
+                return p
+    raise KeyError(f"unknown spacecraft/scenario '{name}' (known: {', '.join(available()) or 'none'})")
+
+
+def find_spacecraft(name: str, beside: Path | None = None) -> Path:
+    """Path of spacecraft ``name``: ``spacecraft/NAME.yaml`` of the config directory of the scenario
+    file ``beside`` first, then of every config directory; KeyError naming the known ones."""
+    roots = ([beside.resolve().parent.parent] if beside is not None else []) + config_dirs()
+    for d in roots:
+        p = d / SPACECRAFT / f"{name}.yaml"
         if p.is_file():
             return p
-    raise KeyError(f"unknown spacecraft/scenario '{name}' (known: {', '.join(available()) or 'none'})")
+    known = sorted({n for d in roots for n in _stems(d / SPACECRAFT)})
+    raise KeyError(f"unknown spacecraft '{name}' (known: {', '.join(known) or 'none'})")
 
 
 @dataclass(frozen=True)
@@ -82,33 +110,105 @@ class Scenario:
     zones: list[Zone] = field(default_factory=list)   # zones_from_params of the 'zones' group
     sensors: SensorSpecs = field(default_factory=SensorSpecs)        # the 'sensors' group
     actuators: ActuatorSpecs = field(default_factory=ActuatorSpecs)  # the 'actuators' group
+    spacecraft_path: Path | None = None            # config/spacecraft/NAME.yaml (None: a self-contained file)
+    params_path: Path | None = None                # the file of node_params (the scenario's own when None)
+
+    @property
+    def node_params_path(self) -> Path:
+        """The file the nodes' sections come from (named in a refused parameter)."""
+        return self.params_path or self.path
 
 
 MAX_FILE_BYTES = config_files.MAX_FILE_BYTES
 
 
-def read(path) -> config_files.Loaded:
-    """The scenario file ``path`` read and validated (:class:`att_sim.models.config_schema.ScenarioFile`);
+@dataclass(frozen=True)
+class Files:
+    """A scenario read and validated: its resolved spacecraft and sky, the node sections, and where
+    each came from (``lines``: field path of :class:`att_sim.models.config_schema.Shared` → (file, line))."""
+
+    path: Path
+    shared: schema.Shared
+    lines: dict
+    node_params: dict
+    spacecraft_path: Path | None = None
+    params_path: Path | None = None
+    demo_path: Path | None = None
+
+
+def _problem_file(problems, path: Path) -> config_files.ConfigFileError:
+    return config_files.ConfigFileError([replace(p, file=str(path)) for p in problems])
+
+
+def read(path) -> Files:
+    """The scenario file ``path`` read and validated with the files it names; a
     :class:`att_sim.models.config_files.ConfigFileError` (code ``INVALID_CONFIG``) with every problem.
-    Anchors and aliases are accepted as ``yaml.safe_dump`` writes them, their expansion bounded."""
+
+    A scenario file of ``scenarios/`` (:class:`~att_sim.models.config_schema.ScenarioSky`) names its
+    spacecraft (``spacecraft/NAME.yaml``, :class:`~att_sim.models.config_schema.SpacecraftFile`);
+    the nodes' sections are in ``NAME.params.yaml`` beside it (a ROS 2 ``--params-file``) and the
+    demo maneuver in ``NAME.demo.yaml``, both optional. A self-contained file
+    (:class:`~att_sim.models.config_schema.ScenarioFile`: a ``/**: ros__parameters:`` section and the
+    node sections) holds all of it. Anchors and aliases are accepted as ``yaml.safe_dump`` writes
+    them, their expansion bounded."""
     path = Path(path)
     data, lines = config_files.read_yaml(path, aliases=True)
-    return config_files.Loaded(path, config_files.validate(path, schema.ScenarioFile, data, lines), data, lines)
+    if "/**" in data or "spacecraft" not in data:
+        model = config_files.validate(path, schema.ScenarioFile, data, lines)
+        prefix = ("/**", "ros__parameters")
+        own = {k[2:]: (path, v) for k, v in lines.items() if k[:2] == prefix}
+        return Files(path, model.shared.ros__parameters, own,
+                     {k: v["ros__parameters"] for k, v in data.items() if k != "/**"})
+    sky = config_files.validate(path, schema.ScenarioSky, data, lines)
+    try:
+        craft_path = find_spacecraft(sky.spacecraft, path)
+    except KeyError as err:
+        raise config_files.ConfigFileError([config_files.Problem(
+            str(path), lines.get(("spacecraft",)), "spacecraft", "the name of a spacecraft file",
+            f"{clip(repr(sky.spacecraft), 80)}: {clip(err.args[0], 200)}")]) from None
+    craft_data, craft_lines = config_files.read_yaml(craft_path, aliases=True)
+    craft = config_files.validate(craft_path, schema.SpacecraftFile, craft_data, craft_lines)
+    origin = {k: (path, v) for k, v in lines.items()}
+    body = set(schema.Spacecraft.model_fields)
+    for k, v in craft_lines.items():
+        if not k:
+            continue
+        key = (("spacecraft",) if k[0] in body else ("environment",) if k[0] in schema.Surface.model_fields
+               else ()) + k
+        origin[key] = (craft_path, v)
+    composed = schema.resolved(sky, craft)
+    try:
+        shared = schema.Shared.model_validate(composed)
+    except ValidationError as exc:          # what the two files say together: reported on the scenario's lines
+        flat = {k: v for k, (_, v) in origin.items()}
+        raise config_files.ConfigFileError(config_files.problems_of(exc, schema.Shared, composed, flat,
+                                                                    str(path))) from None
+    params_path, demo_path = path.with_name(path.stem + PARAMS_SUFFIX), path.with_name(path.stem + DEMO_SUFFIX)
+    nodes = {}
+    if params_path.is_file():
+        p_data, p_lines = config_files.read_yaml(params_path)
+        config_files.validate(params_path, schema.ParametersFile, p_data, p_lines)
+        nodes = {k: v["ros__parameters"] for k, v in p_data.items()}
+    if demo_path.is_file():
+        d_data, d_lines = config_files.read_yaml(demo_path)
+        config_files.validate(demo_path, schema.DemoFile, d_data, d_lines)
+        nodes["demo"] = d_data["demo"]
+    return Files(path, shared, origin, nodes, craft_path, params_path if params_path.is_file() else None,
+                 demo_path if demo_path.is_file() else None)
 
 
 class _Build:
     """The objects of a validated scenario; a check beyond the model is a problem on its line."""
 
-    def __init__(self, loaded: config_files.Loaded):
-        self.loaded = loaded
-        self.shared = loaded.model.shared.ros__parameters
+    def __init__(self, files: Files):
+        self.files = files
+        self.shared = files.shared
 
     def refuse(self, path: tuple, expected: str, found: str) -> config_files.ConfigFileError:
-        full = ("/**", "ros__parameters", *path)
-        line = next((self.loaded.lines[full[:n]] for n in range(len(full), 0, -1) if full[:n] in self.loaded.lines),
-                    None)
-        return config_files.ConfigFileError([config_files.Problem(str(self.loaded.path), line,
-                                                                  config_files.field_path(full), expected, found)])
+        where = next((self.files.lines[path[:n]] for n in range(len(path), 0, -1) if path[:n] in self.files.lines),
+                     (self.files.path, None))
+        return config_files.ConfigFileError([config_files.Problem(str(where[0]), where[1],
+                                                                  config_files.field_path(path), expected, found)])
 
     def epoch(self) -> datetime | None:
         return None if self.shared.epoch is None else epochs.parse_epoch(self.shared.epoch)
@@ -156,13 +256,13 @@ class _Build:
         return out
 
     def scenario(self, epoch: datetime | None) -> Scenario:
-        path, shared = self.loaded.path, self.shared
+        path, shared, files = self.files.path, self.shared, self.files
         orbit_model = self.orbit(epoch)
         return Scenario(
             name=path.stem, path=path, spacecraft=spacecraft_from_model(shared.spacecraft),
             orbit=orbit_model.params if isinstance(orbit_model, orbits.CircularOrbit) else None,
             frame_id=shared.frame_id, body_frame_id=shared.body_frame_id,
-            node_params={k: v["ros__parameters"] for k, v in self.loaded.data.items() if k != "/**"},
+            node_params=files.node_params, spacecraft_path=files.spacecraft_path, params_path=files.params_path,
             epoch=epoch, orbit_model=orbit_model, field_model=self.field_model(epoch),
             environment=self.environment(), zones=self.zones(), sensors=sensors_from_model(shared.sensors),
             actuators=actuators_from_model(shared.actuators))

@@ -123,7 +123,7 @@ class SimulatorNode(Node):
         """Read and check every parameter (ConfigError naming the first bad one); the timing ones
         become attributes, the rest (initial state, checks) are returned."""
         section = self.scenario.node_params.get("simulator", {})
-        param = ParameterReader(self, SIMULATOR, section, source=str(self.scenario.path))
+        param = ParameterReader(self, SIMULATOR, section, source=str(self.scenario.node_params_path))
         self.step = param("step")
         top = (1 + 1e-9) / self.step
         self.publish_period = 1.0 / param("publish_rate", min(10.0, 1.0 / self.step), high=top)

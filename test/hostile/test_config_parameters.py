@@ -210,9 +210,9 @@ NODE_CASES = {
     "scenario file a list": (SIM, ["-p", "scenario:={tmp}/list.yaml"], C, ["list.yaml", "a mapping"]),
     "scenario file broken": (SIM, ["-p", "scenario:={tmp}/broken.yaml"], C, ["broken.yaml", "expected valid YAML"]),
     "scenario with a bad simulator value": (SIM, ["-p", "scenario:={tmp}/bad_step.yaml"], P,
-                                            ["'step'", "bad_step.yaml", "(0, 1]"]),
+                                            ["'step'", "bad_step.params.yaml", "(0, 1]"]),
     "scenario with an unknown simulator key": (SIM, ["-p", "scenario:={tmp}/sim_typo.yaml"], P,
-                                               ["lockstep_timout", "sim_typo.yaml"]),
+                                               ["lockstep_timout", "sim_typo.params.yaml"]),
     "missing --params-file": (SIM, ["--params-file", "no_such_params.yaml"], C,
                               ["no_such_params.yaml", "no such file", "current directory"]),
     "--params-file a directory": (SIM, ["--params-file", "{tmp}"], C, ["no such file"]),
@@ -294,15 +294,21 @@ REFUSAL = re.compile(r"^(\w+)\.py: \[(\d+) (\w+)\] (.+)$")
 
 
 def write_files(tmp: Path) -> None:
-    swift = (Path(scenario.__file__).resolve().parents[2] / "config" / "swift_demo.yaml").read_text()
+    shipped = Path(scenario.__file__).resolve().parents[2] / "config" / "scenarios"
+    sky, params = (shipped / "swift_demo.yaml").read_text(), (shipped / "swift_demo.params.yaml").read_text()
+
+    def swift_with(name: str, tuning: str) -> None:
+        """swift_demo's scenario (naming the shipped spacecraft) with its node tuning ``tuning`` beside it."""
+        (tmp / f"{name}.yaml").write_text(sky)
+        (tmp / f"{name}.params.yaml").write_text(tuning)
     (tmp / "list.yaml").write_text("- 1\n- 2\n")
     (tmp / "broken.yaml").write_text("{{{ not yaml\n")
-    (tmp / "bad_step.yaml").write_text(swift.replace("step: 0.05 ", "step: 5.0 "))
-    (tmp / "sim_typo.yaml").write_text(swift.replace("lockstep_timeout:", "lockstep_timout:"))
+    swift_with("bad_step", params.replace("step: 0.05 ", "step: 5.0 "))
+    swift_with("sim_typo", params.replace("lockstep_timeout:", "lockstep_timout:"))
     (tmp / "rtf_text.yaml").write_text("simulator:\n  ros__parameters:\n    real_time_factor: fast\n")
     (tmp / "typo.yaml").write_text("simulator:\n  ros__parameters:\n    real_time_facter: 2.0\n")
     (tmp / "rtf3.yaml").write_text("simulator:\n  ros__parameters:\n    real_time_factor: 3\n")
-    (tmp / "mine.yaml").write_text(swift.replace("real_time_factor: 8.0", "real_time_factor: 5.0"))
+    swift_with("mine", params.replace("real_time_factor: 8.0", "real_time_factor: 5.0"))
     scale = "{distribution: uniform, low: -0.9, high: 2.0}"
     for name, dispersions in (("campaign", "{}"), ("campaign_typo", f"{{inertia_scal: {scale}}}"),
                               ("campaign_wide", f"{{inertia_scale: {scale}}}")):

@@ -157,9 +157,11 @@ def test_a_real_sky_step_is_cheap_and_fourth_order(leo):
 
 # ------------------------------------------------------------------------- scenario keys checked
 def _file(tmp_path, **shared):
-    """leo_observatory with ``shared`` keys changed (``...``: removed); without its sensors unless
-    given (their Sun and Moon exclusions need the epoch some cases take away)."""
-    doc = yaml.safe_load((scenario.find("leo_observatory")).read_text())
+    """leo_observatory as one self-contained file with ``shared`` keys changed (``...``: removed);
+    without its sensors unless given (their Sun and Moon exclusions need the epoch some cases take away)."""
+    resolved = scenario.read(scenario.find("leo_observatory")).shared    # its scenario and spacecraft files resolved
+    doc = {"/**": {"ros__parameters": {**resolved.model_dump(mode="json", exclude_none=True, exclude={"orbit"}),
+                                       "orbit": resolved.orbit.model_dump(mode="json")}}}
     p = doc["/**"]["ros__parameters"]
     p.pop("sensors")
     for key, value in shared.items():
