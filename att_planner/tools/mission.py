@@ -84,7 +84,7 @@ class MissionDriver:
     def __init__(self, client, mission: mission_config.MissionConfig, log=print):
         self.client, self.mission, self.log = client, mission, log
         controller = mission.scenario.node_params.get("controller", {})
-        settle = float(controller.get("settle_time", ControllerConfig().settle_time))     # as the node reads it
+        settle = float(controller.get("settle_time_s", ControllerConfig().settle_time))     # as the node reads it
         estimator = mission.scenario.sensors.gyro is not None
         self.telemetry = Telemetry(client, estimator)
         self.executive = MissionExecutive.of_mission(mission, settle, converged=not estimator)
@@ -169,7 +169,7 @@ def fly_mission(mission: mission_config.MissionConfig, out: Path, log=print) -> 
     # that takes its whole wall-time budget still comes back before its slew's start
     pace = mission.start_lead / mission.time_budget
     params = {"simulator": {"step": 1.0 / rate, "publish_rate": rate, "clock_rate": rate, "real_time_factor": pace},
-              "controller": {"control_rate": rate, "momentum_dumping": mission.momentum_dumping,
+              "controller": {"control_rate_Hz": rate, "momentum_dumping": mission.momentum_dumping,
                              "handover_blend": mission.handover_blend},
               "estimator": {"publish_rate": rate}}
     name = mission.scenario.name

@@ -229,6 +229,8 @@ NODE_CASES = {
     "planner: not a scenario": ("planner", ["-p", "scenario:=controller_gains"], C,
                                 ["controller_gains.yaml", "/**: expected this key"]),
     "planner: unknown parameter (typo)": ("planner", ["-p", "time_budgett:=5.0"], P, ["time_budgett"]),
+    "controller: an old parameter name": ("controller", ["-p", "settle_time:=5.0"], P,
+                                          ["parameter 'settle_time'", "is renamed 'settle_time_s'"]),
     "planner: unknown warm-up scenario": ("planner", ["-p", "warm_up_scenarios:=swift_demo,no_such_scenario"], C,
                                           ["no_such_scenario"]),
     "planner: plan_markers integer": ("planner", ["-p", "plan_markers:=2"], P, ["'plan_markers'", "true or false"]),

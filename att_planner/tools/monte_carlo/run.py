@@ -7,7 +7,7 @@ on the flown truth.
 A run: the simulation starts at the maneuver's initial attitude and rest, dispersed; the loop
 ticks until the estimate is CONVERGED (at most the campaign's ``converge_timeout_s``), as the demo
 waits before it sends a goal; then the controller flies the plan and holds its end for
-``settle_time``. The outcomes are taken at every control instant of the flown truth.
+``settle_time_s``. The outcomes are taken at every control instant of the flown truth.
 
 The runs of a task fly as a batch (:func:`fly_batch`): each run's flight software steps on its
 own, the heavy numerics of a step are done for all the runs at once — the estimators' propagations,

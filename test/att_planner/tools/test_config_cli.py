@@ -45,6 +45,15 @@ def test_the_node_tuning_is_a_plain_ros_parameter_file(path):
         assert declared(node).problems(section["ros__parameters"]) == []
 
 
+def test_an_old_parameter_name_is_answered_with_its_new_name(tmp_path, capsys):
+    path = tmp_path / "old.params.yaml"
+    path.write_text("controller:\n  ros__parameters:\n    control_rate_Hz: 10.0\n    settle_time: 5.0\n")
+    assert config_cli.main(["check", str(path)]) == 2
+    assert (f"{path}:4: controller.ros__parameters.settle_time: expected a valid controller parameter "
+            f"[INVALID_PARAMETER]; found parameter 'settle_time' is renamed 'settle_time_s' (its unit in its name)"
+            in capsys.readouterr().out.splitlines())
+
+
 def test_a_bad_parameter_file_is_refused_naming_the_node_and_parameter(tmp_path, capsys):
     path = tmp_path / "my.params.yaml"
     path.write_text("simulator:\n  ros__parameters:\n    step: 5.0\n    lockstep_timout: 1.0\n"
