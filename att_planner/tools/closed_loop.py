@@ -84,7 +84,7 @@ class ClosedLoop:
                  q0=rot.IDENTITY, omega0=(0.0, 0.0, 0.0), wheel_speed0=None, simulation: Simulation | None = None,
                  key: Ed25519PrivateKey | None = None):
         """``overrides``: ``{node: {parameter: value}}`` over the scenario's sections (simulator
-        ``step``/``publish_rate``, every controller and estimator parameter); ``seed``: the noise
+        ``step_s``/``publish_rate_Hz``, every controller and estimator parameter); ``seed``: the noise
         seed (default the scenario's); ``simulation``: a prepared one (e.g. a dispersed truth);
         ``key``: the plan-signing key (default a new one; loops sharing one can share issued plans)."""
         overrides = overrides or {}
@@ -95,8 +95,9 @@ class ClosedLoop:
         sections = scenario.node_params
         sim_param = SectionReader(SIMULATOR, sections.get("simulator", {}), str(scenario.node_params_path),
                                   overrides.get("simulator"))
-        self.step = sim_param("step")
-        self.publish_period = 1.0 / sim_param("publish_rate", min(10.0, 1.0 / self.step), high=(1 + 1e-9) / self.step)
+        self.step = sim_param("step_s")
+        self.publish_period = 1.0 / sim_param("publish_rate_Hz", min(10.0, 1.0 / self.step),
+                                                high=(1 + 1e-9) / self.step)
         sim_param.refuse_unknown()
         self.key = key or Ed25519PrivateKey.generate()
         ctl_param = SectionReader(CONTROLLER, sections.get("controller", {}), str(scenario.node_params_path),

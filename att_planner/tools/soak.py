@@ -60,7 +60,7 @@ def run_soak(scenario: str, orbits: float, out_dir: str | Path, sample_period: f
     log = read_log(out / "soak.mcap", topics=[STATE, COMMAND])
     state, command = log[STATE], log[COMMAND]
     sim_time = float(state["header.stamp"][-1])
-    publish_rate = float(sim_params.get("publish_rate", 10.0))
+    publish_rate = float(sim_params.get("publish_rate_Hz", 10.0))
     expected = int(np.floor(sim_time * publish_rate + 1e-6)) + 1          # t = 0, 1/rate, ..., sim_time
     growth = {}
     for name, series in memory.items():

@@ -124,15 +124,15 @@ class SimulatorNode(Node):
         become attributes, the rest (initial state, checks) are returned."""
         section = self.scenario.node_params.get("simulator", {})
         param = ParameterReader(self, SIMULATOR, section, source=str(self.scenario.node_params_path))
-        self.step = param("step")
+        self.step = param("step_s")
         top = (1 + 1e-9) / self.step
-        self.publish_period = 1.0 / param("publish_rate", min(10.0, 1.0 / self.step), high=top)
+        self.publish_period = 1.0 / param("publish_rate_Hz", min(10.0, 1.0 / self.step), high=top)
         self.clock_period = 1.0 / param("clock_rate", min(50.0, 1.0 / self.step), high=top)
         # the 3D view: /tf (default: with every state) and the markers, in Hz of sim time; 0: off
         self.tf_rate = param("tf_rate", 1.0 / self.publish_period, high=top)
         self.marker_rate = param("marker_rate", min(1.0, 1.0 / self.step), high=top)
         self.real_time_factor = param("real_time_factor")
-        self.command_timeout = param("command_timeout")
+        self.command_timeout = param("command_timeout_s")
         self.end_time = param("end_time")      # s of sim time; 0: run until stopped
         # Hold sim time at zero until this many subscribers (recorder, controller) see the state,
         # so that no run starts before it is recorded and controlled; at most start_timeout s.

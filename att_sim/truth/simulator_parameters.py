@@ -4,24 +4,24 @@ from __future__ import annotations
 from att_msgs_py.parameters import Parameter, ParameterTable
 from att_sim.truth.simulation import DEFAULT_STEP
 
-PER_STEP = " (at most 1/step: one per integration step)"
-PER_STEP_OR_OFF = " (at most 1/step: one per integration step; 0: off)"
+PER_STEP = " (at most 1/step_s: one per integration step)"
+PER_STEP_OR_OFF = " (at most 1/step_s: one per integration step; 0: off)"
 INF = float("inf")
 
 SIMULATOR = ParameterTable("simulator", (
-    Parameter("step", float, DEFAULT_STEP, "integration step (RK4, inputs held over a step)", "s",
+    Parameter("step_s", float, DEFAULT_STEP, "integration step (RK4, inputs held over a step)", "s",
               0.0, 1.0, low_open=True),
-    Parameter("publish_rate", float, None, "rate of the state (and sensor) messages, in sim time", "Hz",
-              0.0, INF, low_open=True, default_rule="min(10, 1/step)", high_rule="1/step", hint=PER_STEP),
+    Parameter("publish_rate_Hz", float, None, "rate of the state (and sensor) messages, in sim time", "Hz",
+              0.0, INF, low_open=True, default_rule="min(10, 1/step_s)", high_rule="1/step_s", hint=PER_STEP),
     Parameter("clock_rate", float, None, "rate of /clock, in sim time", "Hz", 0.0, INF, low_open=True,
-              default_rule="min(50, 1/step)", high_rule="1/step", hint=PER_STEP),
+              default_rule="min(50, 1/step_s)", high_rule="1/step_s", hint=PER_STEP),
     Parameter("tf_rate", float, None, "rate of /tf and of the zone margins, in sim time (0: off)", "Hz", 0.0, INF,
-              default_rule="publish_rate", high_rule="1/step", hint=PER_STEP_OR_OFF),
+              default_rule="publish_rate_Hz", high_rule="1/step_s", hint=PER_STEP_OR_OFF),
     Parameter("marker_rate", float, None, "rate of the 3D view's markers, in sim time (0: off)", "Hz", 0.0, INF,
-              default_rule="min(1, 1/step)", high_rule="1/step", hint=PER_STEP_OR_OFF),
+              default_rule="min(1, 1/step_s)", high_rule="1/step_s", hint=PER_STEP_OR_OFF),
     Parameter("real_time_factor", float, 1.0, "sim time per wall time (0: as fast as possible)", "", 0.0, INF),
-    Parameter("command_timeout", float, 1.0, "sim time without a command after which the actuator inputs are "
-                                             "zeroed", "s", 0.0, INF, low_open=True),
+    Parameter("command_timeout_s", float, 1.0, "sim time without a command after which the actuator inputs "
+                                               "are zeroed", "s", 0.0, INF, low_open=True),
     Parameter("end_time", float, 0.0, "sim time at which the simulator stops (0: run until stopped)", "s", 0.0, INF),
     Parameter("wait_for_subscribers", int, 0, "subscribers to the state (recorder, controller, estimator) that "
                                               "must listen before sim time starts", "", 0, 1000),
@@ -46,4 +46,5 @@ SIMULATOR = ParameterTable("simulator", (
     Parameter("campaign", str, "", "Monte Carlo campaign file whose run run_seed is flown (dispersed truth; with "
                                    "run_seed)"),
     Parameter("run_seed", int, -1, "run seed of that campaign (-1: none; with campaign)", "", -1, 2**32 - 1),
-), "the truth simulation: dynamics, environment, sensors and actuators")
+), "the truth simulation: dynamics, environment, sensors and actuators",
+    renamed={"step": "step_s", "publish_rate": "publish_rate_Hz", "command_timeout": "command_timeout_s"})

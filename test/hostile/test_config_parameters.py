@@ -37,7 +37,7 @@ BASE = {
                        "wheel_axes": [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0], "wheel_inertia_kg_m2": 0.01,
                        "wheel_torque_max_Nm": 0.1, "wheel_speed_max_rad_s": 600.0, "dipole_max_Am2": 5.0},
         "orbit": {"altitude_m": 500000.0, "inclination_deg": 97.0}}},
-    "simulator": {"ros__parameters": {"step": 0.1, "publish_rate": 10.0}},
+    "simulator": {"ros__parameters": {"step_s": 0.1, "publish_rate_Hz": 10.0}},
 }
 
 
@@ -141,7 +141,7 @@ def test_the_base_scenario_of_these_cases_is_valid(tmp_path):
     path = tmp_path / "good.yaml"
     path.write_text(yaml.safe_dump(BASE))
     s = scenario.load(str(path))
-    assert s.spacecraft.n_wheels == 3 and s.node_params["simulator"]["step"] == 0.1
+    assert s.spacecraft.n_wheels == 3 and s.node_params["simulator"]["step_s"] == 0.1
     assert s.spacecraft.body_torque_max == 0.1 and s.orbit.altitude == 500000.0
 
 
@@ -166,7 +166,7 @@ P, C = "INVALID_PARAMETER", "INVALID_CONFIG"
 NODE_CASES = {
     # type
     "real_time_factor text": (SIM, ["-p", "real_time_factor:=fast"], P, ["'real_time_factor'", "a number"]),
-    "step text": (SIM, ["-p", "step:=abc"], P, ["'step'", "a number"]),
+    "step text": (SIM, ["-p", "step_s:=abc"], P, ["'step_s'", "a number"]),
     "wait_for_subscribers float": (SIM, ["-p", "wait_for_subscribers:=1.5"], P, ["'wait_for_subscribers'", "integer"]),
     "wait_for_subscribers text": (SIM, ["-p", "wait_for_subscribers:=many"], P, ["'wait_for_subscribers'"]),
     "lockstep integer": (SIM, ["-p", "lockstep:=1"], P, ["'lockstep'", "true or false"]),
@@ -179,17 +179,18 @@ NODE_CASES = {
     "real_time_factor negative": (SIM, ["-p", "real_time_factor:=-1.0"], P, ["'real_time_factor'", "[0, inf]"]),
     "real_time_factor inf": (SIM, ["-p", "real_time_factor:=.inf"], P, ["'real_time_factor'"]),
     "real_time_factor NaN": (SIM, ["-p", "real_time_factor:=.nan"], P, ["'real_time_factor'"]),
-    "step zero": (SIM, ["-p", "step:=0.0"], P, ["'step'", "(0, 1]"]),
-    "step 2 s": (SIM, ["-p", "step:=2.0"], P, ["'step'", "(0, 1]"]),
-    "publish_rate zero": (SIM, ["-p", "publish_rate:=0.0"], P, ["'publish_rate'"]),
-    "publish_rate above 1/step": (SIM, ["-p", "publish_rate:=1000.0"], P, ["'publish_rate'", "1/step"]),
+    "step zero": (SIM, ["-p", "step_s:=0.0"], P, ["'step_s'", "(0, 1]"]),
+    "step 2 s": (SIM, ["-p", "step_s:=2.0"], P, ["'step_s'", "(0, 1]"]),
+    "simulator: an old parameter name": (SIM, ["-p", "step:=0.1"], P, ["parameter 'step'", "is renamed 'step_s'"]),
+    "publish_rate zero": (SIM, ["-p", "publish_rate_Hz:=0.0"], P, ["'publish_rate_Hz'"]),
+    "publish_rate above 1/step": (SIM, ["-p", "publish_rate_Hz:=1000.0"], P, ["'publish_rate_Hz'", "1/step_s"]),
     "clock_rate negative": (SIM, ["-p", "clock_rate:=-5.0"], P, ["'clock_rate'"]),
     "tf_rate negative": (SIM, ["-p", "tf_rate:=-1.0"], P, ["'tf_rate'", "0: off"]),
     "tf_rate above 1/step": (SIM, ["-p", "tf_rate:=1000.0"], P, ["'tf_rate'", "1/step"]),
     "tf_rate NaN": (SIM, ["-p", "tf_rate:=.nan"], P, ["'tf_rate'"]),
     "marker_rate inf": (SIM, ["-p", "marker_rate:=.inf"], P, ["'marker_rate'"]),
     "marker_rate text": (SIM, ["-p", "marker_rate:=often"], P, ["'marker_rate'", "a number"]),
-    "command_timeout zero": (SIM, ["-p", "command_timeout:=0.0"], P, ["'command_timeout'"]),
+    "command_timeout zero": (SIM, ["-p", "command_timeout_s:=0.0"], P, ["'command_timeout_s'"]),
     "end_time negative": (SIM, ["-p", "end_time:=-1.0"], P, ["'end_time'"]),
     "wait_for_subscribers negative": (SIM, ["-p", "wait_for_subscribers:=-1"], P, ["'wait_for_subscribers'"]),
     "start_timeout zero": (SIM, ["-p", "start_timeout:=0.0"], P, ["'start_timeout'"]),
@@ -210,7 +211,7 @@ NODE_CASES = {
     "scenario file a list": (SIM, ["-p", "scenario:={tmp}/list.yaml"], C, ["list.yaml", "a mapping"]),
     "scenario file broken": (SIM, ["-p", "scenario:={tmp}/broken.yaml"], C, ["broken.yaml", "expected valid YAML"]),
     "scenario with a bad simulator value": (SIM, ["-p", "scenario:={tmp}/bad_step.yaml"], P,
-                                            ["'step'", "bad_step.params.yaml", "(0, 1]"]),
+                                            ["'step_s'", "bad_step.params.yaml", "(0, 1]"]),
     "scenario with an unknown simulator key": (SIM, ["-p", "scenario:={tmp}/sim_typo.yaml"], P,
                                                ["lockstep_timout", "sim_typo.params.yaml"]),
     "missing --params-file": (SIM, ["--params-file", "no_such_params.yaml"], C,
@@ -258,7 +259,8 @@ NODE_CASES = {
                                             P, ["'campaign'", "run seed 0", "triangle inequality"]),
     "estimator: a scenario without a gyro": ("estimator", ["-p", "scenario:=bruni_celani"], C, ["no gyro"]),
     "estimator: gate probability 1.5": ("estimator", ["-p", "gate_probability:=1.5"], P, ["'gate_probability'"]),
-    "estimator: publish_rate above the gyro's": ("estimator", ["-p", "publish_rate:=100.0"], P, ["'publish_rate'"]),
+    "estimator: publish_rate above the gyro's": ("estimator", ["-p", "publish_rate_Hz:=100.0"], P,
+                                                  ["'publish_rate_Hz'"]),
     "estimator: history zero": ("estimator", ["-p", "history:=0.0"], P, ["'history'"]),
     "estimator: wait_for_subscribers negative": ("estimator", ["-p", "wait_for_subscribers:=-1"], P,
                                                  ["'wait_for_subscribers'"]),
@@ -289,7 +291,7 @@ NODE_CASES = {
     "controller: m_max zero": ("controller", ["-p", "m_max:=0.0"], P, ["'m_max'", "dipole > 0"]),
     "planner: default_method unknown": ("planner", ["-p", "default_method:=magic"], P,
                                         ["'default_method'", "(the best)", "magic"]),
-    "simulator: step an integer out of range": (SIM, ["-p", "step:=2"], P, ["'step'", "(0, 1]"]),
+    "simulator: step an integer out of range": (SIM, ["-p", "step_s:=2"], P, ["'step_s'", "(0, 1]"]),
 }
 RCL_PARSE_ERROR = re.compile(r"^\[ERROR\] \[[\d.]+\] \[rcl\]: Failed to parse global arguments$")
 REFUSAL = re.compile(r"^(\w+)\.py: \[(\d+) (\w+)\] (.+)$")
@@ -305,7 +307,7 @@ def write_files(tmp: Path) -> None:
         (tmp / f"{name}.params.yaml").write_text(tuning)
     (tmp / "list.yaml").write_text("- 1\n- 2\n")
     (tmp / "broken.yaml").write_text("{{{ not yaml\n")
-    swift_with("bad_step", params.replace("step: 0.05 ", "step: 5.0 "))
+    swift_with("bad_step", params.replace("step_s: 0.05 ", "step_s: 5.0 "))
     swift_with("sim_typo", params.replace("lockstep_timeout:", "lockstep_timout:"))
     (tmp / "rtf_text.yaml").write_text("simulator:\n  ros__parameters:\n    real_time_factor: fast\n")
     (tmp / "typo.yaml").write_text("simulator:\n  ros__parameters:\n    real_time_facter: 2.0\n")

@@ -97,8 +97,8 @@ def test_every_numeric_parameter_with_a_bound_has_its_range(described):
     for node, name in bounded:
         d, _ = described[node][name]
         assert d.floating_point_range or d.integer_range, f"{node}.{name}"
-    step = described["simulator"]["step"][1].double_value
-    assert described["simulator"]["publish_rate"][0].floating_point_range[0].to_value == pytest.approx(1.0 / step)
+    step = described["simulator"]["step_s"][1].double_value
+    assert described["simulator"]["publish_rate_Hz"][0].floating_point_range[0].to_value == pytest.approx(1.0 / step)
 
 
 def test_integers_given_for_doubles_are_taken_as_doubles(described):

@@ -56,11 +56,11 @@ def test_an_old_parameter_name_is_answered_with_its_new_name(tmp_path, capsys):
 
 def test_a_bad_parameter_file_is_refused_naming_the_node_and_parameter(tmp_path, capsys):
     path = tmp_path / "my.params.yaml"
-    path.write_text("simulator:\n  ros__parameters:\n    step: 5.0\n    lockstep_timout: 1.0\n"
+    path.write_text("simulator:\n  ros__parameters:\n    step_s: 5.0\n    lockstep_timout: 1.0\n"
                     "navigator:\n  ros__parameters:\n    x: 1\n")
     assert config_cli.main(["check", str(path)]) == 2
     out = capsys.readouterr().out.splitlines()
-    assert any(line.startswith(f"{path}:3: simulator.ros__parameters.step: expected a valid simulator parameter "
+    assert any(line.startswith(f"{path}:3: simulator.ros__parameters.step_s: expected a valid simulator parameter "
                                f"[INVALID_PARAMETER]") for line in out), out
     assert any(line.startswith(f"{path}:4: simulator.ros__parameters.lockstep_timout:") for line in out), out
     assert any(line.startswith(f"{path}:5: navigator: expected a section of one of the nodes") for line in out), out
@@ -229,8 +229,8 @@ def test_show_a_shipped_scenario_with_where_each_value_came_from(capsys):
                                "torque_max_Nm:"),
                               ("orbit.altitude_m = 450000.0", config / "scenarios" / "swift_demo.yaml", "altitude_m:"),
                               ("sensors.gyro.rate_hz = 20.0", config / "spacecraft" / "swift_demo.yaml", "gyro:"),
-                              ("simulator.ros__parameters.step = 0.05",
-                               config / "scenarios" / "swift_demo.params.yaml", "step:"),
+                              ("simulator.ros__parameters.step_s = 0.05",
+                               config / "scenarios" / "swift_demo.params.yaml", "step_s:"),
                               ("demo.method = ", config / "scenarios" / "swift_demo.demo.yaml", "method:")):
         text = path.read_text().splitlines()
         number = next(i + 1 for i, line in enumerate(text) if line.strip().startswith(key))

@@ -72,8 +72,9 @@ def test_without_parameters_the_estimators_fixed_tuning_is_the_cores():
                                                  "estimate, got 'oracle'"),
     ({"controller": {"m_max": -1.0}}, "parameter 'm_max' (override): expected a dipole > 0 A m², got -1.0"),
     ({"estimator": {"gate_probability": 1.5}}, "parameter 'gate_probability' (override) = 1.5 is outside"),
-    ({"simulator": {"step": 2}}, "parameter 'step' (override) = 2.0 is outside (0, 1]"),
-    ({"simulator": {"publish_rate": 1000.0}}, "(at most 1/step: one per integration step)"),
+    ({"simulator": {"step_s": 2}}, "parameter 'step_s' (override) = 2.0 is outside (0, 1]"),
+    ({"simulator": {"step": 0.1}}, "parameter 'step' (override) is renamed 'step_s'"),
+    ({"simulator": {"publish_rate_Hz": 1000.0}}, "(at most 1/step_s: one per integration step)"),
     ({"controller": {"settle_tme": 1.0}}, "unknown parameter(s) settle_tme"),
     ({"controler": {"settle_time_s": 1.0}}, "overrides of unknown node(s) controler"),
 ])
@@ -111,7 +112,7 @@ def test_the_markdown_reference_lists_every_declared_parameter(node):
 def test_the_reference_has_every_node_and_writes_numbers_as_a_parameter_file_does():
     text = reference()
     assert all(f"## {node}\n" in text for node in NODE_PARAMETERS)
-    assert "| `step` | double | `0.05` | in (0, 1] | s |" in text
+    assert "| `step_s` | double | `0.05` | in (0, 1] | s |" in text
     assert "| `schedule_rate_max` | double | `.inf` |" in text
     assert "| `initial_attitude` | double[] | `[0.0, 0.0, 0.0, 1.0]` |" in text
     assert math.isclose(CONTROLLER["control_rate_Hz"].default, 1.0 / ControllerConfig().control_period)

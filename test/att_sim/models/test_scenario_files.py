@@ -39,7 +39,7 @@ def test_a_name_finds_the_scenario_its_spacecraft_its_tuning_and_its_demo(tree):
     assert s.path == tree / "scenarios" / "swift_demo.yaml"
     assert s.spacecraft_path == tree / "spacecraft" / "swift_demo.yaml"
     assert s.params_path == s.node_params_path == tree / "scenarios" / "swift_demo.params.yaml"
-    assert s.node_params["simulator"]["step"] == 0.05 and s.node_params["demo"]["method"] == "slepian_minimum_time"
+    assert s.node_params["simulator"]["step_s"] == 0.05 and s.node_params["demo"]["method"] == "slepian_minimum_time"
     assert s.spacecraft.body_torque_max == 0.1 and s.sensors.gyro is not None and s.orbit.altitude == 450e3
     assert "swift_demo" in scenario.available()
 
