@@ -148,7 +148,15 @@ def schema(kind: str | None = None) -> dict:
     """The JSON Schema of ``kind`` (None: of every kind, by name)."""
     if kind is None:
         return {k: schema(k) for k in KINDS}
-    out = _finite_defaults(TypeAdapter(KINDS[kind][1]).json_schema(by_alias=True))
+    if kind == "parameters":                  # each node's section typed by that node's parameter table
+        out = {"type": "object", "additionalProperties": False, "title": "parameters",
+               "description": "a ROS 2 parameter file: one ros__parameters mapping per node",
+               "properties": {node: {"type": "object", "additionalProperties": False, "required": ["ros__parameters"],
+                                     "properties": {"ros__parameters": declared(node).json_schema()}}
+                              for node in NODE_PARAMETERS}}
+        out = _finite_defaults(out)
+    else:
+        out = _finite_defaults(TypeAdapter(KINDS[kind][1]).json_schema(by_alias=True))
     out.setdefault("title", kind)
     out["$schema"] = "https://json-schema.org/draft/2020-12/schema"
     return out

@@ -247,3 +247,16 @@ def test_show_refuses_a_scenario_with_real_problems(tmp_path, capsys):
     path.write_text("/**:\n  ros__parameters:\n    spacecraft:\n      inertia_kg_m2: [1, 1, 5]\n")
     assert config_cli.main(["show", str(path)]) == 2
     assert "triangle inequality" in capsys.readouterr().out
+
+
+def test_the_parameter_schema_types_each_node_section_by_its_table():
+    """Editors complete a parameter file from each node's table: every declared parameter with its
+    unit in the description, and nothing else."""
+    from att_planner.tools.node_parameters import NODE_PARAMETERS, declared
+    nodes = config_cli.schema("parameters")["properties"]
+    assert set(nodes) == set(NODE_PARAMETERS)
+    for node, section in nodes.items():
+        params = section["properties"]["ros__parameters"]
+        assert set(params["properties"]) == set(declared(node).parameters) and params["additionalProperties"] is False
+    step = nodes["simulator"]["properties"]["ros__parameters"]["properties"]["step_s"]
+    assert "[s]" in step["description"] and (step["exclusiveMinimum"], step["maximum"]) == (0.0, 1.0)
