@@ -168,7 +168,7 @@ def fly_mission(mission: mission_config.MissionConfig, out: Path, log=print) -> 
     # the simulator does not wait for the planner: at most start_lead / time_budget × real time, a plan
     # that takes its whole wall-time budget still comes back before its slew's start
     pace = mission.start_lead / mission.time_budget
-    params = {"simulator": {"step_s": 1.0 / rate, "publish_rate_Hz": rate, "clock_rate": rate,
+    params = {"simulator": {"step_s": 1.0 / rate, "publish_rate_Hz": rate, "clock_rate_Hz": rate,
                             "real_time_factor": pace},
               "controller": {"control_rate_Hz": rate, "momentum_dumping": mission.momentum_dumping,
                              "handover_blend": mission.handover_blend},

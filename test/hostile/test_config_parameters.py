@@ -184,25 +184,25 @@ NODE_CASES = {
     "simulator: an old parameter name": (SIM, ["-p", "step:=0.1"], P, ["parameter 'step'", "is renamed 'step_s'"]),
     "publish_rate zero": (SIM, ["-p", "publish_rate_Hz:=0.0"], P, ["'publish_rate_Hz'"]),
     "publish_rate above 1/step": (SIM, ["-p", "publish_rate_Hz:=1000.0"], P, ["'publish_rate_Hz'", "1/step_s"]),
-    "clock_rate negative": (SIM, ["-p", "clock_rate:=-5.0"], P, ["'clock_rate'"]),
-    "tf_rate negative": (SIM, ["-p", "tf_rate:=-1.0"], P, ["'tf_rate'", "0: off"]),
-    "tf_rate above 1/step": (SIM, ["-p", "tf_rate:=1000.0"], P, ["'tf_rate'", "1/step"]),
-    "tf_rate NaN": (SIM, ["-p", "tf_rate:=.nan"], P, ["'tf_rate'"]),
-    "marker_rate inf": (SIM, ["-p", "marker_rate:=.inf"], P, ["'marker_rate'"]),
-    "marker_rate text": (SIM, ["-p", "marker_rate:=often"], P, ["'marker_rate'", "a number"]),
+    "clock_rate negative": (SIM, ["-p", "clock_rate_Hz:=-5.0"], P, ["'clock_rate_Hz'"]),
+    "tf_rate negative": (SIM, ["-p", "tf_rate_Hz:=-1.0"], P, ["'tf_rate_Hz'", "0: off"]),
+    "tf_rate above 1/step": (SIM, ["-p", "tf_rate_Hz:=1000.0"], P, ["'tf_rate_Hz'", "1/step_s"]),
+    "tf_rate NaN": (SIM, ["-p", "tf_rate_Hz:=.nan"], P, ["'tf_rate_Hz'"]),
+    "marker_rate inf": (SIM, ["-p", "marker_rate_Hz:=.inf"], P, ["'marker_rate_Hz'"]),
+    "marker_rate text": (SIM, ["-p", "marker_rate_Hz:=often"], P, ["'marker_rate_Hz'", "a number"]),
     "command_timeout zero": (SIM, ["-p", "command_timeout_s:=0.0"], P, ["'command_timeout_s'"]),
-    "end_time negative": (SIM, ["-p", "end_time:=-1.0"], P, ["'end_time'"]),
+    "end_time negative": (SIM, ["-p", "end_time_s:=-1.0"], P, ["'end_time_s'"]),
     "wait_for_subscribers negative": (SIM, ["-p", "wait_for_subscribers:=-1"], P, ["'wait_for_subscribers'"]),
     "start_timeout zero": (SIM, ["-p", "start_timeout:=0.0"], P, ["'start_timeout'"]),
-    "lockstep_timeout zero": (SIM, ["-p", "lockstep_timeout:=0.0"], P, ["'lockstep_timeout'"]),
+    "lockstep_timeout zero": (SIM, ["-p", "lockstep_timeout_s:=0.0"], P, ["'lockstep_timeout_s'"]),
     "initial_attitude norm 2": (SIM, ["-p", "initial_attitude:=[0.0,0.0,0.0,2.0]"], P, ["'initial_attitude'", "norm"]),
     "initial_attitude 3 numbers": (SIM, ["-p", "initial_attitude:=[0.0,0.0,1.0]"], P, ["'initial_attitude'", "4"]),
     "initial_rate 2 numbers": (SIM, ["-p", "initial_rate:=[0.0,0.0]"], P, ["'initial_rate'", "3"]),
     "initial_rate NaN": (SIM, ["-p", "initial_rate:=[.nan,0.0,0.0]"], P, ["'initial_rate'"]),
     "initial_rate above max_reset_rate": (SIM, ["-p", "initial_rate:=[5.0,0.0,0.0]"], P,
-                                          ["'initial_rate'", "max_reset_rate"]),
+                                          ["'initial_rate'", "max_reset_rate_rad_s"]),
     "command_limit_factor below 1": (SIM, ["-p", "command_limit_factor:=0.5"], P, ["'command_limit_factor'"]),
-    "max_reset_rate zero": (SIM, ["-p", "max_reset_rate:=0.0"], P, ["'max_reset_rate'"]),
+    "max_reset_rate zero": (SIM, ["-p", "max_reset_rate_rad_s:=0.0"], P, ["'max_reset_rate_rad_s'"]),
     "unknown parameter (typo)": (SIM, ["-p", "real_time_facter:=3.0"], P, ["real_time_facter"]),
     # scenario and files
     "unknown scenario": (SIM, ["-p", "scenario:=no_such_scenario"], C, ["'scenario'", "no_such_scenario", "known:"]),
@@ -310,7 +310,7 @@ def write_files(tmp: Path) -> None:
     (tmp / "list.yaml").write_text("- 1\n- 2\n")
     (tmp / "broken.yaml").write_text("{{{ not yaml\n")
     swift_with("bad_step", params.replace("step_s: 0.05 ", "step_s: 5.0 "))
-    swift_with("sim_typo", params.replace("lockstep_timeout:", "lockstep_timout:"))
+    swift_with("sim_typo", params.replace("lockstep_timeout_s:", "lockstep_timout_s:"))
     (tmp / "rtf_text.yaml").write_text("simulator:\n  ros__parameters:\n    real_time_factor: fast\n")
     (tmp / "typo.yaml").write_text("simulator:\n  ros__parameters:\n    real_time_facter: 2.0\n")
     (tmp / "rtf3.yaml").write_text("simulator:\n  ros__parameters:\n    real_time_factor: 3\n")
