@@ -337,6 +337,6 @@ class SectionReader(Reader):
                                                            f"known: {', '.join(self.table.parameters)}")
 
 
-SCENARIO = Parameter("scenario", str, "swift_demo", "the scenario: a name of a file in config/ (without .yaml) or "
-                                                    "a path to a scenario file")
+SCENARIO = Parameter("scenario", str, "swift_demo", "the scenario: a name (config/scenarios/NAME.yaml, its "
+                                                    "spacecraft and NAME.params.yaml) or a path to a scenario file")
 SCENARIO_TABLE = ParameterTable("any", (SCENARIO,))
