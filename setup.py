@@ -18,6 +18,8 @@ setup(
         ("share/ament_index/resource_index/packages", ["resource/" + PACKAGE]),
         ("share/" + PACKAGE, ["package.xml"]),
         ("share/" + PACKAGE + "/config", glob("config/*.yaml")),
+        ("share/" + PACKAGE + "/config/spacecraft", glob("config/spacecraft/*.yaml")),
+        ("share/" + PACKAGE + "/config/scenarios", glob("config/scenarios/*.yaml")),
         ("share/" + PACKAGE + "/config/targets", glob("config/targets/*.yaml")),
         ("share/" + PACKAGE + "/config/missions", glob("config/missions/*.yaml")),
         ("share/" + PACKAGE + "/config/schemas", glob("config/schemas/*.schema.json")),

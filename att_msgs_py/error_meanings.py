@@ -164,7 +164,7 @@ MEANINGS: dict[ErrorCode, str] = {
         '`/simulator/reset` with a non-finite field; an attitude whose norm is off 1 by more than 1e-3; the '
         'wrong number of wheel speeds (empty: zeros) or one beyond `wheel_speed_max` relative to the body (`Ω '
         '− Gᵀω`); a non-zero `orbit_phase` on a kepler or tle orbit (only a circular orbit takes a phase); '
-        '‖body_rate‖ above `max_reset_rate`; |orbit_phase| above 1e6 rad'
+        '‖body_rate‖ above `max_reset_rate_rad_s`; |orbit_phase| above 1e6 rad'
     ),
     ErrorCode.INVALID_COMMAND: (
         '(logged) an actuator command with an unknown mode, the wrong number of wheel torques (empty is '

@@ -140,6 +140,9 @@ class ParameterReader(Reader):
         known = set(self.table.parameters) | set(SHARED_PARAMETERS)
         for where, names in ((self.source or "the scenario file", set(self.values)),
                              ("the command line or a --params-file", overrides)):
+            old = sorted(n for n in names if n in self.table.renamed)
+            if old:
+                raise self.table.renamed_error(old[0], f" (from {where})")
             unknown = sorted(n for n in names - known if not n.startswith(SHARED_PREFIXES))
             if unknown:
                 raise ConfigError(ErrorCode.INVALID_PARAMETER,

@@ -185,13 +185,23 @@ def _within(value, low, high, low_open: bool, high_open: bool, allow_inf: bool) 
 
 
 class ParameterTable:
-    """A node's parameters by name, in the order the node documents them."""
+    """A node's parameters by name, in the order the node documents them; ``renamed``: each old
+    parameter name and its new name (the unit in the name), an old name answered with its new one."""
 
-    def __init__(self, node: str, parameters: tuple[Parameter, ...], summary: str = ""):
+    def __init__(self, node: str, parameters: tuple[Parameter, ...], summary: str = "",
+                 renamed: dict[str, str] | None = None):
         self.node, self.summary = node, summary
         self.parameters = {p.name: p for p in parameters}
+        self.renamed = dict(renamed or {})
         if len(self.parameters) != len(parameters):
             raise ValueError(f"node '{node}': a parameter is declared twice")
+        if set(self.renamed) & set(self.parameters) or not set(self.renamed.values()) <= set(self.parameters):
+            raise ValueError(f"node '{node}': a renamed parameter is declared, or its new name is not")
+
+    def renamed_error(self, name: str, where: str = "") -> ConfigError:
+        """The refusal of the old parameter name ``name``, with its new name."""
+        return ConfigError(ErrorCode.INVALID_PARAMETER, f"parameter '{name}'{where} is renamed "
+                                                        f"'{self.renamed[name]}' (its unit in its name)")
 
     def __getitem__(self, name: str) -> Parameter:
         return self.parameters[name]
@@ -206,15 +216,15 @@ class ParameterTable:
         return len(self.parameters)
 
     def __add__(self, other: ParameterTable) -> ParameterTable:
-        return ParameterTable(self.node, (*self, *other), self.summary)
+        return ParameterTable(self.node, (*self, *other), self.summary, {**self.renamed, **other.renamed})
 
     def problems(self, values: dict, where: str = "", allowed=()) -> list[ConfigError]:
         """Every problem of a node section ``values`` (a scenario's or a ``--params-file``'s) at once,
         each a ConfigError naming its parameter: an undeclared name (a typo; ``allowed``: names a node
         shares, such as ``use_sim_time``), a value its declaration refuses. A bound found at start-up
         (``high_rule``) is not checked here: the node checks it."""
-        out = []
-        unknown = sorted(set(values) - set(self.parameters) - set(allowed))
+        out = [self.renamed_error(name, where) for name in values if name in self.renamed]
+        unknown = sorted(set(values) - set(self.parameters) - set(allowed) - set(self.renamed))
         if unknown:
             out.append(ConfigError(ErrorCode.INVALID_PARAMETER,
                                    f"unknown {self.node} parameter(s) {clip(', '.join(unknown), 120)}{where}; "
@@ -322,12 +332,17 @@ class SectionReader(Reader):
         return spec.check(value, where, high)
 
     def refuse_unknown(self) -> None:
+        for names, where in ((self.overrides, " (override)"), (self.values, f" (from {self.source})")):
+            old = sorted(n for n in names if n in self.table.renamed)
+            if old:
+                raise self.table.renamed_error(old[0], where)
         unknown = sorted(set(self.overrides) - set(self.table.parameters))
         if unknown:
             raise ConfigError(ErrorCode.INVALID_PARAMETER, f"unknown parameter(s) {clip(', '.join(unknown), 120)}; "
                                                            f"known: {', '.join(self.table.parameters)}")
 
 
-SCENARIO = Parameter("scenario", str, "swift_demo", "the scenario: a file name (without .yaml) in config/ or "
-                                                    "$ATT_CONFIG_PATH, or a path to a scenario file")
+SCENARIO = Parameter("scenario", str, "swift_demo", "the scenario: a name (config/scenarios/NAME.yaml, its "
+                                                    "spacecraft and NAME.params.yaml, also looked up in "
+                                                    "$ATT_CONFIG_PATH) or a path to a scenario file")
 SCENARIO_TABLE = ParameterTable("any", (SCENARIO,))

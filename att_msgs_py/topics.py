@@ -67,11 +67,11 @@ ABOUT = {
     WHEEL_SPEEDS: "tachometers: `wheel_i` velocity relative to the body",
     SENSOR_TRUTH: "the gyro's and magnetometer's actual biases, for evaluation only (no flight node reads it)",
     ESTIMATE: "attitude, rate, gyro bias, their covariances, health",
-    TF: "the body frame under the inertial frame (rotation: the truth attitude, no translation) at `tf_rate`; "
+    TF: "the body frame under the inertial frame (rotation: the truth attitude, no translation) at `tf_rate_Hz`; "
         "with an epoch also the Earth-fixed frame `itrs`",
     SIM_MARKERS: "the zones as cones at their current directions (keep-out red, keep-in green), the sensor "
-                 "boresights, Sun, Moon and Earth directions, at `marker_rate`",
-    ZONE_MARGINS: "each scenario zone's truth margin (rad, >= 0 clear) and the smallest, at `tf_rate`",
+                 "boresights, Sun, Moon and Earth directions, at `marker_rate_Hz`",
+    ZONE_MARGINS: "each scenario zone's truth margin (rad, >= 0 clear) and the smallest, at `tf_rate_Hz`",
     PLAN_MARKERS: "the latest plan's boresight path (inertial frame, latched)",
     MISSION_EVENTS: "a mission's decisions, slews, dwells, parks and missed targets with why (latched)",
     PLAN_MANEUVER: "plan a rest-to-rest maneuver (or one ending on a pointing law), verified and signed",

@@ -33,9 +33,9 @@ CONTROLLER = ParameterTable("controller", (
               default_rule="true when the scenario's wheels have friction"),
     Parameter("initial_mode", int, int(ControlMode.IDLE), "control mode at start (" + ", ".join(
         f"{m}: {ControlMode(m).name}" for m in INITIAL_MODES) + ")", choices=INITIAL_MODES),
-    Parameter("control_rate", float, 1.0 / _C.control_period, "rate of the commands, in sim time", "Hz", 0.0, 1000.0,
-              low_open=True),
-    Parameter("settle_time", float, _C.settle_time, "time held on the final attitude after a plan ends", "s",
+    Parameter("control_rate_Hz", float, 1.0 / _C.control_period, "rate of the commands, in sim time", "Hz", 0.0,
+              1000.0, low_open=True),
+    Parameter("settle_time_s", float, _C.settle_time, "time held on the final attitude after a plan ends", "s",
               0.0, 86_400.0),
     Parameter("tracking_kp", float, _C.tracking_kp, "attitude feedback gain around the plan reference", "N m/rad",
               0.0, INF),
@@ -85,7 +85,7 @@ CONTROLLER = ParameterTable("controller", (
     Parameter("resync_timeout", float, _G.resync_timeout, "wall time without an accepted state after which the "
                                                           "held publisher's stamps may jump", "s", 0.0, 3600.0,
               low_open=True),
-    Parameter("wall_timeout", float, 2.0, "wall time without a state after which the command is zero and "
+    Parameter("wall_timeout_s", float, 2.0, "wall time without a state after which the command is zero and "
                                           "state_stale is reported", "s", 0.0, 3600.0, low_open=True),
     Parameter("wait_for_subscribers", int, 0, "subscribers to the commands that must listen before the controller "
                                               "takes its inputs", "", 0, 1000),
@@ -100,4 +100,5 @@ CONTROLLER = ParameterTable("controller", (
     Parameter("mode_sequence_ahead", float, MAX_AHEAD, "largest lead of a mode sequence over the controller's wall "
                                                        "clock (with require_signed_modes)", "s", 0.0, 86_400.0,
               low_open=True),
-), "the attitude controller: plan tracking, pointing, magnetorquer and safe modes")
+), "the attitude controller: plan tracking, pointing, magnetorquer and safe modes",
+    renamed={"control_rate": "control_rate_Hz", "settle_time": "settle_time_s", "wall_timeout": "wall_timeout_s"})

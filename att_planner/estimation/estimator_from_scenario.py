@@ -16,7 +16,7 @@ def estimator_config(param, s: Scenario) -> EstimatorConfig:
     :data:`~att_planner.estimation.estimator_parameters.ESTIMATOR` (datasheet units), defaulting to
     :meth:`Estimator.default_config`."""
     d = Estimator.default_config(s.sensors, 1.0 / s.sensors.gyro.rate)
-    rate = param("publish_rate", 1.0 / d.publish_period, high=s.sensors.gyro.rate)
+    rate = param("publish_rate_Hz", 1.0 / d.publish_period, high=s.sensors.gyro.rate)
     return EstimatorConfig(
         publish_period=1.0 / rate,
         arw=param("arw_deg_per_sqrt_h", d.arw * math.sqrt(HOUR) / DEG) * DEG / math.sqrt(HOUR),

@@ -13,7 +13,7 @@ _E = EstimatorConfig()
 _DATASHEET = "from the gyro's datasheet (Estimator.default_config)"
 
 ESTIMATOR = ParameterTable("estimator", (
-    Parameter("publish_rate", float, None, "rate of the estimates, in sim time", "Hz", 0.0, float("inf"),
+    Parameter("publish_rate_Hz", float, None, "rate of the estimates, in sim time", "Hz", 0.0, float("inf"),
               low_open=True, default_rule="the gyro's rate", high_rule="the gyro's rate"),
     Parameter("arw_deg_per_sqrt_h", float, None, "angle random walk of the gyro model", "deg/sqrt(h)", 0.0, 100.0,
               low_open=True, default_rule=_DATASHEET),
@@ -57,4 +57,5 @@ ESTIMATOR = ParameterTable("estimator", (
                                               "takes its inputs", "", 0, 1000),
     Parameter("start_timeout", float, 60.0, "wall time waited for those subscribers before taking inputs anyway", "s",
               0.0, 3600.0, low_open=True),
-), "the attitude estimator: a multiplicative extended Kalman filter (MEKF) on the gyro")
+), "the attitude estimator: a multiplicative extended Kalman filter (MEKF) on the gyro",
+    renamed={"publish_rate": "publish_rate_Hz"})

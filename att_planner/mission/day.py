@@ -95,14 +95,14 @@ def day_report(mcap_path: str | Path, scenario: scen.Scenario) -> dict:
                        window=max(1.0, float(t[-1] - t[0])))
     margins = zone_sky.margins(t, q, true=True)
     table = target_table(events, t, q, margins, scenario)
-    orbit = scen.shared_params(scen.read_document(scenario.path)).get("orbit", {})
+    orbit = scen.read(scenario.path).shared.orbit
     sc = scenario.spacecraft
     relative = np.asarray(state["wheel_speeds"], float) - np.asarray(state["body_rate"], float) @ sc.wheel_axes
     sensor_axis = next((e.sensor_axis for e in events if e.target), np.zeros(3))
     observed = sum(x["observed"] for x in table)
     return {
         "mcap": str(mcap_path), "epoch": (scenario.epoch + timedelta(seconds=float(t[0]))).isoformat(),
-        "sim_seconds": float(t[-1] - t[0]), "tle": [orbit.get("line1", ""), orbit.get("line2", "")],
+        "sim_seconds": float(t[-1] - t[0]), "tle": [getattr(orbit, "line1", ""), getattr(orbit, "line2", "")],
         "sensor_axis": list(sensor_axis), "targets": table,
         "zones": [{"name": z.name, "body": z.body, "half_angle_deg": math.degrees(z.half_angle), "keep_in": z.keep_in,
                    "sensor_axis": list(z.sensor_axis), "min_margin_deg": float(np.degrees(margins[:, i].min()))}

@@ -1,6 +1,7 @@
 """Target lists of a mission: YAML files of what to observe and for how long.
 
-Two kinds, one file each (``config/targets/``; read with ``yaml.safe_load`` only)::
+Two kinds, one file each (``config/targets/``; read by the one loader,
+:mod:`att_sim.models.config_files`, and validated by :mod:`att_planner.mission.schema`)::
 
     kind: inertial                 # an observatory's sources: J2000 right ascension and declination
     scenario: leo_observatory      # the spacecraft and sky they are observed from
@@ -18,8 +19,8 @@ An inertial source becomes a schedule target attitude (:func:`pointing_attitude`
 sensor axis on the source, the body axis after it (x → z → y → x) as near ``roll_reference`` as the
 pointing allows (the vernal equinox where the source lies within a degree of the reference). A
 ground site stays a site: the pointing modes track it through its dwell. Every field is
-checked; a bad file is refused with a :class:`~att_msgs_py.errors.ConfigError` naming the file,
-the target and the field.
+checked; a bad file is refused with a :class:`~att_msgs_py.errors.ConfigError` (``INVALID_CONFIG``)
+listing every problem as ``file:line: targets[i].field: expected ...; found ...``.
 """
 from __future__ import annotations
 
@@ -29,17 +30,12 @@ from pathlib import Path
 
 import numpy as np
 
-from att_msgs_py.errors import ConfigError, ErrorCode, clip
-from att_msgs_py.limits import MAX_TARGETS  # as a PlanSchedule request
+from att_msgs_py.errors import clip
 from att_planner.mission import schema
+from att_sim.models import config_files
 from att_sim.models import rotations as rot
 from att_sim.models import scenario as scen
-from att_sim.models.config_schema import declared
 
-KINDS = {"inertial": ("name", "ra_deg", "dec_deg", "dwell_s"),
-         "ground": ("name", "lat_deg", "lon_deg", "alt_m", "dwell_s")}
-FILE_KEYS = {"inertial": ("kind", "scenario", "roll_reference", "targets"),
-             "ground": ("kind", "scenario", "min_elevation_deg", "targets")}
 CELESTIAL_NORTH = np.array([0.0, 0.0, 1.0])
 
 
@@ -76,48 +72,12 @@ class TargetList:
         return {t.name: t.dwell for t in self.targets}
 
 
-def _invalid(path, message: str) -> ConfigError:
-    return ConfigError(ErrorCode.INVALID_CONFIG, f"target list {clip(path, 200)}: {message}")
-
-
-def _number(path, entry: dict, key: str, label: str, low: float, high: float) -> float:
-    value = entry.get(key)
-    number = None if isinstance(value, bool) or not isinstance(value, (int, float)) else float(value)
-    if number is None or not (math.isfinite(number) and low <= number <= high):
-        raise _invalid(path, f"{label}.{key} = {clip(repr(value), 60)} is not a number in [{low:g}, {high:g}]")
-    return number
-
-
-def _declared(path, entry: dict, key: str, label: str, model) -> float:
-    """``entry[key]`` (or the default ``model`` declares) checked against the range ``model`` declares."""
-    default, low, high = declared(model, key)[:3]
-    return _number(path, entry if default is None else {key: default, **entry}, key, label, low, high)
-
-
-def _target(path, kind: str, i: int, entry) -> Source | Site:
-    label = f"targets[{i}]"
-    if not isinstance(entry, dict):
-        raise _invalid(path, f"{label} is not a mapping of {', '.join(KINDS[kind])}")
-    unknown = sorted(str(k) for k in set(entry) - set(KINDS[kind]))
-    missing = [k for k in KINDS[kind] if k not in entry and k != "alt_m"]
-    if unknown or missing:
-        raise _invalid(path, f"{label} has {'unknown' if unknown else 'no'} key(s) "
-                             f"{clip(', '.join(unknown or missing), 120)} "
-                             f"(a {kind} target has {', '.join(KINDS[kind])})")
-    name = entry["name"]
-    if not isinstance(name, str) or not name or not name.isprintable() or len(name) > 128:
-        raise _invalid(path, f"{label}.name = {clip(repr(name), 60)} is not a printable name of 1-128 characters")
-    label = f"{label} ('{name}')"
-    model = schema.Source if kind == "inertial" else schema.Site
-
-    def number(key):
-        return _declared(path, entry, key, label, model)
-    dwell = number("dwell_s")
+def _target(kind: str, entry: schema.Source | schema.Site) -> Source | Site:
     if kind == "inertial":
-        ra, dec = math.radians(number("ra_deg")), math.radians(number("dec_deg"))
-        return Source(name, np.array([math.cos(dec) * math.cos(ra), math.cos(dec) * math.sin(ra), math.sin(dec)]),
-                      dwell)
-    return Site(name, math.radians(number("lat_deg")), math.radians(number("lon_deg")), number("alt_m"), dwell)
+        ra, dec = math.radians(entry.ra_deg), math.radians(entry.dec_deg)
+        return Source(entry.name, np.array([math.cos(dec) * math.cos(ra), math.cos(dec) * math.sin(ra),
+                                            math.sin(dec)]), entry.dwell_s)
+    return Site(entry.name, math.radians(entry.lat_deg), math.radians(entry.lon_deg), entry.alt_m, entry.dwell_s)
 
 
 def config_file(folder: str, name: str, what: str) -> Path:
@@ -138,40 +98,28 @@ def find(name: str) -> Path:
     return config_file("targets", name, "target list")
 
 
+def read(path) -> config_files.Loaded:
+    """The target list file ``path`` read by the one loader and validated by its kind's model
+    (:func:`att_planner.mission.schema.target_list_model`), its scenario resolved;
+    :class:`att_sim.models.config_files.ConfigFileError` (``INVALID_CONFIG``) with every problem.
+    Anchors and aliases are accepted as ``yaml.safe_dump`` writes them, their expansion bounded."""
+    path = Path(path)
+    data, lines = config_files.read_yaml(path, aliases=True)
+    model = config_files.validate(path, schema.target_list_model, data, lines)
+    if model.scenario not in scen.available():
+        raise config_files.ConfigFileError([config_files.Problem(
+            str(path), lines.get(("scenario",)), "scenario", "the name of a scenario",
+            f"{clip(repr(model.scenario), 80)}, which names none (known: {', '.join(scen.available()) or 'none'})")])
+    return config_files.Loaded(path, model, data, lines)
+
+
 def load(name: str) -> TargetList:
-    """The target list ``name`` (:func:`find`), every field checked (module docstring)."""
+    """The target list ``name`` (:func:`find`), read and validated (:func:`read`)."""
     path = find(name)
-    doc = scen.read_document(path)
-    if not isinstance(doc, dict) or doc.get("kind") not in KINDS:
-        kind = doc.get("kind") if isinstance(doc, dict) else None
-        raise _invalid(path, f"kind = {clip(repr(kind), 60)}; a target list is of kind {' or '.join(KINDS)}")
-    kind = doc["kind"]
-    unknown = sorted(str(k) for k in set(doc) - set(FILE_KEYS[kind]))
-    if unknown:
-        raise _invalid(path, f"unknown key(s) {clip(', '.join(unknown), 120)} (known: {', '.join(FILE_KEYS[kind])})")
-    scenario = doc.get("scenario")
-    if not isinstance(scenario, str) or scenario not in scen.available():
-        raise _invalid(path, f"scenario = {clip(repr(scenario), 80)} is not a known scenario")
-    entries = doc.get("targets")
-    if not isinstance(entries, list) or not entries or len(entries) > MAX_TARGETS:
-        raise _invalid(path, f"targets must list 1 to {MAX_TARGETS} targets, got "
-                             f"{len(entries) if isinstance(entries, list) else clip(repr(entries), 60)}")
-    targets = [_target(path, kind, i, e) for i, e in enumerate(entries)]
-    names = [t.name for t in targets]
-    repeat = next((n for i, n in enumerate(names) if n in names[:i]), None)
-    if repeat is not None:
-        raise _invalid(path, f"target name '{repeat}' appears twice; names must be distinct")
-    extra = {}
-    if kind == "inertial":
-        ref = doc.get("roll_reference", CELESTIAL_NORTH.tolist())
-        vec = np.asarray(ref, float) if isinstance(ref, list) and len(ref) == 3 and all(
-            isinstance(v, (int, float)) and not isinstance(v, bool) for v in ref) else None
-        if vec is None or not np.isfinite(vec).all() or np.linalg.norm(vec) < 1e-9:
-            raise _invalid(path, f"roll_reference = {clip(repr(ref), 60)} is not a non-zero 3-vector")
-        extra["roll_reference"] = vec / np.linalg.norm(vec)
-    else:
-        extra["min_elevation"] = math.radians(_declared(path, doc, "min_elevation_deg", "file", schema.GroundTargets))
-    return TargetList(path, kind, scenario, targets, **extra)
+    m = read(path).model
+    extra = ({"roll_reference": np.asarray(m.roll_reference, float) / np.linalg.norm(m.roll_reference)}
+             if m.kind == "inertial" else {"min_elevation": math.radians(m.min_elevation_deg)})
+    return TargetList(path, m.kind, m.scenario, [_target(m.kind, t) for t in m.targets], **extra)
 
 
 def pointing_attitude(sensor_axis, direction, roll_reference=CELESTIAL_NORTH) -> np.ndarray:

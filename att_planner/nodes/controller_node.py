@@ -1,11 +1,11 @@
 """Controller node: a thin ROS adapter around :class:`att_planner.control.controller.Controller`.
 
 Subscribes ``/spacecraft/state`` and the latched ``/planner/plans``; publishes
-``/actuator/command`` and ``/controller/status`` at ``control_rate`` (Hz of sim time): a command is
+``/actuator/command`` and ``/controller/status`` at ``control_rate_Hz`` (sim time): a command is
 computed when a state at or after the next control instant arrives, and stamped with that state's
 time (the simulator waits for it before it advances); serves ``/controller/set_mode`` and the
 ``/controller/execute`` action (ExecuteManeuver), which runs for the maneuver's duration plus
-``settle_time`` and reports progress as feedback (the zone margins of the feedback are taken
+``settle_time_s`` and reports progress as feedback (the zone margins of the feedback are taken
 on the scenario's sky: its epoch and orbit).
 
 Nothing received is trusted (the size caps of :mod:`att_msgs_py.limits`, checked before a message is
@@ -26,7 +26,7 @@ The states (or estimates) are held to one publisher: another one is ignored whil
 in the ROS graph (:class:`att_msgs_py.source_hold.SourceHold`), so neither pausing nor starving the
 real source hands the loop to an intruder; a silent source is stale input (the watchdog below).
 
-Watchdog: when no state came for ``wall_timeout`` s of wall time the controller commands zero
+Watchdog: when no state came for ``wall_timeout_s`` of wall time the controller commands zero
 and reports ``state_stale`` until states flow again.
 
 ``state_source``: ``truth`` flies on ``/spacecraft/state``; ``estimate`` (the default of a
@@ -78,11 +78,11 @@ class ControllerNode(Node):
         super().__init__("controller")
         self._scenario = scen.load_checked(read_scenario(self))
         param = ParameterReader(self, CONTROLLER, self._scenario.node_params.get("controller", {}),
-                                str(self._scenario.path))
+                                str(self._scenario.node_params_path))
         self._core = controller_from_scenario(param, self._scenario)
         self._core.gate.hold.live = live_publishers(self, topics.STATE if self._core.measured is None
                                                     else topics.ESTIMATE)
-        self._wall_timeout = param("wall_timeout")
+        self._wall_timeout = param("wall_timeout_s")
         wait_for_subscribers = param("wait_for_subscribers")
         start_timeout = param("start_timeout")
         signed = param("require_signed_modes")
@@ -94,7 +94,7 @@ class ControllerNode(Node):
         param.refuse_unknown()
         if self._core.authentication.warning:
             self.get_logger().warning(self._core.authentication.warning)
-        self._state_wall = time.monotonic()   # no "no state" warning before wall_timeout has passed
+        self._state_wall = time.monotonic()   # no "no state" warning before wall_timeout_s has passed
         self._stale = False
         self._refusals = RefusalLog(self.get_logger())   # refused inputs, logged once a second per kind
         self._goal = None                     # the goal handle of the running maneuver

@@ -49,7 +49,7 @@ class EstimatorNode(Node):
     def __init__(self):
         super().__init__("estimator")
         s = scen.load_checked(read_scenario(self))
-        param = ParameterReader(self, ESTIMATOR, s.node_params.get("estimator", {}), str(s.path))
+        param = ParameterReader(self, ESTIMATOR, s.node_params.get("estimator", {}), str(s.node_params_path))
         self._core = estimator_from_scenario(param, s)
         wait_for_subscribers = param("wait_for_subscribers")
         start_timeout = param("start_timeout")

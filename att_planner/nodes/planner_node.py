@@ -54,10 +54,10 @@ class PlannerNode(Node):
         super().__init__("planner")
         scenario = scen.load_checked(read_scenario(self))
         self._scenario_name = scenario.name
-        param = ParameterReader(self, PLANNER, scenario.node_params.get("planner", {}), str(scenario.path))
+        param = ParameterReader(self, PLANNER, scenario.node_params.get("planner", {}), str(scenario.node_params_path))
         self._frame_id = scenario.frame_id
         self._default_method = param("default_method") or methods.REGISTRY[0].name
-        self._default_budget = param("time_budget")
+        self._default_budget = param("time_budget_s")
         self._tolerances = Tolerances(attitude=math.radians(param("accept_attitude_error_deg")),
                                       rate=param("accept_final_rate"),
                                       cone_penetration=math.radians(param("accept_cone_penetration_deg")))

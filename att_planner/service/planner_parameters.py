@@ -13,7 +13,7 @@ PLANNER = ParameterTable("planner", (
     Parameter("default_method", str, "", "planning method of a request that names none ('': the best available)",
               choices=("", *methods.METHODS),
               refusal=f"expected '' (the best) or one of {', '.join(methods.METHODS)}"),
-    Parameter("time_budget", float, 20.0, "wall-time budget of a request whose time_budget is 0", "s",
+    Parameter("time_budget_s", float, 20.0, "wall-time budget of a request whose time_budget is 0", "s",
               0.0, MAX_TIME_BUDGET, low_open=True),
     Parameter("accept_attitude_error_deg", float, math.degrees(TOLERANCES.attitude), "largest final attitude error "
                                                                                      "of an accepted plan", "deg",
@@ -32,4 +32,5 @@ PLANNER = ParameterTable("planner", (
     Parameter("plan_markers", bool, True, "publish each plan's boresight path on /planner/plan_markers (the 3D view)"),
     Parameter("warm_up_scenarios", str, None, "comma-separated scenarios whose demo maneuvers every worker "
                                               "plans before the node serves ('': none)", default_rule="the scenario"),
-), "the maneuver planner: the plan_maneuver and plan_schedule services")
+), "the maneuver planner: the plan_maneuver and plan_schedule services",
+    renamed={"time_budget": "time_budget_s"})

@@ -84,7 +84,7 @@ class ClosedLoop:
                  q0=rot.IDENTITY, omega0=(0.0, 0.0, 0.0), wheel_speed0=None, simulation: Simulation | None = None,
                  key: Ed25519PrivateKey | None = None):
         """``overrides``: ``{node: {parameter: value}}`` over the scenario's sections (simulator
-        ``step``/``publish_rate``, every controller and estimator parameter); ``seed``: the noise
+        ``step_s``/``publish_rate_Hz``, every controller and estimator parameter); ``seed``: the noise
         seed (default the scenario's); ``simulation``: a prepared one (e.g. a dispersed truth);
         ``key``: the plan-signing key (default a new one; loops sharing one can share issued plans)."""
         overrides = overrides or {}
@@ -93,19 +93,20 @@ class ClosedLoop:
             raise ConfigError(ErrorCode.INVALID_PARAMETER, f"overrides of unknown node(s) {', '.join(unknown)}; "
                                                            "known: simulator, controller, estimator")
         sections = scenario.node_params
-        sim_param = SectionReader(SIMULATOR, sections.get("simulator", {}), str(scenario.path),
+        sim_param = SectionReader(SIMULATOR, sections.get("simulator", {}), str(scenario.node_params_path),
                                   overrides.get("simulator"))
-        self.step = sim_param("step")
-        self.publish_period = 1.0 / sim_param("publish_rate", min(10.0, 1.0 / self.step), high=(1 + 1e-9) / self.step)
+        self.step = sim_param("step_s")
+        self.publish_period = 1.0 / sim_param("publish_rate_Hz", min(10.0, 1.0 / self.step),
+                                                high=(1 + 1e-9) / self.step)
         sim_param.refuse_unknown()
         self.key = key or Ed25519PrivateKey.generate()
-        ctl_param = SectionReader(CONTROLLER, sections.get("controller", {}), str(scenario.path),
+        ctl_param = SectionReader(CONTROLLER, sections.get("controller", {}), str(scenario.node_params_path),
                                   overrides.get("controller"))
         self.controller = controller_from_scenario(ctl_param, scenario, key=self.key.public_key())
         ctl_param.refuse_unknown()
         self.estimator = None
         if self.controller.measured is not None:
-            est_param = SectionReader(ESTIMATOR, sections.get("estimator", {}), str(scenario.path),
+            est_param = SectionReader(ESTIMATOR, sections.get("estimator", {}), str(scenario.node_params_path),
                                       overrides.get("estimator"))
             self.estimator = estimator_from_scenario(est_param, scenario)
             est_param.refuse_unknown()
@@ -273,7 +274,7 @@ def plan_in_process(scenario: Scenario, q0, qf, sensor_axis, cones=(), zones=(),
     from att_planner.service.planning import plan_maneuver
     from att_planner.service.requests import ManeuverRequest, validate_maneuver
 
-    planner = SectionReader(PLANNER, scenario.node_params.get("planner", {}), str(scenario.path))
+    planner = SectionReader(PLANNER, scenario.node_params.get("planner", {}), str(scenario.node_params_path))
     request = ManeuverRequest(scenario.frame_id, np.asarray(q0, float), np.asarray(qf, float),
                               np.asarray(sensor_axis, float),
                               [(c.direction, c.half_angle, c.name) for c in cones], method=method,

@@ -1,16 +1,19 @@
 """``att-config``: check, describe and show the configuration files a user writes.
 
-- ``att-config check FILE...``: every file validated against the schema of its kind (by its folder —
-  ``missions/``, ``targets/``, ``campaigns/``, ``spacecraft/``, ``scenarios/`` — else by its keys; or
-  ``--kind``), and the names it refers to (a mission's target list, a target list's or campaign's
-  scenario) resolved. Exit 0 when every file is valid; else 2, after printing every problem of every
-  file, one per line: ``file:line: field.path: expected ...; found ...``.
+- ``att-config check FILE...``: every file validated against the schema of its kind (by its name —
+  ``NAME.params.yaml``, ``NAME.demo.yaml`` — or folder — ``missions/``, ``targets/``, ``campaigns/``,
+  ``spacecraft/``, ``scenarios/`` — else by its keys; or ``--kind``), and the names it refers to (a
+  scenario's spacecraft, a mission's target list, a target list's or campaign's scenario) resolved; a
+  parameter file's sections checked against the nodes' parameter tables. Exit 0 when every file is
+  valid; else 2, after printing every problem of every file, one per line: ``file:line: field.path:
+  expected ...; found ...``.
 - ``att-config schema [KIND] [--out DIR]``: the JSON Schema of a kind (without KIND: of every kind, by
   name), or ``DIR/KIND.schema.json`` files, for editors: a YAML file whose first line is
   ``# yaml-language-server: $schema=<path or URL>`` is completed and checked as it is typed (the
   shipped schemas are under ``config/schemas/``).
 - ``att-config show SCENARIO``: the resolved scenario (a name as ``-p scenario:=NAME`` takes it, or a
-  path), one line per value, with where the value came from: ``file:line`` or ``default``. A file
+  path), one line per value, with where the value came from across its files (the scenario, its
+  spacecraft, its parameter and demo files): ``file:line`` or ``default``. A file
   whose only problems are old key names is shown under the new names (with a note to migrate it).
 - ``att-config migrate FILE...``: each old key name written under its new name, in place (comments
   and layout kept); the file is then checked.
@@ -28,15 +31,23 @@ from pydantic import BaseModel, TypeAdapter
 
 from att_planner.mission import schema as mission_schema
 from att_planner.mission import targets as target_lists
+from att_planner.tools.node_parameters import NODE_PARAMETERS, declared
 from att_sim.models import config_files as cf
 from att_sim.models import config_schema as cs
 from att_sim.models import scenario as scen
 from att_sim.truth import campaign_schema
 
+
 # kind -> (model or a function of the data choosing it, the type whose JSON Schema describes the kind)
+def scenario_model(data: dict) -> type[BaseModel]:
+    """A scenario file's model: a self-contained one (``/**: ros__parameters:``) or one naming its spacecraft."""
+    return cs.ScenarioFile if "/**" in data or "spacecraft" not in data else cs.ScenarioSky
+
+
 KINDS = {
-    "scenario": (cs.ScenarioFile, cs.ScenarioFile),
-    "spacecraft": (cs.Spacecraft, cs.Spacecraft),
+    "scenario": (scenario_model, cs.ScenarioSky),
+    "spacecraft": (cs.SpacecraftFile, cs.SpacecraftFile),
+    "demo": (cs.DemoFile, cs.DemoFile),
     "mission": (mission_schema.Mission, mission_schema.Mission),
     "targets": (mission_schema.target_list_model, mission_schema.TargetList),
     "campaign": (campaign_schema.CampaignFile, campaign_schema.CampaignFile),
@@ -48,6 +59,10 @@ FOLDERS = {"missions": "mission", "targets": "targets", "campaigns": "campaign",
 
 def kind_of(path: Path, data: dict) -> str:
     """The kind of a file: by its folder, else by its keys."""
+    if path.name.endswith(scen.PARAMS_SUFFIX):
+        return "parameters"
+    if path.name.endswith(scen.DEMO_SUFFIX):
+        return "demo"
     if path.parent.name in FOLDERS:
         return FOLDERS[path.parent.name]
     if "/**" in data:
@@ -58,6 +73,8 @@ def kind_of(path: Path, data: dict) -> str:
         return "targets"
     if "targets" in data:
         return "mission"
+    if "demo" in data:
+        return "demo"
     if "inertia_kg_m2" in data or "inertia" in data:
         return "spacecraft"
     return "parameters"
@@ -77,6 +94,16 @@ def _reference(loaded: cf.Loaded, kind: str) -> list[cf.Problem]:
         refs.append((("scenario",), model.scenario, "", "scenario"))
     elif kind == "campaign":
         refs.append((("campaign", "scenario"), model.campaign.scenario, "", "scenario"))
+    elif kind == "scenario" and isinstance(model, cs.ScenarioSky):
+        try:                                  # the spacecraft named and the scenario resolved across its files
+            scen.read(loaded.path)
+        except cf.ConfigFileError as err:
+            return err.problems
+        except KeyError as err:
+            return [cf.Problem(name, loaded.lines.get(("spacecraft",)), "spacecraft", "the name of a spacecraft",
+                               f"'{model.spacecraft}', {err.args[0]}")]
+    elif kind == "parameters":
+        return _parameter_problems(loaded)
     out = []
     for path, ref, folder, what in refs:
         try:
@@ -84,6 +111,25 @@ def _reference(loaded: cf.Loaded, kind: str) -> list[cf.Problem]:
         except KeyError as err:
             out.append(cf.Problem(name, loaded.lines.get(path), cf.field_path(path), f"the name of a {what}",
                                   f"'{ref}', which names none ({err.args[0].split('(')[-1].rstrip(')')})"))
+    return out
+
+
+def _parameter_problems(loaded: cf.Loaded) -> list[cf.Problem]:
+    """Each node section of a parameter file checked against that node's parameter table
+    (:meth:`att_msgs_py.parameters.ParameterTable.problems`): undeclared names, wrong types, values out
+    of range. A section of no suite node is refused."""
+    out, name = [], str(loaded.path)
+    for node, section in loaded.data.items():
+        params = section.get("ros__parameters", {}) if isinstance(section, dict) else {}
+        if node not in NODE_PARAMETERS:
+            out.append(cf.Problem(name, loaded.lines.get((node,)), node, f"a section of one of the nodes "
+                                  f"{', '.join(NODE_PARAMETERS)}", f"the section '{node}'"))
+            continue
+        for key, value in params.items():            # one parameter at a time: each problem on its line
+            for err in declared(node).problems({key: value}, allowed=("use_sim_time",)):
+                path = (node, "ros__parameters", key)
+                out.append(cf.Problem(name, loaded.lines.get(path), cf.field_path(path),
+                                      f"a valid {node} parameter [{err.code.name}]", err.message))
     return out
 
 
@@ -102,7 +148,15 @@ def schema(kind: str | None = None) -> dict:
     """The JSON Schema of ``kind`` (None: of every kind, by name)."""
     if kind is None:
         return {k: schema(k) for k in KINDS}
-    out = _finite_defaults(TypeAdapter(KINDS[kind][1]).json_schema(by_alias=True))
+    if kind == "parameters":                  # each node's section typed by that node's parameter table
+        out = {"type": "object", "additionalProperties": False, "title": "parameters",
+               "description": "a ROS 2 parameter file: one ros__parameters mapping per node",
+               "properties": {node: {"type": "object", "additionalProperties": False, "required": ["ros__parameters"],
+                                     "properties": {"ros__parameters": declared(node).json_schema()}}
+                              for node in NODE_PARAMETERS}}
+        out = _finite_defaults(out)
+    else:
+        out = _finite_defaults(TypeAdapter(KINDS[kind][1]).json_schema(by_alias=True))
     out.setdefault("title", kind)
     out["$schema"] = "https://json-schema.org/draft/2020-12/schema"
     return out
@@ -171,6 +225,21 @@ def _check(args) -> int:
     return 2 if bad else 0
 
 
+def show_files(files: scen.Files) -> list[str]:
+    """One line per value of a scenario resolved across its files (:func:`att_sim.models.scenario.read`):
+    ``field.path = value  (file:line)`` or ``(default)``; then each node's parameter from its file."""
+    out = []
+    for path, value in leaves(files.shared):
+        where = files.lines.get(path)
+        out.append(f"{cf.field_path(path)} = {_shown(value)}  ({f'{where[0]}:{where[1]}' if where else 'default'})")
+    for source in (files.params_path, files.demo_path):
+        if source is not None:
+            data, lines = cf.read_yaml(source)
+            for path, value in leaves(data):
+                out.append(f"{cf.field_path(path)} = {_shown(value)}  ({source}:{lines.get(path)})")
+    return out
+
+
 def _show(args) -> int:
     try:
         path = scen.find(args.scenario)
@@ -178,11 +247,14 @@ def _show(args) -> int:
         print(f"att-config: {err.args[0]}", file=sys.stderr)
         return 2
     try:
-        loaded = _loaded_renamed(path)
+        data = cf.read_yaml(path, aliases=True)[0]
+        if scenario_model(data) is cs.ScenarioFile:
+            print("\n".join(show(_loaded_renamed(path))))
+        else:
+            print("\n".join(show_files(scen.read(path))))
     except cf.ConfigFileError as err:
         print(err.message)
         return 2
-    print("\n".join(show(loaded)))
     return 0
 
 

@@ -84,7 +84,7 @@ class MissionDriver:
     def __init__(self, client, mission: mission_config.MissionConfig, log=print):
         self.client, self.mission, self.log = client, mission, log
         controller = mission.scenario.node_params.get("controller", {})
-        settle = float(controller.get("settle_time", ControllerConfig().settle_time))     # as the node reads it
+        settle = float(controller.get("settle_time_s", ControllerConfig().settle_time))     # as the node reads it
         estimator = mission.scenario.sensors.gyro is not None
         self.telemetry = Telemetry(client, estimator)
         self.executive = MissionExecutive.of_mission(mission, settle, converged=not estimator)
@@ -168,10 +168,11 @@ def fly_mission(mission: mission_config.MissionConfig, out: Path, log=print) -> 
     # the simulator does not wait for the planner: at most start_lead / time_budget × real time, a plan
     # that takes its whole wall-time budget still comes back before its slew's start
     pace = mission.start_lead / mission.time_budget
-    params = {"simulator": {"step": 1.0 / rate, "publish_rate": rate, "clock_rate": rate, "real_time_factor": pace},
-              "controller": {"control_rate": rate, "momentum_dumping": mission.momentum_dumping,
+    params = {"simulator": {"step_s": 1.0 / rate, "publish_rate_Hz": rate, "clock_rate_Hz": rate,
+                            "real_time_factor": pace},
+              "controller": {"control_rate_Hz": rate, "momentum_dumping": mission.momentum_dumping,
                              "handover_blend": mission.handover_blend},
-              "estimator": {"publish_rate": rate}}
+              "estimator": {"publish_rate_Hz": rate}}
     name = mission.scenario.name
     # the driver's telemetry listens to the state: one more subscriber for the simulator to wait for
     suite = start_suite(name, mcap_path, run_dir, env=env, nodes=default_nodes(name), params=params, state_listeners=1)

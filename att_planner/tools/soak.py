@@ -1,6 +1,6 @@
 """Soak run: simulator + controller (+ recorder) for a long sim time as fast as possible.
 
-Starts the nodes of a scenario with the simulator's ``end_time`` set, samples every process's
+Starts the nodes of a scenario with the simulator's ``end_time_s`` set, samples every process's
 resident memory while it runs, then replays the log and counts messages against what the
 configured rates imply. Reports the real-time factor reached. Used by ``att-bench soak`` (10
 orbits) and by the tests (a shorter run). The lockstep waits up to ``LOCKSTEP_TIMEOUT`` s for each
@@ -42,8 +42,8 @@ def run_soak(scenario: str, orbits: float, out_dir: str | Path, sample_period: f
     out = Path(out_dir)
     suite = start_suite(scenario, out / "soak.mcap", out, env=isolated_env(),
                         nodes=("recorder", "simulator", "controller"),
-                        params={"simulator": {"end_time": end_time, "real_time_factor": 0.0,
-                                                      "lockstep_timeout": LOCKSTEP_TIMEOUT}})
+                        params={"simulator": {"end_time_s": end_time, "real_time_factor": 0.0,
+                                                      "lockstep_timeout_s": LOCKSTEP_TIMEOUT}})
     memory = {name: [] for name in suite.procs}
     start = time.monotonic()
     try:
@@ -60,7 +60,7 @@ def run_soak(scenario: str, orbits: float, out_dir: str | Path, sample_period: f
     log = read_log(out / "soak.mcap", topics=[STATE, COMMAND])
     state, command = log[STATE], log[COMMAND]
     sim_time = float(state["header.stamp"][-1])
-    publish_rate = float(sim_params.get("publish_rate", 10.0))
+    publish_rate = float(sim_params.get("publish_rate_Hz", 10.0))
     expected = int(np.floor(sim_time * publish_rate + 1e-6)) + 1          # t = 0, 1/rate, ..., sim_time
     growth = {}
     for name, series in memory.items():

@@ -19,7 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from att_sim.models import config_schema as schema
-from att_sim.models.config_group import Group
+from att_sim.models.sensor_specs import validated
 
 DEG = math.pi / 180.0
 
@@ -59,21 +59,18 @@ class ActuatorSpecs:
     magnetorquers: MagnetorquerSpec | None = None
 
 
-def actuators_from_params(values, label: str = "actuators") -> ActuatorSpecs:
-    """The ``actuators`` group (ValueError naming the field)."""
-    g = Group(values, label)
-    wheels = magnetorquers = None
-    if "wheels" in g:
-        w = g.group("wheels")
-        wheels = WheelDriveSpec(*(w.declared(schema.WheelDrives, key) for key in (
-            "coulomb_friction_Nm", "viscous_friction_Nm_s", "friction_speed_rad_s", "torque_quantization_Nm",
-            "torque_noise_Nm", "power_max_W")))
-        w.done()
-    if "magnetorquers" in g:
-        m = g.group("magnetorquers")
-        magnetorquers = MagnetorquerSpec(quantization=m.declared(schema.Magnetorquers, "quantization_Am2"),
-                                         misalignment=m.declared(schema.Magnetorquers, "misalignment_deg") * DEG)
-        m.done()
-    g.read.update(("wheels", "magnetorquers"))
-    g.done()
+def actuators_from_model(a: schema.Actuators) -> ActuatorSpecs:
+    """The validated ``actuators`` group (:class:`att_sim.models.config_schema.Actuators`) in SI."""
+    w, m = a.wheels, a.magnetorquers
+    wheels = None if w is None else WheelDriveSpec(
+        w.coulomb_friction_Nm, w.viscous_friction_Nm_s, w.friction_speed_rad_s, w.torque_quantization_Nm,
+        w.torque_noise_Nm, w.power_max_W)
+    magnetorquers = None if m is None else MagnetorquerSpec(quantization=m.quantization_Am2,
+                                                            misalignment=m.misalignment_deg * DEG)
     return ActuatorSpecs(wheels, magnetorquers)
+
+
+def actuators_from_params(values, label: str = "actuators") -> ActuatorSpecs:
+    """The ``actuators`` group (a mapping), validated by :class:`att_sim.models.config_schema.Actuators`
+    (ValueError naming the field)."""
+    return actuators_from_model(validated(schema.Actuators, values, label))

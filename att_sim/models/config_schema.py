@@ -343,15 +343,28 @@ class Facet(Schema):
         return self
 
 
-class Environment(Schema):
+class Surface(Schema):
+    """The spacecraft's outer surface and magnetic cleanliness, as the disturbances see them."""
+
     renamed: ClassVar = {"residual_dipole": "residual_dipole_Am2"}
+
+    drag_coefficient: float = number(2.2, gt=0.0, le=10.0, unit="", meaning="drag coefficient C_D")
+    residual_dipole_Am2: Vector3 = Field([0.0, 0.0, 0.0], description="residual magnetic dipole, body (A m^2)")
+    facets: list[Facet] = Field([], max_length=256)
+
+
+class Disturbances(Schema):
+    """Which environment torques act on the spacecraft in a scenario."""
 
     gravity_gradient: bool = False
     solar_pressure: bool = False
     drag: bool = False
-    drag_coefficient: float = number(2.2, gt=0.0, le=10.0, unit="", meaning="drag coefficient C_D")
-    residual_dipole_Am2: Vector3 = Field([0.0, 0.0, 0.0], description="residual magnetic dipole, body (A m^2)")
-    facets: list[Facet] = Field([], max_length=256)
+
+
+class Environment(Disturbances, Surface):
+    """The disturbances of a scenario with the surface they act on."""
+
+    renamed: ClassVar = Surface.renamed
 
     @model_validator(mode="after")
     def _surfaces(self):
@@ -382,20 +395,16 @@ def _epoch(value):
     return value
 
 
-class Shared(Schema):
-    """The ``/**: ros__parameters`` section: the spacecraft and its sky, read by every node."""
+class Sky(Schema):
+    """Where and when a scenario flies: frames, orbit, epoch, field model, zones."""
 
     frame_id: Name = Field("eci", description="the inertial frame's name")
     body_frame_id: Name = Field("body", description="the body frame's name")
-    spacecraft: Spacecraft
     orbit: Orbit = Field(default_factory=CircularOrbit)
     epoch: Annotated[str | datetime, AfterValidator(_epoch)] | None = Field(
         None, description="UTC of sim time zero, ISO 8601 with Z or an offset; none: a fixed sky")
     field_model: Literal["dipole", "igrf14"] = "dipole"
-    environment: Environment = Field(default_factory=Environment)
     zones: list[Zone] = Field([], max_length=64)
-    sensors: Sensors = Field(default_factory=Sensors)
-    actuators: Actuators = Field(default_factory=Actuators)
 
     @field_validator("zones")
     @classmethod
@@ -404,6 +413,16 @@ class Shared(Schema):
         if len(set(names)) != len(names):
             raise ValueError(f"distinct zone names, got {', '.join(names)}")
         return zones
+
+
+class Shared(Sky):
+    """A scenario resolved: the spacecraft and its sky, read by every node (the ``/**:
+    ros__parameters`` section of a self-contained scenario file)."""
+
+    spacecraft: Spacecraft
+    environment: Environment = Field(default_factory=Environment)
+    sensors: Sensors = Field(default_factory=Sensors)
+    actuators: Actuators = Field(default_factory=Actuators)
 
     @model_validator(mode="after")
     def _needs_epoch(self):
@@ -424,6 +443,63 @@ class Shared(Schema):
         if needs:
             raise ValueError(f"an epoch (the Sun, Moon and Earth depend on the date) for {', '.join(needs)}")
         return self
+
+
+class SpacecraftFile(Spacecraft, Surface):
+    """A spacecraft file (``config/spacecraft/NAME.yaml``): the rigid body, wheels and magnetorquer
+    limits, its surface, its sensors' datasheets and its actuators' imperfections."""
+
+    renamed: ClassVar = {**Spacecraft.renamed, **Surface.renamed}
+
+    sensors: Sensors = Field(default_factory=Sensors)
+    actuators: Actuators = Field(default_factory=Actuators)
+
+
+class ScenarioSky(Sky):
+    """A scenario file (``config/scenarios/NAME.yaml``): the spacecraft it flies, by name, and its sky.
+    The nodes' tuning is beside it in ``NAME.params.yaml`` (a ROS 2 ``--params-file``) and its demo
+    maneuver in ``NAME.demo.yaml``."""
+
+    spacecraft: Name = Field(description="the spacecraft flown: a file stem under config/spacecraft/")
+    environment: Disturbances = Field(default_factory=Disturbances)
+
+
+def resolved(sky: ScenarioSky, craft: SpacecraftFile) -> dict:
+    """The data of the :class:`Shared` model of a scenario file and its spacecraft file."""
+    body = set(Spacecraft.model_fields)
+    return {**sky.model_dump(exclude={"spacecraft", "environment", "orbit"}), "orbit": sky.orbit.model_dump(),
+            "spacecraft": craft.model_dump(include=body),
+            "environment": {**sky.environment.model_dump(), **craft.model_dump(include=set(Surface.model_fields))},
+            "sensors": craft.sensors.model_dump(), "actuators": craft.actuators.model_dump()}
+
+
+class Demo(Schema):
+    """A scenario's demo maneuver (``config/scenarios/NAME.demo.yaml``, flown by ``att-demo``)."""
+
+    initial_attitude: Quaternion = Field(description="body-to-inertial quaternion [x, y, z, w] at the start")
+    final_attitude: Quaternion = Field(description="body-to-inertial quaternion [x, y, z, w] at the end")
+    sensor_axis: UnitVector3 = Field(description="unit body axis of the sensor the cones constrain")
+    cone_names: list[Name] = Field([], max_length=64)
+    cone_directions: UnitVectors = Field([], description="unit inertial direction of each cone, 3 numbers each")
+    cone_half_angles_deg: list[Annotated[float, Field(gt=0.0, lt=180.0)]] = Field([], max_length=64)
+    method: Annotated[str, Field(max_length=64)] = Field("", description="planning method; empty: the default")
+    time_budget: float = number(30.0, gt=0.0, le=600.0, unit="s", meaning="planner wall time")
+    start_lead: float = number(0.0, ge=0.0, le=86_400.0, unit="s", meaning="sim time from the request to the start")
+    start_time: float | None = number(None, ge=0.0, unit="s", meaning="sim time of the start, the sky set for it; "
+                                      "none: the request's time plus start_lead")
+
+    @model_validator(mode="after")
+    def _cones(self):
+        n = len(self.cone_names)
+        if len(self.cone_directions) != 3 * n or len(self.cone_half_angles_deg) != n:
+            raise ValueError(f"one direction and one half-angle per cone name, got {n} name(s), "
+                             f"{len(self.cone_directions) // 3} direction(s), {len(self.cone_half_angles_deg)} "
+                             f"half-angle(s)")
+        return self
+
+
+class DemoFile(Schema):
+    demo: Demo
 
 
 class SharedSection(Schema):

@@ -27,16 +27,16 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
+from pydantic import ValidationError
 
 from att_msgs_py.types import ZONE_BODIES
+from att_sim.models import config_files
 from att_sim.models import config_schema as schema
-from att_sim.models.config_group import Group
 
 DEG = math.pi / 180.0
 ARCSEC = DEG / 3600.0
 HOUR = 3600.0
 NANOTESLA = 1e-9
-SENSOR_KINDS = ("seed", "gyro", "star_trackers", "magnetometer", "sun_sensors", "wheel_tachometer")
 EXCLUSION_BODIES = tuple(b for b in ZONE_BODIES)
 
 
@@ -127,94 +127,74 @@ class SensorSpecs:
         return any((self.gyro, self.star_trackers, self.magnetometer, self.sun_sensors, self.tachometer))
 
 
-def gyro_from_params(g: Group) -> GyroSpec:
-    def n(key):
-        return g.declared(schema.Gyro, key)
-    out = GyroSpec(
-        rate=n("rate_hz"), arw=n("arw_deg_per_sqrt_h") * DEG / math.sqrt(HOUR),
-        bias_instability=n("bias_instability_deg_per_h") * DEG / HOUR,
-        rrw=n("rrw_deg_per_h_per_sqrt_h") * DEG / HOUR / math.sqrt(HOUR),
-        initial_bias=n("initial_bias_deg_per_h") * DEG / HOUR, scale_factor=n("scale_factor_ppm") * 1e-6,
-        misalignment=n("misalignment_arcsec") * ARCSEC, quantization=n("quantization_arcsec") * ARCSEC,
-        range=n("range_deg_per_s") * DEG)
-    g.done()
-    return out
+def _refused(exc: ValidationError, model, values, label: str) -> ValueError:
+    """A pydantic error of the group ``label`` as one ValueError naming each field: ``label.field:
+    expected ...; found ...`` (the loader's wording, :mod:`att_sim.models.config_files`)."""
+    problems = config_files.problems_of(exc, model, values if isinstance(values, dict) else {}, {}, label)
+    lines = [f"{label}{'.' + p.field if p.field and not p.field.startswith('[') else p.field}: expected "
+             f"{p.expected}; found {p.found}" for p in problems]
+    return ValueError("\n".join(lines[:8]))
 
 
-def exclusion_from_params(g: Group, epoch_known: bool) -> Exclusion:
-    body = g.choice("body", EXCLUSION_BODIES)
-    limb = body == "earth_limb"
-    angle = g.number("half_angle_deg", None, 0.0, 90.0 if limb else 180.0, low_open=not limb, high_open=True)
-    direction = g.unit_vectors("direction")[0] if body == "inertial" else None
-    if body != "inertial" and "direction" in g:
-        raise ValueError(f"{g.field('direction')} is only for body inertial")
-    if body in ("sun", "moon") and not epoch_known:
-        raise ValueError(f"{g.field('body')} {body} needs the scenario's epoch (the {body}'s position)")
-    g.done()
-    return Exclusion(body, angle * DEG, direction)
+def validated(model, values, label: str):
+    """``values`` (a group of a scenario) validated by the pydantic ``model`` (ValueError naming the field)."""
+    try:
+        return model.model_validate(values)
+    except ValidationError as exc:
+        raise _refused(exc, model, values, label) from None
 
 
-def star_tracker_from_params(g: Group, epoch_known: bool) -> StarTrackerSpec:
-    def n(key):
-        return g.declared(schema.StarTracker, key)
-    out = StarTrackerSpec(
-        name=g.name("name"), mounting=g.quaternion("mounting", schema.StarTracker.model_fields["mounting"].default),
-        rate=n("rate_hz"), latency=n("latency_s"), cross_boresight=n("cross_boresight_arcsec") * ARCSEC,
-        about_boresight=n("about_boresight_arcsec") * ARCSEC, max_rate=n("max_rate_deg_per_s") * DEG,
-        exclusions=tuple(exclusion_from_params(e, epoch_known) for e in g.items("exclusions")))
-    g.done()
-    return out
+def _epoch_needs(s: schema.Sensors, label: str) -> None:
+    for k, t in enumerate(s.star_trackers):
+        for j, e in enumerate(t.exclusions):
+            if e.body in ("sun", "moon"):
+                raise ValueError(f"{label}.star_trackers[{k}].exclusions[{j}].body {e.body} needs the scenario's "
+                                 f"epoch (the {e.body}'s position)")
+    if s.sun_sensors is not None:
+        raise ValueError(f"{label}.sun_sensors needs the scenario's epoch (the Sun's position and the Earth's "
+                         f"shadow)")
 
 
-def magnetometer_from_params(g: Group) -> MagnetometerSpec:
-    def n(key):
-        return g.declared(schema.Magnetometer, key)
-    out = MagnetometerSpec(
-        rate=n("rate_hz"), noise=n("noise_nT") * NANOTESLA, bias=n("bias_nT") * NANOTESLA,
-        misalignment=n("misalignment_deg") * DEG, quantization=n("quantization_nT") * NANOTESLA,
-        dipole_coupling=n("dipole_coupling_nT_per_Am2") * NANOTESLA)
-    g.done()
-    return out
+def _unit(v) -> np.ndarray:
+    a = np.asarray(v, float)
+    return a / np.linalg.norm(a)
 
 
-def sun_sensors_from_params(g: Group, epoch_known: bool) -> SunSensorSpec:
-    if not epoch_known:
-        raise ValueError(f"{g.label} needs the scenario's epoch (the Sun's position and the Earth's shadow)")
-    out = SunSensorSpec(normals=g.unit_vectors("normals", schema.SunSensors.model_fields["normals"].default),
-                        rate=g.declared(schema.SunSensors, "rate_hz"),
-                        fov=g.declared(schema.SunSensors, "fov_deg") * DEG,
-                        noise=g.declared(schema.SunSensors, "noise"))
-    g.done()
-    return out
-
-
-def tachometer_from_params(g: Group) -> TachometerSpec:
-    out = TachometerSpec(rate=g.declared(schema.WheelTachometer, "rate_hz"),
-                         noise=g.declared(schema.WheelTachometer, "noise_rad_per_s"),
-                         quantization=g.declared(schema.WheelTachometer, "quantization_rad_per_s"))
-    g.done()
-    return out
+def sensors_from_model(s: schema.Sensors) -> SensorSpecs:
+    """The validated ``sensors`` group (:class:`att_sim.models.config_schema.Sensors`, datasheet units) in SI."""
+    g, m, ss, w = s.gyro, s.magnetometer, s.sun_sensors, s.wheel_tachometer
+    gyro = None if g is None else GyroSpec(
+        rate=g.rate_hz, arw=g.arw_deg_per_sqrt_h * DEG / math.sqrt(HOUR),
+        bias_instability=g.bias_instability_deg_per_h * DEG / HOUR,
+        rrw=g.rrw_deg_per_h_per_sqrt_h * DEG / HOUR / math.sqrt(HOUR),
+        initial_bias=g.initial_bias_deg_per_h * DEG / HOUR, scale_factor=g.scale_factor_ppm * 1e-6,
+        misalignment=g.misalignment_arcsec * ARCSEC, quantization=g.quantization_arcsec * ARCSEC,
+        range=g.range_deg_per_s * DEG)
+    trackers = tuple(StarTrackerSpec(
+        name=t.name, mounting=_unit(t.mounting), rate=t.rate_hz, latency=t.latency_s,
+        cross_boresight=t.cross_boresight_arcsec * ARCSEC, about_boresight=t.about_boresight_arcsec * ARCSEC,
+        max_rate=t.max_rate_deg_per_s * DEG,
+        exclusions=tuple(Exclusion(e.body, e.half_angle_deg * DEG,
+                                   _unit(e.direction) if e.direction is not None else None) for e in t.exclusions))
+        for t in s.star_trackers)
+    magnetometer = None if m is None else MagnetometerSpec(
+        rate=m.rate_hz, noise=m.noise_nT * NANOTESLA, bias=m.bias_nT * NANOTESLA, misalignment=m.misalignment_deg * DEG,
+        quantization=m.quantization_nT * NANOTESLA, dipole_coupling=m.dipole_coupling_nT_per_Am2 * NANOTESLA)
+    sun = None if ss is None else SunSensorSpec(
+        normals=np.asarray(ss.normals, float).reshape(-1, 3) / np.linalg.norm(
+            np.asarray(ss.normals, float).reshape(-1, 3), axis=1)[:, None],
+        rate=ss.rate_hz, fov=ss.fov_deg * DEG, noise=ss.noise)
+    tachometer = None if w is None else TachometerSpec(rate=w.rate_hz, noise=w.noise_rad_per_s,
+                                                       quantization=w.quantization_rad_per_s)
+    return SensorSpecs(seed=s.seed, gyro=gyro, star_trackers=trackers, magnetometer=magnetometer, sun_sensors=sun,
+                       tachometer=tachometer)
 
 
 def sensors_from_params(values, epoch_known: bool, label: str = "sensors") -> SensorSpecs:
-    """The ``sensors`` group (ValueError naming the field); ``epoch_known``: the scenario has an
-    epoch (Sun and Moon exclusions and sun sensors need it)."""
-    g = Group(values, label)
-    seed = g.raw("seed", 0)
-    if isinstance(seed, bool) or not isinstance(seed, int) or not 0 <= seed < 2**63:
-        raise ValueError(f"{g.field('seed')} must be an integer in [0, 2^63), got {seed!r}"[:200])
-    trackers = tuple(star_tracker_from_params(t, epoch_known) for t in g.items("star_trackers"))
-    names = [t.name for t in trackers]
-    if len(set(names)) != len(names):
-        raise ValueError(f"{g.field('star_trackers')}: names must be unique, got {', '.join(names)}")
-    out = SensorSpecs(
-        seed=seed,
-        gyro=gyro_from_params(g.group("gyro")) if "gyro" in g else None,
-        star_trackers=trackers,
-        magnetometer=magnetometer_from_params(g.group("magnetometer")) if "magnetometer" in g else None,
-        sun_sensors=sun_sensors_from_params(g.group("sun_sensors"), epoch_known) if "sun_sensors" in g else None,
-        tachometer=tachometer_from_params(g.group("wheel_tachometer")) if "wheel_tachometer" in g else None)
-    for kind in ("gyro", "magnetometer", "sun_sensors", "wheel_tachometer"):
-        g.read.add(kind)
-    g.done()
-    return out
+    """The ``sensors`` group of a scenario (a mapping), validated by
+    :class:`att_sim.models.config_schema.Sensors` (ValueError naming the field); ``epoch_known``: the
+    scenario has an epoch (Sun and Moon exclusions and sun sensors need it)."""
+    model = validated(schema.Sensors, values, label)
+    if not epoch_known:
+        _epoch_needs(model, label)
+    return sensors_from_model(model)

@@ -77,7 +77,7 @@ class Dispersions(Schema):
 class Campaign(Schema):
     renamed: ClassVar = {"converge_timeout": "converge_timeout_s"}
 
-    scenario: Name = Field(description="the scenario flown (a file stem under config/)")
+    scenario: Name = Field(description="the scenario flown: a name, config/scenarios/NAME.yaml")
     seed: int = Field(ge=0, le=2**63 - 1, description="campaign seed; run i's seed derives from it")
     runs: int = Field(100, ge=1, le=MAX_RUNS, description="default run count")
     settle_tolerance_deg: float = number(0.01, gt=0.0, le=180.0, unit="deg", meaning="settled: the error to the "

@@ -1,15 +1,15 @@
 """Monte Carlo campaigns: the dispersed truth of one run, drawn from its seed.
 
-A campaign file (YAML read by :func:`att_sim.models.config_files.read_yaml`; one mapping
-``campaign:``) names a scenario and declares how the truth departs from the model the plan was made
-with::
+A campaign file (YAML read by the one loader, :mod:`att_sim.models.config_files`, and validated by
+:class:`att_sim.truth.campaign_schema.CampaignFile`; one mapping ``campaign:``) names a scenario
+and declares how the truth departs from the model the plan was made with::
 
     campaign:
       scenario: swift_demo          # a scenario name: a file stem under config/ or $ATT_CONFIG_PATH
       seed: 16                      # campaign seed s
       runs: 1000                    # default run count (att-mc --runs overrides)
       settle_tolerance_deg: 0.01    # settling: the error to the goal stays below this after the plan
-      converge_timeout: 30.0        # s of sim time for the estimate to converge before the maneuver
+      converge_timeout_s: 30.0      # s of sim time for the estimate to converge before the maneuver
       dispersions:
         inertia_scale: {distribution: normal, three_sigma: 0.05, truncate: 3}
         wheel_misalignment_deg: {distribution: uniform, low: -0.2, high: 0.2}
@@ -36,7 +36,6 @@ reaches non-physical bodies is a mistake to fix in the file.
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
 from dataclasses import dataclass, replace
 from datetime import timedelta
 from pathlib import Path
@@ -48,7 +47,6 @@ from att_sim.models import config_files
 from att_sim.models import rotations as rot
 from att_sim.models import scenario as scen
 from att_sim.models.actuator_specs import MagnetorquerSpec, WheelDriveSpec
-from att_sim.models.config_group import Group
 from att_sim.truth import campaign_schema as schema
 from att_sim.truth.sensors import STREAMS
 
@@ -69,7 +67,7 @@ DISPERSIONS = {
     "com_offset_m": (lambda sc: 3, "centre of mass offset (m, body): facets' centres of pressure move by -offset"),
     "epoch_offset_s": (lambda sc: 1, "the truth's epoch minus the flight software's (s): orbit, sky and field move"),
     "initial_attitude_error_deg": (lambda sc: 3, "rotation vector of the initial attitude error (deg, body)"),
-    "initial_rate_error": (lambda sc: 3, "initial body rate error (rad/s)"),
+    "initial_rate_error_rad_s": (lambda sc: 3, "initial body rate error (rad/s)"),
 }
 
 
@@ -108,62 +106,43 @@ class Campaign:
     runs: int
     dispersions: dict             # name -> Distribution, in DISPERSIONS order
     settle_tolerance: float       # rad
-    converge_timeout: float       # s
+    converge_timeout_s: float     # s
 
 
-def distribution_from(g: Group) -> Distribution:
-    kind = g.choice("distribution", ("normal", "uniform"))
-    if kind == "uniform":
-        low, high = g.number("low"), g.number("high")
-        if not low < high:
-            raise ValueError(f"{g.label}: low {low:g} must be below high {high:g}")
-        g.done()
-        return Distribution(kind, low, high)
-    mean = g.number("mean", 0.0)
-    if ("sigma" in g) == ("three_sigma" in g):
-        raise ValueError(f"{g.label} needs exactly one of sigma, three_sigma")
-    sigma = g.declared(schema.Normal, "sigma") if "sigma" in g else g.declared(schema.Normal, "three_sigma") / 3.0
-    truncate = g.declared(schema.Normal, "truncate")
-    g.done()
-    return Distribution(kind, mean, sigma, truncate)
+def distribution_from(d: schema.Normal | schema.Uniform) -> Distribution:
+    """The validated distribution of a dispersion."""
+    if isinstance(d, schema.Uniform):
+        return Distribution("uniform", d.low, d.high)
+    return Distribution("normal", d.mean, d.standard_deviation, d.truncate)
+
+
+def campaign_of(model: schema.CampaignFile, path: Path) -> Campaign:
+    """The :class:`Campaign` of a validated campaign file."""
+    c = model.campaign
+    dispersions = {name: distribution_from(getattr(c.dispersions, name)) for name in DISPERSIONS
+                   if getattr(c.dispersions, name) is not None}
+    return Campaign(path, c.scenario, c.seed, c.runs, dispersions, c.settle_tolerance_deg * DEG, c.converge_timeout_s)
 
 
 def campaign_from(doc, path: Path) -> Campaign:
-    """The checked ``campaign`` mapping (ValueError naming the field)."""
-    if not isinstance(doc, Mapping) or set(doc) != {"campaign"}:
-        keys = ", ".join(map(str, doc)) if isinstance(doc, Mapping) else type(doc).__name__
-        raise ValueError(f"a campaign file holds one mapping 'campaign:', got {keys[:120]}")
-    g = Group(doc["campaign"], "campaign")
-    name = g.name("scenario")
-    seed = g.declared(schema.Campaign, "seed")
-    runs = g.declared(schema.Campaign, "runs")
-    if seed != int(seed) or runs != int(runs):
-        raise ValueError("campaign.seed and campaign.runs must be integers")
-    settle = g.declared(schema.Campaign, "settle_tolerance_deg") * DEG
-    converge = g.declared(schema.Campaign, "converge_timeout", "converge_timeout_s")
-    d = g.group("dispersions")
-    unknown = sorted(str(k) for k in d.values if k not in DISPERSIONS)
-    if unknown:
-        raise ValueError(f"campaign.dispersions has unknown name(s) {', '.join(unknown)[:120]} "
-                         f"(known: {', '.join(DISPERSIONS)})")
-    dispersions = {k: distribution_from(d.group(k)) for k in DISPERSIONS if k in d}
-    g.done()
-    return Campaign(path, name, int(seed), int(runs), dispersions, settle, converge)
+    """The campaign of the parsed file ``doc`` (read from ``path``), validated by
+    :class:`att_sim.truth.campaign_schema.CampaignFile`;
+    :class:`att_sim.models.config_files.ConfigFileError` (a ValueError) with every problem."""
+    path = Path(path)
+    if not isinstance(doc, dict):
+        raise config_files.ConfigFileError([config_files.Problem(str(path), None, "", "a mapping 'campaign:'",
+                                                                 config_files.shown(doc))])
+    return campaign_of(config_files.validate(path, schema.CampaignFile, doc, {}), path)
 
 
 def load_campaign(path) -> Campaign:
-    """The campaign file at ``path`` (ValueError: one sentence naming the file and the field)."""
+    """The campaign file at ``path``, read by the one loader (:mod:`att_sim.models.config_files`) and
+    validated by :class:`att_sim.truth.campaign_schema.CampaignFile`; a
+    :class:`~att_sim.models.config_files.ConfigFileError` (a ValueError, ``INVALID_CONFIG``) lists
+    every problem as ``file:line: field.path: expected ...; found ...``."""
     path = Path(path)
-    try:
-        doc = config_files.read_yaml(path, MAX_FILE_BYTES, aliases=True)[0]
-    except config_files.ConfigFileError as err:
-        p = err.problems[0]
-        raise ValueError(f"campaign {path}: cannot be read ({f'line {p.line}: ' if p.line else ''}{p.expected} "
-                         f"expected, found {p.found[:200]})") from None
-    try:
-        return campaign_from(doc, path)
-    except ValueError as exc:
-        raise ValueError(f"campaign {path}: {exc}") from None
+    data, lines = config_files.read_yaml(path, MAX_FILE_BYTES, aliases=True)
+    return campaign_of(config_files.validate(path, schema.CampaignFile, data, lines), path)
 
 
 def run_seed(campaign_seed: int, run: int) -> int:
@@ -261,7 +240,7 @@ def truth(scenario: scen.Scenario, values: dict, seed: int, q0=rot.IDENTITY, ome
                                                  for f in environment["facets"]]}
     q = rot.multiply(np.asarray(q0, float), rot.exp_map(v["initial_attitude_error_deg"] * DEG))
     dispersed = replace(scenario, spacecraft=sc, actuators=actuators, environment=environment)
-    return Truth(dispersed, q, np.asarray(omega0, float) + v["initial_rate_error"], seed)
+    return Truth(dispersed, q, np.asarray(omega0, float) + v["initial_rate_error_rad_s"], seed)
 
 
 def seed_truth(campaign: Campaign, scenario: scen.Scenario, seed: int, q0=rot.IDENTITY,

@@ -222,7 +222,7 @@ class Simulation:
         omega = _numbers(omega, "body_rate", bad, (3,))
         rate = float(np.linalg.norm(omega))
         if rate > self.checks.max_reset_rate:
-            raise RequestError(bad, f"body_rate has norm {rate:.6g} rad/s, above max_reset_rate = "
+            raise RequestError(bad, f"body_rate has norm {rate:.6g} rad/s, above max_reset_rate_rad_s = "
                                     f"{self.checks.max_reset_rate:g} rad/s")
         wheel_speed = _numbers(wheel_speed, "wheel_speeds", bad, (-1,))
         if wheel_speed.size == 0:

@@ -5,12 +5,12 @@ callbacks (commands, reset) with ``spin_once``, so a command is handled the mome
 no lock or cross-thread wake-up sits in the control loop.
 
 Subscribes ``/actuator/command`` (ActuatorCommand), publishes ``/spacecraft/state``
-(SpacecraftState) at ``publish_rate`` and ``/clock`` at ``clock_rate`` (Hz of sim time), serves
+(SpacecraftState) at ``publish_rate_Hz`` and ``/clock`` at ``clock_rate_Hz`` (sim time), serves
 ``/simulator/reset``. The 3D view (:mod:`att_sim.models.scene`): ``/tf`` (tf2_msgs/TFMessage: the
 body frame ``body_frame_id`` under the inertial ``frame_id``, attitude only, the view centred on the
 spacecraft) and ``/simulator/zone_margins`` (att_msgs/ZoneMargins: each zone's truth margin) at
-``tf_rate``, and ``/simulator/markers`` (visualization_msgs/MarkerArray: the zones as
-cones where they are now, the sensor boresights, the Sun/Moon/Earth directions) at ``marker_rate``;
+``tf_rate_Hz``, and ``/simulator/markers`` (visualization_msgs/MarkerArray: the zones as
+cones where they are now, the sensor boresights, the Sun/Moon/Earth directions) at ``marker_rate_Hz``;
 a rate of 0 switches either off. With the scenario's sensors it also publishes what they measure,
 each at its own rate (:class:`att_sim.truth.sensors.SensorSuite`): ``/sensors/imu`` (sensor_msgs/Imu),
 ``/sensors/star_tracker`` (att_msgs/StarTracker), ``/sensors/magnetometer``
@@ -37,7 +37,7 @@ refused while the held one is in the ROS graph, however long it is silent; a res
 is followed once the old one has left the graph (at once after a clean stop, when its DDS lease
 expires after a crash). When no valid
 command arrived for ``command_timeout`` s of sim time the actuator inputs are zeroed and the state
-says so. In lockstep, a state that no command answers within ``lockstep_timeout`` s of wall time
+says so. In lockstep, a state that no command answers within ``lockstep_timeout_s`` of wall time
 ends the waiting: the simulator free-runs at its real-time factor with zero inputs
 (``command_timeout`` set) until a command answers again; with a real-time factor of 0 (as fast
 as possible) it free-runs at real time. A controller that lives but fell behind (after a stall of
@@ -96,7 +96,8 @@ class SimulatorNode(Node):
             self.sim = Simulation.for_scenario(
                 truth.scenario, q0=truth.q0, omega0=truth.omega0, gravity_gradient=param["gravity_gradient"],
                 checks=Checks(command_limit_factor=param["command_limit_factor"],
-                              max_reset_rate=param["max_reset_rate"], body_frame_id=self.scenario.body_frame_id,
+                              max_reset_rate=param["max_reset_rate_rad_s"],
+                              body_frame_id=self.scenario.body_frame_id,
                               stamp_ahead=self.step, stamp_age=self.command_timeout), seed=truth.seed)
         except ValueError as err:        # the environment cannot start (e.g. a TLE that fails at t = 0)
             raise ConfigError(ErrorCode.INVALID_CONFIG, f"scenario '{self.scenario.name}': {clip(err, 300)}") from None
@@ -123,26 +124,26 @@ class SimulatorNode(Node):
         """Read and check every parameter (ConfigError naming the first bad one); the timing ones
         become attributes, the rest (initial state, checks) are returned."""
         section = self.scenario.node_params.get("simulator", {})
-        param = ParameterReader(self, SIMULATOR, section, source=str(self.scenario.path))
-        self.step = param("step")
+        param = ParameterReader(self, SIMULATOR, section, source=str(self.scenario.node_params_path))
+        self.step = param("step_s")
         top = (1 + 1e-9) / self.step
-        self.publish_period = 1.0 / param("publish_rate", min(10.0, 1.0 / self.step), high=top)
-        self.clock_period = 1.0 / param("clock_rate", min(50.0, 1.0 / self.step), high=top)
+        self.publish_period = 1.0 / param("publish_rate_Hz", min(10.0, 1.0 / self.step), high=top)
+        self.clock_period = 1.0 / param("clock_rate_Hz", min(50.0, 1.0 / self.step), high=top)
         # the 3D view: /tf (default: with every state) and the markers, in Hz of sim time; 0: off
-        self.tf_rate = param("tf_rate", 1.0 / self.publish_period, high=top)
-        self.marker_rate = param("marker_rate", min(1.0, 1.0 / self.step), high=top)
+        self.tf_rate = param("tf_rate_Hz", 1.0 / self.publish_period, high=top)
+        self.marker_rate = param("marker_rate_Hz", min(1.0, 1.0 / self.step), high=top)
         self.real_time_factor = param("real_time_factor")
-        self.command_timeout = param("command_timeout")
-        self.end_time = param("end_time")      # s of sim time; 0: run until stopped
+        self.command_timeout = param("command_timeout_s")
+        self.end_time = param("end_time_s")      # s of sim time; 0: run until stopped
         # Hold sim time at zero until this many subscribers (recorder, controller) see the state,
         # so that no run starts before it is recorded and controlled; at most start_timeout s.
         self.wait_for_subscribers = param("wait_for_subscribers")
         self.start_timeout = param("start_timeout")
-        # Lockstep: after each published state, wait (up to lockstep_timeout s of wall time) for
+        # Lockstep: after each published state, wait (up to lockstep_timeout_s of wall time) for
         # the command that answers it, so the loop stays closed at any speed and under CPU load.
         self.lockstep = param("lockstep")
-        self.lockstep_timeout = param("lockstep_timeout")
-        values = {name: param(name) for name in ("command_limit_factor", "max_reset_rate", "initial_attitude",
+        self.lockstep_timeout = param("lockstep_timeout_s")
+        values = {name: param(name) for name in ("command_limit_factor", "max_reset_rate_rad_s", "initial_attitude",
                                                  "initial_rate", "campaign", "run_seed")}
         values["gravity_gradient"] = param("gravity_gradient", bool(self.scenario.environment.get("gravity_gradient")))
         values["seed"] = param("seed", self.scenario.sensors.seed)
@@ -152,9 +153,10 @@ class SimulatorNode(Node):
         except RequestError as err:
             raise ConfigError(err.code, err.message) from None
         rate = float(np.linalg.norm(values["initial_rate"]))
-        if rate > values["max_reset_rate"]:
+        if rate > values["max_reset_rate_rad_s"]:
+            limit = values["max_reset_rate_rad_s"]
             raise ConfigError(ErrorCode.INVALID_PARAMETER, f"parameter 'initial_rate' has norm {rate:g} rad/s, above "
-                                                           f"max_reset_rate = {values['max_reset_rate']:g} rad/s")
+                                                           f"max_reset_rate_rad_s = {limit:g} rad/s")
         param.refuse_unknown()
         values["truth"] = self.dispersed_truth(values)
         return values
@@ -317,7 +319,7 @@ class SimulatorNode(Node):
 
     def wait_for_answer(self) -> None:
         """Lockstep: run callbacks until a command answers the state just published; after
-        ``lockstep_timeout`` s stop waiting and free-run at the real-time factor, paced from now."""
+        ``lockstep_timeout_s`` stop waiting and free-run at the real-time factor, paced from now."""
         self.spin_until(lambda: self.answered, time.monotonic() + self.lockstep_timeout)
         if not self.answered:
             self.free_running = True

@@ -103,14 +103,16 @@ def test_a_hundred_thousand_zones_are_refused_by_a_len_not_by_reading_them():
 
 def test_the_receivers_check_the_same_declared_caps():
     from att_planner.control import plan_checks
-    from att_planner.mission import targets
+    from att_planner.mission import schema as target_schema
     from att_planner.service import real_sky, requests
 
     assert validation.MAX_PLAN_SAMPLES is limits.MAX_PLAN_SAMPLES and validation.MAX_PLAN_BYTES is limits.MAX_PLAN_BYTES
     assert (requests.MAX_CONES, requests.MAX_OPTIONS, requests.MAX_TARGETS) == (16, 16, 20)
     assert plan_checks.MAX_CONES is limits.MAX_CONES and plan_checks.MAX_ZONES is limits.MAX_ZONES
     assert real_sky.MAX_ZONES is limits.MAX_ZONES and real_sky.MAX_TLE_LENGTH is limits.MAX_TLE_LENGTH
-    assert targets.MAX_TARGETS is requests.MAX_TARGETS is limits.MAX_TARGETS
+    assert target_schema.MAX_TARGETS is requests.MAX_TARGETS is limits.MAX_TARGETS     # a target list's cap
+    assert any(getattr(m, "max_length", None) == limits.MAX_TARGETS
+               for m in target_schema.InertialTargets.model_fields["targets"].metadata)
 
 
 def test_magnetometer_has_only_its_header_to_cap():

@@ -35,8 +35,8 @@ CONES = [Cone([0.5, 0.866, 0.0], math.radians(47), "sun"), Cone([0.0, 0.0, -1.0]
          Cone([0.1795, 0.3109, 0.9333], math.radians(23), "moon")]
 GOAL = rot.from_axis_angle([0, 1, 0], math.radians(-45))
 METHOD = "eigenaxis_smooth"
-PARAMS = {"simulator": {"real_time_factor": 0.0, "publish_rate": 10.0, "clock_rate": 10.0},
-          "controller": {"control_rate": 10.0, "settle_time": 5.0}}
+PARAMS = {"simulator": {"real_time_factor": 0.0, "publish_rate_Hz": 10.0, "clock_rate_Hz": 10.0},
+          "controller": {"control_rate_Hz": 10.0, "settle_time_s": 5.0}}
 
 
 def main() -> int:

@@ -283,7 +283,7 @@ def test_the_scenario_reader_refuses_duplicate_keys_and_alias_bombs(tmp_path):
     from att_sim.models import scenario
     twice = tmp_path / "twice.yaml"
     twice.write_text("/**:\n  ros__parameters:\n    frame_id: eci\n    frame_id: gcrs\n")
-    with pytest.raises(ConfigError, match=r"twice.yaml: line 4: /\*\*.ros__parameters.frame_id: expected each key "
+    with pytest.raises(ConfigError, match=r"twice.yaml:4: /\*\*.ros__parameters.frame_id: expected each key "
                                           r"once in a mapping"):
         scenario.load(str(twice))
     bomb = tmp_path / "bomb.yaml"

@@ -135,7 +135,8 @@ def test_hostile_sky_request_is_refused_with_its_code_naming_the_field(name):
 def test_a_scenario_epoch_the_wire_cannot_carry_is_refused(tmp_path, monkeypatch, epoch, words):
     monkeypatch.setenv("ATT_CONFIG_PATH", str(tmp_path))
     (tmp_path / "late.yaml").write_text(f'/**:\n  ros__parameters:\n    epoch: "{epoch}"\n    spacecraft:\n'
-                                        "      inertia: [1, 1, 1]\n      torque_max: 1.0\n      wheel_inertia: 0.01\n")
+                                        "      inertia_kg_m2: [1, 1, 1]\n      torque_max_Nm: 1.0\n"
+                                        "      wheel_inertia_kg_m2: 0.01\n")
     with pytest.raises(RequestError) as err:
         validate(sky_request(epoch=None, tle=("", ""), spacecraft="late"))
     assert err.value.code in (ErrorCode.INVALID_EPOCH, ErrorCode.INVALID_SPACECRAFT), err.value.message

@@ -30,7 +30,7 @@ SENSOR = [1.0, 0.0, 0.0]
 def suite(ros_suite):
     with ros_suite("swift_demo", nodes=("simulator", "controller", "planner"),
                    params={"simulator": {"real_time_factor": 0.0},
-                           "controller": {"settle_time": 5.0, "state_source": "truth"}},
+                           "controller": {"settle_time_s": 5.0, "state_source": "truth"}},
                    name="spoofing_test") as s:
         yield s
 

@@ -20,7 +20,7 @@ ROS_TYPE = {float: ParameterType.PARAMETER_DOUBLE, int: ParameterType.PARAMETER_
 NUMERIC = (ParameterType.PARAMETER_DOUBLE, ParameterType.PARAMETER_INTEGER)
 # integers given for doubles (and for a list of doubles): accepted and held as doubles
 GIVEN = {"simulator": {"real_time_factor": 4, "initial_rate": [0, 0, 0]},
-         "controller": {"settle_time": 20, "safe_sun_axis": [0, 0, 1]},
+         "controller": {"settle_time_s": 20, "safe_sun_axis": [0, 0, 1]},
          "bridge": {"port": 0}}
 
 
@@ -97,8 +97,8 @@ def test_every_numeric_parameter_with_a_bound_has_its_range(described):
     for node, name in bounded:
         d, _ = described[node][name]
         assert d.floating_point_range or d.integer_range, f"{node}.{name}"
-    step = described["simulator"]["step"][1].double_value
-    assert described["simulator"]["publish_rate"][0].floating_point_range[0].to_value == pytest.approx(1.0 / step)
+    step = described["simulator"]["step_s"][1].double_value
+    assert described["simulator"]["publish_rate_Hz"][0].floating_point_range[0].to_value == pytest.approx(1.0 / step)
 
 
 def test_integers_given_for_doubles_are_taken_as_doubles(described):
@@ -106,7 +106,7 @@ def test_integers_given_for_doubles_are_taken_as_doubles(described):
     assert sim["real_time_factor"][1].type == ParameterType.PARAMETER_DOUBLE
     assert sim["real_time_factor"][1].double_value == 4.0
     assert list(sim["initial_rate"][1].double_array_value) == [0.0, 0.0, 0.0]
-    assert ctl["settle_time"][1].double_value == 20.0
+    assert ctl["settle_time_s"][1].double_value == 20.0
     assert list(ctl["safe_sun_axis"][1].double_array_value) == [0.0, 0.0, 1.0]
 
 

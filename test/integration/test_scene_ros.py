@@ -19,8 +19,8 @@ from helpers.waiting import wait_until
 
 SCENARIO = "leo_observatory"                    # GCRS, TLE orbit, Sun/Moon/Earth-limb keep-out zones on +y
 END = 6.0                                       # s of sim time
-PARAMS = {"simulator": {"lockstep": False, "real_time_factor": 0.0, "end_time": END, "publish_rate": 10.0,
-                        "tf_rate": 10.0, "marker_rate": 2.0}}
+PARAMS = {"simulator": {"lockstep": False, "real_time_factor": 0.0, "end_time_s": END, "publish_rate_Hz": 10.0,
+                        "tf_rate_Hz": 10.0, "marker_rate_Hz": 2.0}}
 
 
 def decode(path):

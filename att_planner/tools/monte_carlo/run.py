@@ -5,9 +5,9 @@ its plans (:func:`att_planner.verification.rejection` with :data:`~att_planner.v
 on the flown truth.
 
 A run: the simulation starts at the maneuver's initial attitude and rest, dispersed; the loop
-ticks until the estimate is CONVERGED (at most the campaign's ``converge_timeout``), as the demo
+ticks until the estimate is CONVERGED (at most the campaign's ``converge_timeout_s``), as the demo
 waits before it sends a goal; then the controller flies the plan and holds its end for
-``settle_time``. The outcomes are taken at every control instant of the flown truth.
+``settle_time_s``. The outcomes are taken at every control instant of the flown truth.
 
 The runs of a task fly as a batch (:func:`fly_batch`): each run's flight software steps on its
 own, the heavy numerics of a step are done for all the runs at once — the estimators' propagations,
@@ -113,7 +113,7 @@ class _Flight:
 
     def going(self) -> bool:
         """Whether the run takes another step — the checks of converging (until CONVERGED or
-        ``converge_timeout``) and of :meth:`ClosedLoop.fly` (until the controller ends the maneuver),
+        ``converge_timeout_s``) and of :meth:`ClosedLoop.fly` (until the controller ends the maneuver),
         in their order; an ended run gets its outcomes."""
         setup, loop = self.setup, self.loop
         sim, est = loop.sim, loop.estimator
@@ -121,7 +121,7 @@ class _Flight:
             if est is not None and est.health(sim.t) != Health.CONVERGED:
                 if sim.t < self.deadline and not sim.halted:
                     return True
-                return self.end(313, f"the estimate did not converge within {setup.campaign.converge_timeout:g} s")
+                return self.end(313, f"the estimate did not converge within {setup.campaign.converge_timeout_s:g} s")
             self.start, self.flying = sim.t, True
             refused = loop.execute(setup.plan, issued=self.issued)
             if refused is not None:
@@ -158,7 +158,7 @@ def fly_batch(setup: Setup, runs: list[tuple[int, int]], tap=None) -> list[dict]
         loop.tap, loop.controller.references = tap, references
         issued = issued or loop.issue(setup.plan)
         flights.append(_Flight(setup, loop, {"run": run, "seed": seed, **applied_columns(values, loop)},
-                               loop.sim.t + setup.campaign.converge_timeout, issued))
+                               loop.sim.t + setup.campaign.converge_timeout_s, issued))
     going, batch = flights, None
     while going:
         still = [f for f in going if f.going()]

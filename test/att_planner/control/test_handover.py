@@ -37,7 +37,7 @@ def test_the_blend_starts_at_rest_on_the_law_and_joins_it():
 
 @pytest.mark.slow
 def test_a_slew_onto_nadir_hands_over_without_a_jump():
-    loop = ClosedLoop(SWIFT, overrides={"controller": {"state_source": "truth", "settle_time": 0.0}})
+    loop = ClosedLoop(SWIFT, overrides={"controller": {"state_source": "truth", "settle_time_s": 0.0}})
     loop.run(1.0)
     geometry = PointingGeometry.of(world.Environment.from_scenario(SWIFT))
     law = law_of(PointingMode("nadir"), geometry, loop.sim.t, rot.IDENTITY)

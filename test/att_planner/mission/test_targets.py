@@ -59,27 +59,38 @@ def test_sources_beside_the_sun_and_the_moon_are_never_visible_and_the_others_ar
 GOOD = {"kind": "inertial", "scenario": "leo_observatory",
         "targets": [{"name": "a", "ra_deg": 10.0, "dec_deg": 20.0, "dwell_s": 60.0}]}
 HOSTILE = {
-    "kind unknown": ({"kind": "galactic"}, "kind = 'galactic'"),
-    "unknown file key": ({"colour": 1}, "unknown key(s) colour"),
-    "unknown scenario": ({"scenario": "nowhere"}, "scenario = 'nowhere' is not a known scenario"),
-    "no targets": ({"targets": []}, "targets must list 1 to 20"),
+    "kind unknown": ({"kind": "galactic"}, "kind: expected 'inertial' or 'ground'; found 'galactic'"),
+    "unknown file key": ({"colour": 1}, "colour: expected one of the keys"),
+    "unknown scenario": ({"scenario": "nowhere"}, "scenario: expected the name of a scenario; found 'nowhere'"),
+    "no targets": ({"targets": []}, "targets: expected List should have at least 1 item"),
     "21 targets": ({"targets": [{"name": f"t{i}", "ra_deg": i, "dec_deg": 0, "dwell_s": 1} for i in range(21)]},
-                   "got 21"),
-    "target not a mapping": ({"targets": [5]}, "targets[0] is not a mapping"),
-    "typo in a target": ({"targets": [{"name": "a", "ra_deg": 1, "dec": 2, "dwell_s": 1}]}, "unknown key(s) dec"),
-    "missing dwell": ({"targets": [{"name": "a", "ra_deg": 1, "dec_deg": 2}]}, "no key(s) dwell_s"),
-    "dec 95": ({"targets": [{"name": "a", "ra_deg": 1, "dec_deg": 95, "dwell_s": 1}]}, "targets[0] ('a').dec_deg = 95"),
-    "dwell nan": ({"targets": [{"name": "a", "ra_deg": 1, "dec_deg": 2, "dwell_s": float("nan")}]}, "dwell_s = nan"),
-    "dwell negative": ({"targets": [{"name": "a", "ra_deg": 1, "dec_deg": 2, "dwell_s": -5}]}, "dwell_s = -5"),
-    "ra as text": ({"targets": [{"name": "a", "ra_deg": "ten", "dec_deg": 2, "dwell_s": 1}]}, "ra_deg = 'ten'"),
-    "ra true": ({"targets": [{"name": "a", "ra_deg": True, "dec_deg": 2, "dwell_s": 1}]}, "ra_deg = True"),
-    "name with a control": ({"targets": [{"name": "a\x01", "ra_deg": 1, "dec_deg": 2, "dwell_s": 1}]}, "name ="),
-    "names repeat": ({"targets": [{"name": "a", "ra_deg": 1, "dec_deg": 2, "dwell_s": 1}] * 2}, "'a' appears twice"),
-    "roll reference zero": ({"roll_reference": [0, 0, 0]}, "roll_reference = [0, 0, 0]"),
+        "targets: expected List should have at most 20 items"),
+    "target not a mapping": ({"targets": [5]}, "targets[0]: expected a valid dictionary"),
+    "typo in a target": ({"targets": [{"name": "a", "ra_deg": 1, "dec": 2, "dwell_s": 1}]},
+        "targets[0].dec: expected one of the keys"),
+    "missing dwell": ({"targets": [{"name": "a", "ra_deg": 1, "dec_deg": 2}]},
+        "targets[0].dwell_s: expected this key (required)"),
+    "dec 95": ({"targets": [{"name": "a", "ra_deg": 1, "dec_deg": 95, "dwell_s": 1}]},
+        "targets[0].dec_deg: expected less than or equal to 90; found 95"),
+    "dwell nan": ({"targets": [{"name": "a", "ra_deg": 1, "dec_deg": 2, "dwell_s": float("nan")}]},
+        "targets[0].dwell_s: expected less than or equal to 86400; found nan"),
+    "dwell negative": ({"targets": [{"name": "a", "ra_deg": 1, "dec_deg": 2, "dwell_s": -5}]},
+        "targets[0].dwell_s: expected greater than or equal to 0; found -5"),
+    "ra as text": ({"targets": [{"name": "a", "ra_deg": "ten", "dec_deg": 2, "dwell_s": 1}]},
+        "targets[0].ra_deg: expected a valid number; found 'ten'"),
+    "ra true": ({"targets": [{"name": "a", "ra_deg": True, "dec_deg": 2, "dwell_s": 1}]},
+        "targets[0].ra_deg: expected a valid number; found True"),
+    "name with a control": ({"targets": [{"name": "a\x01", "ra_deg": 1, "dec_deg": 2, "dwell_s": 1}]},
+        "targets[0].name: expected a printable name"),
+    "names repeat": ({"targets": [{"name": "a", "ra_deg": 1, "dec_deg": 2, "dwell_s": 1}] * 2},
+        "targets: expected distinct names, got 'a' twice"),
+    "roll reference zero": ({"roll_reference": [0, 0, 0]}, "roll_reference: expected a non-zero 3-vector"),
     "ground site at latitude 100": ({"kind": "ground", "targets": [{"name": "x", "lat_deg": 100, "lon_deg": 0,
-                                                                    "dwell_s": 1}]}, "lat_deg = 100"),
+                                                                    "dwell_s": 1}]},
+        "targets[0].lat_deg: expected less than or equal to 90; found 100"),
     "ground elevation 90": ({"kind": "ground", "min_elevation_deg": 90, "targets": [
-        {"name": "x", "lat_deg": 0, "lon_deg": 0, "dwell_s": 1}]}, "min_elevation_deg = 90"),
+        {"name": "x", "lat_deg": 0, "lon_deg": 0, "dwell_s": 1}]},
+        "min_elevation_deg: expected less than or equal to 89; found 90"),
 }
 
 
@@ -100,5 +111,5 @@ def test_unknown_list_and_unreadable_file(tmp_path):
         tl.load("nowhere")
     path = tmp_path / "broken.yaml"
     path.write_text("kind: [inertial\n")
-    with pytest.raises(ConfigError, match="not valid YAML"):
+    with pytest.raises(ConfigError, match=r"broken.yaml:2: \(file\): expected valid YAML"):
         tl.load(str(path))

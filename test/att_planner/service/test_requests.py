@@ -78,14 +78,15 @@ def test_there_are_more_than_thirty_distinct_bad_requests():
 def test_bad_spacecraft_configs_are_rejected(tmp_path, monkeypatch):
     monkeypatch.setenv("ATT_CONFIG_PATH", str(tmp_path))
     cases = {
-        "not_spd": ("inertia: [1, 0, 0, 0, -1, 0, 0, 0, 1]", "positive definite"),
-        "asymmetric": ("inertia: [1, 0.5, 0, 0, 1, 0, 0, 0, 1]", "symmetric"),
-        "triangle": ("inertia: [1, 1, 5]", "triangle inequality"),
-        "zero_torque": ("inertia: [1, 1, 1]\n      torque_max: 0.0", "torque_max"),
-        "neg_wheel": ("inertia: [1, 1, 1]\n      torque_max: 1.0\n      wheel_torque_max: -1", "wheel_torque_max"),
+        "not_spd": ("inertia_kg_m2: [1, 0, 0, 0, -1, 0, 0, 0, 1]", "positive definite"),
+        "asymmetric": ("inertia_kg_m2: [1, 0.5, 0, 0, 1, 0, 0, 0, 1]", "symmetric"),
+        "triangle": ("inertia_kg_m2: [1, 1, 5]", "triangle inequality"),
+        "zero_torque": ("inertia_kg_m2: [1, 1, 1]\n      torque_max_Nm: 0.0", "torque_max_Nm"),
+        "neg_wheel": ("inertia_kg_m2: [1, 1, 1]\n      torque_max_Nm: 1.0\n      wheel_torque_max_Nm: -1",
+                      "wheel_torque_max_Nm"),
     }
     for name, (body, words) in cases.items():
-        body += "\n      wheel_inertia: 0.01"       # the scenario loader's own checks pass
+        body += "\n      wheel_inertia_kg_m2: 0.01"       # the scenario loader's own checks pass
         (tmp_path / f"{name}.yaml").write_text(f"/**:\n  ros__parameters:\n    spacecraft:\n      {body}\n")
         with pytest.raises(RequestError) as err:
             validate(request(spacecraft=name))

@@ -2,10 +2,10 @@
 from __future__ import annotations
 
 import json
-import shutil
 from pathlib import Path
 
 import pytest
+import yaml
 
 from att_planner.tools import config_cli
 
@@ -13,22 +13,100 @@ ROOT = Path(config_cli.__file__).resolve().parents[2]
 SHIPPED = sorted([*ROOT.glob("config/*.yaml"), *ROOT.glob("config/*/*.yaml"), *ROOT.glob("campaigns/*.yaml")])
 
 
+def expected_kind(path: Path) -> str:
+    if path.name.endswith(".params.yaml") or path.stem == "controller_gains":
+        return "parameters"
+    if path.name.endswith(".demo.yaml"):
+        return "demo"
+    return {"missions": "mission", "targets": "targets", "campaigns": "campaign", "spacecraft": "spacecraft",
+            "scenarios": "scenario"}[path.parent.name]
+
+
 def test_shipped_files_are_found():
-    assert len(SHIPPED) >= 11
+    """The split layout: a spacecraft file, a scenario file and its node tuning for each scenario."""
+    assert len(SHIPPED) >= 22
+    names = {p.stem for p in ROOT.glob("config/scenarios/*.yaml") if "." not in p.stem}
+    assert names == {p.stem for p in ROOT.glob("config/spacecraft/*.yaml")} >= {"swift_demo", "leo_observatory"}
+    assert all((ROOT / "config" / "scenarios" / f"{n}.params.yaml").is_file() for n in names)
+    assert not [p for p in ROOT.glob("config/*.yaml") if p.stem != "controller_gains"]
+
+
+@pytest.mark.parametrize("path", sorted(ROOT.glob("config/scenarios/*.params.yaml")), ids=lambda p: p.name)
+def test_the_node_tuning_is_a_plain_ros_parameter_file(path):
+    """rclpy's own parser (as --params-file reads it) takes every node section of the file, and every
+    parameter is one the node declares, of its type and in its range."""
+    from rclpy.parameter import parameter_dict_from_yaml_file
+
+    from att_planner.tools.node_parameters import declared
+    data = yaml.safe_load(path.read_text())
+    for node, section in data.items():
+        parsed = parameter_dict_from_yaml_file(str(path), target_nodes=[node])
+        assert set(parsed) == set(section["ros__parameters"])
+        assert declared(node).problems(section["ros__parameters"]) == []
+
+
+def test_an_old_parameter_name_is_answered_with_its_new_name(tmp_path, capsys):
+    path = tmp_path / "old.params.yaml"
+    path.write_text("controller:\n  ros__parameters:\n    control_rate_Hz: 10.0\n    settle_time: 5.0\n")
+    assert config_cli.main(["check", str(path)]) == 2
+    assert (f"{path}:4: controller.ros__parameters.settle_time: expected a valid controller parameter "
+            f"[INVALID_PARAMETER]; found parameter 'settle_time' is renamed 'settle_time_s' (its unit in its name)"
+            in capsys.readouterr().out.splitlines())
+
+
+def test_a_bad_parameter_file_is_refused_naming_the_node_and_parameter(tmp_path, capsys):
+    path = tmp_path / "my.params.yaml"
+    path.write_text("simulator:\n  ros__parameters:\n    step_s: 5.0\n    lockstep_timout: 1.0\n"
+                    "navigator:\n  ros__parameters:\n    x: 1\n")
+    assert config_cli.main(["check", str(path)]) == 2
+    out = capsys.readouterr().out.splitlines()
+    assert any(line.startswith(f"{path}:3: simulator.ros__parameters.step_s: expected a valid simulator parameter "
+                               f"[INVALID_PARAMETER]") for line in out), out
+    assert any(line.startswith(f"{path}:4: simulator.ros__parameters.lockstep_timout:") for line in out), out
+    assert any(line.startswith(f"{path}:5: navigator: expected a section of one of the nodes") for line in out), out
 
 
 @pytest.mark.parametrize("path", SHIPPED, ids=lambda p: str(p.relative_to(ROOT)))
-def test_every_shipped_file_passes_check(path, tmp_path, capsys):
-    """Each shipped file is valid under its kind's schema once its old key names are migrated."""
-    copy = tmp_path / path.parent.name / path.name
-    copy.parent.mkdir()
-    shutil.copy(path, copy)
-    config_cli.main(["migrate", str(copy)])
-    kind, problems = config_cli.check_file(copy)
+def test_every_shipped_file_passes_check(path, capsys):
+    """Each file under config/ and campaigns/ is valid under its kind's schema as shipped: no old key
+    name, every reference resolved, the file untouched."""
+    before = path.read_text()
+    kind, problems = config_cli.check_file(path)
     assert problems == [], "\n".join(map(str, problems))
-    assert kind == {"missions": "mission", "targets": "targets", "campaigns": "campaign"}.get(
-        path.parent.name, "parameters" if path.stem == "controller_gains" else "scenario")
-    assert config_cli.main(["check", str(copy)]) == 0
+    assert kind == expected_kind(path)
+    assert config_cli.main(["check", str(path)]) == 0
+    assert path.read_text() == before
+
+
+def test_the_test_inputs_pass_check(monkeypatch, capsys):
+    """The fixture scenario and campaign of test/data pass check (its campaign names the fixture scenario)."""
+    data = ROOT / "test" / "data"
+    monkeypatch.setenv("ATT_CONFIG_PATH", str(data / "config"))
+    files = sorted([*data.glob("config/*/*.yaml"), *data.glob("campaigns/*.yaml")])
+    assert len(files) >= 2 and config_cli.main(["check", *map(str, files)]) == 0
+
+
+def test_a_migrated_copy_of_an_old_file_passes_check(tmp_path, capsys):
+    """A spacecraft and a scenario written under the old key names are refused with each new name,
+    and pass once migrated, their values unchanged."""
+    renames = {"spacecraft": (("inertia_kg_m2:", "inertia:"), ("torque_max_Nm:", "torque_max:")),
+               "scenarios": (("altitude_m:", "altitude:"), ("arg0_rad:", "arg0:"))}
+    expected = {"spacecraft": [("inertia", "inertia_kg_m2"), ("torque_max", "torque_max_Nm"),
+                               ("wheel_inertia", "wheel_inertia_kg_m2"), ("wheel_torque_max", "wheel_torque_max_Nm")],
+                "scenarios": [("altitude", "altitude_m"), ("arg0", "arg0_rad")]}
+    for folder, pairs in renames.items():
+        shipped = ROOT / "config" / folder / "swift_demo.yaml"
+        old = shipped.read_text()
+        for new, previous in pairs:
+            old = old.replace(new, previous)
+        path = tmp_path / folder / "swift_demo.yaml"
+        path.parent.mkdir()
+        path.write_text(old)
+        _, problems = config_cli.check_file(path)
+        assert sorted(p.rename for p in problems) == expected[folder]
+        assert config_cli.main(["migrate", str(path)]) == 0
+        assert config_cli.check_file(path)[1] == []
+        assert yaml.safe_load(path.read_text()) == yaml.safe_load(shipped.read_text())
 
 
 def test_check_exit_2_with_every_problem_of_every_file(tmp_path, capsys):
@@ -98,7 +176,7 @@ def test_shipped_schemas_are_current(kind):
 
 def test_schema_header_names_the_schema_of_the_files_kind():
     headed = [p for p in SHIPPED if p.read_text().startswith("# yaml-language-server: $schema=")]
-    assert {p.parent.name for p in headed} >= {"missions", "targets"}
+    assert headed == SHIPPED, sorted(set(map(str, SHIPPED)) - set(map(str, headed)))
     for path in headed:
         target = path.read_text().splitlines()[0].split("$schema=", 1)[1].strip()
         kind, _ = config_cli.check_file(path)
@@ -110,23 +188,75 @@ def test_schema_out_writes_one_file_per_kind(tmp_path, capsys):
     assert sorted(p.name for p in tmp_path.iterdir()) == sorted(f"{k}.schema.json" for k in config_cli.KINDS)
 
 
-def test_show_a_shipped_scenario_with_old_key_names(capsys):
-    """A file whose only problems are old names is shown under the new names, the file untouched."""
-    path = ROOT / "config" / "swift_demo.yaml"
-    before = path.read_text()
-    assert config_cli.main(["show", "swift_demo"]) == 0
+OLD_SELF_CONTAINED = """/**:
+  ros__parameters:
+    spacecraft:
+      inertia: [10.0, 12.0, 14.0]
+      torque_max: 0.1            # N m
+      wheel_inertia_kg_m2: 0.01
+demo:
+  ros__parameters:
+    method: slepian_minimum_time
+"""
+
+
+def test_show_a_scenario_with_old_key_names(tmp_path, capsys):
+    """A self-contained file whose only problems are old names is shown under the new names, the file untouched."""
+    path = tmp_path / "old_names.yaml"
+    path.write_text(OLD_SELF_CONTAINED)
+    assert config_cli.main(["show", str(path)]) == 0
     captured = capsys.readouterr()
     lines = captured.out.splitlines()
-    assert path.read_text() == before
-    torque = next(line for line in lines if ".spacecraft.torque_max_Nm = " in line)
-    number = next(i + 1 for i, text in enumerate(before.splitlines()) if "torque_max:" in text and "wheel" not in text)
-    assert torque == f"/**.ros__parameters.spacecraft.torque_max_Nm = 0.1  ({path}:{number})"
+    assert path.read_text() == OLD_SELF_CONTAINED
+    assert f"/**.ros__parameters.spacecraft.torque_max_Nm = 0.1  ({path}:5)" in lines
     assert "old key name" in captured.err and "att-config migrate" in captured.err
     assert any(line.startswith("demo.ros__parameters.method = ") for line in lines)
 
 
+def test_show_a_shipped_scenario_with_where_each_value_came_from(capsys):
+    """att-config show NAME: each value with its file and line across the scenario, its spacecraft,
+    its node tuning and its demo, or 'default'."""
+    assert config_cli.main(["show", "swift_demo"]) == 0
+    captured = capsys.readouterr()
+    lines = captured.out.splitlines()
+    assert "old key name" not in captured.err
+
+    def origin(prefix: str) -> str:
+        return next(line for line in lines if line.startswith(prefix)).rsplit("  (", 1)[1].rstrip(")")
+
+    config = ROOT / "config"
+    for prefix, path, key in (("spacecraft.torque_max_Nm = 0.1", config / "spacecraft" / "swift_demo.yaml",
+                               "torque_max_Nm:"),
+                              ("orbit.altitude_m = 450000.0", config / "scenarios" / "swift_demo.yaml", "altitude_m:"),
+                              ("sensors.gyro.rate_hz = 20.0", config / "spacecraft" / "swift_demo.yaml", "gyro:"),
+                              ("simulator.ros__parameters.step_s = 0.05",
+                               config / "scenarios" / "swift_demo.params.yaml", "step_s:"),
+                              ("demo.method = ", config / "scenarios" / "swift_demo.demo.yaml", "method:")):
+        text = path.read_text().splitlines()
+        number = next(i + 1 for i, line in enumerate(text) if line.strip().startswith(key))
+        where = origin(prefix)
+        if key == "gyro:":                   # a leaf below the key: a line after it
+            assert where.startswith(f"{path}:") and int(where.rsplit(":", 1)[1]) > number, where
+        else:
+            assert where == f"{path}:{number}", (prefix, where)
+    assert origin("environment.drag_coefficient = 2.2") == "default"
+
+
 def test_show_refuses_a_scenario_with_real_problems(tmp_path, capsys):
     path = tmp_path / "bad.yaml"
-    path.write_text("/**:\n  ros__parameters:\n    spacecraft:\n      inertia: [1, 1, 5]\n")
+    path.write_text("/**:\n  ros__parameters:\n    spacecraft:\n      inertia_kg_m2: [1, 1, 5]\n")
     assert config_cli.main(["show", str(path)]) == 2
     assert "triangle inequality" in capsys.readouterr().out
+
+
+def test_the_parameter_schema_types_each_node_section_by_its_table():
+    """Editors complete a parameter file from each node's table: every declared parameter with its
+    unit in the description, and nothing else."""
+    from att_planner.tools.node_parameters import NODE_PARAMETERS, declared
+    nodes = config_cli.schema("parameters")["properties"]
+    assert set(nodes) == set(NODE_PARAMETERS)
+    for node, section in nodes.items():
+        params = section["properties"]["ros__parameters"]
+        assert set(params["properties"]) == set(declared(node).parameters) and params["additionalProperties"] is False
+    step = nodes["simulator"]["properties"]["ros__parameters"]["properties"]["step_s"]
+    assert "[s]" in step["description"] and (step["exclusiveMinimum"], step["maximum"]) == (0.0, 1.0)

@@ -160,7 +160,7 @@ def test_an_unreachable_scheduler_is_one_line_within_its_timeout(capsys):
 
 
 @pytest.mark.parametrize("args, words", [
-    (["no_such_campaign.yaml"], "cannot be read"),
+    (["no_such_campaign.yaml"], "no_such_campaign.yaml: (file): expected a readable file"),
     ([str(CAMPAIGN), "--runs", "0"], "--runs"),
     ([str(CAMPAIGN), "--workers", "many"], "--workers"),
     (["rerun", str(CAMPAIGN), "lucky", "--mcap", "x.mcap"], "seed"),

@@ -66,15 +66,17 @@ def test_without_parameters_the_estimators_fixed_tuning_is_the_cores():
 
 
 @pytest.mark.parametrize("overrides, words", [
-    ({"controller": {"control_rate": 0.0}}, "parameter 'control_rate' (override) = 0.0 is outside (0, 1000]"),
+    ({"controller": {"control_rate_Hz": 0.0}}, "parameter 'control_rate_Hz' (override) = 0.0 is outside (0, 1000]"),
+    ({"controller": {"control_rate": 20.0}}, "parameter 'control_rate' (override) is renamed 'control_rate_Hz'"),
     ({"controller": {"state_source": "oracle"}}, "parameter 'state_source' (override): expected one of truth, "
                                                  "estimate, got 'oracle'"),
     ({"controller": {"m_max": -1.0}}, "parameter 'm_max' (override): expected a dipole > 0 A m², got -1.0"),
     ({"estimator": {"gate_probability": 1.5}}, "parameter 'gate_probability' (override) = 1.5 is outside"),
-    ({"simulator": {"step": 2}}, "parameter 'step' (override) = 2.0 is outside (0, 1]"),
-    ({"simulator": {"publish_rate": 1000.0}}, "(at most 1/step: one per integration step)"),
+    ({"simulator": {"step_s": 2}}, "parameter 'step_s' (override) = 2.0 is outside (0, 1]"),
+    ({"simulator": {"step": 0.1}}, "parameter 'step' (override) is renamed 'step_s'"),
+    ({"simulator": {"publish_rate_Hz": 1000.0}}, "(at most 1/step_s: one per integration step)"),
     ({"controller": {"settle_tme": 1.0}}, "unknown parameter(s) settle_tme"),
-    ({"controler": {"settle_time": 1.0}}, "overrides of unknown node(s) controler"),
+    ({"controler": {"settle_time_s": 1.0}}, "overrides of unknown node(s) controler"),
 ])
 def test_the_in_process_loop_refuses_what_a_node_refuses_in_the_same_words(overrides, words):
     with pytest.raises(ConfigError) as err:
@@ -83,7 +85,7 @@ def test_the_in_process_loop_refuses_what_a_node_refuses_in_the_same_words(overr
 
 
 def test_an_integer_for_a_double_runs_in_process():
-    loop = ClosedLoop(SWIFT, overrides={"controller": {"control_rate": 20, "state_source": "truth"}})
+    loop = ClosedLoop(SWIFT, overrides={"controller": {"control_rate_Hz": 20, "state_source": "truth"}})
     assert loop.controller.config.control_period == pytest.approx(0.05)
 
 
@@ -110,10 +112,10 @@ def test_the_markdown_reference_lists_every_declared_parameter(node):
 def test_the_reference_has_every_node_and_writes_numbers_as_a_parameter_file_does():
     text = reference()
     assert all(f"## {node}\n" in text for node in NODE_PARAMETERS)
-    assert "| `step` | double | `0.05` | in (0, 1] | s |" in text
+    assert "| `step_s` | double | `0.05` | in (0, 1] | s |" in text
     assert "| `schedule_rate_max` | double | `.inf` |" in text
     assert "| `initial_attitude` | double[] | `[0.0, 0.0, 0.0, 1.0]` |" in text
-    assert math.isclose(CONTROLLER["control_rate"].default, 1.0 / ControllerConfig().control_period)
+    assert math.isclose(CONTROLLER["control_rate_Hz"].default, 1.0 / ControllerConfig().control_period)
 
 
 def node_sections(name: str) -> tuple[str, dict]:
@@ -146,3 +148,13 @@ def test_each_nodes_json_schema_is_json_and_has_every_declaration(node):
         assert prop["description"].startswith(spec.summary())
         if spec.bounded and spec.kind is not list and spec.low is not None and not math.isinf(spec.low):
             assert prop["exclusiveMinimum" if spec.low_open else "minimum"] == spec.low
+
+
+def test_a_renamed_parameter_is_answered_with_its_new_name_and_its_new_name_is_declared():
+    assert CONTROLLER.renamed == {"control_rate": "control_rate_Hz", "settle_time": "settle_time_s",
+                                  "wall_timeout": "wall_timeout_s"}
+    assert all(new in CONTROLLER and old not in CONTROLLER for old, new in CONTROLLER.renamed.items())
+    [err] = CONTROLLER.problems({"wall_timeout": 2.0})
+    assert err.code == ErrorCode.INVALID_PARAMETER
+    assert err.message == "parameter 'wall_timeout' is renamed 'wall_timeout_s' (its unit in its name)"
+    assert CONTROLLER.problems({"wall_timeout_s": 2.0}) == []

@@ -20,7 +20,7 @@ from att_sim.models import scenario as scen
 from att_sim.models.dynamics import Spacecraft
 from helpers.regression_log import FIXTURE, GOAL, TOPIC_TYPES
 
-FIXTURE_SETTLE_TIME = 5.0          # the controller's settle_time when the fixture was recorded (make_fixture.py)
+FIXTURE_SETTLE_TIME = 5.0          # the controller's settle_time_s when the fixture was recorded (make_fixture.py)
 
 
 @pytest.fixture(scope="module")

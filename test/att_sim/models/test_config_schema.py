@@ -104,8 +104,8 @@ def test_the_readers_take_defaults_and_ranges_from_the_models():
     assert specs.gyro.rate == cs.Gyro.model_fields["rate_hz"].default
     about = cs.StarTracker(name="a").about_boresight_arcsec
     assert specs.star_trackers[0].about_boresight == pytest.approx(about * ARCSEC)
-    with pytest.raises(ValueError, match=r"sensors.gyro.rate_hz must be a number in \(0, 1000\]"):
+    with pytest.raises(ValueError, match=r"sensors.gyro.rate_hz: expected less than or equal to 1000; found 1000.5"):
         sensors_from_params({"gyro": {"rate_hz": 1000.5}}, epoch_known=False)
-    with pytest.raises(ValueError, match=r"actuators.wheels.friction_speed_rad_s must be a number in \(0, 1000\]"):
+    with pytest.raises(ValueError, match=r"actuators.wheels.friction_speed_rad_s: expected greater than 0; found 0.0"):
         actuators_from_params({"wheels": {"friction_speed_rad_s": 0.0}})
     assert actuators_from_params({"wheels": {}}).wheels.power_max == math.inf

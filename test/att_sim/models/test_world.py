@@ -157,9 +157,11 @@ def test_a_real_sky_step_is_cheap_and_fourth_order(leo):
 
 # ------------------------------------------------------------------------- scenario keys checked
 def _file(tmp_path, **shared):
-    """leo_observatory with ``shared`` keys changed (``...``: removed); without its sensors unless
-    given (their Sun and Moon exclusions need the epoch some cases take away)."""
-    doc = yaml.safe_load((scenario.find("leo_observatory")).read_text())
+    """leo_observatory as one self-contained file with ``shared`` keys changed (``...``: removed);
+    without its sensors unless given (their Sun and Moon exclusions need the epoch some cases take away)."""
+    resolved = scenario.read(scenario.find("leo_observatory")).shared    # its scenario and spacecraft files resolved
+    doc = {"/**": {"ros__parameters": {**resolved.model_dump(mode="json", exclude_none=True, exclude={"orbit"}),
+                                       "orbit": resolved.orbit.model_dump(mode="json")}}}
     p = doc["/**"]["ros__parameters"]
     p.pop("sensors")
     for key, value in shared.items():
@@ -178,7 +180,7 @@ def _file(tmp_path, **shared):
     return str(path)
 
 
-FACET = {"area": 1.0, "normal": [1.0, 0.0, 0.0], "center": [0.1, 0.0, 0.0], "specular": 0.1, "diffuse": 0.2}
+FACET = {"area_m2": 1.0, "normal": [1.0, 0.0, 0.0], "center_m": [0.1, 0.0, 0.0], "specular": 0.1, "diffuse": 0.2}
 BAD = {
     "unknown shared key": (dict(feild_model="dipole"), "unknown key(s) feild_model"),
     "epoch naive": (dict(epoch="2026-12-21T00:00:00"), "epoch"),
@@ -186,43 +188,50 @@ BAD = {
     "tle checksum": (dict(orbit__line1="1 28485U          26355.00000000  .00000000  00000-0  20000-4 0    08"),
                      "checksum"),
     "tle without epoch": (dict(epoch=..., field_model="dipole", zones=[],
-                               environment={"gravity_gradient": True}), "needs an epoch"),
+                               environment={"gravity_gradient": True}),
+        "expected an epoch (the Sun, Moon and Earth depend on the date) for orbit type tle"),
     "orbit type unknown": (dict(orbit={"type": "hyperbolic"}), "orbit.type"),
-    "kepler key missing": (dict(orbit={"type": "kepler", "semi_major_axis": 7e6}), "orbit"),
-    "field model unknown": (dict(field_model="wmm"), "field_model must be one of dipole, igrf14"),
-    "igrf14 beyond 2035": (dict(epoch="2040-01-01T00:00:00Z", orbit={"altitude": 5e5}, zones=[]), "field_model"),
-    "orbit below 150 km": (dict(orbit={"type": "kepler", "semi_major_axis": 6.45e6, "eccentricity": 0.0,
+    "kepler key missing": (dict(orbit={"type": "kepler", "semi_major_axis_m": 7e6}), "orbit"),
+    "field model unknown": (dict(field_model="wmm"), "field_model: expected 'dipole' or 'igrf14'; found 'wmm'"),
+    "igrf14 beyond 2035": (dict(epoch="2040-01-01T00:00:00Z", orbit={"altitude_m": 5e5}, zones=[]), "field_model"),
+    "orbit below 150 km": (dict(orbit={"type": "kepler", "semi_major_axis_m": 6.45e6, "eccentricity": 0.0,
                                        "inclination_deg": 50.0, "raan_deg": 0.0, "arg_perigee_deg": 0.0,
                                        "mean_anomaly_deg": 0.0}), "below the minimum"),
-    "igrf14 without epoch": (dict(epoch=..., orbit={"altitude": 5e5}, zones=[],
-                                  environment={"drag": False}), "igrf14 needs"),
+    "igrf14 without epoch": (dict(epoch=..., orbit={"altitude_m": 5e5}, zones=[],
+                                  environment={"drag": False}),
+        "expected an epoch (the Sun, Moon and Earth depend on the date) for field_model igrf14"),
     "environment typo": (dict(environment__gravity_gradiant=True), "unknown key(s) gravity_gradiant"),
-    "environment flag text": (dict(environment__drag="yes"), "environment.drag must be true or false"),
-    "residual dipole of 2": (dict(environment__residual_dipole=[1.0, 2.0]), "environment.residual_dipole"),
+    "environment flag text": (dict(environment__drag="yes"), "environment.drag: expected a valid boolean"),
+    "residual dipole of 2": (dict(environment__residual_dipole_Am2=[1.0, 2.0]), "environment.residual_dipole"),
     "drag coefficient zero": (dict(environment__drag_coefficient=0.0), "environment.drag_coefficient"),
     "facet absorbs negatively": (dict(environment__facets=[dict(FACET, specular=0.9, diffuse=0.5)]),
                                  "environment.facets"),
     "facets not a list": (dict(environment__facets={"area": 1.0}), "environment.facets"),
-    "pressure without facets": (dict(environment__facets=[]), "needs environment.facets"),
+    "pressure without facets": (dict(environment__facets=[]),
+        "environment: expected facets (the surfaces solar_pressure acts on)"),
     "zone body unknown": (dict(zones=[{"name": "x", "body": "mars", "sensor_axis": [0, 1, 0],
                                        "half_angle_deg": 10.0}]), "zones[0].body"),
     "zone axis not unit": (dict(zones=[{"name": "x", "body": "sun", "sensor_axis": [0, 2, 0],
                                         "half_angle_deg": 10.0}]), "zones[0].sensor_axis"),
     "zone angle 180": (dict(zones=[{"name": "x", "body": "moon", "sensor_axis": [0, 1, 0],
-                                    "half_angle_deg": 180.0}]), "zones[0].half_angle_deg"),
+                                    "half_angle_deg": 180.0}]),
+        "zones[0]: expected half_angle_deg a cone half-angle in (0, 180) deg"),
     "negative limb margin": (dict(zones=[{"name": "x", "body": "earth_limb", "sensor_axis": [0, 1, 0],
-                                          "half_angle_deg": -5.0}]), "margin beyond the Earth limb, in [0, 90)"),
+                                          "half_angle_deg": -5.0}]),
+        "zones[0]: expected half_angle_deg the margin beyond the Earth limb in [0, 90) deg"),
     "inertial zone without direction": (dict(zones=[{"name": "x", "body": "inertial", "sensor_axis": [0, 1, 0],
-                                                     "half_angle_deg": 10.0}]), "zones[0].direction"),
+                                                     "half_angle_deg": 10.0}]),
+        "zones[0]: expected direction (a unit inertial vector) for body inertial"),
     "direction on a sun zone": (dict(zones=[{"name": "x", "body": "sun", "sensor_axis": [0, 1, 0],
-                                             "half_angle_deg": 10.0, "direction": [1, 0, 0]}]), "zones[0].direction"),
+                                             "half_angle_deg": 10.0, "direction": [1, 0, 0]}]),
+        "zones[0]: expected direction (a unit inertial vector) for body inertial, and only"),
     "zone typo": (dict(zones=[{"name": "x", "body": "sun", "sensor_axis": [0, 1, 0], "half_angle": 10.0}]),
-                  "zones[0] has unknown key(s) half_angle"),
+        "zones[0].half_angle: expected one of the keys"),
     "zone keep_in text": (dict(zones=[{"name": "x", "body": "sun", "sensor_axis": [0, 1, 0], "half_angle_deg": 9,
                                        "keep_in": "no"}]), "zones[0].keep_in"),
     "duplicate zone names": (dict(zones=[{"name": "x", "body": "sun", "sensor_axis": [0, 1, 0], "half_angle_deg": 9},
                                          {"name": "x", "body": "moon", "sensor_axis": [0, 1, 0],
-                                          "half_angle_deg": 9}]), "zones[1].name"),
+        "half_angle_deg": 9}]), "zones: expected distinct zone names, got x, x"),
 }
 
 
@@ -235,9 +244,10 @@ def test_bad_real_sky_keys_are_config_errors_naming_file_and_field(tmp_path, cha
 
 
 def test_sun_and_moon_zones_need_an_epoch_and_earth_limb_does_not(tmp_path):
-    base = dict(epoch=..., orbit={"altitude": 5e5}, field_model="dipole", environment={"gravity_gradient": True})
+    base = dict(epoch=..., orbit={"altitude_m": 5e5}, field_model="dipole", environment={"gravity_gradient": True})
     zone = {"name": "x", "body": "sun", "sensor_axis": [0, 1, 0], "half_angle_deg": 30.0}
-    with pytest.raises(ConfigError, match="zones.0..body sun needs the scenario's epoch"):
+    with pytest.raises(ConfigError, match=r"expected an epoch \(the Sun, Moon and Earth depend on the "
+                                          r"date\) for zone x \(body sun\)"):
         scenario.load(_file(tmp_path, **base, zones=[zone]))
     s = scenario.load(_file(tmp_path, **base, zones=[dict(zone, body="earth_limb", half_angle_deg=5.0),
                                                      dict(zone, name="y", body="inertial", direction=[0, 0, 1])]))

@@ -90,10 +90,10 @@ def test_no_actuator_datasheet_means_the_ideal_actuators_bit_for_bit():
     ({"wheels": {"coulomb_friction_Nm": -0.1}}, "actuators.wheels.coulomb_friction_Nm"),
     ({"wheels": {"friction_speed_rad_s": 0.0}}, "actuators.wheels.friction_speed_rad_s"),
     ({"wheels": {"power_max_W": "lots"}}, "actuators.wheels.power_max_W"),
-    ({"wheels": {"stiction": 1.0}}, "actuators.wheels has unknown key(s) stiction"),
+    ({"wheels": {"stiction": 1.0}}, "actuators.wheels.stiction: expected one of the keys"),
     ({"magnetorquers": {"misalignment_deg": 45.0}}, "actuators.magnetorquers.misalignment_deg"),
-    ({"thrusters": {}}, "actuators has unknown key(s) thrusters"),
-    ("wheels", "actuators must be a mapping"),
+    ({"thrusters": {}}, "actuators.thrusters: expected one of the keys"),
+    ("wheels", "actuators: expected a valid dictionary"),
 ])
 def test_a_bad_actuator_datasheet_is_refused_naming_the_field(values, field):
     with pytest.raises(ValueError) as err:

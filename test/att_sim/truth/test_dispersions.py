@@ -4,6 +4,7 @@ campaign is refused in one sentence naming the field (or the seed of a non-physi
 from __future__ import annotations
 
 import math
+import re
 from dataclasses import replace
 from pathlib import Path
 
@@ -38,7 +39,7 @@ def test_the_shipped_campaign_declares_the_issues_dispersions():
     assert d["inertia_scale"].b * 3 == pytest.approx(0.05) and d["wheel_torque_scale"].b * 3 == pytest.approx(0.10)
     assert d["wheel_misalignment_deg"].b * 3 == pytest.approx(0.5)
     assert d["initial_attitude_error_deg"].b * 3 == pytest.approx(0.1)
-    assert d["initial_rate_error"].b * 3 == pytest.approx(1e-4)
+    assert d["initial_rate_error_rad_s"].b * 3 == pytest.approx(1e-4)
     assert all(x.kind == "normal" and x.truncate == 3 for x in d.values())
 
 
@@ -59,11 +60,12 @@ def test_the_applied_values_follow_the_declared_distributions(drawn):
 
 
 def test_uniform_draws_stay_within_their_bounds_and_fill_them():
-    c = campaign({"initial_rate_error": {"distribution": "uniform", "low": -2e-4, "high": 1e-4}})
-    v = np.concatenate([disp.draw(c, SWIFT, disp.run_seed(c.seed, i))["initial_rate_error"] for i in range(2000)])
+    c = campaign({"initial_rate_error_rad_s": {"distribution": "uniform", "low": -2e-4, "high": 1e-4}})
+    v = np.concatenate([disp.draw(c, SWIFT, disp.run_seed(c.seed, i))["initial_rate_error_rad_s"]
+                        for i in range(2000)])
     assert v.min() >= -2e-4 and v.max() <= 1e-4
     assert stats.kstest(v, stats.uniform(-2e-4, 3e-4).cdf).pvalue > 1e-3
-    assert c.dispersions["initial_rate_error"].moments() == pytest.approx((-0.5e-4, 3e-4 / math.sqrt(12)))
+    assert c.dispersions["initial_rate_error_rad_s"].moments() == pytest.approx((-0.5e-4, 3e-4 / math.sqrt(12)))
 
 
 def test_a_run_is_reproduced_by_its_seed_alone_and_declaring_another_dispersion_changes_no_other():
@@ -71,8 +73,8 @@ def test_a_run_is_reproduced_by_its_seed_alone_and_declaring_another_dispersion_
     assert seed == disp.run_seed(SHIPPED.seed, 17) != disp.run_seed(SHIPPED.seed, 18)
     a, b = disp.draw(SHIPPED, SWIFT, seed), disp.draw(SHIPPED, SWIFT, seed)
     assert all(np.array_equal(a[k], b[k]) for k in a)
-    only = campaign({"initial_rate_error": {"distribution": "normal", "three_sigma": 1e-4, "truncate": 3}})
-    assert np.array_equal(disp.draw(only, SWIFT, seed)["initial_rate_error"], a["initial_rate_error"])
+    only = campaign({"initial_rate_error_rad_s": {"distribution": "normal", "three_sigma": 1e-4, "truncate": 3}})
+    assert np.array_equal(disp.draw(only, SWIFT, seed)["initial_rate_error_rad_s"], a["initial_rate_error_rad_s"])
 
 
 def test_the_dispersed_truth_carries_the_drawn_values():
@@ -89,7 +91,7 @@ def test_the_dispersed_truth_carries_the_drawn_values():
     assert truth.scenario.actuators.wheels.coulomb_friction == SWIFT.actuators.wheels.coulomb_friction
     assert math.degrees(rot.angle_between(truth.q0, rot.IDENTITY)) == pytest.approx(
         np.linalg.norm(v["initial_attitude_error_deg"]))
-    assert truth.omega0 == pytest.approx(v["initial_rate_error"])
+    assert truth.omega0 == pytest.approx(v["initial_rate_error_rad_s"])
     assert SWIFT.spacecraft.inertia[0, 0] == 100.0                   # the nominal scenario is untouched
 
 
@@ -119,33 +121,44 @@ def test_a_non_physical_inertia_is_refused_naming_the_runs_seed():
 
 
 BAD = {
-    "not a campaign": ({"scenario": "swift_demo"}, "one mapping 'campaign:'"),
-    "unknown key": ({"campaign": {"scenario": "swift_demo", "seed": 1, "rnus": 3}}, "rnus"),
+    "not a campaign": ({"scenario": "swift_demo"}, "bad.yaml: campaign: expected this key (required)"),
+    "unknown key": ({"campaign": {"scenario": "swift_demo", "seed": 1, "rnus": 3}},
+        "campaign.rnus: expected one of the keys"),
     "unknown dispersion": ({"campaign": {"scenario": "swift_demo", "seed": 1,
-                                         "dispersions": {"inertia_scal": {}}}}, "inertia_scal"),
-    "no runs": ({"campaign": {"scenario": "swift_demo", "seed": 1, "runs": 0}}, "campaign.runs"),
-    "fractional runs": ({"campaign": {"scenario": "swift_demo", "seed": 1, "runs": 2.5}}, "integers"),
-    "negative seed": ({"campaign": {"scenario": "swift_demo", "seed": -1}}, "campaign.seed"),
-    "no seed": ({"campaign": {"scenario": "swift_demo"}}, "campaign.seed is missing"),
+                                         "dispersions": {"inertia_scal": {}}}},
+        "campaign.dispersions.inertia_scal: expected one of the keys"),
+    "no runs": ({"campaign": {"scenario": "swift_demo", "seed": 1, "runs": 0}},
+        "campaign.runs: expected greater than or equal to 1"),
+    "fractional runs": ({"campaign": {"scenario": "swift_demo", "seed": 1, "runs": 2.5}},
+        "campaign.runs: expected a valid integer"),
+    "negative seed": ({"campaign": {"scenario": "swift_demo", "seed": -1}},
+        "campaign.seed: expected greater than or equal to 0"),
+    "no seed": ({"campaign": {"scenario": "swift_demo"}}, "campaign.seed: expected this key (required)"),
     "unknown distribution": ({"campaign": {"scenario": "swift_demo", "seed": 1, "dispersions": {
-        "inertia_scale": {"distribution": "cauchy", "sigma": 1}}}}, "normal, uniform"),
+        "inertia_scale": {"distribution": "cauchy", "sigma": 1}}}},
+        "inertia_scale.distribution: expected one of 'normal', 'uniform'; found 'cauchy'"),
     "sigma and three_sigma": ({"campaign": {"scenario": "swift_demo", "seed": 1, "dispersions": {
-        "inertia_scale": {"distribution": "normal", "sigma": 0.1, "three_sigma": 0.3}}}}, "exactly one"),
+        "inertia_scale": {"distribution": "normal", "sigma": 0.1, "three_sigma": 0.3}}}},
+        "inertia_scale: expected exactly one of sigma, three_sigma"),
     "negative sigma": ({"campaign": {"scenario": "swift_demo", "seed": 1, "dispersions": {
-        "inertia_scale": {"distribution": "normal", "sigma": -0.1}}}}, "inertia_scale.sigma"),
+        "inertia_scale": {"distribution": "normal", "sigma": -0.1}}}},
+        "inertia_scale.sigma: expected greater than or equal to 0"),
     "uniform upside down": ({"campaign": {"scenario": "swift_demo", "seed": 1, "dispersions": {
-        "inertia_scale": {"distribution": "uniform", "low": 0.1, "high": -0.1}}}}, "below high"),
+        "inertia_scale": {"distribution": "uniform", "low": 0.1, "high": -0.1}}}},
+        "inertia_scale: expected low below high"),
     "unknown distribution key": ({"campaign": {"scenario": "swift_demo", "seed": 1, "dispersions": {
-        "inertia_scale": {"distribution": "normal", "sigma": 0.1, "mu": 1}}}}, "mu"),
+        "inertia_scale": {"distribution": "normal", "sigma": 0.1, "mu": 1}}}},
+        "inertia_scale.mu: expected one of the keys"),
     "truncate zero": ({"campaign": {"scenario": "swift_demo", "seed": 1, "dispersions": {
-        "inertia_scale": {"distribution": "normal", "sigma": 0.1, "truncate": 0}}}}, "truncate"),
+        "inertia_scale": {"distribution": "normal", "sigma": 0.1, "truncate": 0}}}},
+        "inertia_scale.truncate: expected greater than 0"),
 }
 
 
 @pytest.mark.parametrize("name", BAD)
 def test_a_bad_campaign_is_refused_naming_the_field(name):
     doc, words = BAD[name]
-    with pytest.raises(ValueError, match=words.replace(".", r"\.").replace("'", "'")):
+    with pytest.raises(ValueError, match=re.escape(words)):
         disp.campaign_from(doc, Path("bad.yaml"))
 
 
@@ -177,10 +190,10 @@ def test_an_epoch_offset_moves_the_truths_orbit_and_sky():
 
 
 def test_bad_files_and_a_dispersion_with_nothing_to_act_on_are_refused(tmp_path):
-    with pytest.raises(ValueError, match="cannot be read"):
+    with pytest.raises(ValueError, match=r"missing\.yaml: \(file\): expected a readable file"):
         disp.load_campaign(tmp_path / "missing.yaml")
     (tmp_path / "broken.yaml").write_text("campaign: {{{\n")
-    with pytest.raises(ValueError, match=r"broken\.yaml: cannot be read"):
+    with pytest.raises(ValueError, match=r"broken\.yaml:2: \(file\): expected valid YAML"):
         disp.load_campaign(tmp_path / "broken.yaml")
     c = campaign({"com_offset_m": {"distribution": "normal", "sigma": 0.01}})
     with pytest.raises(ValueError, match="no solar pressure or drag"):
