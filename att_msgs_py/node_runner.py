@@ -111,7 +111,7 @@ class ParameterReader(Reader):
         self.node, self.values, self.source = node, scenario_values, source
 
     def _given(self, spec: Declaration, default, high):
-        """The value given for ``spec`` (an override, the scenario file's, else ``default``) checked,
+        """The value given for ``spec`` (an override, the scenario's ``NAME.params.yaml``, else ``default``) checked,
         with the override rclpy will take replaced by that value in the declared type."""
         overrides = self.node._parameter_overrides          # -p and --params-file values, by name
         if spec.name in overrides:
@@ -131,7 +131,7 @@ class ParameterReader(Reader):
         return value
 
     def refuse_unknown(self) -> None:
-        """A parameter of this node in the scenario file or on the command line that the table does
+        """A parameter of this node in the scenario's parameter file or on the command line that the table does
         not declare (a typo) is an error, not silently ignored; the shared ``/**`` ones are allowed.
         The declared parameters the node did not read (they do not apply in its configuration) are
         then read too, so a ROS user sees every one and a value given for one is still checked.

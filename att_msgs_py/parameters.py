@@ -4,7 +4,7 @@ naming the bad one.
 Each node's parameters are a :class:`ParameterTable` of :class:`Parameter` declarations (name, type,
 default, range, length, choices, unit, description). :class:`att_msgs_py.node_runner.ParameterReader`
 declares them as ROS parameters with full descriptors and checks every value with
-:meth:`Parameter.check`; :class:`SectionReader` reads the same table over a scenario file's section
+:meth:`Parameter.check`; :class:`SectionReader` reads the same table over a scenario's node section
 for the in-process cores (the closed loop of :mod:`att_planner.tools.closed_loop`), so a value a
 node would refuse is refused there too, in the same words. Both are called ``read(name)`` (the table's default) or
 ``read(name, default)`` for a default the node finds at start-up (``default_rule`` says how), and
@@ -316,7 +316,7 @@ class Reader:
 
 class SectionReader(Reader):
     """The reader of :class:`att_msgs_py.node_runner.ParameterReader` (same call, same checks) over
-    a plain mapping: a scenario file's node section, with ``overrides`` on top."""
+    a plain mapping: a node's section of a scenario's ``NAME.params.yaml``, with ``overrides`` on top."""
 
     def __init__(self, table: ParameterTable, values: dict, source: str = "", overrides: dict | None = None):
         super().__init__(table)

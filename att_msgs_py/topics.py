@@ -52,7 +52,7 @@ RECORDED = {
 
 # What each topic, service and action carries (the documentation's node pages are generated from this).
 ABOUT = {
-    STATE: "the truth state at `publish_rate` (sim time): attitude, rate, wheel speeds, field, position, "
+    STATE: "the truth state at `publish_rate_Hz` (sim time): attitude, rate, wheel speeds, field, position, "
            "`command_timeout`",
     CLOCK: "sim time (the controller reads it itself, for its clock-skew check)",
     COMMAND: "wheel torques, dipole or body torque, and the mode",

@@ -3,7 +3,7 @@
 Subscribes ``/sensors/imu`` (sensor_msgs/Imu: its angular velocity), ``/sensors/star_tracker``,
 ``/sensors/magnetometer``, ``/sensors/sun_sensors`` and ``/actuator/command`` (the magnetorquer
 commands, for the magnetometer's blanking); publishes ``/estimator/attitude``
-(att_msgs/AttitudeEstimate) at ``publish_rate`` Hz of sim time, on gyro samples. The filter's
+(att_msgs/AttitudeEstimate) at ``publish_rate_Hz`` of sim time, on gyro samples. The filter's
 datasheets are the scenario's ``sensors`` group (nominal mountings and noise, never the errors the
 simulator drew); its tuning is this node's parameters, defaulting to values derived from them.
 

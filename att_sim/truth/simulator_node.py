@@ -36,7 +36,7 @@ to their publisher (:class:`~att_msgs_py.source_hold.SourceHold`): one from a se
 refused while the held one is in the ROS graph, however long it is silent; a restarted controller
 is followed once the old one has left the graph (at once after a clean stop, when its DDS lease
 expires after a crash). When no valid
-command arrived for ``command_timeout`` s of sim time the actuator inputs are zeroed and the state
+command arrived for ``command_timeout_s`` of sim time the actuator inputs are zeroed and the state
 says so. In lockstep, a state that no command answers within ``lockstep_timeout_s`` of wall time
 ends the waiting: the simulator free-runs at its real-time factor with zero inputs
 (``command_timeout`` set) until a command answers again; with a real-time factor of 0 (as fast
