@@ -45,6 +45,14 @@ def _finite(x: float) -> float:
     return x
 
 
+def distinct_names(items: list, what: str) -> list:
+    """``items`` when their ``name`` fields differ (a validator's ValueError naming them otherwise)."""
+    names = [item.name for item in items]
+    if len(set(names)) != len(names):
+        raise ValueError(f"distinct {what} names, got {', '.join(names)}")
+    return items
+
+
 def _norm_near_one(v: list[float]) -> list[float]:
     norm = float(np.linalg.norm(v))
     if abs(norm - 1.0) > UNIT_TOLERANCE:
@@ -256,10 +264,7 @@ class Sensors(Schema):
     @field_validator("star_trackers")
     @classmethod
     def _distinct(cls, trackers):
-        names = [t.name for t in trackers]
-        if len(set(names)) != len(names):
-            raise ValueError(f"distinct star tracker names, got {', '.join(names)}")
-        return trackers
+        return distinct_names(trackers, "star tracker")
 
 
 # ---------------------------------------------------------------------------------------------
@@ -409,10 +414,7 @@ class Sky(Schema):
     @field_validator("zones")
     @classmethod
     def _distinct(cls, zones):
-        names = [z.name for z in zones]
-        if len(set(names)) != len(names):
-            raise ValueError(f"distinct zone names, got {', '.join(names)}")
-        return zones
+        return distinct_names(zones, "zone")
 
 
 class Shared(Sky):
