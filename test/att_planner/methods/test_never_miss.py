@@ -75,11 +75,15 @@ def test_the_default_smooth_planner_plans_whenever_a_method_does():
 
 
 def test_slepian_plans_where_its_multistart_finds_no_feasible_start():
-    rescued = 0
+    # Whether a coarse start converges on these sets depends on the last bits of the solver's sums
+    # (threaded BLAS reorders them): a set whose multistart found a start is planned again with one
+    # SQP iteration per start, so that every set goes through the graph_smooth-seeded path.
     for seed in SLEPIAN_SETS:
         problem = cone_set(seed)
         assert some_method_finds_a_path(problem), seed
         plan = plan_slepian(replace(problem, deadline=time.monotonic() + 60))
         assert verified(problem, plan), (seed, plan.message)
-        rescued += all(tf is None for tf in plan.stats["explored"])
-    assert rescued >= len(SLEPIAN_SETS) // 2, "the sets no longer exercise the seeded path"
+        if any(tf is not None for tf in plan.stats["explored"]):
+            plan = plan_slepian(replace(problem, deadline=time.monotonic() + 60), explore_maxiter=1)
+            assert all(tf is None for tf in plan.stats["explored"]), seed
+            assert verified(problem, plan), (seed, plan.message)
