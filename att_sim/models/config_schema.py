@@ -191,28 +191,28 @@ class Gyro(Schema):
     range_deg_per_s: float = Field(math.inf, gt=0.0, description="saturation per axis (deg/s); .inf: none")
 
 
-def _cone_angle(body: str, angle: float, label: str) -> None:
-    limb = body == "earth_limb"
-    if not ((0.0 <= angle < 90.0) if limb else (0.0 < angle < 180.0)):
-        what = "the margin beyond the Earth limb in [0, 90) deg" if limb else "a cone half-angle in (0, 180) deg"
-        raise ValueError(f"{label} {what}, got {angle:g}")
+class Cone(Schema):
+    """A cone about a body's direction: a star tracker's exclusion or a scenario's zone. Its half-angle
+    is in (0, 180) deg, or for ``earth_limb`` the margin beyond the Earth limb in [0, 90) deg; a
+    ``direction`` is given for body ``inertial`` and only for it."""
 
-
-def _direction_for(body: str, direction) -> None:
-    if (body == "inertial") != (direction is not None):
-        raise ValueError("direction (a unit inertial vector) for body inertial, and only for it")
-
-
-class Exclusion(Schema):
-    body: Literal[ZONE_BODIES] = Field(description="the body the tracker cannot look near")
-    half_angle_deg: float = Field(description="cone half-angle (deg); for earth_limb the margin beyond the limb")
+    body: Literal[ZONE_BODIES] = Field(description="the body the cone is about")
+    half_angle_deg: float = Field(description="cone half-angle in (0, 180) deg; earth_limb: margin in [0, 90) deg")
     direction: UnitVector3 | None = Field(None, description="unit inertial direction (body inertial only)")
 
     @model_validator(mode="after")
     def _consistent(self):
-        _cone_angle(self.body, self.half_angle_deg, "half_angle_deg")
-        _direction_for(self.body, self.direction)
+        limb, angle = self.body == "earth_limb", self.half_angle_deg
+        if not ((0.0 <= angle < 90.0) if limb else (0.0 < angle < 180.0)):
+            what = "the margin beyond the Earth limb in [0, 90) deg" if limb else "a cone half-angle in (0, 180) deg"
+            raise ValueError(f"half_angle_deg {what}, got {angle:g}")
+        if (self.body == "inertial") != (self.direction is not None):
+            raise ValueError("direction (a unit inertial vector) for body inertial, and only for it")
         return self
+
+
+class Exclusion(Cone):
+    """A cone a star tracker's boresight must stay out of (the tracker is blinded inside it)."""
 
 
 class StarTracker(Schema):
@@ -379,19 +379,12 @@ class Environment(Disturbances, Surface):
         return self
 
 
-class Zone(Schema):
-    name: Name
-    body: Literal[ZONE_BODIES]
-    sensor_axis: UnitVector3 = Field(description="unit body axis of the sensor the zone constrains")
-    half_angle_deg: float = Field(description="cone half-angle in (0, 180) deg; earth_limb: margin in [0, 90) deg")
-    keep_in: bool = False
-    direction: UnitVector3 | None = Field(None, description="unit inertial direction (body inertial only)")
+class Zone(Cone):
+    """A keep-out (or keep-in) cone of a scenario for the sensor along ``sensor_axis``."""
 
-    @model_validator(mode="after")
-    def _consistent(self):
-        _cone_angle(self.body, self.half_angle_deg, "half_angle_deg")
-        _direction_for(self.body, self.direction)
-        return self
+    name: Name
+    sensor_axis: UnitVector3 = Field(description="unit body axis of the sensor the zone constrains")
+    keep_in: bool = False
 
 
 def _epoch(value):
