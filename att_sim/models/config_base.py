@@ -92,17 +92,6 @@ def limit(meaning: str, unit: str) -> Any:
     return Field(math.inf, gt=0.0, description=f"{meaning} ({unit}); .inf: no limit")
 
 
-def declared(model: type[BaseModel], field: str) -> tuple:
-    """``(default, low, high, low_open, high_open)`` of a number field of ``model`` (default None when
-    the field is required; bounds ±inf where it has none): for readers that check a value against
-    the range written here."""
-    info = model.model_fields[field]
-    bounds = {name: getattr(m, name) for m in info.metadata for name in ("ge", "gt", "le", "lt")
-              if getattr(m, name, None) is not None}
-    return (None if info.is_required() else info.default, bounds.get("ge", bounds.get("gt", -math.inf)),
-            bounds.get("le", bounds.get("lt", math.inf)), "gt" in bounds, "lt" in bounds)
-
-
 class Cone(Schema):
     """A cone about a body's direction: a star tracker's exclusion or a scenario's zone. Its half-angle
     is in (0, 180) deg, or for ``earth_limb`` the margin beyond the Earth limb in [0, 90) deg; a
