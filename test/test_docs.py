@@ -123,6 +123,18 @@ def test_node_pages_read_each_node_s_endpoints_from_its_source():
     assert {r[1] for r in rows["recorder"]} == set(RECORDED)
 
 
+def _is_list(annotation) -> bool:
+    """Whether a field's annotation is a list (under ``Annotated`` and ``| None``)."""
+    import types
+    import typing
+    origin, args = typing.get_origin(annotation), typing.get_args(annotation)
+    if origin is typing.Annotated:
+        return _is_list(args[0])
+    if origin in (typing.Union, types.UnionType):
+        return any(_is_list(a) for a in args if a is not type(None))
+    return origin is list
+
+
 def _config_keys(annotation, path: str, seen: set) -> list[tuple[str, object]]:
     """(key path, FieldInfo) of every key reachable from a model or a union of models, each model once."""
     import typing
@@ -136,10 +148,7 @@ def _config_keys(annotation, path: str, seen: set) -> list[tuple[str, object]]:
         for name, info in annotation.model_fields.items():
             key = f"{path}{info.alias or name}"
             out.append((key, info))
-            text = repr(info.annotation)
-            out += _config_keys(info.annotation, key + ("[]." if text.startswith(("list[", "typing.Annotated[list[",
-                                                                                   "typing.Optional[list["))
-                                                       else "."), seen)
+            out += _config_keys(info.annotation, key + ("[]." if _is_list(info.annotation) else "."), seen)
         return out
     return [k for arg in typing.get_args(annotation) for k in _config_keys(arg, path, seen)]
 
