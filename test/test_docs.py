@@ -177,6 +177,12 @@ def _config_row_problem(row: list[str], info) -> str | None:
                 found = [float(v) for v in re.findall(rf"(?:^|, ){op} ([-+.\w]+)", bounds)]
                 if not any(math.isclose(v, getattr(m, name)) for v in found):
                     return f"range {bounds!r} without {op} {getattr(m, name)}"
+    low = next((m.min_length for m in info.metadata if getattr(m, "min_length", None) is not None), None)
+    high = next((m.max_length for m in info.metadata if getattr(m, "max_length", None) is not None), None)
+    lengths = [f"length {low}"] if low is not None and low == high else \
+        [f"length >= {low}"] * bool(low) + [f"length <= {high}"] * (high is not None)
+    if any(text not in bounds.split(", ") for text in lengths):       # its length bounds
+        return f"range {bounds!r} without {lengths}"
     if info.description and meaning != " ".join(info.description.split()):
         return f"meaning {meaning!r}"
     return None

@@ -301,13 +301,13 @@ def _bounds(metadata) -> list[str]:
     words = {"ge": ">=", "gt": ">", "le": "<=", "lt": "<"}
     out = [f"{words[name]} {yaml_text(getattr(m, name))}" for m in metadata for name in words
            if getattr(m, name, None) is not None]
-    for m in metadata:
-        low, high = getattr(m, "min_length", None), getattr(m, "max_length", None)
-        if low is not None and low == high:
-            out.append(f"length {low}")
-        else:
-            out += [f"length >= {low}"] if low else []
-            out += [f"length <= {high}"] if high is not None else []
+    low = next((m.min_length for m in metadata if getattr(m, "min_length", None) is not None), None)
+    high = next((m.max_length for m in metadata if getattr(m, "max_length", None) is not None), None)
+    if low is not None and low == high:
+        out.append(f"length {low}")
+    else:
+        out += [f"length >= {low}"] if low else []
+        out += [f"length <= {high}"] if high is not None else []
     return out
 
 
@@ -402,9 +402,10 @@ def configuration_page(kind: str) -> str:
     from att_planner.tools.config_cli import KINDS
     _, root = KINDS[kind]
     out = [f"# `{kind}` files\n",
-           f"Generated from the schema `att-config check` applies to a `{kind}` file (`att-config schema {kind}` "
-           "prints it as JSON Schema); {doc}`/configuration` says where the files are. A key of an old name is "
-           "refused with its new name (column *old name*). A range is checked when the file is read.\n"]
+           f"Every key of a `{kind}` file, generated from the models `att-config check` validates it with "
+           f"(`att-config schema {kind}` prints them as JSON Schema); {{doc}}`/configuration` says where the files "
+           "are. Each value is checked against its type and range when the file is read; a key of an old name is "
+           "refused with its new name (column *old name*).\n"]
     for model, path in config_models(root):
         where = f"at `{path.rstrip('.')}`" if path else "of the file's root mapping"
         out.append(f"## `{model.__name__}`\n")
