@@ -121,3 +121,97 @@ def test_node_pages_read_each_node_s_endpoints_from_its_source():
     assert ("publishes", "/estimator/attitude", "att_msgs/msg/AttitudeEstimate") in rows["estimator"]
     from att_msgs_py.topics import RECORDED
     assert {r[1] for r in rows["recorder"]} == set(RECORDED)
+
+
+def _is_list(annotation) -> bool:
+    """Whether a field's annotation is a list (under ``Annotated`` and ``| None``)."""
+    import types
+    import typing
+    origin, args = typing.get_origin(annotation), typing.get_args(annotation)
+    if origin is typing.Annotated:
+        return _is_list(args[0])
+    if origin in (typing.Union, types.UnionType):
+        return any(_is_list(a) for a in args if a is not type(None))
+    return origin is list
+
+
+def _config_keys(annotation, path: str, seen: set) -> list[tuple[str, object]]:
+    """(key path, FieldInfo) of every key reachable from a model or a union of models, each model once."""
+    import typing
+
+    from pydantic import BaseModel
+    if isinstance(annotation, type) and issubclass(annotation, BaseModel):
+        if annotation in seen:
+            return []
+        seen.add(annotation)
+        out = []
+        for name, info in annotation.model_fields.items():
+            key = f"{path}{info.alias or name}"
+            out.append((key, info))
+            out += _config_keys(info.annotation, key + ("[]." if _is_list(info.annotation) else "."), seen)
+        return out
+    return [k for arg in typing.get_args(annotation) for k in _config_keys(arg, path, seen)]
+
+
+def _config_row_problem(row: list[str], info) -> str | None:
+    """Why a row of a configuration page does not show the field ``info`` (None when it does)."""
+    import math
+    import re
+
+    import yaml
+    from pydantic import BaseModel
+    _, _, unit, default, bounds, meaning, old = row
+    if info.is_required():
+        if default != "required":
+            return f"default {default!r}, not required"
+    else:
+        value = info.get_default(call_default_factory=True)
+        if isinstance(value, BaseModel):
+            if default != f"the defaults of {type(value).__name__}":
+                return f"default {default!r}"
+        elif yaml.safe_load(default) != value:
+            return f"default {default!r}, not {value!r}"
+    for m in info.metadata:                       # each bound of the field, with its operator
+        for name, op in (("ge", ">="), ("gt", ">"), ("le", "<="), ("lt", "<")):
+            if getattr(m, name, None) is not None:
+                found = [float(v) for v in re.findall(rf"(?:^|, ){op} ([-+.\w]+)", bounds)]
+                if not any(math.isclose(v, getattr(m, name)) for v in found):
+                    return f"range {bounds!r} without {op} {getattr(m, name)}"
+    low = next((m.min_length for m in info.metadata if getattr(m, "min_length", None) is not None), None)
+    high = next((m.max_length for m in info.metadata if getattr(m, "max_length", None) is not None), None)
+    lengths = [f"length {low}"] if low is not None and low == high else \
+        [f"length >= {low}"] * bool(low) + [f"length <= {high}"] * (high is not None)
+    if any(text not in bounds.split(", ") for text in lengths):       # its length bounds
+        return f"range {bounds!r} without {lengths}"
+    if info.description and meaning != " ".join(info.description.split()):
+        return f"meaning {meaning!r}"
+    return None
+
+
+def test_every_configuration_key_is_on_its_kind_s_page_with_its_default_and_range(tmp_path):
+    from att_planner.tools.config_cli import KINDS
+    run = build(tmp_path)
+    assert run.returncode == 0, run.stdout[-3000:] + run.stderr[-3000:]
+    pages = tmp_path / "html" / "reference" / "configuration"
+    assert {p.stem for p in pages.glob("*.html")} == set(KINDS)
+    total = 0
+    for kind, (_, root) in KINDS.items():
+        rows: dict[str, list[list[str]]] = {}
+        for t in _page_tables(pages / f"{kind}.html"):
+            for row in t[1:]:
+                rows.setdefault(row[0], []).append(row)
+        for key, info in _config_keys(root, "", set()):
+            total += 1
+            assert key in rows, f"{kind}: {key} not on the page"
+            problems = [_config_row_problem(row, info) for row in rows[key]]
+            assert None in problems, f"{kind}: {key}: {problems}"   # one table of the key shows the field
+    assert total > 150
+    spacecraft = {row[0]: row for t in _page_tables(pages / "spacecraft.html") for row in t[1:]}
+    # an old key name is answered with its new one, and a unit a key's name carries is shown
+    assert spacecraft["inertia_kg_m2"][6] == "inertia" and spacecraft["inertia_kg_m2"][2] == "kg m^2"
+
+
+def _page_tables(page: Path) -> list[list[list[str]]]:
+    parser = _Tables()
+    parser.feed(page.read_text())
+    return parser.tables

@@ -13,7 +13,7 @@ from pydantic import AfterValidator, ConfigDict, Discriminator, Field, Tag, fiel
 
 from att_msgs_py.limits import MAX_TARGETS
 from att_msgs_py.types import SECONDARY_KINDS
-from att_sim.models.config_schema import Name, Schema, Vector3, number
+from att_sim.models.config_base import Name, Schema, Vector3, number
 
 AXIS_TOLERANCE = 1e-6          # |‖v‖ − 1| accepted for a mission's body axis
 MAX_DWELL_S = 86_400.0

@@ -18,7 +18,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from att_sim.models import config_schema as schema
+from att_sim.models import config_actuators
 from att_sim.models.sensor_specs import validated
 
 DEG = math.pi / 180.0
@@ -59,8 +59,8 @@ class ActuatorSpecs:
     magnetorquers: MagnetorquerSpec | None = None
 
 
-def actuators_from_model(a: schema.Actuators) -> ActuatorSpecs:
-    """The validated ``actuators`` group (:class:`att_sim.models.config_schema.Actuators`) in SI."""
+def actuators_from_model(a: config_actuators.Actuators) -> ActuatorSpecs:
+    """The validated ``actuators`` group (:class:`att_sim.models.config_actuators.Actuators`) in SI."""
     w, m = a.wheels, a.magnetorquers
     wheels = None if w is None else WheelDriveSpec(
         w.coulomb_friction_Nm, w.viscous_friction_Nm_s, w.friction_speed_rad_s, w.torque_quantization_Nm,
@@ -71,6 +71,6 @@ def actuators_from_model(a: schema.Actuators) -> ActuatorSpecs:
 
 
 def actuators_from_params(values, label: str = "actuators") -> ActuatorSpecs:
-    """The ``actuators`` group (a mapping), validated by :class:`att_sim.models.config_schema.Actuators`
+    """The ``actuators`` group (a mapping), validated by :class:`att_sim.models.config_actuators.Actuators`
     (ValueError naming the field)."""
-    return actuators_from_model(validated(schema.Actuators, values, label))
+    return actuators_from_model(validated(config_actuators.Actuators, values, label))

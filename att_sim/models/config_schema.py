@@ -6,110 +6,39 @@ and its sky (epoch, orbit, field model, environment with facets, zones, frames);
 top-level section is one node's ``ros__parameters`` (typed by the nodes' own parameter schemas).
 
 Each key carries its unit in its name where it has one; each default and range is written once,
-here; a key of an older name is refused with its new name (each model's ``renamed`` table,
-reported by :mod:`att_sim.models.config_files`). Physical checks: the inertia is symmetric,
-positive definite and satisfies the triangle inequalities (each principal moment at most the sum
-of the other two); axes, normals and directions are unit vectors (within
-:data:`UNIT_TOLERANCE`); quaternions are [x, y, z, w] of unit norm; numbers are finite but the
-limits documented as accepting ``.inf`` (no limit).
+here and in the modules of the sensors (:mod:`att_sim.models.config_sensors`) and actuators
+(:mod:`att_sim.models.config_actuators`), on the base of :mod:`att_sim.models.config_base`; a key
+of an older name is refused with its new name (each model's ``renamed`` table, reported by
+:mod:`att_sim.models.config_files`). Physical checks: the inertia is symmetric, positive definite
+and satisfies the triangle inequalities (each principal moment at most the sum of the other two);
+axes, normals and directions are unit vectors; quaternions are [x, y, z, w] of unit norm.
 """
 from __future__ import annotations
 
-import math
 from datetime import datetime
 from typing import Annotated, Any, ClassVar, Literal
 
 import numpy as np
-from pydantic import AfterValidator, BaseModel, ConfigDict, Discriminator, Field, Tag, field_validator, model_validator
+from pydantic import AfterValidator, ConfigDict, Discriminator, Field, Tag, field_validator, model_validator
 
-from att_msgs_py.types import ZONE_BODIES
 from att_sim.models import epoch as epochs
+from att_sim.models.config_actuators import Actuators
+from att_sim.models.config_base import (
+    Cone,
+    Finite,
+    Name,
+    Quaternion,
+    Schema,
+    UnitVector3,
+    UnitVectors,
+    Vector3,
+    distinct_names,
+    limit,
+    number,
+)
+from att_sim.models.config_sensors import Sensors
 
-UNIT_TOLERANCE = 1e-3          # |‖v‖ − 1| accepted for a unit vector or quaternion of a file
-MAX_NAME = 128
-MAX_SENSOR_RATE_HZ = 1000.0
 IDENTITY_AXES = (1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0)
-
-
-class Schema(BaseModel):
-    """A mapping of a configuration file: unknown keys refused, values immutable once read."""
-
-    model_config = ConfigDict(extra="forbid", frozen=True, strict=True, populate_by_name=True,
-                              ser_json_inf_nan="strings")
-    renamed: ClassVar[dict[str, str]] = {}     # old key -> its new name (refused, answered with it)
-
-
-def _finite(x: float) -> float:
-    if not math.isfinite(x):
-        raise ValueError(f"a finite number, got {x!r}")
-    return x
-
-
-def distinct_names(items: list, what: str) -> list:
-    """``items`` when their ``name`` fields differ (a validator's ValueError naming them otherwise)."""
-    names = [item.name for item in items]
-    if len(set(names)) != len(names):
-        raise ValueError(f"distinct {what} names, got {', '.join(names)}")
-    return items
-
-
-def _norm_near_one(v: list[float]) -> list[float]:
-    norm = float(np.linalg.norm(v))
-    if abs(norm - 1.0) > UNIT_TOLERANCE:
-        raise ValueError(f"a unit vector (norm within {UNIT_TOLERANCE:g} of 1), got norm {norm:.6g}")
-    return v
-
-
-def _unit_triples(v: list[float]) -> list[float]:
-    rows = np.asarray(v, float).reshape(-1, 3)
-    norms = np.linalg.norm(rows, axis=1)
-    bad = np.flatnonzero(np.abs(norms - 1.0) > UNIT_TOLERANCE)
-    if bad.size:
-        raise ValueError(f"3 numbers per unit vector; vector {int(bad[0])} has norm {norms[bad[0]]:.6g}")
-    return v
-
-
-def _triples(v: list[float]) -> list[float]:
-    if len(v) % 3:
-        raise ValueError(f"3 numbers per vector, got {len(v)} numbers")
-    return v
-
-
-def _printable(name: str) -> str:
-    if not name.isprintable():
-        raise ValueError("a printable name (no control characters)")
-    return name
-
-
-Finite = Annotated[float, AfterValidator(_finite)]
-Vector3 = Annotated[list[Finite], Field(min_length=3, max_length=3)]
-UnitVector3 = Annotated[Vector3, AfterValidator(_norm_near_one)]
-UnitVectors = Annotated[list[Finite], Field(max_length=3 * 64), AfterValidator(_triples),
-                        AfterValidator(_unit_triples)]
-Quaternion = Annotated[list[Finite], Field(min_length=4, max_length=4), AfterValidator(_norm_near_one)]
-Name = Annotated[str, Field(min_length=1, max_length=MAX_NAME), AfterValidator(_printable)]
-
-
-def number(default: Any = ..., *, unit: str, meaning: str, ge: float | None = None, gt: float | None = None,
-           le: float | None = None, lt: float | None = None) -> Any:
-    """A float field with its default, range, unit and meaning (the JSON Schema's description)."""
-    return Field(default, ge=ge, gt=gt, le=le, lt=lt, description=f"{meaning} ({unit})" if unit else meaning)
-
-
-def limit(meaning: str, unit: str) -> Any:
-    """A positive limit; ``.inf`` (the default) for no limit."""
-    return Field(math.inf, gt=0.0, description=f"{meaning} ({unit}); .inf: no limit")
-
-
-def declared(model: type[BaseModel], field: str) -> tuple:
-    """``(default, low, high, low_open, high_open)`` of a number field of ``model`` (default None when
-    the field is required; bounds ±inf where it has none): for readers that check a value against
-    the range written here."""
-    info = model.model_fields[field]
-    bounds = {name: getattr(m, name) for m in info.metadata for name in ("ge", "gt", "le", "lt")
-              if getattr(m, name, None) is not None}
-    return (None if info.is_required() else info.default, bounds.get("ge", bounds.get("gt", -math.inf)),
-            bounds.get("le", bounds.get("lt", math.inf)), "gt" in bounds, "lt" in bounds)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -169,125 +98,6 @@ class Spacecraft(Schema):
         if self.wheel_axes and self.wheel_inertia_kg_m2 <= 0:
             raise ValueError("wheel_inertia_kg_m2 > 0 when there are wheels")
         return self
-
-
-# ---------------------------------------------------------------------------------------------
-# sensors (datasheet units)
-
-
-def rate_hz(default: float) -> Any:
-    return number(default, gt=0.0, le=MAX_SENSOR_RATE_HZ, unit="Hz", meaning="output rate")
-
-
-class Gyro(Schema):
-    rate_hz: float = rate_hz(20.0)
-    arw_deg_per_sqrt_h: float = number(0.0, ge=0.0, le=100.0, unit="deg/sqrt(h)", meaning="angle random walk")
-    bias_instability_deg_per_h: float = number(0.0, ge=0.0, le=1e4, unit="deg/h", meaning="bias instability")
-    rrw_deg_per_h_per_sqrt_h: float = number(0.0, ge=0.0, le=1e4, unit="deg/h/sqrt(h)", meaning="rate random walk")
-    initial_bias_deg_per_h: float = number(0.0, ge=0.0, le=1e5, unit="deg/h", meaning="turn-on bias, 1 sigma per axis")
-    scale_factor_ppm: float = number(0.0, ge=0.0, le=1e5, unit="ppm", meaning="scale factor error, 1 sigma per axis")
-    misalignment_arcsec: float = number(0.0, ge=0.0, le=3600.0, unit="arcsec", meaning="misalignment, 1 sigma")
-    quantization_arcsec: float = number(0.0, ge=0.0, le=3600.0, unit="arcsec", meaning="angle increment LSB")
-    range_deg_per_s: float = Field(math.inf, gt=0.0, description="saturation per axis (deg/s); .inf: none")
-
-
-def _cone_angle(body: str, angle: float, label: str) -> None:
-    limb = body == "earth_limb"
-    if not ((0.0 <= angle < 90.0) if limb else (0.0 < angle < 180.0)):
-        what = "the margin beyond the Earth limb in [0, 90) deg" if limb else "a cone half-angle in (0, 180) deg"
-        raise ValueError(f"{label} {what}, got {angle:g}")
-
-
-def _direction_for(body: str, direction) -> None:
-    if (body == "inertial") != (direction is not None):
-        raise ValueError("direction (a unit inertial vector) for body inertial, and only for it")
-
-
-class Exclusion(Schema):
-    body: Literal[ZONE_BODIES] = Field(description="the body the tracker cannot look near")
-    half_angle_deg: float = Field(description="cone half-angle (deg); for earth_limb the margin beyond the limb")
-    direction: UnitVector3 | None = Field(None, description="unit inertial direction (body inertial only)")
-
-    @model_validator(mode="after")
-    def _consistent(self):
-        _cone_angle(self.body, self.half_angle_deg, "half_angle_deg")
-        _direction_for(self.body, self.direction)
-        return self
-
-
-class StarTracker(Schema):
-    name: Name
-    mounting: Quaternion = Field([0.0, 0.0, 0.0, 1.0], description="sensor-to-body quaternion [x, y, z, w]; "
-                                                                    "the boresight is the sensor's +z")
-    rate_hz: float = rate_hz(5.0)
-    latency_s: float = number(0.0, ge=0.0, le=10.0, unit="s", meaning="from the instant measured to the message")
-    cross_boresight_arcsec: float = number(5.0, gt=0.0, le=3600.0, unit="arcsec", meaning="1 sigma across the "
-                                                                                           "boresight")
-    about_boresight_arcsec: float = number(40.0, gt=0.0, le=36000.0, unit="arcsec", meaning="1 sigma about the "
-                                                                                             "boresight")
-    max_rate_deg_per_s: float = Field(math.inf, gt=0.0, description="faster, the tracker loses its stars (deg/s)")
-    exclusions: list[Exclusion] = Field([], max_length=16)
-
-
-class Magnetometer(Schema):
-    rate_hz: float = rate_hz(10.0)
-    noise_nT: float = number(0.0, ge=0.0, le=1e5, unit="nT", meaning="1 sigma per axis")
-    bias_nT: float = number(0.0, ge=0.0, le=1e5, unit="nT", meaning="fixed bias, 1 sigma per axis")
-    misalignment_deg: float = number(0.0, ge=0.0, le=10.0, unit="deg", meaning="misalignment, 1 sigma")
-    quantization_nT: float = number(0.0, ge=0.0, le=1e4, unit="nT", meaning="per count")
-    dipole_coupling_nT_per_Am2: float = number(0.0, ge=0.0, le=1e5, unit="nT per A m^2",
-                                               meaning="field of the applied magnetorquer dipole")
-
-
-class SunSensors(Schema):
-    normals: UnitVectors = Field([1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, -1.0, 0.0, 0.0, 0.0, -1.0, 0.0,
-                                  0.0, 0.0, -1.0], description="unit body normal of each cosine detector")
-    rate_hz: float = rate_hz(10.0)
-    fov_deg: float = number(80.0, gt=0.0, le=90.0, unit="deg", meaning="half-angle of each detector's view")
-    noise: float = number(0.0, ge=0.0, le=1.0, unit="", meaning="1 sigma of the normal-incidence output")
-
-
-class WheelTachometer(Schema):
-    rate_hz: float = rate_hz(20.0)
-    noise_rad_per_s: float = number(0.0, ge=0.0, le=100.0, unit="rad/s", meaning="1 sigma of a wheel speed")
-    quantization_rad_per_s: float = number(0.0, ge=0.0, le=100.0, unit="rad/s", meaning="per count")
-
-
-class Sensors(Schema):
-    seed: int = Field(0, ge=0, lt=2**63, description="seed of every noise source and drawn error of the run")
-    gyro: Gyro | None = None
-    star_trackers: list[StarTracker] = Field([], max_length=8)
-    magnetometer: Magnetometer | None = None
-    sun_sensors: SunSensors | None = None
-    wheel_tachometer: WheelTachometer | None = None
-
-    @field_validator("star_trackers")
-    @classmethod
-    def _distinct(cls, trackers):
-        return distinct_names(trackers, "star tracker")
-
-
-# ---------------------------------------------------------------------------------------------
-# actuator imperfections (the truth's; the flight software compensates the friction)
-
-
-class WheelDrives(Schema):
-    coulomb_friction_Nm: float = number(0.0, ge=0.0, le=10.0, unit="N m", meaning="Coulomb friction")
-    viscous_friction_Nm_s: float = number(0.0, ge=0.0, le=10.0, unit="N m s/rad", meaning="viscous friction")
-    friction_speed_rad_s: float = number(1.0, gt=0.0, le=1e3, unit="rad/s", meaning="Coulomb term's smoothing")
-    torque_quantization_Nm: float = number(0.0, ge=0.0, le=10.0, unit="N m", meaning="per count")
-    torque_noise_Nm: float = number(0.0, ge=0.0, le=10.0, unit="N m", meaning="1 sigma per control step")
-    power_max_W: float = Field(math.inf, gt=0.0, description="motor power limit while speeding up (W)")
-
-
-class Magnetorquers(Schema):
-    quantization_Am2: float = number(0.0, ge=0.0, le=100.0, unit="A m^2", meaning="per count")
-    misalignment_deg: float = number(0.0, ge=0.0, le=10.0, unit="deg", meaning="1 sigma per off-diagonal element")
-
-
-class Actuators(Schema):
-    wheels: WheelDrives | None = None
-    magnetorquers: Magnetorquers | None = None
 
 
 # ---------------------------------------------------------------------------------------------
@@ -379,19 +189,12 @@ class Environment(Disturbances, Surface):
         return self
 
 
-class Zone(Schema):
-    name: Name
-    body: Literal[ZONE_BODIES]
-    sensor_axis: UnitVector3 = Field(description="unit body axis of the sensor the zone constrains")
-    half_angle_deg: float = Field(description="cone half-angle in (0, 180) deg; earth_limb: margin in [0, 90) deg")
-    keep_in: bool = False
-    direction: UnitVector3 | None = Field(None, description="unit inertial direction (body inertial only)")
+class Zone(Cone):
+    """A keep-out (or keep-in) cone of a scenario for the sensor along ``sensor_axis``."""
 
-    @model_validator(mode="after")
-    def _consistent(self):
-        _cone_angle(self.body, self.half_angle_deg, "half_angle_deg")
-        _direction_for(self.body, self.direction)
-        return self
+    name: Name
+    sensor_axis: UnitVector3 = Field(description="unit body axis of the sensor the zone constrains")
+    keep_in: bool = False
 
 
 def _epoch(value):

@@ -25,7 +25,7 @@ Frames: ``q`` is body-to-inertial (:mod:`att_sim.models.rotations`); inertial ve
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -38,7 +38,6 @@ ASTRONOMICAL_UNIT = 1.495978707e11    # m (IAU 2012)
 EARTH_ANGULAR_VELOCITY = 7.292115e-5  # rad/s, ω_E about the GCRS z axis (Vallado 2013)
 DRAG_COEFFICIENT = 2.2                # C_d of a flat plate in free-molecular flow (Vallado §8.6)
 UNIT_TOLERANCE = 1e-3
-FACET_KEYS = ("area", "normal", "center", "specular", "diffuse")
 
 
 def _vector(value, name: str) -> tuple[float, float, float]:
@@ -99,25 +98,6 @@ class Facet:
     @property
     def absorption(self) -> float:
         return 1.0 - self.specular - self.diffuse
-
-
-def facets_from_params(params, field: str = "environment.facets") -> list[Facet]:
-    """Facets from the scenario's list of ``{area, normal, center, specular, diffuse}`` mappings
-    (every key required); a ``ValueError`` names the facet, e.g. ``environment.facets[2].normal``."""
-    if isinstance(params, str | bytes | Mapping) or not isinstance(params, Sequence):
-        raise ValueError(f"{field} must be a list of facets {{{', '.join(FACET_KEYS)}}}, got {params!r}")
-    out = []
-    for i, item in enumerate(params):
-        name = f"{field}[{i}]"
-        if not isinstance(item, Mapping):
-            raise ValueError(f"{name} must be a mapping with keys {', '.join(FACET_KEYS)}, got {item!r}")
-        missing = [k for k in FACET_KEYS if k not in item]
-        unknown = sorted(str(k) for k in item if k not in FACET_KEYS)
-        if missing or unknown:
-            raise ValueError(f"{name} must have exactly the keys {', '.join(FACET_KEYS)} "
-                             f"(missing: {missing or 'none'}, unknown: {unknown or 'none'})")
-        out.append(Facet(*_checked(name, FACET_KEYS, *(item[k] for k in FACET_KEYS))))
-    return out
 
 
 def _body(q_BN, v_N) -> tuple:

@@ -50,10 +50,11 @@ from att_sim.models import rotations as rot
 
 @dataclass(frozen=True)
 class Spacecraft:
-    """Mass properties and actuator limits (SI units), in body (B) axes: the parameters a scenario
-    file writes, by the same names. ``inertia`` is ``J`` (= I_s, see the module docstring) about the
-    centre of mass in B axes, ``wheel_axes`` the mounting matrix ``G`` whose columns are the wheels'
-    unit spin axes in B axes, ``body_torque_max`` the direct torque limit per B axis."""
+    """Mass properties and actuator limits (SI units), in body (B) axes: the spacecraft file's values
+    (its keys carry their units, :func:`att_sim.models.scenario.spacecraft_from_model`). ``inertia``
+    is ``J`` (= I_s, see the module docstring) about the centre of mass in B axes, ``wheel_axes`` the
+    mounting matrix ``G`` whose columns are the wheels' unit spin axes in B axes, ``body_torque_max``
+    the direct torque limit per B axis."""
 
     inertia: np.ndarray                                   # (3, 3) kg m², J about the centre of mass, B axes
     wheel_axes: np.ndarray = field(default_factory=lambda: np.eye(3))  # (3, N) unit spin axes in B axes, G

@@ -32,7 +32,6 @@ from __future__ import annotations
 
 import functools
 import math
-from dataclasses import fields
 from datetime import UTC, datetime, timedelta
 
 import numpy as np
@@ -385,55 +384,6 @@ class TLEOrbit(Orbit):
             raise ValueError(f"orbit: SGP4 cannot propagate the TLE from t = {when:.0f} s past "
                              f"{format_epoch(self.epoch)} ({why}), needed at t = {bad:.0f} s")
         return r, v
-
-
-# ---------------------------------------------------------------- scenario group
-KEPLER_KEYS = ("semi_major_axis", "eccentricity", "inclination_deg", "raan_deg", "arg_perigee_deg", "mean_anomaly_deg")
-CIRCULAR_KEYS = ("altitude", "inclination_deg", "raan_deg", "arg0")
-TLE_KEYS = ("line1", "line2")
-ORBIT_TYPES = ("circular", "kepler", "tle")
-
-
-def _number(mapping: dict, key: str) -> float:
-    x = mapping[key]
-    if isinstance(x, bool) or not isinstance(x, (int, float)) or not math.isfinite(x):
-        raise ValueError(f"orbit.{key} must be a finite number, got {x!r}")
-    return float(x)
-
-
-def orbit_from_mapping(mapping: dict, epoch=None) -> Orbit:
-    """The scenario's ``orbit`` group as an :class:`Orbit` (``type`` absent: circular, with the
-    circular orbit's keys and defaults); ``epoch`` (sim time zero) is required for kepler and tle."""
-    if not isinstance(mapping, dict):
-        raise ValueError(f"orbit must be a mapping, got {type(mapping).__name__}")
-    kind = mapping.get("type", "circular")
-    if kind not in ORBIT_TYPES:
-        raise ValueError(f"orbit.type must be one of {', '.join(ORBIT_TYPES)}, got {kind!r}")
-    keys = {"circular": CIRCULAR_KEYS, "kepler": KEPLER_KEYS, "tle": TLE_KEYS}[kind]
-    unknown = sorted(str(k) for k in set(mapping) - set(keys) - {"type"})
-    if unknown:
-        raise ValueError(f"orbit keys {', '.join(unknown)} are unknown for type {kind} (accepted: {', '.join(keys)})")
-    if kind == "circular":
-        d = {f.name: f.default for f in fields(env.OrbitParams)}
-        vals = {k: _number(mapping, k) for k in mapping if k != "type"}
-        if vals.get("altitude", 1.0) <= 0.0:
-            raise ValueError(f"orbit.altitude must be positive (m), got {vals['altitude']!r}")
-        return CircularOrbit(env.OrbitParams(
-            altitude=vals.get("altitude", d["altitude"]),
-            inclination=math.radians(vals["inclination_deg"]) if "inclination_deg" in vals else d["inclination"],
-            raan=math.radians(vals["raan_deg"]) if "raan_deg" in vals else d["raan"],
-            arg0=vals.get("arg0", d["arg0"])))
-    missing = [k for k in keys if k not in mapping]
-    if missing:
-        raise ValueError(f"orbit of type {kind} needs keys {', '.join(missing)}")
-    if epoch is None:
-        raise ValueError(f"orbit of type {kind} needs an epoch (the scenario's 'epoch')")
-    if kind == "tle":
-        return TLEOrbit(epoch, mapping["line1"], mapping["line2"])
-    v = {k: _number(mapping, k) for k in keys}
-    return KeplerOrbit(epoch, v["semi_major_axis"], v["eccentricity"], math.radians(v["inclination_deg"]),
-                       math.radians(v["raan_deg"]), math.radians(v["arg_perigee_deg"]),
-                       math.radians(v["mean_anomaly_deg"]))
 
 
 def check_altitude(orbit: Orbit, t0: float, t1: float, minimum: float = 150e3) -> None:

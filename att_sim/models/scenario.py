@@ -136,10 +136,6 @@ class Files:
     demo_path: Path | None = None
 
 
-def _problem_file(problems, path: Path) -> config_files.ConfigFileError:
-    return config_files.ConfigFileError([replace(p, file=str(path)) for p in problems])
-
-
 def read(path) -> Files:
     """The scenario file ``path`` read and validated with the files it names; a
     :class:`att_sim.models.config_files.ConfigFileError` (code ``INVALID_CONFIG``) with every problem.

@@ -30,8 +30,7 @@ import numpy as np
 from pydantic import ValidationError
 
 from att_msgs_py.types import ZONE_BODIES
-from att_sim.models import config_files
-from att_sim.models import config_schema as schema
+from att_sim.models import config_files, config_sensors
 
 DEG = math.pi / 180.0
 ARCSEC = DEG / 3600.0
@@ -144,7 +143,7 @@ def validated(model, values, label: str):
         raise _refused(exc, model, values, label) from None
 
 
-def _epoch_needs(s: schema.Sensors, label: str) -> None:
+def _epoch_needs(s: config_sensors.Sensors, label: str) -> None:
     for k, t in enumerate(s.star_trackers):
         for j, e in enumerate(t.exclusions):
             if e.body in ("sun", "moon"):
@@ -160,8 +159,9 @@ def _unit(v) -> np.ndarray:
     return a / np.linalg.norm(a)
 
 
-def sensors_from_model(s: schema.Sensors) -> SensorSpecs:
-    """The validated ``sensors`` group (:class:`att_sim.models.config_schema.Sensors`, datasheet units) in SI."""
+def sensors_from_model(s: config_sensors.Sensors) -> SensorSpecs:
+    """The validated ``sensors`` group (:class:`att_sim.models.config_sensors.Sensors`, datasheet units)
+    in SI."""
     g, m, ss, w = s.gyro, s.magnetometer, s.sun_sensors, s.wheel_tachometer
     gyro = None if g is None else GyroSpec(
         rate=g.rate_hz, arw=g.arw_deg_per_sqrt_h * DEG / math.sqrt(HOUR),
@@ -192,9 +192,9 @@ def sensors_from_model(s: schema.Sensors) -> SensorSpecs:
 
 def sensors_from_params(values, epoch_known: bool, label: str = "sensors") -> SensorSpecs:
     """The ``sensors`` group of a scenario (a mapping), validated by
-    :class:`att_sim.models.config_schema.Sensors` (ValueError naming the field); ``epoch_known``: the
+    :class:`att_sim.models.config_sensors.Sensors` (ValueError naming the field); ``epoch_known``: the
     scenario has an epoch (Sun and Moon exclusions and sun sensors need it)."""
-    model = validated(schema.Sensors, values, label)
+    model = validated(config_sensors.Sensors, values, label)
     if not epoch_known:
         _epoch_needs(model, label)
     return sensors_from_model(model)

@@ -219,10 +219,6 @@ class Environment:
         if other is not self and self._time_key() == other._time_key():
             self._cache, self._tracks = other._cache, other._tracks
 
-    def shares_time_part(self, other: Environment) -> bool:
-        """Whether this environment's time-only part is ``other``'s (:meth:`share_time_part`)."""
-        return self._cache is other._cache
-
     def _time_key(self) -> tuple:
         return (id(self.orbit), self.epoch, self.field.model, self.field.epoch, self.field.dipole, self.sky is None,
                 self.flags.drag)

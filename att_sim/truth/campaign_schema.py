@@ -11,7 +11,7 @@ from typing import Annotated, ClassVar, Literal
 
 from pydantic import Discriminator, Field, Tag, model_validator
 
-from att_sim.models.config_schema import Finite, Name, Schema, number
+from att_sim.models.config_base import Finite, Name, Schema, number
 
 MAX_RUNS = 10_000_000
 

@@ -47,6 +47,7 @@ from att_sim.models import config_files
 from att_sim.models import rotations as rot
 from att_sim.models import scenario as scen
 from att_sim.models.actuator_specs import MagnetorquerSpec, WheelDriveSpec
+from att_sim.models.config_schema import inertia_problem
 from att_sim.truth import campaign_schema as schema
 from att_sim.truth.sensors import STREAMS
 
@@ -160,20 +161,6 @@ def draw(campaign: Campaign, scenario: scen.Scenario, seed: int) -> dict[str, np
     return out
 
 
-def inertia_problem(inertia: np.ndarray) -> str | None:
-    """Why the symmetric ``inertia`` is not a rigid body's (None when it is): positive definite,
-    each principal moment at most the sum of the other two."""
-    if not np.all(np.isfinite(inertia)):
-        return "not finite"
-    moments = np.linalg.eigvalsh(inertia)
-    if moments[0] <= 0:
-        return f"not positive definite (principal moments {np.array2string(moments, precision=4)})"
-    if moments[2] > moments[0] + moments[1]:
-        return (f"principal moments {np.array2string(moments, precision=4)} break the triangle inequality "
-                f"({moments[2]:.6g} > {moments[0]:.6g} + {moments[1]:.6g})")
-    return None
-
-
 def _tilted(axes: np.ndarray, tilts_rad: np.ndarray) -> np.ndarray:
     """Each unit column of ``axes`` turned by its two tilts about two axes perpendicular to it."""
     out = np.empty_like(axes)
@@ -211,8 +198,8 @@ def truth(scenario: scen.Scenario, values: dict, seed: int, q0=rot.IDENTITY, ome
     inertia = 0.5 * (inertia + inertia.T)
     problem = inertia_problem(inertia)
     if problem is not None:
-        raise ValueError(f"run seed {seed}: the dispersed inertia is {problem}; narrow inertia_scale or "
-                         f"inertia_rotation_deg (a non-physical draw is refused, never resampled)")
+        raise ValueError(f"run seed {seed}: the dispersed inertia is not a rigid body's: expected {problem}; narrow "
+                         f"inertia_scale or inertia_rotation_deg (a non-physical draw is refused, never resampled)")
     wheel_inertia = sc.wheel_inertia * (1.0 + float(v["wheel_inertia_scale"][0]))
     if wheel_inertia < 0:
         raise ValueError(f"run seed {seed}: the dispersed wheel inertia {wheel_inertia:.6g} is negative")

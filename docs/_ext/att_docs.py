@@ -15,14 +15,29 @@ hand-written pages include:
   (:func:`att_planner.tools.node_parameters.declared`, rendered by
   :func:`att_msgs_py.parameter_docs.markdown_table`): type, default, range, unit and description.
 
+and, as pages of their own, into ``docs/reference/configuration/`` (git-ignored):
+
+- ``<kind>.md``: the reference of each kind of configuration file ``att-config`` knows
+  (:data:`att_planner.tools.config_cli.KINDS`): one table per pydantic model of the kind's schema, one
+  row per key with its path, type, unit (the one its name carries), default, range (the field's
+  ``ge``/``gt``/``le``/``lt`` and length bounds), meaning (the field's description) and the old key
+  names answered with it (the model's ``renamed`` table).
+
 The node sources are parsed, not imported, so the build starts no ROS node.
 """
 from __future__ import annotations
 
 import ast
 import importlib.util
+import inspect
+import json
+import math
+import types
+import typing
+from datetime import datetime
 from pathlib import Path
 
+CONFIG_PAGES = "reference/configuration"      # generated pages, under the docs' source folder
 NODES = ("simulator", "planner", "controller", "estimator", "recorder", "bridge")
 _CALLS = {"create_publisher": "publishes", "create_subscription": "subscribes",
           "create_service": "serves (service)", "create_client": "calls (service)",
@@ -210,6 +225,196 @@ def parameters_page(node: str) -> str:
     return markdown_table(declared(node))
 
 
+# -- configuration files -----------------------------------------------------------------------------------
+# the unit a key's name carries, longest suffix first (the unit of a key without one is in its meaning)
+UNIT_SUFFIXES = (("_deg_per_h_per_sqrt_h", "deg/h/sqrt(h)"), ("_deg_per_sqrt_h", "deg/sqrt(h)"),
+                 ("_nT_per_Am2", "nT/(A m^2)"), ("_deg_per_s", "deg/s"), ("_deg_per_h", "deg/h"),
+                 ("_rad_per_s", "rad/s"), ("_rad_s", "rad/s"), ("_Nm_s", "N m s/rad"), ("_kg_m2", "kg m^2"),
+                 ("_arcsec", "arcsec"), ("_Nms", "N m s"), ("_Am2", "A m^2"), ("_ppm", "ppm"), ("_deg", "deg"),
+                 ("_rad", "rad"), ("_Nm", "N m"), ("_nT", "nT"), ("_Hz", "Hz"), ("_hz", "Hz"), ("_m2", "m^2"),
+                 ("_W", "W"), ("_m", "m"), ("_s", "s"))
+CONFIG_COLUMNS = ["key", "type", "unit", "default", "range", "meaning", "old name"]
+
+
+def unit_of(key: str) -> str:
+    """The unit the name ``key`` carries (empty when it carries none)."""
+    return next((unit for suffix, unit in UNIT_SUFFIXES if key.endswith(suffix)), "")
+
+
+def _models_in(annotation) -> list:
+    """The pydantic models an annotation holds (inside unions, lists, mappings, ``Annotated``)."""
+    from pydantic import BaseModel
+    if isinstance(annotation, type) and issubclass(annotation, BaseModel):
+        return [annotation]
+    return [m for arg in typing.get_args(annotation) for m in _models_in(arg)]
+
+
+def type_text(annotation) -> str:
+    """A field's type as a reader of the YAML file sees it."""
+    from pydantic import BaseModel
+    origin, args = typing.get_origin(annotation), typing.get_args(annotation)
+    if origin is typing.Annotated:
+        return type_text(args[0])
+    if origin in (typing.Union, types.UnionType):
+        return " or ".join(type_text(a) for a in args)
+    if origin is typing.Literal:
+        return "one of " + ", ".join(f"{a}" for a in args)
+    if origin is list:
+        return f"list of {type_text(args[0])}" if args else "list"
+    if origin is dict:
+        return f"mapping of {type_text(args[1])}" if args else "mapping"
+    if annotation is type(None):
+        return "null"
+    if isinstance(annotation, type) and issubclass(annotation, BaseModel):
+        return f"mapping ({annotation.__name__})"
+    names = {float: "number", int: "integer", bool: "boolean", str: "string", datetime: "date-time",
+             typing.Any: "any"}
+    return names.get(annotation, getattr(annotation, "__name__", str(annotation)))
+
+
+def yaml_text(value) -> str:
+    """``value`` written as in a YAML file."""
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if value is None:
+        return "null"
+    if isinstance(value, float):
+        return ".nan" if math.isnan(value) else (".inf" if value > 0 else "-.inf") if math.isinf(value) else repr(value)
+    if isinstance(value, (list, tuple)):
+        return "[" + ", ".join(yaml_text(v) for v in value) + "]"
+    if isinstance(value, str):
+        return json.dumps(value)
+    return str(value)
+
+
+def default_text(info) -> str:
+    """The default of a field as its table shows it: ``required`` when it has none, the value in YAML
+    (as code) or, for a mapping, a pointer to its own table."""
+    from pydantic import BaseModel
+    if info.is_required():
+        return "required"
+    value = info.default_factory() if info.default_factory is not None else info.default
+    return f"the defaults of `{type(value).__name__}`" if isinstance(value, BaseModel) else f"`{yaml_text(value)}`"
+
+
+def _bounds(metadata) -> list[str]:
+    words = {"ge": ">=", "gt": ">", "le": "<=", "lt": "<"}
+    out = [f"{words[name]} {yaml_text(getattr(m, name))}" for m in metadata for name in words
+           if getattr(m, name, None) is not None]
+    low = next((m.min_length for m in metadata if getattr(m, "min_length", None) is not None), None)
+    high = next((m.max_length for m in metadata if getattr(m, "max_length", None) is not None), None)
+    if low is not None and low == high:
+        out.append(f"length {low}")
+    else:
+        out += [f"length >= {low}"] if low else []
+        out += [f"length <= {high}"] if high is not None else []
+    return out
+
+
+def range_text(info) -> str:
+    """The range of a field: its bounds (``ge``, ``gt``, ``le``, ``lt``), its length bounds, and those of
+    each item of a list."""
+    out = _bounds(info.metadata)
+    annotation = info.annotation
+    if typing.get_origin(annotation) is list:
+        item = typing.get_args(annotation)[0]
+        if typing.get_origin(item) is typing.Annotated:
+            inner = _bounds(typing.get_args(item)[1:])
+            out += [f"each {', '.join(inner)}"] if inner else []
+    return ", ".join(out)
+
+
+def _extra_sections(model) -> object | None:
+    """The type of the extra sections of a model that allows them (a parameter file's node sections)."""
+    if model.model_config.get("extra") != "allow":
+        return None
+    return typing.get_type_hints(model).get("__pydantic_extra__")
+
+
+def config_models(root) -> list[tuple[type, str]]:
+    """Every model of a configuration kind with the key path it is found at, depth first, each once:
+    ``root`` is a model or a union of models (a kind chosen by a key)."""
+    found: list[tuple[type, str]] = []
+
+    def visit(model, path: str) -> None:
+        if any(model is m for m, _ in found):
+            return
+        found.append((model, path))
+        for name, info in model.model_fields.items():
+            key = info.alias or name
+            suffix = "[]" if typing.get_origin(_plain(info.annotation)) is list else ""
+            for sub in _models_in(info.annotation):
+                visit(sub, f"{path}{key}{suffix}.")
+        extra = _extra_sections(model)
+        for sub in _models_in(extra) if extra is not None else []:
+            visit(sub, f"{path}<section>.")
+
+    for model in _models_in(root):
+        visit(model, "")
+    return found
+
+
+def _plain(annotation):
+    """``annotation`` without ``Annotated`` and ``| None``."""
+    while True:
+        origin, args = typing.get_origin(annotation), typing.get_args(annotation)
+        if origin is typing.Annotated:
+            annotation = args[0]
+        elif origin in (typing.Union, types.UnionType) and type(None) in args and len(args) == 2:
+            annotation = next(a for a in args if a is not type(None))
+        else:
+            return annotation
+
+
+def _keys_of(annotation) -> str:
+    models = _models_in(annotation)
+    return ("its keys: " + ", ".join(f"`{m.__name__}`" for m in models) + " below") if models else ""
+
+
+def config_rows(model, path: str) -> list[list[str]]:
+    """One row (:data:`CONFIG_COLUMNS`) per key of ``model`` found at ``path``."""
+    old = {}
+    for before, after in getattr(model, "renamed", {}).items():
+        old.setdefault(after, []).append(before)
+    rows = []
+    for name, info in model.model_fields.items():
+        key = info.alias or name
+        rows.append([f"`{path}{key}`", type_text(info.annotation), unit_of(key), default_text(info),
+                     range_text(info), info.description or _keys_of(info.annotation),
+                     ", ".join(f"`{o}`" for o in old.get(key, []))])
+    extra = _extra_sections(model)
+    if extra is not None:
+        value = typing.get_args(extra)[1]
+        rows.append([f"`{path}<section>`", type_text(value), "", "", "", "any other key: one section, "
+                     + _keys_of(value), ""])
+    return rows
+
+
+def _about(model) -> str:
+    doc = inspect.getdoc(model) or ""
+    if model.__doc__ is None or doc == inspect.getdoc(model.__mro__[1]):
+        return ""                                                   # no docstring of its own
+    return " ".join(doc.split("\n\n")[0].split())
+
+
+def configuration_page(kind: str) -> str:
+    """The reference page of one kind of configuration file: a table per model of its schema."""
+    from att_planner.tools.config_cli import KINDS
+    _, root = KINDS[kind]
+    out = [f"# `{kind}` files\n",
+           f"Every key of a `{kind}` file, generated from the models `att-config check` validates it with "
+           f"(`att-config schema {kind}` prints them as JSON Schema); {{doc}}`/configuration` says where the files "
+           "are. Each value is checked against its type and range when the file is read; a key of an old name is "
+           "refused with its new name (column *old name*).\n"]
+    for model, path in config_models(root):
+        where = f"at `{path.rstrip('.')}`" if path else "of the file's root mapping"
+        out.append(f"## `{model.__name__}`\n")
+        about = _about(model)
+        out.append((f"{about} " if about else "") + f"Keys {where}.\n")
+        out.append(table(CONFIG_COLUMNS, config_rows(model, path)))
+    return "\n".join(out)
+
+
 def generate(out: Path) -> list[Path]:
     """Write every generated page under ``out``; the paths written."""
     pages = {"errors.md": errors_page(), "methods.md": methods_page()}
@@ -225,8 +430,27 @@ def generate(out: Path) -> list[Path]:
     return written
 
 
+def generate_pages(out: Path) -> list[Path]:
+    """Write the configuration reference pages under ``out`` (one per kind, stale ones removed); the
+    paths written."""
+    from att_planner.tools.config_cli import KINDS
+    pages = {f"{kind}.md": configuration_page(kind) for kind in KINDS}
+    out.mkdir(parents=True, exist_ok=True)
+    for stale in out.glob("*.md"):
+        if stale.name not in pages:
+            stale.unlink()
+    written = []
+    for name, text in pages.items():
+        path = out / name
+        if not path.exists() or path.read_text() != text:
+            path.write_text(text)
+        written.append(path)
+    return written
+
+
 def _on_config(app, config) -> None:
     generate(Path(app.srcdir) / "_generated")
+    generate_pages(Path(app.srcdir) / CONFIG_PAGES)
 
 
 def setup(app):

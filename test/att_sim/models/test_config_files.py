@@ -9,7 +9,7 @@ from pydantic import Field
 
 from att_msgs_py.errors import ConfigError, ErrorCode
 from att_sim.models import config_files as cf
-from att_sim.models.config_schema import Schema
+from att_sim.models.config_base import Schema
 
 
 class Wheel(Schema):

@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 from pydantic import ValidationError
 
+from att_sim.models import config_actuators, config_sensors
 from att_sim.models import config_schema as cs
 from att_sim.models.actuator_specs import WheelDriveSpec
 from att_sim.models.sensor_specs import GyroSpec, MagnetometerSpec, StarTrackerSpec, TachometerSpec
@@ -50,11 +51,13 @@ def test_wheels_need_inertia_and_unit_axes():
 
 def test_sensor_defaults_match_the_datasheet_types():
     """The file's defaults and the SI datasheets' agree (one figure, two units)."""
-    assert cs.Gyro().rate_hz == GyroSpec.rate and cs.Magnetometer().rate_hz == MagnetometerSpec.rate
-    assert cs.WheelTachometer().rate_hz == TachometerSpec.rate
+    assert config_sensors.Gyro().rate_hz == GyroSpec.rate
+    assert config_sensors.Magnetometer().rate_hz == MagnetometerSpec.rate
+    assert config_sensors.WheelTachometer().rate_hz == TachometerSpec.rate
     st = StarTrackerSpec()
-    assert math.isclose(cs.StarTracker(name="a").cross_boresight_arcsec * math.pi / 648000, st.cross_boresight)
-    assert cs.WheelDrives().friction_speed_rad_s == WheelDriveSpec.friction_speed
+    assert math.isclose(config_sensors.StarTracker(name="a").cross_boresight_arcsec * math.pi / 648000,
+                        st.cross_boresight)
+    assert config_actuators.WheelDrives().friction_speed_rad_s == WheelDriveSpec.friction_speed
 
 
 def test_sky_needs_an_epoch():
@@ -101,8 +104,8 @@ def test_the_readers_take_defaults_and_ranges_from_the_models():
     from att_sim.models.actuator_specs import actuators_from_params
     from att_sim.models.sensor_specs import ARCSEC, sensors_from_params
     specs = sensors_from_params({"gyro": {}, "star_trackers": [{"name": "a"}]}, epoch_known=False)
-    assert specs.gyro.rate == cs.Gyro.model_fields["rate_hz"].default
-    about = cs.StarTracker(name="a").about_boresight_arcsec
+    assert specs.gyro.rate == config_sensors.Gyro.model_fields["rate_hz"].default
+    about = config_sensors.StarTracker(name="a").about_boresight_arcsec
     assert specs.star_trackers[0].about_boresight == pytest.approx(about * ARCSEC)
     with pytest.raises(ValueError, match=r"sensors.gyro.rate_hz: expected less than or equal to 1000; found 1000.5"):
         sensors_from_params({"gyro": {"rate_hz": 1000.5}}, epoch_known=False)

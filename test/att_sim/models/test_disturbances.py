@@ -140,29 +140,42 @@ def test_exponential_atmosphere_vallado_table_8_4():
             atm.density(bad)
 
 
-def test_facets_from_params_validates_every_field():
-    good = {"area": 1.2, "normal": [0, 0, 1], "center": [0.1, 0, 0.5], "specular": 0.1, "diffuse": 0.3}
-    facets = dist.facets_from_params([good, dict(good, normal=[0.0, 1.0005, 0.0])])
+def _scenario_facets(facets) -> list:
+    """The facets a scenario's ``environment.facets`` build: validated by the schema, built by the reader."""
+    from types import SimpleNamespace
+
+    from att_sim.models import config_schema as cs
+    from att_sim.models import scenario as scen
+    shared = cs.Shared.model_validate({"spacecraft": {"inertia_kg_m2": [1.0, 1.0, 1.0], "wheel_axes": []},
+                                       "environment": {"facets": facets}})
+    return scen._Build(SimpleNamespace(shared=shared, lines={}, path="scenario.yaml")).environment()["facets"]
+
+
+def test_scenario_facets_are_checked_field_by_field():
+    from pydantic import ValidationError
+    good = {"area_m2": 1.2, "normal": [0.0, 0.0, 1.0], "center_m": [0.1, 0.0, 0.5], "specular": 0.1, "diffuse": 0.3}
+    facets = _scenario_facets([good, dict(good, normal=[0.0, 1.0005, 0.0])])
     assert facets[0] == dist.Facet(1.2, (0.0, 0.0, 1.0), (0.1, 0.0, 0.5), 0.1, 0.3)
     assert facets[1].normal_B == (0.0, 1.0, 0.0) and facets[0].absorption == pytest.approx(0.6)
+    at = r"environment.facets.2"
     cases = [
-        (dict(good, normal=[0, 0.9, 0]), r"environment.facets\[2\].normal is not a unit vector"),
-        (dict(good, area=0.0), r"environment.facets\[2\].area must be a finite area > 0"),
-        (dict(good, area="big"), r"environment.facets\[2\].area must be a number"),
-        (dict(good, center=[0, math.inf, 0]), r"environment.facets\[2\].center must be a list of 3 finite"),
-        (dict(good, normal=[0, 1]), r"environment.facets\[2\].normal must be a list of 3 finite"),
-        (dict(good, specular=-0.1), r"environment.facets\[2\].specular must be a reflectivity in \[0, 1\]"),
-        (dict(good, diffuse=1.5), r"environment.facets\[2\].diffuse must be a reflectivity in \[0, 1\]"),
-        (dict(good, specular=0.6, diffuse=0.5), r"environment.facets\[2\].specular \+ diffuse must be at most 1"),
-        ({k: v for k, v in good.items() if k != "diffuse"}, r"facets\[2\] must have exactly the keys.*'diffuse'"),
-        (dict(good, colour="red"), r"facets\[2\] must have exactly the keys.*unknown: \['colour'\]"),
-        ([1, 2], r"environment.facets\[2\] must be a mapping"),
+        (dict(good, normal=[0.0, 0.9, 0.0]), rf"{at}.normal\n  Value error, a unit vector"),
+        (dict(good, area_m2=0.0), rf"{at}.area_m2\n  Input should be greater than 0"),
+        (dict(good, area_m2="big"), rf"{at}.area_m2\n  Input should be a valid number"),
+        (dict(good, center_m=[0.0, math.inf, 0.0]), rf"{at}.center_m.1\n  Value error, a finite number"),
+        (dict(good, normal=[0.0, 1.0]), rf"{at}.normal\n  List should have at least 3 items"),
+        (dict(good, specular=-0.1), rf"{at}.specular\n  Input should be greater than or equal to 0"),
+        (dict(good, diffuse=1.5), rf"{at}.diffuse\n  Input should be less than or equal to 1"),
+        (dict(good, specular=0.6, diffuse=0.5), rf"{at}\n  Value error, specular \+ diffuse at most 1"),
+        ({k: v for k, v in good.items() if k != "diffuse"}, rf"{at}.diffuse\n  Field required"),
+        (dict(good, colour="red"), rf"{at}.colour\n  Extra inputs are not permitted"),
+        ([1, 2], rf"{at}\n  Input should be a valid dictionary"),
     ]
     for item, message in cases:
-        with pytest.raises(ValueError, match=message):
-            dist.facets_from_params([good, good, item])
-    with pytest.raises(ValueError, match="environment.facets must be a list of facets"):
-        dist.facets_from_params(good)
+        with pytest.raises(ValidationError, match=message):
+            _scenario_facets([good, good, item])
+    with pytest.raises(ValidationError, match=r"environment.facets\n  Input should be a valid list"):
+        _scenario_facets(good)
     with pytest.raises(ValueError, match="facet.normal_B is not a unit vector"):
         dist.Facet(1.0, (2.0, 0.0, 0.0), (0.0, 0.0, 0.0), 0.0, 0.0)
 

@@ -271,36 +271,51 @@ def test_check_altitude_low_perigee_and_decay():
         ob.check_altitude(low, 10.0, 0.0)
 
 
-# ---------------------------------------------------------------- scenario mapping
-def test_orbit_from_mapping_each_type():
-    o = ob.orbit_from_mapping({}, None)
+# ---------------------------------------------------------------- scenario orbit group
+CRAFT = {"inertia_kg_m2": [1.0, 1.0, 1.0], "wheel_axes": []}
+
+
+def _scenario_orbit(orbit: dict, epoch=None):
+    """The orbit a scenario's ``orbit`` group builds: validated by the schema, built by the scenario reader."""
+    from types import SimpleNamespace
+
+    from att_sim.models import config_schema as cs
+    from att_sim.models import scenario as scen
+    shared = cs.Shared.model_validate({"spacecraft": CRAFT, "orbit": orbit, "epoch": epoch})
+    build = scen._Build(SimpleNamespace(shared=shared, lines={}, path="scenario.yaml"))
+    return build.orbit(build.epoch())
+
+
+def test_the_scenario_orbit_group_of_each_type():
+    o = _scenario_orbit({})
     assert isinstance(o, ob.CircularOrbit) and o.params == env.OrbitParams()
-    o = ob.orbit_from_mapping({"type": "circular", "altitude": 500e3, "inclination_deg": 45, "arg0": 0.5}, None)
+    o = _scenario_orbit({"type": "circular", "altitude_m": 500e3, "inclination_deg": 45.0, "arg0_rad": 0.5})
     assert o.params == env.OrbitParams(altitude=500e3, inclination=math.radians(45), raan=0.0, arg0=0.5)
-    k = ob.orbit_from_mapping({"type": "kepler", "semi_major_axis": 7e6, "eccentricity": 0.001,
-                               "inclination_deg": 98, "raan_deg": 10, "arg_perigee_deg": 20,
-                               "mean_anomaly_deg": 30}, EPOCH)
+    k = _scenario_orbit({"type": "kepler", "semi_major_axis_m": 7e6, "eccentricity": 0.001,
+                         "inclination_deg": 98.0, "raan_deg": 10.0, "arg_perigee_deg": 20.0,
+                         "mean_anomaly_deg": 30.0}, EPOCH)
     assert isinstance(k, ob.KeplerOrbit) and k.i == pytest.approx(math.radians(98))
-    t = ob.orbit_from_mapping({"type": "tle", "line1": LINE1, "line2": LINE2}, EPOCH)
+    t = _scenario_orbit({"type": "tle", "line1": LINE1, "line2": LINE2}, EPOCH)
     assert isinstance(t, ob.TLEOrbit) and t.epoch.year == 2026
 
 
-@pytest.mark.parametrize("mapping, epoch, words", [
-    ({"type": "sgp8"}, EPOCH, "orbit.type must be one of circular, kepler, tle"),
-    ({"type": "tle", "line1": LINE1, "line2": LINE2, "bstar": 1}, EPOCH, "orbit keys bstar are unknown"),
-    ({"altitude": 5e5, "semi_major_axis": 7e6}, None, "semi_major_axis are unknown for type circular"),
-    ({"type": "tle", "line1": LINE1}, EPOCH, "needs keys line2"),
-    ({"type": "tle", "line1": LINE1, "line2": LINE2}, None, "needs an epoch"),
-    ({"type": "kepler", "semi_major_axis": "7e6", "eccentricity": 0, "inclination_deg": 0, "raan_deg": 0,
-      "arg_perigee_deg": 0, "mean_anomaly_deg": 0}, EPOCH, "orbit.semi_major_axis must be a finite number"),
-    ({"altitude": -1.0}, None, "orbit.altitude must be positive"),
-    ({"inclination_deg": True}, None, "orbit.inclination_deg"),
-    ({"type": "tle", "line1": LINE1, "line2": LINE2}, "2026-12-21", "naive"),
-    ([1, 2], None, "orbit must be a mapping"),
+@pytest.mark.parametrize("orbit, epoch, words", [
+    ({"type": "sgp8"}, EPOCH, "does not match any of the expected tags: 'circular', 'kepler', 'tle'"),
+    ({"type": "tle", "line1": LINE1, "line2": LINE2, "bstar": 1}, EPOCH, "orbit.tle.bstar\n  Extra inputs"),
+    ({"altitude_m": 5e5, "semi_major_axis_m": 7e6}, None, "semi_major_axis_m\n  Extra inputs"),
+    ({"type": "tle", "line1": LINE1}, EPOCH, "orbit.tle.line2\n  Field required"),
+    ({"type": "tle", "line1": LINE1, "line2": LINE2}, None, "an epoch .* for orbit type tle"),
+    ({"type": "kepler", "semi_major_axis_m": "7e6", "eccentricity": 0.0, "inclination_deg": 0.0, "raan_deg": 0.0,
+      "arg_perigee_deg": 0.0, "mean_anomaly_deg": 0.0}, EPOCH, "semi_major_axis_m\n  Input should be a valid number"),
+    ({"altitude_m": -1.0}, None, "altitude_m\n  Input should be greater than 0"),
+    ({"inclination_deg": True}, None, "inclination_deg\n  Input should be a valid number"),
+    ({"type": "tle", "line1": LINE1, "line2": LINE2}, "2026-12-21", "epoch must carry"),
+    ([1, 2], None, "orbit.circular\n  Input should be a valid dictionary"),
 ])
-def test_orbit_from_mapping_bad(mapping, epoch, words):
-    with pytest.raises(ValueError, match=words):
-        ob.orbit_from_mapping(mapping, epoch)
+def test_a_bad_scenario_orbit_group_is_refused(orbit, epoch, words):
+    from pydantic import ValidationError
+    with pytest.raises(ValidationError, match=words):
+        _scenario_orbit(orbit, epoch)
 
 
 def test_sgp4_error_cases_of_the_verification_file():
