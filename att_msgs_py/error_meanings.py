@@ -125,7 +125,7 @@ MEANINGS: dict[ErrorCode, str] = {
     ErrorCode.WRONG_SPACECRAFT: 'a plan made for another spacecraft configuration (name or physical parameters)',
     ErrorCode.PLAN_CONTEXT: (
         'a plan whose first attitude or rate is too far from the current state, or (moving zones) whose epoch '
-        'is more than `max_start_epoch_error` from the scenario epoch + sim time'
+        'is more than `max_start_epoch_error_s` from the scenario epoch + sim time'
     ),
     ErrorCode.INVALID_STATE: (
         '(logged) a state with a bad field, the wrong frames, or from a second publisher while the held one '
@@ -157,7 +157,7 @@ MEANINGS: dict[ErrorCode, str] = {
     ),
     ErrorCode.STALE_MEASUREMENT: (
         '(logged) a gyro stamp that does not move forward or jumps more than `max_gyro_gap` ahead (unless the '
-        "gyro was silent for `resync_timeout`); a measurement older than the filter's history or more than "
+        "gyro was silent for `resync_timeout_s`); a measurement older than the filter's history or more than "
         '`max_gyro_gap` ahead of the gyro'
     ),
     ErrorCode.INVALID_RESET: (

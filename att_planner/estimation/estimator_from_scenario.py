@@ -31,7 +31,7 @@ def estimator_config(param, s: Scenario) -> EstimatorConfig:
         vector_fallback_after=param("vector_fallback_after"),
         magnetometer_sigma=param("magnetometer_sigma_nT") * NANOTESLA, sun_sigma=param("sun_sigma_deg") * DEG,
         sun_threshold=param("sun_threshold"), pair_window=param("pair_window"), max_gyro_gap=param("max_gyro_gap"),
-        resync_timeout=param("resync_timeout"))
+        resync_timeout=param("resync_timeout_s"))
 
 
 def estimator_from_scenario(param, s: Scenario) -> Estimator:

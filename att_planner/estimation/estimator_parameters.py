@@ -51,11 +51,12 @@ ESTIMATOR = ParameterTable("estimator", (
                                                     "initialisation", "s", 0.0, 60.0),
     Parameter("max_gyro_gap", float, _E.max_gyro_gap, "a gyro sample (or a measurement) further ahead of the last "
                                                       "gyro sample is refused", "s", 0.0, 3600.0, low_open=True),
-    Parameter("resync_timeout", float, _E.resync_timeout, "wall time without a gyro sample after which the next "
+    Parameter("resync_timeout_s", float, _E.resync_timeout, "wall time without a gyro sample after which the next "
                                                           "starts a new timeline", "s", 0.0, 3600.0, low_open=True),
     Parameter("wait_for_subscribers", int, 0, "subscribers to the estimate that must listen before the estimator "
                                               "takes its inputs", "", 0, 1000),
-    Parameter("start_timeout", float, 60.0, "wall time waited for those subscribers before taking inputs anyway", "s",
-              0.0, 3600.0, low_open=True),
+    Parameter("start_timeout_s", float, 60.0, "wall time waited for those subscribers before taking inputs anyway",
+              "s", 0.0, 3600.0, low_open=True),
 ), "the attitude estimator: a multiplicative extended Kalman filter (MEKF) on the gyro",
-    renamed={"publish_rate": "publish_rate_Hz"})
+    renamed={"publish_rate": "publish_rate_Hz", "resync_timeout": "resync_timeout_s",
+             "start_timeout": "start_timeout_s"})

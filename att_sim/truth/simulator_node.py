@@ -138,7 +138,7 @@ class SimulatorNode(Node):
         # Hold sim time at zero until this many subscribers (recorder, controller) see the state,
         # so that no run starts before it is recorded and controlled; at most start_timeout s.
         self.wait_for_subscribers = param("wait_for_subscribers")
-        self.start_timeout = param("start_timeout")
+        self.start_timeout = param("start_timeout_s")
         # Lockstep: after each published state, wait (up to lockstep_timeout_s of wall time) for
         # the command that answers it, so the loop stays closed at any speed and under CPU load.
         self.lockstep = param("lockstep")

@@ -27,7 +27,7 @@ SIMULATOR = ParameterTable("simulator", (
     Parameter("wait_for_subscribers", int, 0, "listeners that must be there before sim time starts: "
                                               "subscriptions to the state, plus nodes that hear only the sensors",
               "", 0, 1000),
-    Parameter("start_timeout", float, 60.0, "wall time waited for those subscribers before starting anyway", "s",
+    Parameter("start_timeout_s", float, 60.0, "wall time waited for those subscribers before starting anyway", "s",
               0.0, INF, low_open=True),
     Parameter("lockstep", bool, True, "wait for the command that answers each state (the loop stays closed at any "
                                       "speed and under CPU load)"),
@@ -52,4 +52,4 @@ SIMULATOR = ParameterTable("simulator", (
     renamed={"step": "step_s", "publish_rate": "publish_rate_Hz", "command_timeout": "command_timeout_s",
              "clock_rate": "clock_rate_Hz", "tf_rate": "tf_rate_Hz", "marker_rate": "marker_rate_Hz",
              "lockstep_timeout": "lockstep_timeout_s", "end_time": "end_time_s",
-             "max_reset_rate": "max_reset_rate_rad_s"})
+             "max_reset_rate": "max_reset_rate_rad_s", "start_timeout": "start_timeout_s"})

@@ -118,7 +118,7 @@ def test_a_parameter_the_node_does_not_use_is_declared_with_its_default(describe
     assert ctl["require_signed_modes"][1].bool_value is False
     assert ctl["mode_public_key"][1].string_value.endswith("plan_signing.pub")
     assert ctl["mode_sequence_file"][1].string_value.endswith("mode_sequences.json")
-    assert ctl["mode_sequence_ahead"][1].double_value == 300.0
+    assert ctl["mode_sequence_ahead_s"][1].double_value == 300.0
 
 
 def test_rclpy_own_use_sim_time_is_described(described):
