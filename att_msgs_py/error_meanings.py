@@ -156,9 +156,9 @@ MEANINGS: dict[ErrorCode, str] = {
         'publisher of the same input while the held one is in the ROS graph'
     ),
     ErrorCode.STALE_MEASUREMENT: (
-        '(logged) a gyro stamp that does not move forward or jumps more than `max_gyro_gap` ahead (unless the '
+        '(logged) a gyro stamp that does not move forward or jumps more than `max_gyro_gap_s` ahead (unless the '
         "gyro was silent for `resync_timeout_s`); a measurement older than the filter's history or more than "
-        '`max_gyro_gap` ahead of the gyro'
+        '`max_gyro_gap_s` ahead of the gyro'
     ),
     ErrorCode.INVALID_RESET: (
         '`/simulator/reset` with a non-finite field; an attitude whose norm is off 1 by more than 1e-3; the '

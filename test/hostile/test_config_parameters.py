@@ -263,7 +263,7 @@ NODE_CASES = {
     "estimator: gate probability 1.5": ("estimator", ["-p", "gate_probability:=1.5"], P, ["'gate_probability'"]),
     "estimator: publish_rate above the gyro's": ("estimator", ["-p", "publish_rate_Hz:=100.0"], P,
                                                   ["'publish_rate_Hz'"]),
-    "estimator: history zero": ("estimator", ["-p", "history:=0.0"], P, ["'history'"]),
+    "estimator: history zero": ("estimator", ["-p", "history_s:=0.0"], P, ["'history_s'"]),
     "estimator: wait_for_subscribers negative": ("estimator", ["-p", "wait_for_subscribers:=-1"], P,
                                                  ["'wait_for_subscribers'"]),
     "controller: start_timeout zero": ("controller", ["-p", "start_timeout_s:=0.0"], P, ["'start_timeout_s'"]),

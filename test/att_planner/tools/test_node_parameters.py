@@ -169,7 +169,9 @@ OLD_NAMES = {
                    "max_clock_skew": "max_clock_skew_s", "resync_timeout": "resync_timeout_s",
                    "start_timeout": "start_timeout_s", "mode_sequence_ahead": "mode_sequence_ahead_s"},
     "estimator": {"publish_rate": "publish_rate_Hz", "resync_timeout": "resync_timeout_s",
-                  "start_timeout": "start_timeout_s"},
+                  "start_timeout": "start_timeout_s", "propagate_timeout": "propagate_timeout_s",
+                  "history": "history_s", "vector_fallback_after": "vector_fallback_after_s",
+                  "pair_window": "pair_window_s", "max_gyro_gap": "max_gyro_gap_s"},
     "simulator": {"step": "step_s", "publish_rate": "publish_rate_Hz", "start_timeout": "start_timeout_s"},
     "planner": {"time_budget": "time_budget_s"},
 }
