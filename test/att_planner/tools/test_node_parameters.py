@@ -113,7 +113,7 @@ def test_the_reference_has_every_node_and_writes_numbers_as_a_parameter_file_doe
     text = reference()
     assert all(f"## {node}\n" in text for node in NODE_PARAMETERS)
     assert "| `step_s` | double | `0.05` | in (0, 1] | s |" in text
-    assert "| `schedule_rate_max` | double | `.inf` |" in text
+    assert "| `schedule_rate_max_rad_s` | double | `.inf` |" in text
     assert "| `initial_attitude` | double[] | `[0.0, 0.0, 0.0, 1.0]` |" in text
     assert math.isclose(CONTROLLER["control_rate_Hz"].default, 1.0 / ControllerConfig().control_period)
 
@@ -172,8 +172,11 @@ OLD_NAMES = {
                   "start_timeout": "start_timeout_s", "propagate_timeout": "propagate_timeout_s",
                   "history": "history_s", "vector_fallback_after": "vector_fallback_after_s",
                   "pair_window": "pair_window_s", "max_gyro_gap": "max_gyro_gap_s"},
-    "simulator": {"step": "step_s", "publish_rate": "publish_rate_Hz", "start_timeout": "start_timeout_s"},
-    "planner": {"time_budget": "time_budget_s"},
+    "simulator": {"step": "step_s", "publish_rate": "publish_rate_Hz", "start_timeout": "start_timeout_s",
+                  "initial_rate": "initial_rate_rad_s"},
+    "planner": {"time_budget": "time_budget_s", "accept_final_rate": "accept_final_rate_rad_s",
+                "schedule_rate_max": "schedule_rate_max_rad_s"},
+    "recorder": {"flush_period": "flush_period_s"},
 }
 
 
