@@ -136,7 +136,7 @@ class SimulatorNode(Node):
         self.command_timeout = param("command_timeout_s")
         self.end_time = param("end_time_s")      # s of sim time; 0: run until stopped
         # Hold sim time at zero until this many subscribers (recorder, controller) see the state,
-        # so that no run starts before it is recorded and controlled; at most start_timeout s.
+        # so that no run starts before it is recorded and controlled; at most start_timeout_s.
         self.wait_for_subscribers = param("wait_for_subscribers")
         self.start_timeout = param("start_timeout_s")
         # Lockstep: after each published state, wait (up to lockstep_timeout_s of wall time) for
