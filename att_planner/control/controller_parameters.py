@@ -45,7 +45,7 @@ CONTROLLER = ParameterTable("controller", (
               0.0, INF),
     Parameter("kd", float, _C.kd, "rate gain of the magnetorquer PD-like law (Bruni & Celani)", "A m^2 s/(T rad)",
               0.0, INF),
-    Parameter("m_max", float, None, "dipole limit per magnetorquer coil the laws command (capped at the "
+    Parameter("m_max_Am2", float, None, "dipole limit per magnetorquer coil the laws command (capped at the "
                                    "spacecraft's dipole_max_Am2)", "A m^2", 0.0,
               low_open=True, refusal="expected a dipole > 0 A m²", allow_inf=True,
               default_rule="the spacecraft's dipole_max_Am2"),
@@ -108,4 +108,4 @@ CONTROLLER = ParameterTable("controller", (
              "handover_blend": "handover_blend_s", "max_start_rate_error": "max_start_rate_error_rad_s",
              "max_start_epoch_error": "max_start_epoch_error_s", "max_state_gap": "max_state_gap_s",
              "max_clock_skew": "max_clock_skew_s", "resync_timeout": "resync_timeout_s",
-             "start_timeout": "start_timeout_s", "mode_sequence_ahead": "mode_sequence_ahead_s"})
+             "start_timeout": "start_timeout_s", "mode_sequence_ahead": "mode_sequence_ahead_s", "m_max": "m_max_Am2"})

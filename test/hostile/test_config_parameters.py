@@ -295,7 +295,7 @@ NODE_CASES = {
     "recorder: an old parameter name": ("recorder", ["-p", "flush_period:=0.5"], P,
                                         ["parameter 'flush_period'", "is renamed 'flush_period_s'"]),
     "recorder: unknown parameter (typo)": ("recorder", ["-p", "outptu:=run.mcap"], P, ["outptu"]),
-    "controller: m_max zero": ("controller", ["-p", "m_max:=0.0"], P, ["'m_max'", "dipole > 0"]),
+    "controller: m_max zero": ("controller", ["-p", "m_max_Am2:=0.0"], P, ["'m_max_Am2'", "dipole > 0"]),
     "planner: default_method unknown": ("planner", ["-p", "default_method:=magic"], P,
                                         ["'default_method'", "(the best)", "magic"]),
     "simulator: step an integer out of range": (SIM, ["-p", "step_s:=2"], P, ["'step_s'", "(0, 1]"]),

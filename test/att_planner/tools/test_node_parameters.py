@@ -70,7 +70,7 @@ def test_without_parameters_the_estimators_fixed_tuning_is_the_cores():
     ({"controller": {"control_rate": 20.0}}, "parameter 'control_rate' (override) is renamed 'control_rate_Hz'"),
     ({"controller": {"state_source": "oracle"}}, "parameter 'state_source' (override): expected one of truth, "
                                                  "estimate, got 'oracle'"),
-    ({"controller": {"m_max": -1.0}}, "parameter 'm_max' (override): expected a dipole > 0 A m², got -1.0"),
+    ({"controller": {"m_max_Am2": -1.0}}, "parameter 'm_max_Am2' (override): expected a dipole > 0 A m², got -1.0"),
     ({"estimator": {"gate_probability": 1.5}}, "parameter 'gate_probability' (override) = 1.5 is outside"),
     ({"simulator": {"step_s": 2}}, "parameter 'step_s' (override) = 2.0 is outside (0, 1]"),
     ({"simulator": {"step": 0.1}}, "parameter 'step' (override) is renamed 'step_s'"),
@@ -167,7 +167,8 @@ OLD_NAMES = {
                    "handover_blend": "handover_blend_s", "max_start_rate_error": "max_start_rate_error_rad_s",
                    "max_start_epoch_error": "max_start_epoch_error_s", "max_state_gap": "max_state_gap_s",
                    "max_clock_skew": "max_clock_skew_s", "resync_timeout": "resync_timeout_s",
-                   "start_timeout": "start_timeout_s", "mode_sequence_ahead": "mode_sequence_ahead_s"},
+                   "start_timeout": "start_timeout_s", "mode_sequence_ahead": "mode_sequence_ahead_s",
+                   "m_max": "m_max_Am2"},
     "estimator": {"publish_rate": "publish_rate_Hz", "resync_timeout": "resync_timeout_s",
                   "start_timeout": "start_timeout_s", "propagate_timeout": "propagate_timeout_s",
                   "history": "history_s", "vector_fallback_after": "vector_fallback_after_s",
