@@ -47,7 +47,7 @@ def controller_config(param, scenario: Scenario) -> ControllerConfig:
         control_period=1.0 / param("control_rate_Hz"), settle_time=param("settle_time_s"),
         tracking_kp=param("tracking_kp"), tracking_kd=tracking_kd, kp=param("kp"), kd=param("kd"),
         m_max=param("m_max_Am2", scenario.spacecraft.dipole_max), safe_kd=param("safe_kd", tracking_kd),
-        max_cached_plans=param("max_cached_plans"), max_cache_bytes=int(param("max_cache_mb") * 2**20),
+        max_cached_plans=param("max_cached_plans"), max_cache_bytes=int(param("max_cache_MiB") * 2**20),
         safe_rate_threshold=param("safe_rate_threshold_rad_s"), dumping=param("momentum_dumping"),
         dumping_gain=param("dumping_gain"), null_space_gain=param("null_space_gain"),
         null_space_speed=param("null_space_speed_rad_s"), handover_blend=param("handover_blend_s"),

@@ -52,7 +52,7 @@ CONTROLLER = ParameterTable("controller", (
     Parameter("safe_kd", float, None, "rate damping gain of the safe mode", "N m s/rad", 0.0, INF,
               default_rule="tracking_kd"),
     Parameter("max_cached_plans", int, _C.max_cached_plans, "most plans kept for execution", "", 1, 10_000),
-    Parameter("max_cache_mb", float, _C.max_cache_bytes / 2**20, "largest total size of the plans kept, serialized",
+    Parameter("max_cache_MiB", float, _C.max_cache_bytes / 2**20, "largest total size of the plans kept, serialized",
               "MiB", 0.0, 4096.0, low_open=True),
     Parameter("safe_rate_threshold_rad_s", float, _C.safe_rate_threshold, "body rate above which the controller, "
                                                                     "starting, damps it first (safe mode)", "rad/s",
@@ -108,4 +108,5 @@ CONTROLLER = ParameterTable("controller", (
              "handover_blend": "handover_blend_s", "max_start_rate_error": "max_start_rate_error_rad_s",
              "max_start_epoch_error": "max_start_epoch_error_s", "max_state_gap": "max_state_gap_s",
              "max_clock_skew": "max_clock_skew_s", "resync_timeout": "resync_timeout_s",
-             "start_timeout": "start_timeout_s", "mode_sequence_ahead": "mode_sequence_ahead_s", "m_max": "m_max_Am2"})
+             "start_timeout": "start_timeout_s", "mode_sequence_ahead": "mode_sequence_ahead_s", "m_max": "m_max_Am2",
+             "max_cache_mb": "max_cache_MiB"})

@@ -168,7 +168,7 @@ OLD_NAMES = {
                    "max_start_epoch_error": "max_start_epoch_error_s", "max_state_gap": "max_state_gap_s",
                    "max_clock_skew": "max_clock_skew_s", "resync_timeout": "resync_timeout_s",
                    "start_timeout": "start_timeout_s", "mode_sequence_ahead": "mode_sequence_ahead_s",
-                   "m_max": "m_max_Am2"},
+                   "m_max": "m_max_Am2", "max_cache_mb": "max_cache_MiB"},
     "estimator": {"publish_rate": "publish_rate_Hz", "resync_timeout": "resync_timeout_s",
                   "start_timeout": "start_timeout_s", "propagate_timeout": "propagate_timeout_s",
                   "history": "history_s", "vector_fallback_after": "vector_fallback_after_s",
