@@ -125,7 +125,7 @@ MEANINGS: dict[ErrorCode, str] = {
     ErrorCode.WRONG_SPACECRAFT: 'a plan made for another spacecraft configuration (name or physical parameters)',
     ErrorCode.PLAN_CONTEXT: (
         'a plan whose first attitude or rate is too far from the current state, or (moving zones) whose epoch '
-        'is more than `max_start_epoch_error` from the scenario epoch + sim time'
+        'is more than `max_start_epoch_error_s` from the scenario epoch + sim time'
     ),
     ErrorCode.INVALID_STATE: (
         '(logged) a state with a bad field, the wrong frames, or from a second publisher while the held one '
@@ -156,9 +156,9 @@ MEANINGS: dict[ErrorCode, str] = {
         'publisher of the same input while the held one is in the ROS graph'
     ),
     ErrorCode.STALE_MEASUREMENT: (
-        '(logged) a gyro stamp that does not move forward or jumps more than `max_gyro_gap` ahead (unless the '
-        "gyro was silent for `resync_timeout`); a measurement older than the filter's history or more than "
-        '`max_gyro_gap` ahead of the gyro'
+        '(logged) a gyro stamp that does not move forward or jumps more than `max_gyro_gap_s` ahead (unless the '
+        "gyro was silent for `resync_timeout_s`); a measurement older than the filter's history or more than "
+        '`max_gyro_gap_s` ahead of the gyro'
     ),
     ErrorCode.INVALID_RESET: (
         '`/simulator/reset` with a non-finite field; an attitude whose norm is off 1 by more than 1e-3; the '

@@ -6,9 +6,10 @@ from att_msgs_py.parameters import Parameter, ParameterTable
 RECORDER = ParameterTable("recorder", (
     Parameter("output", str, None, "MCAP file the run is recorded to (an unfinished one there is first repaired "
                                    "aside)", default_rule="runs/run_YYYYmmdd_HHMMSS.mcap (UTC start time)"),
-    Parameter("flush_period", float, 0.5, "longest time between flushes to disk (a killed recorder loses at most "
+    Parameter("flush_period_s", float, 0.5, "longest time between flushes to disk (a killed recorder loses at most "
                                           "this)", "s", 0.0, 3600.0, low_open=True),
-), "writes every suite topic to one rosbag2-compatible MCAP file per run")
+), "writes every suite topic to one rosbag2-compatible MCAP file per run",
+    renamed={"flush_period": "flush_period_s"})
 
 BRIDGE = ParameterTable("bridge", (
     Parameter("host", str, "127.0.0.1", "address the Foxglove WebSocket server listens on"),

@@ -1,7 +1,7 @@
 """Recorder node: writes every suite topic to one rosbag2-compatible MCAP file per run.
 
 Subscribes in raw (serialized CDR) form to :func:`att_msgs_py.qos.recorded_topics`, so messages
-are stored byte-for-byte as published. The file is flushed at least every ``flush_period`` s (a
+are stored byte-for-byte as published. The file is flushed at least every ``flush_period_s`` s (a
 killed recorder loses at most that) and finalised (summary and index) on SIGINT/SIGTERM. A file
 left at ``output`` by a recorder that did not finish is first repaired to ``OUT.repaired.mcap``
 (``att-log repair``), so starting again on the same path loses nothing.
@@ -29,7 +29,7 @@ class RecorderNode(Node):
         stamp = datetime.now(UTC).strftime("%Y%m%d_%H%M%S")
         param = ParameterReader(self, RECORDER, {})
         output = param("output", f"runs/run_{stamp}.mcap")
-        flush_period = param("flush_period")
+        flush_period = param("flush_period_s")
         param.refuse_unknown()
         if Path(output).is_file():
             self.keep_leftover(Path(output))

@@ -181,7 +181,7 @@ class Controller:
             rate = float(np.linalg.norm(admission.state.omega))
             if rate > self.config.safe_rate_threshold:
                 self.mode = ControlMode.SAFE
-                out.note = (f"the spacecraft rotates at {rate:.4g} rad/s (above safe_rate_threshold "
+                out.note = (f"the spacecraft rotates at {rate:.4g} rad/s (above safe_rate_threshold_rad_s "
                             f"{self.config.safe_rate_threshold:g} rad/s): rate damping (safe mode)")
         return out
 

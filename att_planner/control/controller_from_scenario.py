@@ -46,11 +46,11 @@ def controller_config(param, scenario: Scenario) -> ControllerConfig:
     return ControllerConfig(
         control_period=1.0 / param("control_rate_Hz"), settle_time=param("settle_time_s"),
         tracking_kp=param("tracking_kp"), tracking_kd=tracking_kd, kp=param("kp"), kd=param("kd"),
-        m_max=param("m_max", scenario.spacecraft.dipole_max), safe_kd=param("safe_kd", tracking_kd),
-        max_cached_plans=param("max_cached_plans"), max_cache_bytes=int(param("max_cache_mb") * 2**20),
-        safe_rate_threshold=param("safe_rate_threshold"), dumping=param("momentum_dumping"),
+        m_max=param("m_max_Am2", scenario.spacecraft.dipole_max), safe_kd=param("safe_kd", tracking_kd),
+        max_cached_plans=param("max_cached_plans"), max_cache_bytes=int(param("max_cache_MiB") * 2**20),
+        safe_rate_threshold=param("safe_rate_threshold_rad_s"), dumping=param("momentum_dumping"),
         dumping_gain=param("dumping_gain"), null_space_gain=param("null_space_gain"),
-        null_space_speed=param("null_space_speed"), handover_blend=param("handover_blend"),
+        null_space_speed=param("null_space_speed_rad_s"), handover_blend=param("handover_blend_s"),
         safe_sun_axis=tuple(_unit_param(param, "safe_sun_axis")))
 
 
@@ -69,14 +69,14 @@ def plan_context(param, scenario: Scenario, key=None) -> PlanContext:
     return PlanContext(
         scenario.spacecraft, scenario.name, scenario.frame_id, key or public_key(param, "plan_public_key"),
         max_start_attitude_error=math.radians(param("max_start_attitude_error_deg")),
-        max_start_rate_error=param("max_start_rate_error"),
+        max_start_rate_error=param("max_start_rate_error_rad_s"),
         epoch=scenario.epoch,
-        max_start_epoch_error=param("max_start_epoch_error"))
+        max_start_epoch_error=param("max_start_epoch_error_s"))
 
 
 def gate_config(param) -> GateConfig:
-    return GateConfig(max_state_gap=param("max_state_gap"), max_clock_skew=param("max_clock_skew"),
-                      resync_timeout=param("resync_timeout"))
+    return GateConfig(max_state_gap=param("max_state_gap_s"), max_clock_skew=param("max_clock_skew_s"),
+                      resync_timeout=param("resync_timeout_s"))
 
 
 def measured_state(source: str, scenario: Scenario) -> MeasuredState | None:

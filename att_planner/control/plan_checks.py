@@ -190,7 +190,7 @@ def check_start(plan: Plan, state: State, ctx: PlanContext) -> RequestError | No
     if rate_error > ctx.max_start_rate_error:
         return RequestError(ErrorCode.PLAN_CONTEXT,
                             f"plan '{plan.plan_id}' starts at a rate {rate_error:.4g} rad/s from the current one "
-                            f"(at most {ctx.max_start_rate_error:g} rad/s, parameter max_start_rate_error)")
+                            f"(at most {ctx.max_start_rate_error:g} rad/s, parameter max_start_rate_error_rad_s)")
     moving = any(z.body != "inertial" for z in plan.zones)
     if moving and ctx.epoch is not None and plan.epoch is not None:
         now = ctx.epoch + timedelta(seconds=float(state.t))
@@ -201,5 +201,5 @@ def check_start(plan: Plan, state: State, ctx: PlanContext) -> RequestError | No
                                 f"plan '{plan.plan_id}' avoids moving zones as they are from "
                                 f"{epochs.format_epoch(plan.epoch)}, but it would start at {epochs.format_epoch(now)}, "
                                 f"{when} (at most {ctx.max_start_epoch_error:g} s, "
-                                "parameter max_start_epoch_error): request it with the start epoch")
+                                "parameter max_start_epoch_error_s): request it with the start epoch")
     return None

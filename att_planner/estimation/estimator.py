@@ -163,7 +163,7 @@ class Estimator:
             if not silent:
                 raise RequestError(ErrorCode.STALE_MEASUREMENT,
                                    f"gyro stamp {m.t:.6g} s is {m.t - last:+.6g} s from the last ({last:.6g} s); "
-                                   f"it must move forward by at most max_gyro_gap = {self.config.max_gyro_gap:g} s")
+                                   f"it must move forward by at most max_gyro_gap_s = {self.config.max_gyro_gap:g} s")
             self.monitor.report.notes.append(f"gyro timeline restarted: {last:.3f} s then {m.t:.3f} s; "
                                              "filter restarted")
             self._restart()

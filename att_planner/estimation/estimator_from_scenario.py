@@ -27,11 +27,11 @@ def estimator_config(param, s: Scenario) -> EstimatorConfig:
         gate_probability=param("gate_probability"),
         converged_attitude_sigma=param("converged_attitude_sigma_arcsec", d.converged_attitude_sigma / ARCSEC)
         * ARCSEC,
-        propagate_timeout=param("propagate_timeout"), history=param("history"), lost_after=param("lost_after"),
-        vector_fallback_after=param("vector_fallback_after"),
+        propagate_timeout=param("propagate_timeout_s"), history=param("history_s"), lost_after=param("lost_after"),
+        vector_fallback_after=param("vector_fallback_after_s"),
         magnetometer_sigma=param("magnetometer_sigma_nT") * NANOTESLA, sun_sigma=param("sun_sigma_deg") * DEG,
-        sun_threshold=param("sun_threshold"), pair_window=param("pair_window"), max_gyro_gap=param("max_gyro_gap"),
-        resync_timeout=param("resync_timeout"))
+        sun_threshold=param("sun_threshold"), pair_window=param("pair_window_s"), max_gyro_gap=param("max_gyro_gap_s"),
+        resync_timeout=param("resync_timeout_s"))
 
 
 def estimator_from_scenario(param, s: Scenario) -> Estimator:

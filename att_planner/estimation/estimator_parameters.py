@@ -30,14 +30,14 @@ ESTIMATOR = ParameterTable("estimator", (
     Parameter("converged_attitude_sigma_arcsec", float, None, "largest 3-sigma attitude error of a CONVERGED "
                                                               "estimate", "arcsec", 0.0, 648000.0, low_open=True,
               default_rule="10 x the best star tracker's about-boresight error"),
-    Parameter("propagate_timeout", float, _E.propagate_timeout, "time without an accepted attitude measurement "
+    Parameter("propagate_timeout_s", float, _E.propagate_timeout, "time without an accepted attitude measurement "
                                                                 "after which the estimate is PROPAGATING", "s",
               0.0, 3600.0, low_open=True),
-    Parameter("history", float, _E.history, "span of samples kept to apply late measurements", "s", 0.0, 60.0,
+    Parameter("history_s", float, _E.history, "span of samples kept to apply late measurements", "s", 0.0, 60.0,
               low_open=True),
     Parameter("lost_after", int, _E.lost_after, "tracker measurements rejected in a row after which the estimate is "
                                                 "DIVERGED", "", 1, 1000),
-    Parameter("vector_fallback_after", float, _E.vector_fallback_after, "time without a tracker update after which "
+    Parameter("vector_fallback_after_s", float, _E.vector_fallback_after, "time without a tracker update after which "
                                                                         "vector measurements update the attitude", "s",
               0.0, 3600.0),
     Parameter("magnetometer_sigma_nT", float, _E.magnetometer_sigma / NANOTESLA, "magnetometer noise and field-model "
@@ -47,15 +47,18 @@ ESTIMATOR = ParameterTable("estimator", (
               low_open=True),
     Parameter("sun_threshold", float, _E.sun_threshold, "sun sensor output above which a detector is lit", "",
               0.0, 1.0),
-    Parameter("pair_window", float, _E.pair_window, "largest time between the two vectors of a QUEST "
+    Parameter("pair_window_s", float, _E.pair_window, "largest time between the two vectors of a QUEST "
                                                     "initialisation", "s", 0.0, 60.0),
-    Parameter("max_gyro_gap", float, _E.max_gyro_gap, "a gyro sample (or a measurement) further ahead of the last "
+    Parameter("max_gyro_gap_s", float, _E.max_gyro_gap, "a gyro sample (or a measurement) further ahead of the last "
                                                       "gyro sample is refused", "s", 0.0, 3600.0, low_open=True),
-    Parameter("resync_timeout", float, _E.resync_timeout, "wall time without a gyro sample after which the next "
+    Parameter("resync_timeout_s", float, _E.resync_timeout, "wall time without a gyro sample after which the next "
                                                           "starts a new timeline", "s", 0.0, 3600.0, low_open=True),
     Parameter("wait_for_subscribers", int, 0, "subscribers to the estimate that must listen before the estimator "
                                               "takes its inputs", "", 0, 1000),
-    Parameter("start_timeout", float, 60.0, "wall time waited for those subscribers before taking inputs anyway", "s",
-              0.0, 3600.0, low_open=True),
+    Parameter("start_timeout_s", float, 60.0, "wall time waited for those subscribers before taking inputs anyway",
+              "s", 0.0, 3600.0, low_open=True),
 ), "the attitude estimator: a multiplicative extended Kalman filter (MEKF) on the gyro",
-    renamed={"publish_rate": "publish_rate_Hz"})
+    renamed={"publish_rate": "publish_rate_Hz", "resync_timeout": "resync_timeout_s",
+             "start_timeout": "start_timeout_s", "propagate_timeout": "propagate_timeout_s", "history": "history_s",
+             "vector_fallback_after": "vector_fallback_after_s", "pair_window": "pair_window_s",
+             "max_gyro_gap": "max_gyro_gap_s"})

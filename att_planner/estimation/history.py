@@ -94,7 +94,7 @@ class MeasurementHistory:
         if newest is not None and record.t > newest + self.max_gyro_gap:
             raise RequestError(ErrorCode.STALE_MEASUREMENT,
                                f"{record.kind} measurement of t = {record.t:.6g} s is ahead of the gyro (t = "
-                               f"{newest:.6g} s) by more than max_gyro_gap = {self.max_gyro_gap:g} s")
+                               f"{newest:.6g} s) by more than max_gyro_gap_s = {self.max_gyro_gap:g} s")
         self.records.append(record)
         self.records.sort(key=_instant)               # stable: equal instants keep their arrival order
         if record.t <= self.snapshots[-1][0]:

@@ -68,7 +68,7 @@ class MissionConfig:
     zones: list                   # att_msgs_py.types.Zone: those of the scenario the mission keeps
     secondary: str                # ground sites: the pointing mode's secondary direction
     secondary_axis: np.ndarray    # ground sites: its body axis
-    handover_blend: float         # s: the controller's blend into a site's law (its parameter handover_blend)
+    handover_blend: float         # s: the controller's blend into a site's law (its parameter handover_blend_s)
 
     def targets(self) -> dict:
         """Target name -> :class:`~att_planner.mission.scheduler.MissionTarget`, in the list's order."""

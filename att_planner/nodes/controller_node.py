@@ -14,7 +14,7 @@ read, SIZE_LIMIT; the core's checks, :mod:`att_planner.control.plan_checks` and
 per kind, clipped, with a running count) and changes nothing. Plans must verify against the
 Ed25519 public key ``plan_public_key`` (:mod:`att_msgs_py.signing`); with ``require_signed_modes``
 mode requests must verify against ``mode_public_key`` and carry an increasing sequence number
-(the signer's wall clock in ns, at most ``mode_sequence_ahead`` s ahead of the controller's), the
+(the signer's wall clock in ns, at most ``mode_sequence_ahead_s`` s ahead of the controller's), the
 last accepted one kept in ``mode_sequence_file`` (:mod:`att_planner.control.mode_authentication`).
 
 Sim time comes from the states' stamps. ``/clock`` is read by the node itself, not through
@@ -84,11 +84,11 @@ class ControllerNode(Node):
                                                     else topics.ESTIMATE)
         self._wall_timeout = param("wall_timeout_s")
         wait_for_subscribers = param("wait_for_subscribers")
-        start_timeout = param("start_timeout")
+        start_timeout = param("start_timeout_s")
         signed = param("require_signed_modes")
         mode_key = public_key(param, "mode_public_key", load=signed)
         sequences = param("mode_sequence_file", str(default_sequence_path()))
-        ahead = param("mode_sequence_ahead")
+        ahead = param("mode_sequence_ahead_s")
         if signed:
             self._core.authentication = ModeAuthentication(mode_key, sequences, ahead)
         param.refuse_unknown()

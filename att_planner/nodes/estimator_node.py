@@ -52,7 +52,7 @@ class EstimatorNode(Node):
         param = ParameterReader(self, ESTIMATOR, s.node_params.get("estimator", {}), str(s.node_params_path))
         self._core = estimator_from_scenario(param, s)
         wait_for_subscribers = param("wait_for_subscribers")
-        start_timeout = param("start_timeout")
+        start_timeout = param("start_timeout_s")
         param.refuse_unknown()
         self._refusals = RefusalLog(self.get_logger())
         self._sources = Sources({what: live_publishers(self, topic) for what, topic in INPUTS.items()})

@@ -59,10 +59,10 @@ class PlannerNode(Node):
         self._default_method = param("default_method") or methods.REGISTRY[0].name
         self._default_budget = param("time_budget_s")
         self._tolerances = Tolerances(attitude=math.radians(param("accept_attitude_error_deg")),
-                                      rate=param("accept_final_rate"),
+                                      rate=param("accept_final_rate_rad_s"),
                                       cone_penetration=math.radians(param("accept_cone_penetration_deg")))
         self._cone_padding = math.radians(param("cone_padding_deg"))
-        self._schedule_rate_max = param("schedule_rate_max")        # .inf: no bound
+        self._schedule_rate_max = param("schedule_rate_max_rad_s")  # .inf: no bound
         key_path = param("signing_key", str(signing.default_key_dir() / signing.PRIVATE_NAME))
         self._signing_key = self._load_signing_key(key_path)
         parallel = param("max_parallel_solves")

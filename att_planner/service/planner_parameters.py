@@ -18,14 +18,14 @@ PLANNER = ParameterTable("planner", (
     Parameter("accept_attitude_error_deg", float, math.degrees(TOLERANCES.attitude), "largest final attitude error "
                                                                                      "of an accepted plan", "deg",
               0.0, 180.0, low_open=True),
-    Parameter("accept_final_rate", float, TOLERANCES.rate, "largest final body rate of an accepted plan", "rad/s",
-              0.0, 10.0, low_open=True),
+    Parameter("accept_final_rate_rad_s", float, TOLERANCES.rate, "largest final body rate of an accepted plan",
+              "rad/s", 0.0, 10.0, low_open=True),
     Parameter("accept_cone_penetration_deg", float, math.degrees(TOLERANCES.cone_penetration),
               "largest penetration of a keep-out cone an accepted plan may have", "deg", 0.0, 10.0),
     Parameter("cone_padding_deg", float, 1.0, "cones widened by this for planning (a tracking margin); plans are "
                                               "verified against the cones unpadded", "deg", 0.0, 10.0),
-    Parameter("schedule_rate_max", float, math.inf, "body rate bound of a schedule's slews (.inf: none)", "rad/s",
-              0.0, low_open=True, refusal="expected a body-rate bound > 0 rad/s (.inf: none)", allow_inf=True),
+    Parameter("schedule_rate_max_rad_s", float, math.inf, "body rate bound of a schedule's slews (.inf: none)",
+              "rad/s", 0.0, low_open=True, refusal="expected a body-rate bound > 0 rad/s (.inf: none)", allow_inf=True),
     Parameter("signing_key", str, None, "Ed25519 private key file the plans are signed with",
               default_rule="plan_signing.key in the suite's key directory ($ATT_KEY_DIR, see att-keygen)"),
     Parameter("max_parallel_solves", int, 2, "plans solved at once (worker processes)", "", 1, 64),
@@ -33,4 +33,5 @@ PLANNER = ParameterTable("planner", (
     Parameter("warm_up_scenarios", str, None, "comma-separated scenarios whose demo maneuvers every worker "
                                               "plans before the node serves ('': none)", default_rule="the scenario"),
 ), "the maneuver planner: the plan_maneuver and plan_schedule services",
-    renamed={"time_budget": "time_budget_s"})
+    renamed={"time_budget": "time_budget_s", "accept_final_rate": "accept_final_rate_rad_s",
+             "schedule_rate_max": "schedule_rate_max_rad_s"})

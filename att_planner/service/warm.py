@@ -35,7 +35,7 @@ def maneuver_from_scenario(s: scen.Scenario) -> dict:
     p = s.node_params.get("demo")
     if not isinstance(p, dict):
         raise ValueError(f"scenario '{s.name}' ({s.path}) has no 'demo:' section with the maneuver to fly "
-                         f"({', '.join(DEMO_KEYS)}, optional cones, method, time_budget, start_lead, start_time)")
+                         f"({', '.join(DEMO_KEYS)}, optional cones, method, time_budget_s, start_lead_s, start_time_s)")
     missing = [k for k in DEMO_KEYS if k not in p]
     if missing:
         raise ValueError(f"scenario '{s.name}' ({s.path}): the 'demo:' section lacks {', '.join(missing)}")
@@ -44,8 +44,8 @@ def maneuver_from_scenario(s: scen.Scenario) -> dict:
                                                              p.get("cone_names", []))]
     return {"q0": np.asarray(p["initial_attitude"], float), "qf": np.asarray(p["final_attitude"], float),
             "sensor": np.asarray(p["sensor_axis"], float), "cones": cones, "zones": list(s.zones),
-            "method": p.get("method", ""), "time_budget": float(p.get("time_budget", 30.0)),
-            "start_lead": float(p.get("start_lead", 0.0)), "start_time": p.get("start_time")}
+            "method": p.get("method", ""), "time_budget": float(p.get("time_budget_s", 30.0)),
+            "start_lead": float(p.get("start_lead_s", 0.0)), "start_time": p.get("start_time_s")}
 
 
 def warm_requests(names: list[str], *, frame_id: str, default_method: str) -> list[ValidRequest]:

@@ -171,7 +171,7 @@ def fly_mission(mission: mission_config.MissionConfig, out: Path, log=print) -> 
     params = {"simulator": {"step_s": 1.0 / rate, "publish_rate_Hz": rate, "clock_rate_Hz": rate,
                             "real_time_factor": pace},
               "controller": {"control_rate_Hz": rate, "momentum_dumping": mission.momentum_dumping,
-                             "handover_blend": mission.handover_blend},
+                             "handover_blend_s": mission.handover_blend},
               "estimator": {"publish_rate_Hz": rate}}
     name = mission.scenario.name
     # the driver's telemetry listens to the state: one more subscriber for the simulator to wait for

@@ -4,7 +4,7 @@
     att-tune --mode fixed --ic 0,0,0,0.02,0.02,-0.03,0.332
     att-tune --mode robust --scheduler tcp://scheduler-host:8786      # evaluate on a Dask cluster
 
-Writes ``controller.ros__parameters.{kp, kd, m_max}`` (other keys of an existing file are kept),
+Writes ``controller.ros__parameters.{kp, kd, m_max_Am2}`` (other keys of an existing file are kept),
 the file the controller node loads. A progress bar with the elapsed time, ETA and the best
 settling time so far is drawn on stderr.
 """
@@ -50,14 +50,16 @@ class ProgressBar:
 
 def write_gains(path: str, kp: float, kd: float, m_max: float, node: str = "controller",
                 comment: str = "") -> dict:
-    """Set ``<node>.ros__parameters.{kp, kd, m_max}`` in the YAML at ``path`` (created if missing);
-    ``comment`` lines head the file (YAML comments of an existing file are not kept)."""
+    """Set ``<node>.ros__parameters.{kp, kd, m_max_Am2}`` in the YAML at ``path`` (created if missing);
+    ``comment`` lines head the file (YAML comments of an existing file are not kept); a key of the
+    old name ``m_max`` is replaced."""
     doc = {}
     if os.path.exists(path):
         with open(path) as fh:
             doc = yaml.safe_load(fh) or {}
     params = doc.setdefault(node, {}).setdefault("ros__parameters", {})
-    params.update({"kp": float(kp), "kd": float(kd), "m_max": float(m_max)})
+    params.pop("m_max", None)                   # the old name of m_max_Am2, refused beside it
+    params.update({"kp": float(kp), "kd": float(kd), "m_max_Am2": float(m_max)})
     os.makedirs(os.path.dirname(os.path.abspath(path)), exist_ok=True)
     with open(path, "w") as fh:
         fh.writelines(f"# {line}\n" for line in comment.splitlines())

@@ -281,6 +281,8 @@ def resolved(sky: ScenarioSky, craft: SpacecraftFile) -> dict:
 class Demo(Schema):
     """A scenario's demo maneuver (``config/scenarios/NAME.demo.yaml``, flown by ``att-demo``)."""
 
+    renamed: ClassVar = {"time_budget": "time_budget_s", "start_lead": "start_lead_s", "start_time": "start_time_s"}
+
     initial_attitude: Quaternion = Field(description="body-to-inertial quaternion [x, y, z, w] at the start")
     final_attitude: Quaternion = Field(description="body-to-inertial quaternion [x, y, z, w] at the end")
     sensor_axis: UnitVector3 = Field(description="unit body axis of the sensor the cones constrain")
@@ -288,10 +290,10 @@ class Demo(Schema):
     cone_directions: UnitVectors = Field([], description="unit inertial direction of each cone, 3 numbers each")
     cone_half_angles_deg: list[Annotated[float, Field(gt=0.0, lt=180.0)]] = Field([], max_length=64)
     method: Annotated[str, Field(max_length=64)] = Field("", description="planning method; empty: the default")
-    time_budget: float = number(30.0, gt=0.0, le=600.0, unit="s", meaning="planner wall time")
-    start_lead: float = number(0.0, ge=0.0, le=86_400.0, unit="s", meaning="sim time from the request to the start")
-    start_time: float | None = number(None, ge=0.0, unit="s", meaning="sim time of the start, the sky set for it; "
-                                      "none: the request's time plus start_lead")
+    time_budget_s: float = number(30.0, gt=0.0, le=600.0, unit="s", meaning="planner wall time")
+    start_lead_s: float = number(0.0, ge=0.0, le=86_400.0, unit="s", meaning="sim time from the request to the start")
+    start_time_s: float | None = number(None, ge=0.0, unit="s", meaning="sim time of the start, the sky set for it; "
+                                        "none: the request's time plus start_lead_s")
 
     @model_validator(mode="after")
     def _cones(self):

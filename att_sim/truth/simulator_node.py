@@ -92,7 +92,7 @@ class SimulatorNode(Node):
         self.refused = {"command": 0, "reset": 0}
         try:
             truth = param["truth"] or dispersions.Truth(self.scenario, param["initial_attitude"],
-                                                        param["initial_rate"], param["seed"])
+                                                        param["initial_rate_rad_s"], param["seed"])
             self.sim = Simulation.for_scenario(
                 truth.scenario, q0=truth.q0, omega0=truth.omega0, gravity_gradient=param["gravity_gradient"],
                 checks=Checks(command_limit_factor=param["command_limit_factor"],
@@ -136,15 +136,15 @@ class SimulatorNode(Node):
         self.command_timeout = param("command_timeout_s")
         self.end_time = param("end_time_s")      # s of sim time; 0: run until stopped
         # Hold sim time at zero until this many subscribers (recorder, controller) see the state,
-        # so that no run starts before it is recorded and controlled; at most start_timeout s.
+        # so that no run starts before it is recorded and controlled; at most start_timeout_s.
         self.wait_for_subscribers = param("wait_for_subscribers")
-        self.start_timeout = param("start_timeout")
+        self.start_timeout = param("start_timeout_s")
         # Lockstep: after each published state, wait (up to lockstep_timeout_s of wall time) for
         # the command that answers it, so the loop stays closed at any speed and under CPU load.
         self.lockstep = param("lockstep")
         self.lockstep_timeout = param("lockstep_timeout_s")
         values = {name: param(name) for name in ("command_limit_factor", "max_reset_rate_rad_s", "initial_attitude",
-                                                 "initial_rate", "campaign", "run_seed")}
+                                                 "initial_rate_rad_s", "campaign", "run_seed")}
         values["gravity_gradient"] = param("gravity_gradient", bool(self.scenario.environment.get("gravity_gradient")))
         values["seed"] = param("seed", self.scenario.sensors.seed)
         try:
@@ -152,18 +152,18 @@ class SimulatorNode(Node):
                 values["initial_attitude"], "parameter 'initial_attitude'", ErrorCode.INVALID_PARAMETER)
         except RequestError as err:
             raise ConfigError(err.code, err.message) from None
-        rate = float(np.linalg.norm(values["initial_rate"]))
+        rate = float(np.linalg.norm(values["initial_rate_rad_s"]))
         if rate > values["max_reset_rate_rad_s"]:
             limit = values["max_reset_rate_rad_s"]
-            raise ConfigError(ErrorCode.INVALID_PARAMETER, f"parameter 'initial_rate' has norm {rate:g} rad/s, above "
-                                                           f"max_reset_rate_rad_s = {limit:g} rad/s")
+            raise ConfigError(ErrorCode.INVALID_PARAMETER, f"parameter 'initial_rate_rad_s' has norm {rate:g} rad/s, "
+                                                           f"above max_reset_rate_rad_s = {limit:g} rad/s")
         param.refuse_unknown()
         values["truth"] = self.dispersed_truth(values)
         return values
 
     def dispersed_truth(self, values: dict) -> dispersions.Truth | None:
         """The truth of run ``run_seed`` of the Monte Carlo ``campaign`` (a campaign file of this
-        scenario; the nominal start is ``initial_attitude``/``initial_rate``; the run seed is the
+        scenario; the nominal start is ``initial_attitude``/``initial_rate_rad_s``; the run seed is the
         sensors' seed too), None without a campaign; ConfigError naming the parameter."""
         path, seed = values["campaign"], values["run_seed"]
         if not path and seed < 0:
@@ -177,7 +177,7 @@ class SimulatorNode(Node):
                 raise ValueError(f"its scenario '{campaign.scenario}' is not this simulator's "
                                  f"'{self.scenario.name}' ({self.scenario.path})")
             truth, _ = dispersions.seed_truth(campaign, self.scenario, seed, values["initial_attitude"],
-                                              values["initial_rate"])
+                                              values["initial_rate_rad_s"])
         except (KeyError, ValueError) as err:
             raise ConfigError(ErrorCode.INVALID_PARAMETER, f"parameter 'campaign': {clip(err, 300)}") from None
         return truth

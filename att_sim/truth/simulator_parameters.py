@@ -27,7 +27,7 @@ SIMULATOR = ParameterTable("simulator", (
     Parameter("wait_for_subscribers", int, 0, "listeners that must be there before sim time starts: "
                                               "subscriptions to the state, plus nodes that hear only the sensors",
               "", 0, 1000),
-    Parameter("start_timeout", float, 60.0, "wall time waited for those subscribers before starting anyway", "s",
+    Parameter("start_timeout_s", float, 60.0, "wall time waited for those subscribers before starting anyway", "s",
               0.0, INF, low_open=True),
     Parameter("lockstep", bool, True, "wait for the command that answers each state (the loop stays closed at any "
                                       "speed and under CPU load)"),
@@ -35,14 +35,14 @@ SIMULATOR = ParameterTable("simulator", (
               "s", 0.0, INF, low_open=True),
     Parameter("command_limit_factor", float, 2.0, "a command beyond this multiple of an actuator limit is refused "
                                                   "(within it: saturated)", "", 1.0, INF),
-    Parameter("max_reset_rate_rad_s", float, 1.0, "largest body rate norm a /simulator/reset (or initial_rate) may set",
-              "rad/s", 0.0, INF, low_open=True),
+    Parameter("max_reset_rate_rad_s", float, 1.0, "largest body rate norm a /simulator/reset (or "
+                                                  "initial_rate_rad_s) may set", "rad/s", 0.0, INF, low_open=True),
     Parameter("gravity_gradient", bool, None, "apply the gravity-gradient torque",
               default_rule="the scenario's environment.gravity_gradient (false without it)"),
     Parameter("initial_attitude", list, (0.0, 0.0, 0.0, 1.0), "initial attitude q_BN [x, y, z, w] (unit norm within "
                                                               "1e-3)", "", -INF, INF, length=4),
-    Parameter("initial_rate", list, (0.0, 0.0, 0.0), "initial body rate omega_BN_B (norm at most max_reset_rate_rad_s)",
-              "rad/s", -INF, INF, length=3),
+    Parameter("initial_rate_rad_s", list, (0.0, 0.0, 0.0), "initial body rate omega_BN_B (norm at most "
+                                                                 "max_reset_rate_rad_s)", "rad/s", -INF, INF, length=3),
     Parameter("seed", int, None, "seed of every random stream of the sensors and actuators", "", 0, 2**63 - 1,
               default_rule="the scenario's sensors.seed"),
     Parameter("campaign", str, "", "Monte Carlo campaign file whose run run_seed is flown (dispersed truth; with "
@@ -52,4 +52,5 @@ SIMULATOR = ParameterTable("simulator", (
     renamed={"step": "step_s", "publish_rate": "publish_rate_Hz", "command_timeout": "command_timeout_s",
              "clock_rate": "clock_rate_Hz", "tf_rate": "tf_rate_Hz", "marker_rate": "marker_rate_Hz",
              "lockstep_timeout": "lockstep_timeout_s", "end_time": "end_time_s",
-             "max_reset_rate": "max_reset_rate_rad_s"})
+             "max_reset_rate": "max_reset_rate_rad_s", "start_timeout": "start_timeout_s",
+             "initial_rate": "initial_rate_rad_s"})

@@ -274,7 +274,7 @@ def test_a_plan_far_from_the_current_state_does_not_start(case, state_change, wo
     (0.0, SUN, None), (-8.0, SUN, None),
     (-600.0, SUN, "2026-12-20T23:50:00.000000Z, but it would start at 2026-12-21T00:00:00.000000Z, 600.0 s later"),
     (30.0, Zone("limb", "earth_limb", [0, 1.0, 0], 0.1),
-     "30.0 s earlier (at most 10 s, parameter max_start_epoch_error)"),
+     "30.0 s earlier (at most 10 s, parameter max_start_epoch_error_s)"),
     (-600.0, Zone("i", "inertial", [0, 1.0, 0], 0.1, False, [0, 0, 1.0]), None),     # a fixed zone: no matter
 ])
 def test_a_plan_for_moving_zones_at_another_instant_does_not_start(offset, zone, words):

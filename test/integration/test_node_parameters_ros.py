@@ -19,7 +19,7 @@ ROS_TYPE = {float: ParameterType.PARAMETER_DOUBLE, int: ParameterType.PARAMETER_
             list: ParameterType.PARAMETER_DOUBLE_ARRAY}
 NUMERIC = (ParameterType.PARAMETER_DOUBLE, ParameterType.PARAMETER_INTEGER)
 # integers given for doubles (and for a list of doubles): accepted and held as doubles
-GIVEN = {"simulator": {"real_time_factor": 4, "initial_rate": [0, 0, 0]},
+GIVEN = {"simulator": {"real_time_factor": 4, "initial_rate_rad_s": [0, 0, 0]},
          "controller": {"settle_time_s": 20, "safe_sun_axis": [0, 0, 1]},
          "bridge": {"port": 0}}
 
@@ -105,7 +105,7 @@ def test_integers_given_for_doubles_are_taken_as_doubles(described):
     sim, ctl = described["simulator"], described["controller"]
     assert sim["real_time_factor"][1].type == ParameterType.PARAMETER_DOUBLE
     assert sim["real_time_factor"][1].double_value == 4.0
-    assert list(sim["initial_rate"][1].double_array_value) == [0.0, 0.0, 0.0]
+    assert list(sim["initial_rate_rad_s"][1].double_array_value) == [0.0, 0.0, 0.0]
     assert ctl["settle_time_s"][1].double_value == 20.0
     assert list(ctl["safe_sun_axis"][1].double_array_value) == [0.0, 0.0, 1.0]
 
@@ -118,7 +118,7 @@ def test_a_parameter_the_node_does_not_use_is_declared_with_its_default(describe
     assert ctl["require_signed_modes"][1].bool_value is False
     assert ctl["mode_public_key"][1].string_value.endswith("plan_signing.pub")
     assert ctl["mode_sequence_file"][1].string_value.endswith("mode_sequences.json")
-    assert ctl["mode_sequence_ahead"][1].double_value == 300.0
+    assert ctl["mode_sequence_ahead_s"][1].double_value == 300.0
 
 
 def test_rclpy_own_use_sim_time_is_described(described):

@@ -61,7 +61,7 @@ def start_state(s: scen.Scenario, t: float) -> tuple[np.ndarray, np.ndarray, np.
     geometry = PointingGeometry.of(world.Environment.from_scenario(s))
     law = law_of(PointingMode("nadir"), geometry, t, np.array([0, 0, 0, 1.0]))
     ref = reference(law.attitude, t)
-    bias = float(s.node_params.get("controller", {}).get("null_space_speed", 0.0))
+    bias = float(s.node_params.get("controller", {}).get("null_space_speed_rad_s", 0.0))
     N = null_space(s.spacecraft)
     wheels = N @ np.full(N.shape[1], bias) if N.size else np.zeros(s.spacecraft.n_wheels)
     return ref.q_RN, ref.omega_RN_R, wheels + s.spacecraft.wheel_axes.T @ ref.omega_RN_R      # inertial spin rates

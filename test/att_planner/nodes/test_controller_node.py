@@ -8,7 +8,7 @@ pytestmark = pytest.mark.ros
 
 
 def test_tuned_gains_file_is_loaded_by_the_controller_node(tmp_path):
-    """att-tune writes controller.ros__parameters.{kp, kd, m_max}; --params-file loads them."""
+    """att-tune writes controller.ros__parameters.{kp, kd, m_max_Am2}; --params-file loads them."""
     gains = tmp_path / "controller_gains.yaml"
     write_gains(str(gains), 123456.5, 98765432.25, 7.5)
     suite = Suite(isolated_env(), tmp_path)

@@ -87,23 +87,30 @@ def test_the_test_inputs_pass_check(monkeypatch, capsys):
 
 
 def test_a_migrated_copy_of_an_old_file_passes_check(tmp_path, capsys):
-    """A spacecraft and a scenario written under the old key names are refused with each new name,
-    and pass once migrated, their values unchanged."""
-    renames = {"spacecraft": (("inertia_kg_m2:", "inertia:"), ("torque_max_Nm:", "torque_max:")),
-               "scenarios": (("altitude_m:", "altitude:"), ("arg0_rad:", "arg0:"))}
-    expected = {"spacecraft": [("inertia", "inertia_kg_m2"), ("torque_max", "torque_max_Nm"),
-                               ("wheel_inertia", "wheel_inertia_kg_m2"), ("wheel_torque_max", "wheel_torque_max_Nm")],
-                "scenarios": [("altitude", "altitude_m"), ("arg0", "arg0_rad")]}
-    for folder, pairs in renames.items():
-        shipped = ROOT / "config" / folder / "swift_demo.yaml"
+    """A spacecraft, a scenario and a demo written under the old key names are refused with each new
+    name, and pass once migrated, their values unchanged."""
+    renames = {"spacecraft/swift_demo.yaml": (("inertia_kg_m2:", "inertia:"), ("torque_max_Nm:", "torque_max:")),
+               "scenarios/swift_demo.yaml": (("altitude_m:", "altitude:"), ("arg0_rad:", "arg0:")),
+               "scenarios/leo_observatory.demo.yaml": (("time_budget_s:", "time_budget:"),
+                                                       ("start_lead_s:", "start_lead:"),
+                                                       ("start_time_s:", "start_time:"))}
+    expected = {"spacecraft/swift_demo.yaml": [("inertia", "inertia_kg_m2"), ("torque_max", "torque_max_Nm"),
+                                               ("wheel_inertia", "wheel_inertia_kg_m2"),
+                                               ("wheel_torque_max", "wheel_torque_max_Nm")],
+                "scenarios/swift_demo.yaml": [("altitude", "altitude_m"), ("arg0", "arg0_rad")],
+                "scenarios/leo_observatory.demo.yaml": [("start_lead", "start_lead_s"),
+                                                        ("start_time", "start_time_s"),
+                                                        ("time_budget", "time_budget_s")]}
+    for name, pairs in renames.items():
+        shipped = ROOT / "config" / name
         old = shipped.read_text()
         for new, previous in pairs:
             old = old.replace(new, previous)
-        path = tmp_path / folder / "swift_demo.yaml"
-        path.parent.mkdir()
+        path = tmp_path / name
+        path.parent.mkdir(exist_ok=True)
         path.write_text(old)
         _, problems = config_cli.check_file(path)
-        assert sorted(p.rename for p in problems) == expected[folder]
+        assert sorted(p.rename for p in problems) == expected[name]
         assert config_cli.main(["migrate", str(path)]) == 0
         assert config_cli.check_file(path)[1] == []
         assert yaml.safe_load(path.read_text()) == yaml.safe_load(shipped.read_text())

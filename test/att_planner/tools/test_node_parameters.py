@@ -70,7 +70,7 @@ def test_without_parameters_the_estimators_fixed_tuning_is_the_cores():
     ({"controller": {"control_rate": 20.0}}, "parameter 'control_rate' (override) is renamed 'control_rate_Hz'"),
     ({"controller": {"state_source": "oracle"}}, "parameter 'state_source' (override): expected one of truth, "
                                                  "estimate, got 'oracle'"),
-    ({"controller": {"m_max": -1.0}}, "parameter 'm_max' (override): expected a dipole > 0 A m², got -1.0"),
+    ({"controller": {"m_max_Am2": -1.0}}, "parameter 'm_max_Am2' (override): expected a dipole > 0 A m², got -1.0"),
     ({"estimator": {"gate_probability": 1.5}}, "parameter 'gate_probability' (override) = 1.5 is outside"),
     ({"simulator": {"step_s": 2}}, "parameter 'step_s' (override) = 2.0 is outside (0, 1]"),
     ({"simulator": {"step": 0.1}}, "parameter 'step' (override) is renamed 'step_s'"),
@@ -113,7 +113,7 @@ def test_the_reference_has_every_node_and_writes_numbers_as_a_parameter_file_doe
     text = reference()
     assert all(f"## {node}\n" in text for node in NODE_PARAMETERS)
     assert "| `step_s` | double | `0.05` | in (0, 1] | s |" in text
-    assert "| `schedule_rate_max` | double | `.inf` |" in text
+    assert "| `schedule_rate_max_rad_s` | double | `.inf` |" in text
     assert "| `initial_attitude` | double[] | `[0.0, 0.0, 0.0, 1.0]` |" in text
     assert math.isclose(CONTROLLER["control_rate_Hz"].default, 1.0 / ControllerConfig().control_period)
 
@@ -151,10 +151,43 @@ def test_each_nodes_json_schema_is_json_and_has_every_declaration(node):
 
 
 def test_a_renamed_parameter_is_answered_with_its_new_name_and_its_new_name_is_declared():
-    assert CONTROLLER.renamed == {"control_rate": "control_rate_Hz", "settle_time": "settle_time_s",
-                                  "wall_timeout": "wall_timeout_s"}
+    assert {old: CONTROLLER.renamed[old] for old in ("control_rate", "settle_time", "wall_timeout")} == {
+        "control_rate": "control_rate_Hz", "settle_time": "settle_time_s", "wall_timeout": "wall_timeout_s"}
     assert all(new in CONTROLLER and old not in CONTROLLER for old, new in CONTROLLER.renamed.items())
     [err] = CONTROLLER.problems({"wall_timeout": 2.0})
     assert err.code == ErrorCode.INVALID_PARAMETER
     assert err.message == "parameter 'wall_timeout' is renamed 'wall_timeout_s' (its unit in its name)"
     assert CONTROLLER.problems({"wall_timeout_s": 2.0}) == []
+
+
+# Each node's old parameter names and the new name (with its unit) each is answered with.
+OLD_NAMES = {
+    "controller": {"control_rate": "control_rate_Hz", "settle_time": "settle_time_s", "wall_timeout": "wall_timeout_s",
+                   "safe_rate_threshold": "safe_rate_threshold_rad_s", "null_space_speed": "null_space_speed_rad_s",
+                   "handover_blend": "handover_blend_s", "max_start_rate_error": "max_start_rate_error_rad_s",
+                   "max_start_epoch_error": "max_start_epoch_error_s", "max_state_gap": "max_state_gap_s",
+                   "max_clock_skew": "max_clock_skew_s", "resync_timeout": "resync_timeout_s",
+                   "start_timeout": "start_timeout_s", "mode_sequence_ahead": "mode_sequence_ahead_s",
+                   "m_max": "m_max_Am2", "max_cache_mb": "max_cache_MiB"},
+    "estimator": {"publish_rate": "publish_rate_Hz", "resync_timeout": "resync_timeout_s",
+                  "start_timeout": "start_timeout_s", "propagate_timeout": "propagate_timeout_s",
+                  "history": "history_s", "vector_fallback_after": "vector_fallback_after_s",
+                  "pair_window": "pair_window_s", "max_gyro_gap": "max_gyro_gap_s"},
+    "simulator": {"step": "step_s", "publish_rate": "publish_rate_Hz", "start_timeout": "start_timeout_s",
+                  "initial_rate": "initial_rate_rad_s"},
+    "planner": {"time_budget": "time_budget_s", "accept_final_rate": "accept_final_rate_rad_s",
+                "schedule_rate_max": "schedule_rate_max_rad_s"},
+    "recorder": {"flush_period": "flush_period_s"},
+}
+
+
+@pytest.mark.parametrize("node, old, new", [(n, o, w) for n, names in OLD_NAMES.items() for o, w in names.items()])
+def test_each_old_parameter_name_is_answered_with_its_new_name(node, old, new):
+    table = NODE_PARAMETERS[node]
+    assert table.renamed[old] == new and new in table and old not in table
+    [err] = table.problems({old: 1.0}, " (override)")
+    assert err.code == ErrorCode.INVALID_PARAMETER
+    assert err.message == f"parameter '{old}' (override) is renamed '{new}' (its unit in its name)"
+    if node in ("simulator", "controller", "estimator"):          # the nodes of the in-process closed loop
+        with pytest.raises(ConfigError, match=f"parameter '{old}' \\(override\\) is renamed '{new}'"):
+            ClosedLoop(SWIFT, overrides={node: {old: 1.0}})

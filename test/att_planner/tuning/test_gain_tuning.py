@@ -9,6 +9,7 @@ from att_msgs_py.types import Status
 from att_planner import tuning as gt
 from att_planner.control.magnetorquer import control_torque, dipole_command
 from att_planner.reference.bruni_celani import PUBLISHED_GAINS, PUBLISHED_ICS, robust_seeds
+from att_planner.tools import config_cli
 from att_planner.tools import tune as tune_cli
 from att_planner.tuning.settling import _BatchModel
 from att_sim.models import dynamics as dyn
@@ -248,13 +249,22 @@ def test_dask_executor_on_a_local_two_worker_cluster():
     np.testing.assert_array_equal(par.ts, serial.ts)
 
 
+def test_write_gains_replaces_the_old_dipole_key(tmp_path):
+    path = tmp_path / "controller_gains.yaml"
+    path.write_text(yaml.safe_dump({"controller": {"ros__parameters": {"kp": 1.0, "kd": 2.0, "m_max": 3.0}}}))
+    tune_cli.write_gains(str(path), 4.0, 5.0, 6.0)
+    assert yaml.safe_load(path.read_text())["controller"]["ros__parameters"] == {"kp": 4.0, "kd": 5.0,
+                                                                                  "m_max_Am2": 6.0}
+    assert config_cli.check_file(path, "parameters")[1] == []
+
+
 def test_write_gains_keeps_other_keys_and_progress_line(tmp_path):
     path = tmp_path / "controller_gains.yaml"
     path.write_text(yaml.safe_dump({"controller": {"ros__parameters": {"state_timeout": 0.5}}, "other": {"a": 1}}))
     tune_cli.write_gains(str(path), 205493.83, 117283950.62, 10.0)
     doc = yaml.safe_load(path.read_text())
     p = doc["controller"]["ros__parameters"]
-    assert p == {"state_timeout": 0.5, "kp": 205493.83, "kd": 117283950.62, "m_max": 10.0}
+    assert p == {"state_timeout": 0.5, "kp": 205493.83, "kd": 117283950.62, "m_max_Am2": 10.0}
     assert doc["other"] == {"a": 1}
     line = tune_cli.ProgressBar(width=10).line(0.5, "best 1.3")
     assert line.startswith("[#####-----]  50%") and "ETA" in line and line.endswith("best 1.3")
