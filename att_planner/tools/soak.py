@@ -22,6 +22,7 @@ from att_sim.models import scenario as scen
 
 LOCKSTEP_TIMEOUT = 5.0
 LOCKSTEP_SUSPENDED = "free-running at RTF"     # the simulator's warning when no command answered a state
+READY_LINES = {"recorder": "recording ", "simulator": "scenario '", "controller": "scenario '"}   # set up, logged once
 
 
 def rss_mib(pid: int) -> float:
@@ -47,6 +48,9 @@ def run_soak(scenario: str, orbits: float, out_dir: str | Path, sample_period: f
     memory = {name: [] for name in suite.procs}
     start = time.monotonic()
     try:
+        # memory is sampled once every node has started (its imports and set-up are not growth)
+        for name, line in READY_LINES.items():
+            suite.wait_for_output(name, line, max(timeout - (time.monotonic() - start), 0.0))
         while time.monotonic() - start < timeout:
             for name, proc in suite.procs.items():
                 memory[name].append(rss_mib(proc.pid))
