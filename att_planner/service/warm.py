@@ -31,21 +31,18 @@ WARM_BUDGET = 60.0          # s each warm-up plan may take (it builds; the reque
 
 def maneuver_from_scenario(s: scen.Scenario) -> dict:
     """The ``demo:`` section's maneuver with the scenario's zones; ValueError (one sentence) when
-    the scenario has no such section or it lacks a key."""
+    the scenario has no such section (its keys are checked where the file is read)."""
     p = s.node_params.get("demo")
     if not isinstance(p, dict):
         raise ValueError(f"scenario '{s.name}' ({s.path}) has no 'demo:' section with the maneuver to fly "
                          f"({', '.join(DEMO_KEYS)}, optional cones, method, time_budget_s, start_lead_s, start_time_s)")
-    missing = [k for k in DEMO_KEYS if k not in p]
-    if missing:
-        raise ValueError(f"scenario '{s.name}' ({s.path}): the 'demo:' section lacks {', '.join(missing)}")
-    dirs = np.asarray(p.get("cone_directions", []), float).reshape(-1, 3)
-    cones = [Cone(d, math.radians(a), n) for d, a, n in zip(dirs, p.get("cone_half_angles_deg", []),
-                                                             p.get("cone_names", []))]
+    # the section as config_schema.Demo validated it: every key present, defaults filled in there
+    dirs = np.asarray(p["cone_directions"], float).reshape(-1, 3)
+    cones = [Cone(d, math.radians(a), n) for d, a, n in zip(dirs, p["cone_half_angles_deg"], p["cone_names"])]
     return {"q0": np.asarray(p["initial_attitude"], float), "qf": np.asarray(p["final_attitude"], float),
             "sensor": np.asarray(p["sensor_axis"], float), "cones": cones, "zones": list(s.zones),
-            "method": p.get("method", ""), "time_budget": float(p.get("time_budget_s", 30.0)),
-            "start_lead": float(p.get("start_lead_s", 0.0)), "start_time": p.get("start_time_s")}
+            "method": p["method"], "time_budget": float(p["time_budget_s"]),
+            "start_lead": float(p["start_lead_s"]), "start_time": p["start_time_s"]}
 
 
 def warm_requests(names: list[str], *, frame_id: str, default_method: str) -> list[ValidRequest]:

@@ -187,8 +187,7 @@ def read(path) -> Files:
         nodes = {k: v["ros__parameters"] for k, v in p_data.items()}
     if demo_path.is_file():
         d_data, d_lines = config_files.read_yaml(demo_path)
-        config_files.validate(demo_path, schema.DemoFile, d_data, d_lines)
-        nodes["demo"] = d_data["demo"]
+        nodes["demo"] = config_files.validate(demo_path, schema.DemoFile, d_data, d_lines).demo.model_dump()
     return Files(path, shared, origin, nodes, craft_path, params_path if params_path.is_file() else None,
                  demo_path if demo_path.is_file() else None)
 
