@@ -5,7 +5,7 @@ the day is flown. One YAML file under ``config/missions/`` (read with ``yaml.saf
     sensor_axis: [0, 1, 0]         # body axis put on each source
     horizon_s: 21600               # s of sim time from the scenario's epoch
     margin_deg: 1.0                # a target counts as visible this far outside every zone
-    rate_hz: 5.0                   # simulator step, state, control and estimate rate of the day
+    rate_Hz: 5.0                   # simulator step, state, control and estimate rate of the day
     start_lead_s: 240              # s of sim time from a slew's request to its start (planning)
     time_budget_s: 10              # planner wall-time budget per slew (the day runs at most
                                    # start_lead_s / time_budget_s times real time: a plan is back in time)
@@ -124,7 +124,7 @@ def load(name: str) -> MissionConfig:
                 else math.radians(m.rate_max_deg_per_s))
     if scenario.epoch is None:
         raise _invalid(path, f"scenario '{scenario.name}' has no epoch: a mission flies the real sky")
-    return MissionConfig(path, target_list, scenario, vec, m.horizon_s, math.radians(m.margin_deg), m.rate_hz,
+    return MissionConfig(path, target_list, scenario, vec, m.horizon_s, math.radians(m.margin_deg), m.rate_Hz,
                          m.start_lead_s, m.time_budget_s, m.method, math.radians(m.pointing_tolerance_deg),
                          m.momentum_dumping, rate_max, _zones(path, m.zones, scenario), m.secondary, second,
                          m.handover_blend_s)

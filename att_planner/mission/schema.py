@@ -6,7 +6,7 @@ by ``att-config check``. Ranges and defaults are written once, here; units are i
 """
 from __future__ import annotations
 
-from typing import Annotated, Literal
+from typing import Annotated, ClassVar, Literal
 
 import numpy as np
 from pydantic import AfterValidator, ConfigDict, Discriminator, Field, Tag, field_validator, model_validator
@@ -47,12 +47,14 @@ Secondary = Literal[tuple(k for k in SECONDARY_KINDS if k != "inertial")]
 class Mission(Schema):
     """How a day of observations is flown."""
 
+    renamed: ClassVar = {"rate_hz": "rate_Hz"}
+
     targets: Annotated[str, Field(min_length=1, max_length=4096)] = Field(
         description="the target list: a file stem under config/targets/, or a path to a *.yaml file")
     sensor_axis: UnitAxis = Field(description="body axis put on each target")
     horizon_s: float = number(ge=60.0, le=7 * 86_400.0, unit="s", meaning="sim time from the scenario's epoch")
     margin_deg: float = number(1.0, ge=0.0, le=30.0, unit="deg", meaning="visible this far outside every zone")
-    rate_hz: float = number(5.0, ge=0.5, le=50.0, unit="Hz", meaning="simulator step, state, control and estimate "
+    rate_Hz: float = number(5.0, ge=0.5, le=50.0, unit="Hz", meaning="simulator step, state, control and estimate "
                                                                       "rate of the day")
     start_lead_s: float = number(240.0, ge=1.0, le=3600.0, unit="s", meaning="sim time from a slew's request to "
                                                                               "its start")

@@ -6,21 +6,24 @@ converted to SI by :mod:`att_sim.models.sensor_specs`.
 from __future__ import annotations
 
 import math
-from typing import Any
+from typing import Any, ClassVar
 
 from pydantic import Field, field_validator
 
 from att_sim.models.config_base import Cone, Name, Quaternion, Schema, UnitVectors, distinct_names, number
 
 MAX_SENSOR_RATE_HZ = 1000.0
+RENAMED = {"rate_hz": "rate_Hz"}     # every sensor's output rate
 
 
-def rate_hz(default: float) -> Any:
+def output_rate(default: float) -> Any:
     return number(default, gt=0.0, le=MAX_SENSOR_RATE_HZ, unit="Hz", meaning="output rate")
 
 
 class Gyro(Schema):
-    rate_hz: float = rate_hz(20.0)
+    renamed: ClassVar = RENAMED
+
+    rate_Hz: float = output_rate(20.0)
     arw_deg_per_sqrt_h: float = number(0.0, ge=0.0, le=100.0, unit="deg/sqrt(h)", meaning="angle random walk")
     bias_instability_deg_per_h: float = number(0.0, ge=0.0, le=1e4, unit="deg/h", meaning="bias instability")
     rrw_deg_per_h_per_sqrt_h: float = number(0.0, ge=0.0, le=1e4, unit="deg/h/sqrt(h)", meaning="rate random walk")
@@ -36,10 +39,12 @@ class Exclusion(Cone):
 
 
 class StarTracker(Schema):
+    renamed: ClassVar = RENAMED
+
     name: Name
     mounting: Quaternion = Field([0.0, 0.0, 0.0, 1.0], description="sensor-to-body quaternion [x, y, z, w]; "
                                                                     "the boresight is the sensor's +z")
-    rate_hz: float = rate_hz(5.0)
+    rate_Hz: float = output_rate(5.0)
     latency_s: float = number(0.0, ge=0.0, le=10.0, unit="s", meaning="from the instant measured to the message")
     cross_boresight_arcsec: float = number(5.0, gt=0.0, le=3600.0, unit="arcsec", meaning="1 sigma across the "
                                                                                            "boresight")
@@ -50,7 +55,9 @@ class StarTracker(Schema):
 
 
 class Magnetometer(Schema):
-    rate_hz: float = rate_hz(10.0)
+    renamed: ClassVar = RENAMED
+
+    rate_Hz: float = output_rate(10.0)
     noise_nT: float = number(0.0, ge=0.0, le=1e5, unit="nT", meaning="1 sigma per axis")
     bias_nT: float = number(0.0, ge=0.0, le=1e5, unit="nT", meaning="fixed bias, 1 sigma per axis")
     misalignment_deg: float = number(0.0, ge=0.0, le=10.0, unit="deg", meaning="misalignment, 1 sigma")
@@ -60,15 +67,19 @@ class Magnetometer(Schema):
 
 
 class SunSensors(Schema):
+    renamed: ClassVar = RENAMED
+
     normals: UnitVectors = Field([1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, -1.0, 0.0, 0.0, 0.0, -1.0, 0.0,
                                   0.0, 0.0, -1.0], description="unit body normal of each cosine detector")
-    rate_hz: float = rate_hz(10.0)
+    rate_Hz: float = output_rate(10.0)
     fov_deg: float = number(80.0, gt=0.0, le=90.0, unit="deg", meaning="half-angle of each detector's view")
     noise: float = number(0.0, ge=0.0, le=1.0, unit="", meaning="1 sigma of the normal-incidence output")
 
 
 class WheelTachometer(Schema):
-    rate_hz: float = rate_hz(20.0)
+    renamed: ClassVar = RENAMED
+
+    rate_Hz: float = output_rate(20.0)
     noise_rad_per_s: float = number(0.0, ge=0.0, le=100.0, unit="rad/s", meaning="1 sigma of a wheel speed")
     quantization_rad_per_s: float = number(0.0, ge=0.0, le=100.0, unit="rad/s", meaning="per count")
 

@@ -4,16 +4,16 @@ A scenario's ``/**`` section may hold::
 
     sensors:
       seed: 20261202                  # every noise source of the run derives from it
-      gyro: {rate_hz, arw_deg_per_sqrt_h, bias_instability_deg_per_h, rrw_deg_per_h_per_sqrt_h,
+      gyro: {rate_Hz, arw_deg_per_sqrt_h, bias_instability_deg_per_h, rrw_deg_per_h_per_sqrt_h,
              initial_bias_deg_per_h, scale_factor_ppm, misalignment_arcsec, quantization_arcsec,
              range_deg_per_s}
-      star_trackers: [{name, mounting, rate_hz, latency_s, cross_boresight_arcsec,
+      star_trackers: [{name, mounting, rate_Hz, latency_s, cross_boresight_arcsec,
                        about_boresight_arcsec, max_rate_deg_per_s, exclusions: [{body, half_angle_deg,
                        direction}]}]
-      magnetometer: {rate_hz, noise_nT, bias_nT, misalignment_deg, quantization_nT,
+      magnetometer: {rate_Hz, noise_nT, bias_nT, misalignment_deg, quantization_nT,
                      dipole_coupling_nT_per_Am2}
-      sun_sensors: {rate_hz, normals, fov_deg, noise}
-      wheel_tachometer: {rate_hz, noise_rad_per_s, quantization_rad_per_s}
+      sun_sensors: {rate_Hz, normals, fov_deg, noise}
+      wheel_tachometer: {rate_Hz, noise_rad_per_s, quantization_rad_per_s}
 
 Every field is optional but a sensor's presence; the 1σ figures (``initial_bias``, ``scale_factor``,
 ``misalignment``, ``bias``) are the spread the simulator draws the unit's actual errors from, with
@@ -164,27 +164,27 @@ def sensors_from_model(s: config_sensors.Sensors) -> SensorSpecs:
     in SI."""
     g, m, ss, w = s.gyro, s.magnetometer, s.sun_sensors, s.wheel_tachometer
     gyro = None if g is None else GyroSpec(
-        rate=g.rate_hz, arw=g.arw_deg_per_sqrt_h * DEG / math.sqrt(HOUR),
+        rate=g.rate_Hz, arw=g.arw_deg_per_sqrt_h * DEG / math.sqrt(HOUR),
         bias_instability=g.bias_instability_deg_per_h * DEG / HOUR,
         rrw=g.rrw_deg_per_h_per_sqrt_h * DEG / HOUR / math.sqrt(HOUR),
         initial_bias=g.initial_bias_deg_per_h * DEG / HOUR, scale_factor=g.scale_factor_ppm * 1e-6,
         misalignment=g.misalignment_arcsec * ARCSEC, quantization=g.quantization_arcsec * ARCSEC,
         range=g.range_deg_per_s * DEG)
     trackers = tuple(StarTrackerSpec(
-        name=t.name, mounting=_unit(t.mounting), rate=t.rate_hz, latency=t.latency_s,
+        name=t.name, mounting=_unit(t.mounting), rate=t.rate_Hz, latency=t.latency_s,
         cross_boresight=t.cross_boresight_arcsec * ARCSEC, about_boresight=t.about_boresight_arcsec * ARCSEC,
         max_rate=t.max_rate_deg_per_s * DEG,
         exclusions=tuple(Exclusion(e.body, e.half_angle_deg * DEG,
                                    _unit(e.direction) if e.direction is not None else None) for e in t.exclusions))
         for t in s.star_trackers)
     magnetometer = None if m is None else MagnetometerSpec(
-        rate=m.rate_hz, noise=m.noise_nT * NANOTESLA, bias=m.bias_nT * NANOTESLA, misalignment=m.misalignment_deg * DEG,
+        rate=m.rate_Hz, noise=m.noise_nT * NANOTESLA, bias=m.bias_nT * NANOTESLA, misalignment=m.misalignment_deg * DEG,
         quantization=m.quantization_nT * NANOTESLA, dipole_coupling=m.dipole_coupling_nT_per_Am2 * NANOTESLA)
     sun = None if ss is None else SunSensorSpec(
         normals=np.asarray(ss.normals, float).reshape(-1, 3) / np.linalg.norm(
             np.asarray(ss.normals, float).reshape(-1, 3), axis=1)[:, None],
-        rate=ss.rate_hz, fov=ss.fov_deg * DEG, noise=ss.noise)
-    tachometer = None if w is None else TachometerSpec(rate=w.rate_hz, noise=w.noise_rad_per_s,
+        rate=ss.rate_Hz, fov=ss.fov_deg * DEG, noise=ss.noise)
+    tachometer = None if w is None else TachometerSpec(rate=w.rate_Hz, noise=w.noise_rad_per_s,
                                                        quantization=w.quantization_rad_per_s)
     return SensorSpecs(seed=s.seed, gyro=gyro, star_trackers=trackers, magnetometer=magnetometer, sun_sensors=sun,
                        tachometer=tachometer)

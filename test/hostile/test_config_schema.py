@@ -33,7 +33,7 @@ SCENARIO = """\
       - {name: other, body: inertial, sensor_axis: [0.0, 1.0, 0.0], half_angle_deg: 10.0, direction: [1.0, 0.0, 0.0]}
     sensors:
       seed: 3
-      gyro: {rate_hz: 20.0, arw_deg_per_sqrt_h: 0.005}
+      gyro: {rate_Hz: 20.0, arw_deg_per_sqrt_h: 0.005}
       star_trackers:
         - {name: st1, mounting: [0.0, 0.0, 0.0, 1.0]}
         - {name: st2, mounting: [0.0, 0.0, 0.0, 1.0]}
@@ -48,7 +48,7 @@ MISSION = """\
 targets: observatory
 sensor_axis: [0.0, 1.0, 0.0]
 horizon_s: 3600
-rate_hz: 5.0
+rate_Hz: 5.0
 """
 TARGETS = """\
 kind: inertial
@@ -143,8 +143,10 @@ EDITS = {
     "facet old key": ("scenario", "{area_m2:", "{area:", f"{P}.environment.facets[0].area", "renamed to 'area_m2'"),
     "pressure without epoch": ("scenario", "solar_pressure: false", "solar_pressure: true", P, "an epoch"),
     # sensors and actuators
-    "gyro rate zero": ("scenario", "rate_hz: 20.0, arw", "rate_hz: 0.0, arw", f"{P}.sensors.gyro.rate_hz",
+    "gyro rate zero": ("scenario", "rate_Hz: 20.0, arw", "rate_Hz: 0.0, arw", f"{P}.sensors.gyro.rate_Hz",
                        "greater than 0"),
+    "gyro rate old name": ("scenario", "rate_Hz: 20.0, arw", "rate_hz: 20.0, arw", f"{P}.sensors.gyro.rate_hz",
+                           "renamed to 'rate_Hz'"),
     "gyro unit missing": ("scenario", "arw_deg_per_sqrt_h:", "arw:", f"{P}.sensors.gyro.arw", "arw_deg_per_sqrt_h"),
     "tracker quaternion": ("scenario", "{name: st1, mounting: [0.0, 0.0, 0.0, 1.0]}",
                            "{name: st1, mounting: [0.0, 0.0, 0.0, 2.0]}", f"{P}.sensors.star_trackers[0].mounting",
@@ -162,7 +164,8 @@ EDITS = {
     "mission axis not unit": ("mission", "[0.0, 1.0, 0.0]", "[0.0, 1.5, 0.0]", "sensor_axis", "unit 3-vector"),
     "mission horizon missing": ("mission", "horizon_s: 3600\n", "", "horizon_s", "required"),
     "mission horizon in hours": ("mission", "horizon_s: 3600", "horizon_h: 1", "horizon_h", "horizon_s"),
-    "mission rate a word": ("mission", "rate_hz: 5.0", "rate_hz: fast", "rate_hz", "valid number"),
+    "mission rate a word": ("mission", "rate_Hz: 5.0", "rate_Hz: fast", "rate_Hz", "valid number"),
+    "mission rate old name": ("mission", "rate_Hz: 5.0", "rate_hz: 5.0", "rate_hz", "renamed to 'rate_Hz'"),
     "mission unknown targets": ("mission", "targets: observatory", "targets: nowhere", "targets",
                                 "the name of a target list"),
     # target lists

@@ -34,7 +34,7 @@ def flown(tmp_path_factory):
                for n, dwell in SOURCES.items() for d in [observatory[n].direction]]
     return fly_written(out, {"kind": "inertial", "scenario": "leo_observatory", "targets": targets},
                        {"sensor_axis": [0, 1, 0], "horizon_s": 2400, "start_lead_s": 120, "time_budget_s": 2,
-                        "rate_hz": 2.5})
+                        "rate_Hz": 2.5})
 
 
 def test_both_sources_are_observed_within_the_tolerance(flown):

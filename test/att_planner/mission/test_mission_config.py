@@ -55,7 +55,7 @@ def test_defaults_fill_what_a_file_leaves_out(tmp_path):
 
 @pytest.mark.parametrize("change, field", [
     ({"horizon_s": None}, "horizon_s"), ({"horizon_s": 10}, "horizon_s"), ({"horizon_s": True}, "horizon_s"),
-    ({"horizon_s": float("nan")}, "horizon_s"), ({"rate_hz": 0}, "rate_hz"), ({"rate_hz": "5"}, "rate_hz"),
+    ({"horizon_s": float("nan")}, "horizon_s"), ({"rate_Hz": 0}, "rate_Hz"), ({"rate_Hz": "5"}, "rate_Hz"),
     ({"margin_deg": -1}, "margin_deg"), ({"start_lead_s": 1e9}, "start_lead_s"),
     ({"time_budget_s": 0}, "time_budget_s"), ({"pointing_tolerance_deg": float("inf")}, "pointing_tolerance_deg"),
     ({"sensor_axis": [0, 2, 0]}, "sensor_axis"), ({"sensor_axis": [0, 1]}, "sensor_axis"),

@@ -8,7 +8,7 @@ from att_planner.mission import schema as ms
 
 MISSION = {"targets": "observatory", "sensor_axis": [0.0, 1.0, 0.0], "horizon_s": 3600}
 # key -> (default, low, high) of a mission's numbers, as the mission files document them
-NUMBERS = {"horizon_s": (None, 60.0, 7 * 86_400.0), "margin_deg": (1.0, 0.0, 30.0), "rate_hz": (5.0, 0.5, 50.0),
+NUMBERS = {"horizon_s": (None, 60.0, 7 * 86_400.0), "margin_deg": (1.0, 0.0, 30.0), "rate_Hz": (5.0, 0.5, 50.0),
            "start_lead_s": (240.0, 1.0, 3600.0), "time_budget_s": (10.0, 0.05, 600.0),
            "pointing_tolerance_deg": (0.05, 1e-4, 10.0), "handover_blend_s": (60.0, 0.0, 3600.0)}
 

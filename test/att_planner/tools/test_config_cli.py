@@ -235,7 +235,7 @@ def test_show_a_shipped_scenario_with_where_each_value_came_from(capsys):
     for prefix, path, key in (("spacecraft.torque_max_Nm = 0.1", config / "spacecraft" / "swift_demo.yaml",
                                "torque_max_Nm:"),
                               ("orbit.altitude_m = 450000.0", config / "scenarios" / "swift_demo.yaml", "altitude_m:"),
-                              ("sensors.gyro.rate_hz = 20.0", config / "spacecraft" / "swift_demo.yaml", "gyro:"),
+                              ("sensors.gyro.rate_Hz = 20.0", config / "spacecraft" / "swift_demo.yaml", "gyro:"),
                               ("simulator.ros__parameters.step_s = 0.05",
                                config / "scenarios" / "swift_demo.params.yaml", "step_s:"),
                               ("demo.method = ", config / "scenarios" / "swift_demo.demo.yaml", "method:")):

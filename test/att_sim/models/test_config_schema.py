@@ -51,9 +51,9 @@ def test_wheels_need_inertia_and_unit_axes():
 
 def test_sensor_defaults_match_the_datasheet_types():
     """The file's defaults and the SI datasheets' agree (one figure, two units)."""
-    assert config_sensors.Gyro().rate_hz == GyroSpec.rate
-    assert config_sensors.Magnetometer().rate_hz == MagnetometerSpec.rate
-    assert config_sensors.WheelTachometer().rate_hz == TachometerSpec.rate
+    assert config_sensors.Gyro().rate_Hz == GyroSpec.rate
+    assert config_sensors.Magnetometer().rate_Hz == MagnetometerSpec.rate
+    assert config_sensors.WheelTachometer().rate_Hz == TachometerSpec.rate
     st = StarTrackerSpec()
     assert math.isclose(config_sensors.StarTracker(name="a").cross_boresight_arcsec * math.pi / 648000,
                         st.cross_boresight)
@@ -104,11 +104,11 @@ def test_the_readers_take_defaults_and_ranges_from_the_models():
     from att_sim.models.actuator_specs import actuators_from_params
     from att_sim.models.sensor_specs import ARCSEC, sensors_from_params
     specs = sensors_from_params({"gyro": {}, "star_trackers": [{"name": "a"}]}, epoch_known=False)
-    assert specs.gyro.rate == config_sensors.Gyro.model_fields["rate_hz"].default
+    assert specs.gyro.rate == config_sensors.Gyro.model_fields["rate_Hz"].default
     about = config_sensors.StarTracker(name="a").about_boresight_arcsec
     assert specs.star_trackers[0].about_boresight == pytest.approx(about * ARCSEC)
-    with pytest.raises(ValueError, match=r"sensors.gyro.rate_hz: expected less than or equal to 1000; found 1000.5"):
-        sensors_from_params({"gyro": {"rate_hz": 1000.5}}, epoch_known=False)
+    with pytest.raises(ValueError, match=r"sensors.gyro.rate_Hz: expected less than or equal to 1000; found 1000.5"):
+        sensors_from_params({"gyro": {"rate_Hz": 1000.5}}, epoch_known=False)
     with pytest.raises(ValueError, match=r"actuators.wheels.friction_speed_rad_s: expected greater than 0; found 0.0"):
         actuators_from_params({"wheels": {"friction_speed_rad_s": 0.0}})
     assert actuators_from_params({"wheels": {}}).wheels.power_max == math.inf

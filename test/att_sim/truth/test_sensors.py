@@ -207,7 +207,7 @@ def test_every_stream_is_reproduced_by_its_seed_alone():
 @pytest.mark.parametrize("values, field", [
     ({"gyro": {"arw_deg_per_sqrt_h": -1.0}}, "sensors.gyro.arw_deg_per_sqrt_h"),
     ({"gyro": {"arw_deg_per_sqrt_h": "fast"}}, "sensors.gyro.arw_deg_per_sqrt_h"),
-    ({"gyro": {"rate_hz": 0.0}}, "sensors.gyro.rate_hz"),
+    ({"gyro": {"rate_Hz": 0.0}}, "sensors.gyro.rate_Hz"),
     ({"gyro": {"arw": 0.1}}, "sensors.gyro.arw: expected one of the keys"),
     ({"star_trackers": [{"name": "a", "mounting": [0, 0, 0, 2]}]}, "sensors.star_trackers[0].mounting"),
     ({"star_trackers": [{"name": "a"}, {"name": "a"}]}, "sensors.star_trackers: expected distinct star tracker names"),
