@@ -33,7 +33,7 @@ def flown(tmp_path_factory):
                 "dec_deg": math.degrees(math.asin(d[2])), "dwell_s": dwell}
                for n, dwell in SOURCES.items() for d in [observatory[n].direction]]
     return fly_written(out, {"kind": "inertial", "scenario": "leo_observatory", "targets": targets},
-                       {"sensor_axis": [0, 1, 0], "horizon_s": 2400, "start_lead_s": 120, "time_budget_s": 2,
+                       {"sensor_axis": [0, 1, 0], "horizon_s": 2400, "start_lead_s": 120, "time_budget_s": 5,
                         "rate_Hz": 2.5})
 
 

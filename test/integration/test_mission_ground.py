@@ -27,7 +27,7 @@ def flown(tmp_path_factory):
     return fly_written(out, {"kind": "ground", "scenario": "leo_observatory", "min_elevation_deg": 30.0,
                              "targets": [SITE]},
                        {"sensor_axis": [0, 1, 0], "secondary": "velocity", "secondary_axis": [0, 0, 1],
-                        "zones": ["sun", "moon"], "horizon_s": 1700, "start_lead_s": 120, "time_budget_s": 2,
+                        "zones": ["sun", "moon"], "horizon_s": 1700, "start_lead_s": 240, "time_budget_s": 5,
                         "rate_Hz": 2.5,
                         "pointing_tolerance_deg": 0.1, "handover_blend_s": 180})
 
