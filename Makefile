@@ -48,9 +48,14 @@ $(VENV)/.stamp-package: setup.py package.xml pyproject.toml $(VENV)/.stamp-inter
 	$(PREFIX)/bin/att-keygen --if-missing
 	touch $@
 
-# the habits first (seconds): ruff's rules and the import contracts (pyproject.toml), then every test
+# the habits first (seconds): ruff's rules and the import contracts (pyproject.toml), then every test:
+# the ROS-free ones on both cores (pytest-xdist), then the ones that start nodes or a DDS participant one
+# at a time (each on its own random ROS domain; timing-sensitive). Both parts run; either failing fails.
 test: lint
-	$(PY) -m pytest test $(PYTEST_ARGS)
+	status=0; \
+	$(PY) -m pytest test -m "not ros" -n 2 $(PYTEST_ARGS) || status=$$?; \
+	$(PY) -m pytest test -m ros $(PYTEST_ARGS) || status=$$?; \
+	exit $$status
 
 # the ROS-free unit tests only: no nodes, no DDS, nothing slow (a quick check while working)
 test-fast: lint
