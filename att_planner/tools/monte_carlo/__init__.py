@@ -23,7 +23,7 @@ from pathlib import Path
 
 from att_msgs_py.errors import RequestError
 from att_planner.tools.monte_carlo import report
-from att_planner.tools.monte_carlo.cluster import ClusterError, client_for, local_workers, stream
+from att_planner.tools.monte_carlo.cluster import ClusterError, client_for, local_workers, merge, stream
 from att_planner.tools.monte_carlo.run import checked, planned
 from att_planner.tools.tune import ProgressBar
 from att_sim.truth import dispersions as disp
@@ -78,7 +78,7 @@ def run_campaign(args) -> int:
     runs = [(i, disp.run_seed(campaign.seed, i)) for i in range(count)]
     setup = checked(campaign, [seed for _, seed in runs])
     workers = args.workers or local_workers()
-    rows, interrupted = [], False
+    done, interrupted = {}, False
     with client_for(args.scheduler, workers, args.timeout) as client:
         setup = planned(setup)
         workers = len(client.scheduler_info().get("workers", {})) or workers
@@ -88,15 +88,16 @@ def run_campaign(args) -> int:
         chunks = stream(client, setup, runs, chunk)
         try:
             for got in chunks:
-                rows += got
+                merge(done, got)
                 if bar is not None:
-                    ok = sum(bool(r["success"]) for r in rows)
-                    bar.update(len(rows) / count, f"{len(rows)}/{count} runs, {ok} successful")
+                    ok = sum(bool(r["success"]) for r in done.values())
+                    bar.update(len(done) / count, f"{len(done)}/{count} runs, {ok} successful")
         except KeyboardInterrupt:
             interrupted = True
         finally:
             chunks.close()
         wall = time.monotonic() - start
+    rows = list(done.values())
     if bar is not None:
         bar.close()
     table = report.write_table(rows, args.out / "runs.csv")

@@ -77,16 +77,30 @@ def fly_chunk(setup: Setup, seeds: list[tuple[int, int]]) -> list[dict]:
 
 def stream(client, setup: Setup, runs: list[tuple[int, int]], chunk: int) -> Iterator[list[dict]]:
     """Rows of ``runs`` (``(run, seed)`` pairs) in chunks, each as soon as it finishes (in finishing
-    order). Closing the iterator (an interrupt) cancels the chunks still out."""
+    order). A chunk's result is released on the cluster once it is here (a long campaign does not
+    pile its rows up in the workers' memory). A worker lost mid-campaign: the scheduler runs its
+    chunks again on the others (``distributed.scheduler.allowed-failures`` losses per chunk); a
+    chunk comes back once, but the caller keys rows by run (:func:`merge`), so a row that does come
+    twice is kept once. Closing the iterator (an interrupt) cancels the chunks still out."""
     from distributed import as_completed
 
     shared = client.scatter(setup, broadcast=True)
-    futures = [client.submit(fly_chunk, shared, runs[i:i + chunk], pure=False) for i in range(0, len(runs), chunk)]
+    finished = as_completed(
+        [client.submit(fly_chunk, shared, runs[i:i + chunk], pure=False) for i in range(0, len(runs), chunk)])
     try:
-        for future in as_completed(futures):
-            yield future.result()
+        for future in finished:
+            rows = future.result()
+            future.release()
+            yield rows
     finally:
-        client.cancel(futures)
+        client.cancel(list(finished.futures))
+
+
+def merge(rows: dict[int, dict], got: list[dict]) -> int:
+    """Add the rows of ``got`` to ``rows`` (by run index) that it does not hold yet; how many it added."""
+    new = {row["run"]: row for row in got if row["run"] not in rows}
+    rows.update(new)
+    return len(new)
 
 
 def local_workers() -> int:

@@ -42,6 +42,17 @@ def write_table(rows: list[dict], path: Path) -> Path:
     return path
 
 
+TEXT_COLUMNS = {"run": int, "seed": int, "code": int, "success": lambda text: text == "True", "reason": str}
+
+
+def read_table(path: Path) -> list[dict]:
+    """The rows of a table (:func:`write_table`), typed back: ``run``, ``seed`` and ``code`` int,
+    ``success`` bool, ``reason`` str, every other column float (written as ``repr``: read back
+    exactly)."""
+    with open(path, newline="") as fh:
+        return [{k: TEXT_COLUMNS.get(k, float)(v) for k, v in row.items()} for row in csv.DictReader(fh)]
+
+
 def statistics(values) -> dict:
     """Mean, median, 99th percentile, min and max of the finite values (NaN-free; None when none)."""
     v = np.asarray(values, float)
