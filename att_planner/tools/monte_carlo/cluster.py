@@ -96,11 +96,11 @@ def stream(client, setup: Setup, runs: list[tuple[int, int]], chunk: int) -> Ite
         client.cancel(list(finished.futures))
 
 
-def merge(rows: dict[int, dict], got: list[dict]) -> int:
-    """Add the rows of ``got`` to ``rows`` (by run index) that it does not hold yet; how many it added."""
+def merge(rows: dict[int, dict], got: list[dict]) -> list[dict]:
+    """Add the rows of ``got`` to ``rows`` (by run index) that it does not hold yet; those rows."""
     new = {row["run"]: row for row in got if row["run"] not in rows}
     rows.update(new)
-    return len(new)
+    return list(new.values())
 
 
 def local_workers() -> int:

@@ -1,19 +1,24 @@
 """``att-mc --scheduler`` on a Dask cluster of separate processes (a ``dask scheduler`` and two
 ``dask worker`` processes on localhost, :mod:`att_planner.tools.monte_carlo.processes`): the same
 rows as the local cluster's, also when a worker is killed mid-campaign (its runs flown again on
-the other, every run in the table once). The campaign is the tests' 1° slew (test/data), 40 runs,
-one run a task."""
+the other, every run in the table once); a campaign whose client was killed, resumed from its
+table. The campaign is the tests' 1° slew (test/data), 40 runs, one run a task."""
 from __future__ import annotations
 
+import json
 import math
 import os
+import signal
+import subprocess
+import sys
+import time
 from pathlib import Path
 
 import pytest
 
 import att_planner.tools.monte_carlo as mc
 from att_planner.tools.monte_carlo import report
-from att_planner.tools.monte_carlo.processes import dask_processes
+from att_planner.tools.monte_carlo.processes import dask_processes, stop
 from att_sim.truth import dispersions as disp
 
 DATA = Path(__file__).resolve().parents[2] / "data"
@@ -37,10 +42,12 @@ def local_rows(tmp_path_factory):
     return report.read_table(out / "runs.csv")
 
 
-def assert_same_rows(rows: list[dict], expected: list[dict]) -> None:
-    """Every run once, in run order, each row ``expected``'s but for ``cpu_seconds``: numbers to
-    1e-12 relative (a batch's rows do not depend on the runs flown with them, to rounding)."""
-    assert [r["run"] for r in rows] == [r["run"] for r in expected] == list(range(len(expected)))
+def assert_same_rows(rows: list[dict], expected: list[dict], runs: list[int] | None = None) -> None:
+    """Every run of ``runs`` (default: all) once, in run order, each row ``expected``'s but for
+    ``cpu_seconds``: numbers to 1e-12 relative (a batch's rows do not depend on the runs flown with
+    them, to rounding)."""
+    runs = list(range(len(expected))) if runs is None else runs
+    assert [r["run"] for r in rows] == [r["run"] for r in expected] == runs
     for row, want in zip(rows, expected):
         assert set(row) == set(want)
         for key, value in want.items():
@@ -79,3 +86,48 @@ def test_a_campaign_survives_a_worker_killed_mid_way_with_the_local_clusters_row
         assert sum(w.poll() is None for w in cluster.workers) == 1          # one worker killed, one flew on
     assert killed["pending"] > 0 and killed["rows_before"] < RUNS         # killed while it held runs
     assert_same_rows(report.read_table(tmp_path / "mc" / "runs.csv"), local_rows)
+
+
+def table_rows(path: Path) -> int:
+    """Complete rows in the table at ``path`` (0 before it exists)."""
+    return max(path.read_text().count("\n") - 1, 0) if path.is_file() else 0
+
+
+@pytest.mark.slow
+def test_a_campaign_whose_client_was_killed_resumes_from_its_table(tmp_path, local_rows, monkeypatch):
+    """The client (and its local cluster: one process group) killed once a few rows are in its table;
+    ``--resume`` flies exactly the runs the table does not hold, and the table is the uninterrupted one's."""
+    out = tmp_path / "mc"
+    client = subprocess.Popen([sys.executable, "-m", "att_planner.tools.monte_carlo", str(CAMPAIGN), "--runs",
+                               str(RUNS), "--workers", "1", "--chunk", "1", "--out", str(out), "--no-figures",
+                               "--no-progress"], stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
+                              start_new_session=True)
+    try:
+        end = time.monotonic() + 120
+        while table_rows(out / "runs.csv") < 3 and client.poll() is None and time.monotonic() < end:
+            time.sleep(0.01)            # wait-ok: polls the table the client appends to (its only progress signal)
+        os.killpg(client.pid, signal.SIGKILL)
+        client.wait(10)
+    finally:
+        stop(client)
+    assert client.returncode == -signal.SIGKILL, client.stderr.read().decode()
+    kept = report.read_table(out / "runs.csv")
+    assert 3 <= len(kept) < RUNS
+    assert_same_rows(sorted(kept, key=report.by_run), [local_rows[r["run"]] for r in sorted(kept, key=report.by_run)],
+                     runs=sorted(r["run"] for r in kept))
+
+    streamed, flown = mc.stream, []
+
+    def recorded(client_, setup, runs, chunk):
+        flown.extend(run for run, _ in runs)
+        yield from streamed(client_, setup, runs, chunk)
+
+    monkeypatch.setattr(mc, "stream", recorded)
+    assert mc.main([str(CAMPAIGN), "--runs", str(RUNS), "--workers", "2", "--out", str(out), "--resume",
+                    "--no-figures", "--no-progress"]) == 0
+    assert sorted(flown) == sorted(set(range(RUNS)) - {r["run"] for r in kept})
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["runs"] == RUNS and summary["resumed"] == len(kept) and not summary["interrupted"]
+    final = report.read_table(out / "runs.csv")
+    assert_same_rows(final, local_rows)
+    assert {r["run"]: r["cpu_seconds"] for r in kept}.items() <= {r["run"]: r["cpu_seconds"] for r in final}.items()
