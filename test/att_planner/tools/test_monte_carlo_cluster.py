@@ -2,12 +2,14 @@
 ``dask worker`` processes on localhost, :mod:`att_planner.tools.monte_carlo.processes`): the same
 rows as the local cluster's, also when a worker is killed mid-campaign (its runs flown again on
 the other, every run in the table once); a campaign whose client was killed, resumed from its
-table. The campaign is the tests' 1° slew (test/data), 40 runs, one run a task."""
+table; a worker of another suite version refused. The campaign is the tests' 1° slew (test/data),
+40 runs, one run a task."""
 from __future__ import annotations
 
 import json
 import math
 import os
+import re
 import signal
 import subprocess
 import sys
@@ -15,11 +17,15 @@ import time
 from pathlib import Path
 
 import pytest
+from distributed import Client
 
 import att_planner.tools.monte_carlo as mc
-from att_planner.tools.monte_carlo import report
+from att_msgs_py.errors import ErrorCode
+from att_planner.tools.monte_carlo import cluster as cluster_module
+from att_planner.tools.monte_carlo import report, version
 from att_planner.tools.monte_carlo.processes import dask_processes, stop
 from att_sim.truth import dispersions as disp
+from helpers.other_suite_version import OTHER
 
 DATA = Path(__file__).resolve().parents[2] / "data"
 CAMPAIGN = DATA / "campaigns" / "short.yaml"
@@ -131,3 +137,29 @@ def test_a_campaign_whose_client_was_killed_resumes_from_its_table(tmp_path, loc
     final = report.read_table(out / "runs.csv")
     assert_same_rows(final, local_rows)
     assert {r["run"]: r["cpu_seconds"] for r in kept}.items() <= {r["run"]: r["cpu_seconds"] for r in final}.items()
+
+
+def test_a_worker_of_another_suite_version_is_refused_naming_it_and_both_versions(tmp_path, capsys):
+    other = Path(__file__).resolve().parents[2] / "helpers" / "other_suite_version.py"
+    ours = version.suite_version()
+    assert re.fullmatch(r"\S+\+[0-9a-f]{12}", ours) and ours != OTHER
+    with dask_processes(tmp_path / "cluster", workers=2, preload=[None, str(other)]) as cluster:
+        with Client(cluster.address, timeout=30) as client:
+            versions = client.run(cluster_module.worker_version)
+            assert sorted(versions.values()) == sorted([ours, OTHER])
+            odd = next(address for address, v in versions.items() if v == OTHER)
+        code = mc.main([str(CAMPAIGN), "--runs", "4", "--scheduler", cluster.address, "--out", str(tmp_path / "mc"),
+                        "--no-figures", "--no-progress"])
+    err = capsys.readouterr().err
+    assert code == 2 and len(err.strip().splitlines()) == 1
+    assert err.startswith(f"att-mc: Dask worker {odd} runs suite version {OTHER}, this client {ours}: install")
+    assert report.read_table(tmp_path / "mc" / "runs.csv") == []                # nothing flown
+
+
+def test_a_task_on_a_worker_of_another_version_is_refused():
+    """A worker that joins after the check: its tasks refuse to fly (the campaign stops, its rows kept)."""
+    with pytest.raises(cluster_module.VersionMismatch) as err:
+        cluster_module.fly_chunk(None, [(0, 1)], OTHER)
+    assert err.value.code == ErrorCode.VERSION_MISMATCH
+    assert str(err.value).startswith(f"Dask worker (this process) runs suite version {version.suite_version()}, "
+                                     f"this client {OTHER}")
