@@ -45,7 +45,8 @@ def mismatch(workers: list[str], theirs: str, ours: str) -> VersionMismatch:
 
 def check_versions(client) -> dict[str, str]:
     """Every worker's suite version (by address), each the client's, else :class:`VersionMismatch`
-    naming the workers of each other version (a worker that cannot import the suite: its error)."""
+    naming the workers of one other version, the first in address order (a worker that cannot
+    import the suite: its error as its version)."""
     ours = version.suite_version()
     found = {address: (v if isinstance(v, str) else f"unknown ({type(v).__name__}: {clip(v, 80)})")
              for address, v in client.run(worker_version, on_error="return").items()}
