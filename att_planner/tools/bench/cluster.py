@@ -93,8 +93,8 @@ def campaign(args, out: Path, scheduler: str | None) -> dict:
             "--no-figures", "--no-progress"]
     argv += ["--scheduler", scheduler] if scheduler else ["--workers", str(args.workers)]
     code = mc.main(argv)
-    if code != 0:
-        raise RuntimeError(f"att-mc {' '.join(argv)} exited {code}")
+    if code != 0:                # att-mc printed why (one line): the study stops with one more, exit 1
+        raise SystemExit(f"att-bench cluster: att-mc {' '.join(argv)} exited {code}")
     return json.loads((out / "summary.json").read_text())
 
 

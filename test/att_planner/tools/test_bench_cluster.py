@@ -58,3 +58,11 @@ def test_a_damaged_cluster_json_is_refused(tmp_path, capsys, changes, says):
     path.write_text(json.dumps(payload(**changes)))
     assert main(["history", "--append", str(path), "--history", str(tmp_path / "h.jsonl")]) != 0
     assert says in capsys.readouterr().out
+
+
+def test_a_campaign_that_fails_stops_the_study_in_one_line(tmp_path, capsys):
+    """A campaign att-mc refuses (here: no such file) ends the study with its line and one more, exit 1."""
+    with pytest.raises(SystemExit) as stop:
+        main(["cluster", "--campaign", str(tmp_path / "none.yaml"), "--runs", "2", "--out", str(tmp_path)])
+    assert str(stop.value).startswith("att-bench cluster: att-mc ") and str(stop.value).endswith("exited 2")
+    assert "none.yaml" in capsys.readouterr().err
