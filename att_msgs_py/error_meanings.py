@@ -181,4 +181,8 @@ MEANINGS: dict[ErrorCode, str] = {
         'an unknown scenario, a YAML that is not a scenario, a missing or unparsable `--params-file`, a '
         'missing key file'
     ),
+    ErrorCode.VERSION_MISMATCH: (
+        '`att-mc --scheduler`: a Dask worker runs another suite version (distribution version and digest '
+        'of the sources) than the client; the message names the worker and both versions'
+    ),
 }

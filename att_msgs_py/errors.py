@@ -62,6 +62,7 @@ class ErrorCode(IntEnum):
     # nodes and tools: configuration
     INVALID_PARAMETER = 500       # a parameter of the wrong type or out of range
     INVALID_CONFIG = 501          # an unknown scenario, a YAML that is not a scenario, a missing file
+    VERSION_MISMATCH = 502        # a Dask worker of a campaign runs another suite version than its client
 
 
 MAX_MESSAGE_LENGTH = 400       # characters of a refusal message or a log line (longer: clipped)

@@ -34,6 +34,7 @@ STUDIES = {
     "timing": "att_planner.tools.bench.timing",
     "logtools": "att_planner.tools.bench.logtools",
     "flood": "att_planner.tools.bench.flood",
+    "cluster": "att_planner.tools.bench.cluster",
 }
 TOOLS = {
     "history": "att_planner.tools.bench.history",

@@ -299,6 +299,19 @@ def _soak(p: dict, case: str | None) -> Summary:
                     "settling_orbits": p.get("settling_orbits")})
 
 
+def _cluster(p: dict, case: str | None) -> Summary:
+    ratio, target = _num(p, "throughput_ratio"), _num(p, "throughput_target")
+    workers = _get(p, "rss", "workers")
+    return Summary(case or f"{int(_num(p, 'runs'))} runs, {int(_num(p, 'workers'))} workers",
+                   "cluster processes' runs/s / the local cluster's", ratio, "×",
+                   f"≥ {target:g}×, the same rows, worker RSS growth ≤ {_num(p, 'growth_limit_mib'):g} MiB",
+                   bool(_get(p, "passed")),
+                   {"campaign": _get(p, "campaign"), "local_runs_per_s": _num(p, "local"),
+                    "cluster_runs_per_s": _num(p, "cluster"), "rows_equal": bool(_get(p, "rows_equal")),
+                    "rss_growth_mib": _num(p, "rss_growth_mib"),
+                    "rss_peak_mib": max(_num(w, "peak_mib") for w in workers) if workers else None})
+
+
 def _cmd(template: str) -> Callable[[dict, str], str]:
     return lambda p, path: template.format(path=path, **{k: v for k, v in p.items()
                                                                                  if isinstance(v, str | int | float)})
@@ -329,6 +342,8 @@ STUDIES: tuple[Study, ...] = (
     Study("gains", lambda p: p.get("mode") in ("fixed", "robust") and "kp" in p, _gains,
           _cmd("att-bench gains --mode {mode} --json {path}")),
     Study("soak", lambda p: "dropped_state" in p, _soak, _cmd("att-bench soak --json {path}")),
+    Study("cluster", lambda p: "throughput_ratio" in p, _cluster,
+          _cmd("att-bench cluster --campaign {campaign} --runs {runs} --workers {workers} --json {path}")),
 )
 BY_NAME = {s.name: s for s in STUDIES}
 

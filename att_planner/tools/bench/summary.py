@@ -31,6 +31,7 @@ ROWS: tuple[tuple[str, str], ...] = (
     ("monte-carlo", "1000 runs, 2 workers"),
     ("monte-carlo", "50 runs, 1 worker"),
     ("monte-carlo", "50 runs, 2 workers"),
+    ("cluster", "10000 runs, 2 workers"),
     ("speed", "swift/earth_obs/leo_observatory"),
     ("smooth", "earth_obs"),
     ("smooth", "swift"),

@@ -2,16 +2,19 @@
 
     att-mc campaigns/swift_demo.yaml --runs 1000 --json mc.json          # local Dask cluster, a core each
     att-mc campaigns/swift_demo.yaml --scheduler tcp://host:8786 --json mc.json
+    att-mc campaigns/swift_demo.yaml --runs 1000 --resume                # the runs the table does not hold
     att-mc rerun campaigns/swift_demo.yaml SEED --mcap run.mcap           # one run's full log
 
 The plan is made once on the nominal model (:func:`~att_planner.tools.closed_loop.plan_in_process`),
 then every run flies it on its dispersed truth (:mod:`att_sim.truth.dispersions`,
 :mod:`~att_planner.tools.monte_carlo.run`) on a Dask cluster
-(:mod:`~att_planner.tools.monte_carlo.cluster`), rows streamed back with a progress bar. Ctrl-C
-stops the campaign and writes the report of the runs that finished. Writes the table (CSV), the
-figures and the summary JSON (:mod:`~att_planner.tools.monte_carlo.report`); prints the summary's
-main figures. Exit codes: 0 done (also when runs failed: that is the campaign's finding), 1
-interrupted, 2 bad input (one line ``att-mc: ...``, no traceback).
+(:mod:`~att_planner.tools.monte_carlo.cluster`), rows streamed back with a progress bar, each in
+the table as soon as it is back. Ctrl-C stops the campaign and writes the report of the runs that
+finished; ``--resume`` flies only the runs the table does not hold (after an interrupt, or a client
+killed). Writes the table (CSV), the figures and the summary JSON
+(:mod:`~att_planner.tools.monte_carlo.report`); prints the summary's main figures. Exit codes: 0
+done (also when runs failed: that is the campaign's finding), 1 interrupted, 2 bad input (one line
+``att-mc: ...``, no traceback).
 """
 from __future__ import annotations
 
@@ -23,7 +26,7 @@ from pathlib import Path
 
 from att_msgs_py.errors import RequestError
 from att_planner.tools.monte_carlo import report
-from att_planner.tools.monte_carlo.cluster import ClusterError, client_for, local_workers, stream
+from att_planner.tools.monte_carlo.cluster import ClusterError, client_for, local_workers, merge, stream
 from att_planner.tools.monte_carlo.run import checked, planned
 from att_planner.tools.tune import ProgressBar
 from att_sim.truth import dispersions as disp
@@ -58,6 +61,8 @@ def campaign_parser() -> argparse.ArgumentParser:
                    help="s to reach the scheduler (default 10)")
     p.add_argument("--chunk", type=positive(int, 10_000), default=None,
                    help="runs per task (default: about 4 tasks per worker, at most 50 runs)")
+    p.add_argument("--resume", action="store_true",
+                   help="keep the runs already in OUT/runs.csv (an interrupted campaign's) and fly the others")
     p.add_argument("--no-figures", action="store_true")
     p.add_argument("--no-progress", action="store_true")
     return p
@@ -78,42 +83,47 @@ def run_campaign(args) -> int:
     runs = [(i, disp.run_seed(campaign.seed, i)) for i in range(count)]
     setup = checked(campaign, [seed for _, seed in runs])
     workers = args.workers or local_workers()
-    rows, interrupted = [], False
+    done = report.resumed(args.out / "runs.csv", runs) if args.resume else {}
+    todo, resumed, interrupted = [r for r in runs if r[0] not in done], len(done), False
+    table = report.Table(args.out / "runs.csv", done)
     with client_for(args.scheduler, workers, args.timeout) as client:
         setup = planned(setup)
         workers = len(client.scheduler_info().get("workers", {})) or workers
         bar = None if args.no_progress else ProgressBar()
-        chunk = args.chunk or max(1, min(50, count // (4 * workers)))
+        chunk = args.chunk or max(1, min(50, len(todo) // (4 * workers)))
         start = time.monotonic()
-        chunks = stream(client, setup, runs, chunk)
+        chunks = stream(client, setup, todo, chunk)
         try:
             for got in chunks:
-                rows += got
+                table.add(merge(done, got))
                 if bar is not None:
-                    ok = sum(bool(r["success"]) for r in rows)
-                    bar.update(len(rows) / count, f"{len(rows)}/{count} runs, {ok} successful")
+                    ok = sum(bool(r["success"]) for r in done.values())
+                    bar.update(len(done) / count, f"{len(done)}/{count} runs, {ok} successful")
         except KeyboardInterrupt:
             interrupted = True
         finally:
             chunks.close()
         wall = time.monotonic() - start
+    rows = list(done.values())
     if bar is not None:
         bar.close()
-    table = report.write_table(rows, args.out / "runs.csv")
+    table = table.close()
     correlations = report.rank_correlations(rows)
     top = max(correlations, key=lambda k: abs(correlations[k])) if correlations else None
     figures = [] if args.no_figures or not rows else report.figures(rows, args.out, top)
     plan = {"duration": setup.plan.duration, "method": setup.plan.method}
     summary = report.summary(rows, runs=count, wall=wall, workers=workers, table=table, figures=figures,
                              interrupted=interrupted, campaign=str(campaign.path), scenario=setup.scenario.name,
-                             plan=plan)
+                             plan=plan, resumed=resumed)
     path = args.json or args.out / "summary.json"
     path.parent.mkdir(parents=True, exist_ok=True)
     path.write_text(json.dumps(summary, indent=2, allow_nan=False) + "\n")
     e = summary["final_error_deg"]
+    kept = f", {resumed} resumed from the table" if resumed else ""
     print(f"att-mc: {summary['runs']} runs in {wall:.1f} s on {workers} workers "
-          f"({summary['runs_per_second'] or 0:.3f} runs/s), success {100 * (summary['success_rate'] or 0):.1f} %, "
-          f"final error p99 {e['p99']} deg; {'INTERRUPTED, ' if interrupted else ''}wrote {path}")
+          f"({summary['runs_per_second'] or 0:.3f} runs/s{kept}), "
+          f"success {100 * (summary['success_rate'] or 0):.1f} %, final error p99 {e['p99']} deg; "
+          f"{'INTERRUPTED, ' if interrupted else ''}wrote {path}")
     return 1 if interrupted else 0
 
 
