@@ -299,6 +299,17 @@ def _soak(p: dict, case: str | None) -> Summary:
                     "settling_orbits": p.get("settling_orbits")})
 
 
+def _fastest(p: dict, case: str | None) -> Summary:
+    violations, unverified = len(_get(p, "violations")), len(_get(p, "unverified"))
+    seconds = _get(p, "time_optimal_seconds")
+    return Summary(case or f"{int(_num(p, 'fastest_sets'))} random keep-out sets",
+                   "sets where time_optimal is slower than the verified first or smooth plan", violations, "",
+                   "none, every answer verified", violations == 0 and unverified == 0 and bool(_get(p, "passed")),
+                   {"unverified": unverified, "warm_start_answers": _num(p, "warm_start_answers"),
+                    "further_start_answers": _num(p, "further_start_answers"),
+                    "time_optimal_median_s": _num(seconds, "median"), "time_optimal_max_s": _num(seconds, "max")})
+
+
 def _cmd(template: str) -> Callable[[dict, str], str]:
     return lambda p, path: template.format(path=path, **{k: v for k, v in p.items()
                                                                                  if isinstance(v, str | int | float)})
@@ -329,6 +340,8 @@ STUDIES: tuple[Study, ...] = (
     Study("gains", lambda p: p.get("mode") in ("fixed", "robust") and "kp" in p, _gains,
           _cmd("att-bench gains --mode {mode} --json {path}")),
     Study("soak", lambda p: "dropped_state" in p, _soak, _cmd("att-bench soak --json {path}")),
+    Study("fastest", lambda p: "fastest_sets" in p, _fastest,
+          _cmd("att-bench fastest --sets {fastest_sets} --budget {budget_s:g} --json {path}")),
 )
 BY_NAME = {s.name: s for s in STUDIES}
 
