@@ -10,8 +10,9 @@ service's first stage) and the smooth plan (smooth_collocation, the default meth
 the time-optimal answer must not be slower than: a *violation* is a set where time_optimal's
 verified t_f exceeds the smaller verified t_f of those two, or time_optimal has no verified answer
 where one of them has. The study passes when there is none and every answer verifies. The JSON
-holds each answer's profile (t, q, omega, torque; s, [x, y, z, w], rad/s, N m) for an independent
-check. Times are in TU (J = I, T̄ = 1).
+holds each set's problem (inertia J, torque limit, start and goal attitudes, sensor axis, cones) and
+each answer's profile (t, q, omega, torque; s, [x, y, z, w], rad/s, N m) for an independent check.
+Times are in TU (J = I, T̄ = 1).
 """
 from __future__ import annotations
 
@@ -112,8 +113,10 @@ def run(args) -> dict:
         print(f"{seed:4d} {len(problem.cones):5d} " + " ".join(
             f"{'—' if r['tf'] is None else format(r['tf'], '.4f') + ('' if r['verified'] else '*'):>14}"
             for r in rows.values()) + f"  {answer}{'  VIOLATION: ' + why if why else ''}")
-        sets.append({"seed": seed, "cones": [{"name": c.name, "direction": c.direction, "half_angle_deg":
-                                              math.degrees(c.half_angle)} for c in problem.cones],
+        sets.append({"seed": seed, "J": problem.spacecraft.inertia, "torque_limit": problem.spacecraft.body_torque_max,
+                     "q_initial": problem.q_initial, "q_final": problem.q_final, "sensor_axis": problem.sensor_axis,
+                     "cones": [{"name": c.name, "direction": c.direction, "half_angle_deg": math.degrees(c.half_angle)}
+                               for c in problem.cones],
                      "plans": rows, "violation": why})
     to_seconds = [s["plans"][TIME_OPTIMAL]["seconds"] for s in sets]
     summary = {m: {"verified": sum(s["plans"][m]["verified"] for s in sets),
