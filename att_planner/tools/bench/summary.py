@@ -40,6 +40,7 @@ ROWS: tuple[tuple[str, str], ...] = (
     ("time-optimal", "ba1"),
     ("time-optimal", "bp2"),
     ("time-optimal", "ba2"),
+    ("fastest", "40 random keep-out sets"),
     ("schedule", "experiment A"),
     ("schedule", "experiment B"),
     ("schedule", "experiment C"),
