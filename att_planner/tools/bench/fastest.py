@@ -1,10 +1,11 @@
 """fastest: the time-optimal answer against every other verified plan of the planner service.
 
-``att-bench fastest [--sets N] [--budget S] [--padding-deg D] [--methods M,...] --json PATH`` plans
-each of the seeded random keep-out sets of :mod:`att_planner.reference.random_keepout` (the Swift
-cones plus 1–7 random cones near the path) through the planner service's own pipeline in this
+``att-bench fastest [--sets N] [--budget S] [--padding-deg D] [--options JSON] [--methods M,...] --json PATH``
+plans each of the seeded random keep-out sets of :mod:`att_planner.reference.random_keepout` (the
+Swift cones plus 1–7 random cones near the path) through the planner service's own pipeline in this
 process (:func:`att_planner.service.planning.plan_maneuver`, the node's default cone padding, no
-ROS), once per method, and re-verifies every answer against the unpadded problem
+ROS), once per method (``--options``: time_optimal's request options, checked by the registry, e.g.
+a coarse mesh), and re-verifies every answer against the unpadded problem
 (:func:`att_planner.verification.verify`, the suite's tolerances). The first plan (graph_smooth, the
 service's first stage) and the smooth plan (smooth_collocation, the default method) are the plans
 the time-optimal answer must not be slower than: a *violation* is a set where time_optimal's
@@ -16,12 +17,14 @@ Times are in TU (J = I, T̄ = 1).
 """
 from __future__ import annotations
 
+import json
 import math
 import time
 from dataclasses import replace
 
 import numpy as np
 
+from att_msgs_py.errors import RequestError
 from att_planner import methods
 from att_planner.reference.random_keepout import FASTEST_SETS, keepout_set
 from att_planner.service.planner_parameters import PLANNER
@@ -41,14 +44,19 @@ def configure(parser):
     parser.add_argument("--budget", type=float, default=20.0, help="time budget of each request, seconds")
     parser.add_argument("--padding-deg", type=float, default=None,
                         help="cone padding of the service, deg (default: the planner node's)")
+    parser.add_argument("--options", default="{}", metavar="JSON",
+                        help="time_optimal's request options, a JSON object, e.g. "
+                             "'{\"intervals\": 4, \"max_intervals\": 4}'")
     parser.add_argument("--methods", default=",".join(DEFAULT_METHODS),
                         help=f"methods planned per set, comma-separated (must include {FIRST}, {SMOOTH}, "
                              f"{TIME_OPTIMAL})")
 
 
-def _answer(problem, method: str, budget: float, padding: float) -> dict:
-    """One request through the service: the answer re-verified on the unpadded problem, its profile."""
-    valid = ValidRequest(replace(problem, deadline=time.monotonic() + budget), methods.get(method), {}, "swift", budget)
+def _answer(problem, method: str, budget: float, padding: float, options: dict) -> dict:
+    """One request through the service (``options`` validated by the registry): the answer
+    re-verified on the unpadded problem, its profile."""
+    valid = ValidRequest(replace(problem, deadline=time.monotonic() + budget), methods.get(method), options, "swift",
+                         budget)
     start = time.perf_counter()
     outcome = plan_maneuver(valid, cone_padding=padding, runner=run_method)
     seconds = time.perf_counter() - start
@@ -95,15 +103,22 @@ def run(args) -> dict:
         raise SystemExit(f"att-bench fastest: --methods must include {', '.join(missing)}")
     for name in names:
         methods.get(name)            # an unknown name is refused before anything runs
+    try:
+        options = json.loads(args.options)
+        if not isinstance(options, dict):
+            raise ValueError(f"expected a JSON object, found {type(options).__name__}")
+        options = methods.get(TIME_OPTIMAL).validate(options)
+    except (ValueError, RequestError) as exc:
+        raise SystemExit(f"att-bench fastest: --options {args.options!r}: {exc}") from None
     padding_deg = PLANNER["cone_padding_deg"].default if args.padding_deg is None else args.padding_deg
     padding = math.radians(padding_deg)
     sets, violations, unverified = [], [], []
-    print(f"fastest: {args.sets} random keep-out sets, budget {args.budget:g} s, padding {padding_deg:g} deg "
-          "(t_f in TU; * = not verified)")
+    print(f"fastest: {args.sets} random keep-out sets, budget {args.budget:g} s, padding {padding_deg:g} deg, "
+          f"time_optimal options {options} (t_f in TU; * = not verified)")
     print(f"{'seed':>4} {'cones':>5} " + " ".join(f"{m[:14]:>14}" for m in names) + "  time_optimal answer")
     for seed in list(FASTEST_SETS)[:args.sets]:
         problem = keepout_set(seed)
-        rows = {m: _answer(problem, m, args.budget, padding) for m in names}
+        rows = {m: _answer(problem, m, args.budget, padding, options if m == TIME_OPTIMAL else {}) for m in names}
         why = _violation(rows)
         if why:
             violations.append({"seed": seed, "why": why})
@@ -129,6 +144,7 @@ def run(args) -> dict:
           f"{sum(a.startswith('further start') for a in answers)}; time_optimal request median "
           f"{np.median(to_seconds):.2f} s, max {max(to_seconds):.2f} s")
     return {"fastest_sets": len(sets), "budget_s": args.budget, "padding_deg": padding_deg, "methods": names,
+            "time_optimal_options": options,
             "violations": violations, "unverified": unverified, "summary": summary,
             "time_optimal_seconds": {"median": float(np.median(to_seconds)), "max": float(max(to_seconds))},
             "warm_start_answers": sum(a.startswith("warm start") for a in answers),

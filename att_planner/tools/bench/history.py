@@ -302,7 +302,9 @@ def _soak(p: dict, case: str | None) -> Summary:
 def _fastest(p: dict, case: str | None) -> Summary:
     violations, unverified = len(_get(p, "violations")), len(_get(p, "unverified"))
     seconds = _get(p, "time_optimal_seconds")
-    return Summary(case or f"{int(_num(p, 'fastest_sets'))} random keep-out sets",
+    options = p.get("time_optimal_options") or {}
+    named = ", time_optimal " + ", ".join(f"{k} {v}" for k, v in options.items()) if options else ""
+    return Summary(case or f"{int(_num(p, 'fastest_sets'))} random keep-out sets{named}",
                    "sets where time_optimal is slower than the verified first or smooth plan", violations, "",
                    "none, every answer verified", violations == 0 and unverified == 0 and bool(_get(p, "passed")),
                    {"unverified": unverified, "warm_start_answers": _num(p, "warm_start_answers"),
@@ -341,7 +343,9 @@ STUDIES: tuple[Study, ...] = (
           _cmd("att-bench gains --mode {mode} --json {path}")),
     Study("soak", lambda p: "dropped_state" in p, _soak, _cmd("att-bench soak --json {path}")),
     Study("fastest", lambda p: "fastest_sets" in p, _fastest,
-          _cmd("att-bench fastest --sets {fastest_sets} --budget {budget_s:g} --json {path}")),
+          lambda p, path: f"att-bench fastest --sets {p['fastest_sets']} --budget {p['budget_s']:g} "
+                          + (f"--options '{json.dumps(p['time_optimal_options'])}' " if p.get("time_optimal_options")
+                             else "") + f"--json {path}"),
 )
 BY_NAME = {s.name: s for s in STUDIES}
 
