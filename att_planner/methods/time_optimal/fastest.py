@@ -2,10 +2,10 @@
 
 The collocation NLP of :mod:`.planner` has many local minima (Melton 2012, 2018): a start in one
 homotopy class (the side on which the path passes each zone) converges to that class's optimum, and
-the best coarse-mesh optimum need not stay the best after refinement. A smooth plan (minimum time
-with a C¹ torque, :mod:`.smooth`) may pass the zones in a faster class than every start of the
-NLP: on the random keep-out sets of :mod:`att_planner.reference.random_keepout` the NLP's answer
-was slower than the smooth plan of the same request on some sets. So the planner
+the best coarse-mesh optimum need not stay the best after refinement, nor verify. A smooth plan
+(minimum time with a C¹ torque, :mod:`.smooth`) may pass the zones in a faster class than every
+start of the NLP (``att-bench fastest`` counts such requests on the random keep-out sets of
+:mod:`att_planner.reference.random_keepout`). So the planner
 
 - takes the plans of other methods as warm starts (the planner service passes its first plan) and,
   with ``smooth_seed``, the smooth C¹ plan seeded with them (:func:`smooth_seed_plan`);

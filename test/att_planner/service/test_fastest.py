@@ -23,9 +23,9 @@ from att_planner.verification import rejection, verify
 BUDGET_S = 20.0
 COARSE = {"intervals": 4, "max_intervals": 4}
 COARSE_ONE_START = {"starts": 1, "intervals": 6, "max_intervals": 6, "refine_rounds": 0}
-# (seed, time_optimal's options, how the answer comes). Without the warm-start check, the coarse
-# requests of sets 0 and 37 were answered with the first plan (7.35 and 7.63 TU; the method's plan
-# failed verification) while the smooth plan flew 3.77 and 3.34 TU.
+# (seed, time_optimal's options, how the answer comes). Without the warm-start check the service
+# answers the coarse requests of sets 0 and 37 with its first plan (7.35 and 7.63 TU: the method's
+# plan fails verification) while the smooth plan flies 3.77 and 3.34 TU.
 CASES = [(37, {}, "nlp"), (0, COARSE, "further start"), (37, COARSE, "warm start: smooth_collocation"),
          (37, COARSE_ONE_START, "further start")]
 
