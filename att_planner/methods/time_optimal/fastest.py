@@ -8,7 +8,7 @@ start of the NLP (``att-bench fastest`` counts such requests on the random keep-
 :mod:`att_planner.reference.random_keepout`). So the planner
 
 - takes the plans of other methods as warm starts (the planner service passes its first plan) and,
-  with ``smooth_seed``, the smooth C¹ plan seeded with them (:func:`smooth_seed_plan`);
+  with ``smooth_seed``, the smooth C¹ plan seeded with them (:func:`with_smooth_seed`);
 - when its verified answer is slower than a warm start that verifies here (:func:`fastest_verified`,
   the prediction model and the default tolerances), tries further starts within the budget;
 - and when it is still slower, answers with that warm start, saying so.
@@ -29,21 +29,21 @@ from att_planner.verification import measure, predict, rejection
 SMOOTH_SEED_SHARE = 0.5     # at most this share of the remaining budget goes to the smooth seed
 
 
-def smooth_seed_plan(problem: ManeuverProblem, warm_starts: tuple, seconds: dict) -> Plan | None:
-    """The smooth C¹ plan of :func:`.smooth.plan_smooth_collocation` (its default options) started
-    from ``warm_starts`` (or, without any, from graph_smooth's plan), with at most
+def with_smooth_seed(problem: ManeuverProblem, warm_starts: tuple, seconds: dict) -> tuple:
+    """``warm_starts`` and the smooth C¹ plan of :func:`.smooth.plan_smooth_collocation` (its default
+    options) started from them (or, without any, from graph_smooth's plan), with at most
     :data:`SMOOTH_SEED_SHARE` of the time left before ``problem.deadline``; its seconds to
-    ``seconds['smooth_seed']``. A failed plan is returned as it is (it still serves as a start when it
-    has a trajectory); None for a moving goal (the smooth plans end at rest)."""
+    ``seconds['smooth_seed']``. A failed plan is kept (it still serves as a start when it has a
+    trajectory); a moving goal has none (the smooth plans end at rest)."""
     from att_planner.methods.time_optimal.smooth import plan_smooth_collocation  # smooth imports the planner
 
     if problem.goal_motion is not None:
-        return None
+        return warm_starts
     lap = time.monotonic()
     share = None if problem.deadline is None else lap + SMOOTH_SEED_SHARE * max(0.0, problem.deadline - lap)
     plan = plan_smooth_collocation(replace(problem, deadline=share), warm_starts=warm_starts)
     seconds["smooth_seed"] = time.monotonic() - lap
-    return plan
+    return (*warm_starts, plan)
 
 
 def checked(problem: ManeuverProblem, plan: Plan) -> Plan | None:

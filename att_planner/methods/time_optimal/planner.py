@@ -54,7 +54,7 @@ from att_planner.methods.axis_rotations import eigenaxis_leg, goal_attitude, no_
 from att_planner.methods.lanes import map_in_lanes
 from att_planner.methods.time_optimal import collocation as col
 from att_planner.methods.time_optimal import mesh as meshes
-from att_planner.methods.time_optimal.fastest import fastest_verified, smooth_seed_plan, warm_start_answer
+from att_planner.methods.time_optimal.fastest import fastest_verified, warm_start_answer, with_smooth_seed
 from att_planner.methods.time_optimal.model import Scaling, plan_arrays, scaling, transcription
 from att_planner.methods.time_optimal.routes import Route, candidate_routes, route_guess, select_routes, zone_margin
 from att_planner.methods.time_optimal.swarm import swarm_plan
@@ -318,10 +318,50 @@ class _Fastest:
     """Never slower than a verified warm start (:mod:`.fastest`): the check of the NLP's answer and
     the further starts, logged in ``stats['fastest']``."""
 
-    def __init__(self, run: _Solve, warm_starts: tuple, stats: dict, refine_rounds: int, refine_split: int):
+    def __init__(self, run: _Solve, warm_starts: tuple, stats: dict, refine_rounds: int, refine_split: int,
+                 start: float):
         self.run, self.warm_starts, self.refine = run, warm_starts, (refine_rounds, refine_split)
+        self.stats, self.start = stats, start       # the plan's stats; time.monotonic() at the call
         self.log = stats["fastest"] = {"nlp_tf": None, "checked": [], "further_starts": [], "answer": "nlp"}
         self.why = ""
+
+    def _warm_answer(self, warm: Plan, why: str) -> Plan:
+        self.stats["tf"] = float(warm.duration)
+        answer = warm_start_answer(warm, METHOD, why, time.monotonic() - self.start, self.stats)
+        answer.nit, answer.nfev = self.run.nit, self.run.nfev
+        return answer
+
+    def unsolved(self, start_log: list) -> Plan:
+        """No start converged: the fastest verified warm start (status FEASIBLE), else FAILED."""
+        run, statuses = self.run, sorted({entry["status"] for entry in start_log})
+        message = ("no start converged" + (" before the deadline" if run.budget_hit else "")
+                   + (f" (IPOPT: {', '.join(statuses)})" if statuses else ""))
+        self.log["answer"] = "none"
+        warm = fastest_verified(run.problem, self.warm_starts, np.inf, self.log["checked"])
+        if warm is not None:
+            return self._warm_answer(warm, message)
+        return Plan(status=Status.FAILED, message=message, wall_time=time.monotonic() - self.start,
+                    nit=run.nit, nfev=run.nfev, method=METHOD, stats=self.stats)
+
+    def answer(self, refined: tuple, tr: col.Transcription, others: list, intervals: int, explore_tol: float) -> Plan:
+        """The plan of ``refined`` (incumbent, accepted, plan, truth refinements, label), or of a further
+        start when a verified warm start is faster (:meth:`further_starts`), or that warm start."""
+        incumbent, ok, plan, extra, label = refined
+        lap = time.monotonic()
+        warm, further = self.faster_warm_start(plan, ok), None
+        if warm is not None:
+            further = self.further_starts(tr, others, warm, intervals, explore_tol)
+            self.stats["seconds"]["further_starts"] = time.monotonic() - lap
+            if further is not None:
+                incumbent, ok, plan, extra, label = further
+        self.stats.update({"tf": float(plan.t[-1]), "mesh": incumbent.mesh_log, "truth_refinements": extra,
+                           "intervals": incumbent.sol.phase.intervals, "ipopt_status": incumbent.res.status})
+        if warm is not None and further is None:
+            return self._warm_answer(warm, self.why)
+        plan.status, plan.message = _verdict(plan, ok, self.run, incumbent, label)
+        plan.stats = self.stats
+        plan.nit, plan.nfev, plan.wall_time = self.run.nit, self.run.nfev, time.monotonic() - self.start
+        return plan
 
     def faster_warm_start(self, plan: Plan, ok: bool) -> Plan | None:
         """The fastest warm start that verifies and is faster than the NLP's answer (``plan``,
@@ -398,15 +438,9 @@ def plan_time_optimal(problem: ManeuverProblem, *, intervals: int = DEFAULT_INTE
     ``verify_reserve`` seconds kept before ``problem.deadline`` for the final verification;
     ``parallel_starts``: the starts solved on two cores, every other one by a forked child
     (:mod:`att_planner.methods.lanes`: where this process can fork safely; the same answers);
-    ``smooth_seed``: the smooth C¹ plan (:func:`.fastest.smooth_seed_plan`: smooth_collocation started
-    from the warm starts, or from graph_smooth's plan without any; at most half the remaining budget;
-    not for a moving goal) among the warm starts (the registry passes it: the planner service's answer
-    is never slower than the smooth plan of the same request).
-    Never slower than a verified warm start (:mod:`.fastest`): when the refined, verified answer is
-    slower than a warm start that verifies, or none verifies, the other converged starts and the
-    fastest verified warm start on a mesh twice as fine are solved and refined within the budget
-    (``stats['fastest']``: the NLP's t_f, the warm starts checked, the further starts and the answer);
-    if none is as fast, that warm start is the answer (status FEASIBLE, the message says so).
+    ``smooth_seed``: the smooth C¹ plan among the warm starts (:func:`.fastest.with_smooth_seed`; the
+    registry passes it). Never slower than a verified warm start (:mod:`.fastest`, ``stats['fastest']``):
+    further starts within the budget, else that warm start is the answer (status FEASIBLE).
     The bounds ``problem.rate_max`` and ``problem.wheel_momentum_max`` are imposed when finite.
     ``nit`` and ``nfev`` count IPOPT iterations and objective evaluations over every NLP solved.
     """
@@ -417,9 +451,7 @@ def plan_time_optimal(problem: ManeuverProblem, *, intervals: int = DEFAULT_INTE
         return unsolved
     s = scaling(problem)
     seconds: dict = {}
-    warm_starts = tuple(warm_starts)
-    seed = smooth_seed_plan(problem, warm_starts, seconds) if smooth_seed else None
-    warm_starts = warm_starts if seed is None else (*warm_starts, seed)
+    warm_starts = with_smooth_seed(problem, tuple(warm_starts), seconds) if smooth_seed else tuple(warm_starts)
     lap = time.monotonic()
     routes = _routes(problem, s, starts, warm_starts, smooth_warm_start, seconds)
     run = _Solve(problem, s, np.deg2rad(cone_margin_deg), _tf_bounds(problem, s, routes), tol, max_iter,
@@ -440,19 +472,9 @@ def plan_time_optimal(problem: ManeuverProblem, *, intervals: int = DEFAULT_INTE
     seconds["routes_and_starts"] = (time.monotonic() - lap - seconds.get("smooth_warm_start", 0.0)
                                     - seconds.get("global_stage", 0.0))
     lap = time.monotonic()
-    outcome = dict(method=METHOD, stats=stats)
+    fastest = _Fastest(run, warm_starts, stats, refine_rounds, refine_split, start)
     if not solved:
-        statuses = sorted({entry["status"] for entry in start_log})
-        message = ("no start converged" + (" before the deadline" if run.budget_hit else "")
-                   + (f" (IPOPT: {', '.join(statuses)})" if statuses else ""))
-        stats["fastest"] = {"nlp_tf": None, "checked": [], "further_starts": [], "answer": "none"}
-        warm = fastest_verified(problem, warm_starts, np.inf, stats["fastest"]["checked"])
-        if warm is not None:
-            answer = warm_start_answer(warm, METHOD, message, time.monotonic() - start, stats)
-            answer.nit, answer.nfev = run.nit, run.nfev
-            return answer
-        return Plan(status=Status.FAILED, message=message, wall_time=time.monotonic() - start,
-                    nit=run.nit, nfev=run.nfev, **outcome)
+        return fastest.unsolved(start_log)
     _, best_label, res = solved[0]
     stats["best_start"] = best_label
     incumbent = _Incumbent(run, tr, res)
@@ -461,22 +483,5 @@ def plan_time_optimal(problem: ManeuverProblem, *, intervals: int = DEFAULT_INTE
     extra: list = []
     ok, plan = incumbent.verified(extra)
     seconds["verification"] = time.monotonic() - lap
-    best_label = f"best of {len(start_log)} starts: {best_label}"
-    fastest, lap = _Fastest(run, warm_starts, stats, refine_rounds, refine_split), time.monotonic()
-    warm, further = fastest.faster_warm_start(plan, ok), None
-    if warm is not None:
-        further = fastest.further_starts(tr, solved[1:], warm, intervals, explore_tol)
-        seconds["further_starts"] = time.monotonic() - lap
-        if further is not None:
-            incumbent, ok, plan, extra, best_label = further
-    stats.update({"tf": float(plan.t[-1]), "mesh": incumbent.mesh_log, "truth_refinements": extra,
-                  "intervals": incumbent.sol.phase.intervals, "ipopt_status": incumbent.res.status})
-    if warm is not None and further is None:
-        stats["tf"] = float(warm.duration)
-        answer = warm_start_answer(warm, METHOD, fastest.why, time.monotonic() - start, stats)
-        answer.nit, answer.nfev = run.nit, run.nfev
-        return answer
-    plan.status, plan.message = _verdict(plan, ok, run, incumbent, best_label)
-    plan.stats = stats
-    plan.nit, plan.nfev, plan.wall_time = run.nit, run.nfev, time.monotonic() - start
-    return plan
+    return fastest.answer((incumbent, ok, plan, extra, f"best of {len(start_log)} starts: {best_label}"),
+                          tr, solved[1:], intervals, explore_tol)
