@@ -11,7 +11,9 @@ A new method: write ``plan_<name>(problem, **options) -> Plan`` in a module of t
 add an entry to :data:`REGISTRY` (its options, ranges and, if some combinations cannot run, a hook).
 Entries travel to the planner's child processes, so they must pickle: hooks are module-level
 functions, never lambdas. A method marked ``seeded`` takes ``warm_starts``, a tuple of plans to start
-from: the planner service passes its first plan (:mod:`att_planner.service.planning`).
+from: the planner service passes its first plan (:mod:`att_planner.service.planning`); time_optimal
+adds the smooth plan and answers with none slower than a verified one of them
+(:mod:`att_planner.methods.time_optimal.fastest`).
 """
 from __future__ import annotations
 
@@ -146,7 +148,8 @@ REGISTRY = [
             "global_stage": Option(0, 1, True, doc="particle swarm first"),
             "parallel_starts": Option(0, 1, True, doc="the starts on two cores (a forked child)"),
             "boundary_cone": BOUNDARY_CONE}, check=_time_optimal_check,
-           combined=("intervals", "max_intervals"), seeded=True, paper=_MELTON),
+           # the smooth C1 plan among its starts: never slower than the smooth plan of the same request
+           fixed={"smooth_seed": True}, combined=("intervals", "max_intervals"), seeded=True, paper=_MELTON),
     Method("constrained_axis", "att_planner.methods.constrained_axis", "plan_constrained_axis",
            "eigenaxis bang-bang, or lambda-rotations riding a zone boundary when the path is blocked",
            {"ride_margin_deg": Option(0.0, 10.0, doc="how far outside a zone boundary the sensor rides, deg"),

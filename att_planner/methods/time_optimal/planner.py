@@ -54,6 +54,7 @@ from att_planner.methods.axis_rotations import eigenaxis_leg, goal_attitude, no_
 from att_planner.methods.lanes import map_in_lanes
 from att_planner.methods.time_optimal import collocation as col
 from att_planner.methods.time_optimal import mesh as meshes
+from att_planner.methods.time_optimal.fastest import fastest_verified, warm_start_answer, with_smooth_seed
 from att_planner.methods.time_optimal.model import Scaling, plan_arrays, scaling, transcription
 from att_planner.methods.time_optimal.routes import Route, candidate_routes, route_guess, select_routes, zone_margin
 from att_planner.methods.time_optimal.swarm import swarm_plan
@@ -313,13 +314,109 @@ def _swarm_start(run: _Solve, routes: list, intervals: int, explore_tol: float, 
                                 min_margin=zone_margin(problem, swarm.t, swarm.q))], intervals, explore_tol)
 
 
+class _Fastest:
+    """Never slower than a verified warm start (:mod:`.fastest`): the check of the NLP's answer and
+    the further starts, logged in ``stats['fastest']``."""
+
+    def __init__(self, run: _Solve, warm_starts: tuple, stats: dict, refine_rounds: int, refine_split: int,
+                 start: float):
+        self.run, self.warm_starts, self.refine = run, warm_starts, (refine_rounds, refine_split)
+        self.stats, self.start = stats, start       # the plan's stats; time.monotonic() at the call
+        self.log = stats["fastest"] = {"nlp_tf": None, "checked": [], "further_starts": [], "answer": "nlp"}
+        self.why = ""
+
+    def _warm_answer(self, warm: Plan, why: str) -> Plan:
+        self.stats["tf"] = float(warm.duration)
+        answer = warm_start_answer(warm, METHOD, why, time.monotonic() - self.start, self.stats)
+        answer.nit, answer.nfev = self.run.nit, self.run.nfev
+        return answer
+
+    def unsolved(self, start_log: list) -> Plan:
+        """No start converged: the fastest verified warm start (status FEASIBLE), else FAILED."""
+        run, statuses = self.run, sorted({entry["status"] for entry in start_log})
+        message = ("no start converged" + (" before the deadline" if run.budget_hit else "")
+                   + (f" (IPOPT: {', '.join(statuses)})" if statuses else ""))
+        self.log["answer"] = "none"
+        warm = fastest_verified(run.problem, self.warm_starts, np.inf, self.log["checked"])
+        if warm is not None:
+            return self._warm_answer(warm, message)
+        return Plan(status=Status.FAILED, message=message, wall_time=time.monotonic() - self.start,
+                    nit=run.nit, nfev=run.nfev, method=METHOD, stats=self.stats)
+
+    def answer(self, refined: tuple, tr: col.Transcription, others: list, intervals: int, explore_tol: float) -> Plan:
+        """The plan of ``refined`` (incumbent, accepted, plan, truth refinements, label), or of a further
+        start when a verified warm start is faster (:meth:`further_starts`), or that warm start."""
+        incumbent, ok, plan, extra, label = refined
+        lap = time.monotonic()
+        warm, further = self.faster_warm_start(plan, ok), None
+        if warm is not None:
+            further = self.further_starts(tr, others, warm, intervals, explore_tol)
+            self.stats["seconds"]["further_starts"] = time.monotonic() - lap
+            if further is not None:
+                incumbent, ok, plan, extra, label = further
+        self.stats.update({"tf": float(plan.t[-1]), "mesh": incumbent.mesh_log, "truth_refinements": extra,
+                           "intervals": incumbent.sol.phase.intervals, "ipopt_status": incumbent.res.status})
+        if warm is not None and further is None:
+            return self._warm_answer(warm, self.why)
+        plan.status, plan.message = _verdict(plan, ok, self.run, incumbent, label)
+        plan.stats = self.stats
+        plan.nit, plan.nfev, plan.wall_time = self.run.nit, self.run.nfev, time.monotonic() - self.start
+        return plan
+
+    def faster_warm_start(self, plan: Plan, ok: bool) -> Plan | None:
+        """The fastest warm start that verifies and is faster than the NLP's answer (``plan``,
+        accepted when ``ok``), or None; ``why`` says how the answer compares."""
+        tf = plan.duration if ok else np.inf
+        self.log["nlp_tf"] = float(tf) if ok else None
+        warm = fastest_verified(self.run.problem, self.warm_starts, tf, self.log["checked"])
+        if warm is not None:
+            self.why = (f"the NLP's verified plan (t_f = {tf:.6g} s) is slower than the warm start of {warm.method} "
+                        f"(t_f = {warm.duration:.6g} s)" if ok else
+                        f"the NLP's best plan fails truth verification: {rejection(plan.verification)}")
+        return warm
+
+    def _attempt(self, label: str, tr: col.Transcription, res: col.NlpResult):
+        incumbent = _Incumbent(self.run, tr, res)
+        incumbent.refine(*self.refine)
+        extra: list = []
+        ok, plan = incumbent.verified(extra)
+        self.log["further_starts"].append({"start": label, "tf": float(plan.duration), "verified": ok})
+        return incumbent, ok, plan, extra
+
+    def further_starts(self, tr: col.Transcription, others: list, warm: Plan, intervals: int, explore_tol: float):
+        """The other converged coarse starts (fastest first), then ``warm`` on a mesh twice as fine,
+        each refined and verified until one is as fast as ``warm`` or the budget ends: ``(incumbent,
+        ok, plan, truth refinements, label)`` of that one, or None when none is."""
+        run = self.run
+        attempts = [(f"further start: {label}", lambda res=res: (tr, res)) for _, label, res in others]
+        route = Route(f"warm start: {warm.method}", plan=warm, tf_estimate=warm.duration / run.scaling.tu,
+                      min_margin=zone_margin(run.problem, warm.t, warm.q))
+
+        def finer():
+            fine_tr, solved, _ = _explore(run, [route], 2 * intervals, explore_tol)
+            return (fine_tr, solved[0][2]) if solved else None
+        attempts.append((f"further start: {route.label} on {2 * intervals} intervals", finer))
+        for label, solve in attempts:
+            if run.expired():
+                break
+            started = solve()
+            if started is None:
+                self.log["further_starts"].append({"start": label, "tf": None, "verified": False})
+                continue
+            incumbent, ok, plan, extra = self._attempt(label, *started)
+            if ok and plan.duration <= warm.duration:
+                self.log["answer"] = label
+                return incumbent, ok, plan, extra, f"{self.why}; {label}"
+        return None
+
+
 def plan_time_optimal(problem: ManeuverProblem, *, intervals: int = DEFAULT_INTERVALS, max_intervals: int | None = None,
                       starts: int = 3, refine_rounds: int = 1, refine_split: int = 4,
                       interpolation: str = Interpolation.ZOH,
                       cone_margin_deg: float = 0.05, warm_starts: tuple = (),
                       smooth_warm_start: bool = False, global_stage: bool = False, explore_tol: float = 1e-5,
                       tol: float = 1e-7, max_iter: int = 400, verify_reserve: float = 1.0,
-                      parallel_starts: bool = True) -> Plan:
+                      parallel_starts: bool = True, smooth_seed: bool = False) -> Plan:
     """Minimum-time rest-to-rest slew with per-axis torque limits among the problem's zones.
 
     Options: ``intervals`` coarse mesh for the multi-start stage; ``max_intervals`` cap on mesh
@@ -340,7 +437,10 @@ def plan_time_optimal(problem: ManeuverProblem, *, intervals: int = DEFAULT_INTE
     ``explore_tol``/``tol`` IPOPT tolerances of the two stages; ``max_iter`` per solve;
     ``verify_reserve`` seconds kept before ``problem.deadline`` for the final verification;
     ``parallel_starts``: the starts solved on two cores, every other one by a forked child
-    (:mod:`att_planner.methods.lanes`: where this process can fork safely; the same answers).
+    (:mod:`att_planner.methods.lanes`: where this process can fork safely; the same answers);
+    ``smooth_seed``: the smooth C¹ plan among the warm starts (:func:`.fastest.with_smooth_seed`; the
+    registry passes it). Never slower than a verified warm start (:mod:`.fastest`, ``stats['fastest']``):
+    further starts within the budget, else that warm start is the answer (status FEASIBLE).
     The bounds ``problem.rate_max`` and ``problem.wheel_momentum_max`` are imposed when finite.
     ``nit`` and ``nfev`` count IPOPT iterations and objective evaluations over every NLP solved.
     """
@@ -351,6 +451,7 @@ def plan_time_optimal(problem: ManeuverProblem, *, intervals: int = DEFAULT_INTE
         return unsolved
     s = scaling(problem)
     seconds: dict = {}
+    warm_starts = with_smooth_seed(problem, tuple(warm_starts), seconds) if smooth_seed else tuple(warm_starts)
     lap = time.monotonic()
     routes = _routes(problem, s, starts, warm_starts, smooth_warm_start, seconds)
     run = _Solve(problem, s, np.deg2rad(cone_margin_deg), _tf_bounds(problem, s, routes), tol, max_iter,
@@ -371,13 +472,9 @@ def plan_time_optimal(problem: ManeuverProblem, *, intervals: int = DEFAULT_INTE
     seconds["routes_and_starts"] = (time.monotonic() - lap - seconds.get("smooth_warm_start", 0.0)
                                     - seconds.get("global_stage", 0.0))
     lap = time.monotonic()
-    outcome = dict(method=METHOD, stats=stats)
+    fastest = _Fastest(run, warm_starts, stats, refine_rounds, refine_split, start)
     if not solved:
-        statuses = sorted({entry["status"] for entry in start_log})
-        message = ("no start converged" + (" before the deadline" if run.budget_hit else "")
-                   + (f" (IPOPT: {', '.join(statuses)})" if statuses else ""))
-        return Plan(status=Status.FAILED, message=message, wall_time=time.monotonic() - start,
-                    nit=run.nit, nfev=run.nfev, **outcome)
+        return fastest.unsolved(start_log)
     _, best_label, res = solved[0]
     stats["best_start"] = best_label
     incumbent = _Incumbent(run, tr, res)
@@ -386,9 +483,5 @@ def plan_time_optimal(problem: ManeuverProblem, *, intervals: int = DEFAULT_INTE
     extra: list = []
     ok, plan = incumbent.verified(extra)
     seconds["verification"] = time.monotonic() - lap
-    stats.update({"tf": float(plan.t[-1]), "mesh": incumbent.mesh_log, "truth_refinements": extra,
-                  "intervals": incumbent.sol.phase.intervals, "ipopt_status": incumbent.res.status})
-    plan.status, plan.message = _verdict(plan, ok, run, incumbent, f"best of {len(start_log)} starts: {best_label}")
-    plan.stats = stats
-    plan.nit, plan.nfev, plan.wall_time = run.nit, run.nfev, time.monotonic() - start
-    return plan
+    return fastest.answer((incumbent, ok, plan, extra, f"best of {len(start_log)} starts: {best_label}"),
+                          tr, solved[1:], intervals, explore_tol)

@@ -2,7 +2,8 @@
 
 ``att-bench <study> [options] --json PATH`` runs a study, prints a table and writes its JSON.
 Each study is a module of this package providing ``configure(parser)`` and ``run(args) -> dict``
-(``run`` prints the table and returns the JSON payload). The exit status is 1 when the payload
+(``run`` prints the table and returns the JSON payload; a module's ``JSON_INDENT``, 1 by default,
+sets the JSON's indentation: None writes it on one line). The exit status is 1 when the payload
 says ``"passed": false`` (a study that states a criterion and found it failed), 0 otherwise. A JSON
 that names no ``machine`` gets one (cores, Python, the 1-min load at the end of the run, the UTC
 time and the commit), so that ``att-bench history --append PATH`` can record where it was measured.
@@ -35,6 +36,7 @@ STUDIES = {
     "logtools": "att_planner.tools.bench.logtools",
     "flood": "att_planner.tools.bench.flood",
     "cluster": "att_planner.tools.bench.cluster",
+    "fastest": "att_planner.tools.bench.fastest",
 }
 TOOLS = {
     "history": "att_planner.tools.bench.history",
@@ -77,6 +79,6 @@ def main(argv: list[str] | None = None) -> int:
         payload["machine"] = machine()
     if args.json:
         with open(args.json, "w") as fh:
-            json.dump(payload, fh, indent=1, default=_json_default)
+            json.dump(payload, fh, indent=getattr(modules[args.subcommand], "JSON_INDENT", 1), default=_json_default)
         print(f"JSON: {args.json}")
     return 0 if payload.get("passed", True) else 1

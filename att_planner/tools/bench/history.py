@@ -310,6 +310,17 @@ def _cluster(p: dict, case: str | None) -> Summary:
                     "cluster_runs_per_s": _num(p, "cluster"), "rows_equal": bool(_get(p, "rows_equal")),
                     "rss_growth_mib": _num(p, "rss_growth_mib"),
                     "rss_peak_mib": max(_num(w, "peak_mib") for w in workers) if workers else None})
+def _fastest(p: dict, case: str | None) -> Summary:
+    violations, unverified = len(_get(p, "violations")), len(_get(p, "unverified"))
+    seconds = _get(p, "time_optimal_seconds")
+    options = p.get("time_optimal_options") or {}
+    named = ", time_optimal " + ", ".join(f"{k} {v}" for k, v in options.items()) if options else ""
+    return Summary(case or f"{int(_num(p, 'fastest_sets'))} random keep-out sets{named}",
+                   "sets where time_optimal is slower than the verified first or smooth plan", violations, "",
+                   "none, every answer verified", violations == 0 and unverified == 0 and bool(_get(p, "passed")),
+                   {"unverified": unverified, "warm_start_answers": _num(p, "warm_start_answers"),
+                    "further_start_answers": _num(p, "further_start_answers"),
+                    "time_optimal_median_s": _num(seconds, "median"), "time_optimal_max_s": _num(seconds, "max")})
 
 
 def _cmd(template: str) -> Callable[[dict, str], str]:
@@ -344,6 +355,10 @@ STUDIES: tuple[Study, ...] = (
     Study("soak", lambda p: "dropped_state" in p, _soak, _cmd("att-bench soak --json {path}")),
     Study("cluster", lambda p: "throughput_ratio" in p, _cluster,
           _cmd("att-bench cluster --campaign {campaign} --runs {runs} --workers {workers} --json {path}")),
+    Study("fastest", lambda p: "fastest_sets" in p, _fastest,
+          lambda p, path: f"att-bench fastest --sets {p['fastest_sets']} --budget {p['budget_s']:g} "
+                          + (f"--options '{json.dumps(p['time_optimal_options'])}' " if p.get("time_optimal_options")
+                             else "") + f"--json {path}"),
 )
 BY_NAME = {s.name: s for s in STUDIES}
 

@@ -41,6 +41,8 @@ ROWS: tuple[tuple[str, str], ...] = (
     ("time-optimal", "ba1"),
     ("time-optimal", "bp2"),
     ("time-optimal", "ba2"),
+    ("fastest", "40 random keep-out sets"),
+    ("fastest", "40 random keep-out sets, time_optimal intervals 4, max_intervals 4"),
     ("schedule", "experiment A"),
     ("schedule", "experiment B"),
     ("schedule", "experiment C"),
