@@ -310,6 +310,8 @@ def _cluster(p: dict, case: str | None) -> Summary:
                     "cluster_runs_per_s": _num(p, "cluster"), "rows_equal": bool(_get(p, "rows_equal")),
                     "rss_growth_mib": _num(p, "rss_growth_mib"),
                     "rss_peak_mib": max(_num(w, "peak_mib") for w in workers) if workers else None})
+
+
 def _fastest(p: dict, case: str | None) -> Summary:
     violations, unverified = len(_get(p, "violations")), len(_get(p, "unverified"))
     seconds = _get(p, "time_optimal_seconds")
