@@ -26,6 +26,7 @@ PLAN_MANEUVER = "/planner/plan_maneuver"
 PLAN_SCHEDULE = "/planner/plan_schedule"
 SET_CONTROLLER_MODE = "/controller/set_mode"
 RESET_SIMULATOR = "/simulator/reset"
+HOLD_SIMULATOR = "/simulator/hold"
 EXECUTE_MANEUVER = "/controller/execute"
 
 # Topic -> ROS type name of everything the recorder writes.
@@ -79,6 +80,7 @@ ABOUT = {
                    "dwell, within its window, never while a zone covers it)",
     SET_CONTROLLER_MODE: "idle, magnetorquer PD, safe or pointing (a `PointingMode`); momentum dumping on or off",
     RESET_SIMULATOR: "reset attitude, rate, wheel speeds and orbit phase",
+    HOLD_SIMULATOR: "hold sim time (true) or let it run again (false); a hold ends after `max_hold_s` of wall time",
     EXECUTE_MANEUVER: "execute a plan (by id or inline), with feedback while it runs",
 }
 

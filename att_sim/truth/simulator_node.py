@@ -45,6 +45,12 @@ the estimator chain on a loaded machine) shows itself by commands too old to app
 from the publisher of the last accepted one puts the simulator back to waiting, so the chain
 catches up and the lockstep resumes instead of the simulator drowning it in states. A non-finite
 state stops the propagation (reported, the node stays up).
+
+Holding sim time: ``/simulator/hold`` (std_srvs/SetBool) with ``data: true`` stops the propagation
+after the current step (callbacks keep running, nothing is published) until ``data: false`` or
+``max_hold_s`` of wall time, whichever comes first; the real-time pacing counts from the release.
+A driver that must not race the simulator (a mission planning its next slew at ``real_time_factor``
+0) holds it while it waits, so what it flies never depends on how fast the machine is.
 """
 from __future__ import annotations
 
@@ -55,6 +61,7 @@ import rclpy
 from rclpy.node import Node
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import Imu, JointState, MagneticField
+from std_srvs.srv import SetBool
 from tf2_msgs.msg import TFMessage
 from visualization_msgs.msg import MarkerArray
 
@@ -90,6 +97,7 @@ class SimulatorNode(Node):
         self.pace = (0.0, 0.0)         # (wall, sim) time the real-time pacing counts from
         self.last_command_time = -np.inf
         self.refused = {"command": 0, "reset": 0}
+        self.held_until = None         # monotonic deadline of a /simulator/hold, None: not held
         try:
             truth = param["truth"] or dispersions.Truth(self.scenario, param["initial_attitude"],
                                                         param["initial_rate_rad_s"], param["seed"])
@@ -113,6 +121,7 @@ class SimulatorNode(Node):
         self.sim.command_source.live = live_publishers(self, topics.COMMAND)
         self.create_subscription(ActuatorCommand, topics.COMMAND, self.on_command, qos.STREAM_QOS)
         self.create_service(ResetSimulator, topics.RESET_SIMULATOR, self.on_reset)
+        self.create_service(SetBool, topics.HOLD_SIMULATOR, self.on_hold)
         e = self.sim.environment
         self.get_logger().info(
             f"scenario '{self.scenario.name}', step {self.step} s, RTF "
@@ -133,6 +142,7 @@ class SimulatorNode(Node):
         self.tf_rate = param("tf_rate_Hz", 1.0 / self.publish_period, high=top)
         self.marker_rate = param("marker_rate_Hz", min(1.0, 1.0 / self.step), high=top)
         self.real_time_factor = param("real_time_factor")
+        self.max_hold = param("max_hold_s")
         self.command_timeout = param("command_timeout_s")
         self.end_time = param("end_time_s")      # s of sim time; 0: run until stopped
         # Hold sim time at zero until this many subscribers (recorder, controller) see the state,
@@ -233,6 +243,32 @@ class SimulatorNode(Node):
         response.message = "state reset" if refusal is None else refusal.message
         return response
 
+    def on_hold(self, request: SetBool.Request, response: SetBool.Response):
+        t = self.sim.t
+        if request.data:
+            self.held_until = time.monotonic() + self.max_hold
+            response.message = f"sim time held at t = {t:.3f} s (at most {self.max_hold:g} s of wall time)"
+        else:
+            response.message = (f"sim time released at t = {t:.3f} s" if self.held_until is not None
+                                else f"sim time was not held (t = {t:.3f} s)")
+            self.release()
+        response.success = True
+        return response
+
+    def held(self) -> bool:
+        """Whether a /simulator/hold stops the propagation now (one that outlived ``max_hold_s`` is
+        released with a warning)."""
+        if self.held_until is not None and time.monotonic() > self.held_until:
+            self.get_logger().warning(f"sim time held for more than max_hold_s = {self.max_hold:g} s of wall time: "
+                                      f"released at t = {self.sim.t:.3f} s")
+            self.release()
+        return self.held_until is not None
+
+    def release(self) -> None:
+        if self.held_until is not None:
+            self.held_until = None
+            self.pace = (time.monotonic(), self.sim.t)
+
     def report(self, what: str, refusal: Refusal) -> None:
         """Log a refused command or reset: at most one line a second for each (a flood of commands
         cannot hide a refused reset), with the running count."""
@@ -275,6 +311,9 @@ class SimulatorNode(Node):
             if self.sim.halted:
                 executor.spin_once(timeout_sec=0.1)
                 continue
+            if self.held():
+                executor.spin_once(timeout_sec=0.05)
+                continue
             self.sim.command_timeout = (self.free_running
                                         or self.sim.t - self.last_command_time > self.command_timeout)
             self.sim.advance(self.step)
@@ -310,12 +349,14 @@ class SimulatorNode(Node):
         self.publish_readings()
         if k % clock_every == 0:
             self.clock_pub.publish(Clock(clock=convert.time_msg(t)))
-        self.publish_view(k)
         if k % state_every == 0:
             self.answered, self.awaited_stamp = False, t
             self.state_pub.publish(self.state_message())
+            self.publish_view(k)            # while the estimator and the controller answer the state
             if self.lockstep and not self.free_running:
                 self.wait_for_answer()
+        else:
+            self.publish_view(k)
 
     def wait_for_answer(self) -> None:
         """Lockstep: run callbacks until a command answers the state just published; after
