@@ -14,6 +14,7 @@ counted.
 """
 from __future__ import annotations
 
+import os
 import time
 from pathlib import Path
 
@@ -43,6 +44,15 @@ def rss_mib(pid: int) -> float:
     return float("nan")
 
 
+def cpu_seconds(pid: int) -> float:
+    """User plus system CPU time of process ``pid`` so far (s); NaN once it is gone."""
+    try:
+        fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
+    except (FileNotFoundError, IndexError):
+        return float("nan")
+    return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
+
+
 def soak_nodes(scenario: str) -> tuple[str, ...]:
     """The flight loop of ``scenario``: :func:`~att_planner.tools.launch.default_nodes` without the planner."""
     return tuple(n for n in default_nodes(scenario) if n != "planner")
@@ -70,6 +80,7 @@ def run_soak(scenario: str, orbits: float | None, out_dir: str | Path, sample_pe
     suite = start_suite(scenario, out / "soak.mcap", out, env=isolated_env(), nodes=nodes, params=params,
                         profile_dir=profile_dir)
     memory = {name: [] for name in suite.procs}
+    cpu = {name: [] for name in suite.procs}
     start = time.monotonic()
     try:
         # memory is sampled once every node has started (its imports and set-up are not growth)
@@ -78,6 +89,7 @@ def run_soak(scenario: str, orbits: float | None, out_dir: str | Path, sample_pe
         while time.monotonic() - start < timeout:
             for name, proc in suite.procs.items():
                 memory[name].append(rss_mib(proc.pid))
+                cpu[name].append(cpu_seconds(proc.pid))
             if END_LINE in suite.log_text("simulator") or not all(suite.alive().values()):
                 break
             time.sleep(sample_period)
@@ -109,6 +121,8 @@ def run_soak(scenario: str, orbits: float | None, out_dir: str | Path, sample_pe
               "dropped_state": expected - len(state),
               "memory": growth, "exit_codes": codes, "settling_orbits": settling_orbits,
               "reached_end": sim_time >= end_time - 1.0 / publish_rate}
+    # CPU each node used between its first sample (started) and its last (the end reached)
+    report["cpu_seconds"] = {name: float(np.nanmax(c) - c[0]) if len(c) > 1 else 0.0 for name, c in cpu.items()}
     if profile_dir is not None:
         report["profile"] = {name: profile_rows(Path(profile_dir) / f"{name}.prof") for name in nodes}
     return report
