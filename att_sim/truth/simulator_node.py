@@ -253,6 +253,7 @@ class SimulatorNode(Node):
                                 else f"sim time was not held (t = {t:.3f} s)")
             self.release()
         response.success = True
+        self.get_logger().info(response.message)
         return response
 
     def held(self) -> bool:
