@@ -34,8 +34,9 @@ def run(args) -> dict:
           f"(dropped {r['dropped_state']}); commands {r['command_messages']}; "
           f"lockstep suspended {r['lockstep_suspensions']} times")
     for name, m in r["memory"].items():
+        cpu = r["cpu_seconds"][name]
         print(f"  {name:10s} RSS {m['start_mib']:7.1f} -> {m['end_mib']:7.1f} MiB, "
-              f"CPU {r['cpu_seconds'][name]:6.1f} s ({r['cpu_seconds'][name] / r['sim_time'] * 1e3:.2f} ms per s of sim)")
+              f"CPU {cpu:6.1f} s ({cpu / r['sim_time'] * 1e3:.2f} ms per s of sim)")
     settling = "not within the run" if r["settling_orbits"] is None else f"{r['settling_orbits']:.3f} orbits"
     print(f"  magnetorquer settling (|q_i| <= {SETTLING_THRESHOLD}): {settling}; exit codes {r['exit_codes']}")
     for name, prof in r.get("profile", {}).items():
