@@ -46,6 +46,13 @@ class Hardware:
     magnetometer: bool
     tachometer: bool
 
+    @classmethod
+    def of(cls, n_wheels: int, sensors) -> Hardware:
+        """The hardware of a spacecraft of ``n_wheels`` wheels and the sensors ``sensors``
+        (:class:`att_sim.models.sensor_specs.SensorSpecs`)."""
+        return cls(wheels=n_wheels, star_trackers=len(sensors.star_trackers), gyro=sensors.gyro is not None,
+                   magnetometer=sensors.magnetometer is not None, tachometer=sensors.tachometer is not None)
+
     def count(self, component: str, kind: str) -> tuple[int, str]:
         """How many ``component`` units a ``kind`` fault can name, and what they are called."""
         if component == "wheel":
@@ -137,10 +144,9 @@ def spec(component: str, index: int, kind: str, factor=None, bias_rad=None, bias
                      bias_rad_s=0.0 if bias_rad_s is None else float(bias_rad_s))
 
 
-class Fault(Schema):
-    """One entry of a scenario's ``faults`` list: a hardware fault the truth starts at ``t_s``."""
+class FaultKind(Schema):
+    """What fails and how: a component, its index, a kind valid for it and the parameters of the kind."""
 
-    t_s: Annotated[Finite, Field(ge=0.0, le=MAX_ONSET_S)] = Field(description="sim time of the onset (s)")
     component: Literal[COMPONENTS] = Field(description="the failing component")
     index: int = Field(0, ge=0, le=63, description="wheel, star tracker, gyro axis or coil axis (0-based)")
     kind: str = Field(description="the fault: " + "; ".join(f"{c}: {', '.join(k)}" for c, k in KINDS.items()))
@@ -152,11 +158,23 @@ class Fault(Schema):
 
     @model_validator(mode="after")
     def _consistent(self):
-        problem = fault_problem(self.component, self.index, self.kind, self.factor, self.bias_rad, self.bias_rad_s,
-                                self.t_s)
+        problem = self.problem()
         if problem:
             raise ValueError(problem.phrase())
         return self
 
-    def spec(self) -> FaultSpec:
-        return spec(self.component, self.index, self.kind, self.factor, self.bias_rad, self.bias_rad_s, self.t_s)
+    def problem(self, hardware: Hardware | None = None) -> Problem | None:
+        """:func:`fault_problem` of this entry (on ``hardware``, when given)."""
+        return fault_problem(self.component, self.index, self.kind, self.factor, self.bias_rad, self.bias_rad_s,
+                             getattr(self, "t_s", 0.0), hardware)
+
+    def spec(self, t_s: float | None = None) -> FaultSpec:
+        """The fault starting at ``t_s`` (default: the entry's own onset)."""
+        onset = getattr(self, "t_s", 0.0) if t_s is None else t_s
+        return spec(self.component, self.index, self.kind, self.factor, self.bias_rad, self.bias_rad_s, onset)
+
+
+class Fault(FaultKind):
+    """One entry of a scenario's ``faults`` list: a hardware fault the truth starts at ``t_s``."""
+
+    t_s: Annotated[Finite, Field(ge=0.0, le=MAX_ONSET_S)] = Field(description="sim time of the onset (s)")

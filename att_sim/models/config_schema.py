@@ -36,7 +36,7 @@ from att_sim.models.config_base import (
     limit,
     number,
 )
-from att_sim.models.config_faults import MAX_FAULTS, Fault, Hardware, fault_problem
+from att_sim.models.config_faults import MAX_FAULTS, Fault, Hardware
 from att_sim.models.config_sensors import Sensors
 
 IDENTITY_AXES = (1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0)
@@ -257,7 +257,7 @@ class Shared(Sky):
     def _faults_on_hardware(self):
         hardware = self.hardware()
         for k, f in enumerate(self.faults):
-            problem = fault_problem(f.component, f.index, f.kind, f.factor, f.bias_rad, f.bias_rad_s, f.t_s, hardware)
+            problem = f.problem(hardware)
             if problem:
                 raise ValueError(problem.phrase(f"faults[{k}]."))
         return self

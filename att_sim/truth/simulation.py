@@ -124,9 +124,7 @@ class Simulation:
         self.arg0 = self._arg0()
         sensors, actuators = sensors or SensorSpecs(), actuators or ActuatorSpecs()
         self.seed = sensors.seed if seed is None else int(seed)
-        self.hardware = Hardware(wheels=sc.n_wheels, star_trackers=len(sensors.star_trackers),
-                                 gyro=sensors.gyro is not None, magnetometer=sensors.magnetometer is not None,
-                                 tachometer=sensors.tachometer is not None)
+        self.hardware = Hardware.of(sc.n_wheels, sensors)
         self.faults = Faults(self.hardware, body_frame_id)
         self.allow_fault_injection = allow_fault_injection      # :meth:`request_fault` schedules (else refuses)
         for fault in faults:
@@ -146,14 +144,18 @@ class Simulation:
     @classmethod
     def for_scenario(cls, scenario, q0=rot.IDENTITY, omega0=(0, 0, 0), wheel_speed0=None,
                      gravity_gradient: bool | None = None, checks: Checks = Checks(),
-                     seed: int | None = None) -> Simulation:
+                     seed: int | None = None, dispersed_faults: tuple = ()) -> Simulation:
         """The simulation of a :class:`att_sim.models.scenario.Scenario` in its environment, with its
-        sensors and actuators (``gravity_gradient`` and ``seed``, when given, override the scenario's)."""
-        return cls(scenario.spacecraft, q0=q0, omega0=omega0, wheel_speed0=wheel_speed0, checks=checks,
-                   environment=world.Environment.from_scenario(scenario, gravity_gradient),
-                   sensors=scenario.sensors, actuators=scenario.actuators, seed=seed, frame_id=scenario.frame_id,
-                   body_frame_id=scenario.body_frame_id, faults=scenario.faults,
-                   allow_fault_injection=scenario.allow_fault_injection)
+        sensors and actuators (``gravity_gradient`` and ``seed``, when given, override the scenario's),
+        its faults and the ``dispersed_faults`` a Monte Carlo run drew (:mod:`att_sim.truth.dispersions`)."""
+        sim = cls(scenario.spacecraft, q0=q0, omega0=omega0, wheel_speed0=wheel_speed0, checks=checks,
+                  environment=world.Environment.from_scenario(scenario, gravity_gradient),
+                  sensors=scenario.sensors, actuators=scenario.actuators, seed=seed, frame_id=scenario.frame_id,
+                  body_frame_id=scenario.body_frame_id, faults=scenario.faults,
+                  allow_fault_injection=scenario.allow_fault_injection)
+        for fault in dispersed_faults:
+            sim.faults.schedule(fault, FaultSource.DISPERSION)
+        return sim
 
     def inject(self, fault: FaultSpec, source: FaultSource = FaultSource.SERVICE) -> Refusal | None:
         """Schedule ``fault`` (its onset at or before now: at the next step) or say why it cannot be

@@ -120,7 +120,8 @@ class SimulatorNode(Node):
                 checks=Checks(command_limit_factor=param["command_limit_factor"],
                               max_reset_rate=param["max_reset_rate_rad_s"],
                               body_frame_id=self.scenario.body_frame_id,
-                              stamp_ahead=self.step, stamp_age=self.command_timeout), seed=truth.seed)
+                              stamp_ahead=self.step, stamp_age=self.command_timeout), seed=truth.seed,
+                dispersed_faults=truth.faults)
         except ValueError as err:        # the environment cannot start (e.g. a TLE that fails at t = 0)
             raise ConfigError(ErrorCode.INVALID_CONFIG, f"scenario '{self.scenario.name}': {clip(err, 300)}") from None
 
