@@ -28,6 +28,12 @@ orbit, field model, disturbances, epoch = sim time zero); the state's position i
 Parameters come from the scenario file (``scenario`` parameter), overridable by ROS parameters;
 each is type- and range-checked, and a bad one stops the node with one line on stderr (exit 2).
 
+Faults (:mod:`att_sim.truth.faults`): the scenario's ``faults`` start at their onset, and
+``/simulator/inject_fault`` (att_msgs/InjectFault) schedules one more when the scenario sets
+``allow_fault_injection`` (else it answers FAULT_INJECTION_DISABLED); a refused request changes nothing
+and the simulator keeps running. Every fault started is published, latched, on ``/simulator/faults``
+(att_msgs/FaultEvent, stamped with its onset), for evaluation only.
+
 Safety: a command or reset above the size caps of :mod:`att_msgs_py.limits` is refused (SIZE_LIMIT)
 before it is read; every command and reset is checked by :class:`~att_sim.truth.simulation.Simulation` (sizes,
 NaN/Inf, magnitude against ``command_limit_factor`` × the limits, stamp, frame, text); a refused one
@@ -65,8 +71,16 @@ from std_srvs.srv import SetBool
 from tf2_msgs.msg import TFMessage
 from visualization_msgs.msg import MarkerArray
 
-from att_msgs.msg import ActuatorCommand, CoarseSunSensors, SensorTruth, SpacecraftState, StarTracker, ZoneMargins
-from att_msgs.srv import ResetSimulator
+from att_msgs.msg import (
+    ActuatorCommand,
+    CoarseSunSensors,
+    FaultEvent,
+    SensorTruth,
+    SpacecraftState,
+    StarTracker,
+    ZoneMargins,
+)
+from att_msgs.srv import InjectFault, ResetSimulator
 from att_msgs_py import convert, limits, markers, memory, qos, topics, validation
 from att_msgs_py.errors import ConfigError, ErrorCode, RequestError, clip
 from att_msgs_py.node_runner import (
@@ -96,7 +110,7 @@ class SimulatorNode(Node):
         self.free_running = False      # lockstep suspended: no command answered a state in time
         self.pace = (0.0, 0.0)         # (wall, sim) time the real-time pacing counts from
         self.last_command_time = -np.inf
-        self.refused = {"command": 0, "reset": 0}
+        self.refused = {"command": 0, "reset": 0, "fault": 0}
         self.held_until = None         # monotonic deadline of a /simulator/hold, None: not held
         try:
             truth = param["truth"] or dispersions.Truth(self.scenario, param["initial_attitude"],
@@ -106,7 +120,8 @@ class SimulatorNode(Node):
                 checks=Checks(command_limit_factor=param["command_limit_factor"],
                               max_reset_rate=param["max_reset_rate_rad_s"],
                               body_frame_id=self.scenario.body_frame_id,
-                              stamp_ahead=self.step, stamp_age=self.command_timeout), seed=truth.seed)
+                              stamp_ahead=self.step, stamp_age=self.command_timeout), seed=truth.seed,
+                dispersed_faults=truth.faults)
         except ValueError as err:        # the environment cannot start (e.g. a TLE that fails at t = 0)
             raise ConfigError(ErrorCode.INVALID_CONFIG, f"scenario '{self.scenario.name}': {clip(err, 300)}") from None
 
@@ -122,6 +137,8 @@ class SimulatorNode(Node):
         self.create_subscription(ActuatorCommand, topics.COMMAND, self.on_command, qos.STREAM_QOS)
         self.create_service(ResetSimulator, topics.RESET_SIMULATOR, self.on_reset)
         self.create_service(SetBool, topics.HOLD_SIMULATOR, self.on_hold)
+        self.fault_pub = self.create_publisher(FaultEvent, topics.SIM_FAULTS, qos.MISSION_QOS)
+        self.create_service(InjectFault, topics.INJECT_FAULT, self.on_inject_fault)
         e = self.sim.environment
         self.get_logger().info(
             f"scenario '{self.scenario.name}', step {self.step} s, RTF "
@@ -270,15 +287,33 @@ class SimulatorNode(Node):
             self.held_until = None
             self.pace = (time.monotonic(), self.sim.t)
 
+    def on_inject_fault(self, request: InjectFault.Request, response: InjectFault.Response):
+        refusal = limits.issue(request, limits.INJECT_FAULT)
+        if refusal is None:
+            refusal = self.sim.request_fault(request.component, request.index, request.kind, request.factor,
+                                             np.asarray(request.bias_rad, float), request.bias_rad_s, request.t_s)
+        else:
+            refusal = Refusal(refusal.code, refusal.message)
+        if refusal is not None:
+            self.report("fault", refusal)
+        response.success = refusal is None
+        response.error_code = 0 if refusal is None else int(refusal.code)
+        response.message = (f"{request.component}[{request.index}] {request.kind} scheduled at t = "
+                             f"{max(request.t_s, self.sim.t):.3f} s" if refusal is None else refusal.message)
+        return response
+
     def report(self, what: str, refusal: Refusal) -> None:
-        """Log a refused command or reset: at most one line a second for each (a flood of commands
-        cannot hide a refused reset), with the running count."""
+        """Log a refused command, reset or fault injection: at most one line a second for each (a flood
+        of commands cannot hide a refused reset), with the running count."""
         self.refused[what] += 1
         if refusal.code == ErrorCode.SIZE_LIMIT:
             memory.trim()                # the refused message's deserialised copy goes back to the system
-        line = clip(f"{'actuator command' if what == 'command' else 'reset'} rejected [{int(refusal.code)} "
-                    f"{refusal.code.name}] ({self.refused[what]} so far): {refusal.message}")
-        if what == "command":            # two call sites: rclpy throttles each call site separately
+        name = {"command": "actuator command", "reset": "reset", "fault": "fault injection"}[what]
+        line = clip(f"{name} rejected [{int(refusal.code)} {refusal.code.name}] ({self.refused[what]} so far): "
+                    f"{refusal.message}")
+        if what == "command":            # one call site each: rclpy throttles each call site separately
+            self.get_logger().warning(line, throttle_duration_sec=1.0)
+        elif what == "reset":
             self.get_logger().warning(line, throttle_duration_sec=1.0)
         else:
             self.get_logger().warning(line, throttle_duration_sec=1.0)
@@ -348,6 +383,10 @@ class SimulatorNode(Node):
     def publish(self, k: int, state_every: int, clock_every: int):
         t = self.sim.t
         self.publish_readings()
+        for event in self.sim.faults.take_events():
+            self.fault_pub.publish(convert.fault_event_msg(event))
+            self.get_logger().warning(f"fault injected at t = {event.t:.3f} s ({event.source}): {event.component}"
+                                      f"[{event.index}] {event.kind}")
         if k % clock_every == 0:
             self.clock_pub.publish(Clock(clock=convert.time_msg(t)))
         if k % state_every == 0:
