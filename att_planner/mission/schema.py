@@ -13,17 +13,10 @@ from pydantic import AfterValidator, ConfigDict, Discriminator, Field, Tag, fiel
 
 from att_msgs_py.limits import MAX_TARGETS
 from att_msgs_py.types import SECONDARY_KINDS
-from att_sim.models.config_base import Name, Schema, Vector3, number
+from att_sim.models.config_base import Name, Schema, Vector3, distinct_names, near_unit, number
 
 AXIS_TOLERANCE = 1e-6          # |‖v‖ − 1| accepted for a mission's body axis
 MAX_DWELL_S = 86_400.0
-
-
-def _unit_axis(v: list[float]) -> list[float]:
-    norm = float(np.linalg.norm(v))
-    if abs(norm - 1.0) > AXIS_TOLERANCE:
-        raise ValueError(f"a unit 3-vector (norm within {AXIS_TOLERANCE:g} of 1), got norm {norm:.9g}")
-    return v
 
 
 def _non_zero(v: list[float]) -> list[float]:
@@ -32,15 +25,11 @@ def _non_zero(v: list[float]) -> list[float]:
     return v
 
 
-def _distinct_names(items: list) -> list:
-    names = [t.name for t in items]
-    repeat = next((n for i, n in enumerate(names) if n in names[:i]), None)
-    if repeat is not None:
-        raise ValueError(f"distinct names, got '{repeat}' twice")
-    return items
+def _distinct_targets(items: list) -> list:
+    return distinct_names(items, "target")
 
 
-UnitAxis = Annotated[Vector3, AfterValidator(_unit_axis)]
+UnitAxis = Annotated[Vector3, AfterValidator(near_unit(AXIS_TOLERANCE))]
 Secondary = Literal[tuple(k for k in SECONDARY_KINDS if k != "inertial")]
 
 
@@ -119,7 +108,7 @@ class InertialTargets(Schema):
     scenario: Name = Field(description="the scenario the targets are observed from")
     roll_reference: Annotated[Vector3, AfterValidator(_non_zero)] = Field(
         [0.0, 0.0, 1.0], description="inertial direction the roll axis is kept nearest")
-    targets: Annotated[list[Source], Field(min_length=1, max_length=MAX_TARGETS), AfterValidator(_distinct_names)]
+    targets: Annotated[list[Source], Field(min_length=1, max_length=MAX_TARGETS), AfterValidator(_distinct_targets)]
 
 
 class GroundTargets(Schema):
@@ -127,7 +116,7 @@ class GroundTargets(Schema):
     scenario: Name = Field(description="the scenario the sites are observed from")
     min_elevation_deg: float = number(0.0, ge=0.0, le=89.0, unit="deg", meaning="a site is observable while the "
                                                                                 "spacecraft is this high in its sky")
-    targets: Annotated[list[Site], Field(min_length=1, max_length=MAX_TARGETS), AfterValidator(_distinct_names)]
+    targets: Annotated[list[Site], Field(min_length=1, max_length=MAX_TARGETS), AfterValidator(_distinct_targets)]
 
 
 def _kind(value) -> str | None:

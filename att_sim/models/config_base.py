@@ -37,18 +37,23 @@ def _finite(x: float) -> float:
 
 
 def distinct_names(items: list, what: str) -> list:
-    """``items`` when their ``name`` fields differ (a validator's ValueError naming them otherwise)."""
+    """``items`` when their ``name`` fields differ (a validator's ValueError naming the first repeated
+    one otherwise)."""
     names = [item.name for item in items]
-    if len(set(names)) != len(names):
-        raise ValueError(f"distinct {what} names, got {', '.join(names)}")
+    repeat = next((n for i, n in enumerate(names) if n in names[:i]), None)
+    if repeat is not None:
+        raise ValueError(f"distinct {what} names, got '{repeat}' twice")
     return items
 
 
-def _norm_near_one(v: list[float]) -> list[float]:
-    norm = float(np.linalg.norm(v))
-    if abs(norm - 1.0) > UNIT_TOLERANCE:
-        raise ValueError(f"a unit vector (norm within {UNIT_TOLERANCE:g} of 1), got norm {norm:.6g}")
-    return v
+def near_unit(tolerance: float = UNIT_TOLERANCE):
+    """A validator of a vector whose norm is within ``tolerance`` of 1."""
+    def check(v: list[float]) -> list[float]:
+        norm = float(np.linalg.norm(v))
+        if abs(norm - 1.0) > tolerance:
+            raise ValueError(f"a unit vector (norm within {tolerance:g} of 1), got norm {norm:.9g}")
+        return v
+    return check
 
 
 def _unit_triples(v: list[float]) -> list[float]:
@@ -74,10 +79,10 @@ def _printable(name: str) -> str:
 
 Finite = Annotated[float, AfterValidator(_finite)]
 Vector3 = Annotated[list[Finite], Field(min_length=3, max_length=3)]
-UnitVector3 = Annotated[Vector3, AfterValidator(_norm_near_one)]
+UnitVector3 = Annotated[Vector3, AfterValidator(near_unit())]
 UnitVectors = Annotated[list[Finite], Field(max_length=3 * 64), AfterValidator(_triples),
                         AfterValidator(_unit_triples)]
-Quaternion = Annotated[list[Finite], Field(min_length=4, max_length=4), AfterValidator(_norm_near_one)]
+Quaternion = Annotated[list[Finite], Field(min_length=4, max_length=4), AfterValidator(near_unit())]
 Name = Annotated[str, Field(min_length=1, max_length=MAX_NAME), AfterValidator(_printable)]
 
 

@@ -194,7 +194,8 @@ EDITS = {
     "node section a number": ("scenario", "simulator:\n  ros__parameters:\n    step: 0.05\n", "simulator: 3\n",
                               "simulator", "valid dictionary"),
     # missions
-    "mission axis not unit": ("mission", "[0.0, 1.0, 0.0]", "[0.0, 1.5, 0.0]", "sensor_axis", "unit 3-vector"),
+    "mission axis not unit": ("mission", "[0.0, 1.0, 0.0]", "[0.0, 1.5, 0.0]", "sensor_axis",
+                              "unit vector (norm within 1e-06 of 1)"),
     "mission horizon missing": ("mission", "horizon_s: 3600\n", "", "horizon_s", "required"),
     "mission horizon in hours": ("mission", "horizon_s: 3600", "horizon_h: 1", "horizon_h", "horizon_s"),
     "mission rate a word": ("mission", "rate_Hz: 5.0", "rate_Hz: fast", "rate_Hz", "valid number"),
@@ -204,7 +205,7 @@ EDITS = {
     # target lists
     "targets kind unknown": ("targets", "kind: inertial", "kind: sky", "kind", "'inertial' or 'ground'"),
     "target ra 400": ("targets", "ra_deg: 83.6", "ra_deg: 400", "targets[0].ra_deg", "less than or equal to 360"),
-    "target names repeated": ("targets", "name: vega", "name: crab", "targets", "distinct names"),
+    "target names repeated": ("targets", "name: vega", "name: crab", "targets", "distinct target names"),
     "target dwell in minutes": ("targets", "dwell_s: 600", "dwell_min: 10", "targets[0].dwell_min", "dwell_s"),
     "targets unknown scenario": ("targets", "scenario: leo_observatory", "scenario: nowhere", "scenario",
                                  "the name of a scenario"),

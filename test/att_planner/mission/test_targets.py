@@ -83,7 +83,7 @@ HOSTILE = {
     "name with a control": ({"targets": [{"name": "a\x01", "ra_deg": 1, "dec_deg": 2, "dwell_s": 1}]},
         "targets[0].name: expected a printable name"),
     "names repeat": ({"targets": [{"name": "a", "ra_deg": 1, "dec_deg": 2, "dwell_s": 1}] * 2},
-        "targets: expected distinct names, got 'a' twice"),
+        "targets: expected distinct target names, got 'a' twice"),
     "roll reference zero": ({"roll_reference": [0, 0, 0]}, "roll_reference: expected a non-zero 3-vector"),
     "ground site at latitude 100": ({"kind": "ground", "targets": [{"name": "x", "lat_deg": 100, "lon_deg": 0,
                                                                     "dwell_s": 1}]},

@@ -231,7 +231,7 @@ BAD = {
                                        "keep_in": "no"}]), "zones[0].keep_in"),
     "duplicate zone names": (dict(zones=[{"name": "x", "body": "sun", "sensor_axis": [0, 1, 0], "half_angle_deg": 9},
                                          {"name": "x", "body": "moon", "sensor_axis": [0, 1, 0],
-        "half_angle_deg": 9}]), "zones: expected distinct zone names, got x, x"),
+        "half_angle_deg": 9}]), "zones: expected distinct zone names, got 'x' twice"),
 }
 
 
