@@ -265,7 +265,7 @@ def _end_on_pointing(problem: ManeuverProblem, req: ManeuverRequest, method: Met
     law = goal_law(req.end_pointing, scenario, problem.epoch, problem.q_initial)
     problem.q_final = law(0.0)[0]
     problem.q_final = law(problem.slew_time_bound())[0]
-    problem.goal_motion = MovingGoal(law, problem.zone_sky().window)
+    problem.goal_motion = MovingGoal(law, problem.zone_sky().window, req.end_pointing.kind)
 
 
 def check_wheel_speeds(speeds, sc: Spacecraft) -> np.ndarray | None:
