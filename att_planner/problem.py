@@ -75,6 +75,15 @@ class MovingGoal:
         value = clenshaw(np.array([[2.0 * t / self.window - 1.0]]), list(self.coefficients))[0]
         return value[:4] / np.linalg.norm(value[:4]), value[4:]
 
+    def series(self, t) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The series at the times ``t`` (K,) at once: unit attitudes (K, 4), rates (K, 3) and the rates'
+        derivatives (K, 3) (the derivative of the rate's series)."""
+        x = 2.0 * np.asarray(t, float) / self.window - 1.0
+        value = np.polynomial.chebyshev.chebval(x, self.coefficients).T
+        rate_dot = np.polynomial.chebyshev.chebval(x, np.polynomial.chebyshev.chebder(self.coefficients[:, 4:])).T
+        return (value[:, :4] / np.linalg.norm(value[:, :4], axis=1, keepdims=True), value[:, 4:],
+                rate_dot * 2.0 / self.window)
+
     def __getstate__(self) -> dict:
         return {**self.__dict__, "law": None}          # the law's sky does not travel: its series does
 

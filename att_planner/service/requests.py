@@ -40,7 +40,8 @@ MAX_TIME_BUDGET = 600.0        # s
 MAX_DWELL = 86_400.0           # s: a schedule target's observation, at most a day
 MAX_WINDOW = 7 * 86_400.0      # s: a schedule target's window opens within a week of the start
 SAME_TARGET = 1e-6             # rad: schedule targets closer than this are one attitude (q and -q too)
-END_POINTING_METHOD = "time_optimal"   # the method that ends a slew on a moving pointing mode
+# the methods that end a slew on a moving pointing mode (graph_smooth: the first plan's construction)
+END_POINTING_METHODS = ("time_optimal", "smooth_collocation", "graph_smooth")
 
 
 @dataclass
@@ -256,10 +257,11 @@ def load_scenario(name: str) -> scen.Scenario:
 def _end_on_pointing(problem: ManeuverProblem, req: ManeuverRequest, method: Method, scenario: scen.Scenario) -> None:
     """Make ``problem``'s goal the moving one of ``req.end_pointing`` (:mod:`.moving_goal`); its
     ``q_final`` the law's attitude after the eigenaxis slew time to where the law is at the start."""
-    if method.name != END_POINTING_METHOD:
+    if method.name not in END_POINTING_METHODS:
         raise RequestError(ErrorCode.INVALID_OPTION,
-                           f"end_pointing: a slew that ends on a pointing mode is planned by {END_POINTING_METHOD}; "
-                           f"{method.name} plans rest-to-rest (execute it with point_after: the controller blends)")
+                           f"end_pointing: a slew that ends on a pointing mode is planned by "
+                           f"{', '.join(END_POINTING_METHODS)}; {method.name} plans rest-to-rest (execute it with "
+                           "point_after: the controller blends)")
     if req.semi_free:
         raise RequestError(ErrorCode.INVALID_OPTION, "end_pointing and semi_free exclude each other")
     law = goal_law(req.end_pointing, scenario, problem.epoch, problem.q_initial)

@@ -351,9 +351,7 @@ def _build(problem: ManeuverProblem, s: Scaling, mesh: np.ndarray, control: str,
     tr = col.Transcription([phase], duration_copies=duration_copies, parametric=True, extra_parameters=len(goal))
     v = tr.variables(0)
     q_end = v.x_end[:4]
-    if problem.goal_motion is not None:            # on the moving goal at t_f, at its rate
-        if smooth:
-            raise ValueError("a moving goal is time_optimal's: the smooth plans end at rest")
+    if problem.goal_motion is not None:            # on the moving goal at t_f, at its rate (smooth: any torque)
         rows = [tr.extra[2 + 7 * i:9 + 7 * i] for i in range((len(goal) - 2) // 7)]
         target = clenshaw(tr.extra[0] * v.duration + tr.extra[1], rows)
         tr.add_constraint(symbolic.error_vector(q_end, target[:4]), 0.0, 0.0)

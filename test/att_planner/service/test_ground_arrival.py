@@ -1,4 +1,5 @@
-"""Slews that end on a moving ground site, one per geometry: planned through the planner service,
+"""Slews that end on a moving ground site, one per geometry and method (time_optimal,
+smooth_collocation and the first plan): planned through the planner service,
 the plan's controls integrated through the prediction model end on the site's line of sight and
 rate at t_f, recomputed here from the pointing law (its attitude, central differences of it)."""
 from __future__ import annotations
@@ -9,7 +10,7 @@ import numpy as np
 import pytest
 
 from att_msgs_py.errors import ErrorCode
-from att_msgs_py.types import PointingMode
+from att_msgs_py.types import PointingMode, Stage
 from att_planner.guidance import reference
 from att_planner.guidance.ground_arrival import site_in_view
 from att_planner.guidance.laws import PointingGeometry
@@ -69,12 +70,15 @@ def test_the_goal_series_follows_a_ground_site_over_the_whole_window():
         assert rot.angle_between(q, q_law) < 1e-5 and np.linalg.norm(w - w_law) < 1e-7
 
 
+@pytest.mark.parametrize("method", ["time_optimal", "smooth_collocation", "graph_smooth"])
 @pytest.mark.parametrize("geometry", GEOMETRIES)
-def test_a_time_optimal_slew_ends_on_the_moving_site(geometry):
+def test_the_slew_ends_on_the_moving_site(geometry, method):
+    """Each method's plan (graph_smooth: the first plan's construction) is the answer, verified."""
     mode = ground_mode(geometry)
-    valid = validate(mode)
+    valid = validate(mode, method)
     outcome = plan_maneuver(valid)
-    assert outcome.code == ErrorCode.OK, outcome.message
+    assert outcome.code == ErrorCode.OK and outcome.stage == Stage.METHOD, outcome.message
+    assert all(stage.verified for stage in outcome.stages)
     ver = outcome.plan.verification
     assert ver.goal == "ground"
     attitude, rate = arrival_errors(valid, outcome.plan, mode)
