@@ -9,11 +9,14 @@ mesh interval, with ``|a_j| ≤ a_max`` (``torque_accel``, T̄ per τ_u²)::
     ω̃ = u = u̇ = 0 at both ends,  the final attitude and every zone as in :mod:`.planner`.
 
 A moving goal (``problem.goal_motion``) replaces the end at rest by the goal's attitude and rate at
-t_f (the terminal condition of :mod:`.planner`, on the goal's series) with the torque and its
-derivative at t_f free within the bounds: the goal's own tracking torque can exceed T̄ near a
-ground pass, where an end torque tied to it would leave no solution. Such a plan is not slowed down
-to keep T̄ between the collocation points (:func:`smooth_plan`): where its torque bulges past T̄ the
-NLP is solved again with ``|u|`` bounded by ``1/(bulge (1 + TORQUE_ROOM))²``.
+t_f (the terminal condition of :mod:`.planner`, on the goal's series) and the torque at t_f by the
+one that tracks the goal, ``J̃ ω̃̇_g + ω̃_g × J̃ ω̃_g`` (the derivative of the rate's series), so the
+controller's feedforward continues without a step at the hand-over
+(:func:`.model.ties_end_torque`: when that torque stays within T̄ over the goal's window; near a
+ground pass of a slow spacecraft it does not, and the end torque is left free within the bound).
+Such a plan is not slowed down to keep T̄ between the collocation points (:func:`smooth_plan`):
+where its torque bulges past T̄ the NLP is solved again with ``|u|`` bounded by
+``1/(bulge (1 + TORQUE_ROOM))²``.
 
 So the torque is piecewise quadratic with a continuous derivative (C¹) and it and its rate vanish at
 both ends; ``a_max`` bounds how fast it swings (from −T̄ to +T̄ at rest in ``2 sqrt(2/a_max)`` τ_u): as
