@@ -54,13 +54,43 @@ def earth_axis_N(geometry: PointingGeometry, t: float) -> np.ndarray:
 
 
 def site_state_N(geometry: PointingGeometry, site_E: np.ndarray, t: float) -> tuple[np.ndarray, np.ndarray]:
-    """The inertial position (m) and velocity (m/s) of the Earth-fixed point ``site_E`` (ITRS, m) at ``t``."""
+    """The inertial position and velocity of an Earth-fixed point.
+
+    Parameters
+    ----------
+    geometry : PointingGeometry
+        The onboard geometry (its ``dcm_EN``: the Earth rotation model).
+    site_E : ndarray, shape (3,)
+        The point in ITRS (m).
+    t : float
+        Time (s past the scenario's epoch).
+
+    Returns
+    -------
+    s_N, s_dot_N : ndarray, shape (3,)
+        Position (m) and velocity (m/s) in inertial axes, ``s_dot_N = ω_E k_N × s_N``.
+    """
     s_N = np.asarray(geometry.dcm_EN(t)).T @ site_E
     return s_N, EARTH_ROTATION_RATE * rot.cross(earth_axis_N(geometry, t), s_N)
 
 
 def line_of_sight(geometry: PointingGeometry, site_E: np.ndarray, t: float) -> tuple[np.ndarray, np.ndarray]:
-    """The unit line of sight ``P`` from the spacecraft to the site and its derivative ``Ṗ`` (1/s) at ``t``."""
+    """The unit line of sight from the spacecraft to an Earth-fixed point and its derivative.
+
+    Parameters
+    ----------
+    geometry : PointingGeometry
+        The onboard geometry (orbit state and Earth rotation model).
+    site_E : ndarray, shape (3,)
+        The point in ITRS (m).
+    t : float
+        Time (s past the scenario's epoch).
+
+    Returns
+    -------
+    P, P_dot : ndarray, shape (3,)
+        ``P = d/|d|``, ``d = s_N − r_N``, and ``Ṗ = (ḋ − P (P·ḋ))/|d|`` (1/s), inertial axes.
+    """
     r_N, v_N = geometry.state_N(t)
     s_N, s_dot_N = site_state_N(geometry, site_E, t)
     d, d_dot = s_N - r_N, s_dot_N - v_N
@@ -70,17 +100,48 @@ def line_of_sight(geometry: PointingGeometry, site_E: np.ndarray, t: float) -> t
 
 
 def triad_rate(frame: np.ndarray, frame_dot: np.ndarray) -> np.ndarray:
-    """The inertial angular velocity ``½ Σ e_i × ė_i`` of the orthonormal triad whose columns are ``frame``."""
+    """The inertial angular velocity of an orthonormal triad.
+
+    Parameters
+    ----------
+    frame, frame_dot : ndarray, shape (3, 3)
+        The triad's unit vectors as columns, and their derivatives.
+
+    Returns
+    -------
+    ndarray, shape (3,)
+        ``ω = ½ Σ e_i × ė_i`` (the axial vector of ``Ṙ Rᵀ``; Schaub & Junkins §3.2).
+    """
     return 0.5 * sum(rot.cross(frame[:, i], frame_dot[:, i]) for i in range(3))
 
 
 def ground_motion(geometry: PointingGeometry, latitude: float, longitude: float, altitude: float,
                   primary_B, secondary_B, secondary_N: Callable, yaw: float = 0.0
                   ) -> Callable[[float], tuple[np.ndarray, np.ndarray]]:
-    """``t ↦ (q_RN, ω_RN_R)``: the attitude putting body ``primary_B`` on the line of sight to the site
-    (geodetic ``latitude``, ``longitude`` in rad, ``altitude`` in m) and ``secondary_B`` nearest
-    ``secondary_N(t)``, turned by ``yaw`` about the primary, and its body rate (module docstring).
-    ValueError where the line of sight and the secondary direction are parallel."""
+    """The attitude and body rate that look at a ground site, as a function of time (module docstring).
+
+    Parameters
+    ----------
+    geometry : PointingGeometry
+        The onboard geometry: orbit state and Earth rotation model.
+    latitude, longitude : float
+        The site's geodetic latitude and longitude on WGS-84 (rad).
+    altitude : float
+        Its altitude above the ellipsoid (m).
+    primary_B, secondary_B : array_like, shape (3,)
+        The body axis put on the line of sight, and the one kept nearest the secondary direction.
+    secondary_N : callable
+        ``t ↦`` the unit secondary direction (inertial axes), e.g. of :func:`.laws.directions`.
+    yaw : float, optional
+        Rotation about the primary axis after the alignment (rad).
+
+    Returns
+    -------
+    callable
+        ``t ↦ (q_RN, ω_RN_R)``: the attitude ([x, y, z, w], body to inertial) and the target frame's
+        body rate (rad/s, its own axes). It raises ValueError where the line of sight and the
+        secondary direction are parallel.
+    """
     site_E = geodetic_to_itrs(latitude, longitude, altitude)
     yaw_q = rot.from_axis_angle(np.asarray(primary_B, float), yaw) if yaw else None
 
@@ -106,9 +167,21 @@ def ground_motion(geometry: PointingGeometry, latitude: float, longitude: float,
 
 
 def itrs_to_geodetic(p_E, iterations: int = 6) -> tuple[float, float, float]:
-    """Geodetic latitude, longitude (rad) and altitude (m) on WGS-84 of the ITRS point ``p_E`` (m), by
-    the fixed-point iteration of ``tan φ = z / (ρ (1 − e² N/(N + h)))`` (converged to 1e-12 rad within
-    a few steps below 100 km)."""
+    """Geodetic coordinates on WGS-84 of an ITRS point.
+
+    Parameters
+    ----------
+    p_E : array_like, shape (3,)
+        The point in ITRS (m).
+    iterations : int, optional
+        Steps of the fixed-point iteration ``tan φ = z / (ρ (1 − e² N/(N + h)))`` (converged to
+        1e-12 rad within a few below 100 km).
+
+    Returns
+    -------
+    latitude, longitude, altitude : float
+        rad, rad, m.
+    """
     x, y, z = (float(v) for v in p_E)
     rho = math.hypot(x, y)
     lat = math.atan2(z, rho * (1.0 - WGS84_E2))
@@ -122,10 +195,30 @@ def itrs_to_geodetic(p_E, iterations: int = 6) -> tuple[float, float, float]:
 
 
 def site_in_view(geometry: PointingGeometry, t: float, off_nadir: float, azimuth: float = 0.0) -> tuple[float, float]:
-    """Geodetic latitude and longitude (rad) of the point of the WGS-84 ellipsoid seen at ``t`` from the
-    spacecraft ``off_nadir`` rad from its nadir (``−r̂``), towards ``azimuth`` rad from the along-track
-    direction ``v⊥`` about the nadir (0: ahead, π: behind, π/2: towards ``−r̂ × v⊥``); ValueError
-    when that line misses the Earth."""
+    """The ground point seen from the spacecraft in a given direction from its nadir.
+
+    Parameters
+    ----------
+    geometry : PointingGeometry
+        The onboard geometry: orbit state and Earth rotation model.
+    t : float
+        Time (s past the scenario's epoch).
+    off_nadir : float
+        Angle of the line of sight from the nadir ``−r̂`` (rad).
+    azimuth : float, optional
+        Its direction about the nadir from the along-track ``v⊥`` (rad): 0 ahead, π behind, π/2
+        towards ``−r̂ × v⊥``.
+
+    Returns
+    -------
+    latitude, longitude : float
+        Geodetic, on the WGS-84 ellipsoid (rad).
+
+    Raises
+    ------
+    ValueError
+        When the line of sight misses the Earth.
+    """
     r_N, v_N = geometry.state_N(t)
     nadir = -r_N / np.linalg.norm(r_N)
     along = v_N - nadir * float(nadir @ v_N)

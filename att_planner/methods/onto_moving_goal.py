@@ -40,7 +40,22 @@ BOUND_MARGIN = 1e-3            # relative room kept below the torque, rate and m
 
 
 def profile(problem: ManeuverProblem, duration: float, knots: int = KNOTS):
-    """``(t, q, ω, τ)`` of the construction (module docstring) over ``duration`` s at ``knots`` knots."""
+    """The construction (module docstring) sampled.
+
+    Parameters
+    ----------
+    problem : ManeuverProblem
+        Its start, spacecraft and moving goal.
+    duration : float
+        T (s).
+    knots : int, optional
+        Samples over [0, T].
+
+    Returns
+    -------
+    t, q, omega, torque : ndarray
+        Times (s), attitudes [x, y, z, w], body rates (rad/s) and body torques (N m), one row per knot.
+    """
     T = float(duration)
     q_T, omega_T = problem.goal_motion(T)
     sigma = np.linspace(0.0, 1.0, knots)
@@ -80,8 +95,21 @@ def bound_ratio(problem: ManeuverProblem, omega: np.ndarray, torque: np.ndarray,
 
 
 def plan_onto_moving_goal(problem: ManeuverProblem, knots: int = KNOTS) -> Plan:
-    """The construction's plan of the shortest duration within the bounds (module docstring); FAILED
-    when no duration within the goal's window keeps them."""
+    """The first plan onto the problem's moving goal (module docstring).
+
+    Parameters
+    ----------
+    problem : ManeuverProblem
+        With ``goal_motion`` set; its torque, rate, wheel-momentum and wheel-speed bounds are kept.
+    knots : int, optional
+        Knots of the plan (linear torque between them).
+
+    Returns
+    -------
+    Plan
+        FEASIBLE: the shortest duration within the bounds (to :data:`DURATION_TOLERANCE`); FAILED
+        without a moving goal, or when no duration within the goal's window keeps the bounds.
+    """
     start = time.perf_counter()
     goal = problem.goal_motion
     if goal is None:
