@@ -21,7 +21,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from att_msgs_py.errors import ErrorCode, RequestError
+from att_msgs_py.errors import ErrorCode, RequestError, clip
 from att_msgs_py.limits import MAX_CONES, MAX_OPTIONS, MAX_TARGETS
 from att_msgs_py.types import Cone, PointingMode
 from att_msgs_py.validation import MAX_NAME_LENGTH, finite_array, text, unit_quaternion, unit_vector
@@ -265,9 +265,15 @@ def _end_on_pointing(problem: ManeuverProblem, req: ManeuverRequest, method: Met
     if req.semi_free:
         raise RequestError(ErrorCode.INVALID_OPTION, "end_pointing and semi_free exclude each other")
     law = goal_law(req.end_pointing, scenario, problem.epoch, problem.q_initial)
-    problem.q_final = law(0.0)[0]
-    problem.q_final = law(problem.slew_time_bound())[0]
-    problem.goal_motion = MovingGoal(law, problem.zone_sky().window, req.end_pointing.kind)
+    window = problem.zone_sky().window
+    try:
+        problem.q_final = law(0.0)[0]
+        problem.q_final = law(problem.slew_time_bound())[0]
+        problem.goal_motion = MovingGoal(law, window, req.end_pointing.kind)
+    except ValueError as err:        # the mode has no attitude somewhere in the window the plan may end in
+        raise RequestError(ErrorCode.INVALID_POINTING,
+                           f"end_pointing ({clip(req.end_pointing.kind, 40)}): {err} within {window:.0f} s "
+                           "of the start, where the slew may end") from None
 
 
 def check_wheel_speeds(speeds, sc: Spacecraft) -> np.ndarray | None:

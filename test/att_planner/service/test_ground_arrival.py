@@ -9,7 +9,7 @@ import math
 import numpy as np
 import pytest
 
-from att_msgs_py.errors import ErrorCode
+from att_msgs_py.errors import ErrorCode, RequestError
 from att_msgs_py.types import PointingMode, Stage
 from att_planner.guidance import reference
 from att_planner.guidance.ground_arrival import site_in_view
@@ -85,3 +85,22 @@ def test_the_slew_ends_on_the_moving_site(geometry, method):
     assert attitude < math.radians(0.05) and rate < math.radians(0.01), (math.degrees(attitude), math.degrees(rate))
     assert ver.final_attitude_error == pytest.approx(attitude, abs=1e-6)
     assert ver.torque_ratio <= 1.0 + 1e-6
+
+
+def test_a_mode_without_an_attitude_inside_the_window_is_refused(monkeypatch):
+    """The mode is checked now by its law; a ground site whose line of sight meets the secondary
+    direction later in the window (the goal is fitted there) is refused, naming the field."""
+    from att_planner.service import requests
+
+    def parallel_later(*args):
+        def motion(t):
+            if t > 10.0:
+                raise ValueError("the primary and secondary directions are parallel: no attitude about the primary")
+            return rot.IDENTITY, np.zeros(3)
+        return motion
+
+    monkeypatch.setattr(requests, "goal_law", parallel_later)
+    with pytest.raises(RequestError) as err:
+        validate(ground_mode("nadir"))
+    assert err.value.code == ErrorCode.INVALID_POINTING and "end_pointing (ground)" in err.value.message
+    assert "parallel" in err.value.message
