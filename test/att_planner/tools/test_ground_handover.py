@@ -8,10 +8,10 @@ swift_demo is the agile spacecraft of the shipped scenarios (J = 100 kg m², 0.1
 planned body torque is the wheels' torque); its tracking gains are raised to an imaging loop's
 (kp 10 N m/rad, kd 60 N m s/rad: ω_n 0.32 rad/s, ζ 0.95), with the shipped kp 1 N m/rad the slew's
 0.02 deg tracking error carries 30 s into the dwell. The plan flown is the first plan's
-(:mod:`att_planner.methods.onto_moving_goal`): its knots are the exact kinematics of its torque,
-so the controller tracks it within 0.01 deg up to the hand-over; the collocation plans' knots
-(time_optimal's bang-bang on 31 intervals, smooth_collocation's 30) are flown 0.013-0.017 deg
-off at the hand-over, gone 10 s later."""
+(:mod:`att_planner.methods.onto_moving_goal`: the exact kinematics of its torque), which the
+controller tracks within 0.01 deg up to the hand-over; the collocation plans swing their torque at
+the bound on all three axes and are flown 0.013-0.017 deg behind at the hand-over, 0.003 deg 10 s
+later."""
 from __future__ import annotations
 
 import math
