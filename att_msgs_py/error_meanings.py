@@ -39,7 +39,8 @@ MEANINGS: dict[ErrorCode, str] = {
         "option not known to the method, out of its range (the registry's, "
         '`att_planner/methods/__init__.py`), NaN/Inf, not an integer, a combination the method cannot run '
         '(Slepian N·W < 1 or M > 2·N·W, time-optimal max_intervals < intervals), given twice or with an empty '
-        'name, lists of different length; `end_pointing` with a method other than time_optimal or with '
+        'name, lists of different length; `end_pointing` with a method other than time_optimal, '
+        'smooth_collocation or graph_smooth, or with '
         "`semi_free`; a `boundary_cone` the request's cones do not have, or whose boundary the start or goal "
         'sensor direction is not on (within 1e-6 rad)'
     ),

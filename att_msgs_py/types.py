@@ -128,6 +128,7 @@ class Verification:
     zone_names: list = field(default_factory=list)                # name per entry of cone_margins
     zone_keep_in: list = field(default_factory=list)              # keep-in flag per entry of cone_margins
     boundary_arc: str = ""             # name of the cone a forced boundary arc rides ('' : none)
+    goal: str = ""                     # the pointing kind of a moving goal ('' : at rest or semi-free)
 
 
 class Stage(StrEnum):
@@ -405,7 +406,7 @@ class AttitudeEstimate:
 # ---------------------------------------------------------------------------------------------
 
 POINTING_KINDS = ("inertial", "nadir", "sun", "ground", "inertial_target")
-SECONDARY_KINDS = ("velocity", "orbit_normal", "sun", "nadir", "north", "inertial")
+SECONDARY_KINDS = ("velocity", "ground_velocity", "orbit_normal", "sun", "nadir", "north", "inertial")
 
 
 @dataclass

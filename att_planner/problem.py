@@ -26,31 +26,63 @@ from att_sim.models.dynamics import Spacecraft
 if TYPE_CHECKING:          # the annotations only: att_sim.models.ephemeris loads skyfield
     from att_sim.models.ephemeris import Ephemeris
 
-GOAL_DEGREE = 16         # of a moving goal's series of the attitude (sign-continuous) and the rate
+GOAL_DEGREES = (16, 32, 64, 96, 128)   # series degrees a moving goal's fit tries, lowest first
+GOAL_FIT_ATTITUDE = 1e-6   # rad: a fit is accepted when it stays this close to the law's attitude ...
+GOAL_FIT_RATE = 1e-8       # rad/s: ... and to its rate, between its nodes
 
 
 class MovingGoal:
     """A goal that moves (a pointing law): ``t ↦ (q, ω)`` from the law in this process, or
-    from its Chebyshev series over ``[0, window]`` (the Chebyshev points of the first kind) after
-    pickling: a planner's child process gets the series, the verification the law."""
+    from its Chebyshev series over ``[0, window]`` after pickling: a planner's child process gets
+    the series, the verification the law.
 
-    def __init__(self, law: Callable[[float], tuple[np.ndarray, np.ndarray]], window: float):
-        self.law, self.window = law, float(window)
-        n = 2 * (GOAL_DEGREE + 1)
-        x = np.sort(np.cos(np.pi * (np.arange(n) + 0.5) / n))         # Chebyshev points of the first kind
+    The series (of the sign-continuous attitude and of the rate) is least squares on twice its
+    degree's Chebyshev points of the first kind; its degree is the lowest of :data:`GOAL_DEGREES`
+    whose series stays within :data:`GOAL_FIT_ATTITUDE` and :data:`GOAL_FIT_RATE` of the law at the
+    midpoints between those points (the highest otherwise, its misfit in ``fit_error``). A ground
+    site's line of sight turns within a minute near its pass, so a window of many minutes takes a
+    high degree; a slew whose terminal condition is met on a series that misses the law by more
+    than the arrival tolerance ends beside the target. ``kind``: the pointing mode's kind."""
+
+    def __init__(self, law: Callable[[float], tuple[np.ndarray, np.ndarray]], window: float, kind: str = ""):
+        self.law, self.window, self.kind = law, float(window), kind
+        for degree in GOAL_DEGREES:
+            n = 2 * (degree + 1)
+            nodes = np.cos(np.pi * np.arange(2 * n + 1) / (2 * n))[::-1]   # the fit's points and the midpoints
+            samples = self._samples(nodes)
+            x, check = nodes[1::2], nodes[0::2]
+            self.coefficients = np.polynomial.chebyshev.chebfit(x, samples[1::2], degree)    # (degree + 1, 7)
+            fitted = np.polynomial.chebyshev.chebval(check, self.coefficients).T
+            attitude = np.abs(fitted[:, :4] / np.linalg.norm(fitted[:, :4], axis=1, keepdims=True)
+                              - samples[0::2, :4]).max()
+            self.fit_error = (float(attitude), float(np.abs(fitted[:, 4:] - samples[0::2, 4:]).max()))
+            if self.fit_error[0] <= GOAL_FIT_ATTITUDE and self.fit_error[1] <= GOAL_FIT_RATE:
+                break
+
+    def _samples(self, x: np.ndarray) -> np.ndarray:
+        """``[q, ω]`` of the law at the points ``x`` of [−1, 1] (increasing), the attitude's sign continuous."""
         samples = []
         for t in 0.5 * (x + 1.0) * self.window:
-            q, w = law(float(t))
+            q, w = self.law(float(t))
             if samples and np.dot(q, samples[-1][:4]) < 0:
                 q = -q
             samples.append(np.concatenate([q, w]))
-        self.coefficients = np.polynomial.chebyshev.chebfit(x, np.array(samples), GOAL_DEGREE)   # (degree + 1, 7)
+        return np.array(samples)
 
     def __call__(self, t: float) -> tuple[np.ndarray, np.ndarray]:
         if self.law is not None:
             return self.law(t)
         value = clenshaw(np.array([[2.0 * t / self.window - 1.0]]), list(self.coefficients))[0]
         return value[:4] / np.linalg.norm(value[:4]), value[4:]
+
+    def series(self, t) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The series at the times ``t`` (K,) at once: unit attitudes (K, 4), rates (K, 3) and the rates'
+        derivatives (K, 3) (the derivative of the rate's series)."""
+        x = 2.0 * np.asarray(t, float) / self.window - 1.0
+        value = np.polynomial.chebyshev.chebval(x, self.coefficients).T
+        rate_dot = np.polynomial.chebyshev.chebval(x, np.polynomial.chebyshev.chebder(self.coefficients[:, 4:])).T
+        return (value[:, :4] / np.linalg.norm(value[:, :4], axis=1, keepdims=True), value[:, 4:],
+                rate_dot * 2.0 / self.window)
 
     def __getstate__(self) -> dict:
         return {**self.__dict__, "law": None}          # the law's sky does not travel: its series does

@@ -441,9 +441,12 @@ class Controller:
         out.status.reference_q, out.status.reference_rate = ref.q_RN, ref.omega_RN_R
         out.status.attitude_error = float(rot.angle_between(s.q, ref.q_RN))
         if m.after is not None and elapsed >= plan.duration:
+            # the law takes over at this step: its reference, not the plan's held past its end
             law = handover_law(m.after, plan, s.t, self.config.handover_blend)
             out.result = self._end(True, ErrorCode.OK, f"maneuver complete; pointing {law.name}")
             self.mode, self.pointing, self.hold_q_RN = ControlMode.POINTING, law, None
+            out.command.mode = out.status.mode = ControlMode.POINTING
+            self._point(out, law)
             out.status.message = f"maneuver complete; pointing {law.name}"
             return
         if elapsed >= plan.duration + self.config.settle_time:

@@ -15,10 +15,13 @@ The directions (inertial axes, unit, seen from the spacecraft):
   geomagnetic field; without an epoch the inertial frame turns at the Earth's rate from t = 0);
 * ``inertial_target``: ``P`` a fixed inertial direction; ``inertial``: a fixed attitude.
 
-Secondary directions: ``velocity`` (v⊥), ``orbit_normal`` (r × v), ``sun``, ``nadir``, ``north``
-(the inertial +z) or ``inertial`` (a given direction). Where the primary and secondary directions
-become parallel the law has no attitude; :func:`two_vector_attitude` raises, and the law keeps its
-last attitude (:class:`TwoVectorLaw` notes it) so the controller never sees a jump.
+Secondary directions: ``velocity`` (v⊥), ``ground_velocity`` (the spacecraft's velocity over the
+turning Earth, ``v − ω_E k × r`` with ``k`` the Earth's axis, without its radial part: the ground
+track's direction, on which a detector's along-track axis is kept), ``orbit_normal`` (r × v),
+``sun``, ``nadir``, ``north`` (the inertial +z) or ``inertial`` (a given direction). Where the
+primary and secondary directions become parallel the law has no attitude; :func:`two_vector_attitude`
+raises, and the law keeps its last attitude (:class:`TwoVectorLaw` notes it) so the controller never
+sees a jump.
 """
 from __future__ import annotations
 
@@ -163,11 +166,17 @@ def directions(geometry: PointingGeometry) -> dict[str, Callable]:
         r_hat = _unit(r)
         return _unit(v - (v @ r_hat) * r_hat)
 
+    def ground_velocity(t):
+        r, v = geometry.state_N(t)
+        r_hat = _unit(r)
+        g = v - EARTH_ROTATION_RATE * rot.cross(np.asarray(geometry.dcm_EN(t))[2], r)
+        return _unit(g - (g @ r_hat) * r_hat)
+
     def orbit_normal(t):
         r, v = geometry.state_N(t)
         return _unit(rot.cross(r, v))
 
-    out = {"nadir": nadir, "velocity": velocity, "orbit_normal": orbit_normal,
+    out = {"nadir": nadir, "velocity": velocity, "ground_velocity": ground_velocity, "orbit_normal": orbit_normal,
            "north": lambda t: np.array([0.0, 0.0, 1.0])}
     if geometry.sun_N is not None:
         out["sun"] = lambda t: _unit(geometry.sun_N(t))

@@ -33,6 +33,9 @@ T is the shortest duration within T̄ on the leg's :data:`KNOTS_PER_LEG` knots,
 ``T² = φ max_{s,j} |(J e p''(s) + φ p'(s)² e × J e)_j| / T̄``, or longer for the problem's rate
 and wheel-momentum bounds. The knots hold the torque (linear interpolation) and the exact
 reference attitude and rate of the rotation.
+
+**A moving goal** (``problem.goal_motion``: the slew ends on a pointing law at its rate) has no
+rest-to-rest legs: its first plan is :func:`att_planner.methods.onto_moving_goal.plan_onto_moving_goal`.
 """
 from __future__ import annotations
 
@@ -44,6 +47,7 @@ import numpy as np
 from att_msgs_py.types import Interpolation, Plan, Status
 from att_planner.cones import BOUNDARY_TOLERANCE, boundary_end_zones
 from att_planner.methods.axis_rotations import eigenaxis_leg, no_torque_limit
+from att_planner.methods.onto_moving_goal import plan_onto_moving_goal
 from att_planner.problem import ManeuverProblem
 from att_sim.models import rotations as rot
 
@@ -294,6 +298,10 @@ def legs_profile(problem: ManeuverProblem, q0: np.ndarray, legs: list):
 
 def plan_graph_smooth(problem: ManeuverProblem) -> Plan:
     """The constructive plan (module docstring); FAILED when the graph holds no way round the zones."""
+    if problem.goal_motion is not None:
+        plan = plan_onto_moving_goal(problem)
+        plan.method = METHOD
+        return plan
     start = time.perf_counter()
     why = no_torque_limit(problem)      # an end inside a zone: no leg leaves or reaches it (FAILED below)
     if why:

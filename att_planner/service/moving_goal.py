@@ -3,7 +3,11 @@
 The plan must reach, at its final time, the attitude and body rate of the pointing law the
 controller will hand over to (:mod:`att_planner.guidance`): the law of the scenario's own models
 (orbit, field, Sun — the controller's), at sim time ``offset + t`` for plan time ``t``, ``offset``
-the plan's epoch after the scenario's. :class:`att_planner.problem.MovingGoal` holds the law and its Chebyshev series
+the plan's epoch after the scenario's (a scenario without an epoch: after the wire's zero time, as
+the suite stamps its messages with the sim time); a ground site's attitude and rate in closed form from its line
+of sight and the line of sight's derivative (:mod:`att_planner.guidance.ground_arrival`), every other
+law's rate by the central differences of :func:`att_planner.guidance.reference`.
+:class:`att_planner.problem.MovingGoal` holds the law and its Chebyshev series
 over the problem's window: the time-optimal method meets the series exactly at t_f
 (:func:`att_planner.methods.time_optimal.model.moving_goal_values`, in a child process the series
 is all it gets), the verification measures against the law itself.
@@ -16,7 +20,9 @@ from datetime import datetime
 import numpy as np
 
 from att_msgs_py.types import PointingMode
+from att_msgs_py.validation import UNIX_EPOCH
 from att_planner.guidance import reference
+from att_planner.guidance.ground_arrival import ground_motion
 from att_planner.guidance.laws import PointingGeometry
 from att_planner.guidance.modes import law_of
 from att_sim.models import world
@@ -26,8 +32,13 @@ from att_sim.models.scenario import Scenario
 def goal_law(mode: PointingMode, scenario: Scenario, epoch: datetime | None,
              q_start: np.ndarray) -> Callable[[float], tuple[np.ndarray, np.ndarray]]:
     """``t ↦ (q, ω)`` of ``mode``'s law at plan time ``t`` (RequestError 314 for a bad mode)."""
-    offset = 0.0 if epoch is None or scenario.epoch is None else (epoch - scenario.epoch).total_seconds()
-    law = law_of(mode, PointingGeometry.of(world.Environment.from_scenario(scenario)), offset, q_start)
+    offset = 0.0 if epoch is None else (epoch - (scenario.epoch or UNIX_EPOCH)).total_seconds()
+    geometry = PointingGeometry.of(world.Environment.from_scenario(scenario))
+    law = law_of(mode, geometry, offset, q_start)
+    if mode.kind == "ground":
+        ground = ground_motion(geometry, mode.latitude, mode.longitude, mode.altitude, law.primary_B,
+                               law.secondary_B, law.secondary_N, law.yaw)
+        return lambda t: ground(offset + t)
 
     def motion(t: float) -> tuple[np.ndarray, np.ndarray]:
         ref = reference(law.attitude, offset + t)

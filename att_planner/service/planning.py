@@ -260,11 +260,11 @@ def plan_maneuver(valid: ValidRequest, tol: Tolerances = TOLERANCES, cone_paddin
     """
     problem = valid.problem
     planned = padded(problem, cone_padding)
-    rest_to_rest = problem.goal_motion is None          # a moving goal: only the method can end on it
+    rest_to_rest = problem.goal_motion is None          # a moving goal: the eigenaxis fallback cannot end on it
     can_fall_back = problem.sensor_target is None and valid.method.name != FALLBACK_METHOD and rest_to_rest
     done: list[_Stage] = []
     first = None
-    if not valid.method.cheap and rest_to_rest:
+    if not valid.method.cheap:
         first = _run_stage(Stage.FIRST, methods.get(FIRST_METHOD), planned, {}, run_method, None, valid, tol, False)
         if not first.report.verified and planned is not problem:   # the padding may close a way the zones leave
             first = _run_stage(Stage.FIRST, methods.get(FIRST_METHOD), problem, {}, run_method, None, valid, tol,

@@ -21,7 +21,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from att_msgs_py.errors import ErrorCode, RequestError
+from att_msgs_py.errors import ErrorCode, RequestError, clip
 from att_msgs_py.limits import MAX_CONES, MAX_OPTIONS, MAX_TARGETS
 from att_msgs_py.types import Cone, PointingMode
 from att_msgs_py.validation import MAX_NAME_LENGTH, finite_array, text, unit_quaternion, unit_vector
@@ -40,7 +40,8 @@ MAX_TIME_BUDGET = 600.0        # s
 MAX_DWELL = 86_400.0           # s: a schedule target's observation, at most a day
 MAX_WINDOW = 7 * 86_400.0      # s: a schedule target's window opens within a week of the start
 SAME_TARGET = 1e-6             # rad: schedule targets closer than this are one attitude (q and -q too)
-END_POINTING_METHOD = "time_optimal"   # the method that ends a slew on a moving pointing mode
+# the methods that end a slew on a moving pointing mode (graph_smooth: the first plan's construction)
+END_POINTING_METHODS = ("time_optimal", "smooth_collocation", "graph_smooth")
 
 
 @dataclass
@@ -256,16 +257,23 @@ def load_scenario(name: str) -> scen.Scenario:
 def _end_on_pointing(problem: ManeuverProblem, req: ManeuverRequest, method: Method, scenario: scen.Scenario) -> None:
     """Make ``problem``'s goal the moving one of ``req.end_pointing`` (:mod:`.moving_goal`); its
     ``q_final`` the law's attitude after the eigenaxis slew time to where the law is at the start."""
-    if method.name != END_POINTING_METHOD:
+    if method.name not in END_POINTING_METHODS:
         raise RequestError(ErrorCode.INVALID_OPTION,
-                           f"end_pointing: a slew that ends on a pointing mode is planned by {END_POINTING_METHOD}; "
-                           f"{method.name} plans rest-to-rest (execute it with point_after: the controller blends)")
+                           f"end_pointing: a slew that ends on a pointing mode is planned by "
+                           f"{', '.join(END_POINTING_METHODS)}; {method.name} plans rest-to-rest (execute it with "
+                           "point_after: the controller blends)")
     if req.semi_free:
         raise RequestError(ErrorCode.INVALID_OPTION, "end_pointing and semi_free exclude each other")
     law = goal_law(req.end_pointing, scenario, problem.epoch, problem.q_initial)
-    problem.q_final = law(0.0)[0]
-    problem.q_final = law(problem.slew_time_bound())[0]
-    problem.goal_motion = MovingGoal(law, problem.zone_sky().window)
+    window = problem.zone_sky().window
+    try:
+        problem.q_final = law(0.0)[0]
+        problem.q_final = law(problem.slew_time_bound())[0]
+        problem.goal_motion = MovingGoal(law, window, req.end_pointing.kind)
+    except ValueError as err:        # the mode has no attitude somewhere in the window the plan may end in
+        raise RequestError(ErrorCode.INVALID_POINTING,
+                           f"end_pointing ({clip(req.end_pointing.kind, 40)}): {err} within {window:.0f} s "
+                           "of the start, where the slew may end") from None
 
 
 def check_wheel_speeds(speeds, sc: Spacecraft) -> np.ndarray | None:

@@ -213,6 +213,33 @@ def moving_goal_values(problem: ManeuverProblem, s: Scaling) -> np.ndarray:
     return np.concatenate([[2.0 * s.tu / goal.window, -1.0], coefficients.ravel()])
 
 
+def chebyshev_derivative(rows: list) -> list:
+    """The coefficient rows of the derivative ``d/dx`` of the Chebyshev series of ``rows`` (c_0 first;
+    numpy or CasADi): ``d_{k−1} = d_{k+1} + 2k c_k`` from the top, ``d_0`` halved."""
+    n = len(rows) - 1
+    if n < 1:
+        return [0.0 * rows[0]]
+    d = [0.0 * rows[0] for _ in range(n + 2)]
+    for k in range(n, 0, -1):
+        d[k - 1] = d[k + 1] + 2 * k * rows[k]
+    d[0] = 0.5 * d[0]
+    return d[:n]
+
+
+def ties_end_torque(problem: ManeuverProblem) -> bool:
+    """Whether a smooth plan onto ``problem``'s moving goal ends at the torque that tracks it
+    (``J ω̇_g + ω_g × J ω_g`` at t_f): when that torque stays within the per-axis bound (less
+    :data:`BOUND_MARGIN`) over the goal's whole window (else, near a ground pass of a slow
+    spacecraft, no end could meet it: the end torque is left free)."""
+    goal = problem.goal_motion
+    if goal is None:
+        return False
+    _, omega, omega_dot = goal.series(np.linspace(0.0, goal.window, 4 * len(goal.coefficients) + 1))
+    J = problem.spacecraft.inertia
+    torque = omega_dot @ J.T + np.cross(omega, omega @ J.T)
+    return bool(np.abs(torque).max() <= problem.spacecraft.body_torque_max * (1 - BOUND_MARGIN))
+
+
 CACHE_SIZE = 64          # built NLPs kept (the oldest goes first)
 _NLPS: dict = {}
 
@@ -315,7 +342,7 @@ def transcription(problem: ManeuverProblem, s: Scaling, mesh: np.ndarray, contro
     key = (smooth, torque_accel, s.Jn.tobytes(), len(mesh) - 1, control, sum(z.body == "inertial" for z in zones.zones),
            (moving, degree) if degree is not None else (id(zones), cone_margin),
            problem.spacecraft.wheel_axes.tobytes() if momentum else None, wheel_rows(problem), problem.rate_max,
-           goal_kind(problem), tol, max_iter, expand)
+           goal_kind(problem), smooth and ties_end_torque(problem), tol, max_iter, expand)
     if key not in _NLPS:
         while len(_NLPS) >= CACHE_SIZE:
             _NLPS.pop(next(iter(_NLPS)))
@@ -352,12 +379,15 @@ def _build(problem: ManeuverProblem, s: Scaling, mesh: np.ndarray, control: str,
     v = tr.variables(0)
     q_end = v.x_end[:4]
     if problem.goal_motion is not None:            # on the moving goal at t_f, at its rate
-        if smooth:
-            raise ValueError("a moving goal is time_optimal's: the smooth plans end at rest")
         rows = [tr.extra[2 + 7 * i:9 + 7 * i] for i in range((len(goal) - 2) // 7)]
-        target = clenshaw(tr.extra[0] * v.duration + tr.extra[1], rows)
+        x_f = tr.extra[0] * v.duration + tr.extra[1]
+        target = clenshaw(x_f, rows)
         tr.add_constraint(symbolic.error_vector(q_end, target[:4]), 0.0, 0.0)
         tr.add_constraint(v.x_end[4:7] - target[4:7], 0.0, 0.0)
+        if smooth and ties_end_torque(problem):     # and at the torque that tracks it
+            rate, rate_dot = target[4:7], tr.extra[0] * clenshaw(x_f, chebyshev_derivative(rows))[4:7]
+            Jn = ca.DM(s.Jn)
+            tr.add_constraint(v.x_end[7:10] - ca.mtimes(Jn, rate_dot) - ca.cross(rate, ca.mtimes(Jn, rate)), 0.0, 0.0)
         tr.minimize(v.duration)
         return tr
     tr.bound_state(0, -1, *_end_bounds(smooth))

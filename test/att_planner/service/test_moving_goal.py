@@ -1,5 +1,6 @@
-"""Requests for a slew that ends on a pointing mode: planned by time_optimal only, not
-with a semi-free goal, the mode checked field by field; the goal's law is the controller's."""
+"""Requests for a slew that ends on a pointing mode: planned by time_optimal, smooth_collocation
+or the first plan only, not with a semi-free goal, the mode checked field by field; the goal's law
+is the controller's."""
 from __future__ import annotations
 
 import math
@@ -53,7 +54,7 @@ def test_a_valid_request_carries_the_moving_goal_and_a_first_guess_of_its_end():
 
 
 @pytest.mark.parametrize("fields, code, words", [
-    ({"method": "smooth_collocation"}, ErrorCode.INVALID_OPTION, "time_optimal"),
+    ({"method": "slepian_minimum_time"}, ErrorCode.INVALID_OPTION, "time_optimal"),
     ({"semi_free": True, "sensor_target": np.array([1.0, 0.0, 0.0])}, ErrorCode.INVALID_OPTION, "semi_free"),
     ({"mode": PointingMode("sideways")}, ErrorCode.INVALID_POINTING, "pointing.kind"),
     ({"mode": PointingMode("nadir", primary_axis=np.array([0.0, 0.0, math.nan]))}, ErrorCode.INVALID_POINTING,
@@ -79,6 +80,7 @@ def test_the_goal_travels_to_a_child_process_as_its_series_and_is_met_there():
     warm_up()
     outcome = plan_maneuver(validate(), runner=run_isolated)
     assert outcome.code == ErrorCode.OK and outcome.stage == Stage.METHOD, outcome.message
-    assert [s.name for s in outcome.stages] == [Stage.METHOD]          # no rest-to-rest first plan
+    assert [s.name for s in outcome.stages] == [Stage.FIRST, Stage.METHOD]      # the first plan ends on it too
+    assert outcome.stages[0].verified
     ver = outcome.plan.verification
     assert ver.final_attitude_error < 1e-4 and ver.final_rate < 1e-6
