@@ -21,6 +21,7 @@ def test_the_figures_are_the_flight_loops(swift):
     code, _, out = swift
     assert out["scenario"] == "swift_demo" and out["in_process"] is True and out["estimator"] is True
     assert out["rtf"] == pytest.approx(out["sim_seconds"] / out["wall_seconds"], rel=1e-12)
+    assert out["rtf_cpu"] == pytest.approx(out["sim_seconds"] / out["cpu_seconds"], rel=1e-12)
     # the flight: the lead, the plan, then the controller's settle time (60 s in swift_demo's params)
     assert rtf.LEAD_S + out["maneuver_seconds"] < out["sim_seconds"] < rtf.LEAD_S + out["maneuver_seconds"] + 70.0
     assert out["steps"] == round(out["sim_seconds"] / out["step_s"])
