@@ -331,7 +331,8 @@ def _rtf(p: dict, case: str | None) -> Summary:
     return Summary(case or f"{_get(p, 'scenario')}, in process", "real-time factor, one closed-loop run alone", rtf,
                    "×", f"≥ {target:g}× real time, the maneuver a success", rtf >= target and success,
                    {"sim_s": _num(p, "sim_seconds"), "flight_wall_s": _num(p, "wall_seconds"),
-                    "setup_s": _num(p, "setup_seconds"), "planning_s": _num(p, "planning_seconds"),
+                    "rtf_cpu": _num(p, "rtf_cpu"), "setup_s": _num(p, "setup_seconds"),
+                    "planning_s": _num(p, "planning_seconds"),
                     "final_error_deg": _num(p, "final_error_deg"), "success": success})
 
 
