@@ -30,6 +30,7 @@ from datetime import timedelta
 
 import numpy as np
 
+from att_msgs_py.errors import RequestError
 from att_planner.service.warm import maneuver_from_scenario
 from att_planner.tools.closed_loop import ClosedLoop, plan_in_process
 from att_sim.models import rotations as rot
@@ -118,6 +119,9 @@ def run(args) -> dict:
         figures = fly(args.scenario)
     except KeyError as err:
         raise SystemExit(f"att-bench rtf: {err.args[0] if err.args else err}") from None
+    except RequestError as err:         # the planner's refusal (a ValueError too)
+        raise SystemExit(f"att-bench rtf: the demo maneuver of '{args.scenario}' was not planned: "
+                         f"code {int(err.code)}: {err.message}") from None
     except ValueError as err:
         raise SystemExit(f"att-bench rtf: {err}") from None
     load_after = os.getloadavg()[0]

@@ -59,9 +59,22 @@ def test_the_history_summarises_the_run(swift, tmp_path):
 @pytest.mark.parametrize("argv, says", [
     (["rtf", "--scenario", "swift_demo"], "--in-process"),
     (["rtf", "--in-process", "--scenario", "no_such_scenario"], "no_such_scenario"),
+    (["rtf", "--in-process", "--scenario", "bruni_celani"], "has no 'demo:' section"),
     (["rtf", "--in-process", "--scenario", "swift_demo", "--profile-rows", "0"], "--profile-rows must be at least 1"),
 ])
 def test_a_wrong_request_is_refused_with_a_sentence(argv, says, capsys):
     with pytest.raises(SystemExit) as exc:
         main(argv)
     assert says in str(exc.value.code) + capsys.readouterr().err
+
+
+def test_a_maneuver_the_planner_refuses_is_said_in_one_sentence(monkeypatch):
+    from att_msgs_py.errors import ErrorCode, RequestError
+
+    def refuse(*args, **kwargs):
+        raise RequestError(ErrorCode.INFEASIBLE, "no path clears the zones")
+    monkeypatch.setattr(rtf, "plan_in_process", refuse)
+    with pytest.raises(SystemExit) as exc:
+        main(["rtf", "--in-process", "--scenario", "swift_demo", "--no-profile"])
+    assert str(exc.value.code) == (f"att-bench rtf: the demo maneuver of 'swift_demo' was not planned: "
+                                   f"code {int(ErrorCode.INFEASIBLE)}: no path clears the zones")
