@@ -101,8 +101,13 @@ class Facet:
 
 
 def _body(q_BN, v_N) -> tuple:
-    """``v_B = [BN] v_N`` (:func:`att_sim.models.rotations.to_body`) as its three components."""
+    """``v_B = [BN] v_N`` (:func:`att_sim.models.rotations.to_body`) as its three components: Python
+    floats for one vector (the per-stage path: the facet sums below then run on floats, the same
+    IEEE operations as on numpy scalars at a fraction of their cost), arrays for stacks."""
     b = rot.to_body(q_BN, v_N)
+    if b.ndim == 1:
+        x, y, z = b.tolist()
+        return x, y, z
     return b[..., 0], b[..., 1], b[..., 2]
 
 

@@ -225,7 +225,10 @@ def rates(sc: SpacecraftStack, x: np.ndarray, torque_B: np.ndarray, u: np.ndarra
     limit (:func:`limited`) and, with ``drive(u, ν)``, made the imperfect drives' net torques."""
     out = np.empty_like(x)
     w = x[:, 4:7]
-    out.T[:4] = quaternion_rate(x.T[:4], w.T)
+    if len(x) == 1:                 # one run: the same formula on Python floats (the same bits, cheaper)
+        out[0, :4] = quaternion_rate(x[0, :4].tolist(), x[0, 4:7].tolist())
+    else:
+        out.T[:4] = quaternion_rate(x.T[:4], w.T)
     h = (sc.momentum_map @ x[:, 4:, None])[:, :, 0]
     if u is not None and sc.n_wheels:
         relative = relative_wheel_speed(sc, x[:, 7:], w)

@@ -35,6 +35,9 @@ def cross(a: np.ndarray, b: np.ndarray, axis: int = -1) -> np.ndarray:
     """``a × b`` along ``axis``, broadcasting: single vectors, rows of runs ``(n, 3)`` and
     component-first batches alike (cheaper than ``np.cross`` on small stacks)."""
     a, b = np.asarray(a, float), np.asarray(b, float)
+    if a.shape == b.shape and a.size == 3 and a.shape[axis] == 3:   # one pair: the same products on Python floats
+        (ax, ay, az), (bx, by, bz) = a.ravel().tolist(), b.ravel().tolist()
+        return np.array([ay * bz - az * by, az * bx - ax * bz, ax * by - ay * bx]).reshape(a.shape)
     return a.take(_NEXT_AXIS, axis) * b.take(_PREV_AXIS, axis) - a.take(_PREV_AXIS, axis) * b.take(_NEXT_AXIS, axis)
 
 

@@ -337,6 +337,17 @@ def _fastest(p: dict, case: str | None) -> Summary:
                     "time_optimal_median_s": _num(seconds, "median"), "time_optimal_max_s": _num(seconds, "max")})
 
 
+def _rtf(p: dict, case: str | None) -> Summary:
+    rtf, target = _num(p, "rtf"), _num(p, "target_rtf")
+    success = bool(_get(p, "success"))
+    return Summary(case or f"{_get(p, 'scenario')}, in process", "real-time factor, one closed-loop run alone", rtf,
+                   "×", f"≥ {target:g}× real time, the maneuver a success", rtf >= target and success,
+                   {"sim_s": _num(p, "sim_seconds"), "flight_wall_s": _num(p, "wall_seconds"),
+                    "rtf_cpu": _num(p, "rtf_cpu"), "setup_s": _num(p, "setup_seconds"),
+                    "planning_s": _num(p, "planning_seconds"),
+                    "final_error_deg": _num(p, "final_error_deg"), "success": success})
+
+
 def _cmd(template: str) -> Callable[[dict, str], str]:
     return lambda p, path: template.format(path=path, **{k: v for k, v in p.items()
                                                                                  if isinstance(v, str | int | float)})
@@ -369,6 +380,8 @@ STUDIES: tuple[Study, ...] = (
     Study("soak", lambda p: "dropped_state" in p, _soak, _cmd("att-bench soak --json {path}")),
     Study("cluster", lambda p: "throughput_ratio" in p, _cluster,
           _cmd("att-bench cluster --campaign {campaign} --runs {runs} --workers {workers} --json {path}")),
+    Study("rtf", lambda p: "target_rtf" in p and p.get("in_process") is True, _rtf,
+          _cmd("att-bench rtf --in-process --scenario {scenario} --json {path}")),
     Study("fastest", lambda p: "fastest_sets" in p, _fastest,
           lambda p, path: f"att-bench fastest --sets {p['fastest_sets']} --budget {p['budget_s']:g} "
                           + (f"--options '{json.dumps(p['time_optimal_options'])}' " if p.get("time_optimal_options")

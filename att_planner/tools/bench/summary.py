@@ -56,6 +56,8 @@ ROWS: tuple[tuple[str, str], ...] = (
     ("sky", "leo_observatory"),
     ("observe", "4 sources"),
     ("day", "observatory_day"),
+    ("rtf", "leo_observatory, in process"),
+    ("rtf", "swift_demo, in process"),
     ("estimation", "swift_demo"),
     ("momentum", "15 orbits"),
     ("soak", "10 orbits"),

@@ -195,6 +195,8 @@ def test_rates_of_a_stack_are_each_spacecraft_s_equations():
         np.testing.assert_allclose(row, dyn.derivative(sc, xi, dyn.Inputs(wheel_torque=ui, torque_B=ti)),
                                    rtol=1e-12, atol=1e-18)
     assert got[1, 7] == 0.0 and got[2, 8] == pytest.approx(scs[2].wheel_torque_max / scs[2].wheel_inertia)
+    for i, sc in enumerate(scs):            # one row alone (its quaternion rate on floats): the same bits
+        np.testing.assert_array_equal(dyn.rates(sc.stacked, x[i:i + 1], tau[i:i + 1], u[i:i + 1]), got[i:i + 1])
 
 
 def test_a_stack_refuses_unlike_wheel_counts():

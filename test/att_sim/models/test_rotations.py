@@ -110,3 +110,16 @@ def test_to_body_on_rows_is_the_transposed_dcm_of_each_row():
                                atol=rounding(qs[3], vs[3]))
     stacked = rot.to_body(qs.reshape(5, 10, 4), vs.reshape(5, 10, 3))
     np.testing.assert_array_equal(stacked.reshape(50, 3), rot.to_body(qs, vs))
+
+
+def test_cross_of_one_pair_is_the_rows_formula_bit_for_bit():
+    """One pair of vectors (shaped (3,), (1, 3) or component-first (3, 1)) takes the products on
+    Python floats: the same bits as the pair inside a stack."""
+    rng = np.random.default_rng(4)
+    a, b = rng.normal(size=(50, 3)) * 1e3, rng.normal(size=(50, 3)) * 1e-5
+    rows = rot.cross(a, b)
+    for k in range(50):
+        np.testing.assert_array_equal(rot.cross(a[k], b[k]), rows[k])
+        np.testing.assert_array_equal(rot.cross(a[k:k + 1], b[k:k + 1]), rows[k:k + 1])
+        np.testing.assert_array_equal(rot.cross(a[k][:, None], b[k][:, None], axis=0), rows[k][:, None])
+    np.testing.assert_allclose(rows, np.cross(a, b), rtol=1e-12, atol=1e-18)

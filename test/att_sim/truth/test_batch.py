@@ -187,3 +187,24 @@ def test_a_run_whose_environment_fails_halts_as_it_would_alone_and_the_others_go
     assert alone[0].halted and together[0].halted and "the orbit decayed" in together[0].halt_reason
     assert together[0].halt_reason == alone[0].halt_reason and not together[1].halted
     assert_same(alone, together)
+
+
+def test_a_steps_first_stage_taken_from_the_last_end_sample_changes_no_bit():
+    """A step's first environment stage is the previous step's end sample (same time, state and
+    environment), computed once: a run stepped so equals, bit for bit, the run whose every stage is
+    evaluated afresh; a reset between steps (a new state) is evaluated afresh."""
+    reused, fresh = disturbed_pair(5)
+    rng_a, rng_b = np.random.default_rng(3), np.random.default_rng(3)
+    for k in range(40):
+        if k % 3 == 0:
+            assert reused.set_command(commands(reused, rng_a)) is None
+            assert fresh.set_command(commands(fresh, rng_b)) is None
+        if k == 25:
+            for s in (reused, fresh):
+                assert s.reset([0.0, 0.6, 0.0, 0.8], [0.001, 0.0, -0.002], [], 0.0) is None
+        reused.advance(0.05)
+        fresh.batch()._last_stage = None
+        fresh.advance(0.05)
+    np.testing.assert_array_equal(reused.x, fresh.x)
+    np.testing.assert_array_equal(reused.now.torque_B, fresh.now.torque_B)
+    np.testing.assert_array_equal(reused.applied.body_torque, fresh.applied.body_torque)
