@@ -19,8 +19,6 @@ overhead turn the line of sight faster than a large spacecraft can follow.
 """
 from __future__ import annotations
 
-import math
-
 import numpy as np
 
 from att_msgs_py.types import PointingMode
@@ -39,10 +37,11 @@ def site_mode(site, sensor_axis, secondary_axis, secondary: str) -> PointingMode
                         latitude=site.latitude, longitude=site.longitude, altitude=site.altitude)
 
 
-def geodetic_up(latitude: float, longitude: float) -> np.ndarray:
-    """The unit normal of the WGS-84 ellipsoid at a geodetic latitude and longitude (ITRS)."""
-    return np.array([math.cos(latitude) * math.cos(longitude), math.cos(latitude) * math.sin(longitude),
-                     math.sin(latitude)])
+def geodetic_up(latitude, longitude) -> np.ndarray:
+    """The unit normal of the WGS-84 ellipsoid at geodetic latitudes and longitudes (rad), ITRS,
+    shape ``latitude.shape + (3,)``."""
+    lat, lon = np.asarray(latitude, float), np.asarray(longitude, float)
+    return np.stack([np.cos(lat) * np.cos(lon), np.cos(lat) * np.sin(lon), np.sin(lat)], axis=-1)
 
 
 class GroundTrack:
