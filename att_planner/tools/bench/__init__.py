@@ -37,6 +37,7 @@ STUDIES = {
     "flood": "att_planner.tools.bench.flood",
     "cluster": "att_planner.tools.bench.cluster",
     "fastest": "att_planner.tools.bench.fastest",
+    "aeos": "att_planner.tools.bench.aeos",
 }
 TOOLS = {
     "history": "att_planner.tools.bench.history",
