@@ -18,7 +18,8 @@ Computed for all sites at once:
    threshold is searched for its peak (golden section over the two neighbouring steps); a peak above
    the threshold gives a window whose edges are bisected as in 2.
 
-A window open at the horizon's start (end) starts (ends) there.
+A window open at the horizon's start (end) starts (ends) there. A strip's access is its first
+point's (the site's latitude and longitude).
 """
 from __future__ import annotations
 

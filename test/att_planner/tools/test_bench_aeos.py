@@ -60,3 +60,15 @@ def test_bad_options_are_refused_with_a_sentence(argv, says, capsys):
     with pytest.raises(SystemExit) as exit_:
         main(["aeos", *argv])
     assert exit_.value.code == 2 and says in capsys.readouterr().err
+
+
+def test_a_csv_target_list_is_planned(tmp_path, capsys):
+    csv_path = tmp_path / "sites.csv"
+    csv_path.write_text("name,latitude_deg,longitude_deg,priority\nnorth,60,10,1\nsouth,-30,170,2\nequator,0,0,0.5\n")
+    out = tmp_path / "aeos.json"
+    assert main(["aeos", "--targets", str(csv_path), "--orbits", "2", "--json", str(out)]) == 0
+    payload = json.loads(out.read_text())
+    assert payload["targets"] == str(csv_path) and payload["sites"] == 3
+    assert set(payload["access_windows"]["per_site"]) == {"north", "south", "equator"}
+    assert payload["greedy"]["images"] <= payload["accessible"]["sites"] <= 3
+    assert "planned, not flown" in capsys.readouterr().out
