@@ -11,7 +11,7 @@ from att_msgs_py.types import ControlMode, PointingMode
 from att_planner.guidance import reference
 from att_planner.guidance.laws import PointingGeometry
 from att_planner.guidance.modes import law_of
-from att_planner.tools.closed_loop import ClosedLoop
+from att_planner.tools.closed_loop import ClosedLoop, plan_in_process
 from att_sim.models import rotations as rot
 from att_sim.models import scenario as scen
 from att_sim.models import world
@@ -48,3 +48,12 @@ def test_the_spacecraft_holds_nadir_on_the_estimate():
     late = t > 40.0
     truth = [rot.angle_between(q, law.attitude(tt)) for q, tt in zip(trace["q_true"][late], t[late])]
     assert max(truth) < math.radians(0.05), np.degrees(max(truth))
+
+
+def test_the_demo_maneuver_plans_among_the_star_trackers_zones():
+    """att-demo's slew: off nadir by 25° across track, a verified plan among the six zones at its time."""
+    demo = AEOS.node_params["demo"]
+    plan = plan_in_process(AEOS, demo["initial_attitude"], demo["final_attitude"], demo["sensor_axis"],
+                           zones=AEOS.zones, time_budget=demo["time_budget_s"], epoch=(int(demo["start_time_s"]), 0))
+    assert 0.0 < plan.duration < 60.0
+    assert rot.angle_between(plan.q[-1], np.asarray(demo["final_attitude"])) < math.radians(0.5)
