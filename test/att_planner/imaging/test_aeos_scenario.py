@@ -38,6 +38,7 @@ def test_the_scenario_states_bsk_rls_orbit_and_spacecraft():
 def test_the_spacecraft_holds_nadir_on_the_estimate():
     law = law_of(PointingMode("nadir"), PointingGeometry.of(world.Environment.from_scenario(AEOS)), 0.0, rot.IDENTITY)
     loop = ClosedLoop(AEOS, q0=law.attitude(0.0), omega0=reference(law.attitude, 0.0).omega_RN_R)
+    assert loop.estimator is not None               # the controller flies on the estimate
     loop.run(2.0)
     code, message, _ = loop.controller.set_mode(ControlMode.POINTING, PointingMode("nadir"))
     assert code == 0, message
