@@ -93,6 +93,28 @@ WINDOW_FACTOR = 4.0       # the default window: this many times the eigenaxis sl
 ZONE_SKY_CACHE = 4        # ZoneSkies a problem keeps (one per window asked for)
 
 
+def rest_to_rest_time(spacecraft: Spacecraft, axis_B, angle, rate_max: float = math.inf,
+                      wheel_momentum_max: float = math.inf) -> np.ndarray:
+    """Durations (s) of rest-to-rest eigenaxis slews by ``angle`` (rad, (M,)) about the body unit
+    axes ``axis_B`` (M, 3): bang-bang at the largest acceleration the per-axis torque bound T̄
+    allows, ``α = T̄ / max_j (|(J e)_j| + φ |(e × J e)_j|)`` (:mod:`att_planner.methods.axis_rotations`),
+    coasting at the peak rate ``w = min(sqrt(α φ), ω̄ / max|e_j|, h̄ / max|(G⁺ J e)_i|)`` when the
+    per-axis rate bound ``rate_max`` or the wheel momentum bound ``wheel_momentum_max`` is lower:
+    ``T = φ / w + w / α`` (accelerate, coast, brake); 0 for a zero angle. The spacecraft needs a
+    finite, positive ``body_torque_max``."""
+    e = np.atleast_2d(np.asarray(axis_B, float))
+    phi = np.atleast_1d(np.asarray(angle, float))
+    Je = e @ spacecraft.inertia.T
+    alpha = spacecraft.body_torque_max / np.max(np.abs(Je) + phi[:, None] * np.abs(np.cross(e, Je)), axis=1)
+    w = np.sqrt(alpha * phi)                             # peak rate of the bang-bang slew
+    if np.isfinite(rate_max):
+        w = np.minimum(w, rate_max / np.abs(e).max(axis=1))
+    if np.isfinite(wheel_momentum_max) and spacecraft.n_wheels:
+        w = np.minimum(w, wheel_momentum_max / np.abs(Je @ spacecraft.wheel_axes_pinv.T).max(axis=1))
+    positive = phi > 0
+    return np.where(positive, phi / np.where(positive, w, 1.0) + w / alpha, 0.0)
+
+
 @dataclass
 class ManeuverProblem:
     """Reorientation of body-fixed sensors among keep-out cones and zones, from rest to rest.
@@ -198,11 +220,4 @@ class ManeuverProblem:
         e, phi = rot.to_axis_angle(q_rel)
         if self.sensor_target is not None or phi < 1e-12:
             e, phi = np.ones(3) / np.sqrt(3.0), math.pi
-        J = sc.inertia
-        alpha = sc.body_torque_max / np.max(np.abs(J @ e) + phi * np.abs(np.cross(e, J @ e)))
-        w = math.sqrt(alpha * phi)                       # peak rate of the bang-bang slew
-        if np.isfinite(self.rate_max):
-            w = min(w, self.rate_max / np.abs(e).max())
-        if np.isfinite(self.wheel_momentum_max) and sc.n_wheels:
-            w = min(w, self.wheel_momentum_max / np.abs(sc.wheel_axes_pinv @ J @ e).max())
-        return float(phi / w + w / alpha)                # accelerate, coast, brake
+        return float(rest_to_rest_time(sc, e, phi, self.rate_max, self.wheel_momentum_max)[0])

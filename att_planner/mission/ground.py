@@ -19,8 +19,6 @@ overhead turn the line of sight faster than a large spacecraft can follow.
 """
 from __future__ import annotations
 
-import math
-
 import numpy as np
 
 from att_msgs_py.types import PointingMode
@@ -39,10 +37,30 @@ def site_mode(site, sensor_axis, secondary_axis, secondary: str) -> PointingMode
                         latitude=site.latitude, longitude=site.longitude, altitude=site.altitude)
 
 
-def geodetic_up(latitude: float, longitude: float) -> np.ndarray:
-    """The unit normal of the WGS-84 ellipsoid at a geodetic latitude and longitude (ITRS)."""
-    return np.array([math.cos(latitude) * math.cos(longitude), math.cos(latitude) * math.sin(longitude),
-                     math.sin(latitude)])
+def geodetic_up(latitude, longitude) -> np.ndarray:
+    """The unit normal of the WGS-84 ellipsoid at geodetic latitudes and longitudes (rad), ITRS,
+    shape ``latitude.shape + (3,)``."""
+    lat, lon = np.asarray(latitude, float), np.asarray(longitude, float)
+    return np.stack([np.cos(lat) * np.cos(lon), np.cos(lat) * np.sin(lon), np.sin(lat)], axis=-1)
+
+
+def elevation_sines(r_itrs: np.ndarray, sites_itrs: np.ndarray, up_itrs: np.ndarray, pairs: bool = False) -> np.ndarray:
+    """``sin e = û · (r − s) / |r − s|``, the elevation of the spacecraft at ``r`` above the horizon of
+    the site at ``s`` with geodetic up ``û`` (all ITRS, m), written ``(û·r − û·s) / sqrt(|r|² − 2 s·r + |s|²)``.
+
+    ``r_itrs`` (K, 3) against N sites ``sites_itrs`` and ``up_itrs`` (N, 3): the grid (N, K) in two
+    matrix products; ``pairs``: K = N, the k-th position against the k-th site, (K,)."""
+    r = np.asarray(r_itrs, float).reshape(-1, 3)
+    s = np.asarray(sites_itrs, float).reshape(-1, 3)
+    u = np.asarray(up_itrs, float).reshape(-1, 3)
+
+    def rows(a, b):
+        return np.einsum("ij,ij->i", a, b)
+
+    cross = rows if pairs else (lambda a, b: a @ b.T)
+    column = (lambda x: x) if pairs else (lambda x: x[:, None])
+    along = cross(u, r) - column(rows(u, s))
+    return along / np.sqrt(rows(r, r) - 2.0 * cross(s, r) + column(rows(s, s)))
 
 
 class GroundTrack:
@@ -62,8 +80,8 @@ class GroundTrack:
         t = np.atleast_1d(np.asarray(t, float))
         R = self.environment.field.itrs_rotation(t)                       # GCRS -> ITRS, (K, 3, 3)
         r = np.asarray(self.environment.orbit.position(t), float).reshape(-1, 3)    # GCRS, as the law's
-        up_to_sc = np.einsum("kij,kj->ki", R, r) - self.r_itrs             # ITRS, site to spacecraft
-        return np.arcsin(np.clip(up_to_sc @ self.up_itrs / np.linalg.norm(up_to_sc, axis=1), -1.0, 1.0))
+        sines = elevation_sines(np.einsum("kij,kj->ki", R, r), self.r_itrs, self.up_itrs)[0]
+        return np.arcsin(np.clip(sines, -1.0, 1.0))
 
     def attitudes(self, t) -> np.ndarray:
         """The law's attitude (body-to-inertial) at each time of ``t``, (K, 4)."""

@@ -38,6 +38,7 @@ STUDIES = {
     "cluster": "att_planner.tools.bench.cluster",
     "fastest": "att_planner.tools.bench.fastest",
     "rtf": "att_planner.tools.bench.rtf",
+    "aeos": "att_planner.tools.bench.aeos",
 }
 TOOLS = {
     "history": "att_planner.tools.bench.history",

@@ -348,6 +348,16 @@ def _rtf(p: dict, case: str | None) -> Summary:
                     "final_error_deg": _num(p, "final_error_deg"), "success": success})
 
 
+def _aeos(p: dict, case: str | None) -> Summary:
+    greedy, accessible = _get(p, "greedy"), _get(p, "accessible")
+    return Summary(case or f"{_get(p, 'targets')} seed {_get(p, 'seed')}, {_num(p, 'orbits'):g} orbits",
+                   f"greedy images {_get(greedy, 'status')}", _num(greedy, "images"),
+                   f"of {int(_num(accessible, 'sites'))} accessible", "none (a planning estimate)", None,
+                   {"accessible_sites": _num(accessible, "sites"), "accessible_priority": _num(accessible, "priority"),
+                    "greedy_priority": _num(greedy, "priority"), "access_windows": _num(p, "access_windows", "total"),
+                    "compute_s": _num(p, "compute_s", "access") + _num(p, "compute_s", "greedy")})
+
+
 def _cmd(template: str) -> Callable[[dict, str], str]:
     return lambda p, path: template.format(path=path, **{k: v for k, v in p.items()
                                                                                  if isinstance(v, str | int | float)})
@@ -386,6 +396,9 @@ STUDIES: tuple[Study, ...] = (
           lambda p, path: f"att-bench fastest --sets {p['fastest_sets']} --budget {p['budget_s']:g} "
                           + (f"--options '{json.dumps(p['time_optimal_options'])}' " if p.get("time_optimal_options")
                              else "") + f"--json {path}"),
+    Study("aeos", lambda p: p.get("study") == "aeos", _aeos,
+          lambda p, path: f"att-bench aeos --targets {p['targets']} --seed {p['seed']} --orbits {p['orbits']:g} "
+                          f"--json {path}"),
 )
 BY_NAME = {s.name: s for s in STUDIES}
 
