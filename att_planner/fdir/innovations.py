@@ -27,23 +27,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from att_planner.estimation.health import Innovation
 from att_planner.fdir.persistence import Persistence
 from att_planner.fdir.status import Verdict
 
 PAIR_WINDOW_S = 0.5            # s: two trackers' innovations this close in time are compared
 TRACKER, GYRO = "tracker_innovation", "gyro_innovation"
-
-
-@dataclass(frozen=True)
-class Innovation:
-    """One tracker measurement's innovation, as the estimator computed it when it first arrived."""
-
-    t: float                   # s of sim time the measurement was taken
-    sensor: str                # the tracker's name
-    y: np.ndarray              # (3,) rad, body axes: the measured small rotation from the estimate
-    d2: float                  # yᵀ S⁻¹ y
-    R: np.ndarray              # (3, 3) rad², the measurement noise in body axes
-    used: bool = True          # False: the tracker was excluded (innovation computed, not applied)
 
 
 @dataclass

@@ -8,7 +8,8 @@ import math
 import numpy as np
 import pytest
 
-from att_planner.fdir.innovations import Innovation, InnovationDetector
+from att_planner.estimation.health import Innovation
+from att_planner.fdir.innovations import InnovationDetector
 from att_sim.models import rotations as rot
 
 ARCSEC = math.pi / 180.0 / 3600.0
