@@ -12,7 +12,10 @@ when ``d²_k > threshold``. Which part failed:
   with a healthy partner (``d²_kj > threshold``, its own ``d²`` the larger) is the faulty one;
 * an inconsistent tracker that **agrees** with its partner (``d²_kj ≤ threshold``) shares its error
   with it: the common cause is the propagation, the gyro (a bias step); its axis is the largest
-  component of the mean innovation over the run (the attitude error the bias integrates);
+  component of the mean innovation over the run (the attitude error the bias integrates). The run
+  is broken by a tracker inconsistent on its own or by every tracker consistent, not by one
+  consistent tracker while another is not (a tracker's noise about its boresight hides an error
+  about that axis longer than its partner's does);
 * a lone tracker (no partner within :data:`PAIR_WINDOW_S`, others excluded) that is inconsistent is
   taken as faulty itself.
 
@@ -106,17 +109,20 @@ class InnovationDetector:
             out.append(Verdict(inn.t, "star_tracker", index, TRACKER, f"{inn.sensor}: d² = {inn.d2:.4g} > "
                                f"{threshold:g} since t = {tr.persistence.since:.3f} s; {why}",
                                since=tr.persistence.since))
-        out += self._gyro(inn, common, agreement)
+        out += self._gyro(inn, common, inconsistent and not common, agreement)
         return out
 
-    def _gyro(self, inn: Innovation, common: bool, agreement: float) -> list[Verdict]:
+    def _gyro(self, inn: Innovation, common: bool, own: bool, agreement: float) -> list[Verdict]:
+        """The gyro's condition after ``inn``: held by a common-cause inconsistency, broken by a
+        tracker inconsistent on its own (``own``) or by every tracker consistent, left as it is by a
+        consistent tracker while another is not (a tracker blind along the error's axis)."""
         if self.gyro_threshold is None or self.gyro_declared:
             return []
         consistent_everywhere = not (inn.d2 > self.gyro_threshold) and all(
             tr.last is None or tr.excluded or not (tr.last.d2 > self.gyro_threshold) for tr in self.trackers.values())
-        if not common and not consistent_everywhere:
-            return []                         # an inconsistent tracker on its own, or a lone consistent one
-        if consistent_everywhere:
+        if not common and not consistent_everywhere and not own:
+            return []
+        if consistent_everywhere or own:
             self.gyro.update(False, inn.t)
             self.gyro_run = []
             return []
