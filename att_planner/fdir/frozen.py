@@ -20,8 +20,9 @@ class FrozenDetector:
 
     def __init__(self, component: str, detector: str, n_channels: int, threshold: float, persistence_s: float,
                  unit: str, single_unit: bool = False):
-        """``single_unit``: the channels are the axes of one unit (the magnetometer: index 0, the axis in
-        the evidence); else each channel is a unit (a wheel's tachometer, a gyro axis)."""
+        """``single_unit``: the channels are the axes of one unit (the magnetometer: index 0, declared
+        once, by its first stuck axis, named in the evidence); else each channel is a unit (a wheel's
+        tachometer, a gyro axis)."""
         self.component, self.detector, self.threshold, self.unit = component, detector, threshold, unit
         self.single_unit = single_unit
         self.persistence = [Persistence(persistence_s) for _ in range(n_channels)]
@@ -41,6 +42,7 @@ class FrozenDetector:
             if not p.holding and change[i] <= self.threshold:
                 p.since = self.last_t          # unchanged since the sample before
             if p.update(bool(change[i] <= self.threshold), t) and not self.declared[i]:
+                self.declared = [True] * len(self.declared) if self.single_unit else self.declared
                 self.declared[i] = True
                 where = f"axis {i}" if self.single_unit else f"{self.component} {i}"
                 out.append(Verdict(t, self.component, 0 if self.single_unit else i, self.detector,

@@ -19,6 +19,7 @@ import numpy as np
 from att_msgs_py.types import Health
 from att_planner.estimation.health import Innovation
 from att_planner.fdir import table as tables
+from att_planner.fdir.bias import BiasJumpDetector
 from att_planner.fdir.frozen import FrozenDetector
 from att_planner.fdir.innovations import InnovationDetector
 from att_planner.fdir.outage import OutageDetector
@@ -71,6 +72,8 @@ class FaultMonitor:
             return "innovations", (InnovationDetector(self.trackers, gyro_threshold=e.threshold,
                                                       gyro_persistence_s=e.persistence_s)
                                    if len(self.trackers) > 1 else None)
+        if isinstance(e, tables.GyroBiasJump):
+            return "bias", BiasJumpDetector(e.threshold_deg_h, e.window_s, e.persistence_s) if specs.gyro else None
         if isinstance(e, tables.TrackerOutage):
             return "tick", OutageDetector(self.trackers, e.threshold_s, e.persistence_s) if self.trackers else None
         if isinstance(e, tables.AttitudeError):
@@ -115,12 +118,16 @@ class FaultMonitor:
             out += self._run("rate", lambda d: d.update(t, math.degrees(rate_error_rad_s)))
         return out
 
-    def on_estimate(self, t: float, health: int, attitude_covariance) -> list[FaultStatus]:
-        """The estimate's health and attitude covariance (rad²): its 3σ, infinite without an attitude."""
-        sigma3 = math.inf
+    def on_estimate(self, t: float, health: int, attitude_covariance, gyro_bias=None,
+                    bias_covariance=None) -> list[FaultStatus]:
+        """The estimate's health, attitude covariance (rad²: its 3σ, infinite without an attitude),
+        gyro bias estimate (rad/s; None: not judged) and its covariance ((rad/s)²)."""
+        sigma3, out = math.inf, []
         if health in KNOWN:
             sigma3 = math.degrees(3.0 * math.sqrt(max(float(np.linalg.eigvalsh(attitude_covariance).max()), 0.0)))
-        return self._run("estimate", lambda d: d.update(t, sigma3))
+            if gyro_bias is not None:
+                out += self._run("bias", lambda d: d.update(t, gyro_bias, bias_covariance))
+        return out + self._run("estimate", lambda d: d.update(t, sigma3))
 
     # -- state ------------------------------------------------------------------------------------
     def responses(self) -> Responses:

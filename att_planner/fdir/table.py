@@ -132,6 +132,16 @@ class GyroInnovation(Entry):
     threshold: float = number(gt=0.0, le=1e6, unit="", meaning="d² above which a measurement is inconsistent")
 
 
+class GyroBiasJump(Entry):
+    """The gyro, when the estimator's bias estimate moves on one axis by more than the threshold within
+    ``window_s`` (a bias step the filter is following; one star tracker is enough)."""
+
+    component: ClassVar[str] = "gyro"
+    detector: Literal["gyro_bias_jump"]
+    threshold_deg_h: float = number(gt=0.0, le=1e5, unit="deg/h", meaning="change of the bias estimate")
+    window_s: float = number(10.0, gt=0.0, le=3600.0, unit="s", meaning="span the change is measured over")
+
+
 class TrackerOutage(Entry):
     """A star tracker from which no measurement (valid or not) arrived for the threshold."""
 
@@ -166,7 +176,7 @@ class EstimateUncertain(Entry):
 
 
 Detector = Annotated[WheelTorque | TachometerFrozen | GyroFrozen | MagnetometerFrozen | TrackerInnovation
-                     | GyroInnovation | TrackerOutage | AttitudeError | RateError | EstimateUncertain,
+                     | GyroInnovation | GyroBiasJump | TrackerOutage | AttitudeError | RateError | EstimateUncertain,
                      Field(discriminator="detector")]
 DETECTORS = {typing.get_args(m.model_fields["detector"].annotation)[0]: m
              for m in typing.get_args(typing.get_args(Detector)[0])}   # detector name -> its entry model

@@ -48,7 +48,7 @@ class MonitorTap:
             self.omega_BN_B = np.asarray(m.omega, float)
             if self.estimator is not None:
                 out += mon.on_innovations(self.estimator.take_innovations())
-            out += mon.on_estimate(m.t, m.health, m.attitude_covariance)
+            out += mon.on_estimate(m.t, m.health, m.attitude_covariance, m.gyro_bias, m.bias_covariance)
         elif topic == topics.CONTROLLER_STATUS:
             out += mon.on_control(t, float(m.attitude_error), math.nan)
         if self.chain is not None:
