@@ -31,7 +31,7 @@ class FrozenDetector:
         self.last_t = 0.0
 
     def update(self, t: float, values) -> list[Verdict]:
-        """A sample at ``t`` of every channel; the verdicts of the channels declared stuck now."""
+        """A sample at ``t`` of every channel; the verdicts of the channels declared stuck at this sample."""
         values = np.asarray(values, float)
         if self.last is None:
             self.last, self.last_t = values, t

@@ -81,8 +81,10 @@ class FaultMonitor:
                                         "attitude error")
         if isinstance(e, tables.RateError):
             return "rate", Watchdog("rate", e.detector, e.threshold_deg_s, e.persistence_s, "deg/s", "rate error")
-        return "estimate", Watchdog("estimate", e.detector, e.threshold_deg, e.persistence_s, "deg",
-                                    "attitude 3 sigma of the estimate")
+        if isinstance(e, tables.EstimateUncertain):
+            return "estimate", Watchdog("estimate", e.detector, e.threshold_deg, e.persistence_s, "deg",
+                                        "attitude 3 sigma of the estimate")
+        raise TypeError(f"a detector of the fault table ({', '.join(tables.DETECTORS)}), got {type(e).__name__}")
 
     # -- inputs -----------------------------------------------------------------------------------
     def on_wheels(self, t: float, speeds_rad_s, torque_Nm, friction_Nm=None, omega_BN_B=None) -> list[FaultStatus]:

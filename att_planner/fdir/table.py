@@ -193,7 +193,3 @@ def read(path=DEFAULT_TABLE) -> FaultTable:
     :class:`att_sim.models.config_files.ConfigFileError` (``INVALID_CONFIG``) with every problem."""
     return config_files.load_file(path, FaultTable).model
 
-
-def component_of(entry: Entry) -> str:
-    """The component an entry's detector watches."""
-    return type(entry).component

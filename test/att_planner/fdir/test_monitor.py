@@ -92,3 +92,12 @@ def test_noiseless_sensors_are_not_watched_for_a_stuck_reading(leo):
     m = monitor(leo, SensorSpecs())
     assert set(m.detectors) == {"wheels", "attitude", "rate", "estimate"}
     assert m.on_gyro(1.0, np.zeros(3)) == [] and m.on_innovations([]) == [] and m.tick(100.0) == []
+
+
+def test_every_detector_of_the_table_is_built(leo):
+    """Each detector the schema knows has its detector in the monitor (one entry of each kind)."""
+    m = monitor(leo)
+    built = {type(d).__name__ for ds in m.detectors.values() for _, d in ds}
+    assert built == {"WheelTorqueDetector", "FrozenDetector", "InnovationDetector", "BiasJumpDetector",
+                     "OutageDetector", "Watchdog"}
+    assert sum(len(ds) for ds in m.detectors.values()) == len(table.read().faults) == len(table.DETECTORS)
