@@ -23,6 +23,8 @@ from att_msgs.msg import (
     AttitudeEstimate,
     CoarseSunSensors,
     ControllerStatus,
+    FaultEvent,
+    FaultStatus,
     KeepOutCone,
     ManeuverPlan,
     MissionEvent,
@@ -402,6 +404,32 @@ def mission_event_from_msg(msg) -> types.MissionEvent:
         direction=from_vector3(msg.direction), sensor_axis=from_vector3(msg.sensor_axis),
         tolerance=float(msg.tolerance), plan_id=msg.plan_id, message=msg.message,
         frame_id=msg.header.frame_id, pointing=_site_pointing(msg), zones=tuple(getattr(msg, "zones", ())))
+
+
+def fault_event_msg(e: types.FaultEvent) -> FaultEvent:
+    return _header(FaultEvent(component=e.component, index=int(e.index), kind=e.kind, factor=float(e.factor),
+                              bias_rad=[float(v) for v in e.bias_rad], bias_rad_s=float(e.bias_rad_s),
+                              source=str(e.source)), e.t, e.frame_id)
+
+
+def fault_event_from_msg(msg) -> types.FaultEvent:
+    return types.FaultEvent(t=from_time(msg.header.stamp), component=msg.component, index=int(msg.index),
+                            kind=msg.kind, factor=float(msg.factor), bias_rad=tuple(float(v) for v in msg.bias_rad),
+                            bias_rad_s=float(msg.bias_rad_s), source=types.FaultSource(msg.source),
+                            frame_id=msg.header.frame_id)
+
+
+def fault_status_msg(s: types.FaultStatus) -> FaultStatus:
+    return _header(FaultStatus(fault_id=s.fault_id, component=s.component, index=int(s.index), detector=s.detector,
+                               evidence=s.evidence, response=s.response, active=bool(s.active),
+                               detected_at=time_msg(s.detected_at)), s.t, s.frame_id)
+
+
+def fault_status_from_msg(msg) -> types.FaultStatus:
+    return types.FaultStatus(t=from_time(msg.header.stamp), fault_id=msg.fault_id, component=msg.component,
+                             index=int(msg.index), detector=msg.detector, evidence=msg.evidence,
+                             response=msg.response, active=bool(msg.active), detected_at=from_time(msg.detected_at),
+                             frame_id=msg.header.frame_id)
 
 
 def _site_pointing(msg) -> types.PointingMode | None:

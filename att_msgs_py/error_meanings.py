@@ -176,6 +176,15 @@ MEANINGS: dict[ErrorCode, str] = {
         '(logged) an actuator command beyond `command_limit_factor` (2) × its limit (wheel torque, dipole, '
         'body torque; any mode). Within the factor the command is saturated'
     ),
+    ErrorCode.INVALID_FAULT: (
+        '`/simulator/inject_fault`: an unknown component or a kind it cannot have, an index beyond the '
+        "spacecraft's hardware (wheels, star trackers, gyro or coil axes, the one magnetometer), a missing "
+        'sensor, a NaN/Inf or out-of-range `factor`, `bias_rad` or `bias_rad_s`, a parameter given to a kind '
+        'that takes none, a negative or non-finite `t_s`'
+    ),
+    ErrorCode.FAULT_INJECTION_DISABLED: (
+        '`/simulator/inject_fault` to a simulator whose scenario does not set `allow_fault_injection: true`'
+    ),
     ErrorCode.INVALID_PARAMETER: 'a node parameter of the wrong type, out of range, or unknown (a typo)',
     ErrorCode.INVALID_CONFIG: (
         'an unknown scenario, a YAML that is not a scenario, a missing or unparsable `--params-file`, a '

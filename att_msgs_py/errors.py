@@ -59,6 +59,8 @@ class ErrorCode(IntEnum):
     INVALID_RESET = 400
     INVALID_COMMAND = 401         # actuator command with a bad field or stamp (refused, reported)
     COMMAND_LIMIT = 402           # actuator command far beyond its limit (refused, reported)
+    INVALID_FAULT = 403           # a fault to inject with a bad field (component, index, kind, parameter, time)
+    FAULT_INJECTION_DISABLED = 404  # a fault injection request to a scenario without allow_fault_injection
     # nodes and tools: configuration
     INVALID_PARAMETER = 500       # a parameter of the wrong type or out of range
     INVALID_CONFIG = 501          # an unknown scenario, a YAML that is not a scenario, a missing file

@@ -64,6 +64,7 @@ SPACECRAFT_STATE = {**_HEADER, "body_frame_id": MAX_NAME_LENGTH, "wheel_speeds":
 ATTITUDE_ESTIMATE = {**_HEADER, "body_frame_id": MAX_NAME_LENGTH, "message": MAX_TEXT_LENGTH}
 ACTUATOR_COMMAND = {**_HEADER, "wheel_torques": MAX_WHEELS, "plan_id": MAX_NAME_LENGTH}
 RESET_SIMULATOR = {"wheel_speeds": MAX_WHEELS}
+INJECT_FAULT = {"component": MAX_NAME_LENGTH, "kind": MAX_NAME_LENGTH, "bias_rad": 3}
 JOINT_STATE = {**_HEADER, "name": MAX_WHEELS, "name[]": MAX_NAME_LENGTH, "position": MAX_WHEELS,
                "velocity": MAX_WHEELS, "effort": MAX_WHEELS}
 STAR_TRACKER = {**_HEADER, "sensor_frame_id": MAX_NAME_LENGTH}

@@ -21,11 +21,14 @@ SIM_MARKERS = "/simulator/markers"           # zones, boresights, Sun/Moon/Earth
 ZONE_MARGINS = "/simulator/zone_margins"     # the zones' truth margins, for plots
 PLAN_MARKERS = "/planner/plan_markers"       # the latest plan's boresight path
 MISSION_EVENTS = "/mission/events"           # att-mission's decisions, slews, dwells and missed targets
+SIM_FAULTS = "/simulator/faults"             # every hardware fault the truth started (evaluation only)
 
 PLAN_MANEUVER = "/planner/plan_maneuver"
 PLAN_SCHEDULE = "/planner/plan_schedule"
 SET_CONTROLLER_MODE = "/controller/set_mode"
 RESET_SIMULATOR = "/simulator/reset"
+HOLD_SIMULATOR = "/simulator/hold"
+INJECT_FAULT = "/simulator/inject_fault"
 EXECUTE_MANEUVER = "/controller/execute"
 
 # Topic -> ROS type name of everything the recorder writes.
@@ -47,6 +50,7 @@ RECORDED = {
     ZONE_MARGINS: "att_msgs/msg/ZoneMargins",
     PLAN_MARKERS: "visualization_msgs/msg/MarkerArray",
     MISSION_EVENTS: "att_msgs/msg/MissionEvent",
+    SIM_FAULTS: "att_msgs/msg/FaultEvent",
 }
 
 
@@ -74,11 +78,16 @@ ABOUT = {
     ZONE_MARGINS: "each scenario zone's truth margin (rad, >= 0 clear) and the smallest, at `tf_rate_Hz`",
     PLAN_MARKERS: "the latest plan's boresight path (inertial frame, latched)",
     MISSION_EVENTS: "a mission's decisions, slews, dwells, parks and missed targets with why (latched)",
+    SIM_FAULTS: "each hardware fault the truth started: component, index, kind, parameters, source (latched; "
+                "for evaluation only, no flight node reads it)",
+    INJECT_FAULT: "inject a hardware fault into the truth at a sim time (refused unless the scenario sets "
+                  "`allow_fault_injection`)",
     PLAN_MANEUVER: "plan a rest-to-rest maneuver (or one ending on a pointing law), verified and signed",
     PLAN_SCHEDULE: "the fastest tour through target attitudes, each flown through or observed (held for its "
                    "dwell, within its window, never while a zone covers it)",
     SET_CONTROLLER_MODE: "idle, magnetorquer PD, safe or pointing (a `PointingMode`); momentum dumping on or off",
     RESET_SIMULATOR: "reset attitude, rate, wheel speeds and orbit phase",
+    HOLD_SIMULATOR: "hold sim time (true) or let it run again (false); a hold ends after `max_hold_s` of wall time",
     EXECUTE_MANEUVER: "execute a plan (by id or inline), with feedback while it runs",
 }
 

@@ -481,3 +481,48 @@ class MissionEvent:
     frame_id: str = ""
     pointing: PointingMode | None = None
     zones: tuple = ()
+
+
+class FaultSource(StrEnum):
+    """Where an injected fault came from: ``att_msgs/FaultEvent.SOURCE_*``."""
+
+    SCENARIO = "scenario"              # the scenario's faults list
+    SERVICE = "service"                # a /simulator/inject_fault request
+    DISPERSION = "dispersion"          # drawn for a Monte Carlo run from its seed
+
+
+@dataclass(frozen=True)
+class FaultEvent:
+    """A hardware fault the truth started at sim time ``t`` (``att_msgs/FaultEvent``): the failing
+    ``component`` and its ``index``, the ``kind``, its parameters (``factor`` the friction multiplier,
+    ``bias_rad`` a star tracker's bias rotation vector in its sensor axes (rad; empty for another kind),
+    ``bias_rad_s`` a gyro axis's bias step) and its ``source``."""
+
+    t: float
+    component: str
+    index: int
+    kind: str
+    factor: float = 1.0
+    bias_rad: tuple = ()
+    bias_rad_s: float = 0.0
+    source: FaultSource = FaultSource.SCENARIO
+    frame_id: str = ""
+
+
+@dataclass(frozen=True)
+class FaultStatus:
+    """A fault the flight software detected (``att_msgs/FaultStatus``), reported at sim time ``t``:
+    the fault table entry ``fault_id``, the ``component`` and ``index`` it isolated, the ``detector``
+    that fired on what ``evidence``, the ``response`` taken, whether the fault stands (``active``)
+    and when it was confirmed (``detected_at``, s of sim time)."""
+
+    t: float
+    fault_id: str
+    component: str
+    index: int
+    detector: str
+    evidence: str
+    response: str
+    active: bool
+    detected_at: float
+    frame_id: str = ""

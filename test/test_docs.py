@@ -116,6 +116,7 @@ def test_node_pages_read_each_node_s_endpoints_from_its_source():
             for node in att_docs.NODES}
     assert ("serves (action)", "/controller/execute", "att_msgs/action/ExecuteManeuver") in rows["controller"]
     assert ("serves (service)", "/simulator/reset", "att_msgs/srv/ResetSimulator") in rows["simulator"]
+    assert ("serves (service)", "/simulator/hold", "std_srvs/srv/SetBool") in rows["simulator"]
     # the simulator publishes a sensor's topic only when the scenario has that sensor
     assert ("publishes (when configured)", "/sensors/imu", "sensor_msgs/msg/Imu") in rows["simulator"]
     assert ("publishes", "/estimator/attitude", "att_msgs/msg/AttitudeEstimate") in rows["estimator"]

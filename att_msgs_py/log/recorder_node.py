@@ -6,6 +6,9 @@ killed recorder loses at most that) and finalised (summary and index) on SIGINT/
 left at ``output`` by a recorder that did not finish is first repaired to ``OUT.repaired.mcap``
 (``att-log repair``), so starting again on the same path loses nothing.
 
+Spun by rclpy's events executor: the recorder listens to every topic, and the default executor's
+per-message wait-set rebuild made it the busiest process of a fast run.
+
 Usage: ``att-recorder --ros-args -p output:=runs/demo.mcap``
 """
 from __future__ import annotations
@@ -14,6 +17,7 @@ import time
 from datetime import UTC, datetime
 from pathlib import Path
 
+from rclpy.experimental import EventsExecutor
 from rclpy.node import Node
 
 from att_msgs_py import memory, qos, topics
@@ -69,7 +73,9 @@ class RecorderNode(Node):
 
 def main(args=None):
     memory.reexec_with_c_allocator()
-    run_node(RecorderNode, args)
+    # rclpy's events executor (C++): each message costs a callback, not a Python rebuild of the wait set
+    # over every recorded topic; it serves raw subscriptions, timers and the parameter services
+    run_node(RecorderNode, args, make_executor=EventsExecutor)
 
 
 if __name__ == "__main__":

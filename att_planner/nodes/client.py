@@ -26,6 +26,7 @@ from datetime import datetime
 import rclpy
 from rclpy.action import ActionClient
 from rclpy.node import Node
+from std_srvs.srv import SetBool
 
 from att_msgs.action import ExecuteManeuver
 from att_msgs.msg import AttitudeEstimate
@@ -107,6 +108,7 @@ class SuiteClient(Node):
         self.schedule_client = self.create_client(PlanSchedule, topics.PLAN_SCHEDULE, qos_profile=qos.SERVICE_QOS)
         self.mode_client = self.create_client(SetControllerMode, topics.SET_CONTROLLER_MODE)
         self.execute_client = ActionClient(self, ExecuteManeuver, topics.EXECUTE_MANEUVER)
+        self.hold_client = self.create_client(SetBool, topics.HOLD_SIMULATOR)
 
     def wait_for_servers(self, timeout: float = 30.0, schedule: bool = False, estimate: bool = False) -> None:
         """Wait for the planner's and the controller's services and action (``schedule``: the schedule
@@ -195,6 +197,19 @@ class SuiteClient(Node):
 
     def schedule(self, request: PlanSchedule.Request, timeout: float = 300.0) -> PlanSchedule.Response:
         return self._call(self.schedule_client, request, timeout)
+
+    def hold_simulator(self, held: bool, timeout: float = 10.0) -> SetBool.Response:
+        """Hold sim time (``held``) or let it run again (the simulator's ``/simulator/hold``)."""
+        return self._call(self.hold_client, SetBool.Request(data=held), timeout)
+
+    @contextmanager
+    def simulator_held(self, timeout: float = 10.0):
+        """Sim time held for the block, released after it whatever happened in it."""
+        self.hold_simulator(True, timeout)
+        try:
+            yield
+        finally:
+            self.hold_simulator(False, timeout)
 
     def set_mode(self, mode: int, timeout: float = 10.0, key=DEFAULT_KEY, pointing=None,
                  dumping: bool | None = None) -> SetControllerMode.Response:

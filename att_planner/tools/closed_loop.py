@@ -241,13 +241,16 @@ class ClosedLoop:
             self.result = outcome.ended
 
     def _tap_readings(self, t: float, readings, state_due: bool) -> None:
-        """Hand the tap what the simulator publishes now: the sensors' readings, then the state."""
+        """Hand the tap what the simulator publishes now: the sensors' readings, the faults the truth
+        started (each at its onset), then the state."""
         for topic, m in ((topics.IMU, readings.gyro), (topics.MAGNETOMETER, readings.magnetometer),
                          (topics.SUN_SENSORS, readings.sun_sensors), (topics.WHEEL_SPEEDS, readings.wheel_speeds),
                          (topics.SENSOR_TRUTH, readings.truth), *((topics.STAR_TRACKER, m) for m in
                                                                   readings.star_trackers)):
             if m is not None:
                 self.tap(topic, t, m)
+        for event in self.sim.faults.take_events():
+            self.tap(topics.SIM_FAULTS, event.t, event)
         if state_due:
             self.tap(topics.STATE, t, self.sim.state(self.scenario.frame_id, self.scenario.body_frame_id))
 

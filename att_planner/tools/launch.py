@@ -81,6 +81,7 @@ class Suite:
     env: dict
     log_dir: Path
     procs: dict = field(default_factory=dict)
+    profile_dir: Path | None = None      # run every node under cProfile, writing NAME.prof here
 
     def __enter__(self) -> Suite:
         return self
@@ -92,7 +93,8 @@ class Suite:
     def start(self, name: str, params: dict | None = None, params_files: tuple = ()) -> subprocess.Popen:
         """Start node ``name`` with ``-p key:=value`` parameters and ``--params-file`` files
         (both override the scenario defaults; between them rcl's rule applies, see docs/running.md)."""
-        args = [sys.executable, "-m", NODE_MODULES[name], "--ros-args"]
+        profile = [] if self.profile_dir is None else ["-m", "cProfile", "-o", str(self.profile_dir / f"{name}.prof")]
+        args = [sys.executable, *profile, "-m", NODE_MODULES[name], "--ros-args"]
         for path in params_files:
             args += ["--params-file", str(path)]
         for key, value in (params or {}).items():
@@ -147,10 +149,12 @@ def default_nodes(scenario: str) -> tuple[str, ...]:
 
 
 def start_suite(scenario: str, mcap_path: str | Path, log_dir: str | Path, *, env: dict | None = None,
-                nodes=None, params: dict | None = None, state_listeners: int = 0) -> Suite:
+                nodes=None, params: dict | None = None, state_listeners: int = 0,
+                profile_dir: str | Path | None = None) -> Suite:
     """Start ``nodes`` (default: :func:`default_nodes`) for ``scenario``; ``params`` maps node name ->
     extra ROS parameters; ``state_listeners``: the caller's own nodes that will subscribe to the
-    state (a mission driver), which the simulator counts among its subscribers too.
+    state (a mission driver), which the simulator counts among its subscribers too; ``profile_dir``:
+    every node runs under cProfile and writes ``NAME.prof`` there when it stops.
 
     The simulator holds sim time at zero until the recorder, the controller and the estimator
     (those started), and the caller's ``state_listeners``, subscribe to its state or sensors; the
@@ -160,7 +164,7 @@ def start_suite(scenario: str, mcap_path: str | Path, log_dir: str | Path, *, en
     for a late recorder).
     """
     nodes = default_nodes(scenario) if nodes is None else nodes
-    suite = Suite(env or isolated_env(), Path(log_dir))
+    suite = Suite(env or isolated_env(), Path(log_dir), profile_dir=None if profile_dir is None else Path(profile_dir))
     recorder = "recorder" in nodes
     listeners = {"simulator": sum(n in nodes for n in ("recorder", "controller", "estimator")) + state_listeners,
                  "controller": ("simulator" in nodes) + int(recorder),

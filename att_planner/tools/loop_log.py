@@ -1,8 +1,8 @@
 """An MCAP of an in-process closed loop (:class:`~att_planner.tools.closed_loop.ClosedLoop`): every
-message the nodes would publish — the sensors, the state, the estimate, the commands and the
-controller's status — converted by :mod:`att_msgs_py.convert` and written in the recorder's rosbag2
-layout (:class:`att_msgs_py.log.writer.LogWriter`), stamped with sim time. ``att-review`` and
-``read_log`` read it as any recording.
+message the nodes would publish — the sensors, the state, the faults the truth started, the
+estimate, the commands and the controller's status — converted by :mod:`att_msgs_py.convert` and
+written in the recorder's rosbag2 layout (:class:`att_msgs_py.log.writer.LogWriter`), stamped with
+sim time. ``att-review`` and ``read_log`` read it as any recording.
 """
 from __future__ import annotations
 
@@ -20,7 +20,7 @@ MESSAGES = {
     topics.MAGNETOMETER: convert.magnetometer_msg, topics.SUN_SENSORS: convert.sun_sensors_msg,
     topics.WHEEL_SPEEDS: convert.wheel_speeds_msg, topics.SENSOR_TRUTH: convert.sensor_truth_msg,
     topics.STATE: convert.state_msg, topics.ESTIMATE: convert.estimate_msg, topics.COMMAND: convert.command_msg,
-    topics.CONTROLLER_STATUS: convert.controller_status_msg,
+    topics.CONTROLLER_STATUS: convert.controller_status_msg, topics.SIM_FAULTS: convert.fault_event_msg,
 }
 
 

@@ -1,8 +1,8 @@
 """``att-mission MISSION``: a day in orbit flown by the suite's nodes.
 
 Starts recorder, simulator, estimator, controller and planner (the mission file's rate for the
-simulator's step, its state, the control and the estimate; the simulator as fast as the loop goes;
-the controller's momentum dumping as the file says) and flies the target list of the mission file
+simulator's step, its state, the control and the estimate; the controller's momentum dumping as the
+file says) and flies the target list of the mission file
 (:mod:`att_planner.mission.config`) from the scenario's epoch to its horizon. What happens next is
 decided by :class:`~att_planner.mission.executive.MissionExecutive` (no ROS): :class:`MissionDriver`
 turns what the client's node hears (states, the estimate's health, the planner's and controller's
@@ -14,6 +14,14 @@ Every decision, slew, dwell, park and miss is published on ``/mission/events``
 figures are measured from that log (:func:`att_planner.mission.day.day_report`): the targets' dwells
 and pointing errors from the truth state, the zones' margins at their true positions, the wheels.
 The last line printed is ``MCAP: <path>``.
+
+Pace: by default the planner plans while the spacecraft flies, as it would on board: the simulator
+runs at most at ``start_lead_s / time_budget_s`` × real time, so a plan that takes its whole
+wall-time budget still comes back before its slew starts. With ``--rtf max`` the simulator never
+waits on wall time (only on the lockstep of its controller) and sim time is held
+(``/simulator/hold``) while the planner plans: the day flown no longer depends on how fast the
+machine is, and a long mission takes what its compute takes. ``--rtf X`` does the same at most at
+X × real time.
 """
 from __future__ import annotations
 
@@ -81,8 +89,9 @@ class MissionDriver:
     """One mission flown through ``client`` (a :class:`~att_planner.nodes.client.SuiteClient`): the
     executive's events from the client's node, its actions as calls."""
 
-    def __init__(self, client, mission: mission_config.MissionConfig, log=print):
+    def __init__(self, client, mission: mission_config.MissionConfig, log=print, hold_while_planning: bool = False):
         self.client, self.mission, self.log = client, mission, log
+        self.hold_while_planning = hold_while_planning
         controller = mission.scenario.node_params.get("controller", {})
         settle = float(controller.get("settle_time_s", ControllerConfig().settle_time))     # as the node reads it
         estimator = mission.scenario.sensors.gyro is not None
@@ -140,14 +149,19 @@ class MissionDriver:
         raise TypeError(f"unknown mission action {action!r}")
 
     def plan(self, action: io.RequestPlan):
-        """The planner's answer to ``action`` among the mission's zones where they are at its start."""
+        """The planner's answer to ``action`` among the mission's zones where they are at its start
+        (sim time held meanwhile when the driver holds it)."""
         m = self.mission
         epoch = m.scenario.epoch + timedelta(seconds=action.t_start)
         options = {"rate_max": m.rate_max} if math.isfinite(m.rate_max) else {}
         request = maneuver_request(action.q_from_BN, action.q_to_BN, m.sensor_axis, [], method=m.method,
                                    options=options, time_budget=action.time_budget, frame_id=m.scenario.frame_id,
                                    epoch=epoch, zones=list(m.zones), wheel_speeds=list(self.telemetry.msg.wheel_speeds))
-        response = self.client.plan(request)
+        if self.hold_while_planning:
+            with self.client.simulator_held():
+                response = self.client.plan(request)
+        else:
+            response = self.client.plan(request)
         if not response.success:
             return self.heard(io.PlanRefused, request=action.request, code=int(response.error_code),
                               message=response.message)
@@ -157,8 +171,11 @@ class MissionDriver:
                           min_cone_margin=plan.verification.min_cone_margin)
 
 
-def fly_mission(mission: mission_config.MissionConfig, out: Path, log=print) -> tuple[Path, dict]:
-    """Start the nodes, fly ``mission``, stop them; the MCAP's path and the day's report."""
+def fly_mission(mission: mission_config.MissionConfig, out: Path, log=print,
+                rtf: float | None = None) -> tuple[Path, dict]:
+    """Start the nodes, fly ``mission``, stop them; the MCAP's path and the day's report. ``rtf``:
+    None, the planner races the flight (module docstring); 0, as fast as possible and sim time held
+    while the planner plans; X > 0, the same at most at X × real time."""
     run_dir = out / f"{mission.path.stem}_{datetime.now(UTC).strftime('%Y%m%d_%H%M%S')}"
     mcap_path = run_dir / "run.mcap"
     env = isolated_env(inherit=True)
@@ -167,7 +184,7 @@ def fly_mission(mission: mission_config.MissionConfig, out: Path, log=print) -> 
     rate = mission.rate
     # the simulator does not wait for the planner: at most start_lead / time_budget × real time, a plan
     # that takes its whole wall-time budget still comes back before its slew's start
-    pace = mission.start_lead / mission.time_budget
+    pace = mission.start_lead / mission.time_budget if rtf is None else rtf
     params = {"simulator": {"step_s": 1.0 / rate, "publish_rate_Hz": rate, "clock_rate_Hz": rate,
                             "real_time_factor": pace},
               "controller": {"control_rate_Hz": rate, "momentum_dumping": mission.momentum_dumping,
@@ -180,7 +197,7 @@ def fly_mission(mission: mission_config.MissionConfig, out: Path, log=print) -> 
     try:
         with client_session("mission") as client:
             client.wait_for_servers(timeout=120)
-            MissionDriver(client, mission, log).run()
+            MissionDriver(client, mission, log, hold_while_planning=rtf is not None).run()
     finally:
         codes = suite.stop()
         log(f"[mission] nodes stopped: {codes}")
@@ -190,18 +207,35 @@ def fly_mission(mission: mission_config.MissionConfig, out: Path, log=print) -> 
     return mcap_path, report
 
 
+def real_time_factor(text: str) -> float:
+    """``--rtf``: 'max' (0.0: as fast as possible) or a finite number > 0."""
+    if text.strip().lower() == "max":
+        return 0.0
+    try:
+        value = float(text)
+    except ValueError:
+        value = math.nan
+    if not (math.isfinite(value) and value > 0):
+        raise argparse.ArgumentTypeError(f"--rtf must be 'max' or a finite real-time factor > 0, not {text[:40]!r}")
+    return value
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(prog="att-mission", description=__doc__.splitlines()[0])
     parser.add_argument("mission", help="a mission file (config/missions/NAME.yaml, or a path)")
     parser.add_argument("--out", default="runs", help="directory for the MCAP and the node logs")
     parser.add_argument("--json", help="write the day's report here")
+    parser.add_argument("--rtf", type=real_time_factor, default=None,
+                        help="'max' (sim time never waits on wall time; held while the planner plans) or a "
+                             "real-time factor > 0 (the same, at most that fast); default: the planner plans "
+                             "while the spacecraft flies, at start_lead_s / time_budget_s x real time")
     args = parser.parse_args(argv)
     try:
         mission = mission_config.load(args.mission)
     except (KeyError, ConfigError) as err:
         print(f"att-mission: {err.args[0] if isinstance(err, KeyError) else err}", file=sys.stderr)
         return 2
-    mcap_path, report = fly_mission(mission, Path(args.out))
+    mcap_path, report = fly_mission(mission, Path(args.out), rtf=args.rtf)
     for target in report["targets"]:
         print(f"[mission]   {target['name']:14s} {'observed' if target['observed'] else 'missed  '} "
               f"{target.get('why', '')}")

@@ -36,6 +36,7 @@ from att_sim.models.config_base import (
     limit,
     number,
 )
+from att_sim.models.config_faults import MAX_FAULTS, Fault, Hardware
 from att_sim.models.config_sensors import Sensors
 
 IDENTITY_AXES = (1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0)
@@ -213,6 +214,9 @@ class Sky(Schema):
         None, description="UTC of sim time zero, ISO 8601 with Z or an offset; none: a fixed sky")
     field_model: Literal["dipole", "igrf14"] = "dipole"
     zones: list[Zone] = Field([], max_length=64)
+    faults: list[Fault] = Field([], max_length=MAX_FAULTS, description="hardware faults the truth starts at their "
+                                                                       "onset (att_sim.truth.faults)")
+    allow_fault_injection: bool = Field(False, description="the simulator serves /simulator/inject_fault")
 
     @field_validator("zones")
     @classmethod
@@ -248,6 +252,22 @@ class Shared(Sky):
         if needs:
             raise ValueError(f"an epoch (the Sun, Moon and Earth depend on the date) for {', '.join(needs)}")
         return self
+
+    @model_validator(mode="after")
+    def _faults_on_hardware(self):
+        hardware = self.hardware()
+        for k, f in enumerate(self.faults):
+            problem = f.problem(hardware)
+            if problem:
+                raise ValueError(problem.phrase(f"faults[{k}]."))
+        return self
+
+    def hardware(self) -> Hardware:
+        """What of this spacecraft can fail (the counts a fault's index ranges over)."""
+        s = self.sensors
+        return Hardware(wheels=len(self.spacecraft.wheel_axes) // 3, star_trackers=len(s.star_trackers),
+                        gyro=s.gyro is not None, magnetometer=s.magnetometer is not None,
+                        tachometer=s.wheel_tachometer is not None)
 
 
 class SpacecraftFile(Spacecraft, Surface):

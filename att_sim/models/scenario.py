@@ -112,6 +112,8 @@ class Scenario:
     actuators: ActuatorSpecs = field(default_factory=ActuatorSpecs)  # the 'actuators' group
     spacecraft_path: Path | None = None            # config/spacecraft/NAME.yaml (None: a self-contained file)
     params_path: Path | None = None                # the file of node_params (the scenario's own when None)
+    faults: tuple = ()                             # FaultSpec: the hardware faults the truth starts
+    allow_fault_injection: bool = False            # the simulator serves /simulator/inject_fault
 
     @property
     def node_params_path(self) -> Path:
@@ -260,7 +262,8 @@ class _Build:
             node_params=files.node_params, spacecraft_path=files.spacecraft_path, params_path=files.params_path,
             epoch=epoch, orbit_model=orbit_model, field_model=self.field_model(epoch),
             environment=self.environment(), zones=self.zones(), sensors=sensors_from_model(shared.sensors),
-            actuators=actuators_from_model(shared.actuators))
+            actuators=actuators_from_model(shared.actuators), faults=tuple(f.spec() for f in shared.faults),
+            allow_fault_injection=shared.allow_fault_injection)
 
 
 def spacecraft_from_model(p: schema.Spacecraft) -> Spacecraft:

@@ -23,6 +23,7 @@ from att_msgs_py.types import WheelSpeedMeasurement
 from att_sim.models import dynamics as dyn
 from att_sim.models import rotations as rot
 from att_sim.models import world
+from att_sim.truth import faults as faulting
 from att_sim.truth.actuators import Magnetorquers, WheelDrive
 from att_sim.truth.sensors import Readings, Taken
 from att_sim.truth.sensors.gyro import Gyros
@@ -67,6 +68,8 @@ class SimulationBatch:
         """One RK4 step of every simulation, the actuator inputs held and each environment evaluated at
         every stage; a run whose state becomes non-finite or whose environment cannot be evaluated
         (e.g. a decayed TLE) halts, alone. The applied body torque reported is the step's RK4-weighted mean."""
+        for s in self.sims:
+            s.faults.start_due(s.t)
         x = np.array([s.x for s in self.sims])
         self.advance_with(x, self.inputs(x), dt)
 
@@ -78,7 +81,7 @@ class SimulationBatch:
 
         def f(t, state):
             torques.append(dyn.external_torque(inputs, world.stages(environments, t, state)))
-            return dyn.rates(sc, state, torques[-1], inputs.wheel_torque, self.drives)
+            return dyn.rates(sc, state, torques[-1], inputs.wheel_torque, inputs.wheel_drive)
         try:
             x_new = dyn.rk4(f, sims[0].t, x, dt)
         except ValueError as err:       # some run's environment failed: each run alone, as it would be
@@ -87,13 +90,14 @@ class SimulationBatch:
                 return
             for i, s in enumerate(sims):
                 alone = s.batch()
-                alone.advance_with(x[i:i + 1], inputs_row(inputs, i, alone.drives), dt)
+                alone.advance_with(x[i:i + 1], inputs_row(inputs, i, alone.drive()), dt)
             return
         dyn.renormalised(x_new.T)
         u = net = inputs.wheel_torque
-        if self.drives is not None:     # at the step's start: motor torque, and less friction
+        drive = inputs.wheel_drive
+        if drive is not None:           # at the step's start: motor torque, and less friction
             speed = dyn.relative_wheel_speed(sc, x[:, 7:], x[:, 4:7])
-            u, net = self.drives.motor(u, speed), self.drives(u, speed)
+            u, net = drive.motor(u, speed), drive(u, speed)
         body = dyn.rk4_mean(*torques) - (sc.wheel_axes @ net[:, :, None])[:, :, 0]
         samples = self._samples(sims[0].t + dt, x_new)
         for i, s in enumerate(sims):
@@ -103,7 +107,9 @@ class SimulationBatch:
         """Every run's actuator inputs for the next step at its state (a row of ``x``), on rows: the
         commands zeroed where the watchdog is tripped (the drives draw no noise there), the drives'
         hold, the torque and speed limits (:func:`att_sim.models.dynamics.effective_wheel_torque`),
-        the dipole's and body torque's limits, the coils of the runs that have them."""
+        the dipole's and body torque's limits, the coils of the runs that have them; each run's
+        wheel and coil faults (:mod:`att_sim.truth.faults`: a wheel off or seized has no motor
+        torque, an open coil no dipole)."""
         sims, sc = self.sims, self.spacecraft
         active = [not s.command_timeout for s in sims]
         on = np.array(active)[:, None]
@@ -111,13 +117,24 @@ class SimulationBatch:
         if self.drives is not None:
             u = self.drives.hold(u, active)
         u = dyn.effective_wheel_torque(sc, x[:, 7:], u, x[:, 4:7])
+        run_faults = [s.faults for s in sims]
+        wheels = faulting.wheel_rows(run_faults)
+        if wheels is not None:
+            u = u * wheels.motor
         limit = sc.dipole_max
         m = np.where(on, np.minimum(np.maximum(np.array([s.dipole_cmd for s in sims]), -limit), limit), 0.0)
+        m = faulting.open_coils(run_faults, m)
         if self.coils is not None:
             m[self.coiled] = self.coils(m[self.coiled])
         limit = sc.body_torque_max
         tau = np.where(on, np.minimum(np.maximum(np.array([s.body_cmd for s in sims]), -limit), limit), 0.0)
-        return dyn.Inputs(wheel_torque=u, torque_B=tau, dipole_B=m, wheel_drive=self.drives)
+        return dyn.Inputs(wheel_torque=u, torque_B=tau, dipole_B=m, wheel_drive=self.drive(wheels))
+
+    def drive(self, wheels: faulting.WheelRows | None = None):
+        """The runs' wheel drives for the dynamics: the drives (None: ideal motors), through the runs'
+        wheel faults when one has any (``wheels``: their rows, when stacked already)."""
+        wheels = wheels or faulting.wheel_rows([s.faults for s in self.sims])
+        return self.drives if wheels is None else faulting.FaultedDrive(self.drives, wheels)
 
     def _samples(self, t: float, x: np.ndarray) -> list:
         """Each run's :meth:`Environment.sample <att_sim.models.world.Environment.sample>` at ``t`` and its
@@ -135,6 +152,8 @@ class SimulationBatch:
         <att_sim.truth.sensors.SensorSuite.sample>`; nothing for a run without sensors), the gyros due
         measuring on rows, the tachometers due too."""
         sims = self.sims
+        for s in sims:
+            s.faults.start_due(s.t)
         suites = [i for i, s in enumerate(sims) if s.sensors is not None]
         taken = [Taken() for _ in sims]
         rotations = self._gyro_rotations(suites)
@@ -147,14 +166,17 @@ class SimulationBatch:
                     or any(a is not b for a, b in zip(self.gyros[0], units)):
                 self.gyros = (units, Gyros(units))
             rotation = np.array([taken[i].gyro_interval[0] for i in due])[:, None, :]
-            rates = self.gyros[1].measure(rotation, [taken[i].gyro_interval[1] for i in due])
+            rates = self.gyros[1].measure(rotation, [taken[i].gyro_interval[1] for i in due])[:, 0]
+            rates = faulting.gyro_rows([sims[i].faults for i in due], rates)
             for i, rate in zip(due, rates):
-                taken[i].gyro_rate = rate[0]
+                taken[i].gyro_rate = rate
         due = [i for i in suites if sims[i].sensors.tachometer_due(sims[i].t)]
         if due:
             x = np.array([s.x for s in sims])
             relative = dyn.relative_wheel_speed(self.spacecraft, x[:, 7:], x[:, 4:7])[due]
-            measured = measure_tachometers([sims[i].sensors.tachometer for i in due], relative)
+            measured = faulting.tachometer_rows([sims[i].faults for i in due],
+                                                measure_tachometers([sims[i].sensors.tachometer for i in due],
+                                                                    relative))
             for i, speeds in zip(due, measured):
                 taken[i].wheel_speeds = WheelSpeedMeasurement(sims[i].t, speeds, sims[i].sensors.body_frame_id)
         return [s.sense_taken(got) for s, got in zip(sims, taken)]

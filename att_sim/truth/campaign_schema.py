@@ -2,7 +2,8 @@
 
 The campaign names a scenario, its seed and run count, and the dispersions of the truth, each a
 distribution (:class:`Normal` or :class:`Uniform`) drawn independently per component
-(:mod:`att_sim.truth.dispersions`). Ranges and defaults are written once, here.
+(:mod:`att_sim.truth.dispersions`), and the hardware faults a run may have (:class:`FaultDispersion`:
+a probability and an onset window each). Ranges and defaults are written once, here.
 """
 from __future__ import annotations
 
@@ -12,6 +13,7 @@ from typing import Annotated, ClassVar, Literal
 from pydantic import Discriminator, Field, Tag, model_validator
 
 from att_sim.models.config_base import Finite, Name, Schema, number
+from att_sim.models.config_faults import MAX_FAULTS, MAX_ONSET_S, FaultKind
 
 MAX_RUNS = 10_000_000
 
@@ -74,6 +76,22 @@ class Dispersions(Schema):
     initial_rate_error_rad_s: Distribution | None = Field(None, description="initial body rate error")
 
 
+class FaultDispersion(FaultKind):
+    """A hardware fault a run may have: it occurs with ``probability``, its onset uniform in ``window_s``."""
+
+    probability: float = number(ge=0.0, le=1.0, unit="", meaning="probability that a run has the fault")
+    window_s: Annotated[list[Finite], Field(min_length=2, max_length=2)] = Field(
+        description="[earliest, latest] onset (s of sim time), drawn uniformly between them")
+
+    @model_validator(mode="after")
+    def _window(self):
+        low, high = self.window_s
+        if not 0.0 <= low <= high <= MAX_ONSET_S:
+            raise ValueError(f"window_s [earliest, latest] with 0 <= earliest <= latest <= {MAX_ONSET_S:g} s, got "
+                             f"[{low:g}, {high:g}]")
+        return self
+
+
 class Campaign(Schema):
     renamed: ClassVar = {"converge_timeout": "converge_timeout_s"}
 
@@ -85,6 +103,8 @@ class Campaign(Schema):
     converge_timeout_s: float = number(30.0, gt=0.0, le=3600.0, unit="s", meaning="sim time for the estimate to "
                                                                                   "converge before the maneuver")
     dispersions: Dispersions = Field(default_factory=Dispersions)
+    faults: list[FaultDispersion] = Field([], max_length=MAX_FAULTS, description="hardware faults drawn per run "
+                                                                                "(att_sim.truth.faults)")
 
 
 class CampaignFile(Schema):

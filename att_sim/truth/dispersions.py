@@ -27,6 +27,12 @@ from its own stream ``SeedSequence(seed, spawn_key=(DISPERSION_STREAM, k))`` (``
 noise and drawn biases, the wheel drives' noise and the coils' misalignment from the sensor streams
 of :mod:`att_sim.truth.sensors` with that seed. A run is therefore reproduced by its seed alone.
 
+Faults: each entry ``k`` of ``faults`` (:class:`att_sim.truth.campaign_schema.FaultDispersion`)
+draws two uniforms ``u₁, u₂`` from its own stream ``SeedSequence(seed, spawn_key=(FAULT_STREAM, k))``:
+the run has the fault when ``u₁ < probability``, starting at ``t_s = earliest + u₂ (latest − earliest)``
+(:func:`draw_faults`; both drawn whatever the outcome, so no entry changes another's). The truth
+schedules it with the source ``dispersion`` (:mod:`att_sim.truth.faults`).
+
 Physical inertia: a draw whose inertia is not positive definite or breaks the triangle inequality
 (each principal moment at most the sum of the other two) is **refused**, naming the run's seed
 (:func:`truth` raises ValueError; the campaign tool checks every run before any flies) — a
@@ -47,11 +53,13 @@ from att_sim.models import config_files
 from att_sim.models import rotations as rot
 from att_sim.models import scenario as scen
 from att_sim.models.actuator_specs import MagnetorquerSpec, WheelDriveSpec
+from att_sim.models.config_faults import FaultSpec, Hardware
 from att_sim.models.config_schema import inertia_problem
 from att_sim.truth import campaign_schema as schema
 from att_sim.truth.sensors import STREAMS
 
 DISPERSION_STREAM = 1000 + len(STREAMS)     # spawn_key (DISPERSION_STREAM, k): clear of the sensors' streams
+FAULT_STREAM = DISPERSION_STREAM + 1        # spawn_key (FAULT_STREAM, k): fault entry k
 MAX_RUNS = schema.MAX_RUNS
 MAX_FILE_BYTES = 100_000
 DEG = math.pi / 180.0
@@ -108,6 +116,7 @@ class Campaign:
     dispersions: dict             # name -> Distribution, in DISPERSIONS order
     settle_tolerance: float       # rad
     converge_timeout_s: float     # s
+    faults: tuple = ()            # FaultDispersion: the faults a run may have
 
 
 def distribution_from(d: schema.Normal | schema.Uniform) -> Distribution:
@@ -122,7 +131,8 @@ def campaign_of(model: schema.CampaignFile, path: Path) -> Campaign:
     c = model.campaign
     dispersions = {name: distribution_from(getattr(c.dispersions, name)) for name in DISPERSIONS
                    if getattr(c.dispersions, name) is not None}
-    return Campaign(path, c.scenario, c.seed, c.runs, dispersions, c.settle_tolerance_deg * DEG, c.converge_timeout_s)
+    return Campaign(path, c.scenario, c.seed, c.runs, dispersions, c.settle_tolerance_deg * DEG, c.converge_timeout_s,
+                    tuple(c.faults))
 
 
 def campaign_from(doc, path: Path) -> Campaign:
@@ -161,6 +171,22 @@ def draw(campaign: Campaign, scenario: scen.Scenario, seed: int) -> dict[str, np
     return out
 
 
+def draw_faults(campaign: Campaign, scenario: scen.Scenario, seed: int) -> list[FaultSpec | None]:
+    """Each fault entry's draw for the run of seed ``seed`` (see module docstring): the fault, or None
+    when the run does not have it; ValueError naming the entry when the scenario's hardware cannot
+    have it."""
+    hardware = Hardware.of(scenario.spacecraft.n_wheels, scenario.sensors)
+    out = []
+    for k, entry in enumerate(campaign.faults):
+        problem = entry.problem(hardware)
+        if problem:
+            raise ValueError(problem.phrase(f"campaign.faults[{k}]."))
+        occurs, where = np.random.default_rng(np.random.SeedSequence(seed, spawn_key=(FAULT_STREAM, k))).random(2)
+        low, high = entry.window_s
+        out.append(entry.spec(low + where * (high - low)) if occurs < entry.probability else None)
+    return out
+
+
 def _tilted(axes: np.ndarray, tilts_rad: np.ndarray) -> np.ndarray:
     """Each unit column of ``axes`` turned by its two tilts about two axes perpendicular to it."""
     out = np.empty_like(axes)
@@ -178,6 +204,7 @@ class Truth:
     q0: np.ndarray
     omega0: np.ndarray
     seed: int
+    faults: tuple = ()          # FaultSpec: the faults drawn for the run (source: dispersion)
 
 
 def truth(scenario: scen.Scenario, values: dict, seed: int, q0=rot.IDENTITY, omega0=(0.0, 0.0, 0.0)) -> Truth:
@@ -232,6 +259,11 @@ def truth(scenario: scen.Scenario, values: dict, seed: int, q0=rot.IDENTITY, ome
 
 def seed_truth(campaign: Campaign, scenario: scen.Scenario, seed: int, q0=rot.IDENTITY,
                omega0=(0.0, 0.0, 0.0)) -> tuple[Truth, dict]:
-    """The run of seed ``seed`` of ``campaign`` on ``scenario``: its truth and applied values."""
+    """The run of seed ``seed`` of ``campaign`` on ``scenario``: its truth (with the faults drawn for it)
+    and applied values (each fault entry's onset ``fault_t_s[k]``, NaN when the run does not have it)."""
     values = draw(campaign, scenario, seed)
-    return truth(scenario, values, seed, q0, omega0), values
+    faults = draw_faults(campaign, scenario, seed)
+    run = replace(truth(scenario, values, seed, q0, omega0), faults=tuple(f for f in faults if f is not None))
+    if faults:
+        values = {**values, "fault_t_s": np.array([math.nan if f is None else f.t_s for f in faults])}
+    return run, values

@@ -27,16 +27,19 @@ import numpy as np
 from att_msgs_py import validation
 from att_msgs_py.errors import ErrorCode, RequestError, clip
 from att_msgs_py.source_hold import SourceHold
-from att_msgs_py.types import CONTROL_MODES, Command, ControlMode, State
+from att_msgs_py.types import CONTROL_MODES, Command, ControlMode, FaultSource, State
 from att_sim.models import dynamics as dyn
 from att_sim.models import environment as env
 from att_sim.models import rotations as rot
 from att_sim.models import world
 from att_sim.models.actuator_specs import ActuatorSpecs
+from att_sim.models.config_faults import PARAMETERS, FaultSpec, Hardware, fault_problem
+from att_sim.models.config_faults import spec as fault_spec
 from att_sim.models.orbit import CircularOrbit
 from att_sim.models.sensor_specs import SensorSpecs
 from att_sim.truth.actuators import Magnetorquers, WheelDrive
 from att_sim.truth.batch import Applied, SimulationBatch
+from att_sim.truth.faults import Faults
 from att_sim.truth.sensors import Readings, SensorSuite, Taken, rng
 
 DEFAULT_STEP = 0.05             # s: the simulator's RK4 step unless its parameter says otherwise
@@ -82,18 +85,27 @@ def _number(value, name: str, code: ErrorCode, low: float = -math.inf, high: flo
         raise RequestError(code, f"{name} is not a number") from None
 
 
+def _given(fault: FaultSpec) -> tuple:
+    """The parameters of ``fault`` its kind takes (``factor``, ``bias_rad``, ``bias_rad_s``), None for the others."""
+    wanted = PARAMETERS.get(fault.kind)
+    return tuple(getattr(fault, name) if name == wanted else None for name in ("factor", "bias_rad", "bias_rad_s"))
+
+
 class Simulation:
     """Truth state, held actuator command and environment. Give ``orbit`` (a circular orbit with the
     tilted dipole and optional ``gravity_gradient``) or a :class:`att_sim.models.world.Environment`
     (:meth:`for_scenario` builds the scenario's). ``sensors`` and ``actuators``: the
     datasheets of the sensors :meth:`sense` samples and of the imperfect wheel drives and
-    magnetorquers; ``seed`` (default: the sensors' ``seed``) makes every random stream of the run."""
+    magnetorquers; ``seed`` (default: the sensors' ``seed``) makes every random stream of the run;
+    ``faults``: the hardware faults (:class:`~att_sim.models.config_faults.FaultSpec`) the scenario
+    schedules (:meth:`inject` adds more; :meth:`request_fault` when ``allow_fault_injection``)."""
 
     def __init__(self, sc: dyn.Spacecraft, orbit: env.OrbitParams | None = None, q0=rot.IDENTITY,
                  omega0=(0, 0, 0), wheel_speed0=None, gravity_gradient: bool = False, checks: Checks = Checks(),
                  environment: world.Environment | None = None, sensors: SensorSpecs | None = None,
                  actuators: ActuatorSpecs | None = None, seed: int | None = None,
-                 frame_id: str = "", body_frame_id: str = ""):
+                 frame_id: str = "", body_frame_id: str = "", faults: tuple = (),
+                 allow_fault_injection: bool = False):
         if (orbit is None) == (environment is None):
             raise ValueError("Simulation needs either orbit parameters or an environment, not both")
         self.sc, self.checks = sc, checks
@@ -112,7 +124,12 @@ class Simulation:
         self.arg0 = self._arg0()
         sensors, actuators = sensors or SensorSpecs(), actuators or ActuatorSpecs()
         self.seed = sensors.seed if seed is None else int(seed)
-        self.sensors = SensorSuite(sensors, self.seed, frame_id, body_frame_id) if sensors else None
+        self.hardware = Hardware.of(sc.n_wheels, sensors)
+        self.faults = Faults(self.hardware, body_frame_id)
+        self.allow_fault_injection = allow_fault_injection      # :meth:`request_fault` schedules (else refuses)
+        for fault in faults:
+            self.inject(fault, FaultSource.SCENARIO)
+        self.sensors = SensorSuite(sensors, self.seed, frame_id, body_frame_id, self.faults) if sensors else None
         self.wheel_drive = (WheelDrive(actuators.wheels, rng(self.seed, "wheel_drive"), sc.n_wheels)
                             if actuators.wheels else None)
         self.magnetorquers = (Magnetorquers(actuators.magnetorquers, rng(self.seed, "magnetorquers"))
@@ -127,13 +144,57 @@ class Simulation:
     @classmethod
     def for_scenario(cls, scenario, q0=rot.IDENTITY, omega0=(0, 0, 0), wheel_speed0=None,
                      gravity_gradient: bool | None = None, checks: Checks = Checks(),
-                     seed: int | None = None) -> Simulation:
+                     seed: int | None = None, dispersed_faults: tuple = ()) -> Simulation:
         """The simulation of a :class:`att_sim.models.scenario.Scenario` in its environment, with its
-        sensors and actuators (``gravity_gradient`` and ``seed``, when given, override the scenario's)."""
-        return cls(scenario.spacecraft, q0=q0, omega0=omega0, wheel_speed0=wheel_speed0, checks=checks,
-                   environment=world.Environment.from_scenario(scenario, gravity_gradient),
-                   sensors=scenario.sensors, actuators=scenario.actuators, seed=seed, frame_id=scenario.frame_id,
-                   body_frame_id=scenario.body_frame_id)
+        sensors and actuators (``gravity_gradient`` and ``seed``, when given, override the scenario's),
+        its faults and the ``dispersed_faults`` a Monte Carlo run drew (:mod:`att_sim.truth.dispersions`)."""
+        sim = cls(scenario.spacecraft, q0=q0, omega0=omega0, wheel_speed0=wheel_speed0, checks=checks,
+                  environment=world.Environment.from_scenario(scenario, gravity_gradient),
+                  sensors=scenario.sensors, actuators=scenario.actuators, seed=seed, frame_id=scenario.frame_id,
+                  body_frame_id=scenario.body_frame_id, faults=scenario.faults,
+                  allow_fault_injection=scenario.allow_fault_injection)
+        for fault in dispersed_faults:
+            sim.faults.schedule(fault, FaultSource.DISPERSION)
+        return sim
+
+    def inject(self, fault: FaultSpec, source: FaultSource = FaultSource.SERVICE) -> Refusal | None:
+        """Schedule ``fault`` (its onset at or before now: at the next step) or say why it cannot be
+        (INVALID_FAULT: a component, index, kind or parameter this spacecraft's hardware cannot have)."""
+        problem = fault_problem(fault.component, fault.index, fault.kind, *_given(fault), t_s=fault.t_s,
+                                hardware=self.hardware)
+        if problem:
+            return Refusal(ErrorCode.INVALID_FAULT, problem.sentence())
+        self.faults.schedule(fault, source)
+        return None
+
+    def request_fault(self, component, index, kind, factor, bias_rad, bias_rad_s, t_s) -> Refusal | None:
+        """Schedule the fault of a ``/simulator/inject_fault`` request (its fields as received) or say why
+        not: FAULT_INJECTION_DISABLED unless :attr:`allow_fault_injection`; INVALID_TEXT, INVALID_FAULT
+        naming the field otherwise. A parameter its kind does not take is 0 (``bias_rad`` empty); an
+        onset before now starts at the next step."""
+        if not self.allow_fault_injection:
+            return Refusal(ErrorCode.FAULT_INJECTION_DISABLED, "fault injection is off: the scenario does not set "
+                                                              "allow_fault_injection: true")
+        bad = ErrorCode.INVALID_FAULT
+        try:
+            component = validation.text(component, "component")
+            kind = validation.text(kind, "kind")
+            factor = _number(factor, "factor", bad)
+            bias_rad = _numbers(bias_rad, "bias_rad", bad, (-1,))
+            bias_rad_s = _number(bias_rad_s, "bias_rad_s", bad)
+            t_s = _number(t_s, "t_s", bad, 0.0)
+        except RequestError as err:
+            return Refusal(err.code, err.message)
+        if isinstance(index, bool) or not isinstance(index, (int, np.integer)):
+            return Refusal(bad, f"index: expected a whole number; found {clip(repr(index), 40)}")
+        given = (factor if factor != 0.0 else None, bias_rad.tolist() if bias_rad.size else None,
+                 bias_rad_s if bias_rad_s != 0.0 else None)
+        problem = fault_problem(component, int(index), kind, *given, t_s=t_s, hardware=self.hardware)
+        if problem:
+            return Refusal(bad, problem.sentence())
+        self.faults.schedule(fault_spec(component, int(index), kind, *given, t_s=max(t_s, self.t)),
+                             FaultSource.SERVICE)
+        return None
 
     def set_command(self, command: Command, source: bytes | None = None) -> Refusal | None:
         """Accept a command from publisher ``source`` (None: unnamed) or say why it is refused; a

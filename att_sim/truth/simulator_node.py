@@ -28,6 +28,12 @@ orbit, field model, disturbances, epoch = sim time zero); the state's position i
 Parameters come from the scenario file (``scenario`` parameter), overridable by ROS parameters;
 each is type- and range-checked, and a bad one stops the node with one line on stderr (exit 2).
 
+Faults (:mod:`att_sim.truth.faults`): the scenario's ``faults`` start at their onset, and
+``/simulator/inject_fault`` (att_msgs/InjectFault) schedules one more when the scenario sets
+``allow_fault_injection`` (else it answers FAULT_INJECTION_DISABLED); a refused request changes nothing
+and the simulator keeps running. Every fault started is published, latched, on ``/simulator/faults``
+(att_msgs/FaultEvent, stamped with its onset), for evaluation only.
+
 Safety: a command or reset above the size caps of :mod:`att_msgs_py.limits` is refused (SIZE_LIMIT)
 before it is read; every command and reset is checked by :class:`~att_sim.truth.simulation.Simulation` (sizes,
 NaN/Inf, magnitude against ``command_limit_factor`` × the limits, stamp, frame, text); a refused one
@@ -45,6 +51,12 @@ the estimator chain on a loaded machine) shows itself by commands too old to app
 from the publisher of the last accepted one puts the simulator back to waiting, so the chain
 catches up and the lockstep resumes instead of the simulator drowning it in states. A non-finite
 state stops the propagation (reported, the node stays up).
+
+Holding sim time: ``/simulator/hold`` (std_srvs/SetBool) with ``data: true`` stops the propagation
+after the current step (callbacks keep running, nothing is published) until ``data: false`` or
+``max_hold_s`` of wall time, whichever comes first; the real-time pacing counts from the release.
+A driver that must not race the simulator (a mission planning its next slew at ``real_time_factor``
+0) holds it while it waits, so what it flies never depends on how fast the machine is.
 """
 from __future__ import annotations
 
@@ -55,11 +67,20 @@ import rclpy
 from rclpy.node import Node
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import Imu, JointState, MagneticField
+from std_srvs.srv import SetBool
 from tf2_msgs.msg import TFMessage
 from visualization_msgs.msg import MarkerArray
 
-from att_msgs.msg import ActuatorCommand, CoarseSunSensors, SensorTruth, SpacecraftState, StarTracker, ZoneMargins
-from att_msgs.srv import ResetSimulator
+from att_msgs.msg import (
+    ActuatorCommand,
+    CoarseSunSensors,
+    FaultEvent,
+    SensorTruth,
+    SpacecraftState,
+    StarTracker,
+    ZoneMargins,
+)
+from att_msgs.srv import InjectFault, ResetSimulator
 from att_msgs_py import convert, limits, markers, memory, qos, topics, validation
 from att_msgs_py.errors import ConfigError, ErrorCode, RequestError, clip
 from att_msgs_py.node_runner import (
@@ -89,7 +110,8 @@ class SimulatorNode(Node):
         self.free_running = False      # lockstep suspended: no command answered a state in time
         self.pace = (0.0, 0.0)         # (wall, sim) time the real-time pacing counts from
         self.last_command_time = -np.inf
-        self.refused = {"command": 0, "reset": 0}
+        self.refused = {"command": 0, "reset": 0, "fault": 0}
+        self.held_until = None         # monotonic deadline of a /simulator/hold, None: not held
         try:
             truth = param["truth"] or dispersions.Truth(self.scenario, param["initial_attitude"],
                                                         param["initial_rate_rad_s"], param["seed"])
@@ -98,7 +120,8 @@ class SimulatorNode(Node):
                 checks=Checks(command_limit_factor=param["command_limit_factor"],
                               max_reset_rate=param["max_reset_rate_rad_s"],
                               body_frame_id=self.scenario.body_frame_id,
-                              stamp_ahead=self.step, stamp_age=self.command_timeout), seed=truth.seed)
+                              stamp_ahead=self.step, stamp_age=self.command_timeout), seed=truth.seed,
+                dispersed_faults=truth.faults)
         except ValueError as err:        # the environment cannot start (e.g. a TLE that fails at t = 0)
             raise ConfigError(ErrorCode.INVALID_CONFIG, f"scenario '{self.scenario.name}': {clip(err, 300)}") from None
 
@@ -113,6 +136,9 @@ class SimulatorNode(Node):
         self.sim.command_source.live = live_publishers(self, topics.COMMAND)
         self.create_subscription(ActuatorCommand, topics.COMMAND, self.on_command, qos.STREAM_QOS)
         self.create_service(ResetSimulator, topics.RESET_SIMULATOR, self.on_reset)
+        self.create_service(SetBool, topics.HOLD_SIMULATOR, self.on_hold)
+        self.fault_pub = self.create_publisher(FaultEvent, topics.SIM_FAULTS, qos.MISSION_QOS)
+        self.create_service(InjectFault, topics.INJECT_FAULT, self.on_inject_fault)
         e = self.sim.environment
         self.get_logger().info(
             f"scenario '{self.scenario.name}', step {self.step} s, RTF "
@@ -133,6 +159,7 @@ class SimulatorNode(Node):
         self.tf_rate = param("tf_rate_Hz", 1.0 / self.publish_period, high=top)
         self.marker_rate = param("marker_rate_Hz", min(1.0, 1.0 / self.step), high=top)
         self.real_time_factor = param("real_time_factor")
+        self.max_hold = param("max_hold_s")
         self.command_timeout = param("command_timeout_s")
         self.end_time = param("end_time_s")      # s of sim time; 0: run until stopped
         # Hold sim time at zero until this many subscribers (recorder, controller) see the state,
@@ -233,15 +260,60 @@ class SimulatorNode(Node):
         response.message = "state reset" if refusal is None else refusal.message
         return response
 
+    def on_hold(self, request: SetBool.Request, response: SetBool.Response):
+        t = self.sim.t
+        if request.data:
+            self.held_until = time.monotonic() + self.max_hold
+            response.message = f"sim time held at t = {t:.3f} s (at most {self.max_hold:g} s of wall time)"
+        else:
+            response.message = (f"sim time released at t = {t:.3f} s" if self.held_until is not None
+                                else f"sim time was not held (t = {t:.3f} s)")
+            self.release()
+        response.success = True
+        self.get_logger().info(response.message)
+        return response
+
+    def held(self) -> bool:
+        """Whether a /simulator/hold stops the propagation now (one that outlived ``max_hold_s`` is
+        released with a warning)."""
+        if self.held_until is not None and time.monotonic() > self.held_until:
+            self.get_logger().warning(f"sim time held for more than max_hold_s = {self.max_hold:g} s of wall time: "
+                                      f"released at t = {self.sim.t:.3f} s")
+            self.release()
+        return self.held_until is not None
+
+    def release(self) -> None:
+        if self.held_until is not None:
+            self.held_until = None
+            self.pace = (time.monotonic(), self.sim.t)
+
+    def on_inject_fault(self, request: InjectFault.Request, response: InjectFault.Response):
+        refusal = limits.issue(request, limits.INJECT_FAULT)
+        if refusal is None:
+            refusal = self.sim.request_fault(request.component, request.index, request.kind, request.factor,
+                                             np.asarray(request.bias_rad, float), request.bias_rad_s, request.t_s)
+        else:
+            refusal = Refusal(refusal.code, refusal.message)
+        if refusal is not None:
+            self.report("fault", refusal)
+        response.success = refusal is None
+        response.error_code = 0 if refusal is None else int(refusal.code)
+        response.message = (f"{request.component}[{request.index}] {request.kind} scheduled at t = "
+                             f"{max(request.t_s, self.sim.t):.3f} s" if refusal is None else refusal.message)
+        return response
+
     def report(self, what: str, refusal: Refusal) -> None:
-        """Log a refused command or reset: at most one line a second for each (a flood of commands
-        cannot hide a refused reset), with the running count."""
+        """Log a refused command, reset or fault injection: at most one line a second for each (a flood
+        of commands cannot hide a refused reset), with the running count."""
         self.refused[what] += 1
         if refusal.code == ErrorCode.SIZE_LIMIT:
             memory.trim()                # the refused message's deserialised copy goes back to the system
-        line = clip(f"{'actuator command' if what == 'command' else 'reset'} rejected [{int(refusal.code)} "
-                    f"{refusal.code.name}] ({self.refused[what]} so far): {refusal.message}")
-        if what == "command":            # two call sites: rclpy throttles each call site separately
+        name = {"command": "actuator command", "reset": "reset", "fault": "fault injection"}[what]
+        line = clip(f"{name} rejected [{int(refusal.code)} {refusal.code.name}] ({self.refused[what]} so far): "
+                    f"{refusal.message}")
+        if what == "command":            # one call site each: rclpy throttles each call site separately
+            self.get_logger().warning(line, throttle_duration_sec=1.0)
+        elif what == "reset":
             self.get_logger().warning(line, throttle_duration_sec=1.0)
         else:
             self.get_logger().warning(line, throttle_duration_sec=1.0)
@@ -274,6 +346,9 @@ class SimulatorNode(Node):
                 return
             if self.sim.halted:
                 executor.spin_once(timeout_sec=0.1)
+                continue
+            if self.held():
+                executor.spin_once(timeout_sec=0.05)
                 continue
             self.sim.command_timeout = (self.free_running
                                         or self.sim.t - self.last_command_time > self.command_timeout)
@@ -308,14 +383,20 @@ class SimulatorNode(Node):
     def publish(self, k: int, state_every: int, clock_every: int):
         t = self.sim.t
         self.publish_readings()
+        for event in self.sim.faults.take_events():
+            self.fault_pub.publish(convert.fault_event_msg(event))
+            self.get_logger().warning(f"fault injected at t = {event.t:.3f} s ({event.source}): {event.component}"
+                                      f"[{event.index}] {event.kind}")
         if k % clock_every == 0:
             self.clock_pub.publish(Clock(clock=convert.time_msg(t)))
-        self.publish_view(k)
         if k % state_every == 0:
             self.answered, self.awaited_stamp = False, t
             self.state_pub.publish(self.state_message())
+            self.publish_view(k)            # while the estimator and the controller answer the state
             if self.lockstep and not self.free_running:
                 self.wait_for_answer()
+        else:
+            self.publish_view(k)
 
     def wait_for_answer(self) -> None:
         """Lockstep: run callbacks until a command answers the state just published; after

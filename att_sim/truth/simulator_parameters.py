@@ -20,6 +20,8 @@ SIMULATOR = ParameterTable("simulator", (
     Parameter("marker_rate_Hz", float, None, "rate of /simulator/markers (the 3D view), in sim time (0: off)", "Hz",
               0.0, INF, default_rule="min(1, 1/step_s)", high_rule="1/step_s", hint=PER_STEP_OR_OFF),
     Parameter("real_time_factor", float, 1.0, "sim time per wall time (0: as fast as possible)", "", 0.0, INF),
+    Parameter("max_hold_s", float, 600.0, "wall time a /simulator/hold stops sim time at most (then released)", "s",
+              0.0, INF, low_open=True),
     Parameter("command_timeout_s", float, 1.0, "sim time without a valid command after which the actuator "
                                                "inputs are zeroed; also the largest age of a command's stamp", "s",
               0.0, INF, low_open=True),

@@ -164,3 +164,19 @@ def test_the_signature_covers_the_epoch_and_every_zone_field():
         forged = copy.deepcopy(msg)
         change(forged)
         assert signing.check(signing.payload(forged), forged.signature, forged.key_id, key.public_key()), what
+
+
+def test_fault_event_and_status_round_trip_and_the_sources_are_the_message_constants():
+    from att_msgs.msg import FaultEvent as FaultEventMsg
+    from att_msgs_py.types import FaultEvent, FaultSource, FaultStatus
+
+    assert {s.value for s in FaultSource} == {getattr(FaultEventMsg, n) for n in dir(FaultEventMsg)
+                                              if n.startswith("SOURCE_")}
+    event = FaultEvent(t=12.25, component="star_tracker", index=1, kind="bias_jump", factor=1.0,
+                       bias_rad=(1e-3, -2e-3, 0.5), source=FaultSource.SERVICE, frame_id="body")
+    back = convert.fault_event_from_msg(convert.fault_event_msg(event))
+    assert back == event and isinstance(back.source, FaultSource)
+    status = FaultStatus(t=30.5, fault_id="wheel_stall", component="wheel", index=2, detector="wheel_acceleration",
+                         evidence="|a_cmd - a_meas| = 3.1 rad/s^2 > 0.5 for 1.0 s", response="reallocate",
+                         active=True, detected_at=29.75, frame_id="body")
+    assert convert.fault_status_from_msg(convert.fault_status_msg(status)) == status

@@ -10,7 +10,7 @@ from sensor_msgs.msg import Imu, JointState, MagneticField
 
 from att_msgs.action import ExecuteManeuver
 from att_msgs.msg import ActuatorCommand, AttitudeEstimate, CoarseSunSensors, ManeuverPlan, SpacecraftState, StarTracker
-from att_msgs.srv import PlanManeuver, PlanSchedule, ResetSimulator, SetControllerMode
+from att_msgs.srv import InjectFault, PlanManeuver, PlanSchedule, ResetSimulator, SetControllerMode
 from att_msgs_py import limits, validation
 from att_msgs_py.errors import ErrorCode
 
@@ -18,7 +18,8 @@ TABLES = {
     "PLAN_MANEUVER": PlanManeuver.Request, "PLAN_SCHEDULE": PlanSchedule.Request, "MANEUVER_PLAN": ManeuverPlan,
     "EXECUTE_MANEUVER": ExecuteManeuver.Goal, "SET_CONTROLLER_MODE": SetControllerMode.Request,
     "SPACECRAFT_STATE": SpacecraftState, "ATTITUDE_ESTIMATE": AttitudeEstimate, "ACTUATOR_COMMAND": ActuatorCommand,
-    "RESET_SIMULATOR": ResetSimulator.Request, "JOINT_STATE": JointState, "STAR_TRACKER": StarTracker,
+    "RESET_SIMULATOR": ResetSimulator.Request, "INJECT_FAULT": InjectFault.Request, "JOINT_STATE": JointState,
+    "STAR_TRACKER": StarTracker,
     "SUN_SENSORS": CoarseSunSensors, "HEADER_ONLY": Imu,
 }
 

@@ -40,6 +40,10 @@ SCENARIO = """\
       magnetometer: {noise_nT: 50.0}
     actuators:
       wheels: {coulomb_friction_Nm: 0.002}
+    allow_fault_injection: true
+    faults:
+      - {t_s: 10.0, component: wheel, index: 2, kind: seized}
+      - {t_s: 20.0, component: gyro, index: 1, kind: bias_step, bias_rad_s: 0.001}
 simulator:
   ros__parameters:
     step: 0.05
@@ -142,6 +146,35 @@ EDITS = {
                               f"{P}.environment.facets[0]", "at most 1"),
     "facet old key": ("scenario", "{area_m2:", "{area:", f"{P}.environment.facets[0].area", "renamed to 'area_m2'"),
     "pressure without epoch": ("scenario", "solar_pressure: false", "solar_pressure: true", P, "an epoch"),
+    # faults: kind, index against the hardware, time, parameters
+    "fault kind unknown": ("scenario", "kind: seized}", "kind: jammed}", f"{P}.faults[0]",
+                           "kind one of seized, off, friction, tachometer_stuck for a wheel, got 'jammed'"),
+    "fault component unknown": ("scenario", "component: wheel", "component: thruster", f"{P}.faults[0].component",
+                                "'wheel'"),
+    "fault wheel beyond the wheels": ("scenario", "index: 2, kind: seized", "index: 3, kind: seized", P,
+                                      "faults[0].index below 3 (the spacecraft has 3 wheels), got 3"),
+    "fault gyro axis 3": ("scenario", "index: 1, kind: bias_step", "index: 3, kind: bias_step", P,
+                          "faults[1].index below 3 (the spacecraft has 3 gyro axes)"),
+    "fault tracker beyond the trackers": ("scenario", "component: wheel, index: 2, kind: seized",
+                                          "component: star_tracker, index: 2, kind: outage", P,
+                                          "faults[0].index below 2 (the spacecraft has 2 star trackers), got 2"),
+    "fault index negative": ("scenario", "index: 2, kind: seized", "index: -1, kind: seized",
+                             f"{P}.faults[0].index", "greater than or equal to 0"),
+    "fault time negative": ("scenario", "t_s: 10.0", "t_s: -1.0", f"{P}.faults[0].t_s",
+                            "greater than or equal to 0"),
+    "fault time NaN": ("scenario", "t_s: 10.0", "t_s: .nan", f"{P}.faults[0].t_s", "finite"),
+    "fault parameter of another kind": ("scenario", "kind: seized}", "kind: seized, factor: 2.0}", f"{P}.faults[0]",
+                                        "factor none for a seized fault (it takes no parameter), got 2.0"),
+    "fault bias step missing": ("scenario", "kind: bias_step, bias_rad_s: 0.001", "kind: bias_step",
+                                f"{P}.faults[1]", "bias_rad_s a value for a bias_step fault, got none"),
+    "fault bias step NaN": ("scenario", "bias_rad_s: 0.001", "bias_rad_s: .nan", f"{P}.faults[1].bias_rad_s",
+                            "finite"),
+    "fault friction factor zero": ("scenario", "kind: seized}", "kind: friction, factor: 0.0}", f"{P}.faults[0]",
+                                   "factor a friction multiplier in (0, 1000], got 0.0"),
+    "fault tachometer missing": ("scenario", "kind: seized}", "kind: tachometer_stuck}", P,
+                                 "tachometer_stuck fault, got no wheels with a tachometer"),
+    "fault injection a word": ("scenario", "allow_fault_injection: true", "allow_fault_injection: maybe",
+                               f"{P}.allow_fault_injection", "valid boolean"),
     # sensors and actuators
     "gyro rate zero": ("scenario", "rate_Hz: 20.0, arw", "rate_Hz: 0.0, arw", f"{P}.sensors.gyro.rate_Hz",
                        "greater than 0"),

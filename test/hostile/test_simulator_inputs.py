@@ -20,6 +20,7 @@ from dataclasses import replace
 import numpy as np
 import pytest
 import rclpy
+from std_srvs.srv import SetBool
 
 from att_msgs.msg import ActuatorCommand, SpacecraftState
 from att_msgs.srv import ResetSimulator
@@ -34,6 +35,7 @@ from helpers.waiting import wait_until
 SWIFT = scenario.load("swift_demo")
 SC = SWIFT.spacecraft
 STEP, TIMEOUT = 0.05, 1.0
+MAX_HOLD = 3.0                                # s of wall time a hold of the ROS cases lasts at most
 T_NOW = 5.0                                   # sim time of the fixture's simulation
 W_MAX, M_MAX, TAU_MAX, SPEED_MAX = SC.wheel_torque_max, SC.dipole_max, SC.body_torque_max, SC.wheel_speed_max
 INVALID, LIMIT, TEXT, SIZE = (ErrorCode.INVALID_COMMAND, ErrorCode.COMMAND_LIMIT, ErrorCode.INVALID_TEXT,
@@ -226,8 +228,8 @@ def lonely_sim(ros_suite):
     """A simulator of the test's own, alone (RTF 4, lockstep on): no controller answers its states
     (each test sees a simulator no other test has commanded, in any order). Yields the suite, the
     states received as (wall time, message) and a function giving the latest stamp."""
-    with ros_suite("swift_demo", nodes=("simulator",), params={"simulator": {"real_time_factor": RTF}},
-                   name="sim_inputs") as s:
+    with ros_suite("swift_demo", nodes=("simulator",),
+                   params={"simulator": {"real_time_factor": RTF, "max_hold_s": MAX_HOLD}}, name="sim_inputs") as s:
         states, latest = [], [0.0]
 
         def on_state(msg):
@@ -404,3 +406,39 @@ def test_hostile_resets_over_the_service_are_refused(lonely_sim):
     q = convert.from_quaternion(states[-1][1].attitude)
     assert rot.angle_between(q, Q_OK) < 0.5 and all(s.suite.alive().values())
     assert "reset rejected [400 INVALID_RESET]" in s.suite.log_text("simulator")
+
+
+@pytest.mark.ros
+def test_a_hold_stops_sim_time_until_released_or_max_hold(lonely_sim):
+    """/simulator/hold: no state is stamped after the held time while held; released by a call, or
+    by the simulator itself after ``max_hold_s`` of wall time; sim time then runs again."""
+    s, states, now = lonely_sim
+    client = s.client.create_client(SetBool, topics.HOLD_SIMULATOR)
+    assert client.wait_for_service(timeout_sec=20)
+    wait_until(lambda: len(states) > 0, 30, "a state from the simulator", node=s.client)
+
+    def hold(data: bool) -> tuple[bool, str, float]:
+        future = client.call_async(SetBool.Request(data=data))
+        rclpy.spin_until_future_complete(s.client, future, timeout_sec=10)
+        r = future.result()
+        return r.success, r.message, float(re.search(r"t = ([0-9.]+) s", r.message).group(1))
+
+    def stamps():
+        return [convert.from_time(m.header.stamp) for _, m in states]
+
+    for release in ("call", "max_hold_s"):
+        ok, message, held_at = hold(True)
+        assert ok and "held at t =" in message, message
+        states.clear()
+        spin_for(s.client, 1.0)                          # RTF 4: 4 s of sim time if it were running
+        assert all(t <= held_at + STEP + 1e-9 for t in stamps()), f"states after the hold at {held_at}: {stamps()}"
+        if release == "call":
+            ok, message, _ = hold(False)
+            assert ok and "released at t =" in message, message
+        else:
+            wait_until(lambda: "held for more than max_hold_s" in s.suite.log_text("simulator"), MAX_HOLD + 30,
+                       "the simulator releasing its hold after max_hold_s", node=s.client)
+        wait_until(lambda h=held_at: any(t > h + 1.0 for t in stamps()), 30, "sim time running after the release",
+                   node=s.client)
+    assert all(s.suite.alive().values())
+    assert hold(False)[1].startswith("sim time was not held")

@@ -1,11 +1,13 @@
 """att-mission through the nodes: a short mission of two sources on leo_observatory's
-real sky, flown by the simulator, estimator, controller and planner nodes; the log holds every event
+real sky, flown by the simulator, estimator, controller and planner nodes as ``--rtf max`` flies it
+(as fast as the lockstep goes, sim time held while the planner plans); the log holds every event
 and plan, each source is held for its dwell on target (checked here from the truth states against
 the source's direction, with the Sun and Moon from the sky, apart from the day's own report), and the
 review draws the day and lists the targets."""
 from __future__ import annotations
 
 import math
+import re
 
 import numpy as np
 import pytest
@@ -34,7 +36,7 @@ def flown(tmp_path_factory):
                for n, dwell in SOURCES.items() for d in [observatory[n].direction]]
     return fly_written(out, {"kind": "inertial", "scenario": "leo_observatory", "targets": targets},
                        {"sensor_axis": [0, 1, 0], "horizon_s": 2400, "start_lead_s": 120, "time_budget_s": 5,
-                        "rate_Hz": 2.5})
+                        "rate_Hz": 2.5}, rtf=0.0)
 
 
 def test_both_sources_are_observed_within_the_tolerance(flown):
@@ -72,6 +74,17 @@ def test_the_log_holds_the_events_plans_and_the_dwells_on_target(flown):
         for body, direction in (("sun", sky.sun_direction(t[held])), ("moon", sky.moon_direction(t[held]))):
             angle = np.arccos(np.clip(np.einsum("ni,ni->n", boresight, direction), -1, 1))
             assert angle.min() > zones[body].half_angle, (e.target, body)
+
+
+def test_sim_time_stood_still_while_the_planner_planned(flown):
+    """--rtf max: every plan request was made with sim time held and released at the same instant."""
+    _, mcap, _ = flown
+    text = (mcap.parent / "simulator.log").read_text()
+    held = [float(t) for t in re.findall(r"sim time held at t = ([0-9.]+) s", text)]
+    released = [float(t) for t in re.findall(r"sim time released at t = ([0-9.]+) s", text)]
+    plans = read_log(mcap, topics=[PLANS])[PLANS]
+    assert len(held) >= 2 and held == released, (held, released)
+    assert len(held) >= len(plans) > 0
 
 
 def test_the_review_draws_the_day_and_lists_the_targets(flown):

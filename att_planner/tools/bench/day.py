@@ -13,18 +13,23 @@ from __future__ import annotations
 from pathlib import Path
 
 from att_planner.mission import config as mission_config
-from att_planner.tools.mission import fly_mission
+from att_planner.tools.mission import fly_mission, real_time_factor
 
 
 def configure(parser) -> None:
     parser.add_argument("--mission", default="observatory_day",
                         help="a mission file (config/missions/NAME.yaml or a path)")
     parser.add_argument("--out", default="runs", help="directory for the MCAP and the node logs")
+    parser.add_argument("--rtf", type=real_time_factor, default=None,
+                        help="'max' or a real-time factor: sim time held while the planner plans (att-mission --rtf)")
 
 
 def run(args) -> dict:
     mission = mission_config.load(args.mission)
-    _, report = fly_mission(mission, Path(args.out))
+    _, report = fly_mission(mission, Path(args.out), rtf=args.rtf)
+    report["mission"] = mission.path.stem
+    report["rtf_mode"] = "paced by the planner's budget" if args.rtf is None else (
+        "max, sim time held while planning" if args.rtf == 0 else f"at most {args.rtf:g}, held while planning")
     print(f"{'target':14s} {'observed':8s} {'start (UTC)':32s} {'pointing error':>14s}  why")
     for x in report["targets"]:
         err = f"{x['pointing_error_deg']:.4f} deg" if x["pointing_error_deg"] is not None else "-"

@@ -221,6 +221,8 @@ def _observe(p: dict, case: str | None) -> Summary:
 def _day(p: dict, case: str | None) -> Summary:
     observed, missed = int(_num(p, "observed")), int(_num(p, "missed"))
     margin = _num(p, "min_margin_deg")
+    if case is None and p.get("rtf_mode", "").startswith("max"):
+        case = f"{p.get('mission', 'observatory_day')}, --rtf max"
     return Summary(case or "observatory_day", "targets observed", observed, f"of {observed + missed}",
                    "every zone kept (smallest margin ≥ 0)", margin >= 0.0,
                    {"observed": observed, "missed": missed, "min_margin_deg": margin,
@@ -293,6 +295,16 @@ def _gains(p: dict, case: str | None) -> Summary:
 
 def _soak(p: dict, case: str | None) -> Summary:
     dropped = int(_num(p, "dropped_state"))
+    clean = dropped == 0 and not any(_get(p, "exit_codes").values())
+    if "rtf_target" in p:          # a real-time factor study: the scenario, its length and rate name the case
+        rtf, target = _num(p, "real_time_factor"), _num(p, "rtf_target")
+        return Summary(case or f"{p['scenario']}, {_num(p, 'hours'):g} h at {_num(p, 'rate_Hz'):g} Hz, "
+                               f"{', '.join(p['nodes'])}",
+                       "real-time factor through the nodes", rtf, "×",
+                       f"≥ {target:g}, every state recorded, every process exits 0", rtf >= target and clean,
+                       {"rtf": rtf, "dropped_state": dropped, "sim_s": _num(p, "sim_time"),
+                        "loop_wall_s": _num(p, "loop_wall_seconds"),
+                        "cpu_ms_per_sim_s": {k: v / _num(p, "sim_time") * 1e3 for k, v in p["cpu_seconds"].items()}})
     return Summary(case or f"{_num(p, 'orbits'):g} orbits", "state messages dropped", dropped, "",
                    "none dropped, every process exits 0", dropped == 0 and not any(_get(p, "exit_codes").values()),
                    {"rtf": _num(p, "real_time_factor"), "state_messages": _num(p, "state_messages"),

@@ -95,7 +95,7 @@ def loop_for(setup: Setup, truth: disp.Truth, key: Ed25519PrivateKey | None = No
     its plan-signing key, default a new one)."""
     s = truth.scenario
     sim = Simulation.for_scenario(s, q0=truth.q0, omega0=truth.omega0, seed=truth.seed,
-                                  checks=Checks(body_frame_id=s.body_frame_id))
+                                  checks=Checks(body_frame_id=s.body_frame_id), dispersed_faults=truth.faults)
     return ClosedLoop(setup.scenario, simulation=sim, key=key)
 
 

@@ -26,6 +26,7 @@ from att_msgs_py.types import (
 from att_sim.models import rotations as rot
 from att_sim.models.sensor_specs import SensorSpecs
 from att_sim.models.world import Bodies
+from att_sim.truth import faults as faulting
 from att_sim.truth.sensors.gyro import Gyro
 from att_sim.truth.sensors.magnetometer import Magnetometer
 from att_sim.truth.sensors.star_tracker import StarTracker
@@ -81,8 +82,10 @@ class _Schedule:
 class SensorSuite:
     """Every sensor of ``specs``, sampled as :meth:`sample` is called at increasing times."""
 
-    def __init__(self, specs: SensorSpecs, seed: int, frame_id: str = "", body_frame_id: str = ""):
+    def __init__(self, specs: SensorSpecs, seed: int, frame_id: str = "", body_frame_id: str = "",
+                 faults: faulting.Faults | None = None):
         self.specs, self.frame_id, self.body_frame_id = specs, frame_id, body_frame_id
+        self.faults = faults              # the run's hardware faults (:mod:`att_sim.truth.faults`; None: none)
         self.gyro = Gyro(specs.gyro, rng(seed, "gyro")) if specs.gyro else None
         self.trackers = [StarTracker(s, rng(seed, "star_tracker", i)) for i, s in enumerate(specs.star_trackers)]
         self.magnetometer = Magnetometer(specs.magnetometer, rng(seed, "magnetometer")) if specs.magnetometer else None
@@ -126,30 +129,43 @@ class SensorSuite:
         period); a tracker's measurement of ``t`` comes out at the first call at or after ``t`` + its
         latency. ``taken``: the gyro's and the tachometer's measurements when they were taken already
         on rows of runs (:meth:`att_sim.truth.batch.SimulationBatch.sense`; then
-        ``relative_wheel_speed`` is not used); else this suite takes them, a row of one."""
+        ``relative_wheel_speed`` is not used); else this suite takes them, a row of one. The run's
+        faults act on every reading (:mod:`att_sim.truth.faults`)."""
+        faults = self.faults
         if taken is None:
             taken = Taken(self.gyro_interval(t, q, omega))
             if taken.gyro_interval is not None:
                 taken.gyro_rate = self.gyro.measure(*taken.gyro_interval)
+                if faults is not None:
+                    taken.gyro_rate = faulting.gyro_rows([faults], taken.gyro_rate[None])[0]
             if self.tachometer_due(t):
-                speeds = measure_tachometers([self.tachometer], np.asarray(relative_wheel_speed, float)[None])[0]
-                taken.wheel_speeds = WheelSpeedMeasurement(t, speeds, self.body_frame_id)
+                speeds = measure_tachometers([self.tachometer], np.asarray(relative_wheel_speed, float)[None])
+                if faults is not None:
+                    speeds = faulting.tachometer_rows([faults], speeds)
+                taken.wheel_speeds = WheelSpeedMeasurement(t, speeds[0], self.body_frame_id)
         out = Readings()
         body = self.body_frame_id
         if taken.gyro_interval is not None:
             out.gyro = GyroMeasurement(t, taken.gyro_rate, self.gyro.noise_covariance(taken.gyro_interval[1]), body)
-            out.truth = SensorTruth(t, self.gyro.bias.copy(), self._magnetometer_bias(), body)
+            bias = self.gyro.bias.copy() if faults is None else self.gyro.bias + faults.gyro_bias
+            out.truth = SensorTruth(t, bias, self._magnetometer_bias(), body)
         sky = None
-        for tracker, schedule in zip(self.trackers, self.tracker_schedules):
+        for k, (tracker, schedule) in enumerate(zip(self.trackers, self.tracker_schedules)):
             if schedule.due(t):
                 sky = bodies() if sky is None else sky
-                self.pending.append((t + tracker.spec.latency, tracker.measure(t, q, omega, sky, self.frame_id)))
+                measured = tracker.measure(t, q, omega, sky, self.frame_id)
+                if faults is not None:
+                    measured = faults.tracker_reading(k, measured)
+                if measured is not None:
+                    self.pending.append((t + tracker.spec.latency, measured))
         if self.pending:
             out.star_trackers = [m for release, m in self.pending if release <= t + 1e-9]
             self.pending = [(release, m) for release, m in self.pending if release > t + 1e-9]
         out.wheel_speeds = taken.wheel_speeds
         if self.magnetometer is not None and self.schedules["magnetometer"].due(t):
             out.magnetometer = self.magnetometer.measure(t, field_B, dipole_applied, body)
+            if faults is not None:
+                out.magnetometer = faults.magnetometer_reading(out.magnetometer)
         if self.sun_sensors is not None and self.schedules["sun_sensors"].due(t):
             out.sun_sensors = self.sun_sensors.measure(t, q, bodies() if sky is None else sky, body)
         return out

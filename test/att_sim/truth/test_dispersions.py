@@ -153,6 +153,21 @@ BAD = {
     "truncate zero": ({"campaign": {"scenario": "swift_demo", "seed": 1, "dispersions": {
         "inertia_scale": {"distribution": "normal", "sigma": 0.1, "truncate": 0}}}},
         "inertia_scale.truncate: expected greater than 0"),
+    "fault probability 1.5": ({"campaign": {"scenario": "swift_demo", "seed": 1, "faults": [
+        {"component": "wheel", "index": 0, "kind": "off", "probability": 1.5, "window_s": [0.0, 10.0]}]}},
+        "campaign.faults[0].probability: expected less than or equal to 1"),
+    "fault window reversed": ({"campaign": {"scenario": "swift_demo", "seed": 1, "faults": [
+        {"component": "wheel", "index": 0, "kind": "off", "probability": 0.5, "window_s": [10.0, 5.0]}]}},
+        "campaign.faults[0]: expected window_s [earliest, latest] with 0 <= earliest <= latest"),
+    "fault window negative": ({"campaign": {"scenario": "swift_demo", "seed": 1, "faults": [
+        {"component": "wheel", "index": 0, "kind": "off", "probability": 0.5, "window_s": [-1.0, 5.0]}]}},
+        "window_s [earliest, latest] with 0 <= earliest"),
+    "fault kind unknown": ({"campaign": {"scenario": "swift_demo", "seed": 1, "faults": [
+        {"component": "gyro", "index": 0, "kind": "seized", "probability": 0.5, "window_s": [0.0, 5.0]}]}},
+        "campaign.faults[0]: expected kind one of axis_stuck, bias_step for a gyro, got 'seized'"),
+    "fault probability NaN": ({"campaign": {"scenario": "swift_demo", "seed": 1, "faults": [
+        {"component": "wheel", "index": 0, "kind": "off", "probability": math.nan, "window_s": [0.0, 5.0]}]}},
+        "campaign.faults[0].probability"),
 }
 
 
@@ -199,3 +214,46 @@ def test_bad_files_and_a_dispersion_with_nothing_to_act_on_are_refused(tmp_path)
     c = campaign({"com_offset_m": {"distribution": "normal", "sigma": 0.01}})
     with pytest.raises(ValueError, match="no solar pressure or drag"):
         disp.seed_truth(c, SWIFT, 1)
+
+
+FAULTS = [{"component": "wheel", "index": 1, "kind": "seized", "probability": 0.3, "window_s": [10.0, 20.0]},
+          {"component": "gyro", "index": 2, "kind": "bias_step", "bias_rad_s": 1e-3, "probability": 1.0,
+           "window_s": [5.0, 5.0]}]
+
+
+def test_faults_occur_with_their_probability_in_their_window_and_a_run_keeps_its_own():
+    c = campaign({}, faults=FAULTS)
+    seeds = [disp.run_seed(c.seed, i) for i in range(2000)]
+    runs = [disp.seed_truth(c, SWIFT, seed) for seed in seeds]
+    seized = [f for truth, _ in runs for f in truth.faults if f.kind == "seized"]
+    # binomial: 0.3 of 2000 runs, standard error 0.010
+    assert len(seized) / len(runs) == pytest.approx(0.3, abs=0.035)
+    onsets = np.array([f.t_s for f in seized])
+    assert onsets.min() >= 10.0 and onsets.max() <= 20.0
+    assert stats.kstest((onsets - 10.0) / 10.0, "uniform").pvalue > 1e-3
+    assert all(any(f.kind == "bias_step" and f.t_s == 5.0 and f.bias_rad_s == 1e-3 for f in truth.faults)
+               for truth, _ in runs)
+    # the applied values name each entry's onset (NaN: the run does not have it)
+    for truth, values in runs[:50]:
+        by_kind = {f.kind: f.t_s for f in truth.faults}
+        assert values["fault_t_s"][1] == 5.0
+        assert (math.isnan(values["fault_t_s"][0]) and "seized" not in by_kind) or \
+            values["fault_t_s"][0] == by_kind["seized"]
+    # reproduced by its seed; another entry declared after it changes nothing of it
+    more = campaign({}, faults=[*FAULTS, {**FAULTS[0], "index": 2}])
+    for seed, (truth, _) in zip(seeds[:50], runs[:50]):
+        again = disp.seed_truth(more, SWIFT, seed)[0]
+        assert again.faults[:len(truth.faults)] == truth.faults
+
+
+def test_a_dispersed_fault_is_scheduled_as_a_dispersion_and_refused_beyond_the_hardware():
+    c = campaign({}, faults=[FAULTS[1]])
+    truth = disp.seed_truth(c, SWIFT, 7)[0]
+    sim = Simulation.for_scenario(truth.scenario, seed=truth.seed, dispersed_faults=truth.faults)
+    for _ in range(101):
+        sim.advance(0.05)
+    [event] = sim.faults.take_events()
+    assert (event.kind, event.source, event.t) == ("bias_step", "dispersion", pytest.approx(5.0))
+    bad = campaign({}, faults=[{**FAULTS[0], "index": 3}])
+    with pytest.raises(ValueError, match=re.escape("campaign.faults[0].index below 3 (the spacecraft has 3 wheels)")):
+        disp.seed_truth(bad, SWIFT, 7)
