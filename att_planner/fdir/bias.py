@@ -7,8 +7,10 @@ propagation until the filter has moved ``b̂`` by the step: a change ``|b̂_k(t)
 above the threshold on axis ``k`` for the persistence is a bias step of that axis. The detector is
 armed once the filter is first sure of the bias (3σ of its bias covariance below the threshold):
 while it converges on the turn-on bias it moves ``b̂`` by as much as that bias. Once armed it stays
-armed (a filter that re-initialises after a step keeps its bias estimate and opens its covariance:
-what it then learns is the step). This needs one
+armed, and a change counts only beyond the larger of the threshold and the bias 3σ of the moment:
+a filter that re-initialises (after a tracker jump it rejected, or a step) keeps its bias estimate
+but opens its covariance, and the estimate then wanders within that 3σ while it re-converges,
+whereas a step moves it beyond. This needs one
 star tracker only (the innovation detector needs two to tell the gyro from a tracker,
 :mod:`.innovations`), and sees the step once the filter has followed it, seconds later.
 """
@@ -40,9 +42,11 @@ class BiasJumpDetector:
         """The bias estimate (rad/s, body axes) and its covariance ((rad/s)²; None: taken as sure) of
         an estimate at ``t`` that has an attitude."""
         bias = np.asarray(bias_B, float)
-        if not self.armed and bias_covariance is not None:
+        limit = self.threshold
+        if bias_covariance is not None:
             sigma3 = 3.0 * float(np.sqrt(max(np.linalg.eigvalsh(np.asarray(bias_covariance, float)).max(), 0.0)))
-            self.armed = sigma3 < self.threshold
+            self.armed = self.armed or sigma3 < self.threshold
+            limit = max(limit, sigma3)
         if not (self.armed or bias_covariance is None):
             return []
         self.samples.append((t, bias))
@@ -53,10 +57,11 @@ class BiasJumpDetector:
             return []
         change = bias - before
         axis = int(np.argmax(np.abs(change)))
-        if not self.persistence.update(bool(abs(change[axis]) > self.threshold), t):
+        if not self.persistence.update(bool(abs(change[axis]) > limit), t):
             return []
         self.declared = True
         return [Verdict(t, "gyro", axis, DETECTOR, f"bias estimate of axis {axis} moved by "
-                        f"{change[axis] / RAD_S_PER_DEG_H:+.4g} deg/h in {t - t0:.3g} s (threshold "
-                        f"{self.threshold_deg_h:g} deg/h) since t = {self.persistence.since:.3f} s",
+                        f"{change[axis] / RAD_S_PER_DEG_H:+.4g} deg/h in {t - t0:.3g} s (beyond "
+                        f"{limit / RAD_S_PER_DEG_H:.3g} deg/h: the threshold {self.threshold_deg_h:g} deg/h or "
+                        f"the bias 3 sigma) since t = {self.persistence.since:.3f} s",
                         since=self.persistence.since)]

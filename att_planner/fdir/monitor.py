@@ -16,7 +16,7 @@ import math
 
 import numpy as np
 
-from att_msgs_py.types import Health
+from att_msgs_py.types import FaultStatus, Health
 from att_planner.estimation.health import Innovation
 from att_planner.fdir import table as tables
 from att_planner.fdir.bias import BiasJumpDetector
@@ -24,7 +24,7 @@ from att_planner.fdir.frozen import FrozenDetector
 from att_planner.fdir.innovations import InnovationDetector
 from att_planner.fdir.outage import OutageDetector
 from att_planner.fdir.responses import Responses, responses
-from att_planner.fdir.status import FaultStatus, Verdict
+from att_planner.fdir.status import Verdict
 from att_planner.fdir.watchdogs import Watchdog
 from att_planner.fdir.wheel_health import WheelTorqueDetector
 from att_sim.models.dynamics import Spacecraft

@@ -19,7 +19,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from att_planner.fdir.status import FaultStatus
+from att_msgs_py.types import FaultStatus
 
 
 @dataclass(frozen=True)

@@ -3,9 +3,9 @@
 A detector's :class:`Verdict` names the component and unit it isolated, the detector, the evidence
 (the numbers it saw against its threshold) and whether the condition is active (a detector that
 clears, such as a tracker re-admitted after a consistent window, says so with ``active`` False).
-The monitor (:mod:`.monitor`) turns a verdict into a :class:`FaultStatus`, the fault topic's message
-(``att_msgs/FaultStatus``: header, fault id, component, index, detector, evidence, response,
-active, detected_at), with the fault id and response of the table's entry.
+The monitor (:mod:`.monitor`) turns a verdict into a :class:`att_msgs_py.types.FaultStatus`, the
+fault topic's message (``att_msgs/FaultStatus``: header, fault id, component, index, detector,
+evidence, response, active, detected_at), with the fault id and response of the table's entry.
 """
 from __future__ import annotations
 
@@ -23,19 +23,3 @@ class Verdict:
     evidence: str              # what was measured against what threshold, in words and numbers
     active: bool = True        # False: the condition cleared (a sensor re-admitted, a tracker heard again)
     since: float = float("nan")  # s of sim time the condition started to hold
-
-
-@dataclass(frozen=True)
-class FaultStatus:
-    """A fault declared or cleared (``att_msgs/FaultStatus``; ``t`` and ``frame_id`` are its header)."""
-
-    t: float                   # s of sim time of this report
-    fault_id: str              # the table's id
-    component: str
-    index: int
-    detector: str
-    evidence: str
-    response: str              # the table's response (att_planner.fdir.table.RESPONSE_MEANINGS)
-    active: bool
-    detected_at: float         # s of sim time the fault was declared
-    frame_id: str = ""

@@ -15,8 +15,8 @@ import math
 import numpy as np
 
 from att_msgs_py import topics
+from att_msgs_py.types import FaultStatus
 from att_planner.fdir.monitor import FaultMonitor
-from att_planner.fdir.status import FaultStatus
 
 
 class MonitorTap:

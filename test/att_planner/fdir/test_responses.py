@@ -6,8 +6,8 @@ import math
 
 import numpy as np
 
+from att_msgs_py.types import FaultStatus
 from att_planner.fdir.responses import responses
-from att_planner.fdir.status import FaultStatus
 
 PYRAMID = np.array([[1, -1, 0, 0], [0, 0, 1, -1], [1, 1, 1, 1]], float) / math.sqrt(2.0)
 TRACKERS = ["st1", "st2"]

@@ -8,6 +8,7 @@ import math
 import numpy as np
 import pytest
 
+from att_planner.fdir import table
 from att_planner.fdir.wheel_health import WheelTorqueDetector
 
 DT = 0.05                     # s: the tachometer's 20 Hz
@@ -24,7 +25,8 @@ def fly(leo, duration_s, fault=None, fault_at=math.inf, wheel=2, seed=1):
     tachometer's noisy quantized speeds and the expected friction. The verdicts."""
     rng = np.random.default_rng(seed)
     d, tach, I_w = leo.actuators.wheels, leo.sensors.wheel_tachometer, leo.wheel_inertia_kg_m2
-    det = WheelTorqueDetector(4, I_w, threshold_Nm=0.01, persistence_s=0.5, window_s=1.0, wheel_axes=PYRAMID)
+    e = table.read().faults["wheel_torque"]                      # the shipped table's entry
+    det = WheelTorqueDetector(4, I_w, e.threshold_Nm, e.persistence_s, e.window_s, wheel_axes=PYRAMID)
     speeds = np.array([150.0, -80.0, 60.0, -120.0])     # rad/s relative to the body (the body at rest)
     phase = np.array([0.0, 1.3, 2.1, 4.0])
     frozen = None
