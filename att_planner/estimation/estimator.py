@@ -28,6 +28,11 @@ the filter, their propagations and updates as stacks (a single estimator is a ba
   and the bias prior), else QUEST (Shuster & Oh 1981) on a sun vector and a clean magnetometer
   sample taken within ``pair_window`` s of each other.
 * **Health**: :mod:`.health`.
+* **Exclusion**: the sensors named in :attr:`Estimator.excluded` (a tracker's name, ``magnetometer``,
+  ``sun``) are not used: a vector not at all, a tracker's measurement not applied nor used to
+  initialise, but its innovation still computed (and not counted as a rejection) so that a fault
+  monitor can judge when to re-admit it. Every tracker measurement's innovation, used or not, is
+  kept for the monitor (:meth:`Estimator.take_innovations`, :class:`~.health.Innovation`).
 
 Inputs are hostile until checked (:mod:`.inputs`): a refused measurement raises
 :class:`~att_msgs_py.errors.RequestError` (320 INVALID_MEASUREMENT, 321 STALE_MEASUREMENT) and
@@ -52,7 +57,7 @@ from att_msgs_py.types import (
 )
 from att_planner.estimation import mekf
 from att_planner.estimation.attitude_determination import quest, sun_vector
-from att_planner.estimation.health import HealthMonitor, Report
+from att_planner.estimation.health import HealthMonitor, Innovation, Report
 from att_planner.estimation.history import MeasurementHistory, Record, Step
 from att_planner.estimation.inputs import DipoleLog, InputChecks
 from att_sim.models import rotations as rot
@@ -117,6 +122,7 @@ class Estimator:
         self.last_q_BN = rot.IDENTITY.copy()
         self.next_publish = -math.inf
         self.last_wall = -math.inf                # when the last gyro sample arrived (monotonic s)
+        self.excluded: set[str] = set()           # sensors not used (a fault monitor's exclusion)
 
     @staticmethod
     def default_config(specs: SensorSpecs, publish_period: float = 0.05) -> EstimatorConfig:
@@ -215,6 +221,14 @@ class Estimator:
     def take_report(self) -> Report:
         return self.monitor.take_report()
 
+    def take_innovations(self) -> list[Innovation]:
+        """The tracker innovations computed since the last call, in the order they were first processed."""
+        return self.monitor.take_innovations()
+
+    def is_excluded(self, r: Record) -> bool:
+        """Whether the sensor of ``r`` is in :attr:`excluded`."""
+        return bool(self.excluded) and (r.data[0] if r.kind == "tracker" else r.kind) in self.excluded
+
     # -- output -----------------------------------------------------------------------------------
     def health(self, t: float) -> Health:
         return self.monitor.health(t, self.state)
@@ -254,16 +268,27 @@ class Estimator:
             dcm_BS = rot.dcm_NB(q_SB)
             y = mekf.attitude_residual(x.q_BN, rot.multiply(q_SN, rot.conjugate(q_SB)))
             H, R = mekf.attitude_sensitivity(), dcm_BS @ self.trackers[name].covariance @ dcm_BS.T
-        elif r.t - self.monitor.last_tracker <= self.config.vector_fallback_after or self.environment is None:
+        elif (r.t - self.monitor.last_tracker <= self.config.vector_fallback_after or self.environment is None
+              or self.is_excluded(r)):
             return None
         else:
             reference_N, measured_B, R = self._vector(r)
             y, H = mekf.vector_residual(x.q_BN, measured_B, reference_N)
+        if r.accepted is None and self.is_excluded(r):
+            return mekf.Correction(x, y, H, R, -math.inf)          # its innovation only
         return mekf.Correction(x, y, H, R, self.gates[3] if r.accepted is None else math.inf)
 
-    def corrected(self, x: mekf.FilterState, r: Record, update: mekf.Update) -> mekf.FilterState | None:
-        """``x`` after the measurement ``r`` made ``update`` (None: the estimate is lost)."""
+    def corrected(self, x: mekf.FilterState, r: Record, update: mekf.Update,
+                  correction: mekf.Correction | None = None) -> mekf.FilterState | None:
+        """``x`` after the measurement ``r`` made ``update`` (None: the estimate is lost); ``correction``
+        (the update asked): its innovation kept the first time ``r`` is processed."""
         monitor = self.monitor
+        if r.accepted is None and correction is not None and r.kind == "tracker":
+            used = not self.is_excluded(r)
+            monitor.innovation(Innovation(r.t, r.data[0], correction.y.copy(), update.d2, correction.R.copy(), used))
+            if not used:
+                r.accepted = False
+                return x
         if r.accepted is None and monitor.judged(r, update, self.gates[3]):
             return monitor.lose(r.t, f"{self.config.lost_after} star tracker measurements in a row rejected")
         if not (r.accepted and update.accepted):
@@ -287,6 +312,8 @@ class Estimator:
     def initialise(self, r: Record) -> mekf.FilterState | None:
         """A first state from a tracker, or from a sun vector and a field sample close in time."""
         bias_cov = np.eye(3) * self.config.initial_bias_sigma**2
+        if self.is_excluded(r):
+            return None
         if r.kind == "tracker":
             name, q_SN = r.data
             spec = self.trackers[name]
@@ -311,6 +338,8 @@ class Estimator:
         if partner is None:
             return None
         sun, field_record = (r, partner) if r.kind == "sun" else (partner, r)
+        if self.is_excluded(partner):
+            return None
         bodies = self.environment.bodies(r.t)
         field_B = field_record.data
         field_var = (self.config.magnetometer_sigma / max(float(np.linalg.norm(field_B)), 1e-9)) ** 2
@@ -385,5 +414,5 @@ def _correct(records: list[tuple[_Replay, Record]]) -> None:
             correction = run.estimator.correction(run.x, r)
             if correction is not None:
                 asked.append((run, r, correction))
-    for (run, r, _), update in zip(asked, mekf.update([c for _, _, c in asked])):
-        run.x = run.estimator.corrected(run.x, r, update)
+    for (run, r, correction), update in zip(asked, mekf.update([c for _, _, c in asked])):
+        run.x = run.estimator.corrected(run.x, r, update, correction)

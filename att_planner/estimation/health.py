@@ -6,7 +6,8 @@ is dropped and the filter reinitialises from the next measurements); CONVERGED w
 — a star tracker measurement, or a vector measurement on a spacecraft without trackers — was
 accepted within ``propagate_timeout`` s and the attitude's 3σ is below ``converged_attitude_sigma``;
 PROPAGATING otherwise (on the gyro, with at most the coarse aid of the vectors while the trackers
-are blind). The monitor also counts the gate's rejections and keeps the notes the node logs.
+are blind). The monitor also counts the gate's rejections, keeps the notes the node logs and the tracker
+innovations a fault monitor judges the sensors by (:class:`Innovation`).
 """
 from __future__ import annotations
 
@@ -14,11 +15,28 @@ import math
 from collections import deque
 from dataclasses import dataclass, field
 
+import numpy as np
+
 from att_msgs_py.types import Health
 from att_planner.estimation import mekf
 from att_planner.estimation.history import Record
 
 MAX_NOTES = 100                    # notes kept for the node between two reports
+MAX_INNOVATIONS = 1000             # innovations kept between two takes (the oldest dropped)
+
+
+@dataclass(frozen=True)
+class Innovation:
+    """A tracker measurement's innovation as the filter computed it when the measurement first arrived:
+    ``y`` the measured small rotation from the estimate (rad, body axes), ``d² = yᵀ S⁻¹ y``, ``R`` the
+    measurement noise in body axes (rad²); ``used`` False when the tracker was excluded."""
+
+    t: float
+    sensor: str
+    y: np.ndarray
+    d2: float
+    R: np.ndarray
+    used: bool = True
 
 
 @dataclass
@@ -36,6 +54,7 @@ class HealthMonitor:
         self.lost_after, self.has_trackers = lost_after, has_trackers
         self.rejected = 0
         self.report = Report()
+        self.innovations: deque = deque(maxlen=MAX_INNOVATIONS)
         self._sigma3: tuple = (None, 0.0)        # (state, its attitude 3σ): the cache of health()
         self.restart()
 
@@ -104,6 +123,15 @@ class HealthMonitor:
             return False
         self.rejected_in_a_row = 0
         return True
+
+    def innovation(self, innovation: Innovation) -> None:
+        """Keep a tracker measurement's innovation for :meth:`take_innovations`."""
+        self.innovations.append(innovation)
+
+    def take_innovations(self) -> list[Innovation]:
+        out = list(self.innovations)
+        self.innovations.clear()
+        return out
 
     def take_report(self) -> Report:
         out, self.report = self.report, Report()

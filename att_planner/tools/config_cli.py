@@ -2,7 +2,7 @@
 
 - ``att-config check FILE...``: every file validated against the schema of its kind (by its name —
   ``NAME.params.yaml``, ``NAME.demo.yaml`` — or folder — ``missions/``, ``targets/``, ``campaigns/``,
-  ``spacecraft/``, ``scenarios/`` — else by its keys; or ``--kind``), and the names it refers to (a
+  ``spacecraft/``, ``scenarios/``, ``faults/`` — else by its keys; or ``--kind``), and the names it refers to (a
   scenario's spacecraft, a mission's target list, a target list's or campaign's scenario) resolved; a
   parameter file's sections checked against the nodes' parameter tables. Exit 0 when every file is
   valid; else 2, after printing every problem of every file, one per line: ``file:line: field.path:
@@ -29,6 +29,7 @@ from pathlib import Path
 
 from pydantic import BaseModel, TypeAdapter
 
+from att_planner.fdir import table as fault_table
 from att_planner.mission import schema as mission_schema
 from att_planner.mission import targets as target_lists
 from att_planner.tools.node_parameters import NODE_PARAMETERS, declared
@@ -52,9 +53,10 @@ KINDS = {
     "targets": (mission_schema.target_list_model, mission_schema.TargetList),
     "campaign": (campaign_schema.CampaignFile, campaign_schema.CampaignFile),
     "parameters": (cs.ParametersFile, cs.ParametersFile),
+    "faults": (fault_table.FaultTable, fault_table.FaultTable),
 }
 FOLDERS = {"missions": "mission", "targets": "targets", "campaigns": "campaign", "spacecraft": "spacecraft",
-           "scenarios": "scenario"}
+           "scenarios": "scenario", "faults": "faults"}
 
 
 def kind_of(path: Path, data: dict) -> str:
@@ -69,6 +71,8 @@ def kind_of(path: Path, data: dict) -> str:
         return "scenario"
     if "campaign" in data:
         return "campaign"
+    if "faults" in data:
+        return "faults"
     if "kind" in data:
         return "targets"
     if "targets" in data:

@@ -321,3 +321,74 @@ def test_estimators_replayed_as_a_batch_reach_the_states_they_reach_alone():
         if a.state is not None:
             for name in ("t", "q_BN", "bias_B", "P", "C"):
                 np.testing.assert_array_equal(getattr(a.state, name), getattr(b.state, name))
+
+
+def converged(est: Estimator, until: float = 2.0) -> None:
+    for k in range(int(round(until / 0.05)) + 1):
+        t = 0.05 * k
+        if k % 4 == 0:
+            est.on_star_tracker(tracker(t, truth(t)))
+        est.on_gyro(gyro(t, OMEGA))
+
+
+def test_each_tracker_innovation_is_kept_with_the_rotation_it_measured():
+    """A tracker measurement rotated by a known small body rotation from the truth (the estimate
+    converged on the truth) has the innovation y ≈ that rotation and d² = yᵀ S⁻¹ y with S ≥ R."""
+    est = estimator()
+    converged(est)
+    assert [i.used for i in est.take_innovations()] == [True] * 10
+    delta = np.array([20.0, -10.0, 5.0]) * ARCSEC
+    t = 2.05
+    est.on_star_tracker(tracker(t, rot.multiply(truth(t), rot.exp_map(delta))))
+    est.on_gyro(gyro(t, OMEGA))                                # applied once the gyro reaches its instant
+    (inn,) = est.take_innovations()
+    assert inn.sensor == "st" and inn.t == t and inn.used
+    assert np.allclose(inn.y, delta, atol=2.0 * ARCSEC)
+    assert inn.d2 <= float(inn.y @ np.linalg.solve(inn.R, inn.y)) + 1e-9   # S = H P Hᵀ + R ≥ R
+    assert est.take_innovations() == []
+
+
+def test_an_excluded_tracker_is_not_applied_but_its_innovation_is_computed():
+    used, excluded, without = estimator(), estimator(), estimator()
+    for est in (used, excluded, without):
+        converged(est)
+    excluded.excluded.add("st")
+    jump = rot.exp_map(np.array([0.0, 300.0, 0.0]) * ARCSEC)              # far beyond the gate
+    for k in range(41, 201):
+        t = 0.05 * k
+        if k % 4 == 0:
+            for est in (used, excluded):
+                est.on_star_tracker(tracker(t, rot.multiply(truth(t), jump)))
+        for est in (used, excluded, without):
+            est.on_gyro(gyro(t, OMEGA))
+    x, w = excluded.state, without.state
+    assert rot.angle_between(x.q_BN, w.q_BN) < 1e-12 and np.allclose(x.P, w.P, rtol=1e-12, atol=0)
+    inn = [i for i in excluded.take_innovations() if i.t > 2.0]
+    assert len(inn) == 40 and not any(i.used for i in inn) and min(i.d2 for i in inn) > 100.0
+    assert excluded.monitor.rejected == 0                                  # not gated: not counted
+    assert used.monitor.rejected > 0 and any(not i.used or i.d2 > 100 for i in used.take_innovations())
+    # re-admitted: the next measurement is applied again
+    excluded.excluded.clear()
+    excluded.on_star_tracker(tracker(10.0, truth(10.0)))
+    excluded.on_gyro(gyro(10.05, OMEGA))
+    assert np.trace(excluded.state.P[:3, :3]) < np.trace(without.state.P[:3, :3])
+
+
+def test_an_excluded_tracker_does_not_initialise_the_filter():
+    est = estimator()
+    est.excluded.add("st")
+    est.on_gyro(gyro(0.0))
+    est.on_star_tracker(tracker(0.05, Q))
+    assert est.on_gyro(gyro(0.05)).health == Health.INITIALISING
+    est.excluded.clear()
+    est.on_star_tracker(tracker(0.1, Q))
+    assert est.on_gyro(gyro(0.1)).health == Health.CONVERGED
+
+
+def test_an_excluded_magnetometer_is_not_used_for_the_vector_fallback():
+    est = estimator(vector_fallback_after=0.0)
+    converged(est)
+    est.excluded.add("magnetometer")
+    before = est.state.P.copy()
+    est.on_magnetometer(MagnetometerMeasurement(2.0, rot.dcm_BN(truth(2.0)) @ FIELD_N, np.eye(3), "body"))
+    assert np.array_equal(est.state.P, before)

@@ -19,7 +19,7 @@ def expected_kind(path: Path) -> str:
     if path.name.endswith(".demo.yaml"):
         return "demo"
     return {"missions": "mission", "targets": "targets", "campaigns": "campaign", "spacecraft": "spacecraft",
-            "scenarios": "scenario"}[path.parent.name]
+            "scenarios": "scenario", "faults": "faults"}[path.parent.name]
 
 
 def test_shipped_files_are_found():

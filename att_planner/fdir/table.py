@@ -1,0 +1,195 @@
+"""The fault table (pydantic v2 schema): each fault the flight software watches for, the detector
+that sees it, its threshold (the unit in the key's name), its persistence and its response.
+
+A fault table file (``config/faults/NAME.yaml``) is a mapping ``faults:`` of fault ids to entries,
+so that an id written twice is refused by the loader as a duplicate key (its file and line). Each
+entry names its ``detector`` (the union's tag: an unknown one is refused with the known ones); the
+detector fixes the **component** it watches (a wheel, a star tracker, the gyro...), the threshold's
+key and unit, and the responses that fit that component (:data:`RESPONSES`): a response that does
+not fit is refused naming the ones that do. Thresholds are > 0, persistences ≥ 0 s.
+
+The file is read by :func:`read` through :mod:`att_sim.models.config_files` (every problem with
+file, line and field path) and checked by ``att-config check``.
+"""
+from __future__ import annotations
+
+import typing
+from pathlib import Path
+from typing import Annotated, ClassVar, Literal
+
+from pydantic import Field, model_validator
+
+from att_sim.models import config_files
+from att_sim.models.config_base import Schema, number
+
+DEFAULT_TABLE = Path(__file__).resolve().parents[2] / "config" / "faults" / "default.yaml"
+MAX_FAULTS = 64
+
+# response -> what it does (one definition; the docs page and the schema's descriptions read it)
+RESPONSE_MEANINGS = {
+    "report": "report the fault only",
+    "exclude_wheel": "fly on the other wheels: the allocation re-made on the healthy set, the planner's "
+                     "envelope reduced",
+    "exclude_sensor": "the estimator continues on the other sensors (the excluded one re-admitted after a "
+                      "healthy window where its detector allows)",
+    "safe_mode": "rate damping, then Sun pointing (on the healthy wheels, else the magnetorquers)",
+}
+Response = Literal["report", "exclude_wheel", "exclude_sensor", "safe_mode"]
+
+# component -> the responses that fit it
+RESPONSES = {
+    "wheel": ("report", "exclude_wheel", "safe_mode"),
+    "wheel_tachometer": ("report", "exclude_wheel", "safe_mode"),
+    "star_tracker": ("report", "exclude_sensor", "safe_mode"),
+    "magnetometer": ("report", "exclude_sensor"),
+    "gyro": ("report", "safe_mode"),
+    "attitude": ("report", "safe_mode"),
+    "rate": ("report", "safe_mode"),
+    "estimate": ("report", "safe_mode"),
+}
+
+FaultId = Annotated[str, Field(min_length=1, max_length=64, pattern=r"^[a-z][a-z0-9_]*$")]
+
+
+def persistence() -> object:
+    return number(ge=0.0, le=3600.0, unit="s", meaning="sim time the detector's condition must hold before the "
+                                                        "fault is declared (0: at once)")
+
+
+class Entry(Schema):
+    """One fault of the table: the detector (the tag), its threshold and persistence, the response."""
+
+    component: ClassVar[str] = ""
+    response: Response = Field(description="what the flight software does once the fault is declared: "
+                                           + "; ".join(f"{k}: {v}" for k, v in RESPONSE_MEANINGS.items()))
+    persistence_s: float = persistence()
+
+    @model_validator(mode="after")
+    def _response_fits(self):
+        allowed = RESPONSES[self.component]
+        if self.response not in allowed:
+            raise ValueError(f"a response that fits detector {self.detector}'s component {self.component} "
+                             f"(one of {', '.join(allowed)}), got {self.response}")
+        return self
+
+
+class WheelTorque(Entry):
+    """A wheel whose measured acceleration (its tachometer speeds differentiated) departs from the
+    commanded motor torque over its inertia, minus the expected friction, by more than the threshold
+    expressed as a torque: seized, off, or with abnormal friction."""
+
+    component: ClassVar[str] = "wheel"
+    detector: Literal["wheel_torque"]
+    threshold_Nm: float = number(gt=0.0, le=10.0, unit="N m", meaning="residual motor torque")
+    window_s: float = number(1.0, gt=0.0, le=60.0, unit="s", meaning="span of each half of the two windows "
+                                                                     "whose mean speeds are differenced")
+
+
+class TachometerFrozen(Entry):
+    """A tachometer whose reading does not change by more than the threshold (a stuck counter)."""
+
+    component: ClassVar[str] = "wheel_tachometer"
+    detector: Literal["tachometer_frozen"]
+    threshold_rad_s: float = number(gt=0.0, le=10.0, unit="rad/s", meaning="largest change counted as frozen")
+
+
+class GyroFrozen(Entry):
+    """A gyro axis whose reading does not change by more than the threshold (a stuck axis)."""
+
+    component: ClassVar[str] = "gyro"
+    detector: Literal["gyro_frozen"]
+    threshold_rad_s: float = number(gt=0.0, le=1.0, unit="rad/s", meaning="largest change counted as frozen")
+
+
+class MagnetometerFrozen(Entry):
+    """A magnetometer whose field does not change by more than the threshold on any axis."""
+
+    component: ClassVar[str] = "magnetometer"
+    detector: Literal["magnetometer_frozen"]
+    threshold_nT: float = number(gt=0.0, le=1e5, unit="nT", meaning="largest change counted as frozen")
+
+
+class TrackerInnovation(Entry):
+    """A star tracker whose normalised innovation squared ``d² = yᵀ S⁻¹ y`` exceeds the threshold
+    on every measurement for the persistence while another tracker stays consistent; re-admitted
+    after ``readmit_s`` of consistent measurements."""
+
+    component: ClassVar[str] = "star_tracker"
+    detector: Literal["tracker_innovation"]
+    threshold: float = number(gt=0.0, le=1e6, unit="", meaning="d² above which a measurement is inconsistent "
+                                                               "(the chi-square quantile with 3 degrees of freedom)")
+    readmit_s: float = number(30.0, ge=0.0, le=3600.0, unit="s", meaning="consistent sim time before an "
+                                                                         "excluded tracker is used again")
+
+
+class GyroInnovation(Entry):
+    """The gyro, when every star tracker (at least two) is inconsistent at once for the persistence:
+    the common cause of their innovations is the propagation (a bias step); the axis is the largest
+    component of their mean innovation."""
+
+    component: ClassVar[str] = "gyro"
+    detector: Literal["gyro_innovation"]
+    threshold: float = number(gt=0.0, le=1e6, unit="", meaning="d² above which a measurement is inconsistent")
+
+
+class GyroBiasJump(Entry):
+    """The gyro, when the estimator's bias estimate moves on one axis by more than the threshold within
+    ``window_s`` (a bias step the filter is following; one star tracker is enough)."""
+
+    component: ClassVar[str] = "gyro"
+    detector: Literal["gyro_bias_jump"]
+    threshold_deg_h: float = number(gt=0.0, le=1e5, unit="deg/h", meaning="change of the bias estimate")
+    window_s: float = number(10.0, gt=0.0, le=3600.0, unit="s", meaning="span the change is measured over")
+
+
+class TrackerOutage(Entry):
+    """A star tracker from which no measurement (valid or not) arrived for the threshold."""
+
+    component: ClassVar[str] = "star_tracker"
+    detector: Literal["tracker_outage"]
+    threshold_s: float = number(gt=0.0, le=3600.0, unit="s", meaning="silence after which the tracker is out")
+
+
+class AttitudeError(Entry):
+    """The attitude error from the reference above the threshold (the attitude cannot be controlled)."""
+
+    component: ClassVar[str] = "attitude"
+    detector: Literal["attitude_error"]
+    threshold_deg: float = number(gt=0.0, le=180.0, unit="deg", meaning="attitude error from the reference")
+
+
+class RateError(Entry):
+    """The body rate error from the reference above the threshold."""
+
+    component: ClassVar[str] = "rate"
+    detector: Literal["rate_error"]
+    threshold_deg_s: float = number(gt=0.0, le=360.0, unit="deg/s", meaning="rate error from the reference")
+
+
+class EstimateUncertain(Entry):
+    """The estimate lost (diverged or initialising) or its attitude 3σ above the threshold: the
+    attitude cannot be known."""
+
+    component: ClassVar[str] = "estimate"
+    detector: Literal["estimate_uncertain"]
+    threshold_deg: float = number(gt=0.0, le=180.0, unit="deg", meaning="attitude 3 sigma of the estimate")
+
+
+Detector = Annotated[WheelTorque | TachometerFrozen | GyroFrozen | MagnetometerFrozen | TrackerInnovation
+                     | GyroInnovation | GyroBiasJump | TrackerOutage | AttitudeError | RateError | EstimateUncertain,
+                     Field(discriminator="detector")]
+DETECTORS = {typing.get_args(m.model_fields["detector"].annotation)[0]: m
+             for m in typing.get_args(typing.get_args(Detector)[0])}   # detector name -> its entry model
+
+
+class FaultTable(Schema):
+    """A fault table file (``config/faults/NAME.yaml``): fault ids and their entries."""
+
+    faults: dict[FaultId, Detector] = Field(max_length=MAX_FAULTS, description="fault id -> its entry")
+
+
+def read(path=DEFAULT_TABLE) -> FaultTable:
+    """The fault table file ``path`` read by the one loader;
+    :class:`att_sim.models.config_files.ConfigFileError` (``INVALID_CONFIG``) with every problem."""
+    return config_files.load_file(path, FaultTable).model
+

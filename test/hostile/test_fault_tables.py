@@ -1,0 +1,116 @@
+"""Hostile fault table files: each refused by the loader and ``att-config check`` with its file, line
+and field path, with what was expected (an unknown detector or response, a threshold ≤ 0, a negative
+persistence, a response that does not fit its detector's component, an id written twice...)."""
+from __future__ import annotations
+
+import pytest
+
+from att_msgs_py.errors import ErrorCode
+from att_planner.fdir import table
+from att_planner.tools import config_cli
+from att_sim.models.config_files import ConfigFileError
+
+BASE = """\
+faults:
+  wheel_torque:
+    detector: wheel_torque
+    threshold_Nm: 0.01
+    persistence_s: 0.5
+    response: exclude_wheel
+  tracker_inconsistent:
+    detector: tracker_innovation
+    threshold: 21.1
+    persistence_s: 1.0
+    readmit_s: 30.0
+    response: exclude_sensor
+  attitude_error:
+    detector: attitude_error
+    threshold_deg: 10.0
+    persistence_s: 10.0
+    response: safe_mode
+"""
+
+# name: (text replaced, its replacement, line, field path, words of what was expected or found)
+EDITS = {
+    "unknown detector": ("detector: wheel_torque", "detector: wheel_temperature", 3, "faults.wheel_torque.detector",
+                         "'wheel_torque'"),
+    "unknown response": ("response: exclude_wheel", "response: reboot", 6, "faults.wheel_torque.response",
+                         "'exclude_wheel'"),
+    "response of another component": ("response: exclude_wheel", "response: exclude_sensor", 2,
+                                      "faults.wheel_torque", "fits detector wheel_torque's component wheel"),
+    "safe mode excluding a wheel": ("response: safe_mode", "response: exclude_wheel", 13, "faults.attitude_error",
+                                    "(one of report, safe_mode)"),
+    "threshold zero": ("threshold_Nm: 0.01", "threshold_Nm: 0.0", 4, "faults.wheel_torque.threshold_Nm",
+                       "greater than 0"),
+    "threshold negative": ("threshold: 21.1", "threshold: -21.1", 9, "faults.tracker_inconsistent.threshold",
+                           "greater than 0"),
+    "threshold NaN": ("threshold_deg: 10.0", "threshold_deg: .nan", 15, "faults.attitude_error.threshold_deg",
+                      "nan"),
+    "threshold a word": ("threshold_Nm: 0.01", "threshold_Nm: small", 4, "faults.wheel_torque.threshold_Nm",
+                         "valid number"),
+    "threshold of another unit": ("threshold_Nm: 0.01", "threshold_deg: 0.01", 4, "faults.wheel_torque.threshold_deg",
+                                  "threshold_Nm"),
+    "threshold missing": ("    threshold_Nm: 0.01\n", "", 2, "faults.wheel_torque.threshold_Nm", "required"),
+    "persistence negative": ("persistence_s: 0.5", "persistence_s: -0.5", 5, "faults.wheel_torque.persistence_s",
+                             "greater than or equal to 0"),
+    "persistence in ms": ("persistence_s: 0.5", "persistence_ms: 500", 5, "faults.wheel_torque.persistence_ms",
+                          "persistence_s"),
+    "readmit negative": ("readmit_s: 30.0", "readmit_s: -1.0", 11, "faults.tracker_inconsistent.readmit_s",
+                         "greater than or equal to 0"),
+    "readmit on a wheel": ("    persistence_s: 0.5\n", "    persistence_s: 0.5\n    readmit_s: 3.0\n", 6,
+                           "faults.wheel_torque.readmit_s", "one of the keys"),
+    "id with a space": ("  attitude_error:\n", "  attitude error:\n", 13, "faults.attitude error",
+                        "match pattern"),
+    "faults a list": ("faults:\n  wheel_torque:\n", "faults:\n- wheel_torque:\n", 1, "faults", "valid dictionary"),
+}
+
+
+@pytest.mark.parametrize("name", sorted(EDITS))
+def test_hostile_fault_table_refused_with_file_line_and_field(name, tmp_path):
+    old, new, line, field, words = EDITS[name]
+    assert old in BASE, f"case {name}: {old!r} is not in the base"
+    path = tmp_path / "faults" / "hostile.yaml"
+    path.parent.mkdir()
+    path.write_text(BASE.replace(old, new, 1))
+    kind, problems = config_cli.check_file(path)
+    assert kind == "faults" and problems, f"{name}: accepted"
+    mine = [p for p in problems if p.field == field]
+    assert mine, f"{name}: no problem at {field}: " + "\n".join(map(str, problems))
+    p = mine[0]
+    assert p.file == str(path) and p.line == line and words in p.expected + " " + p.found, str(p)
+    with pytest.raises(ConfigFileError) as err:      # the runtime reader refuses it the same way
+        table.read(path)
+    assert err.value.code == ErrorCode.INVALID_CONFIG and str(path) in str(err.value)
+
+
+def test_an_id_written_twice_is_refused_on_its_second_line(tmp_path):
+    path = tmp_path / "twice.yaml"
+    path.write_text(BASE + "  wheel_torque:\n    detector: wheel_torque\n    threshold_Nm: 0.02\n"
+                           "    persistence_s: 0.5\n    response: report\n")
+    with pytest.raises(ConfigFileError) as err:
+        table.read(path)
+    (p,) = err.value.problems
+    assert (p.file, p.line, p.field) == (str(path), 18, "faults.wheel_torque")
+    assert "duplicate of the key on line 2" in p.found
+
+
+def test_every_problem_of_a_table_at_once(tmp_path):
+    path = tmp_path / "many.yaml"
+    path.write_text(BASE.replace("threshold_Nm: 0.01", "threshold_Nm: -1").replace("persistence_s: 10.0",
+                                                                                    "persistence_s: -2")
+                    .replace("detector: tracker_innovation", "detector: star_counter"))
+    with pytest.raises(ConfigFileError) as err:
+        table.read(path)
+    assert [(p.line, p.field) for p in err.value.problems] == [
+        (4, "faults.wheel_torque.threshold_Nm"), (8, "faults.tracker_inconsistent.detector"),
+        (16, "faults.attitude_error.persistence_s")]
+
+
+def test_the_base_and_the_shipped_table_pass(tmp_path):
+    path = tmp_path / "base.yaml"
+    path.write_text(BASE)
+    assert config_cli.check_file(path, "faults") == ("faults", [])
+    shipped = table.read()
+    assert set(shipped.faults) >= {"wheel_torque", "tracker_inconsistent", "tracker_outage", "gyro_axis_frozen",
+                                   "gyro_bias_step", "magnetometer_frozen", "attitude_error", "rate_error"}
+    assert {e.detector for e in shipped.faults.values()} == set(table.DETECTORS)
