@@ -18,8 +18,10 @@ The decisions, each from where the spacecraft holds at that moment:
    attitude clear of the zones is planned ``start_lead`` s of sim time before its start (later when
    the target becomes visible later), planned again when it would arrive before the target is
    visible (three plans at most; a ground site: its arrival fixed first, four plans at most);
-3. when none can wait there, the spacecraft parks at a source clear until the first one's start
-   (the nearest three tried), or holds for :data:`RECOVERY_STEP` s, and decides again;
+3. when none can wait there, the spacecraft parks at a source, or at one of the scheduler's sky
+   park attitudes (:func:`~att_planner.mission.scheduler.sky_parks`: directions spread over the
+   sky, so that a mission of few sources still has somewhere clear to go), clear until the first
+   one's start (the nearest three tried), or holds for :data:`RECOVERY_STEP` s, and decides again;
 4. the controller flies the plan and holds the target for its dwell (a ground site after the
    controller's blend into its law); then back to 1. A slew the planner or the controller refuses
    counts as an attempt at its target when the held attitude can start another slew: after
@@ -43,7 +45,8 @@ import numpy as np
 from att_msgs_py.types import MissionEvent
 from att_msgs_py.types import MissionEventKind as Kind
 from att_planner.mission import executive_io as io
-from att_planner.mission.scheduler import MissionScheduler
+from att_planner.mission.scheduler import MissionScheduler, sky_parks
+from att_planner.mission.targets import CELESTIAL_NORTH, pointing_attitude
 
 SITE_DURATION_MATCH = 2.0      # s: a site's plan starts within this of the start its sky was planned for
 SITE_ARRIVAL_SLACK = 1.0       # s: a slew to a site must arrive within this of the site's visibility
@@ -88,9 +91,11 @@ class MissionExecutive:
         """The executive of a :class:`~att_planner.mission.config.MissionConfig`, its scheduler as the
         mission file says (the controller's ``settle``; the estimate's health at the start)."""
         targets = mission.targets()
+        roll = getattr(mission.target_list, "roll_reference", CELESTIAL_NORTH)
+        parks = sky_parks(mission.sensor_axis, lambda axis, d: pointing_attitude(axis, d, roll))
         scheduler = MissionScheduler(mission.scenario, targets, mission.horizon, zones=mission.zones,
                                      margin=mission.margin, lead=mission.start_lead, rate_max=mission.rate_max,
-                                     slew_factor=SLEW_FACTOR, settle=settle, blend=mission.handover_blend)
+                                     slew_factor=SLEW_FACTOR, settle=settle, blend=mission.handover_blend, parks=parks)
         return cls(scheduler, targets, horizon=mission.horizon, start_lead=mission.start_lead,
                    time_budget=mission.time_budget, settle=settle, blend=mission.handover_blend,
                    sensor_axis_B=mission.sensor_axis, pointing_tolerance=mission.pointing_tolerance,
@@ -146,8 +151,9 @@ class MissionExecutive:
         q_BN, direction_N, pointing = np.array([0.0, 0.0, 0.0, 1.0]), np.zeros(3), None
         if target:
             at = start or self.t
-            q_BN, direction_N = self.targets[target].attitudes(at)[0], self.targets[target].direction_at(at)
-            pointing = self.targets[target].track.mode if self.targets[target].moving else None
+            reported = self._target(target)
+            q_BN, direction_N = reported.attitudes(at)[0], reported.direction_at(at)
+            pointing = reported.track.mode if reported.moving else None
         self._out.append(io.Report(MissionEvent(
             self.t, kind, target, start, end, q_BN, direction_N, self.sensor_axis_B if target else np.zeros(3),
             self.pointing_tolerance if target else 0.0, plan_id, message, self.frame_id, pointing, self.zone_names)))
@@ -280,6 +286,10 @@ class MissionExecutive:
                                          f"t = {self.t:.0f} s")
         self.phase, self.done = "ended", True
 
+    def _target(self, name: str):
+        """Target ``name`` of the mission, or a park attitude of the scheduler's (never observed)."""
+        return self.targets[name] if name in self.targets else self.scheduler.park_targets[name]
+
     def startable(self, q_hold_BN, t: float) -> bool:
         """Whether a slew can start from ``q_hold_BN`` soon after ``t``: the attitude clear of every
         zone until ``start_lead`` from now and the estimate converged."""
@@ -302,7 +312,7 @@ class MissionExecutive:
         ``then`` its end time, or None after a refusal (none while the estimate is not converged). A
         plan that would arrive before the target is visible for its dwell (``wait_for_visibility``)
         is planned again to arrive then."""
-        q_to_BN = self.targets[name].attitude
+        q_to_BN = self._target(name).attitude
         if not self.converged:
             return then(None)
         plans = 0
@@ -399,7 +409,7 @@ class MissionExecutive:
         the attitude of that moment. After a site, whose pass can blind both star trackers (a mode
         starts on a converged estimate), the hold is asked again every :data:`RECOVERY_STEP` s, at
         most :data:`RECOVERY_LIMIT` s, while the controller refuses it. ``then`` the attitude held."""
-        target = self.targets[name] if name is not None else None
+        target = self._target(name) if name is not None else None
         fixed = target is not None and not target.moving
         q_BN = target.attitude if fixed else None
         t = self.t

@@ -50,6 +50,7 @@ from att_sim.models.ephemeris import Ephemeris
 
 MAX_ORDERS = 5_000            # orders examined per decision (the search is best-first: the good ones come early)
 HOLD_CHECK_STEP = 10.0        # s between the zone checks of an attitude held while waiting
+SKY_PARKS = 64                # directions of the sky the spacecraft may park at besides its sources
 
 
 @dataclass(frozen=True)
@@ -106,6 +107,20 @@ def tracker_skies(scenario: scen.Scenario, sky: Ephemeris, window: float) -> lis
     return out
 
 
+def sky_parks(sensor_axis, attitude_of, n: int = SKY_PARKS) -> dict:
+    """``n`` park attitudes spread evenly over the sky (a Fibonacci lattice of boresight directions),
+    named ``sky_00``...: where the spacecraft can wait when no source of the mission stays clear.
+    ``attitude_of(sensor_axis, direction)`` makes each attitude as the mission's sources are made."""
+    k = np.arange(n) + 0.5
+    z = 1.0 - 2.0 * k / n
+    phi = math.pi * (1.0 + math.sqrt(5.0)) * k
+    r = np.sqrt(1.0 - z * z)
+    directions = np.column_stack([r * np.cos(phi), r * np.sin(phi), z])
+    width = len(str(n - 1))
+    return {f"sky_{i:0{width}d}": MissionTarget(f"sky_{i:0{width}d}", 0.0, attitude_of(sensor_axis, d), d)
+            for i, d in enumerate(directions)}
+
+
 def slew_estimate(inertia: np.ndarray, torque_max: float, q_from, q_to, rate_max: float = math.inf) -> float:
     """Rest-to-rest eigenaxis slew time (s) at the per-axis torque limit: bang-bang, or
     bang-coast-bang when the eigenaxis rate reaches ``rate_max`` (per body axis, rad/s) first."""
@@ -121,11 +136,12 @@ def slew_estimate(inertia: np.ndarray, torque_max: float, q_from, q_to, rate_max
 class MissionScheduler:
     """Orders ``targets`` (name -> :class:`MissionTarget`) for ``scenario`` over ``[0, horizon]`` s of
     mission time (t = 0 at the scenario's epoch), keeping ``zones`` (default: the scenario's; module
-    docstring)."""
+    docstring). ``parks``: more attitudes (name -> inertial :class:`MissionTarget`, e.g. :func:`sky_parks`)
+    the spacecraft may wait at besides the sources, never observed."""
 
     def __init__(self, scenario: scen.Scenario, targets: dict, horizon: float, *, zones: list | None = None,
                  margin: float = 0.0, slew_factor: float = 1.5, lead: float = 60.0, rate_max: float = math.inf,
-                 settle: float = 0.0, blend: float = 0.0):
+                 settle: float = 0.0, blend: float = 0.0, parks: dict | None = None):
         if scenario.epoch is None:
             raise ValueError(f"scenario '{scenario.name}' has no epoch: a mission needs the real sky")
         self.scenario, self.horizon, self.targets = scenario, float(horizon), dict(targets)
@@ -137,6 +153,8 @@ class MissionScheduler:
         self.grid = visibility_grid(0.0, self.horizon)
         self.visible = {k: self._site_spans(target, margin) if target.moving else
                         spans(self.grid, self._clear_samples(target, margin)) for k, target in self.targets.items()}
+        self.park_targets = {k: p for k, p in (parks or {}).items() if k not in self.targets and not p.moving}
+        self.visible.update({k: spans(self.grid, self._clear_samples(p, margin)) for k, p in self.park_targets.items()})
 
     def _clear_samples(self, target: MissionTarget, margin: float) -> np.ndarray:
         """Whether source ``target`` keeps the zones and a tracker sees the sky, at each time of the grid."""
@@ -283,10 +301,11 @@ class MissionScheduler:
         return bool(self.zones.margins(t, np.asarray(q, float), true=True).min() >= 0.0)
 
     def parks(self, q_from, t_now: float, until: float) -> list[str]:
-        """Sources (observed or not; never a site) to wait at from ``t_now`` until ``until``: reached by
-        a leg from ``q_from`` and visible from their arrival to ``until``, the nearest first."""
+        """Sources (observed or not; never a site) and the scheduler's other park attitudes to wait at
+        from ``t_now`` until ``until``: reached by a leg from ``q_from`` and visible from their arrival
+        to ``until``, the nearest first."""
         found = []
-        for name, target in self.targets.items():
+        for name, target in (self.targets | self.park_targets).items():
             if target.moving:
                 continue
             arrive = t_now + self.leg(q_from, target.attitude)

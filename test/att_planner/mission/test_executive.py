@@ -34,8 +34,10 @@ class Scheduler:
     visibility from ``visible`` (name -> first time, None: never), ``clear``/``keeps`` as functions
     of (q, t0, t1), ``parks`` the park sources, every slew ``slew`` s."""
 
-    def __init__(self, arrivals: dict, visible=None, clear=None, keeps=None, parks=(), slew=60.0, missed=None):
+    def __init__(self, arrivals: dict, visible=None, clear=None, keeps=None, parks=(), slew=60.0, missed=None,
+                 park_targets=None):
         self.arrivals, self.visible = arrivals, visible or {}
+        self.park_targets = {t.name: t for t in park_targets or ()}        # parks that are not mission targets
         self.clear_fn, self.keeps_fn = clear or (lambda q, t0, t1: True), keeps or (lambda q, t0, t1: True)
         self.park_names, self.slew, self.missed = list(parks), slew, dict(missed or {})
         self.decisions = []
@@ -245,6 +247,23 @@ def test_a_held_attitude_that_cannot_wait_parks_at_a_source_then_decides_again()
     assert world.plans[1].t_start == 540.0
     assert [e.target for e in world.reports(Kind.DWELL)] == ["a"]
     assert [(e.target, "not reached" in e.message) for e in world.reports(Kind.MISSED)] == [("p", True)]
+
+
+def test_a_park_of_the_scheduler_s_sky_is_flown_held_and_never_counted_as_a_target():
+    """A park attitude the scheduler offers that is not a mission target (a sky park): planned to its
+    attitude, reported as the park, and neither observed nor missed."""
+    a, sky = source("a", 30.0), source("sky_07", 120.0, dwell=0.0)
+
+    def clear(q, t0, t1):
+        return not (np.array_equal(q, IDENTITY) and t1 > 150.0)
+    ex = executive(Scheduler({"a": 600.0}, clear=clear, parks=["sky_07"], park_targets=[sky]), [a])
+    world = World(ex).run()
+    park = world.reports(Kind.PARK)[0]
+    assert world.plans[0].target == "sky_07" and np.array_equal(world.plans[0].q_to_BN, sky.attitude)
+    assert park.target == "sky_07" and np.array_equal(park.attitude, sky.attitude)
+    assert np.array_equal(world.plans[1].q_from_BN, sky.attitude) and world.plans[1].target == "a"
+    assert [e.target for e in world.reports(Kind.DWELL)] == ["a"] and not world.reports(Kind.MISSED)
+    assert ex.observed == 1
 
 
 def test_an_estimate_not_converged_is_waited_for_before_any_slew():

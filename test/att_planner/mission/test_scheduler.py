@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from att_planner.mission import targets as tl
-from att_planner.mission.scheduler import MissionScheduler, MissionTarget, slew_estimate
+from att_planner.mission.scheduler import MissionScheduler, MissionTarget, sky_parks, slew_estimate
 from att_sim.models import rotations as rot
 from att_sim.models import scenario as scen
 
@@ -160,3 +160,28 @@ def test_a_visibility_too_short_after_the_lead_is_named_with_its_length(day):
     now = b - scheduler.held(name) - scheduler.lead + 30.0
     assert scheduler.observable_from(name, now + scheduler.lead) is None
     assert f"lasts {scheduler.held(name) - 30.0:g} s at most" in scheduler.why_missed(name, now), name
+
+
+def test_sky_parks_spread_over_the_sky_and_are_parks_when_no_source_is_clear():
+    """Sky parks: unit directions evenly spread (no two closer than a lattice's spacing), the sensor
+    axis on each; with one source only, the parks offered after it leaves view are the sky's, each
+    clear of every zone from its arrival to the end of the wait (recomputed here)."""
+    parks = sky_parks(SENSOR, tl.pointing_attitude, 64)
+    d = np.array([p.direction for p in parks.values()])
+    assert len(parks) == 64 and np.allclose(np.linalg.norm(d, axis=1), 1.0)
+    cosines = d @ d.T - 2.0 * np.eye(64)
+    assert np.degrees(np.arccos(cosines.max())) > 20.0                 # 4π/64 sr: about 25 deg apart
+    assert abs(d.mean(axis=0)).max() < 0.05                             # no side of the sky favoured
+    for p in parks.values():
+        assert np.allclose(rot.dcm_NB(p.attitude) @ SENSOR, p.direction, atol=1e-9)
+    source = tl.load("observatory").targets[0]
+    one = {source.name: MissionTarget(source.name, 60.0, tl.pointing_attitude(SENSOR, source.direction))}
+    scheduler = MissionScheduler(scen.load("leo_observatory"), one, HORIZON, parks=parks)
+    t_now, until = 5000.0, 5600.0
+    offered = scheduler.parks(rot.IDENTITY, t_now, until)
+    assert any(name in parks for name in offered)
+    for name in offered:
+        q = (one | parks)[name].attitude
+        arrive = t_now + scheduler.leg(rot.IDENTITY, q)
+        held = np.linspace(arrive, until, 20)
+        assert scheduler.zones.margins(held, q, true=True).min() >= -np.deg2rad(0.5), name
