@@ -303,12 +303,12 @@ class MissionScheduler:
     def parks(self, q_from, t_now: float, until: float) -> list[str]:
         """Sources (observed or not; never a site) and the scheduler's other park attitudes to wait at
         from ``t_now`` until ``until``: reached by a leg from ``q_from`` and visible from their arrival
-        to ``until``, the nearest first."""
+        to ``until``, the nearest first (one reached only at ``until`` or later is no place to wait)."""
         found = []
         for name, target in (self.targets | self.park_targets).items():
             if target.moving:
                 continue
             arrive = t_now + self.leg(q_from, target.attitude)
-            if any(a <= arrive and until <= b for a, b in self.visible[name]):
+            if arrive < until and any(a <= arrive and until <= b for a, b in self.visible[name]):
                 found.append((arrive, name))
         return [name for _, name in sorted(found)]
