@@ -298,8 +298,8 @@ def _soak(p: dict, case: str | None) -> Summary:
     clean = dropped == 0 and not any(_get(p, "exit_codes").values())
     if "rtf_target" in p:          # a real-time factor study: the scenario, its length and rate name the case
         rtf, target = _num(p, "real_time_factor"), _num(p, "rtf_target")
-        return Summary(case or f"{p['scenario']}, {_num(p, 'hours'):g} h at {_num(p, 'rate_Hz'):g} Hz, "
-                               f"{', '.join(p['nodes'])}",
+        estimator = ", with the estimator" if "estimator" in p["nodes"] else ""
+        return Summary(case or f"{p['scenario']}, {_num(p, 'hours'):g} h at {_num(p, 'rate_Hz'):g} Hz{estimator}",
                        "real-time factor through the nodes", rtf, "×",
                        f"≥ {target:g}, every state recorded, every process exits 0", rtf >= target and clean,
                        {"rtf": rtf, "dropped_state": dropped, "sim_s": _num(p, "sim_time"),
