@@ -24,6 +24,7 @@ from att_planner.fdir.envelope import planning_spacecraft
 from att_planner.tools.closed_loop import ClosedLoop, plan_in_process
 
 BRAKE_LIMIT_S = 120.0     # s of sim time the hold may take to bring the rate under the start tolerance
+SAFE_HOLD_S = 120.0       # s of sim time :func:`fly` watches safe mode held before it stops
 
 
 @dataclass
@@ -112,19 +113,26 @@ class Flight:
     t_end: float
 
 
-def fly(loop: ClosedLoop, plan: Plan, goal: dict, until: float) -> Flight:
+def fly(loop: ClosedLoop, plan: Plan, goal: dict, until: float, safe_hold_s: float = SAFE_HOLD_S) -> Flight:
     """Fly ``plan`` now on ``loop`` (its fault table on) with the re-planning recovery toward ``goal``,
-    until a maneuver ends successfully, or until sim time ``until`` (safe mode, or a maneuver that did
-    not end). The loop's ``recovery`` is set."""
+    until a maneuver ends successfully, ``safe_hold_s`` of sim time after safe mode began (to see it
+    held), or sim time ``until``. The loop's ``recovery`` is set."""
     replanner = Replanner(goal)
     loop.recovery = replanner
     refused = loop.execute(plan)
     if refused is not None:
         return Flight(ManeuverResult(False, int(refused.code), refused.message), replanner, loop.sim.t)
     loop.result = None
+    safe_since = None
     while loop.sim.t < until and not loop.sim.halted:
         loop.tick()
         replanner.poll(loop)
         if loop.result is not None and loop.result.success and replanner.braking_since is None:
             break
+        if loop.controller.mode == ControlMode.SAFE:
+            safe_since = loop.sim.t if safe_since is None else safe_since
+            if loop.sim.t - safe_since >= safe_hold_s:
+                break
+        else:
+            safe_since = None
     return Flight(loop.result, replanner, loop.sim.t)
