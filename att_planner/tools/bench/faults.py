@@ -190,6 +190,11 @@ def case(setup: Setup, name: str, phase: str, instant: float, reference=None) ->
 
 _SETUP: Setup | None = None
 _REFERENCES: dict = {}
+_MC = None                  # the false-alarm campaign's Monte Carlo setup (shared with forked workers)
+
+
+def _baseline(phase: str):
+    return baseline(_SETUP, phase)
 
 
 def _case(args) -> dict:
@@ -200,8 +205,8 @@ def _case(args) -> dict:
 def _false_alarm_batch(args) -> list[dict]:
     from att_planner.tools.monte_carlo import run as mc
 
-    setup, seeds, fault_table = args
-    rows = mc.fly_batch(setup, seeds, fault_table=fault_table)
+    seeds, fault_table = args
+    rows = mc.fly_batch(_MC, seeds, fault_table=fault_table)
     print(f"fault-free runs {seeds[0][0]}-{seeds[-1][0]}: {sum(bool(r.get('fault_reports')) for r in rows)} with a "
           "report", file=sys.stderr, flush=True)
     return rows
@@ -224,7 +229,7 @@ def cases(setup: Setup, names, instants: int, workers: int = 1) -> tuple[list[di
         rows = [_case(j) for j in jobs]
     else:
         with _pool(workers) as pool:
-            refs = pool.starmap(baseline, [(setup, "slew"), (setup, "hold")])
+            refs = pool.map(_baseline, ["slew", "hold"])
             _REFERENCES.update(zip(("slew", "hold"), refs))
         with _pool(workers) as pool:
             rows = pool.map(_case, jobs, chunksize=1)
@@ -238,11 +243,12 @@ def false_alarms(campaign_path, runs: int, batch: int, workers: int = 1,
     from att_planner.tools.monte_carlo import run as mc
     from att_sim.truth import dispersions as disp
 
+    global _MC
     campaign = disp.load_campaign(campaign_path)
-    setup = mc.planned(mc.checked(campaign))
+    _MC = mc.planned(mc.checked(campaign))
     wall = time.perf_counter()
     seeds = [(i, campaign.seed + i) for i in range(runs)]
-    jobs = [(setup, seeds[k:k + batch], fault_table) for k in range(0, runs, batch)]
+    jobs = [(seeds[k:k + batch], fault_table) for k in range(0, runs, batch)]
     if workers <= 1:
         rows = [row for job in jobs for row in _false_alarm_batch(job)]
     else:
