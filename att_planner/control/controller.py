@@ -114,6 +114,8 @@ class Controller:
         self.safe_law = None                           # the safe mode's Sun pointing, built when first used
         self.dumping = config.dumping
         self.authentication = ModeAuthentication()     # of mode requests (no key: none)
+        self.healthy: tuple[bool, ...] | None = None   # the wheels the demand is allocated on (None: every one)
+        self.safe_actuation = None                     # safe mode on what is left: state -> SafeActuation | None
 
     @property
     def spacecraft(self) -> Spacecraft:
@@ -286,6 +288,13 @@ class Controller:
         """End the running maneuver unsuccessfully (cancelled, or safe mode); safe mode follows."""
         return self._end(False, ErrorCode.ABORTED, message)
 
+    def hold(self, message: str) -> ManeuverResult | None:
+        """End the running maneuver unsuccessfully (``message``) and hold the latest attitude at rest
+        (plan tracking about it): the brake before a re-plan; the ended maneuver's result."""
+        ended = self._end(False, ErrorCode.ABORTED, message) if self.maneuver is not None else None
+        self.mode, self.pointing, self.hold_q_RN = ControlMode.PLAN_TRACKING, None, self.state.q.copy()
+        return ended
+
     # -- the control loop -------------------------------------------------------------------------
     def due(self) -> bool:
         """Whether the latest state is at or after the next control instant (then it becomes the
@@ -320,7 +329,8 @@ class Controller:
         object), gains, null-space control and friction compensation. Controllers of one law
         evaluate it as rows (:func:`step_controllers`)."""
         k = self.config
-        return id(self.spacecraft), k.tracking_kp, k.tracking_kd, k.null_space_speed, k.null_space_gain, self.friction
+        return (id(self.spacecraft), k.tracking_kp, k.tracking_kd, k.null_space_speed, k.null_space_gain, self.friction,
+                self.healthy)
 
     def tracking_command(self, states: list[State], ref: Reference) -> np.ndarray:
         """Wheel torques (rows) of this controller's tracking law for rows of ``states`` about the
@@ -330,7 +340,7 @@ class Controller:
         torque_B = tracking.tracking_torque(np.array([s.q for s in states]), omega_BN_B, ref, c.tracking_kp,
                                             c.tracking_kd)
         return wheels.wheel_command(sc, torque_B, omega_BN_B, np.array([s.wheel_speeds for s in states]),
-                                    c.null_space_speed, c.null_space_gain, self.friction)
+                                    c.null_space_speed, c.null_space_gain, self.friction, healthy=self.healthy)
 
     def step_with(self, cancel_requested: bool, ref: Reference | None, tracked: np.ndarray | None) -> StepOutput:
         """The step of :func:`step_controllers` once the tracking law is evaluated: ``ref`` from
@@ -373,7 +383,8 @@ class Controller:
         s, c = self.state, self.config
         return wheels.wheel_command(self.spacecraft, np.asarray(torque_B, float)[None], s.omega[None],
                                     s.wheel_speeds[None], c.null_space_speed, c.null_space_gain, self.friction,
-                                    None if gyroscopic_speeds is None else gyroscopic_speeds[None])[0]
+                                    None if gyroscopic_speeds is None else gyroscopic_speeds[None],
+                                    healthy=self.healthy)[0]
 
     def _point(self, out: StepOutput, law) -> None:
         """Track ``law``'s reference (:func:`~.pointing.pointing_torque`) through the wheels, dumping
@@ -398,6 +409,14 @@ class Controller:
         ``safe_rate_threshold``, with a Sun to see and an attitude to trust, the safe Sun pointing
         (``safe_sun_axis`` on the Sun, the orbit normal as secondary)."""
         s, c = self.state, self.config
+        act = self.safe_actuation(s) if self.safe_actuation is not None else None
+        if act is not None:             # the healthy wheels or the gyro no longer do: what is left
+            if act.on_wheels:
+                out.command.wheel_torques = self._wheels(act.torque_B)
+            else:
+                out.command.dipole = act.dipole_B
+            out.status.message = f"safe mode on what is left ({act.law})"
+            return
         sun_ok = self.guidance_sky is not None and self.guidance_sky.sun_N is not None and \
             (self.measured is None or self.estimate_health in USABLE)
         if not sun_ok or not safe.damped(s.omega, c.safe_rate_threshold):
@@ -423,6 +442,8 @@ class Controller:
                                           feedforward=False)
             u = ref.torque_R + self._wheels(fb, np.zeros(sc.n_wheels))
             u = np.clip(u, -sc.wheel_torque_max, sc.wheel_torque_max)
+            if self.healthy is not None:
+                u = u * np.asarray(self.healthy, bool)
         else:
             u = tracked
         out.command.wheel_torques = u

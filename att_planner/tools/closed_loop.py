@@ -7,7 +7,11 @@ the nodes (:func:`~att_planner.control.controller_from_scenario.controller_from_
 :func:`~att_planner.estimation.estimator_from_scenario.estimator_from_scenario`) from the scenario's sections, with
 ``overrides`` on top — and passes what the nodes would publish, in the order the simulator publishes
 it: each step the sensors' readings, then the state; the estimator's estimate (or the truth state)
-to the controller; its command, at each control instant, back to the simulator. No DDS: tests, the
+to the controller; its command, at each control instant, back to the simulator. With a fault table
+(``fault_table=``) a :class:`~att_planner.fdir.monitor.FaultMonitor` watches what the nodes publish
+(:class:`~att_planner.fdir.tap.MonitorTap`) and its responses are acted on before each control step
+(:func:`att_planner.fdir.recovery.act`: allocation on the healthy wheels, the estimator's exclusions,
+safe mode), and ``recovery`` is called when the healthy wheels change. No DDS: tests, the
 benchmarks and Monte Carlo campaigns fly thousands of maneuvers this way. Plans are signed with the
 loop's own key, as the planner would sign them.
 
@@ -82,11 +86,13 @@ class Trace:
 class ClosedLoop:
     def __init__(self, scenario: Scenario, *, overrides: dict | None = None, seed: int | None = None,
                  q0=rot.IDENTITY, omega0=(0.0, 0.0, 0.0), wheel_speed0=None, simulation: Simulation | None = None,
-                 key: Ed25519PrivateKey | None = None):
+                 key: Ed25519PrivateKey | None = None, fault_table=None):
         """``overrides``: ``{node: {parameter: value}}`` over the scenario's sections (simulator
         ``step_s``/``publish_rate_Hz``, every controller and estimator parameter); ``seed``: the noise
         seed (default the scenario's); ``simulation``: a prepared one (e.g. a dispersed truth);
-        ``key``: the plan-signing key (default a new one; loops sharing one can share issued plans)."""
+        ``key``: the plan-signing key (default a new one; loops sharing one can share issued plans);
+        ``fault_table``: a fault table (:class:`att_planner.fdir.table.FaultTable` or its file path)
+        watched and acted on (None: no fault handling)."""
         overrides = overrides or {}
         unknown = sorted(set(overrides) - {"simulator", "controller", "estimator"})
         if unknown:
@@ -120,6 +126,41 @@ class ClosedLoop:
         self.next_state = 0.0
         self.result: ManeuverResult | None = None
         self.tap = None     # optional (topic, t, mirror object) of everything the nodes would publish: a log
+        self.monitor = self.monitor_tap = None
+        self.recovery = None  # optional (loop, healthy before, healthy after) when the healthy wheels change
+        self._reports_seen = 0
+        if fault_table is not None:
+            self._watch(fault_table)
+
+    def _watch(self, fault_table) -> None:
+        from att_planner.fdir import table as fault_tables
+        from att_planner.fdir.monitor import FaultMonitor
+        from att_planner.fdir.tap import MonitorTap
+
+        ft = fault_table if isinstance(fault_table, fault_tables.FaultTable) else fault_tables.read(fault_table)
+        self.monitor = FaultMonitor(ft, self.scenario.spacecraft, self.scenario.sensors,
+                                    self.scenario.body_frame_id)
+        self.monitor_tap = MonitorTap(self.monitor, self.estimator, self.controller.friction)
+
+    def _emit(self, topic: str, t: float, m) -> None:
+        if self.monitor_tap is not None:
+            self.monitor_tap(topic, t, m)
+        if self.tap is not None:
+            self.tap(topic, t, m)
+
+    def respond(self) -> None:
+        """Act on the monitor's responses when it reported something new (:func:`att_planner.fdir.recovery.act`)."""
+        from att_planner.fdir import recovery
+
+        if self.monitor is None or len(self.monitor.history) == self._reports_seen:
+            return
+        self._reports_seen = len(self.monitor.history)
+        before = self.controller.healthy
+        ended = recovery.act(self.monitor.responses(), self.controller, self.estimator)
+        if ended is not None:
+            self.result = ended
+        if self.controller.healthy != before and self.recovery is not None:
+            self.recovery(self, before, self.controller.healthy)
 
     # -- plans ------------------------------------------------------------------------------------
     def issue(self, plan: Plan, plan_id: str = "plan") -> tuple[Plan, bytes]:
@@ -166,7 +207,8 @@ class ClosedLoop:
         state_due = t >= self.next_state - 1e-9
         if state_due:
             self.next_state = t + self.publish_period
-        if self.tap is not None:
+        tapped = self.tap is not None or self.monitor_tap is not None
+        if tapped:
             self._tap_readings(t, readings, state_due)
         outcome = None
         if est is not None:
@@ -187,21 +229,22 @@ class ClosedLoop:
                 yield Reprocessing(est, est.newest)
                 estimate = est.publish(readings.gyro.t, omega)
                 if estimate is not None:
-                    if self.tap is not None:
-                        self.tap(topics.ESTIMATE, t, estimate)
+                    if tapped:
+                        self._emit(topics.ESTIMATE, t, estimate)
                     outcome = ctl.accept_estimate(estimate)
         elif state_due:
             outcome = ctl.accept_state(sim.state(self.scenario.frame_id, self.scenario.body_frame_id))
         if outcome is not None:
             self._outcome(outcome)
+            self.respond()
             if ctl.due():
                 out = yield ctl
                 out = ctl.step() if out is None else out
                 if out.result is not None:
                     self.result = out.result
-                if self.tap is not None:
-                    self.tap(topics.COMMAND, t, out.command)
-                    self.tap(topics.CONTROLLER_STATUS, t, out.status)
+                if tapped:
+                    self._emit(topics.COMMAND, t, out.command)
+                    self._emit(topics.CONTROLLER_STATUS, t, out.status)
                 refused = sim.set_command(out.command)
                 if refused is not None:
                     self.refusals.append(RequestError(refused.code, refused.message))
@@ -248,11 +291,11 @@ class ClosedLoop:
                          (topics.SENSOR_TRUTH, readings.truth), *((topics.STAR_TRACKER, m) for m in
                                                                   readings.star_trackers)):
             if m is not None:
-                self.tap(topic, t, m)
+                self._emit(topic, t, m)
         for event in self.sim.faults.take_events():
-            self.tap(topics.SIM_FAULTS, event.t, event)
+            self._emit(topics.SIM_FAULTS, event.t, event)
         if state_due:
-            self.tap(topics.STATE, t, self.sim.state(self.scenario.frame_id, self.scenario.body_frame_id))
+            self._emit(topics.STATE, t, self.sim.state(self.scenario.frame_id, self.scenario.body_frame_id))
 
     def _record(self, out) -> None:
         sim, est, command = self.sim, self.estimator, out.command
@@ -269,10 +312,11 @@ class ClosedLoop:
 
 def plan_in_process(scenario: Scenario, q0, qf, sensor_axis, cones=(), zones=(), method: str = "",
                     time_budget: float = 30.0, epoch: tuple = (0, 0), wheel_speeds=(),
-                    end_pointing: PointingMode | None = None) -> Plan:
+                    end_pointing: PointingMode | None = None, spacecraft: dyn.Spacecraft | None = None) -> Plan:
     """A verified plan as the planner service makes it (same validation, padding, method, fallback and
     verification; the planner's ``cone_padding_deg`` and ``default_method`` of the scenario), in this
-    process. RequestError when there is none."""
+    process; ``spacecraft``: the model planned for instead of the scenario's (the envelope of its healthy
+    wheels, :func:`att_planner.fdir.envelope.planning_spacecraft`). RequestError when there is none."""
     from att_planner import methods
     from att_planner.service.planning import plan_maneuver
     from att_planner.service.requests import ManeuverRequest, validate_maneuver
@@ -286,6 +330,8 @@ def plan_in_process(scenario: Scenario, q0, qf, sensor_axis, cones=(), zones=(),
     valid = validate_maneuver(request, frame_id=scenario.frame_id, default_spacecraft=scenario.name,
                               default_method=planner("default_method") or methods.REGISTRY[0].name,
                               default_budget=time_budget)
+    if spacecraft is not None:
+        valid.problem.spacecraft = spacecraft
     outcome = plan_maneuver(valid, cone_padding=math.radians(planner("cone_padding_deg")))
     if outcome.code != 0:
         raise RequestError(outcome.code, outcome.message)

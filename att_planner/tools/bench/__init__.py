@@ -39,6 +39,7 @@ STUDIES = {
     "fastest": "att_planner.tools.bench.fastest",
     "rtf": "att_planner.tools.bench.rtf",
     "aeos": "att_planner.tools.bench.aeos",
+    "faults": "att_planner.tools.bench.faults",
 }
 TOOLS = {
     "history": "att_planner.tools.bench.history",

@@ -358,6 +358,18 @@ def _aeos(p: dict, case: str | None) -> Summary:
                     "compute_s": _num(p, "compute_s", "access") + _num(p, "compute_s", "greedy")})
 
 
+def _faults(p: dict, case: str | None) -> Summary:
+    met, alarms = _get(p, "met"), _get(p, "false_alarm_campaign")
+    right, cases = _num(met, "detected_in_time_right"), _num(met, "cases")
+    runs, false = _num(alarms, "runs"), _num(alarms, "runs_with_a_report")
+    return Summary(case or f"{_get(p, 'scenario')}, {int(cases)} cases, {int(runs)} fault-free runs",
+                   "faults detected in time and isolated right", right, f"of {int(cases)}",
+                   "every fault in <= 5 s (wheels, gyro) or <= 30 s, no zone entered, 0 false alarms in 1000 runs",
+                   bool(_get(p, "passed")) and runs >= 1000,
+                   {"zone_entered": _num(met, "zone_entered"), "false_alarm_runs": false, "fault_free_runs": runs,
+                    "wall_s": _num(p, "wall_seconds")})
+
+
 def _cmd(template: str) -> Callable[[dict, str], str]:
     return lambda p, path: template.format(path=path, **{k: v for k, v in p.items()
                                                                                  if isinstance(v, str | int | float)})
@@ -396,6 +408,8 @@ STUDIES: tuple[Study, ...] = (
           lambda p, path: f"att-bench fastest --sets {p['fastest_sets']} --budget {p['budget_s']:g} "
                           + (f"--options '{json.dumps(p['time_optimal_options'])}' " if p.get("time_optimal_options")
                              else "") + f"--json {path}"),
+    Study("faults", lambda p: p.get("study") == "faults", _faults,
+          _cmd("att-bench faults --scenario {scenario} --runs {runs} --workers {workers} --json {path}")),
     Study("aeos", lambda p: p.get("study") == "aeos", _aeos,
           lambda p, path: f"att-bench aeos --targets {p['targets']} --seed {p['seed']} --orbits {p['orbits']:g} "
                           f"--json {path}"),

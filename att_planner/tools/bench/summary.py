@@ -59,6 +59,7 @@ ROWS: tuple[tuple[str, str], ...] = (
     ("day", "observatory_day, --rtf max"),
     ("rtf", "leo_observatory, in process"),
     ("rtf", "swift_demo, in process"),
+    ("faults", "leo_pyramid, 60 cases, 1000 fault-free runs"),
     ("estimation", "swift_demo"),
     ("momentum", "15 orbits"),
     ("soak", "10 orbits"),

@@ -90,13 +90,15 @@ def applied_columns(values: dict, loop: ClosedLoop) -> dict:
     return out
 
 
-def loop_for(setup: Setup, truth: disp.Truth, key: Ed25519PrivateKey | None = None) -> ClosedLoop:
+def loop_for(setup: Setup, truth: disp.Truth, key: Ed25519PrivateKey | None = None,
+             fault_table=None) -> ClosedLoop:
     """The closed loop of the nominal scenario's flight software on the dispersed truth (``key``:
-    its plan-signing key, default a new one)."""
+    its plan-signing key, default a new one; ``fault_table``: watched and acted on, see
+    :class:`~att_planner.tools.closed_loop.ClosedLoop`)."""
     s = truth.scenario
     sim = Simulation.for_scenario(s, q0=truth.q0, omega0=truth.omega0, seed=truth.seed,
                                   checks=Checks(body_frame_id=s.body_frame_id), dispersed_faults=truth.faults)
-    return ClosedLoop(setup.scenario, simulation=sim, key=key)
+    return ClosedLoop(setup.scenario, simulation=sim, key=key, fault_table=fault_table)
 
 
 @dataclass
@@ -136,10 +138,13 @@ class _Flight:
     def end(self, code: int, message: str) -> bool:
         start = self.start if self.flying else self.loop.sim.t
         self.row.update(outcomes(self.setup, self.loop, start, code, message))
+        if self.loop.monitor is not None:
+            history = self.loop.monitor.history
+            self.row.update(fault_reports=len(history), fault_ids=sorted({f.fault_id for f in history}))
         return False
 
 
-def fly_batch(setup: Setup, runs: list[tuple[int, int]], tap=None) -> list[dict]:
+def fly_batch(setup: Setup, runs: list[tuple[int, int]], tap=None, fault_table=None) -> list[dict]:
     """The rows of ``(run, seed)`` pairs (applied values and outcomes, :data:`OUTCOMES`), flown as one
     batch: each run converges, then flies the plan, as it would alone; at each step the runs'
     sensors are read on rows (:meth:`SimulationBatch.sense <att_sim.truth.batch.SimulationBatch.sense>`),
@@ -149,12 +154,13 @@ def fly_batch(setup: Setup, runs: list[tuple[int, int]], tap=None) -> list[dict]
     compute its tracking law as rows (:func:`~att_planner.control.controller.step_controllers`), and
     the simulations of the runs still going advance as one batch (:class:`att_sim.truth.batch.SimulationBatch`).
     ``cpu_seconds``: the group's CPU time shared equally. ``tap``: see :attr:`ClosedLoop.tap` (a full
-    log; one run)."""
+    log; one run). ``fault_table``: each run's loop watches it and acts on it (:func:`loop_for`); the
+    rows then carry ``fault_reports`` and ``fault_ids``."""
     cpu = time.process_time()
     flights, key, references, issued = [], Ed25519PrivateKey.generate(), ReferenceMemo(), None
     for run, seed in runs:
         truth, values = dispersed(setup, seed)
-        loop = loop_for(setup, truth, key)
+        loop = loop_for(setup, truth, key, fault_table)
         loop.tap, loop.controller.references = tap, references
         issued = issued or loop.issue(setup.plan)
         flights.append(_Flight(setup, loop, {"run": run, "seed": seed, **applied_columns(values, loop)},

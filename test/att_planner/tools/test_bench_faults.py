@@ -1,0 +1,44 @@
+"""att-bench faults on two cases and three fault-free runs: every case is in the JSON with its
+detection, isolation, response and outcome; the summary counts them; the false-alarm campaign
+counts the runs with a report; the history line names the study; unknown fault names are refused."""
+from __future__ import annotations
+
+import argparse
+import math
+
+import pytest
+
+from att_planner.tools.bench import faults, history
+
+
+def args(**kw):
+    parser = argparse.ArgumentParser()
+    faults.configure(parser)
+    a = parser.parse_args([])
+    for k, v in {"faults": "wheel seized", "instants": 1, "runs": 3, "batch": 3, **kw}.items():
+        setattr(a, k, v)
+    return a
+
+
+@pytest.mark.slow
+def test_the_study_on_two_cases_and_three_fault_free_runs():
+    p = faults.run(args())
+    assert [(c["fault"], c["phase"]) for c in p["cases"]] == [("wheel seized", "slew"), ("wheel seized", "hold")]
+    for c in p["cases"]:
+        assert c["detected"] and c["right"] and c["isolated"] == ["wheel", 1] and c["response"] == "exclude_wheel"
+        assert c["latency_s"] > 0.0 and math.isfinite(c["final_error_deg"]) and c["healthy_wheels"][1] is False
+        assert not c["report_before_onset"]
+    slew = p["cases"][0]
+    assert slew["completed"] and [r["verified"] for r in slew["replans"]] == [True] and slew["time_lost_s"] > 0
+    assert [r["cases"] for r in p["summary"]] == [1, 1] and p["met"]["cases"] == 2
+    alarms = p["false_alarm_campaign"]
+    assert alarms["runs"] == 3 and alarms["runs_with_a_report"] == len(alarms["alarms"])
+    line = history.line(p, json_path="x.json", date="2026-12-05T10:00:00Z", commit=None, source="test")
+    assert line["study"] == "faults" and line["met"] is False          # 3 runs are not the 1000 the target needs
+
+
+def test_unknown_faults_and_instants_are_refused():
+    with pytest.raises(SystemExit, match="unknown"):
+        faults.run(args(faults="wheel melted"))
+    with pytest.raises(SystemExit, match="--instants must be 1 to 3"):
+        faults.run(args(instants=4))
