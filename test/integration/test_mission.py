@@ -6,7 +6,6 @@ the source's direction, with the Sun and Moon from the sky, apart from the day's
 review draws the day and lists the targets."""
 from __future__ import annotations
 
-import math
 import re
 
 import numpy as np
@@ -16,12 +15,11 @@ from att_msgs_py import convert
 from att_msgs_py.log import read_log
 from att_msgs_py.topics import MISSION_EVENTS, PLANS, STATE
 from att_msgs_py.types import MissionEventKind as Kind
-from att_planner.mission.targets import load as load_targets
 from att_planner.tools.review import review
 from att_sim.models import rotations as rot
 from att_sim.models import scenario as scen
 from att_sim.models.ephemeris import Ephemeris
-from helpers.missions import fly_written
+from helpers.missions import fly_observatory_sources
 
 pytestmark = [pytest.mark.ros, pytest.mark.slow]     # flies 2400 s of sim time: 121 s of module setup
 SOURCES = {"polaris": 60.0, "cas_a": 60.0}         # visible at the epoch for 1870 s, from 1070 s on (1 deg margin)
@@ -29,14 +27,7 @@ SOURCES = {"polaris": 60.0, "cas_a": 60.0}         # visible at the epoch for 18
 
 @pytest.fixture(scope="module")
 def flown(tmp_path_factory):
-    out = tmp_path_factory.mktemp("mission")
-    observatory = {t.name: t for t in load_targets("observatory").targets}
-    targets = [{"name": n, "ra_deg": math.degrees(math.atan2(d[1], d[0])) % 360.0,
-                "dec_deg": math.degrees(math.asin(d[2])), "dwell_s": dwell}
-               for n, dwell in SOURCES.items() for d in [observatory[n].direction]]
-    return fly_written(out, {"kind": "inertial", "scenario": "leo_observatory", "targets": targets},
-                       {"sensor_axis": [0, 1, 0], "horizon_s": 2400, "start_lead_s": 120, "time_budget_s": 5,
-                        "rate_Hz": 2.5}, rtf=0.0)
+    return fly_observatory_sources(tmp_path_factory.mktemp("mission"), SOURCES)
 
 
 def test_both_sources_are_observed_within_the_tolerance(flown):

@@ -5,8 +5,6 @@ scheduler's sky. The day keeps every zone, checked here from the truth states ag
 Moon and the Earth's limb recomputed from the sky, apart from the day's own report."""
 from __future__ import annotations
 
-import math
-
 import numpy as np
 import pytest
 
@@ -14,10 +12,9 @@ from att_msgs_py import convert
 from att_msgs_py.log import read_log
 from att_msgs_py.topics import MISSION_EVENTS, STATE
 from att_msgs_py.types import MissionEventKind as Kind
-from att_planner.mission.targets import load as load_targets
 from att_sim.models import rotations as rot
 from att_sim.models.ephemeris import Ephemeris
-from helpers.missions import fly_written
+from helpers.missions import fly_observatory_sources
 
 pytestmark = [pytest.mark.ros, pytest.mark.slow]     # 2400 s of sim time at --rtf max: about a minute
 SOURCES = {"m87": 60.0, "3c273": 60.0}
@@ -26,14 +23,7 @@ EARTH_RADIUS_M = 6378137.0                          # WGS-84 equatorial, the lim
 
 @pytest.fixture(scope="module")
 def flown(tmp_path_factory):
-    out = tmp_path_factory.mktemp("escape")
-    observatory = {t.name: t for t in load_targets("observatory").targets}
-    targets = [{"name": n, "ra_deg": math.degrees(math.atan2(d[1], d[0])) % 360.0,
-                "dec_deg": math.degrees(math.asin(d[2])), "dwell_s": dwell}
-               for n, dwell in SOURCES.items() for d in [observatory[n].direction]]
-    return fly_written(out, {"kind": "inertial", "scenario": "leo_observatory", "targets": targets},
-                       {"sensor_axis": [0, 1, 0], "horizon_s": 2400, "start_lead_s": 120, "time_budget_s": 5,
-                        "rate_Hz": 2.5}, rtf=0.0)
+    return fly_observatory_sources(tmp_path_factory.mktemp("escape"), SOURCES)
 
 
 def test_after_the_last_target_the_spacecraft_parks_at_the_sky_and_keeps_every_zone(flown):
