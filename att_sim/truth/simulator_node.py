@@ -246,19 +246,11 @@ class SimulatorNode(Node):
                                    throttle_duration_sec=1.0)
 
     def on_reset(self, request: ResetSimulator.Request, response: ResetSimulator.Response):
-        refusal = limits.issue(request, limits.RESET_SIMULATOR)
-        if refusal is None:
+        def reset():
             q = convert.from_quaternion(request.attitude)
             w = convert.from_vector3(request.body_rate)
-            refusal = self.sim.reset(q, w, np.asarray(request.wheel_speeds, float), request.orbit_phase)
-        else:
-            refusal = Refusal(refusal.code, refusal.message)
-        if refusal is not None:
-            self.report("reset", refusal)
-        response.success = refusal is None
-        response.error_code = 0 if refusal is None else int(refusal.code)
-        response.message = "state reset" if refusal is None else refusal.message
-        return response
+            return self.sim.reset(q, w, np.asarray(request.wheel_speeds, float), request.orbit_phase)
+        return self.answer("reset", request, limits.RESET_SIMULATOR, reset, response, lambda: "state reset")
 
     def on_hold(self, request: SetBool.Request, response: SetBool.Response):
         t = self.sim.t
@@ -288,18 +280,24 @@ class SimulatorNode(Node):
             self.pace = (time.monotonic(), self.sim.t)
 
     def on_inject_fault(self, request: InjectFault.Request, response: InjectFault.Response):
-        refusal = limits.issue(request, limits.INJECT_FAULT)
-        if refusal is None:
-            refusal = self.sim.request_fault(request.component, request.index, request.kind, request.factor,
-                                             np.asarray(request.bias_rad, float), request.bias_rad_s, request.t_s)
-        else:
-            refusal = Refusal(refusal.code, refusal.message)
+        def inject():
+            return self.sim.request_fault(request.component, request.index, request.kind, request.factor,
+                                          np.asarray(request.bias_rad, float), request.bias_rad_s, request.t_s)
+        return self.answer("fault", request, limits.INJECT_FAULT, inject, response,
+                           lambda: f"{request.component}[{request.index}] {request.kind} scheduled at t = "
+                                   f"{max(request.t_s, self.sim.t):.3f} s")
+
+    def answer(self, what: str, request, size_limit, act, response, done):
+        """Answer a service request: refused above ``size_limit`` (SIZE_LIMIT) or by ``act()`` (a
+        ``Refusal`` or None); a refusal is reported and answered with its code and sentence, a success
+        with ``done()``."""
+        refusal = limits.issue(request, size_limit)
+        refusal = act() if refusal is None else Refusal(refusal.code, refusal.message)
         if refusal is not None:
-            self.report("fault", refusal)
+            self.report(what, refusal)
         response.success = refusal is None
         response.error_code = 0 if refusal is None else int(refusal.code)
-        response.message = (f"{request.component}[{request.index}] {request.kind} scheduled at t = "
-                             f"{max(request.t_s, self.sim.t):.3f} s" if refusal is None else refusal.message)
+        response.message = done() if refusal is None else refusal.message
         return response
 
     def report(self, what: str, refusal: Refusal) -> None:
