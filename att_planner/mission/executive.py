@@ -191,8 +191,12 @@ class MissionExecutive:
         for name, why in decision.missed.items():
             self._report(Kind.MISSED, name, message=why)
             self.remaining.remove(name)
-        if not decision.order:
+        if not decision.order and not decision.left_out:
             return self._finish()
+        if not decision.order:             # observable later, but no order fits from here now: decide again
+            self._log(t, f"no order fits from t = {t:.0f} s for {', '.join(decision.left_out)}: holding "
+                         f"{RECOVERY_STEP:g} s before deciding again")
+            return self._await_time(t + RECOVERY_STEP, "holding", self._stepped)
         self._report(Kind.SCHEDULED, message="order " + ", ".join(
             f"{k} at {a:.0f} s" for k, a in zip(decision.order, decision.arrivals)))
         name, t_start = self.next_slew(decision, q_hold_BN, t)

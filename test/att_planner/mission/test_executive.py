@@ -35,8 +35,8 @@ class Scheduler:
     of (q, t0, t1), ``parks`` the park sources, every slew ``slew`` s."""
 
     def __init__(self, arrivals: dict, visible=None, clear=None, keeps=None, parks=(), slew=60.0, missed=None,
-                 park_targets=None):
-        self.arrivals, self.visible = arrivals, visible or {}
+                 park_targets=None, no_order_before=-math.inf):
+        self.arrivals, self.visible, self.no_order_before = arrivals, visible or {}, no_order_before
         self.park_targets = {t.name: t for t in park_targets or ()}        # parks that are not mission targets
         self.clear_fn, self.keeps_fn = clear or (lambda q, t0, t1: True), keeps or (lambda q, t0, t1: True)
         self.park_names, self.slew, self.missed = list(parks), slew, dict(missed or {})
@@ -46,6 +46,8 @@ class Scheduler:
         self.decisions.append((t, list(remaining)))
         missed = {k: v for k, v in self.missed.items() if k in remaining}
         order = [k for k in self.arrivals if k in remaining and k not in missed]
+        if t < self.no_order_before:                   # observable, but no order fits yet
+            return Decision([], [], missed, order)
         return Decision(order, [max(self.arrivals[k], t + LEAD) for k in order], missed)
 
     def observable_from(self, name, t):
@@ -324,6 +326,22 @@ def test_no_target_left_holds_to_the_horizon_and_missed_ones_are_reported():
     assert [(e.event, e.target) for e in world.reports()] == [(Kind.MISSED, "a"), (Kind.ENDED, "")]
     assert world.reports(Kind.MISSED)[0].message == "a sun zone covers it until the horizon"
     assert world.reports(Kind.ENDED)[0].message.startswith("0 targets held for their dwell, 1 missed")
+
+
+def test_a_target_observable_later_but_in_no_order_now_is_decided_again_not_given_up():
+    """The scheduler finds no order that reaches the one target left (it is observable later): the
+    executive holds :data:`RECOVERY_STEP` s at a time and decides again until an order fits, then flies
+    it; the day does not end early."""
+    a = source("a", 30.0)
+    scheduler = Scheduler({"a": 800.0}, no_order_before=450.0)
+    world = World(executive(scheduler, [a], horizon=3000.0)).run()
+    times = [t for t, _ in scheduler.decisions]
+    assert times[0] == 0.0 and np.allclose(np.diff(times[:-1]), exe.RECOVERY_STEP)
+    assert times[-2] < 450.0 <= times[-1] < 450.0 + exe.RECOVERY_STEP
+    assert [(e.event, e.target) for e in world.reports() if e.event != Kind.SCHEDULED] == [
+        (Kind.SLEW, "a"), (Kind.DWELL, "a"), (Kind.ENDED, "")]
+    assert world.reports(Kind.DWELL)[0].start == pytest.approx(800.0)
+    assert sum("no order fits" in line for line in world.logs()) == len(times) - 1
 
 
 def test_hostile_events_change_nothing():
