@@ -14,6 +14,7 @@ from att_msgs_py.types import MissionEventKind as Kind
 from att_msgs_py.types import PointingMode
 from att_planner.mission import executive as exe
 from att_planner.mission import executive_io as io
+from att_planner.mission import holds
 from att_planner.mission.scheduler import Decision, MissionTarget
 
 IDENTITY = np.array([0.0, 0.0, 0.0, 1.0])
@@ -287,9 +288,9 @@ def test_recovery_gives_up_after_its_limit_and_the_day_still_ends():
     waits = [x.t for x in world.actions if isinstance(x, io.WaitUntil)]
     # one recovery: a check every step up to the limit; then the hold, the decision and the wait for
     # the slew's request (a's start: a lead and its slew after the decision), whose slew cannot start
-    checks = round(exe.RECOVERY_LIMIT / exe.RECOVERY_STEP)
+    checks = round(holds.RECOVERY_LIMIT / exe.RECOVERY_STEP)
     assert waits[:checks] == [exe.RECOVERY_STEP * k for k in range(1, checks + 1)]
-    assert waits[checks] == max(300.0 - 60.0, exe.RECOVERY_LIMIT + LEAD) - LEAD
+    assert waits[checks] == max(300.0 - 60.0, holds.RECOVERY_LIMIT + LEAD) - LEAD
     assert world.logs()[:2] == ["holding: the estimate is not converged"] * 2
     assert not world.plans and world.reports()[-1].event == Kind.ENDED
 
@@ -430,9 +431,9 @@ def test_a_zone_about_to_cover_the_start_attitude_is_escaped_by_a_quick_park():
     world = World(ex).run()
     assert world.logs()[0] == "a zone is about to cover the held attitude: leaving it"
     escape = world.plans[0]
-    assert (escape.target, escape.t_start, escape.time_budget) == ("p", exe.ESCAPE_LEAD, exe.ESCAPE_BUDGET)
+    assert (escape.target, escape.t_start, escape.time_budget) == ("p", holds.ESCAPE_LEAD, holds.ESCAPE_BUDGET)
     park = world.reports(Kind.PARK)[0]
-    assert (park.start, park.end) == (exe.ESCAPE_LEAD + 50.0 + SETTLE, exe.ESCAPE_LEAD + 2.0 * LEAD)
+    assert (park.start, park.end) == (holds.ESCAPE_LEAD + 50.0 + SETTLE, holds.ESCAPE_LEAD + 2.0 * LEAD)
     assert world.plans[1].target == "a" and np.array_equal(world.plans[1].q_from_BN, p.attitude)
 
 
