@@ -257,3 +257,22 @@ def site_in_view(geometry: PointingGeometry, t: float, off_nadir: float, azimuth
         raise ValueError(f"a line of sight {math.degrees(off_nadir):.1f} deg off nadir misses the Earth")
     lat, lon, _ = itrs_to_geodetic(dcm_EN @ (r_N + (-b - math.sqrt(disc)) / a * d_N))
     return lat, lon
+
+
+def elevation_sines(r_itrs: np.ndarray, sites_itrs: np.ndarray, up_itrs: np.ndarray, pairs: bool = False) -> np.ndarray:
+    """``sin e = û · (r − s) / |r − s|``, the elevation of the spacecraft at ``r`` above the horizon of
+    the site at ``s`` with geodetic up ``û`` (all ITRS, m), written ``(û·r − û·s) / sqrt(|r|² − 2 s·r + |s|²)``.
+
+    ``r_itrs`` (K, 3) against N sites ``sites_itrs`` and ``up_itrs`` (N, 3): the grid (N, K) in two
+    matrix products; ``pairs``: K = N, the k-th position against the k-th site, (K,)."""
+    r = np.asarray(r_itrs, float).reshape(-1, 3)
+    s = np.asarray(sites_itrs, float).reshape(-1, 3)
+    u = np.asarray(up_itrs, float).reshape(-1, 3)
+
+    def rows(a, b):
+        return np.einsum("ij,ij->i", a, b)
+
+    cross = rows if pairs else (lambda a, b: a @ b.T)
+    column = (lambda x: x) if pairs else (lambda x: x[:, None])
+    along = cross(u, r) - column(rows(u, s))
+    return along / np.sqrt(rows(r, r) - 2.0 * cross(s, r) + column(rows(s, s)))

@@ -55,7 +55,8 @@ from att_sim.models.geomagnetic import EARTH_ROTATION_RATE
 
 WGS84_B = WGS84_A * (1.0 - WGS84_F)          # m, polar radius
 QUADRATURE_POINTS = 16                       # Gauss-Legendre points of the arc length
-NEWTON_ITERATIONS = 6                        # Newton steps of θ(s) (quadratic: 1e-12 m in 3 on 2000 km)
+NEWTON_ITERATIONS = 6                        # Newton steps of θ(s) at most (quadratic: 1e-12 m in 3 on 2000 km)
+NEWTON_TOLERANCE = 1e-15                     # relative step of θ where Newton's method stops
 TANGENT_STEP = 1e-5                          # rad of θ: the central difference of the tangent
 RATE_STEP = 0.05                             # s: the central difference of the rate
 MAX_STRIP_LENGTH_M = 2_000_000.0             # m: a strip is imaged within one pass
@@ -141,9 +142,14 @@ class Strip:
     def theta_of(self, s: float) -> float:
         """``θ(s)``: Newton's method on :meth:`arc_length` (``s`` may be negative or past the end: the
         great ellipse continues)."""
+        if s == 0.0:
+            return 0.0
         theta = s / float(np.linalg.norm(self.point(0.0)[1]))
         for _ in range(NEWTON_ITERATIONS):
-            theta -= (self.arc_length(theta) - s) / float(np.linalg.norm(self.point(theta)[1]))
+            step = (self.arc_length(theta) - s) / float(np.linalg.norm(self.point(theta)[1]))
+            theta -= step
+            if abs(step) <= NEWTON_TOLERANCE * max(abs(theta), 1e-300):
+                break
         return theta
 
     def tangent(self, theta: float) -> tuple[np.ndarray, np.ndarray]:
@@ -228,7 +234,7 @@ def strip_start_goal(geometry: PointingGeometry, strip: Strip, primary_B, second
 
 
 def tracking_demand(spacecraft, geometry: PointingGeometry, strip: Strip, primary_B, secondary_B, t_start: float,
-                    samples: int = 41) -> tuple[float, float]:
+                    samples: int = 11) -> tuple[float, float]:
     """The largest body rate (rad/s, per axis) and body torque (N m, per axis,
     ``τ = J ω̇ + ω × J ω`` on the reference) the scan asks, sampled over its duration."""
     rate, torque = 0.0, 0.0
