@@ -46,9 +46,11 @@ from att_sim.models import rotations as rot
 from att_sim.models.geomagnetic import EARTH_ROTATION_RATE
 
 BAD = ErrorCode.INVALID_SITE
+MIN_ELEVATION_DEG = math.degrees(math.atan2(800.0, 500.0))   # the instrument's default: bsk-rl's imager, 58.0 deg
 MAX_SCAN_SPEED_M_S = 20_000.0     # m/s: over twice a LEO ground track's speed
 VISIBILITY_STEP_S = 5.0           # s between the elevation samples over the planning window
-IMAGE_STEP_S = 1.0                # s between the elevation samples over a dwell or a scan
+IMAGE_STEP_S = 1.0                # s between the elevation samples over a dwell or a scan ...
+IMAGE_SAMPLES = 600               # ... at most this many
 # an imaging request naming no method, when the node's default cannot end on a moving goal
 DEFAULT_IMAGE_METHOD = "time_optimal"
 
@@ -172,7 +174,7 @@ def check_rises(valid: ValidImage, what: str) -> None:
 
 
 def validate_image_target(req: ImageTargetRequest, *, frame_id: str, default_spacecraft: str, default_method: str,
-                          default_budget: float, min_elevation_deg: float) -> ValidImage:
+                          default_budget: float, min_elevation_deg: float = MIN_ELEVATION_DEG) -> ValidImage:
     """Check an ImageTarget request (module docstring); the maneuver onto the site's ground mode."""
     lat = _degrees(req.latitude_deg, "latitude_deg", 90.0)
     lon = _degrees(req.longitude_deg, "longitude_deg", 180.0)
@@ -202,13 +204,16 @@ def sub_satellite_speed(geometry: PointingGeometry, t: float, site_E: np.ndarray
 
 
 def validate_image_strip(req: ImageStripRequest, *, frame_id: str, default_spacecraft: str, default_method: str,
-                         default_budget: float, min_elevation_deg: float, rate_max: float = math.inf) -> ValidImage:
+                         default_budget: float, min_elevation_deg: float = MIN_ELEVATION_DEG,
+                         rate_max: float = math.inf, default_scan_speed_m_s: float = 0.0) -> ValidImage:
     """Check an ImageStrip request (module docstring); the maneuver onto the strip's first point at its
-    rate. ``rate_max``: the body-rate bound (rad/s per axis) the scan keeps (with the problem's own)."""
+    rate. ``rate_max``: the body-rate bound (rad/s per axis) the scan keeps (with the problem's own);
+    ``default_scan_speed_m_s``: the speed of a request that gives none (0: the sub-satellite point's)."""
     lat0 = _degrees(req.start_latitude_deg, "start_latitude_deg", 90.0)
     lon0 = _degrees(req.start_longitude_deg, "start_longitude_deg", 180.0)
     alt = _altitude(req.altitude_m, "altitude_m")
-    speed = validation.number(req.scan_speed_m_s, "scan_speed_m_s", BAD, 0.0, MAX_SCAN_SPEED_M_S)
+    speed = validation.number(req.scan_speed_m_s, "scan_speed_m_s", BAD, 0.0, MAX_SCAN_SPEED_M_S) or \
+        default_scan_speed_m_s
     if req.by_azimuth:
         azimuth = _degrees(req.azimuth_deg, "azimuth_deg", 360.0)
         length = validation.number(req.length_m, "length_m", BAD, MIN_STRIP_LENGTH_M, MAX_STRIP_LENGTH_M)
@@ -234,6 +239,11 @@ def validate_image_strip(req: ImageStripRequest, *, frame_id: str, default_space
     maneuver = _maneuver(req, end_goal=end_goal, frame_id=frame_id, default_spacecraft=default_spacecraft,
                          default_method=default_method, default_budget=default_budget)
     strip = built["strip"]
+    window = maneuver.problem.zone_sky().window
+    if strip.duration_s > window:
+        raise RequestError(BAD, f"scan_speed_m_s: the {strip.length_m:.0f} m strip scanned at "
+                                f"{strip.scan_speed_m_s:.4g} m/s lasts {strip.duration_s:.0f} s, longer than the "
+                                f"{window:.0f} s planning window (a strip is imaged within one pass)")
 
     def aim(start: float, t: np.ndarray) -> np.ndarray:
         return np.array([strip.point(strip.theta_of(strip.scan_speed_m_s * (tk - start)))[0] for tk in t])
@@ -273,7 +283,8 @@ def plan_image(valid: ValidImage, tol: Tolerances = TOLERANCES, cone_padding: fl
     arrival = float(outcome.plan.t[-1] - outcome.plan.t[0])
     image.image_start, image.image_end = arrival, arrival + valid.duration
     start = valid.offset + arrival
-    t = np.linspace(start, start + valid.duration, max(2, int(math.ceil(valid.duration / IMAGE_STEP_S)) + 1))
+    t = np.linspace(start, start + valid.duration,
+                    min(IMAGE_SAMPLES, max(2, int(math.ceil(valid.duration / IMAGE_STEP_S)) + 1)))
     seen = elevation(valid.geometry, valid.sites_E(start, t), t)
     image.lowest_elevation = float(seen.min())
     try:
