@@ -1,8 +1,8 @@
 """Hostile ImageTarget and ImageStrip requests: every field NaN/Inf or out of its range, a strip of
 zero length, an absurd scan speed, a site below the instrument's minimum elevation or never in view
 within the planning window, refused with a code and a sentence naming the field (ROS-free: the
-service core the planner node calls); one request of each over the node's wire with the module's
-planner (test_planner_requests.py's fixture is a module's: the node test here starts its own)."""
+service core the planner node calls). Over the node's wire: test_planner_requests.py, on its planner
+fixture."""
 from __future__ import annotations
 
 import math
