@@ -258,9 +258,11 @@ class Controller:
         strip's :class:`att_planner.guidance.strip.StripLaw`) as it is."""
         if self.state is None:
             raise RequestError(ErrorCode.NO_STATE, "no spacecraft state received yet")
-        if pointing is not None and not isinstance(pointing, PointingMode) and callable(
-                getattr(pointing, "attitude", None)):
-            return pointing
+        if pointing is not None and not isinstance(pointing, PointingMode):
+            if callable(getattr(pointing, "attitude", None)):
+                return pointing
+            raise RequestError(ErrorCode.INVALID_POINTING, f"a pointing mode or a pointing law is expected; found "
+                                                           f"a {type(pointing).__name__}")
         if pointing is None:
             raise RequestError(ErrorCode.INVALID_POINTING, "MODE_POINTING needs a pointing mode")
         if self.guidance_sky is None:
