@@ -13,8 +13,9 @@ dwell or scan must be seen above it (SITE_NOT_VISIBLE, 163): elevation ``sin e =
 (:func:`att_planner.guidance.ground_arrival.elevation_sines`), sampled every :data:`VISIBILITY_STEP_S` over the
 window and every :data:`IMAGE_STEP_S` over the image. A strip's tracking (its reference rate and the
 torque ``J ω̇ + ω × J ω``, :func:`att_planner.guidance.strip.tracking_demand`) must stay within the
-body-rate bound and the per-axis torque bound, before the plan at its first estimate of the arrival
-and after it at the arrival (INVALID_SITE naming ``scan_speed_m_s``).
+body-rate bound and the per-axis torque bound: before the plan from at least one of
+:data:`TRACKING_STARTS` starts where the strip's start is in view, after it from the arrival
+(INVALID_SITE naming ``scan_speed_m_s``).
 """
 from __future__ import annotations
 
@@ -51,6 +52,7 @@ MAX_SCAN_SPEED_M_S = 20_000.0     # m/s: over twice a LEO ground track's speed
 VISIBILITY_STEP_S = 5.0           # s between the elevation samples over the planning window
 IMAGE_STEP_S = 1.0                # s between the elevation samples over a dwell or a scan ...
 IMAGE_SAMPLES = 600               # ... at most this many
+TRACKING_STARTS = 8               # scan starts in view a strip's tracking is checked at before the plan
 # an imaging request naming no method, when the node's default cannot end on a moving goal
 DEFAULT_IMAGE_METHOD = "time_optimal"
 
@@ -160,17 +162,19 @@ def _up(site_E: np.ndarray) -> np.ndarray:
     return np.array([math.cos(lat) * math.cos(lon), math.cos(lat) * math.sin(lon), math.sin(lat)])
 
 
-def check_rises(valid: ValidImage, what: str) -> None:
-    """The image's first point rises above the minimum elevation somewhere in the planning window."""
+def check_rises(valid: ValidImage, what: str) -> np.ndarray:
+    """The image's first point rises above the minimum elevation somewhere in the planning window;
+    the sampled sim times when it stands above it."""
     window = valid.maneuver.problem.zone_sky().window
     t = valid.offset + np.arange(0.0, window + VISIBILITY_STEP_S, VISIBILITY_STEP_S)
     first = valid.sites_E(0.0, np.zeros(1))[0]
-    highest = float(elevation(valid.geometry, np.tile(first, (len(t), 1)), t).max())
-    if highest < valid.min_elevation:
+    seen = elevation(valid.geometry, np.tile(first, (len(t), 1)), t)
+    if seen.max() < valid.min_elevation:
         raise RequestError(ErrorCode.SITE_NOT_VISIBLE,
-                           f"{what} rises to {math.degrees(highest):.1f} deg above its horizon at most within the "
+                           f"{what} rises to {math.degrees(seen.max()):.1f} deg above its horizon at most within the "
                            f"{window:.0f} s planning window; the instrument images above "
                            f"{math.degrees(valid.min_elevation):.1f} deg (ask with a later epoch)")
+    return t[seen >= valid.min_elevation]
 
 
 def validate_image_target(req: ImageTargetRequest, *, frame_id: str, default_spacecraft: str, default_method: str,
@@ -251,24 +255,28 @@ def validate_image_strip(req: ImageStripRequest, *, frame_id: str, default_space
     valid = ValidImage(maneuver, built["geometry"], built["offset"], aim, strip.duration_s,
                        math.radians(min_elevation_deg), strip=strip, axes=(boresight, along),
                        rate_max=min(rate_max, maneuver.problem.rate_max))
-    check_rises(valid, f"the strip's start ({req.start_latitude_deg:.4f}, {req.start_longitude_deg:.4f}) deg")
-    check_tracking(valid, valid.offset + maneuver.problem.slew_time_bound())
+    visible = check_rises(valid, f"the strip's start ({req.start_latitude_deg:.4f}, "
+                                 f"{req.start_longitude_deg:.4f}) deg")
+    check_tracking(valid, visible[np.linspace(0, len(visible) - 1, min(len(visible), TRACKING_STARTS)).astype(int)])
     return valid
 
 
-def check_tracking(valid: ValidImage, t_start: float) -> None:
-    """The strip's scan from ``t_start`` (sim time) within the body-rate and per-axis torque bounds
-    (INVALID_SITE naming the scan speed)."""
+def check_tracking(valid: ValidImage, starts) -> None:
+    """A scan of the strip from one of the sim times ``starts`` at least keeps the body-rate and per-axis
+    torque bounds (INVALID_SITE naming the scan speed and the least demand found)."""
     sc = valid.maneuver.problem.spacecraft
-    rate, torque = tracking_demand(sc, valid.geometry, valid.strip, *valid.axes, t_start)
+    demands = [tracking_demand(sc, valid.geometry, valid.strip, *valid.axes, float(t)) for t in np.atleast_1d(starts)]
+    if any(rate <= valid.rate_max and torque <= sc.body_torque_max for rate, torque in demands):
+        return
+    rate, torque = min(demands, key=lambda d: max(d[0] / valid.rate_max, d[1] / sc.body_torque_max))
     speed = valid.strip.scan_speed_m_s
+    when = "from the arrival" if len(demands) == 1 else "from any start where the strip's start is in view"
     if rate > valid.rate_max:
-        raise RequestError(BAD, f"scan_speed_m_s: scanning the strip at {speed:.0f} m/s asks a body rate of "
+        raise RequestError(BAD, f"scan_speed_m_s: scanning the strip at {speed:.0f} m/s {when} asks a body rate of "
                                 f"{math.degrees(rate):.2f} deg/s, beyond the bound of "
                                 f"{math.degrees(valid.rate_max):.2f} deg/s")
-    if torque > sc.body_torque_max:
-        raise RequestError(BAD, f"scan_speed_m_s: scanning the strip at {speed:.0f} m/s asks a body torque of "
-                                f"{torque:.3g} N m, beyond the spacecraft's {sc.body_torque_max:.3g} N m per axis")
+    raise RequestError(BAD, f"scan_speed_m_s: scanning the strip at {speed:.0f} m/s {when} asks a body torque of "
+                            f"{torque:.3g} N m, beyond the spacecraft's {sc.body_torque_max:.3g} N m per axis")
 
 
 def plan_image(valid: ValidImage, tol: Tolerances = TOLERANCES, cone_padding: float = 0.0,
