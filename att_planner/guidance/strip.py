@@ -88,8 +88,11 @@ class Strip:
         u1 = _unit(geodetic_to_itrs(latitude1, longitude1, 0.0))
         normal = rot.cross(u0, u1)
         sine = float(np.linalg.norm(normal))
-        if sine < MIN_STRIP_LENGTH_M / WGS84_A or float(u0 @ u1) < 0.0:
-            raise ValueError("the end is the start (or its antipode): no strip between them")
+        if sine < MIN_STRIP_LENGTH_M / WGS84_A and float(u0 @ u1) > 0.0:
+            raise ValueError("the end is the start: no strip between them")
+        if float(u0 @ u1) < 0.0:
+            raise ValueError(f"the end is {math.degrees(math.atan2(sine, float(u0 @ u1))):.1f} deg of arc from the "
+                             f"start; a strip is at most {MAX_STRIP_LENGTH_M:g} m long")
         w = _unit(u1 - u0 * float(u0 @ u1))
         strip = cls(u0, w, float(altitude_m), 0.0, float(scan_speed_m_s))
         return strip._with_length(strip.arc_length(math.atan2(sine, float(u0 @ u1))))

@@ -101,7 +101,7 @@ class ValidImage:
     maneuver: ValidRequest
     geometry: PointingGeometry
     offset: float                             # s: sim time of plan time 0
-    sites_E: Callable                         # (plan time of the image's start, times) ↦ aim points (K, 3) ITRS
+    sites_E: Callable                         # (sim time the image starts, sim times (K,)) ↦ aim points (K, 3) ITRS
     duration: float                           # s: the dwell, or the scan
     min_elevation: float                      # rad
     mode: PointingMode | None = None          # the target's pointing mode (the controller's law after the slew)

@@ -74,6 +74,10 @@ STRIP_CASES = {
                           ErrorCode.INVALID_SITE, "end_longitude_deg = nan"),
     "zero length, end on the start": (dict(by_azimuth=False, end_latitude_deg=LAT, end_longitude_deg=LON),
                                       ErrorCode.INVALID_SITE, "end_latitude_deg, end_longitude_deg"),
+    "the end on another continent": (dict(by_azimuth=False, end_latitude_deg=-LAT, end_longitude_deg=LON - 120.0
+                                          if LON > 0 else LON + 120.0), ErrorCode.INVALID_SITE, "deg of arc"),
+    "the end 30 deg away": (dict(by_azimuth=False, end_latitude_deg=LAT, end_longitude_deg=LON - 30.0 if LON > 0
+                                 else LON + 30.0), ErrorCode.INVALID_SITE, "outside [1, 2e+06] m"),
     "zero length": (dict(length_m=0.0), ErrorCode.INVALID_SITE, "length_m = 0.0"),
     "length nan": (dict(length_m=NAN), ErrorCode.INVALID_SITE, "length_m = nan"),
     "a continent": (dict(length_m=5e6), ErrorCode.INVALID_SITE, "length_m = 5000000.0"),
