@@ -218,12 +218,12 @@ def validate_image_strip(req: ImageStripRequest, *, frame_id: str, default_space
     alt = _altitude(req.altitude_m, "altitude_m")
     speed = validation.number(req.scan_speed_m_s, "scan_speed_m_s", BAD, 0.0, MAX_SCAN_SPEED_M_S) or \
         default_scan_speed_m_s
-    if req.by_azimuth:
-        azimuth = _degrees(req.azimuth_deg, "azimuth_deg", 360.0)
-        length = validation.number(req.length_m, "length_m", BAD, MIN_STRIP_LENGTH_M, MAX_STRIP_LENGTH_M)
-    else:
-        lat1 = _degrees(req.end_latitude_deg, "end_latitude_deg", 90.0)
-        lon1 = _degrees(req.end_longitude_deg, "end_longitude_deg", 180.0)
+    # every field is checked, the form's unused ones too (a NaN is never silently ignored)
+    lat1 = _degrees(req.end_latitude_deg, "end_latitude_deg", 90.0)
+    lon1 = _degrees(req.end_longitude_deg, "end_longitude_deg", 180.0)
+    azimuth = _degrees(req.azimuth_deg, "azimuth_deg", 360.0)
+    length = validation.number(req.length_m, "length_m", BAD, MIN_STRIP_LENGTH_M if req.by_azimuth else 0.0,
+                               MAX_STRIP_LENGTH_M)
     boresight, along = _axes(req)
     built = {}
 
