@@ -93,6 +93,16 @@ MEANINGS: dict[ErrorCode, str] = {
         'a day; a window opening NaN/Inf, negative or more than a week after the start; a window closing NaN '
         "or before its opening plus the target's dwell"
     ),
+    ErrorCode.INVALID_SITE: (
+        "an `ImageTarget` or `ImageStrip` field NaN/Inf or out of its range: a latitude outside [-90, 90] deg, a "
+        "longitude outside [-180, 180] deg, an altitude outside [-500 m, 100 km], a negative or over-a-day dwell, "
+        "a strip shorter than 1 m or longer than 2000 km, a scan speed negative or above 20 km/s, or a scan "
+        "whose tracking asks more body rate or torque than the spacecraft has"
+    ),
+    ErrorCode.SITE_NOT_VISIBLE: (
+        "the site (a strip: its first point) never rises above the instrument's minimum elevation within the "
+        "planning window, or the slew arrives, or the dwell or scan runs, where it is below it"
+    ),
     ErrorCode.SOLVER_FAILED: 'the method failed (or its process died) and no safe fallback exists',
     ErrorCode.VERIFICATION_FAILED: (
         'the plan did not survive integration through the dynamics and no safe fallback exists'

@@ -25,6 +25,8 @@ SIM_FAULTS = "/simulator/faults"             # every hardware fault the truth st
 
 PLAN_MANEUVER = "/planner/plan_maneuver"
 PLAN_SCHEDULE = "/planner/plan_schedule"
+IMAGE_TARGET = "/planner/image_target"
+IMAGE_STRIP = "/planner/image_strip"
 SET_CONTROLLER_MODE = "/controller/set_mode"
 RESET_SIMULATOR = "/simulator/reset"
 HOLD_SIMULATOR = "/simulator/hold"
@@ -85,6 +87,10 @@ ABOUT = {
     PLAN_MANEUVER: "plan a rest-to-rest maneuver (or one ending on a pointing law), verified and signed",
     PLAN_SCHEDULE: "the fastest tour through target attitudes, each flown through or observed (held for its "
                    "dwell, within its window, never while a zone covers it)",
+    IMAGE_TARGET: "plan a slew that ends on a ground site at its line of sight's rate, for a dwell seen above the "
+                  "instrument's minimum elevation (docs/strips.md), verified and signed",
+    IMAGE_STRIP: "plan a slew that ends on a strip's first point at its scan's rate (the strip then followed at its "
+                 "scan speed, the detector across it; docs/strips.md), verified and signed",
     SET_CONTROLLER_MODE: "idle, magnetorquer PD, safe or pointing (a `PointingMode`); momentum dumping on or off",
     RESET_SIMULATOR: "reset attitude, rate, wheel speeds and orbit phase",
     HOLD_SIMULATOR: "hold sim time (true) or let it run again (false); a hold ends after `max_hold_s` of wall time",

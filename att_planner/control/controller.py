@@ -254,9 +254,15 @@ class Controller:
 
     def pointing_law(self, pointing: PointingMode | None):
         """The law of a requested pointing mode, checked now (RequestError: 304 without a state,
-        314 for a bad field or no attitude)."""
+        314 for a bad field or no attitude); a law built onboard (one with an ``attitude``, e.g. a
+        strip's :class:`att_planner.guidance.strip.StripLaw`) as it is."""
         if self.state is None:
             raise RequestError(ErrorCode.NO_STATE, "no spacecraft state received yet")
+        if pointing is not None and not isinstance(pointing, PointingMode):
+            if callable(getattr(pointing, "attitude", None)):
+                return pointing
+            raise RequestError(ErrorCode.INVALID_POINTING, f"a pointing mode or a pointing law is expected; found "
+                                                           f"a {type(pointing).__name__}")
         if pointing is None:
             raise RequestError(ErrorCode.INVALID_POINTING, "MODE_POINTING needs a pointing mode")
         if self.guidance_sky is None:

@@ -115,6 +115,40 @@ def triad_rate(frame: np.ndarray, frame_dot: np.ndarray) -> np.ndarray:
     return 0.5 * sum(rot.cross(frame[:, i], frame_dot[:, i]) for i in range(3))
 
 
+def two_vector_motion(primary_B, secondary_B, P, P_dot, S, S_dot, yaw_q=None) -> tuple[np.ndarray, np.ndarray]:
+    """The two-vector attitude of a primary direction and a secondary one, and its body rate (module docstring).
+
+    Parameters
+    ----------
+    primary_B, secondary_B : array_like, shape (3,)
+        The body axis put on ``P``, and the one kept nearest ``S``.
+    P, P_dot : ndarray, shape (3,)
+        The unit primary direction (inertial axes) and its derivative (1/s).
+    S, S_dot : ndarray, shape (3,)
+        The unit secondary direction and its derivative.
+    yaw_q : ndarray, shape (4,), optional
+        A rotation about the primary axis applied after the alignment (fixed in the body).
+
+    Returns
+    -------
+    q_RN, omega_RN_R : ndarray
+        The attitude ([x, y, z, w]) and the target frame's body rate (rad/s, its own axes); ValueError
+        where ``P`` and ``S`` are parallel.
+    """
+    q_RN = two_vector_attitude(primary_B, secondary_B, P, S)
+    n = rot.cross(P, S)
+    norm = math.sqrt(float(n @ n))
+    C = n / norm
+    n_dot = rot.cross(P_dot, S) + rot.cross(P, S_dot)
+    C_dot = (n_dot - C * float(C @ n_dot)) / norm
+    frame = np.column_stack([P, C, rot.cross(P, C)])
+    frame_dot = np.column_stack([P_dot, C_dot, rot.cross(P_dot, C) + rot.cross(P, C_dot)])
+    omega_N = triad_rate(frame, frame_dot)
+    if yaw_q is not None:
+        q_RN = rot.multiply(q_RN, yaw_q)
+    return q_RN, rot.dcm_NB(q_RN).T @ omega_N
+
+
 def ground_motion(geometry: PointingGeometry, latitude: float, longitude: float, altitude: float,
                   primary_B, secondary_B, secondary_N: Callable, yaw: float = 0.0
                   ) -> Callable[[float], tuple[np.ndarray, np.ndarray]]:
@@ -150,18 +184,7 @@ def ground_motion(geometry: PointingGeometry, latitude: float, longitude: float,
         S = np.asarray(secondary_N(t), float)
         S_dot = (np.asarray(secondary_N(t + SECONDARY_STEP), float)
                  - np.asarray(secondary_N(t - SECONDARY_STEP), float)) / (2.0 * SECONDARY_STEP)
-        q_RN = two_vector_attitude(primary_B, secondary_B, P, S)
-        n = rot.cross(P, S)
-        norm = math.sqrt(float(n @ n))
-        C = n / norm
-        n_dot = rot.cross(P_dot, S) + rot.cross(P, S_dot)
-        C_dot = (n_dot - C * float(C @ n_dot)) / norm
-        frame = np.column_stack([P, C, rot.cross(P, C)])
-        frame_dot = np.column_stack([P_dot, C_dot, rot.cross(P_dot, C) + rot.cross(P, C_dot)])
-        omega_N = triad_rate(frame, frame_dot)
-        if yaw_q is not None:
-            q_RN = rot.multiply(q_RN, yaw_q)
-        return q_RN, rot.dcm_NB(q_RN).T @ omega_N
+        return two_vector_motion(primary_B, secondary_B, P, P_dot, S, S_dot, yaw_q)
 
     return motion
 
@@ -234,3 +257,22 @@ def site_in_view(geometry: PointingGeometry, t: float, off_nadir: float, azimuth
         raise ValueError(f"a line of sight {math.degrees(off_nadir):.1f} deg off nadir misses the Earth")
     lat, lon, _ = itrs_to_geodetic(dcm_EN @ (r_N + (-b - math.sqrt(disc)) / a * d_N))
     return lat, lon
+
+
+def elevation_sines(r_itrs: np.ndarray, sites_itrs: np.ndarray, up_itrs: np.ndarray, pairs: bool = False) -> np.ndarray:
+    """``sin e = û · (r − s) / |r − s|``, the elevation of the spacecraft at ``r`` above the horizon of
+    the site at ``s`` with geodetic up ``û`` (all ITRS, m), written ``(û·r − û·s) / sqrt(|r|² − 2 s·r + |s|²)``.
+
+    ``r_itrs`` (K, 3) against N sites ``sites_itrs`` and ``up_itrs`` (N, 3): the grid (N, K) in two
+    matrix products; ``pairs``: K = N, the k-th position against the k-th site, (K,)."""
+    r = np.asarray(r_itrs, float).reshape(-1, 3)
+    s = np.asarray(sites_itrs, float).reshape(-1, 3)
+    u = np.asarray(up_itrs, float).reshape(-1, 3)
+
+    def rows(a, b):
+        return np.einsum("ij,ij->i", a, b)
+
+    cross = rows if pairs else (lambda a, b: a @ b.T)
+    column = (lambda x: x) if pairs else (lambda x: x[:, None])
+    along = cross(u, r) - column(rows(u, s))
+    return along / np.sqrt(rows(r, r) - 2.0 * cross(s, r) + column(rows(s, s)))

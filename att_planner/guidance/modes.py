@@ -28,6 +28,7 @@ from att_planner.guidance.laws import (
 )
 
 BAD = ErrorCode.INVALID_POINTING
+MIN_ALTITUDE = -500.0          # m: the shores of the Dead Sea are at -430 m
 MAX_ALTITUDE = 100e3           # m: a ground target is on the ground (or a mountain, or a balloon)
 
 
@@ -57,7 +58,7 @@ def law_of(mode: PointingMode, geometry: PointingGeometry, t: float, q_BN: np.nd
         primary = ground_line_of_sight(geometry,
                                        _angle(mode.latitude, "pointing.latitude", -math.pi / 2, math.pi / 2),
                                        _angle(mode.longitude, "pointing.longitude", -math.pi, math.pi),
-                                       _angle(mode.altitude, "pointing.altitude", -500.0, MAX_ALTITUDE))
+                                       _angle(mode.altitude, "pointing.altitude", MIN_ALTITUDE, MAX_ALTITUDE))
     elif kind == "inertial_target":
         target = _axis(mode.target_direction, "pointing.target_direction")
         primary = lambda t: target                                  # noqa: E731

@@ -23,6 +23,7 @@ import numpy as np
 
 from att_msgs_py.types import PointingMode
 from att_planner.guidance import reference
+from att_planner.guidance.ground_arrival import elevation_sines as elevation_sines  # its users import it here too
 from att_planner.guidance.laws import PointingGeometry, geodetic_to_itrs
 from att_planner.guidance.modes import law_of
 from att_sim.models import world
@@ -42,25 +43,6 @@ def geodetic_up(latitude, longitude) -> np.ndarray:
     shape ``latitude.shape + (3,)``."""
     lat, lon = np.asarray(latitude, float), np.asarray(longitude, float)
     return np.stack([np.cos(lat) * np.cos(lon), np.cos(lat) * np.sin(lon), np.sin(lat)], axis=-1)
-
-
-def elevation_sines(r_itrs: np.ndarray, sites_itrs: np.ndarray, up_itrs: np.ndarray, pairs: bool = False) -> np.ndarray:
-    """``sin e = û · (r − s) / |r − s|``, the elevation of the spacecraft at ``r`` above the horizon of
-    the site at ``s`` with geodetic up ``û`` (all ITRS, m), written ``(û·r − û·s) / sqrt(|r|² − 2 s·r + |s|²)``.
-
-    ``r_itrs`` (K, 3) against N sites ``sites_itrs`` and ``up_itrs`` (N, 3): the grid (N, K) in two
-    matrix products; ``pairs``: K = N, the k-th position against the k-th site, (K,)."""
-    r = np.asarray(r_itrs, float).reshape(-1, 3)
-    s = np.asarray(sites_itrs, float).reshape(-1, 3)
-    u = np.asarray(up_itrs, float).reshape(-1, 3)
-
-    def rows(a, b):
-        return np.einsum("ij,ij->i", a, b)
-
-    cross = rows if pairs else (lambda a, b: a @ b.T)
-    column = (lambda x: x) if pairs else (lambda x: x[:, None])
-    along = cross(u, r) - column(rows(u, s))
-    return along / np.sqrt(rows(r, r) - 2.0 * cross(s, r) + column(rows(s, s)))
 
 
 class GroundTrack:

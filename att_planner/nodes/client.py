@@ -30,7 +30,7 @@ from std_srvs.srv import SetBool
 
 from att_msgs.action import ExecuteManeuver
 from att_msgs.msg import AttitudeEstimate
-from att_msgs.srv import PlanManeuver, PlanSchedule, SetControllerMode
+from att_msgs.srv import ImageStrip, ImageTarget, PlanManeuver, PlanSchedule, SetControllerMode
 from att_msgs_py import convert, qos, signing, topics
 from att_msgs_py.errors import ErrorCode, RequestError
 from att_msgs_py.types import Cone, PointingMode, Zone
@@ -106,6 +106,8 @@ class SuiteClient(Node):
         super().__init__(name)
         self.plan_client = self.create_client(PlanManeuver, topics.PLAN_MANEUVER, qos_profile=qos.SERVICE_QOS)
         self.schedule_client = self.create_client(PlanSchedule, topics.PLAN_SCHEDULE, qos_profile=qos.SERVICE_QOS)
+        self.image_target_client = self.create_client(ImageTarget, topics.IMAGE_TARGET, qos_profile=qos.SERVICE_QOS)
+        self.image_strip_client = self.create_client(ImageStrip, topics.IMAGE_STRIP, qos_profile=qos.SERVICE_QOS)
         self.mode_client = self.create_client(SetControllerMode, topics.SET_CONTROLLER_MODE)
         self.execute_client = ActionClient(self, ExecuteManeuver, topics.EXECUTE_MANEUVER)
         self.hold_client = self.create_client(SetBool, topics.HOLD_SIMULATOR)
@@ -197,6 +199,12 @@ class SuiteClient(Node):
 
     def schedule(self, request: PlanSchedule.Request, timeout: float = 300.0) -> PlanSchedule.Response:
         return self._call(self.schedule_client, request, timeout)
+
+    def image_target(self, request: ImageTarget.Request, timeout: float = 120.0) -> ImageTarget.Response:
+        return self._call(self.image_target_client, request, timeout)
+
+    def image_strip(self, request: ImageStrip.Request, timeout: float = 120.0) -> ImageStrip.Response:
+        return self._call(self.image_strip_client, request, timeout)
 
     def hold_simulator(self, held: bool, timeout: float = 10.0) -> SetBool.Response:
         """Hold sim time (``held``) or let it run again (the simulator's ``/simulator/hold``)."""

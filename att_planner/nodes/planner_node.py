@@ -1,5 +1,8 @@
-"""Planner node: serves ``/planner/plan_maneuver`` (PlanManeuver) and publishes every returned
-plan on the latched ``/planner/plans`` for the controller and the recorder; with ``plan_markers``
+"""Planner node: serves ``/planner/plan_maneuver`` (PlanManeuver), ``/planner/plan_schedule``
+(PlanSchedule), ``/planner/image_target`` (ImageTarget) and ``/planner/image_strip`` (ImageStrip:
+:mod:`att_planner.service.imaging`, a slew onto a ground site or a strip's start, answered as a
+maneuver) and publishes every returned plan on the latched ``/planner/plans`` for the controller and
+the recorder; with ``plan_markers``
 (default true) it also publishes the latest plan's boresight path for the 3D view on the latched
 ``/planner/plan_markers`` (visualization_msgs/MarkerArray, :func:`att_sim.models.scene.plan_shapes`): the
 planner shows its own plans, so the simulator stays on the truth side.
@@ -32,13 +35,20 @@ from rclpy.node import Node
 from visualization_msgs.msg import MarkerArray
 
 from att_msgs.msg import ManeuverPlan
-from att_msgs.srv import PlanManeuver, PlanSchedule
+from att_msgs.srv import ImageStrip, ImageTarget, PlanManeuver, PlanSchedule
 from att_msgs_py import convert, limits, markers, memory, qos, signing, topics
 from att_msgs_py.errors import ConfigError, ErrorCode, RequestError, clip
 from att_msgs_py.node_runner import ParameterReader, read_scenario, run_node
 from att_msgs_py.types import Plan
 from att_planner import methods
 from att_planner.methods.schedule import plan_schedule
+from att_planner.service.imaging import (
+    ImageStripRequest,
+    ImageTargetRequest,
+    plan_image,
+    validate_image_strip,
+    validate_image_target,
+)
 from att_planner.service.planner_parameters import PLANNER
 from att_planner.service.planning import PlanOutcome, plan_maneuver, plan_schedule_request, prepare, run_method
 from att_planner.service.requests import ManeuverRequest, validate_maneuver, validate_schedule
@@ -63,6 +73,8 @@ class PlannerNode(Node):
                                       cone_penetration=math.radians(param("accept_cone_penetration_deg")))
         self._cone_padding = math.radians(param("cone_padding_deg"))
         self._schedule_rate_max = param("schedule_rate_max_rad_s")  # .inf: no bound
+        self._min_elevation_deg = param("image_min_elevation_deg")
+        self._scan_speed = param("strip_scan_speed_m_s")        # 0: the sub-satellite point's
         key_path = param("signing_key", str(signing.default_key_dir() / signing.PRIVATE_NAME))
         self._signing_key = self._load_signing_key(key_path)
         parallel = param("max_parallel_solves")
@@ -83,6 +95,10 @@ class PlannerNode(Node):
         self.create_service(PlanManeuver, topics.PLAN_MANEUVER, self.on_plan_maneuver, qos_profile=qos.SERVICE_QOS,
                             callback_group=group)
         self.create_service(PlanSchedule, topics.PLAN_SCHEDULE, self.on_plan_schedule, qos_profile=qos.SERVICE_QOS,
+                            callback_group=group)
+        self.create_service(ImageTarget, topics.IMAGE_TARGET, self.on_image_target, qos_profile=qos.SERVICE_QOS,
+                            callback_group=group)
+        self.create_service(ImageStrip, topics.IMAGE_STRIP, self.on_image_strip, qos_profile=qos.SERVICE_QOS,
                             callback_group=group)
         self.get_logger().info(f"methods: {', '.join(methods.METHODS)} (default {self._default_method}); plans "
                                f"signed with key {signing.key_id(self._signing_key.public_key())}")
@@ -151,6 +167,58 @@ class PlannerNode(Node):
                     spacecraft_digest=valid.problem.spacecraft.digest)
         return response
 
+    def on_image_target(self, request: ImageTarget.Request, response: ImageTarget.Response):
+        try:
+            limits.check(request, limits.IMAGE_TARGET)
+            valid = validate_image_target(
+                ImageTargetRequest(**_image_common(request), latitude_deg=request.latitude_deg,
+                                   longitude_deg=request.longitude_deg, altitude_m=request.altitude_m,
+                                   dwell_s=request.dwell_s, align_along_track=request.align_along_track),
+                **self._image_defaults())
+        except RequestError as err:
+            return self.refuse(response, err, "image target")
+        return self._image(valid, request, response, "image target")
+
+    def on_image_strip(self, request: ImageStrip.Request, response: ImageStrip.Response):
+        try:
+            limits.check(request, limits.IMAGE_STRIP)
+            valid = validate_image_strip(
+                ImageStripRequest(**_image_common(request), start_latitude_deg=request.start_latitude_deg,
+                                  start_longitude_deg=request.start_longitude_deg,
+                                  end_latitude_deg=request.end_latitude_deg,
+                                  end_longitude_deg=request.end_longitude_deg,
+                                  by_azimuth=request.by_azimuth, azimuth_deg=request.azimuth_deg,
+                                  length_m=request.length_m, altitude_m=request.altitude_m,
+                                  scan_speed_m_s=request.scan_speed_m_s),
+                **self._image_defaults(), rate_max=self._schedule_rate_max, default_scan_speed_m_s=self._scan_speed)
+        except RequestError as err:
+            return self.refuse(response, err, "image strip")
+        return self._image(valid, request, response, "image strip")
+
+    def _image_defaults(self) -> dict:
+        return dict(frame_id=self._frame_id, default_spacecraft=self._scenario_name,
+                    default_method=self._default_method, default_budget=self._default_budget,
+                    min_elevation_deg=self._min_elevation_deg)
+
+    def _image(self, valid, request, response, what: str):
+        """Plan an image (:func:`att_planner.service.imaging.plan_image`) and answer as a maneuver."""
+        runner = run_method if valid.maneuver.method.cheap else run_isolated
+        try:
+            outcome = plan_image(valid, self._tolerances, self._cone_padding, runner)
+        except Exception as exc:  # a fault of the service itself is answered, never left hanging
+            outcome = self.internal_error(exc)
+        response.stage = str(outcome.stage)
+        response.stages = [convert.stage_msg(stage) for stage in outcome.stages]
+        response.slowdown = outcome.slowdown
+        for name in ("image_start", "image_end"):
+            setattr(response, name, float(getattr(outcome, name, math.nan)))
+        response.lowest_elevation_deg = math.degrees(getattr(outcome, "lowest_elevation", math.nan))
+        problem = valid.maneuver.problem
+        self.answer(response, outcome, valid.maneuver.spacecraft, f"{what} ({valid.maneuver.method.name})",
+                    sensor_axis=problem.sensor_axis, cones=problem.cones, zones=problem.zones, epoch=problem.epoch,
+                    spacecraft_digest=problem.spacecraft.digest)
+        return response
+
     def internal_error(self, exc: Exception) -> PlanOutcome:
         self.get_logger().error(clip(f"planning failed unexpectedly: {type(exc).__name__}: {exc}"))
         return PlanOutcome(ErrorCode.SOLVER_FAILED, clip(f"internal error while planning: {type(exc).__name__}: {exc}"),
@@ -209,6 +277,15 @@ def maneuver_from_msg(request) -> ManeuverRequest:
         tle_line1=request.tle_line1, tle_line2=request.tle_line2,
         wheel_speeds=list(request.wheel_speeds),
         end_pointing=convert.pointing_from_msg(request.end_pointing))
+
+
+def _image_common(request) -> dict:
+    """The fields every imaging request has, as :class:`att_planner.service.imaging.ImageCommon`'s."""
+    return dict(frame_id=request.header.frame_id, q_initial=convert.from_quaternion(request.initial_attitude),
+                sensor_axis=convert.from_vector3(request.sensor_axis),
+                along_track_axis=convert.from_vector3(request.along_track_axis), method=request.method,
+                time_budget=request.time_budget, spacecraft=request.spacecraft,
+                epoch=convert.epoch_parts(request.epoch), wheel_speeds=list(request.wheel_speeds))
 
 
 def main(args=None):

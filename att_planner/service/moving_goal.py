@@ -6,7 +6,8 @@ controller will hand over to (:mod:`att_planner.guidance`): the law of the scena
 the plan's epoch after the scenario's (a scenario without an epoch: after the wire's zero time, as
 the suite stamps its messages with the sim time); a ground site's attitude and rate in closed form from its line
 of sight and the line of sight's derivative (:mod:`att_planner.guidance.ground_arrival`), every other
-law's rate by the central differences of :func:`att_planner.guidance.reference`.
+law's rate by the central differences of :func:`att_planner.guidance.reference`; a strip's first
+point at the scan's rate (:func:`att_planner.guidance.strip.strip_start_goal`, :func:`strip_goal_law`).
 :class:`att_planner.problem.MovingGoal` holds the law and its Chebyshev series
 over the problem's window: the time-optimal method meets the series exactly at t_f
 (:func:`att_planner.methods.time_optimal.model.moving_goal_values`, in a child process the series
@@ -25,15 +26,21 @@ from att_planner.guidance import reference
 from att_planner.guidance.ground_arrival import ground_motion
 from att_planner.guidance.laws import PointingGeometry
 from att_planner.guidance.modes import law_of
+from att_planner.guidance.strip import Strip, strip_start_goal
 from att_sim.models import world
 from att_sim.models.scenario import Scenario
+
+
+def onboard_geometry(scenario: Scenario, epoch: datetime | None) -> tuple[PointingGeometry, float]:
+    """The scenario's onboard pointing geometry and the request's ``offset`` (s): sim time of plan time 0."""
+    offset = 0.0 if epoch is None else (epoch - (scenario.epoch or UNIX_EPOCH)).total_seconds()
+    return PointingGeometry.of(world.Environment.from_scenario(scenario)), offset
 
 
 def goal_law(mode: PointingMode, scenario: Scenario, epoch: datetime | None,
              q_start: np.ndarray) -> Callable[[float], tuple[np.ndarray, np.ndarray]]:
     """``t ↦ (q, ω)`` of ``mode``'s law at plan time ``t`` (RequestError 314 for a bad mode)."""
-    offset = 0.0 if epoch is None else (epoch - (scenario.epoch or UNIX_EPOCH)).total_seconds()
-    geometry = PointingGeometry.of(world.Environment.from_scenario(scenario))
+    geometry, offset = onboard_geometry(scenario, epoch)
     law = law_of(mode, geometry, offset, q_start)
     if mode.kind == "ground":
         ground = ground_motion(geometry, mode.latitude, mode.longitude, mode.altitude, law.primary_B,
@@ -45,3 +52,11 @@ def goal_law(mode: PointingMode, scenario: Scenario, epoch: datetime | None,
         return ref.q_RN, ref.omega_RN_R
 
     return motion
+
+
+def strip_goal_law(strip: Strip, scenario: Scenario, epoch: datetime | None, primary_B, secondary_B
+                   ) -> Callable[[float], tuple[np.ndarray, np.ndarray]]:
+    """``t ↦ (q, ω)`` at plan time ``t``: the strip's first point at its scan's rate, the scan starting at ``t``."""
+    geometry, offset = onboard_geometry(scenario, epoch)
+    goal = strip_start_goal(geometry, strip, primary_B, secondary_B)
+    return lambda t: goal(offset + t)

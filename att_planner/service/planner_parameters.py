@@ -6,6 +6,7 @@ import math
 
 from att_msgs_py.parameters import Parameter, ParameterTable
 from att_planner import methods
+from att_planner.service.imaging import MAX_SCAN_SPEED_M_S, MIN_ELEVATION_DEG
 from att_planner.service.requests import MAX_TIME_BUDGET
 from att_planner.verification import TOLERANCES
 
@@ -26,12 +27,16 @@ PLANNER = ParameterTable("planner", (
                                               "verified against the cones unpadded", "deg", 0.0, 10.0),
     Parameter("schedule_rate_max_rad_s", float, math.inf, "body rate bound of a schedule's slews (.inf: none)",
               "rad/s", 0.0, low_open=True, refusal="expected a body-rate bound > 0 rad/s (.inf: none)", allow_inf=True),
+    Parameter("image_min_elevation_deg", float, MIN_ELEVATION_DEG, "the instrument's minimum elevation of an "
+              "imaged site above its horizon (image_target, image_strip)", "deg", 0.0, 90.0),
+    Parameter("strip_scan_speed_m_s", float, 0.0, "ground speed of a strip's scan when a request gives none (0: the "
+              "sub-satellite point's ground speed at the slew's start)", "m/s", 0.0, MAX_SCAN_SPEED_M_S),
     Parameter("signing_key", str, None, "Ed25519 private key file the plans are signed with",
               default_rule="plan_signing.key in the suite's key directory ($ATT_KEY_DIR, see att-keygen)"),
     Parameter("max_parallel_solves", int, 2, "plans solved at once (worker processes)", "", 1, 64),
     Parameter("plan_markers", bool, True, "publish each plan's boresight path on /planner/plan_markers (the 3D view)"),
     Parameter("warm_up_scenarios", str, None, "comma-separated scenarios whose demo maneuvers every worker "
                                               "plans before the node serves ('': none)", default_rule="the scenario"),
-), "the maneuver planner: the plan_maneuver and plan_schedule services",
+), "the maneuver planner: the plan_maneuver, plan_schedule, image_target and image_strip services",
     renamed={"time_budget": "time_budget_s", "accept_final_rate": "accept_final_rate_rad_s",
              "schedule_rate_max": "schedule_rate_max_rad_s"})

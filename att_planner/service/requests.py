@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import math
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -66,6 +67,8 @@ class ManeuverRequest:
     tle_line2: str = ""
     wheel_speeds: list = field(default_factory=list)   # rad/s relative to the body at the start; empty: stopped
     end_pointing: PointingMode | None = None           # end on this mode's attitude and rate (kind ''/None: at rest)
+    # a goal the service builds (not from the wire): (scenario, epoch) ↦ (law t ↦ (q, ω), kind); a strip's start
+    end_goal: Callable | None = None
 
 
 @dataclass
@@ -217,6 +220,9 @@ def validate_maneuver(req: ManeuverRequest, *, frame_id: str, default_spacecraft
                               wheel_speeds=check_wheel_speeds(req.wheel_speeds, scenario.spacecraft), **limits)
     if req.end_pointing is not None and req.end_pointing.kind:
         _end_on_pointing(problem, req, method, scenario)
+    elif req.end_goal is not None:
+        law, kind = req.end_goal(scenario, problem.epoch)
+        _end_on_goal(problem, law, kind, method)
     check_sky(problem, real)
     check_reachable(problem)
     problem.deadline = received + budget          # set last: the zone sky built by the checks stays cached
@@ -255,24 +261,34 @@ def load_scenario(name: str) -> scen.Scenario:
 
 
 def _end_on_pointing(problem: ManeuverProblem, req: ManeuverRequest, method: Method, scenario: scen.Scenario) -> None:
-    """Make ``problem``'s goal the moving one of ``req.end_pointing`` (:mod:`.moving_goal`); its
-    ``q_final`` the law's attitude after the eigenaxis slew time to where the law is at the start."""
+    """Make ``problem``'s goal the moving one of ``req.end_pointing`` (:mod:`.moving_goal`)."""
+    _check_end_method(method)
+    if req.semi_free:
+        raise RequestError(ErrorCode.INVALID_OPTION, "end_pointing and semi_free exclude each other")
+    _end_on_goal(problem, goal_law(req.end_pointing, scenario, problem.epoch, problem.q_initial),
+                 req.end_pointing.kind, method)
+
+
+def _check_end_method(method: Method) -> None:
     if method.name not in END_POINTING_METHODS:
         raise RequestError(ErrorCode.INVALID_OPTION,
                            f"end_pointing: a slew that ends on a pointing mode is planned by "
                            f"{', '.join(END_POINTING_METHODS)}; {method.name} plans rest-to-rest (execute it with "
                            "point_after: the controller blends)")
-    if req.semi_free:
-        raise RequestError(ErrorCode.INVALID_OPTION, "end_pointing and semi_free exclude each other")
-    law = goal_law(req.end_pointing, scenario, problem.epoch, problem.q_initial)
+
+
+def _end_on_goal(problem: ManeuverProblem, law: Callable, kind: str, method: Method) -> None:
+    """Make ``problem``'s goal the moving ``law`` (``t ↦ (q, ω)``); its ``q_final`` the law's attitude
+    after the eigenaxis slew time to where the law is at the start."""
+    _check_end_method(method)
     window = problem.zone_sky().window
     try:
         problem.q_final = law(0.0)[0]
         problem.q_final = law(problem.slew_time_bound())[0]
-        problem.goal_motion = MovingGoal(law, window, req.end_pointing.kind)
+        problem.goal_motion = MovingGoal(law, window, kind)
     except ValueError as err:        # the mode has no attitude somewhere in the window the plan may end in
         raise RequestError(ErrorCode.INVALID_POINTING,
-                           f"end_pointing ({clip(req.end_pointing.kind, 40)}): {err} within {window:.0f} s "
+                           f"end_pointing ({clip(kind, 40)}): {err} within {window:.0f} s "
                            "of the start, where the slew may end") from None
 
 

@@ -14,6 +14,7 @@ import rclpy
 
 from att_msgs.action import ExecuteManeuver
 from att_msgs.msg import ManeuverPlan
+from att_msgs.srv import ImageStrip, ImageTarget
 from att_msgs_py import convert, qos, signing, topics
 from att_msgs_py.errors import ErrorCode, RequestError
 from att_msgs_py.types import Cone, PointingMode
@@ -393,3 +394,38 @@ def test_the_node_slows_a_plan_for_its_wheels_says_so_and_refuses_a_bad_end_poin
     assert (refused.success, refused.error_code) == (False, ErrorCode.INVALID_POINTING)
     assert "pointing.latitude" in refused.message
     assert planner.client.plan(good_request()).success and planner.suite.alive()["planner"]
+
+
+@pytest.mark.ros
+def test_the_node_answers_an_image_strip_with_a_verified_plan_and_refuses_bad_sites(planner):
+    """ImageStrip and ImageTarget on the wire (test_image_requests.py has every field's refusal): a
+    NaN latitude and a zero-length strip refused naming the field, a strip across the track 100 s
+    ahead answered with the verified plan onto its start, and the node keeps serving."""
+    from att_planner.guidance.ground_arrival import site_in_view
+    from att_planner.guidance.laws import PointingGeometry
+    from att_sim.models import world
+
+    client = planner.client
+    assert client.image_strip_client.wait_for_service(timeout_sec=30)
+    swift = scen.load("swift_demo")
+    lat, lon = (math.degrees(a) for a in site_in_view(PointingGeometry.of(world.Environment.from_scenario(swift)),
+                                                        100.0, math.radians(20.0), math.radians(90.0)))
+    bad = ImageTarget.Request(latitude_deg=NAN, longitude_deg=lon, dwell_s=10.0, method="graph_smooth")
+    bad.sensor_axis.y = bad.along_track_axis.z = 1.0
+    refused = client.image_target(bad)
+    assert (refused.success, refused.error_code) == (False, ErrorCode.INVALID_SITE)
+    assert "latitude_deg = nan" in refused.message, refused.message
+    req = ImageStrip.Request(start_latitude_deg=lat, start_longitude_deg=lon, end_latitude_deg=lat,
+                             end_longitude_deg=lon, method="graph_smooth", time_budget=20.0)
+    req.sensor_axis.y = req.along_track_axis.z = 1.0
+    refused = client.image_strip(req)
+    assert (refused.success, refused.error_code) == (False, ErrorCode.INVALID_SITE)
+    assert "end_latitude_deg, end_longitude_deg" in refused.message, refused.message
+    req.by_azimuth, req.azimuth_deg, req.length_m = True, 45.0, 30e3
+    answer = client.image_strip(req)
+    assert answer.success, answer.message
+    ver = answer.plan.verification
+    assert ver.final_attitude_error < math.radians(0.05) and ver.final_rate < math.radians(0.01)
+    assert answer.image_start == pytest.approx(answer.plan.times[-1]) and answer.image_end > answer.image_start
+    assert answer.lowest_elevation_deg >= 58.0 and answer.plan.signature
+    assert client.plan(good_request()).success and planner.suite.alive()["planner"]

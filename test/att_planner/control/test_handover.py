@@ -9,6 +9,7 @@ from datetime import timedelta
 import numpy as np
 import pytest
 
+from att_msgs_py.errors import ErrorCode, RequestError
 from att_msgs_py.types import ControlMode, PointingMode
 from att_planner.guidance import reference
 from att_planner.guidance.laws import BlendedLaw, PointingGeometry
@@ -33,6 +34,18 @@ def test_the_blend_starts_at_rest_on_the_law_and_joins_it():
         assert rot.angle_between(blended.attitude(t), law.attitude(t)) < 1e-12
     middle = reference(blended.attitude, 140.0)
     assert np.linalg.norm(middle.omega_RN_R) == pytest.approx(4 / 3 * SWIFT.orbit.mean_motion, rel=1e-3)
+
+
+def test_the_controller_takes_a_law_built_onboard_and_refuses_anything_else():
+    """A strip's law (no PointingMode on the wire carries it) is handed over as it is; what is neither a
+    mode nor a law is refused naming what it found."""
+    loop = ClosedLoop(SWIFT, overrides={"controller": {"state_source": "truth"}})
+    loop.run(0.2)
+    law = law_of(PointingMode("nadir"), PointingGeometry.of(world.Environment.from_scenario(SWIFT)), 0.0, rot.IDENTITY)
+    assert loop.controller.pointing_law(law) is law
+    with pytest.raises(RequestError) as refused:
+        loop.controller.pointing_law(np.zeros(4))
+    assert refused.value.code == ErrorCode.INVALID_POINTING and "found a ndarray" in refused.value.message
 
 
 @pytest.mark.slow
