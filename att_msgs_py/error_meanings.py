@@ -93,6 +93,10 @@ MEANINGS: dict[ErrorCode, str] = {
         'a day; a window opening NaN/Inf, negative or more than a week after the start; a window closing NaN '
         "or before its opening plus the target's dwell"
     ),
+    ErrorCode.INVALID_WHEEL_SET: (
+        "a `PlanManeuver`'s `healthy_wheels` with a number of values other than the spacecraft's wheels (or "
+        "none), or healthy wheels whose axes do not span the body (the attitude cannot be controlled on them)"
+    ),
     ErrorCode.SOLVER_FAILED: 'the method failed (or its process died) and no safe fallback exists',
     ErrorCode.VERIFICATION_FAILED: (
         'the plan did not survive integration through the dynamics and no safe fallback exists'

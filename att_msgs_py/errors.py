@@ -32,6 +32,7 @@ class ErrorCode(IntEnum):
     CONTRADICTORY_ZONES = 155     # zones no direction can satisfy together (e.g. keep-in inside keep-out)
     INVALID_WHEEL_SPEEDS = 160    # wheel_speeds of the wrong length, not finite, or beyond the wheels' limit
     INVALID_OBSERVATION = 161     # a schedule's dwell or window: wrong length, not finite, negative, or too short
+    INVALID_WHEEL_SET = 162       # healthy_wheels of the wrong length, or wheels that cannot control the attitude
     # planner: solving
     SOLVER_FAILED = 200           # the method failed and no fallback plan was possible
     VERIFICATION_FAILED = 201     # the plan did not survive integration through the dynamics
