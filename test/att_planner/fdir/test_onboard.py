@@ -1,0 +1,85 @@
+"""The fault_table parameter read (empty: off; a name of config/faults; a path) and hostile values
+refused naming the parameter; the brake before a re-plan after a wheel loss (att_planner.fdir.replan)."""
+from __future__ import annotations
+
+from datetime import UTC, datetime
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+
+from att_msgs_py.errors import ConfigError, ErrorCode
+from att_msgs_py.types import ControlMode
+from att_planner.fdir import replan
+from att_planner.fdir import table as tables
+from att_planner.fdir.onboard import load_table
+
+
+def test_an_empty_fault_table_is_off_and_a_name_or_a_path_is_read():
+    assert load_table("") is None
+    by_name, by_path = load_table("default"), load_table(str(tables.DEFAULT_TABLE))
+    assert by_name == by_path == tables.read()
+    assert "wheel_torque" in by_name.faults
+
+
+@pytest.mark.parametrize("value, words", [("no_such_table", "found 'no_such_table', which is neither"),
+                                          ("/nonexistent/faults.yaml", "a fault table file"),
+                                          ("../../etc/passwd", "which is neither"),
+                                          ("x" * 500, "which is neither")])
+def test_a_fault_table_that_is_not_there_is_refused_naming_the_parameter(value, words):
+    with pytest.raises(ConfigError) as err:
+        load_table(value)
+    assert err.value.code == ErrorCode.INVALID_CONFIG
+    assert err.value.message.startswith("parameter 'fault_table': expected empty") and words in err.value.message
+    assert len(err.value.message) < 400
+
+
+def test_a_fault_table_file_with_a_bad_entry_is_refused_with_its_line(tmp_path):
+    bad = tmp_path / "bad.yaml"
+    bad.write_text("faults:\n  w:\n    detector: wheel_torque\n    threshold_Nm: -1\n    persistence_s: 0\n"
+                   "    response: exclude_wheel\n")
+    with pytest.raises(ConfigError) as err:
+        load_table(str(bad))
+    assert err.value.code == ErrorCode.INVALID_CONFIG
+    assert err.value.message.startswith("parameter 'fault_table': ") and "threshold_Nm" in err.value.message
+
+
+class Controller:
+    """What the brake reads of a controller: its mode, estimated rate, start tolerance; and its hold."""
+
+    def __init__(self, rate: float):
+        self.mode = ControlMode.PLAN_TRACKING
+        self.state = SimpleNamespace(omega=np.array([rate, 0.0, 0.0]))
+        self.context = SimpleNamespace(max_start_rate_error=0.01)
+        self.held = []
+
+    def hold(self, message):
+        self.held.append(message)
+        return "ended"
+
+
+def test_the_brake_holds_then_says_re_plan_once_the_rate_is_below_half_the_start_tolerance():
+    ctl, brake = Controller(0.02), replan.Brake()
+    assert brake.poll(ctl, 0.0) == replan.IDLE
+    assert brake.begin(ctl, 10.0) == "ended" and ctl.held == [replan.HOLD_MESSAGE] and brake.since == 10.0
+    assert brake.poll(ctl, 20.0) == replan.WAIT
+    ctl.state.omega[0] = 0.0049
+    assert brake.poll(ctl, 21.0) == replan.REPLAN and brake.since is None
+    assert brake.poll(ctl, 22.0) == replan.IDLE
+
+
+def test_the_brake_gives_up_after_its_limit_and_leaves_safe_mode_alone():
+    ctl, brake = Controller(0.02), replan.Brake()
+    brake.begin(ctl, 0.0)
+    assert brake.poll(ctl, replan.BRAKE_LIMIT_S) == replan.WAIT
+    assert brake.poll(ctl, replan.BRAKE_LIMIT_S + 0.1) == replan.SAFE and "0.02 rad/s" in brake.why
+    ctl.mode = ControlMode.SAFE
+    assert brake.begin(ctl, 200.0) is None and brake.since is None and len(ctl.held) == 1
+    brake.since = 200.0
+    assert brake.poll(ctl, 201.0) == replan.IDLE and brake.since is None
+
+
+def test_the_utc_epoch_of_a_sim_time():
+    assert replan.utc_epoch(None, 5.0) == (0, 0)
+    epoch = datetime(2025, 3, 1, tzinfo=UTC)
+    assert replan.utc_epoch(epoch, 1.25) == (int(epoch.timestamp()) + 1, 250_000_000)
