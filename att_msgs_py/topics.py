@@ -22,6 +22,7 @@ ZONE_MARGINS = "/simulator/zone_margins"     # the zones' truth margins, for plo
 PLAN_MARKERS = "/planner/plan_markers"       # the latest plan's boresight path
 MISSION_EVENTS = "/mission/events"           # att-mission's decisions, slews, dwells and missed targets
 SIM_FAULTS = "/simulator/faults"             # every hardware fault the truth started (evaluation only)
+CONTROLLER_FAULTS = "/controller/faults"     # the faults the controller's monitor detected and its responses
 
 PLAN_MANEUVER = "/planner/plan_maneuver"
 PLAN_SCHEDULE = "/planner/plan_schedule"
@@ -51,6 +52,7 @@ RECORDED = {
     PLAN_MARKERS: "visualization_msgs/msg/MarkerArray",
     MISSION_EVENTS: "att_msgs/msg/MissionEvent",
     SIM_FAULTS: "att_msgs/msg/FaultEvent",
+    CONTROLLER_FAULTS: "att_msgs/msg/FaultStatus",
 }
 
 
@@ -80,6 +82,8 @@ ABOUT = {
     MISSION_EVENTS: "a mission's decisions, slews, dwells, parks and missed targets with why (latched)",
     SIM_FAULTS: "each hardware fault the truth started: component, index, kind, parameters, source (latched; "
                 "for evaluation only, no flight node reads it)",
+    CONTROLLER_FAULTS: "each fault the controller's monitor declared or cleared (with `fault_table`): fault id, "
+                       "component and index isolated, detector, evidence, response, detection time",
     INJECT_FAULT: "inject a hardware fault into the truth at a sim time (refused unless the scenario sets "
                   "`allow_fault_injection`)",
     PLAN_MANEUVER: "plan a rest-to-rest maneuver (or one ending on a pointing law), verified and signed",

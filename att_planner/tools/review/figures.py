@@ -181,6 +181,16 @@ def _limits(ax, limit, label=None, color="r", ls="--"):
             ax.axhline(sign * limit, color=color, ls=ls, lw=0.8, label=label if sign == 1 else None)
 
 
+def draw_marks(ax, marks: list, labels: bool = False) -> None:
+    """Events (t, label, colour) as vertical lines (``labels``: each written beside its line): the
+    faults injected, detected and the re-plans flown (:func:`att_planner.tools.review.faults.marks`)."""
+    for t, label, color in marks:
+        ax.axvline(t, color=color, ls="-.", lw=1.0)
+        if labels:
+            ax.annotate(label, (t, 0.98), xycoords=("data", "axes fraction"), rotation=90, va="top", ha="right",
+                        fontsize=6, color=color)
+
+
 def _maneuver_end(ax, run):
     if run.kind == "maneuver":
         ax.axvline(run.plan.duration, color="0.5", ls=":", lw=0.8)
@@ -328,6 +338,7 @@ def figure_time_histories(run: Run, sc: Spacecraft | None, path: Path, zones: Fi
     for ax in axes.ravel():
         ax.grid(alpha=0.3)
         _maneuver_end(ax, run)
+        draw_marks(ax, run.marks, labels=ax is axes[0, 0] or ax is axes[1, 1])
     for ax in axes[-1]:
         ax.set_xlabel(_time_label(run))
     fig.suptitle(_title(run))
