@@ -182,13 +182,12 @@ def _limits(ax, limit, label=None, color="r", ls="--"):
 
 
 def draw_marks(ax, marks: list, labels: bool = False) -> None:
-    """Events (t, label, colour) as vertical lines (``labels``: each written beside its line): the
-    faults injected, detected and the re-plans flown (:func:`att_planner.tools.review.faults.marks`)."""
+    """Events (t, label, colour) as vertical lines (``labels``: named in the axes' legend): the faults
+    injected, detected and the re-plans flown (:func:`att_planner.tools.review.faults.marks`)."""
     for t, label, color in marks:
-        ax.axvline(t, color=color, ls="-.", lw=1.0)
-        if labels:
-            ax.annotate(label, (t, 0.98), xycoords=("data", "axes fraction"), rotation=90, va="top", ha="right",
-                        fontsize=6, color=color)
+        ax.axvline(t, color=color, ls="-.", lw=1.0, label=f"t = {t:.1f} s: {label}" if labels else None)
+    if labels and marks:
+        ax.legend(loc="center right", fontsize=6)
 
 
 def _maneuver_end(ax, run):
@@ -338,7 +337,7 @@ def figure_time_histories(run: Run, sc: Spacecraft | None, path: Path, zones: Fi
     for ax in axes.ravel():
         ax.grid(alpha=0.3)
         _maneuver_end(ax, run)
-        draw_marks(ax, run.marks, labels=ax is axes[0, 0] or ax is axes[1, 1])
+        draw_marks(ax, run.marks, labels=ax is axes[3, 1])
     for ax in axes[-1]:
         ax.set_xlabel(_time_label(run))
     fig.suptitle(_title(run))
