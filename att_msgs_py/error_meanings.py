@@ -165,6 +165,11 @@ MEANINGS: dict[ErrorCode, str] = {
         "gyro was silent for `resync_timeout_s`); a measurement older than the filter's history or more than "
         '`max_gyro_gap_s` ahead of the gyro'
     ),
+    ErrorCode.INVALID_FAULT_REPORT: (
+        "(logged) a `FaultStatus` on `/estimator/faults` whose fault id the controller's fault table does not "
+        "declare, whose component or response is not that entry's, or whose index is below -1; a second "
+        "publisher of them while the held one is in the ROS graph"
+    ),
     ErrorCode.INVALID_RESET: (
         '`/simulator/reset` with a non-finite field; an attitude whose norm is off 1 by more than 1e-3; the '
         'wrong number of wheel speeds (empty: zeros) or one beyond `wheel_speed_max` relative to the body (`Ω '

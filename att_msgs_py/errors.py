@@ -56,6 +56,7 @@ class ErrorCode(IntEnum):
     # estimator
     INVALID_MEASUREMENT = 320     # a sensor message with a bad field (discarded, reported)
     STALE_MEASUREMENT = 321       # a measurement older than the filter's history, or a gyro stamp not moving forward
+    INVALID_FAULT_REPORT = 322    # a fault report of a fault the table does not declare, or with another response
     # simulator
     INVALID_RESET = 400
     INVALID_COMMAND = 401         # actuator command with a bad field or stamp (refused, reported)

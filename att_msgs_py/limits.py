@@ -71,6 +71,8 @@ JOINT_STATE = {**_HEADER, "name": MAX_WHEELS, "name[]": MAX_NAME_LENGTH, "positi
 STAR_TRACKER = {**_HEADER, "sensor_frame_id": MAX_NAME_LENGTH}
 SUN_SENSORS = {**_HEADER, "values": MAX_SUN_SENSORS}
 HEADER_ONLY = _HEADER          # Imu, MagneticField: fixed-size fields besides their header
+FAULT_STATUS = {**_HEADER, "fault_id": MAX_NAME_LENGTH, "component": MAX_NAME_LENGTH, "detector": MAX_NAME_LENGTH,
+                "evidence": 400, "response": MAX_NAME_LENGTH}
 
 
 def inline_plan(table: Mapping[str, int] = EXECUTE_MANEUVER) -> dict[str, int]:

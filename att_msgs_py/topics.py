@@ -23,6 +23,7 @@ PLAN_MARKERS = "/planner/plan_markers"       # the latest plan's boresight path
 MISSION_EVENTS = "/mission/events"           # att-mission's decisions, slews, dwells and missed targets
 SIM_FAULTS = "/simulator/faults"             # every hardware fault the truth started (evaluation only)
 CONTROLLER_FAULTS = "/controller/faults"     # the faults the controller's monitor detected and its responses
+ESTIMATOR_FAULTS = "/estimator/faults"       # the sensor faults the estimator's monitor detected
 
 PLAN_MANEUVER = "/planner/plan_maneuver"
 PLAN_SCHEDULE = "/planner/plan_schedule"
@@ -53,6 +54,7 @@ RECORDED = {
     MISSION_EVENTS: "att_msgs/msg/MissionEvent",
     SIM_FAULTS: "att_msgs/msg/FaultEvent",
     CONTROLLER_FAULTS: "att_msgs/msg/FaultStatus",
+    ESTIMATOR_FAULTS: "att_msgs/msg/FaultStatus",
 }
 
 
@@ -84,6 +86,9 @@ ABOUT = {
                 "for evaluation only, no flight node reads it)",
     CONTROLLER_FAULTS: "each fault the controller's monitor declared or cleared (with `fault_table`): fault id, "
                        "component and index isolated, detector, evidence, response, detection time",
+    ESTIMATOR_FAULTS: "each sensor fault the estimator's monitor declared or cleared (with `fault_table`): a star "
+                      "tracker, the gyro or the magnetometer, its evidence and response (the controller acts on "
+                      "safe mode)",
     INJECT_FAULT: "inject a hardware fault into the truth at a sim time (refused unless the scenario sets "
                   "`allow_fault_injection`)",
     PLAN_MANEUVER: "plan a rest-to-rest maneuver (or one ending on a pointing law), verified and signed",

@@ -26,6 +26,17 @@ The states (or estimates) are held to one publisher: another one is ignored whil
 in the ROS graph (:class:`att_msgs_py.source_hold.SourceHold`), so neither pausing nor starving the
 real source hands the loop to an intruder; a silent source is stale input (the watchdog below).
 
+Faults: with ``fault_table`` (a name of ``config/faults`` or a file's path; empty, the default: off;
+it needs ``state_source`` estimate) the node runs the table's monitor on what it has
+(:class:`att_planner.fdir.onboard.Onboard`: the wheel speeds against its commands, the estimates, its
+attitude error), hears the estimator's reports on ``/estimator/faults`` (held to one publisher;
+refused, 322, unless the table declares them as reported), publishes its own on the latched
+``/controller/faults`` (att_msgs/FaultStatus), names the active faults in the status message and acts
+on the responses of both (:func:`att_planner.fdir.recovery.act`: the allocation on the healthy wheels,
+safe mode). A wheel isolated during a maneuver: it brakes (:class:`att_planner.fdir.replan.Brake`),
+asks ``/planner/plan_maneuver`` for the rest on the healthy wheels (``healthy_wheels``) and flies it;
+the execute goal ends with the re-planned maneuver, or unsuccessfully with why (then safe mode).
+
 Watchdog: when no state came for ``wall_timeout_s`` of wall time the controller commands zero
 and reports ``state_stale`` until states flow again.
 
@@ -133,6 +144,8 @@ class ControllerNode(Node):
         if self._fdir is not None:
             self._fault_pub = self.create_publisher(FaultStatus, topics.CONTROLLER_FAULTS, qos.MISSION_QOS)
             self._planner = self.create_client(PlanManeuver, topics.PLAN_MANEUVER, qos_profile=qos.SERVICE_QOS)
+            self._fault_sources = Sources({"estimator fault report": live_publishers(self, topics.ESTIMATOR_FAULTS)})
+            self.create_subscription(FaultStatus, topics.ESTIMATOR_FAULTS, self.on_estimator_fault, qos.MISSION_QOS)
         self.create_timer(0.5, self.on_wall_watchdog, clock=Clock(clock_type=ClockType.STEADY_TIME))
         self._action = ActionServer(self, ExecuteManeuver, topics.EXECUTE_MANEUVER, execute_callback=self.execute,
                                     goal_callback=self.on_goal, cancel_callback=lambda _: CancelResponse.ACCEPT)
@@ -241,9 +254,26 @@ class ControllerNode(Node):
                      f"{'declared' if report.active else 'cleared'} at t = {report.t:.2f} s ({report.detector}: "
                      f"{report.evidence}); response {report.response}"))
 
+    def on_estimator_fault(self, msg: FaultStatus, info: dict):
+        """A report of the estimator's monitor: its responses are acted on with this monitor's (held to one
+        publisher; a fault the table does not declare as reported is refused, 322)."""
+        try:
+            limits.check(msg, limits.FAULT_STATUS, "fault")
+            report = convert.fault_status_from_msg(msg)
+            refused = self._fault_sources.guarded("estimator fault report", publisher_of(info), self._fdir.hear,
+                                                  report)
+        except RequestError as err:
+            refused = err
+        if refused is not None:
+            self._refusals("estimator fault report", refused)
+            return
+        self.get_logger().info(clip(f"estimator fault {report.fault_id} on {report.component} {report.index} "
+                                    f"{'declared' if report.active else 'cleared'} ({report.response})"))
+
     def _with_faults(self, message: str) -> str:
         """The status message with the active faults named (the fault topic has their reports)."""
-        active = sorted(f"{f.fault_id}[{f.index}]" for f in self._fdir.monitor.active.values())
+        active = sorted(f"{f.fault_id}[{f.index}]" for f in [*self._fdir.monitor.active.values(),
+                                                             *self._fdir.heard.values()])
         return clip(f"{message}; faults: {', '.join(active)}" if active and message else
                     f"faults: {', '.join(active)}" if active else message)
 

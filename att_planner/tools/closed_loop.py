@@ -117,6 +117,7 @@ class ClosedLoop:
             est_param = SectionReader(ESTIMATOR, sections.get("estimator", {}), str(scenario.node_params_path),
                                       overrides.get("estimator"))
             self.estimator = estimator_from_scenario(est_param, scenario)
+            table_param = table_param or est_param("fault_table")      # one monitor in process runs both sides'
             est_param.refuse_unknown()
         self.scenario = scenario
         self.sim = simulation or Simulation.for_scenario(

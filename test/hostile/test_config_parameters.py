@@ -305,6 +305,8 @@ NODE_CASES = {
                                                             "state_source:=truth"], P,
                                              ["parameter 'fault_table'", "state_source estimate"]),
     "controller: fault_table integer": ("controller", ["-p", "fault_table:=5"], P, ["'fault_table'", "a string"]),
+    "estimator: fault_table not there": ("estimator", ["-p", "fault_table:=/no/such/faults.yaml"], C,
+                                         ["parameter 'fault_table': expected empty", "/no/such/faults.yaml"]),
     "planner: default_method unknown": ("planner", ["-p", "default_method:=magic"], P,
                                         ["'default_method'", "(the best)", "magic"]),
     "simulator: step an integer out of range": (SIM, ["-p", "step_s:=2"], P, ["'step_s'", "(0, 1]"]),

@@ -1,10 +1,11 @@
-"""A wheel seized mid-slew through the nodes: leo_pyramid with the controller's fault table on, a
-10 deg slew about body x planned over the service, wheel 0 (the one that carries most of that axis)
-seized through ``/simulator/inject_fault`` 30 % into it. The controller isolates it
-(``/controller/faults``), brakes on the three others, asks the planner for the rest on their envelope
-(``PlanManeuver.healthy_wheels``) and the one execute goal ends with the re-planned slew complete:
-the final error from the truth, no zone entered (the simulator's truth margins), all recorded; then
-``att-review`` of that MCAP marks the fault, its detection and the response on the time histories."""
+"""A wheel seized mid-slew through the nodes: leo_pyramid with the controller's and the estimator's
+fault table on, a 10 deg slew about body x planned over the service, wheel 0 (the one that carries
+most of that axis) seized through ``/simulator/inject_fault`` 30 % into it. The controller isolates
+it (``/controller/faults``; the estimator's sensor detectors stay quiet), brakes on the three others,
+asks the planner for the rest on their envelope (``PlanManeuver.healthy_wheels``) and the one execute
+goal ends with the re-planned slew complete: the final error from the truth, no zone entered (the
+simulator's truth margins), all recorded; then ``att-review`` of that MCAP marks the fault, its
+detection and the response on the time histories."""
 from __future__ import annotations
 
 import math
@@ -40,15 +41,17 @@ def call(node, client, request, timeout: float = 30.0):
 
 def test_a_wheel_seized_mid_slew_is_isolated_re_planned_on_three_wheels_and_reviewed(ros_suite, tmp_path):
     s = scen.load("leo_pyramid")
-    params = {"controller": {"fault_table": "default", "settle_time_s": 5.0},
+    params = {"controller": {"fault_table": "default", "settle_time_s": 5.0}, "estimator": {"fault_table": "default"},
               "simulator": {"real_time_factor": 0.0}, "planner": {"warm_up_scenarios": "''"}}   # (YAML ''): no warm-up
     with ros_suite("leo_pyramid", params=params, name="fault_recovery") as suite:
         node = suite.client
-        estimates, reports, events = [], [], []
+        estimates, reports, sensor_reports, events = [], [], [], []
         node.create_subscription(AttitudeEstimate, topics.ESTIMATE,
                                  lambda m: estimates.append(convert.estimate_from_msg(m)), qos.STREAM_QOS)
         node.create_subscription(FaultStatus, topics.CONTROLLER_FAULTS,
                                  lambda m: reports.append(convert.fault_status_from_msg(m)), qos.MISSION_QOS)
+        node.create_subscription(FaultStatus, topics.ESTIMATOR_FAULTS,
+                                 lambda m: sensor_reports.append(convert.fault_status_from_msg(m)), qos.MISSION_QOS)
         node.create_subscription(FaultEvent, topics.SIM_FAULTS,
                                  lambda m: events.append(convert.fault_event_from_msg(m)), qos.MISSION_QOS)
         inject = node.create_client(InjectFault, topics.INJECT_FAULT)
@@ -77,6 +80,7 @@ def test_a_wheel_seized_mid_slew_is_isolated_re_planned_on_three_wheels_and_revi
         wheel = [f for f in reports if f.component == "wheel"]
         assert wheel and (wheel[0].index, wheel[0].response, wheel[0].active) == (SEIZED, "exclude_wheel", True)
         assert event.t < wheel[0].detected_at <= event.t + 5.0, (event.t, wheel[0])
+        assert sensor_reports == []                   # the estimator's sensor detectors: no false alarm
         log = suite.suite.log_text("controller")
         assert "re-planning from" in log and "flying re-plan" in log
         suite.stop()

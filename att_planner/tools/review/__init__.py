@@ -27,10 +27,11 @@ executed plan, else the last magnetorquer-PD run, else the whole log), and write
   mode), the zones' margins, wheel momentum and dipoles over the day, and the sky with the day's
   boresight track, the targets and the Sun, Moon and nadir tracks (:mod:`.mission`); the summary
   gains ``mission``: the table of targets observed (start, dwell, pointing error) and missed (why);
-* with faults (a log with ``/simulator/faults`` or ``/controller/faults``): each fault injected, its
-  detection (detector, evidence, latency) and the response, and each re-plan flown after it, marked
-  on the time histories and listed in the summary (``faults``; :mod:`.faults`); the reviewed segment
-  is then the maneuver in flight at the first detection through its re-plans;
+* with faults (a log with ``/simulator/faults``, ``/controller/faults`` or ``/estimator/faults``):
+  each fault injected, its detection (detector, evidence, latency) and the response, and each
+  re-plan flown after it, marked on the time histories and listed in the summary (``faults``;
+  :mod:`.faults`); the reviewed segment is then the maneuver in flight at the first detection
+  through its re-plans;
 * ``summary.txt``, ``summary.json`` and ``index.html`` (summary table, figures embedded).
 
 For a maneuver, "executed" is the whole reviewed segment: the maneuver (the plan, t = 0 to its
@@ -61,6 +62,7 @@ from att_msgs_py.topics import (
     CONTROLLER_FAULTS,
     CONTROLLER_STATUS,
     ESTIMATE,
+    ESTIMATOR_FAULTS,
     IMU,
     MAGNETOMETER,
     MISSION_EVENTS,
@@ -77,7 +79,7 @@ __all__ = ["Review", "extract_run", "format_summary", "main", "review", "settlin
 # ``TOPICS``); named here so that a log is read, and a damaged one refused, before the figures and
 # the models are imported (a second or more on a loaded machine)
 REVIEWED_TOPICS = sorted({STATE, COMMAND, PLANS, CONTROLLER_STATUS, ESTIMATE, SENSOR_TRUTH, STAR_TRACKER, IMU,
-                          MAGNETOMETER, MISSION_EVENTS, SIM_FAULTS, CONTROLLER_FAULTS})
+                          MAGNETOMETER, MISSION_EVENTS, SIM_FAULTS, CONTROLLER_FAULTS, ESTIMATOR_FAULTS})
 _LAZY = {"extract_run": "run", "settling_time": "run", "format_summary": "summary", "summarize": "summary"}
 
 

@@ -2,9 +2,10 @@
 and how it responded, marked on the time histories.
 
 :func:`faults_of` reads ``/simulator/faults`` (each fault the truth started: onset, component, index,
-kind; evaluation only) and ``/controller/faults`` (each fault the controller's monitor declared or
-cleared: detection time, detector, evidence, response), and the plans the controller flew after the
-first detection (the re-plans on the healthy wheels: their first command). Each detection is paired
+kind; evaluation only), ``/controller/faults`` and ``/estimator/faults`` (each fault the controller's
+or the estimator's monitor declared or cleared: detection time, detector, evidence, response), and
+the plans the controller flew after the first detection (the re-plans on the healthy wheels: their
+first command). Each detection is paired
 with the injection it isolated (same component and index, the latest onset before it) for its
 latency. :func:`marks` gives the vertical lines the time histories draw
 (:func:`att_planner.tools.review.figures.draw_marks`: injected red, detected orange, re-plan flown
@@ -18,9 +19,9 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from att_msgs_py.log import TopicLog
-from att_msgs_py.topics import CONTROLLER_FAULTS, SIM_FAULTS
+from att_msgs_py.topics import CONTROLLER_FAULTS, ESTIMATOR_FAULTS, SIM_FAULTS
 
-TOPICS = (SIM_FAULTS, CONTROLLER_FAULTS)
+TOPICS = (SIM_FAULTS, CONTROLLER_FAULTS, ESTIMATOR_FAULTS)
 COLORS = {"injected": "tab:red", "detected": "tab:orange", "cleared": "tab:cyan", "replan": "tab:green"}
 
 
@@ -42,14 +43,15 @@ def faults_of(log: dict[str, TopicLog], cmd_t: np.ndarray | None = None, cmd_pla
               ) -> FaultLog | None:
     """The faults of ``log`` (None when it has neither topic); ``cmd_t``/``cmd_plan``: the commands'
     times and plan ids, for the re-plans flown after the first detection."""
-    sim, flight = log.get(SIM_FAULTS), log.get(CONTROLLER_FAULTS)
-    if not (sim is not None and len(sim)) and not (flight is not None and len(flight)):
+    sim = log.get(SIM_FAULTS)
+    flights = [log[t] for t in (CONTROLLER_FAULTS, ESTIMATOR_FAULTS) if t in log and len(log[t])]
+    if not (sim is not None and len(sim)) and not flights:
         return None
     out = FaultLog()
     if sim is not None and len(sim):
         for t, c, i, k, s in zip(*(_column(sim, n) for n in ("header.stamp", "component", "index", "kind", "source"))):
             out.injected.append({"t": float(t), "component": str(c), "index": int(i), "kind": str(k), "source": str(s)})
-    if flight is not None and len(flight):
+    for flight in flights:
         names = ("detected_at", "fault_id", "component", "index", "detector", "evidence", "response", "active",
                  "header.stamp")
         for at, fid, c, i, d, e, r, a, stamp in zip(*(_column(flight, n) for n in names)):
@@ -58,6 +60,7 @@ def faults_of(log: dict[str, TopicLog], cmd_t: np.ndarray | None = None, cmd_pla
             out.detected.append({"t": t, "fault_id": str(fid), "component": str(c), "index": int(i),
                                  "detector": str(d), "evidence": str(e), "response": str(r), "active": bool(a),
                                  "latency_s": float(at - max(onsets)) if onsets and a else None})
+    out.detected.sort(key=lambda d: d["t"])
     first = min((d["t"] for d in out.detected if d["active"]), default=None)
     if first is not None and cmd_t is not None and len(cmd_t):
         seen = set(np.asarray(cmd_plan)[np.asarray(cmd_t) <= first].tolist())

@@ -1,5 +1,7 @@
 """The fault_table parameter read (empty: off; a name of config/faults; a path) and hostile values
-refused naming the parameter; the brake before a re-plan after a wheel loss (att_planner.fdir.replan)."""
+refused naming the parameter; the brake before a re-plan after a wheel loss (att_planner.fdir.replan);
+the two nodes' monitors (att_planner.fdir.onboard.Onboard): the estimator's exclusions, the
+controller acting on the estimator's reports, and a report the table does not declare refused."""
 from __future__ import annotations
 
 from datetime import UTC, datetime
@@ -9,7 +11,7 @@ import numpy as np
 import pytest
 
 from att_msgs_py.errors import ConfigError, ErrorCode
-from att_msgs_py.types import ControlMode
+from att_msgs_py.types import ControlMode, FaultStatus
 from att_planner.fdir import replan
 from att_planner.fdir import table as tables
 from att_planner.fdir.onboard import load_table
@@ -83,3 +85,54 @@ def test_the_utc_epoch_of_a_sim_time():
     assert replan.utc_epoch(None, 5.0) == (0, 0)
     epoch = datetime(2025, 3, 1, tzinfo=UTC)
     assert replan.utc_epoch(epoch, 1.25) == (int(epoch.timestamp()) + 1, 250_000_000)
+
+
+def report(fault_id, component, index, response, active=True):
+    return FaultStatus(12.0, fault_id, component, index, "d", "e", response, active, 12.0, "body")
+
+
+@pytest.fixture(scope="module")
+def sides():
+    """The two nodes' monitors on leo_pyramid: the estimator's (no controller) and the controller's."""
+    from att_planner.fdir.onboard import Onboard
+    from att_planner.tools.closed_loop import ClosedLoop
+    from att_sim.models import scenario as scen
+
+    s = scen.load("leo_pyramid")
+    loop = ClosedLoop(s)
+    estimator = SimpleNamespace(excluded=set(), take_innovations=list)
+    return s, Onboard(tables.read(), s, None, estimator), Onboard(tables.read(), s, loop.controller)
+
+
+def test_the_estimator_side_excludes_what_its_monitor_isolated_and_touches_no_controller(sides):
+    s, estimator_side, _ = sides
+    tracker = s.sensors.star_trackers[0].name
+    assert estimator_side.hear(report("tracker_outage", "star_tracker", 0, "exclude_sensor")) is None
+    ended, changed = estimator_side.respond()
+    assert ended is None and not changed and estimator_side.estimator.excluded == {tracker}
+    assert estimator_side.respond() == (None, False)            # nothing new: nothing acted on
+    estimator_side.hear(report("tracker_outage", "star_tracker", 0, "exclude_sensor", active=False))
+    estimator_side.respond()
+    assert estimator_side.estimator.excluded == set() and estimator_side.heard == {}
+
+
+def test_the_controller_side_flies_safe_mode_on_a_gyro_fault_the_estimator_reported(sides):
+    _, _, controller_side = sides
+    ctl = controller_side.controller
+    assert controller_side.hear(report("gyro_axis_frozen", "gyro", 1, "safe_mode")) is None
+    controller_side.respond()
+    assert ctl.mode == ControlMode.SAFE and ctl.safe_actuation is not None and not ctl.safe_actuation.gyro_trusted
+
+
+@pytest.mark.parametrize("fault, words", [
+    (("no_such_fault", "gyro", 0, "safe_mode"), "fault_id: expected one of the fault table's; found 'no_such_fault'"),
+    (("gyro_axis_frozen", "wheel", 0, "safe_mode"), "expected component gyro and response safe_mode"),
+    (("wheel_torque", "wheel", 0, "safe_mode"), "expected component wheel and response exclude_wheel"),
+    (("wheel_torque", "wheel", -2, "exclude_wheel"), "index: expected a unit (0 or more) or -1"),
+])
+def test_a_report_the_table_does_not_declare_as_reported_is_refused(sides, fault, words):
+    _, _, controller_side = sides
+    before = dict(controller_side.heard)
+    refused = controller_side.hear(report(*fault))
+    assert refused.code == ErrorCode.INVALID_FAULT_REPORT and words in refused.message
+    assert controller_side.heard == before                   # nothing kept
