@@ -13,8 +13,10 @@ parameter: empty (no fault handling), a table's name under ``config/faults/`` or
 """
 from __future__ import annotations
 
+from collections import deque
 from pathlib import Path
 
+from att_msgs_py import topics
 from att_msgs_py.errors import ConfigError, ErrorCode, RequestError, clip
 from att_msgs_py.types import FaultStatus, ManeuverResult
 from att_planner.fdir import recovery
@@ -25,6 +27,7 @@ from att_planner.fdir.tap import MonitorTap
 from att_sim.models.config_files import ConfigFileError
 
 TABLES = tables.DEFAULT_TABLE.parent          # config/faults/: the tables known by name
+MAX_PENDING = 64                              # commands waiting for the tachometer sample that ends them
 
 
 def load_table(value: str) -> tables.FaultTable | None:
@@ -58,6 +61,7 @@ class Onboard:
         self.controller, self.estimator = controller, estimator
         self.heard: dict[tuple[str, int], FaultStatus] = {}
         self._seen, self._heard = (0, 0), 0
+        self._commands: deque = deque(maxlen=MAX_PENDING)   # (t, command) not yet in force at a sample
 
     def hear(self, report: FaultStatus) -> RequestError | None:
         """A report of another node's monitor on the same table (the estimator's, for the controller):
@@ -88,8 +92,19 @@ class Onboard:
         return self.monitor.on_innovations(self.estimator.take_innovations())
 
     def feed(self, topic: str, t: float, message) -> list[FaultStatus]:
-        """What was published on ``topic`` (the mirror type of :mod:`att_msgs_py.types`): the reports it made."""
+        """What was published on ``topic`` (the mirror type of :mod:`att_msgs_py.types`): the reports it made.
+
+        A tachometer sample stamped ``t_s`` ends the interval over which the command stamped before
+        ``t_s`` was in force, whichever of the two arrived first (a node may compute the command at
+        ``t_s`` before the sample of ``t_s`` arrives): commands wait here and reach the monitor just
+        before the first sample stamped after them (at most :data:`MAX_PENDING` wait)."""
         n = len(self.tap.reports)
+        if topic == topics.COMMAND:
+            self._commands.append((t, message))
+            return []
+        if topic == topics.WHEEL_SPEEDS:
+            while self._commands and self._commands[0][0] < message.t:
+                self.tap(topics.COMMAND, *self._commands.popleft())
         self.tap(topic, t, message)
         return self.tap.reports[n:]
 

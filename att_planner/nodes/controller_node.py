@@ -291,9 +291,11 @@ class ControllerNode(Node):
             self._brake.begin(core, t)
             self.get_logger().warning(f"healthy wheels {list(core.healthy or ())}: braking at t = {t:.2f} s to "
                                       f"re-plan maneuver '{self._replan_of.plan_id}'")
-        if self._replan_of is not None and self._goal is not None and self._goal.is_cancel_requested:
+        if self._replan_of is not None and (core.mode == ControlMode.SAFE or self._goal is not None
+                                            and self._goal.is_cancel_requested):
+            why = "safe mode" if core.mode == ControlMode.SAFE else "cancelled"
             self._replan_of = self._brake.since = None
-            self.finish(ManeuverResult(False, int(ErrorCode.ABORTED), "cancelled while re-planning"))
+            self.finish(ManeuverResult(False, int(ErrorCode.ABORTED), f"{why} while re-planning"))
             return
         said = self._brake.poll(core, t)
         if said == SAFE:
@@ -323,9 +325,14 @@ class ControllerNode(Node):
         self._replanning = None
         if self._replan_of is None:               # cancelled or safe mode meanwhile
             return
-        response = future.result()
+        try:
+            response = future.result()
+        except Exception as exc:  # a call the middleware failed: no re-plan, never a dead callback
+            response, exc_text = None, f"{type(exc).__name__}: {exc}"
+        else:
+            exc_text = "no answer"
         if response is None or not response.success:
-            why = "no answer" if response is None else f"code {response.error_code}: {response.message}"
+            why = exc_text if response is None else f"code {response.error_code}: {response.message}"
             return self._give_up(f"no verified re-plan ({why})")
         msg = response.plan
         refused = limits.issue(msg, limits.MANEUVER_PLAN, "plan") or check_message(msg)

@@ -136,3 +136,27 @@ def test_a_report_the_table_does_not_declare_as_reported_is_refused(sides, fault
     refused = controller_side.hear(report(*fault))
     assert refused.code == ErrorCode.INVALID_FAULT_REPORT and words in refused.message
     assert controller_side.heard == before                   # nothing kept
+
+
+def test_a_tachometer_sample_meets_the_command_in_force_over_its_interval_whatever_arrived_first(sides):
+    """A node may compute the command at t before the sample stamped t arrives: that command is in
+    force after t, so the sample of t meets the one before it (as the in-process loop orders them)."""
+    _, _, controller_side = sides
+    tap = controller_side.tap
+    at_rest = np.zeros(4)
+
+    def command(t, torque):
+        return SimpleNamespace(t=t, wheel_torques=[torque] * 4)
+
+    def sample(t):
+        return SimpleNamespace(t=t, speeds=at_rest)
+
+    controller_side.feed("/actuator/command", 1.00, command(1.00, 0.1))
+    assert controller_side.feed("/sensors/wheel_speeds", 0.95, sample(0.95)) == []
+    controller_side.feed("/sensors/wheel_speeds", 1.00, sample(1.00))
+    assert np.all(tap.torques != 0.1)                        # the command of 1.00 is not in force yet
+    controller_side.feed("/actuator/command", 1.05, command(1.05, 0.2))
+    controller_side.feed("/sensors/wheel_speeds", 1.05, sample(1.05))
+    assert np.all(tap.torques == 0.1)                        # over [1.00, 1.05]: the command of 1.00
+    controller_side.feed("/sensors/wheel_speeds", 1.10, sample(1.10))
+    assert np.all(tap.torques == 0.2)
