@@ -160,3 +160,16 @@ def test_a_tachometer_sample_meets_the_command_in_force_over_its_interval_whatev
     assert np.all(tap.torques == 0.1)                        # over [1.00, 1.05]: the command of 1.00
     controller_side.feed("/sensors/wheel_speeds", 1.10, sample(1.10))
     assert np.all(tap.torques == 0.2)
+
+
+def test_the_in_process_loop_reads_either_node_s_fault_table_parameter():
+    from att_planner.tools.closed_loop import ClosedLoop
+    from att_sim.models import scenario as scen
+
+    s = scen.load("leo_pyramid")
+    loop = ClosedLoop(s, overrides={"estimator": {"fault_table": "default"}})
+    assert loop.onboard is not None and loop.monitor.table == tables.read()
+    assert loop.onboard.estimator is loop.estimator and loop.onboard.controller is loop.controller
+    with pytest.raises(ConfigError) as err:
+        ClosedLoop(s, overrides={"controller": {"fault_table": "no_such_table"}})
+    assert "parameter 'fault_table'" in err.value.message
