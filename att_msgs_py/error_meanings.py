@@ -103,6 +103,10 @@ MEANINGS: dict[ErrorCode, str] = {
         "the site (a strip: its first point) never rises above the instrument's minimum elevation within the "
         "planning window, or the slew arrives, or the dwell or scan runs, where it is below it"
     ),
+    ErrorCode.INVALID_WHEEL_SET: (
+        "a `PlanManeuver`'s `healthy_wheels` with a number of values other than the spacecraft's wheels (or "
+        "none), or healthy wheels whose axes do not span the body (the attitude cannot be controlled on them)"
+    ),
     ErrorCode.SOLVER_FAILED: 'the method failed (or its process died) and no safe fallback exists',
     ErrorCode.VERIFICATION_FAILED: (
         'the plan did not survive integration through the dynamics and no safe fallback exists'
@@ -170,6 +174,11 @@ MEANINGS: dict[ErrorCode, str] = {
         '(logged) a gyro stamp that does not move forward or jumps more than `max_gyro_gap_s` ahead (unless the '
         "gyro was silent for `resync_timeout_s`); a measurement older than the filter's history or more than "
         '`max_gyro_gap_s` ahead of the gyro'
+    ),
+    ErrorCode.INVALID_FAULT_REPORT: (
+        "(logged) a `FaultStatus` on `/estimator/faults` whose fault id the controller's fault table does not "
+        "declare, whose component or response is not that entry's, or whose index is below -1; a second "
+        "publisher of them while the held one is in the ROS graph"
     ),
     ErrorCode.INVALID_RESET: (
         '`/simulator/reset` with a non-finite field; an attitude whose norm is off 1 by more than 1e-3; the '

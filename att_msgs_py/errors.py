@@ -34,6 +34,7 @@ class ErrorCode(IntEnum):
     INVALID_OBSERVATION = 161     # a schedule's dwell or window: wrong length, not finite, negative, or too short
     INVALID_SITE = 162            # an imaging site or strip: NaN/Inf, out of range, zero length, absurd scan speed
     SITE_NOT_VISIBLE = 163        # the site or strip is below the minimum elevation where it would be imaged
+    INVALID_WHEEL_SET = 164       # healthy_wheels of the wrong length, or wheels that cannot control the attitude
     # planner: solving
     SOLVER_FAILED = 200           # the method failed and no fallback plan was possible
     VERIFICATION_FAILED = 201     # the plan did not survive integration through the dynamics
@@ -57,6 +58,7 @@ class ErrorCode(IntEnum):
     # estimator
     INVALID_MEASUREMENT = 320     # a sensor message with a bad field (discarded, reported)
     STALE_MEASUREMENT = 321       # a measurement older than the filter's history, or a gyro stamp not moving forward
+    INVALID_FAULT_REPORT = 322    # a fault report of a fault the table does not declare, or with another response
     # simulator
     INVALID_RESET = 400
     INVALID_COMMAND = 401         # actuator command with a bad field or stamp (refused, reported)

@@ -46,7 +46,8 @@ def _under(prefix: str, table: Mapping[str, int]) -> dict[str, int]:
 PLAN_MANEUVER = {**_HEADER, "cones": MAX_CONES, "cones[].name": MAX_NAME_LENGTH, "method": MAX_NAME_LENGTH,
                  "spacecraft": MAX_NAME_LENGTH, "option_names": MAX_OPTIONS, "option_values": MAX_OPTIONS,
                  "option_names[]": MAX_NAME_LENGTH, **_ZONES, "tle_line1": MAX_TLE_LENGTH,
-                 "tle_line2": MAX_TLE_LENGTH, "wheel_speeds": MAX_WHEELS, **_under("end_pointing.", _POINTING)}
+                 "tle_line2": MAX_TLE_LENGTH, "wheel_speeds": MAX_WHEELS, "healthy_wheels": MAX_WHEELS,
+                 **_under("end_pointing.", _POINTING)}
 PLAN_SCHEDULE = {**_HEADER, "target_names": MAX_TARGETS, "targets": MAX_TARGETS, "target_names[]": MAX_NAME_LENGTH,
                  "spacecraft": MAX_NAME_LENGTH, **_ZONES, "tle_line1": MAX_TLE_LENGTH, "tle_line2": MAX_TLE_LENGTH,
                  "dwell_times": MAX_TARGETS, "window_opens": MAX_TARGETS, "window_closes": MAX_TARGETS}
@@ -72,6 +73,8 @@ JOINT_STATE = {**_HEADER, "name": MAX_WHEELS, "name[]": MAX_NAME_LENGTH, "positi
 STAR_TRACKER = {**_HEADER, "sensor_frame_id": MAX_NAME_LENGTH}
 SUN_SENSORS = {**_HEADER, "values": MAX_SUN_SENSORS}
 HEADER_ONLY = _HEADER          # Imu, MagneticField: fixed-size fields besides their header
+FAULT_STATUS = {**_HEADER, "fault_id": MAX_NAME_LENGTH, "component": MAX_NAME_LENGTH, "detector": MAX_NAME_LENGTH,
+                "evidence": 400, "response": MAX_NAME_LENGTH}
 
 
 def inline_plan(table: Mapping[str, int] = EXECUTE_MANEUVER) -> dict[str, int]:

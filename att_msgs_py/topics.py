@@ -22,6 +22,8 @@ ZONE_MARGINS = "/simulator/zone_margins"     # the zones' truth margins, for plo
 PLAN_MARKERS = "/planner/plan_markers"       # the latest plan's boresight path
 MISSION_EVENTS = "/mission/events"           # att-mission's decisions, slews, dwells and missed targets
 SIM_FAULTS = "/simulator/faults"             # every hardware fault the truth started (evaluation only)
+CONTROLLER_FAULTS = "/controller/faults"     # the faults the controller's monitor detected and its responses
+ESTIMATOR_FAULTS = "/estimator/faults"       # the sensor faults the estimator's monitor detected
 
 PLAN_MANEUVER = "/planner/plan_maneuver"
 PLAN_SCHEDULE = "/planner/plan_schedule"
@@ -53,6 +55,8 @@ RECORDED = {
     PLAN_MARKERS: "visualization_msgs/msg/MarkerArray",
     MISSION_EVENTS: "att_msgs/msg/MissionEvent",
     SIM_FAULTS: "att_msgs/msg/FaultEvent",
+    CONTROLLER_FAULTS: "att_msgs/msg/FaultStatus",
+    ESTIMATOR_FAULTS: "att_msgs/msg/FaultStatus",
 }
 
 
@@ -82,6 +86,11 @@ ABOUT = {
     MISSION_EVENTS: "a mission's decisions, slews, dwells, parks and missed targets with why (latched)",
     SIM_FAULTS: "each hardware fault the truth started: component, index, kind, parameters, source (latched; "
                 "for evaluation only, no flight node reads it)",
+    CONTROLLER_FAULTS: "each fault the controller's monitor declared or cleared (with `fault_table`): fault id, "
+                       "component and index isolated, detector, evidence, response, detection time",
+    ESTIMATOR_FAULTS: "each sensor fault the estimator's monitor declared or cleared (with `fault_table`): a star "
+                      "tracker, the gyro or the magnetometer, its evidence and response (the controller acts on "
+                      "safe mode)",
     INJECT_FAULT: "inject a hardware fault into the truth at a sim time (refused unless the scenario sets "
                   "`allow_fault_injection`)",
     PLAN_MANEUVER: "plan a rest-to-rest maneuver (or one ending on a pointing law), verified and signed",

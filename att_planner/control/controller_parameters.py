@@ -69,6 +69,8 @@ CONTROLLER = ParameterTable("controller", (
                                                           "moving pointing reference", "s", 0.0, 3600.0),
     Parameter("safe_sun_axis", list, _C.safe_sun_axis, "body axis the safe mode points at the Sun once the rates are "
                                                        "damped (a unit vector)", "", -1.0, 1.0, length=3),
+    Parameter("fault_table", str, "", "fault table watched and acted on (docs/fdir.md): a name of config/faults or "
+                                      "a file's path; empty: no fault handling (needs state_source estimate)"),
     Parameter("plan_public_key", str, None, "Ed25519 public key file plans must be signed with",
               default_rule=_KEY_RULE),
     Parameter("max_start_attitude_error_deg", float, math.degrees(_P["max_start_attitude_error"]),

@@ -53,6 +53,9 @@ ESTIMATOR = ParameterTable("estimator", (
                                                       "gyro sample is refused", "s", 0.0, 3600.0, low_open=True),
     Parameter("resync_timeout_s", float, _E.resync_timeout, "wall time without a gyro sample after which the next "
                                                           "starts a new timeline", "s", 0.0, 3600.0, low_open=True),
+    Parameter("fault_table", str, "", "fault table whose sensor detectors the estimator runs, excluding a sensor "
+                                      "isolated (docs/fdir.md): a name of config/faults or a file's path; empty: "
+                                      "none"),
     Parameter("wait_for_subscribers", int, 0, "subscribers to the estimate that must listen before the estimator "
                                               "takes its inputs", "", 0, 1000),
     Parameter("start_timeout_s", float, 60.0, "wall time waited for those subscribers before taking inputs anyway",

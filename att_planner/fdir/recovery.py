@@ -50,11 +50,14 @@ class SafeActuator:
 
 
 def act(r: Responses, controller, estimator=None) -> ManeuverResult | None:
-    """Fly ``controller`` (and ``estimator``, when given) on the responses ``r`` (module docstring); the
-    result of a maneuver that safe mode aborted."""
-    controller.healthy = None if all(r.healthy_wheels) else tuple(r.healthy_wheels)
+    """Fly ``controller`` (and ``estimator``, when given; a controller None: the estimator alone, as in
+    the estimator node) on the responses ``r`` (module docstring); the result of a maneuver that safe
+    mode aborted."""
     if estimator is not None:
         estimator.excluded = set(r.excluded_sensors)
+    if controller is None:
+        return None
+    controller.healthy = None if all(r.healthy_wheels) else tuple(r.healthy_wheels)
     ended = None
     if r.safe_mode:
         if controller.mode != ControlMode.SAFE:

@@ -21,14 +21,16 @@ The decisions, each from where the spacecraft holds at that moment:
 3. when none can wait there, the spacecraft parks at a source, or at one of the scheduler's sky
    park attitudes (:func:`~att_planner.mission.scheduler.sky_parks`: directions spread over the
    sky, so that a mission of few sources still has somewhere clear to go), clear until the first
-   one's start (the nearest three tried), or holds for :data:`~att_planner.mission.holds.RECOVERY_STEP` s, and decides again;
+   one's start (the nearest three tried), or holds for
+   :data:`~att_planner.mission.holds.RECOVERY_STEP` s, and decides again;
 4. the controller flies the plan and holds the target for its dwell (a ground site after the
    controller's blend into its law); then back to 1. A slew the planner or the controller refuses
    counts as an attempt at its target when the held attitude can start another slew: after
    :data:`MAX_ATTEMPTS` attempts the target is missed;
 5. a held attitude that cannot start a slew (estimate not converged, a zone or the trackers' blind
    sky within the lead) is recovered: left for a park when a zone is about to cover it and the
-   estimate is converged, else held until a slew can start (checked every :data:`~att_planner.mission.holds.RECOVERY_STEP` s,
+   estimate is converged, else held until a slew can start (checked every
+   :data:`~att_planner.mission.holds.RECOVERY_STEP` s,
    :data:`~att_planner.mission.holds.RECOVERY_LIMIT` s at most);
 6. with no target left, the spacecraft holds until the horizon, leaving a zone's path by a park, and
    reports the end.

@@ -26,6 +26,17 @@ The states (or estimates) are held to one publisher: another one is ignored whil
 in the ROS graph (:class:`att_msgs_py.source_hold.SourceHold`), so neither pausing nor starving the
 real source hands the loop to an intruder; a silent source is stale input (the watchdog below).
 
+Faults: with ``fault_table`` (a name of ``config/faults`` or a file's path; empty, the default: off;
+it needs ``state_source`` estimate) the node runs the table's monitor on what it has
+(:class:`att_planner.fdir.onboard.Onboard`: the wheel speeds against its commands, the estimates, its
+attitude error), hears the estimator's reports on ``/estimator/faults`` (held to one publisher;
+refused, 322, unless the table declares them as reported), publishes its own on the latched
+``/controller/faults`` (att_msgs/FaultStatus), names the active faults in the status message and acts
+on the responses of both (:func:`att_planner.fdir.recovery.act`: the allocation on the healthy wheels,
+safe mode). A wheel isolated during a maneuver: it brakes (:class:`att_planner.fdir.replan.Brake`),
+asks ``/planner/plan_maneuver`` for the rest on the healthy wheels (``healthy_wheels``) and flies it;
+the execute goal ends with the re-planned maneuver, or unsuccessfully with why (then safe mode).
+
 Watchdog: when no state came for ``wall_timeout_s`` of wall time the controller commands zero
 and reports ``state_stale`` until states flow again.
 
@@ -40,6 +51,7 @@ clock from the simulator).
 from __future__ import annotations
 
 import time
+from datetime import timedelta
 
 from rclpy.action import ActionServer, CancelResponse, GoalResponse
 from rclpy.clock import Clock, ClockType
@@ -50,10 +62,17 @@ from rosgraph_msgs.msg import Clock as ClockMsg
 from sensor_msgs.msg import JointState, MagneticField
 
 from att_msgs.action import ExecuteManeuver
-from att_msgs.msg import ActuatorCommand, AttitudeEstimate, ControllerStatus, ManeuverPlan, SpacecraftState
-from att_msgs.srv import SetControllerMode
+from att_msgs.msg import (
+    ActuatorCommand,
+    AttitudeEstimate,
+    ControllerStatus,
+    FaultStatus,
+    ManeuverPlan,
+    SpacecraftState,
+)
+from att_msgs.srv import PlanManeuver, SetControllerMode
 from att_msgs_py import convert, limits, memory, qos, signing, topics
-from att_msgs_py.errors import ErrorCode, RequestError
+from att_msgs_py.errors import ConfigError, ErrorCode, RequestError, clip
 from att_msgs_py.node_runner import (
     ParameterReader,
     RefusalLog,
@@ -64,12 +83,16 @@ from att_msgs_py.node_runner import (
     run_node,
     subscribe_when_heard,
 )
-from att_msgs_py.types import ManeuverResult
+from att_msgs_py.types import ControlKind, ControlMode, ManeuverResult
+from att_planner import methods
 from att_planner.control.controller_from_scenario import controller_from_scenario, public_key
 from att_planner.control.controller_parameters import CONTROLLER
 from att_planner.control.mode_authentication import ModeAuthentication, default_sequence_path
 from att_planner.control.plan_checks import check_message
 from att_planner.estimation.inputs import Sources
+from att_planner.fdir.onboard import Onboard, load_table
+from att_planner.fdir.replan import REPLAN, SAFE, Brake
+from att_planner.nodes.client import maneuver_request
 from att_sim.models import scenario as scen
 
 
@@ -91,7 +114,12 @@ class ControllerNode(Node):
         ahead = param("mode_sequence_ahead_s")
         if signed:
             self._core.authentication = ModeAuthentication(mode_key, sequences, ahead)
+        fault_table = load_table(param("fault_table"))
         param.refuse_unknown()
+        if fault_table is not None and self._core.measured is None:
+            raise ConfigError(ErrorCode.INVALID_PARAMETER, "parameter 'fault_table': expected state_source estimate "
+                                                           "(the monitor watches the measured wheel speeds and the "
+                                                           "estimate); found state_source truth")
         if self._core.authentication.warning:
             self.get_logger().warning(self._core.authentication.warning)
         self._state_wall = time.monotonic()   # no "no state" warning before wall_timeout_s has passed
@@ -102,6 +130,10 @@ class ControllerNode(Node):
         self._sources = Sources({"wheel speed measurement": live_publishers(self, topics.WHEEL_SPEEDS),
                                  "magnetometer measurement": live_publishers(self, topics.MAGNETOMETER)})
         self._done: Future | None = None
+        self._fdir = None if fault_table is None else Onboard(fault_table, self._scenario, self._core)
+        self._brake = Brake()                 # the brake before a re-plan after a wheel loss
+        self._replan_of = None                # the plan of the maneuver being re-planned (None: none)
+        self._replanning: Future | None = None   # the planner's answer awaited
 
         self._cmd_pub = self.create_publisher(ActuatorCommand, topics.COMMAND, qos.STREAM_QOS)
         self._status_pub = self.create_publisher(ControllerStatus, topics.CONTROLLER_STATUS, qos.STREAM_QOS)
@@ -109,13 +141,19 @@ class ControllerNode(Node):
         self.create_subscription(ManeuverPlan, topics.PLANS, self.on_plan, qos.LATCHED_QOS)
         self.create_subscription(ClockMsg, topics.CLOCK, self.on_clock, qos.CLOCK_QOS)
         self.create_service(SetControllerMode, topics.SET_CONTROLLER_MODE, self.on_set_mode)
+        if self._fdir is not None:
+            self._fault_pub = self.create_publisher(FaultStatus, topics.CONTROLLER_FAULTS, qos.MISSION_QOS)
+            self._planner = self.create_client(PlanManeuver, topics.PLAN_MANEUVER, qos_profile=qos.SERVICE_QOS)
+            self._fault_sources = Sources({"estimator fault report": live_publishers(self, topics.ESTIMATOR_FAULTS)})
+            self.create_subscription(FaultStatus, topics.ESTIMATOR_FAULTS, self.on_estimator_fault, qos.MISSION_QOS)
         self.create_timer(0.5, self.on_wall_watchdog, clock=Clock(clock_type=ClockType.STEADY_TIME))
         self._action = ActionServer(self, ExecuteManeuver, topics.EXECUTE_MANEUVER, execute_callback=self.execute,
                                     goal_callback=self.on_goal, cancel_callback=lambda _: CancelResponse.ACCEPT)
         c = self._core.config
         source = "truth" if self._core.measured is None else "estimate"
         self.get_logger().info(f"scenario '{self._scenario.name}', state from the {source}, mode {self._core.mode}, "
-                               f"friction compensation {'on' if self._core.friction else 'off'}, plan key "
+                               f"friction compensation {'on' if self._core.friction else 'off'}, fault table "
+                               f"{'off' if self._fdir is None else 'on'}, plan key "
                                f"{signing.key_id(self._core.context.public_key)}; magnetorquer gains "
                                f"kp={c.kp:.6g} kd={c.kd:.6g} m_max={self._core.m_max:g}")
 
@@ -149,19 +187,21 @@ class ControllerNode(Node):
         if outcome.refused is not None and outcome.refused.code == ErrorCode.NO_STATE:
             self._waiting = (estimate, source)   # the first wheel speeds are on their way: answer then
             return
-        self._step(outcome, "attitude estimate")
+        self._step(outcome, "attitude estimate", estimate)
 
     def on_wheel_speeds(self, msg: JointState, info: dict):
         try:
             limits.check(msg, limits.JOINT_STATE, "wheel_speeds")
+            speeds = convert.wheel_speeds_from_msg(msg)
             self._sources.guarded("wheel speed measurement", publisher_of(info), self._core.measured.on_wheel_speeds,
-                                  convert.wheel_speeds_from_msg(msg))
+                                  speeds)
         except RequestError as err:
             self._refusals("wheel speed measurement", err)
             return
+        self._watch(topics.WHEEL_SPEEDS, speeds.t, speeds)
         if self._waiting is not None:
             (estimate, source), self._waiting = self._waiting, None
-            self._step(self._core.accept_estimate(estimate, time.monotonic(), source), "attitude estimate")
+            self._step(self._core.accept_estimate(estimate, time.monotonic(), source), "attitude estimate", estimate)
 
     def on_magnetometer(self, msg: MagneticField, info: dict):
         try:
@@ -171,11 +211,14 @@ class ControllerNode(Node):
         except RequestError as err:
             self._refusals("magnetometer measurement", err)
 
-    def _step(self, outcome, what: str) -> None:
-        """After a state or estimate: report, and command when a control instant is due."""
+    def _step(self, outcome, what: str, estimate=None) -> None:
+        """After a state or estimate: report, act on the fault monitor, and command when a control instant
+        is due."""
         if outcome.refused is not None:
             self._refusals(what, outcome.refused)
             return
+        if estimate is not None:
+            self._watch(topics.ESTIMATE, estimate.t, estimate)
         if outcome.note:
             self.get_logger().warning(outcome.note)
         if outcome.ended is not None:
@@ -184,14 +227,132 @@ class ControllerNode(Node):
         if self._stale:
             self._stale = False
             self.get_logger().info("state is fresh again")
+        if self._fdir is not None:
+            self._respond()
         if self._core.due():
             out = self._core.step(cancel_requested=self._goal is not None and self._goal.is_cancel_requested)
+            if self._fdir is not None:
+                self._watch(topics.COMMAND, out.command.t, out.command)
+                self._watch(topics.CONTROLLER_STATUS, out.status.t, out.status)
+                out.status.message = self._with_faults(out.status.message)
             self._cmd_pub.publish(convert.command_msg(out.command))
             self._status_pub.publish(convert.controller_status_msg(out.status))
             if out.feedback is not None and self._goal is not None:
                 self._to_client("feedback", self._goal.publish_feedback, convert.feedback_msg(out.feedback))
             if out.result is not None:
                 self.finish(out.result)
+
+    # -- faults ---------------------------------------------------------------------------------------
+    def _watch(self, topic: str, t: float, message) -> None:
+        """Feed the fault monitor (when configured) and publish what it reported."""
+        if self._fdir is None:
+            return
+        for report in self._fdir.feed(topic, t, message):
+            self._fault_pub.publish(convert.fault_status_msg(report))
+            log = self.get_logger().warning if report.active else self.get_logger().info
+            log(clip(f"fault {report.fault_id} on {report.component} {report.index} "
+                     f"{'declared' if report.active else 'cleared'} at t = {report.t:.2f} s ({report.detector}: "
+                     f"{report.evidence}); response {report.response}"))
+
+    def on_estimator_fault(self, msg: FaultStatus, info: dict):
+        """A report of the estimator's monitor: its responses are acted on with this monitor's (held to one
+        publisher; a fault the table does not declare as reported is refused, 322)."""
+        try:
+            limits.check(msg, limits.FAULT_STATUS, "fault")
+            report = convert.fault_status_from_msg(msg)
+            refused = self._fault_sources.guarded("estimator fault report", publisher_of(info), self._fdir.hear,
+                                                  report)
+        except RequestError as err:
+            refused = err
+        if refused is not None:
+            self._refusals("estimator fault report", refused)
+            return
+        self.get_logger().info(clip(f"estimator fault {report.fault_id} on {report.component} {report.index} "
+                                    f"{'declared' if report.active else 'cleared'} ({report.response})"))
+
+    def _with_faults(self, message: str) -> str:
+        """The status message with the active faults named (the fault topic has their reports)."""
+        active = sorted(f"{f.fault_id}[{f.index}]" for f in [*self._fdir.monitor.active.values(),
+                                                             *self._fdir.heard.values()])
+        return clip(f"{message}; faults: {', '.join(active)}" if active and message else
+                    f"faults: {', '.join(active)}" if active else message)
+
+    def _respond(self) -> None:
+        """Act on the monitor's responses (:meth:`Onboard.respond`); after a wheel isolated mid-maneuver,
+        brake, then ask the planner for the rest on the healthy wheels (:mod:`att_planner.fdir.replan`):
+        the execute goal in flight ends with the re-planned maneuver."""
+        ended, changed = self._fdir.respond()
+        if ended is not None:                      # safe mode aborted the maneuver
+            self._replan_of, self._brake.since = None, None
+            self.finish(ended)
+        core, t = self._core, self._core.state.t
+        if changed and (core.maneuver is not None or self._replan_of is not None):
+            self._replan_of = core.maneuver.plan if core.maneuver is not None else self._replan_of
+            self._brake.begin(core, t)
+            self.get_logger().warning(f"healthy wheels {list(core.healthy or ())}: braking at t = {t:.2f} s to "
+                                      f"re-plan maneuver '{self._replan_of.plan_id}'")
+        if self._replan_of is not None and (core.mode == ControlMode.SAFE or self._goal is not None
+                                            and self._goal.is_cancel_requested):
+            why = "safe mode" if core.mode == ControlMode.SAFE else "cancelled"
+            self._replan_of = self._brake.since = None
+            self.finish(ManeuverResult(False, int(ErrorCode.ABORTED), f"{why} while re-planning"))
+            return
+        said = self._brake.poll(core, t)
+        if said == SAFE:
+            self._give_up(self._brake.why)
+        elif said == REPLAN and self._replanning is None:
+            self._request_replan()
+
+    def _request_replan(self) -> None:
+        """Ask the planner for the rest of the interrupted maneuver, from the estimate at rest to its
+        goal among its cones and zones, for the healthy wheels' envelope (``healthy_wheels``)."""
+        plan, state = self._replan_of, self._core.state
+        epoch = None if self._scenario.epoch is None else self._scenario.epoch + timedelta(seconds=state.t)
+        try:
+            request = maneuver_request(state.q, plan.q[-1], plan.sensor_axis, plan.cones,
+                                       method=plan.method if plan.method in methods.METHODS else "",
+                                       frame_id=self._scenario.frame_id, epoch=epoch, zones=plan.zones)
+        except ValueError as err:
+            return self._give_up(f"no re-plan request: {err}")
+        request.healthy_wheels = [bool(h) for h in (self._core.healthy or ())]
+        if not self._planner.service_is_ready():
+            return self._give_up(f"no re-plan: the planner service {topics.PLAN_MANEUVER} is not available")
+        self.get_logger().info(f"re-planning from t = {state.t:.2f} s on wheels {list(request.healthy_wheels)}")
+        self._replanning = self._planner.call_async(request)
+        self._replanning.add_done_callback(self._on_replan)
+
+    def _on_replan(self, future) -> None:
+        self._replanning = None
+        if self._replan_of is None:               # cancelled or safe mode meanwhile
+            return
+        try:
+            response = future.result()
+        except Exception as exc:  # a call the middleware failed: no re-plan, never a dead callback
+            response, exc_text = None, f"{type(exc).__name__}: {exc}"
+        else:
+            exc_text = "no answer"
+        if response is None or not response.success:
+            why = exc_text if response is None else f"code {response.error_code}: {response.message}"
+            return self._give_up(f"no verified re-plan ({why})")
+        msg = response.plan
+        refused = limits.issue(msg, limits.MANEUVER_PLAN, "plan") or check_message(msg)
+        plan = None
+        if refused is None:
+            plan, refused = self._core.resolve(msg.plan_id, convert.plan_from_msg(msg), signing.payload(msg))
+        if refused is None and plan.control_kind == ControlKind.WHEEL_TORQUE:
+            refused = RequestError(ErrorCode.INVALID_PLAN, "a re-plan of wheel torques (flown as body torques only)")
+        refused = refused or self._core.start(plan)
+        if refused is not None:
+            return self._give_up(f"the re-plan did not start: code {int(refused.code)}: {refused.message}")
+        self._replan_of = None
+        self.get_logger().info(f"flying re-plan '{plan.plan_id}' ({plan.method}, {plan.duration:.1f} s)")
+
+    def _give_up(self, why: str) -> None:
+        """No re-plan: safe mode; the execute goal in flight ends with why."""
+        self._replan_of, self._brake.since = None, None
+        self.get_logger().error(clip(f"re-planning after a wheel loss failed: {why}; safe mode"))
+        self._core.set_mode(ControlMode.SAFE)
+        self.finish(ManeuverResult(False, int(ErrorCode.ABORTED), clip(f"re-planning failed: {why}")))
 
     def on_plan(self, msg: ManeuverPlan):
         refused = (limits.issue(msg, limits.MANEUVER_PLAN, "plan") or check_message(msg)
@@ -223,7 +384,8 @@ class ControllerNode(Node):
 
     # -- action -----------------------------------------------------------------------------------
     def on_goal(self, goal: ExecuteManeuver.Goal):
-        return GoalResponse.REJECT if self._core.maneuver is not None else GoalResponse.ACCEPT
+        busy = self._core.maneuver is not None or self._replan_of is not None
+        return GoalResponse.REJECT if busy else GoalResponse.ACCEPT
 
     async def execute(self, goal_handle):
         """Start tracking and wait (without blocking the executor) until the control loop ends

@@ -132,7 +132,7 @@ class PlannerNode(Node):
         response.slowdown = outcome.slowdown
         self.answer(response, outcome, valid.spacecraft, valid.method.name, sensor_axis=valid.problem.sensor_axis,
                     cones=valid.problem.cones, zones=valid.problem.zones, epoch=valid.problem.epoch,
-                    spacecraft_digest=valid.problem.spacecraft.digest)
+                    spacecraft_digest=valid.spacecraft_digest)
         return response
 
     def on_plan_schedule(self, request: PlanSchedule.Request, response: PlanSchedule.Response):
@@ -276,7 +276,7 @@ def maneuver_from_msg(request) -> ManeuverRequest:
         epoch=convert.epoch_parts(request.epoch), zones=[convert.zone_from_msg(z) for z in request.zones],
         tle_line1=request.tle_line1, tle_line2=request.tle_line2,
         wheel_speeds=list(request.wheel_speeds),
-        end_pointing=convert.pointing_from_msg(request.end_pointing))
+        end_pointing=convert.pointing_from_msg(request.end_pointing), healthy_wheels=list(request.healthy_wheels))
 
 
 def _image_common(request) -> dict:

@@ -28,6 +28,7 @@ from att_msgs_py.types import Cone, PointingMode
 from att_msgs_py.validation import MAX_NAME_LENGTH, finite_array, text, unit_quaternion, unit_vector
 from att_planner import methods
 from att_planner.cones import BOUNDARY_TOLERANCE, boundary_arc_issue, check_zones, endpoint_in_cone
+from att_planner.fdir.envelope import planning_spacecraft
 from att_planner.methods import Method
 from att_planner.problem import ManeuverProblem, MovingGoal
 from att_planner.service.moving_goal import goal_law
@@ -67,6 +68,7 @@ class ManeuverRequest:
     tle_line2: str = ""
     wheel_speeds: list = field(default_factory=list)   # rad/s relative to the body at the start; empty: stopped
     end_pointing: PointingMode | None = None           # end on this mode's attitude and rate (kind ''/None: at rest)
+    healthy_wheels: list = field(default_factory=list)  # the wheels the plan may use (empty: every one)
     # a goal the service builds (not from the wire): (scenario, epoch) ↦ (law t ↦ (q, ω), kind); a strip's start
     end_goal: Callable | None = None
 
@@ -78,6 +80,7 @@ class ValidRequest:
     options: dict
     spacecraft: str
     time_budget: float
+    spacecraft_digest: str = ""      # of the configuration named (the problem's model may be its healthy wheels')
 
 
 def check_spacecraft(sc: Spacecraft, name: str) -> None:
@@ -215,9 +218,14 @@ def validate_maneuver(req: ManeuverRequest, *, frame_id: str, default_spacecraft
     options, limits = method.split(check_options(method, list(req.option_names), list(req.option_values)))
     budget = check_budget(float(req.time_budget), default_budget)
     real = resolve_sky(*req.epoch, req.zones, req.tle_line1, req.tle_line2, scenario)
-    problem = ManeuverProblem(scenario.spacecraft, q0, qf, r, cones, sensor_target=sensor_target, zones=real.zones,
-                              epoch=real.epoch, sky=real.sky if real.moving else None,
-                              wheel_speeds=check_wheel_speeds(req.wheel_speeds, scenario.spacecraft), **limits)
+    healthy = check_healthy_wheels(req.healthy_wheels, scenario.spacecraft)
+    speeds = check_wheel_speeds(req.wheel_speeds, scenario.spacecraft)
+    sc = scenario.spacecraft
+    if healthy is not None:
+        sc = planning_spacecraft(sc, healthy)
+        speeds = None if speeds is None else speeds[healthy]
+    problem = ManeuverProblem(sc, q0, qf, r, cones, sensor_target=sensor_target, zones=real.zones,
+                              epoch=real.epoch, sky=real.sky if real.moving else None, wheel_speeds=speeds, **limits)
     if req.end_pointing is not None and req.end_pointing.kind:
         _end_on_pointing(problem, req, method, scenario)
     elif req.end_goal is not None:
@@ -226,7 +234,7 @@ def validate_maneuver(req: ManeuverRequest, *, frame_id: str, default_spacecraft
     check_sky(problem, real)
     check_reachable(problem)
     problem.deadline = received + budget          # set last: the zone sky built by the checks stays cached
-    return ValidRequest(problem, method, options, name, budget)
+    return ValidRequest(problem, method, options, name, budget, scenario.spacecraft.digest)
 
 
 @dataclass
@@ -307,6 +315,23 @@ def check_wheel_speeds(speeds, sc: Spacecraft) -> np.ndarray | None:
                            f"wheel_speeds[{over[0]}] = {out[over[0]]:g} rad/s is beyond the wheels' limit of "
                            f"{sc.wheel_speed_max:g} rad/s")
     return out
+
+
+def check_healthy_wheels(healthy, sc: Spacecraft) -> np.ndarray | None:
+    """The wheels a plan may use: none given (every one), or one flag per wheel whose true ones span
+    the body (the plan is then made for their envelope, :func:`att_planner.fdir.envelope.planning_spacecraft`)."""
+    if len(healthy) == 0:
+        return None
+    if len(healthy) != sc.n_wheels:
+        raise RequestError(ErrorCode.INVALID_WHEEL_SET,
+                           f"healthy_wheels: expected {sc.n_wheels} values (one per wheel of the spacecraft) or "
+                           f"none; found {len(healthy)}")
+    mask = np.array([bool(h) for h in healthy], bool)
+    if not mask.any() or np.linalg.matrix_rank(sc.wheel_axes[:, mask]) < 3:
+        raise RequestError(ErrorCode.INVALID_WHEEL_SET,
+                           f"healthy_wheels: expected healthy wheels whose axes span the body; found "
+                           f"{mask.tolist()}, on which the attitude cannot be controlled")
+    return mask
 
 
 def check_budget(budget: float, default: float) -> float:

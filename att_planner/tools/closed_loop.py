@@ -92,7 +92,8 @@ class ClosedLoop:
         seed (default the scenario's); ``simulation``: a prepared one (e.g. a dispersed truth);
         ``key``: the plan-signing key (default a new one; loops sharing one can share issued plans);
         ``fault_table``: a fault table (:class:`att_planner.fdir.table.FaultTable` or its file path)
-        watched and acted on (None: no fault handling)."""
+        watched and acted on (None: the controller's ``fault_table`` parameter, empty by default: no fault
+        handling)."""
         overrides = overrides or {}
         unknown = sorted(set(overrides) - {"simulator", "controller", "estimator"})
         if unknown:
@@ -109,12 +110,14 @@ class ClosedLoop:
         ctl_param = SectionReader(CONTROLLER, sections.get("controller", {}), str(scenario.node_params_path),
                                   overrides.get("controller"))
         self.controller = controller_from_scenario(ctl_param, scenario, key=self.key.public_key())
+        table_param = ctl_param("fault_table")
         ctl_param.refuse_unknown()
         self.estimator = None
         if self.controller.measured is not None:
             est_param = SectionReader(ESTIMATOR, sections.get("estimator", {}), str(scenario.node_params_path),
                                       overrides.get("estimator"))
             self.estimator = estimator_from_scenario(est_param, scenario)
+            table_param = table_param or est_param("fault_table")      # one monitor in process runs both sides'
             est_param.refuse_unknown()
         self.scenario = scenario
         self.sim = simulation or Simulation.for_scenario(
@@ -126,21 +129,21 @@ class ClosedLoop:
         self.next_state = 0.0
         self.result: ManeuverResult | None = None
         self.tap = None     # optional (topic, t, mirror object) of everything the nodes would publish: a log
-        self.monitor = self.monitor_tap = None
+        self.monitor = self.monitor_tap = self.onboard = None
         self.recovery = None  # optional (loop, healthy before, healthy after) when the healthy wheels change
-        self._reports_seen = 0
+        if fault_table is None and table_param:
+            from att_planner.fdir.onboard import load_table
+            fault_table = load_table(table_param)
         if fault_table is not None:
             self._watch(fault_table)
 
     def _watch(self, fault_table) -> None:
         from att_planner.fdir import table as fault_tables
-        from att_planner.fdir.monitor import FaultMonitor
-        from att_planner.fdir.tap import MonitorTap
+        from att_planner.fdir.onboard import Onboard
 
         ft = fault_table if isinstance(fault_table, fault_tables.FaultTable) else fault_tables.read(fault_table)
-        self.monitor = FaultMonitor(ft, self.scenario.spacecraft, self.scenario.sensors,
-                                    self.scenario.body_frame_id)
-        self.monitor_tap = MonitorTap(self.monitor, self.estimator, self.controller.friction)
+        self.onboard = Onboard(ft, self.scenario, self.controller, self.estimator)
+        self.monitor, self.monitor_tap = self.onboard.monitor, self.onboard.tap
 
     def _emit(self, topic: str, t: float, m) -> None:
         if self.monitor_tap is not None:
@@ -149,17 +152,15 @@ class ClosedLoop:
             self.tap(topic, t, m)
 
     def respond(self) -> None:
-        """Act on the monitor's responses when it reported something new (:func:`att_planner.fdir.recovery.act`)."""
-        from att_planner.fdir import recovery
-
-        if self.monitor is None or len(self.monitor.history) == self._reports_seen:
+        """Act on the monitor's responses when it reported something new
+        (:meth:`att_planner.fdir.onboard.Onboard.respond`)."""
+        if self.onboard is None:
             return
-        self._reports_seen = len(self.monitor.history)
         before = self.controller.healthy
-        ended = recovery.act(self.monitor.responses(), self.controller, self.estimator)
+        ended, changed = self.onboard.respond()
         if ended is not None:
             self.result = ended
-        if self.controller.healthy != before and self.recovery is not None:
+        if changed and self.recovery is not None:
             self.recovery(self, before, self.controller.healthy)
 
     # -- plans ------------------------------------------------------------------------------------

@@ -1,10 +1,9 @@
 """A maneuver flown through faults in process: a wheel isolated mid-slew brakes, re-plans and flies on.
 
 :class:`Replanner`, set as :attr:`att_planner.tools.closed_loop.ClosedLoop.recovery`, is called when
-the fault monitor's healthy wheels change. During a maneuver it ends it and holds the estimated
-attitude at rest on the healthy wheels (:meth:`att_planner.control.controller.Controller.hold`, the
-allocation already on them); once the estimated rate is below the controller's start tolerance it
-plans the rest of the maneuver from the estimated attitude to the goal among the scenario's zones
+the fault monitor's healthy wheels change. During a maneuver it brakes
+(:class:`att_planner.fdir.replan.Brake`: the estimated attitude held at rest on the healthy wheels);
+once braked it plans the rest of the maneuver from the estimated attitude to the goal among the scenario's zones
 for the envelope of the healthy wheels (:func:`att_planner.fdir.envelope.planning_spacecraft`),
 verified by the planner's own checks (:func:`~att_planner.tools.closed_loop.plan_in_process`), and
 flies it. Without a verified plan, or healthy wheels that cannot control the attitude, safe mode.
@@ -12,18 +11,14 @@ flies it. Without a verified plan, or healthy wheels that cannot control the att
 """
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field
-from datetime import timedelta
-
-import numpy as np
 
 from att_msgs_py.errors import RequestError
 from att_msgs_py.types import ControlKind, ControlMode, ManeuverResult, Plan
 from att_planner.fdir.envelope import planning_spacecraft
+from att_planner.fdir.replan import REPLAN, SAFE, Brake, utc_epoch
 from att_planner.tools.closed_loop import ClosedLoop, plan_in_process
 
-BRAKE_LIMIT_S = 120.0     # s of sim time the hold may take to bring the rate under the start tolerance
 SAFE_HOLD_S = 120.0       # s of sim time :func:`fly` watches safe mode held before it stops
 
 
@@ -33,37 +28,29 @@ class Replanner:
     :func:`att_planner.service.warm.maneuver_from_scenario`) and what the recovery did."""
 
     goal: dict
-    braking_since: float | None = None
+    brake: Brake = field(default_factory=Brake)
     healthy: tuple[bool, ...] | None = None
     replans: list[dict] = field(default_factory=list)      # each: t, healthy, verified, method, duration, why
     safe_mode: bool = False
     why: str = ""
 
+    @property
+    def braking_since(self) -> float | None:
+        return self.brake.since
+
     def __call__(self, loop: ClosedLoop, before, after) -> None:
-        ctl = loop.controller
         self.healthy = after
-        if ctl.maneuver is None and self.braking_since is None and not self.replans:
+        if loop.controller.maneuver is None and self.brake.since is None and not self.replans:
             return                     # not flying: the hold or pointing goes on on the healthy wheels
-        if ctl.mode == ControlMode.SAFE:
-            return
-        ctl.hold("a wheel isolated: braking to re-plan on the healthy wheels")
-        self.braking_since = loop.sim.t
+        self.brake.begin(loop.controller, loop.sim.t)
 
     def poll(self, loop: ClosedLoop) -> None:
         """At each step: once braked, re-plan and fly (or safe mode)."""
-        ctl = loop.controller
-        if self.braking_since is None or ctl.state is None:
-            return
-        if ctl.mode == ControlMode.SAFE:          # the monitor's responses asked for it meanwhile
-            self.braking_since = None
-            return
-        rate = float(np.linalg.norm(ctl.state.omega))
-        if rate > 0.5 * ctl.context.max_start_rate_error:
-            if loop.sim.t - self.braking_since > BRAKE_LIMIT_S:
-                self._safe(loop, f"the rate stayed at {rate:.3g} rad/s for {BRAKE_LIMIT_S:g} s of braking")
-            return
-        self.braking_since = None
-        self.replan(loop)
+        said = self.brake.poll(loop.controller, loop.sim.t)
+        if said == SAFE:
+            self._safe(loop, self.brake.why)
+        elif said == REPLAN:
+            self.replan(loop)
 
     def replan(self, loop: ClosedLoop) -> None:
         ctl, s, g = loop.controller, loop.scenario, self.goal
@@ -76,13 +63,9 @@ class Replanner:
             entry["why"] = str(err)
             self._safe(loop, f"no re-plan: {err}")
             return
-        epoch = (0, 0)
-        if s.epoch is not None:
-            at = (s.epoch + timedelta(seconds=float(loop.sim.t))).timestamp()
-            epoch = (math.floor(at), round((at - math.floor(at)) * 1e9))
         try:
             plan = plan_in_process(s, ctl.state.q, g["qf"], g["sensor"], g["cones"], g["zones"], g["method"],
-                                   g["time_budget"], epoch=epoch, spacecraft=sc)
+                                   g["time_budget"], epoch=utc_epoch(s.epoch, loop.sim.t), spacecraft=sc)
         except RequestError as err:
             entry["why"] = f"code {int(err.code)}: {err.message}"
             self._safe(loop, f"no verified re-plan: {entry['why']}")

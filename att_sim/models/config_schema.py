@@ -109,7 +109,8 @@ class CircularOrbit(Schema):
     renamed: ClassVar = {"altitude": "altitude_m", "arg0": "arg0_rad"}
 
     type: Literal["circular"] = "circular"
-    altitude_m: float = number(450e3, gt=0.0, unit="m", meaning="altitude above the WGS-84 equatorial radius, 6378.137 km")
+    altitude_m: float = number(450e3, gt=0.0, unit="m",
+                               meaning="altitude above the WGS-84 equatorial radius, 6378.137 km")
     inclination_deg: Finite = Field(87.0, description="inclination (deg)")
     raan_deg: Finite = Field(0.0, description="right ascension of the ascending node (deg)")
     arg0_rad: Finite = Field(0.0, description="argument of latitude at sim time zero (rad)")

@@ -11,10 +11,11 @@ from att_msgs_py import topics
 from att_sim.models import rotations as rot
 
 FIXTURE = Path(__file__).parents[1] / "data" / "swift_short.mcap"
-# the 3D view's topics, the mission events and the injected faults are recorded since after the fixture
-# was made (test_scene_ros, test_mission and test_simulator_faults check them)
+# the 3D view's topics, the mission events, the injected faults and the fault reports are recorded since
+# after the fixture was made (test_scene_ros, test_mission, test_simulator_faults and test_fault_recovery
+# check them)
 VIEW_TOPICS = {topics.TF, topics.SIM_MARKERS, topics.PLAN_MARKERS, topics.ZONE_MARGINS, topics.MISSION_EVENTS,
-               topics.SIM_FAULTS}
+               topics.SIM_FAULTS, topics.CONTROLLER_FAULTS, topics.ESTIMATOR_FAULTS}
 CHANNEL_TYPES = {t: name for t, name in topics.RECORDED.items() if t not in VIEW_TOPICS}   # a channel each
 TOPIC_TYPES = {t: name for t, name in CHANNEL_TYPES.items() if t != topics.SUN_SENSORS}   # with messages
 STATE_FIELDS = {"header.stamp", "header.frame_id", "body_frame_id", "attitude", "body_rate", "wheel_speeds",

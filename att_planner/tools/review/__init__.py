@@ -27,6 +27,11 @@ executed plan, else the last magnetorquer-PD run, else the whole log), and write
   mode), the zones' margins, wheel momentum and dipoles over the day, and the sky with the day's
   boresight track, the targets and the Sun, Moon and nadir tracks (:mod:`.mission`); the summary
   gains ``mission``: the table of targets observed (start, dwell, pointing error) and missed (why);
+* with faults (a log with ``/simulator/faults``, ``/controller/faults`` or ``/estimator/faults``):
+  each fault injected, its detection (detector, evidence, latency) and the response, and each
+  re-plan flown after it, marked on the time histories and listed in the summary (``faults``;
+  :mod:`.faults`); the reviewed segment is then the maneuver in flight at the first detection
+  through its re-plans;
 * ``summary.txt``, ``summary.json`` and ``index.html`` (summary table, figures embedded).
 
 For a maneuver, "executed" is the whole reviewed segment: the maneuver (the plan, t = 0 to its
@@ -54,13 +59,16 @@ from pathlib import Path
 from att_msgs_py.log import read_log
 from att_msgs_py.topics import (
     COMMAND,
+    CONTROLLER_FAULTS,
     CONTROLLER_STATUS,
     ESTIMATE,
+    ESTIMATOR_FAULTS,
     IMU,
     MAGNETOMETER,
     MISSION_EVENTS,
     PLANS,
     SENSOR_TRUTH,
+    SIM_FAULTS,
     STAR_TRACKER,
     STATE,
 )
@@ -71,7 +79,7 @@ __all__ = ["Review", "extract_run", "format_summary", "main", "review", "settlin
 # ``TOPICS``); named here so that a log is read, and a damaged one refused, before the figures and
 # the models are imported (a second or more on a loaded machine)
 REVIEWED_TOPICS = sorted({STATE, COMMAND, PLANS, CONTROLLER_STATUS, ESTIMATE, SENSOR_TRUTH, STAR_TRACKER, IMU,
-                          MAGNETOMETER, MISSION_EVENTS})
+                          MAGNETOMETER, MISSION_EVENTS, SIM_FAULTS, CONTROLLER_FAULTS, ESTIMATOR_FAULTS})
 _LAZY = {"extract_run": "run", "settling_time": "run", "format_summary": "summary", "summarize": "summary"}
 
 
@@ -106,12 +114,35 @@ def _html(log_path: Path, text: str, remarks: list[str], figures: dict) -> str:
             "</body></html>\n")
 
 
+def _commands(log) -> tuple:
+    import numpy as np
+
+    cmd = log.get(COMMAND)
+    if cmd is None or not len(cmd):
+        return np.zeros(0), np.zeros(0, dtype=str)
+    return np.asarray(cmd["header.stamp"], float), np.asarray(cmd["plan_id"], dtype=str)
+
+
+def _faults(log):
+    """The run's faults (:func:`.faults.faults_of`), None without any."""
+    from att_planner.tools.review.faults import faults_of
+
+    return faults_of(log, *_commands(log))
+
+
+def _interrupted(log, faults) -> str | None:
+    from att_planner.tools.review.faults import interrupted_plan
+
+    return interrupted_plan(faults, *_commands(log))
+
+
 def review(log_path: str | Path, out_dir: str | Path | None = None, *, plan_id: str | None = None,
            scenario: str | None = None) -> Review:
     """Read ``log_path`` and write figures, summary and HTML page into ``out_dir``."""
     log_path = Path(log_path)
     log = read_log(log_path, topics=REVIEWED_TOPICS, keep_messages=(PLANS, MISSION_EVENTS))
     from att_planner.tools.review.estimation import estimation_of, estimation_summary, figure_estimation
+    from att_planner.tools.review.faults import faults_summary, marks
     from att_planner.tools.review.figures import figure_overview, figure_sky, figure_time_histories
     from att_planner.tools.review.mission import figure_mission, figure_mission_sky, mission_of, mission_summary
     from att_planner.tools.review.pointing import figure_pointing, pointing_of, pointing_summary
@@ -119,12 +150,19 @@ def review(log_path: str | Path, out_dir: str | Path | None = None, *, plan_id: 
     from att_planner.tools.review.summary import format_summary, notes, scenario_for, summary_of, zone_sky_for
 
     out = Path(out_dir) if out_dir is not None else log_path.parent / "review"
-    run = extract_run(log, plan_id)
+    faults = _faults(log)
+    through = None
+    if plan_id is None and faults is not None and faults.replans:      # the maneuver re-planned and its re-plans
+        plan_id, through = _interrupted(log, faults), faults.replans[-1]["plan_id"]
+    run = extract_run(log, plan_id, through)
+    run.marks = marks(faults, run.t0)
     out.mkdir(parents=True, exist_ok=True)
     found = scenario_for(run, scenario)
     sc = found.spacecraft if found is not None else None
     zones, zones_note = zone_sky_for(run, found)
     summary = summary_of(run, sc, zones, zones_note)
+    if faults is not None:
+        summary["faults"] = faults_summary(faults)
     figures = {"overview": figure_overview(run, sc, out / "overview.png", zones),
                "sky": figure_sky(run, out / "sky.png", zones),
                "time histories": figure_time_histories(run, sc, out / "time_histories.png", zones)}

@@ -181,6 +181,15 @@ def _limits(ax, limit, label=None, color="r", ls="--"):
             ax.axhline(sign * limit, color=color, ls=ls, lw=0.8, label=label if sign == 1 else None)
 
 
+def draw_marks(ax, marks: list, labels: bool = False) -> None:
+    """Events (t, label, colour) as vertical lines (``labels``: named in the axes' legend): the faults
+    injected, detected and the re-plans flown (:func:`att_planner.tools.review.faults.marks`)."""
+    for t, label, color in marks:
+        ax.axvline(t, color=color, ls="-.", lw=1.0, label=f"t = {t:.1f} s: {label}" if labels else None)
+    if labels and marks:
+        ax.legend(loc="center right", fontsize=6)
+
+
 def _maneuver_end(ax, run):
     if run.kind == "maneuver":
         ax.axvline(run.plan.duration, color="0.5", ls=":", lw=0.8)
@@ -328,6 +337,7 @@ def figure_time_histories(run: Run, sc: Spacecraft | None, path: Path, zones: Fi
     for ax in axes.ravel():
         ax.grid(alpha=0.3)
         _maneuver_end(ax, run)
+        draw_marks(ax, run.marks, labels=ax is axes[3, 1])
     for ax in axes[-1]:
         ax.set_xlabel(_time_label(run))
     fig.suptitle(_title(run))

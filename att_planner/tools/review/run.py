@@ -1,7 +1,7 @@
 """The reviewed run, extracted from a read log (numpy only)."""
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -38,6 +38,7 @@ class Run:
     goal: np.ndarray | None        # (4,) goal attitude (plan end; identity for magnetorquer runs)
     plan: Plan | None = None       # the executed (or last recorded) plan
     goal_end: float | None = None  # maneuvers: t of the last command carrying the plan id (the execute goal's end)
+    marks: list = field(default_factory=list)   # (t, label, colour): events drawn on the time histories
 
 
 def plans_of(log: dict[str, TopicLog]) -> list[Plan]:
@@ -62,9 +63,10 @@ def _segment(cmd_t, cmd_mode, cmd_plan, plan_id):
     return start, (after[0] if after.size else len(cmd_t))
 
 
-def extract_run(log: dict[str, TopicLog], plan_id: str | None = None) -> Run:
+def extract_run(log: dict[str, TopicLog], plan_id: str | None = None, through: str | None = None) -> Run:
     """The reviewed segment: plan ``plan_id`` (default: the last executed plan) from its first
-    command to the next change of mode or plan; else the last magnetorquer-PD run; else the log."""
+    command to the next change of mode or plan (``through``: a plan executed after it, up to the change
+    after that one: a maneuver and its re-plans); else the last magnetorquer-PD run; else the log."""
     if STATE not in log or len(log[STATE]) == 0:
         raise ValueError(f"the log has no {STATE} messages to review")
     state, cmd = log[STATE], log.get(COMMAND)
@@ -87,6 +89,8 @@ def extract_run(log: dict[str, TopicLog], plan_id: str | None = None) -> Run:
     if plan_id is not None:
         kind, plan = "maneuver", by_id[plan_id]
         i0, i1 = _segment(cmd_t, cmd_mode, cmd_plan, plan_id)
+        if through is not None and through in executed:
+            i1 = max(i1, _segment(cmd_t, cmd_mode, cmd_plan, through)[1])
         goal, goal_end = plan.q[-1], float(cmd_t[np.flatnonzero(cmd_plan == plan_id)[-1]] - cmd_t[i0])
     elif np.any(cmd_mode == ControlMode.MAGNETORQUER_PD):
         kind, goal = "magnetorquer", rot.IDENTITY.copy()

@@ -283,9 +283,25 @@ def format_summary(s: dict, with_notes: bool = True) -> str:
                      f"{pt['peak_wheel_speed_ratio']:.3f} of its limit (saturated {sat}); dipole duty "
                      f"{pt['dipole_duty']:.2f}")
     lines += mission_lines(s.get("mission"))
+    lines += fault_lines(s.get("faults"))
     if with_notes:
         lines += [f"note: {n}" for n in notes(s)]
     return "\n".join(lines)
+
+
+def fault_lines(f: dict | None) -> list[str]:
+    """The faults: each injection, each detection with its latency and response, the re-plans flown."""
+    if not f:
+        return []
+    lines = [f"fault injected        {i['component']} {i['index']} {i['kind']} at t = {i['t']:.2f} s ({i['source']})"
+             for i in f["injected"]]
+    for d in f["detected"]:
+        late = "" if d["latency_s"] is None else f", {d['latency_s']:.2f} s after the onset"
+        lines.append(f"fault {'detected' if d['active'] else 'cleared '}        {d['fault_id']} on {d['component']} "
+                     f"{d['index']} at t = {d['t']:.2f} s{late}: {d['evidence']}; response {d['response']}")
+    if f["replans"]:
+        lines.append(f"re-planned            flown: {', '.join(f['replans'])}")
+    return lines
 
 
 def mission_lines(m: dict | None) -> list[str]:

@@ -245,9 +245,11 @@ def test_the_reviewed_topics_cover_every_part_of_the_review():
     from att_msgs_py.topics import COMMAND, CONTROLLER_STATUS, PLANS, STATE
     from att_planner.tools.review import REVIEWED_TOPICS
     from att_planner.tools.review.estimation import TOPICS as ESTIMATION_TOPICS
+    from att_planner.tools.review.faults import TOPICS as FAULT_TOPICS
     from att_planner.tools.review.mission import TOPICS as MISSION_TOPICS
 
-    assert REVIEWED_TOPICS == sorted({STATE, COMMAND, PLANS, CONTROLLER_STATUS, *ESTIMATION_TOPICS, *MISSION_TOPICS})
+    assert REVIEWED_TOPICS == sorted({STATE, COMMAND, PLANS, CONTROLLER_STATUS, *ESTIMATION_TOPICS, *MISSION_TOPICS,
+                                      *FAULT_TOPICS})
 
 
 def test_a_damaged_log_is_refused_before_the_figures_and_models_are_imported(tmp_path):
