@@ -52,7 +52,9 @@ class FaultMonitor:
         n = sc.n_wheels
         if isinstance(e, tables.WheelTorque):
             return "wheels", (WheelTorqueDetector(n, sc.wheel_inertia, e.threshold_Nm, e.persistence_s, e.window_s,
-                                                  sc.wheel_axes) if n and sc.wheel_inertia > 0 else None)
+                                                  sc.wheel_axes, e.drive_gain_tolerance,
+                                                  e.wheel_inertia_tolerance)
+                              if n and sc.wheel_inertia > 0 else None)
         if isinstance(e, tables.TachometerFrozen):
             noisy = specs.tachometer is not None and specs.tachometer.noise > 0
             return "tachometer", (FrozenDetector("wheel_tachometer", e.detector, n, e.threshold_rad_s, e.persistence_s,
