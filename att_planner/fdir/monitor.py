@@ -91,7 +91,11 @@ class FaultMonitor:
     # -- inputs -----------------------------------------------------------------------------------
     def on_wheels(self, t: float, speeds_rad_s, torque_Nm, friction_Nm=None, omega_BN_B=None) -> list[FaultStatus]:
         """A tachometer sample (speeds relative to the body) and the motor torques commanded over the
-        interval it ends, the drive friction expected over it, the body rate."""
+        interval it ends, the drive friction expected over it, the body rate. A wheel whose tachometer
+        is declared frozen is not judged on its speeds."""
+        unread = {s.index for s in self.active.values() if s.component == "wheel_tachometer"}
+        for _, d in self.detectors.get("wheels", []):
+            d.unread = unread
         out = self._run("wheels", lambda d: d.update(t, speeds_rad_s, torque_Nm, friction_Nm, omega_BN_B))
         return out + self._run("tachometer", lambda d: d.update(t, speeds_rad_s))
 

@@ -34,7 +34,9 @@ friction ``k`` times the expected, ``−(k − 1) f_i`` whatever the command.
 A wheel that is commanded no torque shows no residual when it is switched off, and a seized wheel
 only the net torque ``u_i − f_i`` it is asked (nothing where the command only compensates the
 friction): the detector sees a fault only through torque that is asked and not delivered (or friction
-that is not expected), once that torque exceeds the test's bound.
+that is not expected), once that torque exceeds the test's bound. A wheel whose tachometer is declared
+frozen (:attr:`WheelTorqueDetector.unread`) is not judged: its residual is the reading's fault, not the
+wheel's.
 """
 from __future__ import annotations
 
@@ -69,6 +71,7 @@ class WheelTorqueDetector:
         self.axes = None if wheel_axes is None else np.asarray(wheel_axes, float).reshape(3, n_wheels)
         self.persistence = [Persistence(persistence_s) for _ in range(n_wheels)]
         self.declared = [False] * n_wheels
+        self.unread: set[int] = set()           # wheels whose speed reading is declared bad: not judged
         self.commanded = np.zeros(n_wheels)     # ∫ (u − f) / I_w dt, rad/s
         self.asked = np.zeros((2, n_wheels))    # ∫ |u| dt, ∫ |u − f| dt, N m s
         self.last_t: float | None = None
@@ -97,7 +100,7 @@ class WheelTorqueDetector:
         residual, bound = means[0], self.bound(means[1], means[2])
         out = []
         for i, tau in enumerate(residual):
-            if self.persistence[i].update(abs(tau) > bound[i], t) and not self.declared[i]:
+            if self.persistence[i].update(abs(tau) > bound[i] and i not in self.unread, t) and not self.declared[i]:
                 self.declared[i] = True
                 out.append(Verdict(t, "wheel", i, DETECTOR, f"wheel {i}: {tau:+.4g} N m of motor torque not "
                                    f"delivered (measured minus commanded acceleration {tau / self.inertia:+.4g} "
