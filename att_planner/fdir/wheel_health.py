@@ -25,11 +25,15 @@ of ``|u_i|`` and ``|u_i − f_i|`` (kept as ``∫|u_i| dt`` and ``∫|u_i − f_
 
     ``|τ_res,i| > threshold_Nm + a/(1 − b) ū_i + b/(1 − b) n̄_i``
 
-(``a = drive_gain_tolerance``, ``b = wheel_inertia_tolerance``), held for ``persistence_s``: wheel ``i``
-is isolated. ``threshold_Nm`` covers the tachometer's noise and what the drive adds to each command
-(its quantisation and noise). A fault makes the wheel deliver a fraction far from one of what it is
-asked: seized (no net torque, its inertial spin held), ``τ_res = −(u_i − f_i)``; off, ``−u_i``;
-friction ``k`` times the expected, ``−(k − 1) f_i`` whatever the command.
+(``a = drive_gain_tolerance``, ``b = wheel_inertia_tolerance``; an adaptive threshold for a
+multiplicative model uncertainty, Emami-Naeini, Akhter & Rock 1988, IEEE TAC 33(12)), held for
+``persistence_s``: wheel ``i`` is isolated. The shipped table's ``a`` and ``b`` are the largest draws
+of the Monte Carlo campaigns' ``wheel_torque_scale`` and ``wheel_inertia_scale`` (truncated normals),
+so no dispersed healthy wheel can pass the bound. ``threshold_Nm`` covers the tachometer's noise and
+what the drive adds to each command (its quantisation and noise). A fault makes the wheel deliver a
+fraction far from one of what it is asked: seized (no net torque, its inertial spin held),
+``τ_res = −(u_i − f_i)``; off, ``−u_i``; friction ``k`` times the expected, ``−(k − 1) f_i`` whatever
+the command.
 
 A wheel that is commanded no torque shows no residual when it is switched off, and a seized wheel
 only the net torque ``u_i − f_i`` it is asked (nothing where the command only compensates the
