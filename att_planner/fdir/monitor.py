@@ -52,7 +52,9 @@ class FaultMonitor:
         n = sc.n_wheels
         if isinstance(e, tables.WheelTorque):
             return "wheels", (WheelTorqueDetector(n, sc.wheel_inertia, e.threshold_Nm, e.persistence_s, e.window_s,
-                                                  sc.wheel_axes) if n and sc.wheel_inertia > 0 else None)
+                                                  sc.wheel_axes, e.drive_gain_tolerance,
+                                                  e.wheel_inertia_tolerance)
+                              if n and sc.wheel_inertia > 0 else None)
         if isinstance(e, tables.TachometerFrozen):
             noisy = specs.tachometer is not None and specs.tachometer.noise > 0
             return "tachometer", (FrozenDetector("wheel_tachometer", e.detector, n, e.threshold_rad_s, e.persistence_s,
@@ -89,7 +91,11 @@ class FaultMonitor:
     # -- inputs -----------------------------------------------------------------------------------
     def on_wheels(self, t: float, speeds_rad_s, torque_Nm, friction_Nm=None, omega_BN_B=None) -> list[FaultStatus]:
         """A tachometer sample (speeds relative to the body) and the motor torques commanded over the
-        interval it ends, the drive friction expected over it, the body rate."""
+        interval it ends, the drive friction expected over it, the body rate. A wheel whose tachometer
+        is declared frozen is not judged on its speeds."""
+        unread = {s.index for s in self.active.values() if s.component == "wheel_tachometer"}
+        for _, d in self.detectors.get("wheels", []):
+            d.unread = unread
         out = self._run("wheels", lambda d: d.update(t, speeds_rad_s, torque_Nm, friction_Nm, omega_BN_B))
         return out + self._run("tachometer", lambda d: d.update(t, speeds_rad_s))
 

@@ -76,13 +76,29 @@ class Entry(Schema):
 class WheelTorque(Entry):
     """A wheel whose measured acceleration (its tachometer speeds differentiated) departs from the
     commanded motor torque over its inertia, minus the expected friction, by more than the threshold
-    expressed as a torque: seized, off, or with abnormal friction."""
+    expressed as a torque, grown by the drive's torque gain and the wheel's inertia tolerances times the
+    torque commanded: seized, off, or with abnormal friction (:mod:`att_planner.fdir.wheel_health`)."""
 
     component: ClassVar[str] = "wheel"
     detector: Literal["wheel_torque"]
     threshold_Nm: float = number(gt=0.0, le=10.0, unit="N m", meaning="residual motor torque")
     window_s: float = number(1.0, gt=0.0, le=60.0, unit="s", meaning="span of each half of the two windows "
                                                                      "whose mean speeds are differenced")
+    drive_gain_tolerance: float = number(0.0, ge=0.0, lt=1.0, unit="", meaning=(
+        "relative tolerance a of a healthy drive's torque gain (delivered over commanded motor torque within "
+        "1 +- a): the threshold grows by a/(1 - b) times the motor torque commanded over the windows; "
+        "a + b below 1, or a wheel that delivers nothing would pass (0: exact drives)"))
+    wheel_inertia_tolerance: float = number(0.0, ge=0.0, lt=1.0, unit="", meaning=(
+        "relative tolerance b of the wheels' spin inertia against the nominal one: the threshold grows by "
+        "b/(1 - b) times the net torque (motor minus expected friction) commanded over the windows (0: exact)"))
+
+    @model_validator(mode="after")
+    def _a_fault_stays_visible(self):
+        a, b = self.drive_gain_tolerance, self.wheel_inertia_tolerance
+        if not a + b < 1.0:
+            raise ValueError(f"drive_gain_tolerance + wheel_inertia_tolerance below 1 (a wheel that delivers no "
+                             f"torque would pass as healthy: a/(1 - b) >= 1), got {a:g} + {b:g} = {a + b:g}")
+        return self
 
 
 class TachometerFrozen(Entry):

@@ -8,11 +8,39 @@ while the wheel does what it is told — and compares the mean of ``r_i`` over t
 with its mean over the window before: ``τ_res,i = I_w (r̄_now − r̄_before) / (t̄_now − t̄_before)``
 (``t̄`` the mean sample time of each window: exact for a residual that grows linearly) is the motor
 torque the wheel did not deliver (a seized wheel, a wheel off, friction ``k`` times the expected).
-``|τ_res,i| > threshold_Nm`` held for ``persistence_s`` isolates wheel ``i``. Averaging ``n``
-samples of a tachometer of noise ``σ`` leaves ``√2 σ I_w / (√n window_s)`` of noise on ``τ_res``.
+Averaging ``n`` samples of a tachometer of noise ``σ`` leaves ``√2 σ I_w / (√n window_s)`` of noise on
+``τ_res``.
 
-A wheel that is commanded no torque shows no residual when it is switched off: the detector sees
-a fault only through torque that is asked and not delivered (or friction that is not expected).
+**Drive and inertia tolerances.** A healthy wheel does not deliver exactly ``(u_i − f_i) / I_w``: its
+drive's torque gain ``s_i`` (delivered over commanded motor torque) lies within ``1 ± a`` and its spin
+inertia ``I_true`` within ``I_w (1 ± b)``, so its acceleration is ``(s_i u_i − f_i) / I_true`` and, with
+``ρ = I_w / I_true``,
+
+    ``τ_res,i = ρ (s_i − 1) u_i + (ρ − 1)(u_i − f_i)``,   ``|ρ| ≤ 1/(1 − b)``, ``|ρ − 1| ≤ b/(1 − b)``.
+
+The difference of the window means is a weighted mean of the residual torque over the two windows
+with non-negative weights summing to one (a triangle peaking between them); the same weighted mean
+of ``|u_i|`` and ``|u_i − f_i|`` (kept as ``∫|u_i| dt`` and ``∫|u_i − f_i| dt`` beside the residual),
+``ū_i`` and ``n̄_i``, bounds a healthy wheel's residual whatever the signs of its commands. The test is
+
+    ``|τ_res,i| > threshold_Nm + a/(1 − b) ū_i + b/(1 − b) n̄_i``
+
+(``a = drive_gain_tolerance``, ``b = wheel_inertia_tolerance``; an adaptive threshold for a
+multiplicative model uncertainty, Emami-Naeini, Akhter & Rock 1988, IEEE TAC 33(12)), held for
+``persistence_s``: wheel ``i`` is isolated. The shipped table's ``a`` and ``b`` are the largest draws
+of the Monte Carlo campaigns' ``wheel_torque_scale`` and ``wheel_inertia_scale`` (truncated normals),
+so no dispersed healthy wheel can pass the bound. ``threshold_Nm`` covers the tachometer's noise and
+what the drive adds to each command (its quantisation and noise). A fault makes the wheel deliver a
+fraction far from one of what it is asked: seized (no net torque, its inertial spin held),
+``τ_res = −(u_i − f_i)``; off, ``−u_i``; friction ``k`` times the expected, ``−(k − 1) f_i`` whatever
+the command.
+
+A wheel that is commanded no torque shows no residual when it is switched off, and a seized wheel
+only the net torque ``u_i − f_i`` it is asked (nothing where the command only compensates the
+friction): the detector sees a fault only through torque that is asked and not delivered (or friction
+that is not expected), once that torque exceeds the test's bound. A wheel whose tachometer is declared
+frozen (:attr:`WheelTorqueDetector.unread`) is not judged: its residual is the reading's fault, not the
+wheel's.
 """
 from __future__ import annotations
 
@@ -30,18 +58,28 @@ class WheelTorqueDetector:
     """Per-wheel residual torque between commanded and measured acceleration (module docstring)."""
 
     def __init__(self, n_wheels: int, wheel_inertia_kg_m2: float, threshold_Nm: float, persistence_s: float,
-                 window_s: float, wheel_axes=None):
+                 window_s: float, wheel_axes=None, drive_gain_tolerance: float = 0.0,
+                 wheel_inertia_tolerance: float = 0.0):
         """``wheel_axes``: the mounting matrix ``G`` (3 × n_wheels) to add the body rate's share to the
-        relative speeds (None: the speeds are taken as the wheels' spin rates)."""
+        relative speeds (None: the speeds are taken as the wheels' spin rates); ``drive_gain_tolerance``
+        ``a`` and ``wheel_inertia_tolerance`` ``b``: the relative tolerances of a healthy drive's torque
+        gain and of the wheel's spin inertia (module docstring; 0: exact)."""
         if not wheel_inertia_kg_m2 > 0:
             raise ValueError(f"wheel_inertia_kg_m2 > 0, got {wheel_inertia_kg_m2!r}")
+        if not 0.0 <= drive_gain_tolerance < 1.0 or not 0.0 <= wheel_inertia_tolerance < 1.0:
+            raise ValueError(f"drive_gain_tolerance and wheel_inertia_tolerance in [0, 1), got "
+                             f"{drive_gain_tolerance!r} and {wheel_inertia_tolerance!r}")
         self.n, self.inertia, self.threshold, self.window = n_wheels, wheel_inertia_kg_m2, threshold_Nm, window_s
+        self.motor_tolerance = drive_gain_tolerance / (1.0 - wheel_inertia_tolerance)     # bounds |ρ (s − 1)|
+        self.net_tolerance = wheel_inertia_tolerance / (1.0 - wheel_inertia_tolerance)    # bounds |ρ − 1|
         self.axes = None if wheel_axes is None else np.asarray(wheel_axes, float).reshape(3, n_wheels)
         self.persistence = [Persistence(persistence_s) for _ in range(n_wheels)]
         self.declared = [False] * n_wheels
+        self.unread: set[int] = set()           # wheels whose speed reading is declared bad: not judged
         self.commanded = np.zeros(n_wheels)     # ∫ (u − f) / I_w dt, rad/s
+        self.asked = np.zeros((2, n_wheels))    # ∫ |u| dt, ∫ |u − f| dt, N m s
         self.last_t: float | None = None
-        self.samples: deque = deque()           # (t, residual speeds r)
+        self.samples: deque = deque()           # (t, residual speeds r, ∫ |u| dt and ∫ |u − f| dt)
 
     def update(self, t: float, speeds_rad_s, torque_Nm, friction_Nm=None, omega_BN_B=None) -> list[Verdict]:
         """A tachometer sample at ``t``: ``speeds_rad_s`` relative to the body (n), ``torque_Nm`` the
@@ -52,33 +90,51 @@ class WheelTorqueDetector:
         if self.axes is not None and omega_BN_B is not None:
             speeds = speeds + self.axes.T @ np.asarray(omega_BN_B, float)
         if self.last_t is not None and t > self.last_t:
-            drive = np.asarray(torque_Nm, float) - (0.0 if friction_Nm is None else np.asarray(friction_Nm, float))
+            torque = np.asarray(torque_Nm, float)
+            drive = torque - (0.0 if friction_Nm is None else np.asarray(friction_Nm, float))
             self.commanded = self.commanded + drive / self.inertia * (t - self.last_t)
+            self.asked = self.asked + np.abs([torque, drive]) * (t - self.last_t)
         self.last_t = t
-        self.samples.append((t, speeds - self.commanded))
+        self.samples.append((t, speeds - self.commanded, self.asked.copy()))
         while self.samples and self.samples[0][0] < t - 2.0 * self.window - 1e-9:
             self.samples.popleft()
-        residual = self.residual_torque(t)
-        if residual is None:
+        means = self.window_means(t)
+        if means is None:
             return []
+        residual, bound = means[0], self.bound(means[1], means[2])
         out = []
         for i, tau in enumerate(residual):
-            if self.persistence[i].update(abs(tau) > self.threshold, t) and not self.declared[i]:
+            if self.persistence[i].update(abs(tau) > bound[i] and i not in self.unread, t) and not self.declared[i]:
                 self.declared[i] = True
                 out.append(Verdict(t, "wheel", i, DETECTOR, f"wheel {i}: {tau:+.4g} N m of motor torque not "
                                    f"delivered (measured minus commanded acceleration {tau / self.inertia:+.4g} "
-                                   f"rad/s^2 over {self.window:g} s windows; threshold {self.threshold:g} N m)",
+                                   f"rad/s^2 over {self.window:g} s windows; bound {bound[i]:.4g} N m for "
+                                   f"{means[1][i]:.4g} N m of motor torque asked, {means[2][i]:.4g} N m net)",
                                    since=self.persistence[i].since))
         return out
 
-    def residual_torque(self, t: float) -> np.ndarray | None:
-        """``τ_res`` (n, N m) at ``t``; None until two windows of samples are kept."""
+    def bound(self, motor_Nm, net_Nm) -> np.ndarray:
+        """The largest ``|τ_res|`` of a healthy wheel (N m) asked the mean motor torque magnitude
+        ``motor_Nm`` and net torque magnitude ``net_Nm``: ``threshold_Nm + a/(1 − b) ū + b/(1 − b) n̄``."""
+        return self.threshold + self.motor_tolerance * np.asarray(motor_Nm) + self.net_tolerance * np.asarray(net_Nm)
+
+    def window_means(self, t: float) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
+        """``(τ_res, ū, n̄)`` (n each, N m) at ``t``: the residual torque and the same weighted means of
+        the commanded motor torque's and net torque's magnitudes (module docstring); None until two
+        windows of samples are kept."""
         if len(self.samples) < 4 or self.samples[0][0] > t - 2.0 * self.window + 1e-9:
             return None
         times = np.array([s[0] for s in self.samples])
-        values = np.array([s[1] for s in self.samples])
         now = times > t - self.window + 1e-9
         if now.all() or not now.any():
             return None
         span = times[now].mean() - times[~now].mean()
-        return self.inertia * (values[now].mean(axis=0) - values[~now].mean(axis=0)) / span
+        values = np.array([s[1] for s in self.samples])
+        asked = np.array([s[2] for s in self.samples])
+        motor, net = (asked[now].mean(axis=0) - asked[~now].mean(axis=0)) / span
+        return self.inertia * (values[now].mean(axis=0) - values[~now].mean(axis=0)) / span, motor, net
+
+    def residual_torque(self, t: float) -> np.ndarray | None:
+        """``τ_res`` (n, N m) at ``t``; None until two windows of samples are kept."""
+        means = self.window_means(t)
+        return None if means is None else means[0]

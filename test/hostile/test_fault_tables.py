@@ -30,6 +30,8 @@ faults:
     response: safe_mode
 """
 
+THRESHOLD = "    threshold_Nm: 0.01\n"
+
 # name: (text replaced, its replacement, line, field path, words of what was expected or found)
 EDITS = {
     "unknown detector": ("detector: wheel_torque", "detector: wheel_temperature", 3, "faults.wheel_torque.detector",
@@ -62,6 +64,22 @@ EDITS = {
     "id with a space": ("  attitude_error:\n", "  attitude error:\n", 13, "faults.attitude error",
                         "match pattern"),
     "faults a list": ("faults:\n  wheel_torque:\n", "faults:\n- wheel_torque:\n", 1, "faults", "valid dictionary"),
+    "gain tolerance negative": (THRESHOLD, THRESHOLD + "    drive_gain_tolerance: -0.1\n", 5,
+                                "faults.wheel_torque.drive_gain_tolerance", "greater than or equal to 0"),
+    "gain tolerance of one": (THRESHOLD, THRESHOLD + "    drive_gain_tolerance: 1.0\n", 5,
+                              "faults.wheel_torque.drive_gain_tolerance", "less than 1"),
+    "gain tolerance NaN": (THRESHOLD, THRESHOLD + "    drive_gain_tolerance: .nan\n", 5,
+                           "faults.wheel_torque.drive_gain_tolerance", "nan"),
+    "gain tolerance in percent": (THRESHOLD, THRESHOLD + "    drive_gain_tolerance_pct: 10\n", 5,
+                                  "faults.wheel_torque.drive_gain_tolerance_pct", "drive_gain_tolerance"),
+    "inertia tolerance a word": (THRESHOLD, THRESHOLD + "    wheel_inertia_tolerance: five percent\n", 5,
+                                 "faults.wheel_torque.wheel_inertia_tolerance", "valid number"),
+    "inertia tolerance on a tracker": ("    readmit_s: 30.0\n",
+                                       "    readmit_s: 30.0\n    wheel_inertia_tolerance: 0.05\n", 12,
+                                       "faults.tracker_inconsistent.wheel_inertia_tolerance", "one of the keys"),
+    "tolerances that hide a dead wheel": (THRESHOLD, THRESHOLD + "    drive_gain_tolerance: 0.6\n"
+                                          "    wheel_inertia_tolerance: 0.5\n", 2, "faults.wheel_torque",
+                                          "a wheel that delivers no torque would pass as healthy"),
 }
 
 
