@@ -25,6 +25,7 @@ from att_planner.fdir.innovations import InnovationDetector
 from att_planner.fdir.outage import OutageDetector
 from att_planner.fdir.responses import Responses, responses
 from att_planner.fdir.status import Verdict
+from att_planner.fdir.tracker_gyro import GyroRampDetector, Residuals, TrackerStepDetector
 from att_planner.fdir.watchdogs import Watchdog
 from att_planner.fdir.wheel_health import WheelTorqueDetector
 from att_sim.models.dynamics import Spacecraft
@@ -42,6 +43,7 @@ class FaultMonitor:
         self.active: dict[tuple[str, int], FaultStatus] = {}
         self.history: list[FaultStatus] = []          # every report, in order
         self.detectors: dict[str, list] = {}          # input kind -> [(fault id, detector)]
+        self._residuals: dict[tuple, Residuals] = {}   # (window_s, onset_s) -> the trackers' residuals against the gyro
         for fault_id, entry in table.faults.items():
             kind, detector = self._detector(entry, spacecraft, specs)
             if detector is not None:
@@ -74,6 +76,14 @@ class FaultMonitor:
                                    if len(self.trackers) > 1 else None)
         if isinstance(e, tables.GyroBiasJump):
             return "bias", BiasJumpDetector(e.threshold_deg_h, e.window_s, e.persistence_s) if specs.gyro else None
+        if isinstance(e, tables.TrackerStep | tables.GyroRamp):
+            if not (specs.star_trackers and specs.gyro):
+                return "tracker_gyro", None
+            key = (e.window_s, e.onset_s)
+            if key not in self._residuals:
+                self._residuals[key] = Residuals(specs.star_trackers, e.window_s, e.onset_s)
+            kind = TrackerStepDetector if isinstance(e, tables.TrackerStep) else GyroRampDetector
+            return "tracker_gyro", kind(self._residuals[key], e.threshold, e.persistence_s)
         if isinstance(e, tables.TrackerOutage):
             return "tick", OutageDetector(self.trackers, e.threshold_s, e.persistence_s) if self.trackers else None
         if isinstance(e, tables.AttitudeError):
@@ -94,7 +104,8 @@ class FaultMonitor:
         return out + self._run("tachometer", lambda d: d.update(t, speeds_rad_s))
 
     def on_gyro(self, t: float, omega_BN_B_measured) -> list[FaultStatus]:
-        return self._run("gyro", lambda d: d.update(t, omega_BN_B_measured))
+        out = self._run("gyro", lambda d: d.update(t, omega_BN_B_measured))
+        return out + self._run("tracker_gyro", lambda d: d.on_gyro(t, omega_BN_B_measured))
 
     def on_magnetometer(self, t: float, field_B_T) -> list[FaultStatus]:
         return self._run("magnetometer", lambda d: d.update(t, np.asarray(field_B_T, float) * 1e9))
@@ -106,6 +117,11 @@ class FaultMonitor:
         """A measurement of tracker ``name`` (valid or not) taken at ``t`` arrived."""
         for _, d in self.detectors.get("tick", []):
             d.heard_from(name, t)
+
+    def on_star_tracker(self, t: float, name: str, q_SN, valid: bool) -> list[FaultStatus]:
+        """A measurement of tracker ``name`` taken at ``t``: its sensor attitude (sensor-to-inertial) and
+        whether it is valid, judged against the gyro's propagation (:mod:`.tracker_gyro`)."""
+        return self._run("tracker_gyro", lambda d: d.on_tracker(t, name, q_SN, valid))
 
     def tick(self, t: float) -> list[FaultStatus]:
         """The time-driven detectors (tracker silence) at sim time ``t``."""

@@ -4,7 +4,7 @@
 hands them (the mirror types of :mod:`att_msgs_py.types`) and feeds a
 :class:`~.monitor.FaultMonitor`: each wheel speed sample with the motor torques last commanded and
 the friction the controller expects at those speeds; each gyro sample (and the time-driven detectors
-at its stamp); the magnetometer; each star tracker message's arrival; each estimate (its health and
+at its stamp); the magnetometer; each star tracker message's arrival and attitude; each estimate (its health and
 covariance, and the innovations the estimator computed since the last one); each controller status's
 attitude error. A node does the same from its subscriptions.
 """
@@ -44,6 +44,7 @@ class MonitorTap:
             out += mon.on_magnetometer(m.t, m.field)
         elif topic == topics.STAR_TRACKER:
             mon.on_tracker(m.name, m.t)
+            out += mon.on_star_tracker(m.t, m.name, m.q, bool(m.valid))
         elif topic == topics.ESTIMATE:
             self.omega_BN_B = np.asarray(m.omega, float)
             if self.estimator is not None:
