@@ -43,7 +43,7 @@ class FaultMonitor:
         self.active: dict[tuple[str, int], FaultStatus] = {}
         self.history: list[FaultStatus] = []          # every report, in order
         self.detectors: dict[str, list] = {}          # input kind -> [(fault id, detector)]
-        self._residuals: dict[tuple, Residuals] = {}   # (window_s, onset_s) -> the trackers' residuals against the gyro
+        self._residuals: dict[tuple, Residuals] = {}   # (window, onset, discontinuity) -> residuals
         for fault_id, entry in table.faults.items():
             kind, detector = self._detector(entry, spacecraft, specs)
             if detector is not None:
@@ -79,9 +79,10 @@ class FaultMonitor:
         if isinstance(e, tables.TrackerStep | tables.GyroRamp):
             if not (specs.star_trackers and specs.gyro):
                 return "tracker_gyro", None
-            key = (e.window_s, e.onset_s)
+            key = (e.window_s, e.onset_s, e.discontinuity_deg)
             if key not in self._residuals:
-                self._residuals[key] = Residuals(specs.star_trackers, e.window_s, e.onset_s)
+                self._residuals[key] = Residuals(specs.star_trackers, e.window_s, e.onset_s,
+                                                 math.radians(e.discontinuity_deg))
             kind = TrackerStepDetector if isinstance(e, tables.TrackerStep) else GyroRampDetector
             return "tracker_gyro", kind(self._residuals[key], e.threshold, e.persistence_s)
         if isinstance(e, tables.TrackerOutage):

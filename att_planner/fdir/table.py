@@ -152,6 +152,9 @@ class _TrackerGyro(Entry):
     window_s: float = number(12.0, gt=0.0, le=600.0, unit="s", meaning="span of each tracker's residuals fitted "
                                                                        "(a line, and the change)")
     onset_s: float = number(4.0, gt=0.0, le=600.0, unit="s", meaning="span, at the window's end, of the onsets tried")
+    discontinuity_deg: float = number(1.0, gt=0.0, le=180.0, unit="deg", meaning="change of a tracker's residual "
+                                      "between two measurements taken as the attitude itself moving (a simulation "
+                                      "reset): its window starts again, no verdict")
 
     @model_validator(mode="after")
     def _onset_in_window(self):

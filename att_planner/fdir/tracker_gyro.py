@@ -34,11 +34,15 @@ threshold on every test for the persistence gives a verdict: a tracker whose own
 amplitudes, its axis the most significant component). Assumptions: white tracker noise (the
 datasheet's, the covariance the estimator uses); the gyro's scale factor and misalignment times the
 change of rate within a window far below the noise; a window of consecutive valid measurements (an
-invalid one, or a gap over :data:`GAP_S`, starts the tracker's window again). A tracker that stepped
-starts its window again from the step (its new level), so that a jump is never taken later for the
-gyro's ramp (the gyro's detector leaves a tracker whose residual stepped for :data:`STEP_HOLD_S`
-aside until its window starts again). This needs one tracker: a lone tracker's jump and a gyro rate
-step are told apart by the signature's shape, two trackers' by which residuals move.
+invalid one, or a gap over :data:`GAP_S`, starts the tracker's window again), and a change of the
+residual between two measurements above ``discontinuity`` is the attitude itself moving under the
+gyro (the simulation's truth reset to another attitude, tracker and gyro healthy): the window starts
+again without a verdict (a tracker fault larger than that is left to the estimator's gate and the
+innovation detector). A tracker that stepped starts its window again from the step (its new level),
+so that a jump is never taken later for the gyro's ramp (the gyro's detector leaves a tracker whose
+residual stepped for :data:`STEP_HOLD_S` aside until its window starts again). This needs one
+tracker: a lone tracker's jump and a gyro rate step are told apart by the signature's shape, two
+trackers' by which residuals move.
 """
 from __future__ import annotations
 
@@ -87,11 +91,15 @@ class Residuals:
     """The gyro's own propagation and each tracker's window of residuals (module docstring), shared by
     the two detectors: a measurement is tested once (:meth:`on_tracker` memoises on its name and instant)."""
 
-    def __init__(self, trackers, window_s: float, onset_s: float):
-        """``trackers``: the :class:`att_sim.models.sensor_specs.StarTrackerSpec` of each tracker."""
+    def __init__(self, trackers, window_s: float, onset_s: float, discontinuity_rad: float = math.inf):
+        """``trackers``: the :class:`att_sim.models.sensor_specs.StarTrackerSpec` of each tracker;
+        ``discontinuity_rad``: a change of the residual between two measurements above which the window
+        starts again without a test."""
         if not 0.0 < onset_s < window_s:
             raise ValueError(f"onset_s must be in (0, window_s = {window_s:g} s), got {onset_s!r}")
-        self.window_s, self.onset_s = window_s, onset_s
+        if not discontinuity_rad > 0.0:
+            raise ValueError(f"discontinuity_rad must be > 0, got {discontinuity_rad!r}")
+        self.window_s, self.onset_s, self.discontinuity = window_s, onset_s, discontinuity_rad
         self.specs = {s.name: s for s in trackers}
         self.whiten = {}
         for s in trackers:
@@ -149,6 +157,10 @@ class Residuals:
             if q_G is None:
                 return None
         q_B = rot.multiply(np.asarray(q_SN, float), rot.conjugate(np.asarray(self.specs[name].mounting, float)))
+        if w:
+            _, q_G0, q_B0 = w[-1]
+            if rot.angle_between(q_B, rot.multiply(rot.multiply(q_B0, rot.conjugate(q_G0)), q_G)) > self.discontinuity:
+                self.restart(name)          # the attitude itself moved (a simulation reset): no fault of a unit
         w.append((t, q_G, q_B))
         while len(w) > 1 and w[1][0] <= t - self.window_s + 1e-9:
             w.popleft()

@@ -146,3 +146,17 @@ def test_an_invalid_measurement_or_a_gap_starts_the_window_again(trackers):
 def test_an_onset_span_outside_the_window_is_refused(trackers):
     with pytest.raises(ValueError, match="onset_s must be in"):
         Residuals(trackers, 4.0, 4.0)
+    with pytest.raises(ValueError, match="discontinuity_rad must be > 0"):
+        Residuals(trackers, 12.0, 4.0, float("nan"))
+
+
+def test_the_attitude_itself_moving_is_no_fault_of_a_unit(trackers):
+    """A jump of the truth's attitude (a simulation reset: every tracker moves, the gyro saw nothing)
+    beyond the discontinuity starts the window again; below it, it is a tracker's step."""
+    out = {}
+    for discontinuity in (math.radians(1.0), math.inf):
+        res = Residuals(trackers, 12.0, 4.0, discontinuity)
+        out[discontinuity] = fly(trackers, 40.0, 5, on=(1,), jump=(1, 30.0, (0.03, -0.02, 0.0)), residuals=res)
+        assert res.epoch["st2"] == 1          # started again: at the jump, or after the verdict
+    assert out[math.radians(1.0)] == []
+    assert [(v.component, v.index) for v in out[math.inf]] == [("star_tracker", 1)]
