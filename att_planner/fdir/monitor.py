@@ -20,6 +20,7 @@ from att_msgs_py.types import FaultStatus, Health
 from att_planner.estimation.health import Innovation
 from att_planner.fdir import table as tables
 from att_planner.fdir.bias import BiasJumpDetector
+from att_planner.fdir.coils import CoilDetector, momentum_noise
 from att_planner.fdir.frozen import FrozenDetector
 from att_planner.fdir.innovations import InnovationDetector
 from att_planner.fdir.outage import OutageDetector
@@ -85,6 +86,14 @@ class FaultMonitor:
                                                  math.radians(e.discontinuity_deg))
             kind = TrackerStepDetector if isinstance(e, tables.TrackerStep) else GyroRampDetector
             return "tracker_gyro", kind(self._residuals[key], e.threshold, e.persistence_s)
+        if isinstance(e, tables.CoilTorque):
+            if specs.gyro is None or specs.gyro.arw <= 0 or specs.tachometer is None and n:
+                return "coils", None
+            tacho = specs.tachometer.noise if n else 0.0
+            sigma_H = momentum_noise(sc.inertia, sc.wheel_axes, sc.wheel_inertia, specs.gyro.arw, specs.gyro.rate,
+                                     tacho)
+            return "coils", CoilDetector(sc.inertia, sc.wheel_axes, sc.wheel_inertia, sigma_H, e.threshold, e.window_s,
+                                         e.persistence_s)
         if isinstance(e, tables.TrackerOutage):
             return "tick", OutageDetector(self.trackers, e.threshold_s, e.persistence_s) if self.trackers else None
         if isinstance(e, tables.AttitudeError):
@@ -102,14 +111,22 @@ class FaultMonitor:
         """A tachometer sample (speeds relative to the body) and the motor torques commanded over the
         interval it ends, the drive friction expected over it, the body rate."""
         out = self._run("wheels", lambda d: d.update(t, speeds_rad_s, torque_Nm, friction_Nm, omega_BN_B))
+        out += self._run("coils", lambda d: d.on_wheels(t, speeds_rad_s))
         return out + self._run("tachometer", lambda d: d.update(t, speeds_rad_s))
 
     def on_gyro(self, t: float, omega_BN_B_measured) -> list[FaultStatus]:
         out = self._run("gyro", lambda d: d.update(t, omega_BN_B_measured))
+        out += self._run("coils", lambda d: d.on_gyro(t, omega_BN_B_measured))
         return out + self._run("tracker_gyro", lambda d: d.on_gyro(t, omega_BN_B_measured))
 
     def on_magnetometer(self, t: float, field_B_T) -> list[FaultStatus]:
-        return self._run("magnetometer", lambda d: d.update(t, np.asarray(field_B_T, float) * 1e9))
+        out = self._run("coils", lambda d: d.on_field(t, field_B_T))
+        return out + self._run("magnetometer", lambda d: d.update(t, np.asarray(field_B_T, float) * 1e9))
+
+    def on_dipole(self, t: float, dipole_Am2) -> list[FaultStatus]:
+        """The magnetorquer dipole commanded (A m², body axes; empty: none) at ``t``, until the next."""
+        d = np.asarray(dipole_Am2, float)
+        return self._run("coils", lambda det: det.on_dipole(t, d if d.shape == (3,) else np.zeros(3)))
 
     def on_innovations(self, innovations: list[Innovation]) -> list[FaultStatus]:
         return self._run("innovations", lambda d: d.update(innovations))

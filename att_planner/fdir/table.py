@@ -43,6 +43,7 @@ RESPONSES = {
     "star_tracker": ("report", "exclude_sensor", "safe_mode"),
     "magnetometer": ("report", "exclude_sensor"),
     "gyro": ("report", "safe_mode"),
+    "magnetorquer": ("report", "safe_mode"),
     "attitude": ("report", "safe_mode"),
     "rate": ("report", "safe_mode"),
     "estimate": ("report", "safe_mode"),
@@ -181,6 +182,20 @@ class GyroRamp(_TrackerGyro):
     detector: Literal["gyro_ramp"]
 
 
+class CoilTorque(Entry):
+    """A magnetorquer coil whose commanded dipole does not turn the body: the momentum measured (gyro and
+    tachometers) explained better with that coil open than with every coil healthy
+    (:mod:`att_planner.fdir.coils`); a coil never commanded cannot be seen."""
+
+    component: ClassVar[str] = "magnetorquer"
+    detector: Literal["coil_torque"]
+    threshold: float = number(gt=0.0, le=1e6, unit="", meaning="generalised likelihood ratio of the coil open "
+                                                               "against every coil healthy (chi-square, 1 degree "
+                                                               "of freedom)")
+    window_s: float = number(60.0, gt=0.0, le=3600.0, unit="s", meaning="span of the momentum balance, the "
+                                                                        "disturbance taken as constant over it")
+
+
 class TrackerOutage(Entry):
     """A star tracker from which no measurement (valid or not) arrived for the threshold."""
 
@@ -215,8 +230,8 @@ class EstimateUncertain(Entry):
 
 
 Detector = Annotated[WheelTorque | TachometerFrozen | GyroFrozen | MagnetometerFrozen | TrackerInnovation
-                     | GyroInnovation | GyroBiasJump | TrackerStep | GyroRamp | TrackerOutage | AttitudeError
-                     | RateError | EstimateUncertain,
+                     | GyroInnovation | GyroBiasJump | TrackerStep | GyroRamp | CoilTorque | TrackerOutage
+                     | AttitudeError | RateError | EstimateUncertain,
                      Field(discriminator="detector")]
 DETECTORS = {typing.get_args(m.model_fields["detector"].annotation)[0]: m
              for m in typing.get_args(typing.get_args(Detector)[0])}   # detector name -> its entry model

@@ -130,6 +130,12 @@ faults:
     threshold: 40.0
     persistence_s: 0.4
     response: safe_mode
+  coil_open:
+    detector: coil_torque
+    threshold: 30.0
+    persistence_s: 2.0
+    window_s: 60.0
+    response: report
 """
 
 # the detectors comparing each tracker with the gyro's propagation: (text replaced, its replacement, line,
@@ -149,6 +155,13 @@ GLR_EDITS = {
     "tracker excluding a wheel": ("response: exclude_sensor", "response: exclude_wheel", 2, "faults.tracker_step",
                                   "fits detector tracker_step's component star_tracker"),
     "onset a word": ("onset_s: 4.0", "onset_s: soon", 6, "faults.tracker_step.onset_s", "valid number"),
+    "coil excluded as a sensor": ("response: report", "response: exclude_sensor", 14, "faults.coil_open",
+                                  "(one of report, safe_mode)"),
+    "coil window negative": ("window_s: 60.0", "window_s: -60.0", 18, "faults.coil_open.window_s",
+                             "greater than 0"),
+    "coil threshold missing": ("    threshold: 30.0\n", "", 14, "faults.coil_open.threshold", "required"),
+    "coil with an onset": ("window_s: 60.0", "window_s: 60.0\n    onset_s: 4.0", 19, "faults.coil_open.onset_s",
+                           "one of the keys"),
 }
 
 

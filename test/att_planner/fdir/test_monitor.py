@@ -99,5 +99,6 @@ def test_every_detector_of_the_table_is_built(leo):
     m = monitor(leo)
     built = {type(d).__name__ for ds in m.detectors.values() for _, d in ds}
     assert built == {"WheelTorqueDetector", "FrozenDetector", "InnovationDetector", "BiasJumpDetector",
-                     "OutageDetector", "Watchdog", "TrackerStepDetector", "GyroRampDetector"}
+                     "OutageDetector", "Watchdog", "TrackerStepDetector", "GyroRampDetector",
+                     "CoilDetector"}
     assert sum(len(ds) for ds in m.detectors.values()) == len(table.read().faults) == len(table.DETECTORS)
