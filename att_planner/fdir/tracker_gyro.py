@@ -25,24 +25,25 @@ Automatic Control* 21(1)) of the least-squares fit of ``a + b t + ν s`` against
 
 χ²-distributed with 3 degrees of freedom for each ``j`` while both are healthy. A test is the
 largest ``G`` over the onsets and the two signatures; its kind is the signature that gives it (a
-ramp needs three samples after its onset, so that a one-sample step is never taken for one), and
-counts only when it beats the other signature's best by :data:`MARGIN` (a likelihood ratio of 100: a
-ramp seen early, about a tracker's noisy boresight, fits a step almost as well). A kind above the
-threshold on every test for the persistence gives a verdict: a tracker whose own residual steps
-(:class:`TrackerStepDetector`), the gyro when a tracker's residual ramps while no tracker steps
-(:class:`GyroRampDetector`; the rate error is the information-weighted mean of the ramping trackers'
-amplitudes, its axis the most significant component). Assumptions: white tracker noise (the
-datasheet's, the covariance the estimator uses); the gyro's scale factor and misalignment times the
-change of rate within a window far below the noise; a window of consecutive valid measurements (an
-invalid one, or a gap over :data:`GAP_S`, starts the tracker's window again), and a change of the
-residual between two measurements above ``discontinuity`` is the attitude itself moving under the
-gyro (the simulation's truth reset to another attitude, tracker and gyro healthy): the window starts
-again without a verdict (a tracker fault larger than that is left to the estimator's gate and the
-innovation detector). A tracker that stepped starts its window again from the step (its new level),
-so that a jump is never taken later for the gyro's ramp (the gyro's detector leaves a tracker whose
-residual stepped for :data:`STEP_HOLD_S` aside until its window starts again). This needs one
-tracker: a lone tracker's jump and a gyro rate step are told apart by the signature's shape, two
-trackers' by which residuals move.
+ramp needs three samples after its onset, so that a one-sample step is never taken for one). A step
+counts only when it beats the best ramp by :data:`MARGIN` (a likelihood ratio of 100: a ramp seen
+early, or about a tracker's noisy boresight, fits a step almost as well, while a jump's step beats
+every ramp by hundreds). A condition held on every test for the persistence gives a verdict: a
+tracker whose own residual steps clearly (:class:`TrackerStepDetector`); the gyro when a tracker's
+test is above the threshold while no tracker's steps clearly (:class:`GyroRampDetector`; the rate
+error is the information-weighted mean of those trackers' best ramps, its axis the most significant
+component). Assumptions: white tracker noise (the datasheet's, the covariance the estimator uses);
+the gyro's scale factor and misalignment times the change of rate within a window far below the
+noise; a window of consecutive valid measurements (an invalid one, or a gap over :data:`GAP_S`,
+starts the tracker's window again), and a change of the residual between two measurements above
+``discontinuity`` is the attitude itself moving under the gyro (the simulation's truth reset to
+another attitude, tracker and gyro healthy): the window starts again without a verdict (a tracker
+fault larger than that is left to the estimator's gate and the innovation detector). A tracker that
+stepped starts its window again from the step (its new level), so that a jump is never taken later
+for the gyro's ramp (the gyro's detector leaves a tracker whose residual stepped for
+:data:`STEP_HOLD_S` aside until its window starts again). This needs one tracker: a lone tracker's
+jump and a gyro rate step are told apart by the signature's shape, two trackers' by which residuals
+move.
 """
 from __future__ import annotations
 
@@ -76,6 +77,9 @@ class Test:
     onset: float               # s: the onset of the best signature
     covariance_B: np.ndarray   # rad² or (rad/s)²: the amplitude's covariance, R_B / |S⊥|²
     margin: float              # the best GLR less the best of the other signature's
+    ramp_B: np.ndarray         # rad/s: the best ramp's amplitude (body axes), its covariance and onset
+    ramp_covariance_B: np.ndarray
+    ramp_onset: float
 
     def clear(self, threshold: float, kind: str) -> bool:
         """The test above ``threshold``, of signature ``kind``, by :data:`MARGIN` over the other."""
@@ -194,8 +198,10 @@ class Residuals:
         other = G[len(onsets):] if kind == STEP else G[:len(onsets)]
         margin = float(G[best] - (other.max() if other.size else 0.0))
         onset = ts[onsets[best]] if kind == STEP else ts[ramp_onsets[best - len(onsets)]]
+        r = len(onsets) + int(np.argmax(G[len(onsets):])) if ramp_onsets.size else best
         return Test(float(ts[-1]), name, float(G[best]), kind, L @ (num[best] / den[best]), float(onset),
-                    L @ L.T / den[best], margin)
+                    L @ L.T / den[best], margin, L @ (num[r] / den[r]), L @ L.T / den[r],
+                    float(ts[ramp_onsets[r - len(onsets)]]) if ramp_onsets.size else float(onset))
 
 
 class _Detector:
@@ -263,20 +269,19 @@ class GyroRampDetector(_Detector):
         if self.stepped.get(name) == self.residuals.epoch[name]:
             test = None                         # a tracker that stepped: not judged until its window starts again
         self.latest[name] = test
-        tests = [x for x in self.latest.values() if x is not None and x.stat > self.threshold]
-        ramps = [x for x in tests if x.clear(self.threshold, RAMP)]
-        holds = bool(ramps) and not any(x.clear(self.threshold, STEP) for x in tests)
+        ramps = [x for x in self.latest.values() if x is not None and x.stat > self.threshold]
+        holds = bool(ramps) and not any(x.clear(self.threshold, STEP) for x in ramps)
         if not self.persistence.update(holds, t):
             return []
         self.declared = True
-        info = sum(np.linalg.inv(x.covariance_B) for x in ramps)
+        info = sum(np.linalg.inv(x.ramp_covariance_B) for x in ramps)
         cov = np.linalg.inv(info)
-        rate = cov @ sum(np.linalg.solve(x.covariance_B, x.amplitude_B) for x in ramps)
+        rate = cov @ sum(np.linalg.solve(x.ramp_covariance_B, x.ramp_B) for x in ramps)
         z = np.abs(rate) / np.sqrt(np.diag(cov))
         axis = int(np.argmax(z))
         names = ", ".join(x.name for x in ramps)
         return [Verdict(t, "gyro", axis, GYRO, f"{names}: attitude against the gyro's propagation ramps at "
                         f"{np.array2string(rate, precision=3)} rad/s ({math.degrees(rate[axis]):+.3g} deg/s about axis "
-                        f"{axis}, {z[axis]:.3g} sigma) from t = {min(x.onset for x in ramps):.3f} s: GLR "
+                        f"{axis}, {z[axis]:.3g} sigma) from t = {min(x.ramp_onset for x in ramps):.3f} s: GLR "
                         f"{max(x.stat for x in ramps):.4g} > {self.threshold:g} since t = "
                         f"{self.persistence.since:.3f} s", since=self.persistence.since)]
