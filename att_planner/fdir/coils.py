@@ -134,6 +134,10 @@ class CoilDetector:
         return glr
 
     def _judge(self, t: float) -> list[Verdict]:
+        if not np.any(self.samples[-1][3] - self.samples[0][3]):
+            for p in self.persistence:                  # no coil commanded in the window: nothing to see
+                p.update(False, t)
+            return []
         glr = self.ratios()
         best = int(np.argmax(glr))
         out = []
