@@ -20,11 +20,13 @@ from att_msgs_py.types import FaultStatus, Health
 from att_planner.estimation.health import Innovation
 from att_planner.fdir import table as tables
 from att_planner.fdir.bias import BiasJumpDetector
+from att_planner.fdir.coils import CoilDetector, momentum_noise
 from att_planner.fdir.frozen import FrozenDetector
 from att_planner.fdir.innovations import InnovationDetector
 from att_planner.fdir.outage import OutageDetector
 from att_planner.fdir.responses import Responses, responses
 from att_planner.fdir.status import Verdict
+from att_planner.fdir.tracker_gyro import GyroRampDetector, Residuals, TrackerStepDetector
 from att_planner.fdir.watchdogs import Watchdog
 from att_planner.fdir.wheel_health import WheelTorqueDetector
 from att_sim.models.dynamics import Spacecraft
@@ -42,6 +44,7 @@ class FaultMonitor:
         self.active: dict[tuple[str, int], FaultStatus] = {}
         self.history: list[FaultStatus] = []          # every report, in order
         self.detectors: dict[str, list] = {}          # input kind -> [(fault id, detector)]
+        self._residuals: dict[tuple, Residuals] = {}   # (window, onset, discontinuity) -> residuals
         for fault_id, entry in table.faults.items():
             kind, detector = self._detector(entry, spacecraft, specs)
             if detector is not None:
@@ -76,6 +79,23 @@ class FaultMonitor:
                                    if len(self.trackers) > 1 else None)
         if isinstance(e, tables.GyroBiasJump):
             return "bias", BiasJumpDetector(e.threshold_deg_h, e.window_s, e.persistence_s) if specs.gyro else None
+        if isinstance(e, tables.TrackerStep | tables.GyroRamp):
+            if not (specs.star_trackers and specs.gyro):
+                return "tracker_gyro", None
+            key = (e.window_s, e.onset_s, e.discontinuity_deg)
+            if key not in self._residuals:
+                self._residuals[key] = Residuals(specs.star_trackers, e.window_s, e.onset_s,
+                                                 math.radians(e.discontinuity_deg))
+            kind = TrackerStepDetector if isinstance(e, tables.TrackerStep) else GyroRampDetector
+            return "tracker_gyro", kind(self._residuals[key], e.threshold, e.persistence_s)
+        if isinstance(e, tables.CoilTorque):
+            if specs.gyro is None or specs.gyro.arw <= 0 or specs.tachometer is None and n:
+                return "coils", None
+            tacho = specs.tachometer.noise if n else 0.0
+            sigma_H = momentum_noise(sc.inertia, sc.wheel_axes, sc.wheel_inertia, specs.gyro.arw, specs.gyro.rate,
+                                     tacho)
+            return "coils", CoilDetector(sc.inertia, sc.wheel_axes, sc.wheel_inertia, sigma_H, e.threshold, e.window_s,
+                                         e.persistence_s)
         if isinstance(e, tables.TrackerOutage):
             return "tick", OutageDetector(self.trackers, e.threshold_s, e.persistence_s) if self.trackers else None
         if isinstance(e, tables.AttitudeError):
@@ -97,13 +117,22 @@ class FaultMonitor:
         for _, d in self.detectors.get("wheels", []):
             d.unread = unread
         out = self._run("wheels", lambda d: d.update(t, speeds_rad_s, torque_Nm, friction_Nm, omega_BN_B))
+        out += self._run("coils", lambda d: d.on_wheels(t, speeds_rad_s))
         return out + self._run("tachometer", lambda d: d.update(t, speeds_rad_s))
 
     def on_gyro(self, t: float, omega_BN_B_measured) -> list[FaultStatus]:
-        return self._run("gyro", lambda d: d.update(t, omega_BN_B_measured))
+        out = self._run("gyro", lambda d: d.update(t, omega_BN_B_measured))
+        out += self._run("coils", lambda d: d.on_gyro(t, omega_BN_B_measured))
+        return out + self._run("tracker_gyro", lambda d: d.on_gyro(t, omega_BN_B_measured))
 
     def on_magnetometer(self, t: float, field_B_T) -> list[FaultStatus]:
-        return self._run("magnetometer", lambda d: d.update(t, np.asarray(field_B_T, float) * 1e9))
+        out = self._run("coils", lambda d: d.on_field(t, field_B_T))
+        return out + self._run("magnetometer", lambda d: d.update(t, np.asarray(field_B_T, float) * 1e9))
+
+    def on_dipole(self, t: float, dipole_Am2) -> list[FaultStatus]:
+        """The magnetorquer dipole commanded (A m², body axes; empty: none) at ``t``, until the next."""
+        d = np.asarray(dipole_Am2, float)
+        return self._run("coils", lambda det: det.on_dipole(t, d if d.shape == (3,) else np.zeros(3)))
 
     def on_innovations(self, innovations: list[Innovation]) -> list[FaultStatus]:
         return self._run("innovations", lambda d: d.update(innovations))
@@ -112,6 +141,11 @@ class FaultMonitor:
         """A measurement of tracker ``name`` (valid or not) taken at ``t`` arrived."""
         for _, d in self.detectors.get("tick", []):
             d.heard_from(name, t)
+
+    def on_star_tracker(self, t: float, name: str, q_SN, valid: bool) -> list[FaultStatus]:
+        """A measurement of tracker ``name`` taken at ``t``: its sensor attitude (sensor-to-inertial) and
+        whether it is valid, judged against the gyro's propagation (:mod:`.tracker_gyro`)."""
+        return self._run("tracker_gyro", lambda d: d.on_tracker(t, name, q_SN, valid))
 
     def tick(self, t: float) -> list[FaultStatus]:
         """The time-driven detectors (tracker silence) at sim time ``t``."""

@@ -43,6 +43,7 @@ RESPONSES = {
     "star_tracker": ("report", "exclude_sensor", "safe_mode"),
     "magnetometer": ("report", "exclude_sensor"),
     "gyro": ("report", "safe_mode"),
+    "magnetorquer": ("report", "safe_mode"),
     "attitude": ("report", "safe_mode"),
     "rate": ("report", "safe_mode"),
     "estimate": ("report", "safe_mode"),
@@ -158,6 +159,59 @@ class GyroBiasJump(Entry):
     window_s: float = number(10.0, gt=0.0, le=3600.0, unit="s", meaning="span the change is measured over")
 
 
+class _TrackerGyro(Entry):
+    """The fields of the detectors that compare each star tracker with the gyro's propagation
+    (:mod:`att_planner.fdir.tracker_gyro`): a GLR threshold, the window and the onsets' span."""
+
+    threshold: float = number(gt=0.0, le=1e6, unit="", meaning="generalised likelihood ratio above which a tracker's "
+                                                               "residual against the gyro has changed (chi-square, "
+                                                               "3 degrees of freedom)")
+    window_s: float = number(12.0, gt=0.0, le=600.0, unit="s", meaning="span of each tracker's residuals fitted "
+                                                                       "(a line, and the change)")
+    onset_s: float = number(4.0, gt=0.0, le=600.0, unit="s", meaning="span, at the window's end, of the onsets tried")
+    discontinuity_deg: float = number(1.0, gt=0.0, le=180.0, unit="deg", meaning="change of a tracker's residual "
+                                      "between two measurements taken as the attitude itself moving (a simulation "
+                                      "reset): its window starts again, no verdict")
+
+    @model_validator(mode="after")
+    def _onset_in_window(self):
+        if not self.onset_s < self.window_s:
+            raise ValueError(f"onset_s below window_s (the onsets tried lie inside the window), got onset_s "
+                             f"{self.onset_s:g} s and window_s {self.window_s:g} s")
+        return self
+
+
+class TrackerStep(_TrackerGyro):
+    """A star tracker whose attitude steps against the gyro's propagation (a bias jump), its residual
+    alone: one tracker is enough."""
+
+    component: ClassVar[str] = "star_tracker"
+    detector: Literal["tracker_step"]
+
+
+class GyroRamp(_TrackerGyro):
+    """The gyro, when a star tracker's attitude ramps away from the gyro's propagation (a rate bias
+    step, a stuck axis) while no tracker's steps: one tracker is enough; the axis is the rate error's
+    most significant component."""
+
+    component: ClassVar[str] = "gyro"
+    detector: Literal["gyro_ramp"]
+
+
+class CoilTorque(Entry):
+    """A magnetorquer coil whose commanded dipole does not turn the body: the momentum measured (gyro and
+    tachometers) explained better with that coil open than with every coil healthy
+    (:mod:`att_planner.fdir.coils`); a coil never commanded cannot be seen."""
+
+    component: ClassVar[str] = "magnetorquer"
+    detector: Literal["coil_torque"]
+    threshold: float = number(gt=0.0, le=1e6, unit="", meaning="generalised likelihood ratio of the coil open "
+                                                               "against every coil healthy (chi-square, 1 degree "
+                                                               "of freedom)")
+    window_s: float = number(60.0, gt=0.0, le=3600.0, unit="s", meaning="span of the momentum balance, the "
+                                                                        "disturbance taken as constant over it")
+
+
 class TrackerOutage(Entry):
     """A star tracker from which no measurement (valid or not) arrived for the threshold."""
 
@@ -192,7 +246,8 @@ class EstimateUncertain(Entry):
 
 
 Detector = Annotated[WheelTorque | TachometerFrozen | GyroFrozen | MagnetometerFrozen | TrackerInnovation
-                     | GyroInnovation | GyroBiasJump | TrackerOutage | AttitudeError | RateError | EstimateUncertain,
+                     | GyroInnovation | GyroBiasJump | TrackerStep | GyroRamp | CoilTorque | TrackerOutage
+                     | AttitudeError | RateError | EstimateUncertain,
                      Field(discriminator="detector")]
 DETECTORS = {typing.get_args(m.model_fields["detector"].annotation)[0]: m
              for m in typing.get_args(typing.get_args(Detector)[0])}   # detector name -> its entry model

@@ -2,9 +2,9 @@
 
 :class:`MonitorTap` takes ``(topic, t, message)`` as :attr:`att_planner.tools.closed_loop.ClosedLoop.tap`
 hands them (the mirror types of :mod:`att_msgs_py.types`) and feeds a
-:class:`~.monitor.FaultMonitor`: each wheel speed sample with the motor torques last commanded and
-the friction the controller expects at those speeds; each gyro sample (and the time-driven detectors
-at its stamp); the magnetometer; each star tracker message's arrival; each estimate (its health and
+:class:`~.monitor.FaultMonitor`: each command's dipole; each wheel speed sample with the motor torques
+last commanded and the friction the controller expects at those speeds; each gyro sample (and the time-driven detectors
+at its stamp); the magnetometer; each star tracker message's arrival and attitude; each estimate (its health and
 covariance, and the innovations the estimator computed since the last one); each controller status's
 attitude error. A node does the same from its subscriptions.
 """
@@ -34,6 +34,7 @@ class MonitorTap:
         mon, out = self.monitor, self.reports
         if topic == topics.COMMAND:
             self.torques = np.asarray(m.wheel_torques, float)
+            out += mon.on_dipole(t, m.dipole)
         elif topic == topics.WHEEL_SPEEDS:
             friction = None if self.friction is None else self.friction(np.asarray(m.speeds, float))
             out += mon.on_wheels(m.t, m.speeds, self.torques, friction, self.omega_BN_B)
@@ -44,6 +45,7 @@ class MonitorTap:
             out += mon.on_magnetometer(m.t, m.field)
         elif topic == topics.STAR_TRACKER:
             mon.on_tracker(m.name, m.t)
+            out += mon.on_star_tracker(m.t, m.name, m.q, bool(m.valid))
         elif topic == topics.ESTIMATE:
             self.omega_BN_B = np.asarray(m.omega, float)
             if self.estimator is not None:

@@ -132,3 +132,78 @@ def test_the_base_and_the_shipped_table_pass(tmp_path):
     assert set(shipped.faults) >= {"wheel_torque", "tracker_inconsistent", "tracker_outage", "gyro_axis_frozen",
                                    "gyro_bias_step", "magnetometer_frozen", "attitude_error", "rate_error"}
     assert {e.detector for e in shipped.faults.values()} == set(table.DETECTORS)
+
+
+GLR_BASE = """\
+faults:
+  tracker_step:
+    detector: tracker_step
+    threshold: 40.0
+    window_s: 12.0
+    onset_s: 4.0
+    persistence_s: 1.0
+    response: exclude_sensor
+  gyro_rate_step:
+    detector: gyro_ramp
+    threshold: 40.0
+    persistence_s: 0.4
+    response: safe_mode
+  coil_open:
+    detector: coil_torque
+    threshold: 30.0
+    persistence_s: 2.0
+    window_s: 60.0
+    response: report
+"""
+
+# the detectors comparing each tracker with the gyro's propagation: (text replaced, its replacement, line,
+# field path, words of what was expected or found)
+GLR_EDITS = {
+    "onset beyond the window": ("onset_s: 4.0", "onset_s: 12.0", 2, "faults.tracker_step",
+                                "onset_s below window_s"),
+    "window zero": ("window_s: 12.0", "window_s: 0", 5, "faults.tracker_step.window_s", "greater than 0"),
+    "window of hours": ("window_s: 12.0", "window_s: 7200", 5, "faults.tracker_step.window_s",
+                        "less than or equal to 600"),
+    "threshold zero": ("threshold: 40.0\n    window_s", "threshold: 0\n    window_s", 4,
+                       "faults.tracker_step.threshold", "greater than 0"),
+    "threshold in a unit": ("threshold: 40.0\n    persistence_s", "threshold_deg: 40.0\n    persistence_s", 11,
+                            "faults.gyro_rate_step.threshold_deg", "threshold"),
+    "gyro excluded as a sensor": ("response: safe_mode", "response: exclude_sensor", 9, "faults.gyro_rate_step",
+                                  "(one of report, safe_mode)"),
+    "tracker excluding a wheel": ("response: exclude_sensor", "response: exclude_wheel", 2, "faults.tracker_step",
+                                  "fits detector tracker_step's component star_tracker"),
+    "onset a word": ("onset_s: 4.0", "onset_s: soon", 6, "faults.tracker_step.onset_s", "valid number"),
+    "coil excluded as a sensor": ("response: report", "response: exclude_sensor", 14, "faults.coil_open",
+                                  "(one of report, safe_mode)"),
+    "coil window negative": ("window_s: 60.0", "window_s: -60.0", 18, "faults.coil_open.window_s",
+                             "greater than 0"),
+    "coil threshold missing": ("    threshold: 30.0\n", "", 14, "faults.coil_open.threshold", "required"),
+    "coil with an onset": ("window_s: 60.0", "window_s: 60.0\n    onset_s: 4.0", 19, "faults.coil_open.onset_s",
+                           "one of the keys"),
+}
+
+
+@pytest.mark.parametrize("name", sorted(GLR_EDITS))
+def test_hostile_tracker_gyro_entry_refused_with_file_line_and_field(name, tmp_path):
+    old, new, line, field, words = GLR_EDITS[name]
+    assert old in GLR_BASE, f"case {name}: {old!r} is not in the base"
+    path = tmp_path / "faults" / "hostile.yaml"
+    path.parent.mkdir()
+    path.write_text(GLR_BASE.replace(old, new, 1))
+    kind, problems = config_cli.check_file(path)
+    assert kind == "faults" and problems, f"{name}: accepted"
+    mine = [p for p in problems if p.field == field]
+    assert mine, f"{name}: no problem at {field}: " + "\n".join(map(str, problems))
+    p = mine[0]
+    assert p.file == str(path) and p.line == line and words in p.expected + " " + p.found, str(p)
+    with pytest.raises(ConfigFileError) as err:
+        table.read(path)
+    assert err.value.code == ErrorCode.INVALID_CONFIG and str(path) in str(err.value)
+
+
+def test_the_tracker_gyro_base_passes_with_its_defaults(tmp_path):
+    path = tmp_path / "glr.yaml"
+    path.write_text(GLR_BASE)
+    assert config_cli.check_file(path, "faults") == ("faults", [])
+    ramp = table.read(path).faults["gyro_rate_step"]
+    assert (ramp.window_s, ramp.onset_s) == (12.0, 4.0)

@@ -60,6 +60,8 @@ FAULTS = {
     "star tracker outage": (("star_tracker", 0, "outage", {}), {("star_tracker", 0)}),
     "star tracker bias jump": (("star_tracker", 0, "bias_jump", {"bias_rad": (2e-4, -2e-4, 0.0)}),
                                {("star_tracker", 0)}),
+    "star tracker 1 bias jump": (("star_tracker", 1, "bias_jump", {"bias_rad": (2e-4, -2e-4, 0.0)}),
+                                 {("star_tracker", 1)}),
     "gyro axis stuck": (("gyro", 0, "axis_stuck", {}), {("gyro", 0)}),
     "gyro bias step": (("gyro", 0, "bias_step", {"bias_rad_s": DEG_S}), {("gyro", 0)}),
     "magnetometer stuck": (("magnetometer", 0, "stuck", {}), {("magnetometer", 0)}),

@@ -11,6 +11,7 @@ from att_msgs_py.types import Health
 from att_planner.estimation.health import Innovation
 from att_planner.fdir import table
 from att_planner.fdir.monitor import FaultMonitor
+from att_sim.models import rotations as rot
 from att_sim.models.scenario import spacecraft_from_model
 from att_sim.models.sensor_specs import SensorSpecs, sensors_from_model
 
@@ -99,5 +100,31 @@ def test_every_detector_of_the_table_is_built(leo):
     m = monitor(leo)
     built = {type(d).__name__ for ds in m.detectors.values() for _, d in ds}
     assert built == {"WheelTorqueDetector", "FrozenDetector", "InnovationDetector", "BiasJumpDetector",
-                     "OutageDetector", "Watchdog"}
+                     "OutageDetector", "Watchdog", "TrackerStepDetector", "GyroRampDetector",
+                     "CoilDetector"}
     assert sum(len(ds) for ds in m.detectors.values()) == len(table.read().faults) == len(table.DETECTORS)
+
+
+def test_the_trackers_against_the_gyro_and_the_coils_are_fed_by_the_monitor(leo):
+    """A gyro bias step of 0.01 deg/s about body y with one tracker valid: the shipped table's
+    gyro_rate_step reports it (safe mode) within 3 s; the commanded dipoles reach the coil detector."""
+    m = monitor(leo)
+    st2 = m.detectors["tracker_gyro"][0][1].residuals.specs["st2"]
+    rng = np.random.default_rng(4)
+    q, w, reports = np.array([0.0, 0.0, 0.0, 1.0]), np.array([0.0, 0.002, 0.0]), []
+    for k in range(1, 801):                               # 40 s at 20 Hz, the step at 30 s
+        t = 0.05 * k
+        q = rot.propagate_constant_rate(q, w, 0.05)
+        step = np.array([0.0, math.radians(0.01), 0.0]) if t >= 30.0 else 0.0
+        reports += m.on_gyro(t, w + step + rng.normal(0.0, math.radians(0.005) / 60.0 * math.sqrt(20.0), 3))
+        reports += m.on_dipole(t, [1.0, 2.0, 3.0])
+        if k % 4 == 0:
+            noise = rng.normal(size=3) * np.sqrt(np.diag(st2.covariance))
+            reports += m.on_star_tracker(t, "st1", q, False)
+            reports += m.on_star_tracker(t, "st2", rot.multiply(rot.multiply(q, st2.mounting), rot.exp_map(noise)),
+                                         True)
+    assert [(r.fault_id, r.component, r.index, r.response) for r in reports] == [
+        ("gyro_rate_step", "gyro", 1, "safe_mode")]
+    assert 30.0 < reports[0].detected_at <= 33.0
+    (coils,) = [d for _, d in m.detectors["coils"]]
+    assert coils.dipole.tolist() == [1.0, 2.0, 3.0]
