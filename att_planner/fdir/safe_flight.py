@@ -15,8 +15,8 @@ are known:
    the Sun line keeping the zones clear along the approach and for :data:`HOLD_HORIZON_S` of hold);
    without a Sun to see the body is kept at rest;
 3. every torque through the zone barrier (:func:`.safe_zones.barrier_torque`) with the zones where
-   they are at that step, within the torque the healthy wheels give in any direction
-   (:func:`.safe_zones.torque_authority`).
+   they are at that step and their own drift (over :data:`DRIFT_STEP_S`), within the torque the
+   healthy wheels give in any direction (:func:`.safe_zones.torque_authority`).
 """
 from __future__ import annotations
 
@@ -27,6 +27,7 @@ from att_planner.fdir.safe_mode import SafeActuation
 
 HOLD_HORIZON_S = 6000.0       # s of hold the Sun attitude is checked over (a low Earth orbit and more)
 HOLD_STEP_S = 60.0            # s between the checked instants of the hold
+DRIFT_STEP_S = 1.0            # s: the zones' own margin rate is their difference over this step
 
 
 class ZoneKeeper:
@@ -80,7 +81,10 @@ class ZoneKeeper:
         else:
             nominal, law = sz.approach_torque(state.q, omega, self.target, c.tracking_kp, c.tracking_kd), \
                 "sun_among_zones"
-        axes, half = self.zones.at(np.array([float(state.t)]), true=True)
+        t = float(state.t)
+        axes, half = self.zones.at(np.array([t, t + DRIFT_STEP_S]), true=True)
+        now, later = (sz.margins(state.q, self.zones.sensor_axes, axes[k], half[k], self.zones.keep_in) for k in (0, 1))
         tau, self.active = sz.barrier_torque(state.q, omega, nominal, self.zones.sensor_axes, axes[0], half[0],
-                                             self.zones.keep_in, self.spacecraft.inertia, self.torque_max)
+                                             self.zones.keep_in, self.spacecraft.inertia, self.torque_max,
+                                             (later - now) / DRIFT_STEP_S)
         return SafeActuation(True, tau, np.zeros(3), law)

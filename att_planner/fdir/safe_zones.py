@@ -87,11 +87,14 @@ def margins(q_BN, sensor_axes_B, axes_N, half_angles, keep_in) -> np.ndarray:
 
 
 def barrier_torque(q_BN, omega_BN_B, nominal_torque_B, sensor_axes_B, axes_N, half_angles, keep_in, inertia_B,
-                   torque_max_Nm: float, buffer_rad: float = BUFFER_RAD, rate_out_rad_s: float = RATE_OUT_RAD_S,
-                   gain_s: float = BARRIER_GAIN_S) -> tuple[np.ndarray, np.ndarray]:
+                   torque_max_Nm: float, drift_rad_s=None, buffer_rad: float = BUFFER_RAD,
+                   rate_out_rad_s: float = RATE_OUT_RAD_S, gain_s: float = BARRIER_GAIN_S
+                   ) -> tuple[np.ndarray, np.ndarray]:
     """The nominal body torque filtered by the zone barrier (module docstring): the torque (N m, body
     axes, scaled as a whole to the norm ``torque_max_Nm``, a torque the healthy wheels give in any
-    direction: :func:`torque_authority`) and a flag per zone (Z,) whether its barrier acts."""
+    direction: :func:`torque_authority`) and a flag per zone (Z,) whether its barrier acts.
+    ``drift_rad_s`` (Z,): each margin's rate at a fixed attitude, the zones' own motion (the Earth limb
+    turning with the orbit; None: zones at rest), added to the margin rate the body's turn makes."""
     J = np.asarray(inertia_B, float).reshape(3, 3)
     R = rot.dcm_NB(np.asarray(q_BN, float))
     omega_N = R @ np.asarray(omega_BN_B, float)
@@ -100,6 +103,7 @@ def barrier_torque(q_BN, omega_BN_B, nominal_torque_B, sensor_axes_B, axes_N, ha
     a = np.asarray(axes_N, float).reshape(-1, 3)
     m = margins(q_BN, s, a, half_angles, keep_in)
     keep_in = np.asarray(keep_in, bool).reshape(-1)
+    drift = np.zeros(len(m)) if drift_rad_s is None else np.asarray(drift_rad_s, float).reshape(-1)
     push, active = np.zeros(3), np.zeros(len(m), bool)
     for z in range(len(m)):
         b = R @ (s[z] / np.linalg.norm(s[z]))
@@ -109,7 +113,7 @@ def barrier_torque(q_BN, omega_BN_B, nominal_torque_B, sensor_axes_B, axes_N, ha
         u_N = (n if keep_in[z] else -n) / np.linalg.norm(n)
         u_B = R.T @ u_N
         alpha = AUTHORITY_SHARE * torque_max_Nm / np.linalg.norm(J @ u_B)
-        rate = float(omega_N @ u_N)
+        rate = float(omega_N @ u_N) + float(drift[z])
         floor = (-np.sqrt(2.0 * alpha * (m[z] - buffer_rad)) if m[z] >= buffer_rad
                  else rate_out_rad_s * min(1.0, (buffer_rad - m[z]) / buffer_rad))
         if rate >= floor:

@@ -99,6 +99,31 @@ def test_a_body_spinning_toward_a_zone_is_stopped_before_it():
     assert sz.margins(bare, zs.sensor_axes, axes[0], halves[0], zs.keep_in).min() < 0.0   # the barrier's doing
 
 
+def test_a_zone_moving_toward_a_body_at_rest_is_kept_out():
+    rate = math.radians(0.06)                       # rad/s: the Earth limb's motion in a low orbit
+    half = 30.0
+    start = math.radians(half) + 2 * sz.BUFFER_RAD
+
+    def axis(t):                                    # the zone's axis turning about +x toward the sensor +y
+        return rot.dcm_NB(rot.from_axis_angle(np.array([1.0, 0.0, 0.0]), start - rate * t)) @ SENSOR_B
+
+    def barrier(t, q, w, h):
+        a = axis(t)[None]
+        drift = (sz.margins(q, [SENSOR_B], axis(t + 1.0)[None], [math.radians(half)], [False])
+                 - sz.margins(q, [SENSOR_B], a, [math.radians(half)], [False]))
+        return sz.barrier_torque(q, w, np.zeros(3), [SENSOR_B], a, [math.radians(half)], [False], J, TORQUE_MAX,
+                                 drift)[0]
+
+    q, _ = fly_rigid(rot.IDENTITY, np.zeros(3), barrier, 400.0, dt=1.0, substeps=4)
+    t = np.arange(len(q)) * 1.0
+    m = np.array([sz.margins(qk, [SENSOR_B], axis(tk)[None], [math.radians(half)], [False])[0]
+                  for qk, tk in zip(q, t)])
+    assert m.min() >= 0.0
+    still = np.array([sz.margins(rot.IDENTITY, [SENSOR_B], axis(tk)[None], [math.radians(half)], [False])[0]
+                      for tk in t])
+    assert still.min() < 0.0                        # at rest it would have been entered
+
+
 def test_a_keep_in_zone_is_kept():
     zs = FittedZones([zone(SENSOR_B, 10.0, keep_in=True)])
     axes, halves = zs.at(np.zeros(1), true=True)
