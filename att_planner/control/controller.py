@@ -116,6 +116,7 @@ class Controller:
         self.authentication = ModeAuthentication()     # of mode requests (no key: none)
         self.healthy: tuple[bool, ...] | None = None   # the wheels the demand is allocated on (None: every one)
         self.safe_actuation = None                     # safe mode on what is left: state -> SafeActuation | None
+        self.safe_zones = None                         # the zones safe mode keeps clear of (FittedZones), None: none
 
     @property
     def spacecraft(self) -> Spacecraft:

@@ -17,10 +17,12 @@ import numpy as np
 from att_msgs_py import signing
 from att_msgs_py.errors import ConfigError, ErrorCode, clip
 from att_planner.control.controller import Controller, ControllerConfig
+from att_planner.control.maneuver import ZONE_FIT_WINDOW
 from att_planner.control.measured_state import MeasuredState
 from att_planner.control.plan_checks import PlanContext
 from att_planner.control.state_gate import GateConfig
 from att_planner.guidance.laws import PointingGeometry
+from att_planner.zones import FittedZones
 from att_sim.models import world
 from att_sim.models.ephemeris import Ephemeris
 from att_sim.models.scenario import Scenario
@@ -98,7 +100,19 @@ def controller_from_scenario(param, scenario: Scenario, key=None) -> Controller:
     compensate = param("friction_compensation", bool(wheels and (wheels.coulomb_friction or wheels.viscous_friction)))
     sky = None if scenario.epoch is None else Ephemeris(scenario.epoch, scenario.orbit_model)
     mode = param("initial_mode")
-    return Controller(plan_context(param, scenario, key), controller_config(param, scenario), mode,
-                      scenario.body_frame_id, gate_config(param), sky, measured_state(source, scenario),
-                      wheels.friction if compensate and wheels else None,
-                      PointingGeometry.of(world.Environment.from_scenario(scenario)))
+    controller = Controller(plan_context(param, scenario, key), controller_config(param, scenario), mode,
+                            scenario.body_frame_id, gate_config(param), sky, measured_state(source, scenario),
+                            wheels.friction if compensate and wheels else None,
+                            PointingGeometry.of(world.Environment.from_scenario(scenario)))
+    controller.safe_zones = scenario_zones(scenario, sky)
+    return controller
+
+
+def scenario_zones(scenario: Scenario, sky: Ephemeris | None) -> FittedZones | None:
+    """The scenario's zones on ``sky`` (those that move left out without one), the zones safe mode keeps
+    clear of (:mod:`att_planner.fdir.safe_flight`); None when there are none."""
+    zones = [z for z in scenario.zones if sky is not None or z.body == "inertial"]
+    if not zones:
+        return None
+    moving = any(z.body != "inertial" for z in zones)
+    return FittedZones(zones, sky if moving else None, window=ZONE_FIT_WINDOW)

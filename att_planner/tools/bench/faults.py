@@ -11,7 +11,9 @@ Per case: whether the fault was detected and its latency (s of sim time from the
 report), the component the first report isolated and whether it is the faulty one, the response
 taken, and the outcome: final pointing error (truth to the goal, or to the held attitude), the
 worst zone margin from the start (truth, the zones as they are in the sky), the time lost on the
-slew (its end against the nominal plan's), the slew completed, safe mode reached and held.
+slew (its end against the nominal plan's), the slew completed, safe mode reached and held, and in
+safe mode (flown ``--safe-hold-s`` once reached) the worst zone margin at its entry and from then
+on, the Sun-pointing error and the body rate at the end.
 
 The false-alarm campaign flies ``--runs`` dispersed fault-free runs of a Monte Carlo campaign
 (``--campaign``; :func:`att_planner.tools.monte_carlo.run.fly_batch`, the campaign's own draws) with
@@ -77,6 +79,8 @@ def configure(parser) -> None:
     parser.add_argument("--faults", default="", help="comma-separated fault names (default every one)")
     parser.add_argument("--instants", type=int, default=3, help="instants per fault and phase (1 to 3)")
     parser.add_argument("--workers", type=int, default=1, help="processes flying the cases")
+    parser.add_argument("--safe-hold-s", type=float, default=fault_flight.SAFE_HOLD_S,
+                        help="s of sim time safe mode is flown once reached (a hold: at least 90 s after the onset)")
 
 
 @dataclass
@@ -115,10 +119,12 @@ def loop_at_start(setup: Setup) -> ClosedLoop:
     return copy.deepcopy(setup.loop, {id(setup.loop.key): setup.loop.key})
 
 
-def flown(setup: Setup, fault, phase: str, instant: float) -> tuple[ClosedLoop, float, dict]:
+def flown(setup: Setup, fault, phase: str, instant: float,
+          safe_hold_s: float = fault_flight.SAFE_HOLD_S) -> tuple[ClosedLoop, float, dict]:
     """The loop flown with the truth fault ``fault`` ((component, index, kind, parameters); None: none)
     from ``instant`` into ``phase`` (``slew``: a fraction of it; ``hold``: s): the loop, the onset and
-    the slew's figures (completed, time lost, re-plans) and the attitude aimed at."""
+    the slew's figures (completed, time lost, re-plans) and the attitude aimed at; safe mode, once
+    reached, flown ``safe_hold_s`` (in a hold: to at least :data:`HOLD_AFTER_S` after the onset)."""
     loop = loop_at_start(setup)
     t0, plan = setup.start, setup.plan
     onset = t0 + (instant * plan.duration if phase == "slew" else instant)
@@ -129,7 +135,8 @@ def flown(setup: Setup, fault, phase: str, instant: float) -> tuple[ClosedLoop, 
             raise RuntimeError(f"fault {fault}: the simulation refused it: {refused.message}")
     figures = {"completed": False, "time_lost_s": math.nan, "replans": [], "goal": setup.maneuver["qf"]}
     if phase == "slew":
-        flight = fault_flight.fly(loop, plan, setup.maneuver, t0 + plan.duration + SLEW_AFTER_S)
+        flight = fault_flight.fly(loop, plan, setup.maneuver, t0 + plan.duration + SLEW_AFTER_S + safe_hold_s,
+                                  safe_hold_s)
         figures["completed"] = completed = flight.result is not None and flight.result.success
         end = t0 + plan.duration + loop.controller.config.settle_time
         figures["time_lost_s"] = loop.sim.t - end if completed else math.nan
@@ -138,6 +145,10 @@ def flown(setup: Setup, fault, phase: str, instant: float) -> tuple[ClosedLoop, 
         figures["goal"] = loop.controller.state.q.copy()
         loop.controller.hold("")
         loop.run(onset + HOLD_AFTER_S - loop.sim.t)
+        safe = loop.trace.arrays("t", "mode")
+        entered = safe["t"][safe["mode"] == int(ControlMode.SAFE)]
+        if entered.size and loop.sim.t < entered[0] + safe_hold_s:
+            loop.run(entered[0] + safe_hold_s - loop.sim.t)
     return loop, onset, figures
 
 
@@ -151,13 +162,14 @@ def baseline(setup: Setup, phase: str) -> tuple[np.ndarray, np.ndarray]:
     return a["t"], np.minimum.accumulate(worst)
 
 
-def case(setup: Setup, name: str, phase: str, instant: float, reference=None) -> dict:
+def case(setup: Setup, name: str, phase: str, instant: float, reference=None,
+         safe_hold_s: float = fault_flight.SAFE_HOLD_S) -> dict:
     """Fault ``name`` injected ``instant`` into ``phase``, flown and judged (module docstring);
     ``reference``: the phase's :func:`baseline`, a zone margin the fault-free flight has too is not the fault's."""
     fault, right = FAULTS[name]
     component = fault[0]
     wall = time.perf_counter()
-    loop, onset, figures = flown(setup, fault, phase, instant)
+    loop, onset, figures = flown(setup, fault, phase, instant, safe_hold_s)
     t0 = setup.start
     a = loop.trace.arrays("t", "q_true", "mode")
     history = loop.monitor.history
@@ -170,6 +182,7 @@ def case(setup: Setup, name: str, phase: str, instant: float, reference=None) ->
         base = float(reference[1][min(np.searchsorted(reference[0], a["t"][-1]), len(reference[0]) - 1)])
     safe = np.flatnonzero(a["mode"] == int(ControlMode.SAFE))
     target = LATENCY_S.get(component, OTHER_LATENCY_S)
+    in_safe = safe_figures(loop, a, margins, safe)
     return {"fault": name, "phase": phase, "instant": instant, "onset_s": onset - t0,
             "truth": {"component": component, "index": fault[1], "kind": fault[2]},
             "detected": first is not None, "latency_s": latency, "latency_target_s": target,
@@ -185,9 +198,31 @@ def case(setup: Setup, name: str, phase: str, instant: float, reference=None) ->
             "zone_entered": worst < 0.0, "zone_entered_by_fault": worst < 0.0 and worst < base - ZONE_TOLERANCE,
             "completed": figures["completed"], "time_lost_s": figures["time_lost_s"], "replans": figures["replans"],
             "safe_mode": safe.size > 0,
-            "safe_mode_held": bool(safe.size and np.all(a["mode"][safe[0]:] == int(ControlMode.SAFE))),
+            "safe_mode_held": bool(safe.size and np.all(a["mode"][safe[0]:] == int(ControlMode.SAFE))), **in_safe,
             "healthy_wheels": list(loop.controller.healthy or ()), "excluded": sorted(loop.estimator.excluded),
             "sim_end_s": loop.sim.t - t0, "wall_s": time.perf_counter() - wall}
+
+
+def safe_figures(loop: ClosedLoop, a: dict, margins: np.ndarray, safe: np.ndarray) -> dict:
+    """Safe mode's figures (NaN without it): the worst zone margin (deg, truth) at its entry and from
+    then on, its time flown, and at the end the angle of the controller's ``safe_sun_axis`` (truth) from
+    the Sun of its guidance and the body rate."""
+    out = {"safe_entry_zone_margin_deg": math.nan, "safe_worst_zone_margin_deg": math.nan, "safe_flown_s": 0.0,
+           "safe_sun_error_deg": math.nan, "safe_final_rate_deg_s": math.nan}
+    if not safe.size:
+        return out
+    if margins.size:
+        out["safe_entry_zone_margin_deg"] = math.degrees(float(margins[safe[0]].min()))
+        out["safe_worst_zone_margin_deg"] = math.degrees(float(margins[safe[0]:].min()))
+    out["safe_flown_s"] = float(a["t"][-1] - a["t"][safe[0]])
+    sky = loop.controller.guidance_sky
+    if sky is not None and sky.sun_N is not None:
+        axis_N = rot.dcm_NB(loop.sim.x[:4]) @ np.asarray(loop.controller.config.safe_sun_axis, float)
+        sun_N = np.asarray(sky.sun_N(loop.sim.t), float)
+        out["safe_sun_error_deg"] = math.degrees(math.acos(float(np.clip(axis_N @ sun_N / np.linalg.norm(axis_N)
+                                                                        / np.linalg.norm(sun_N), -1.0, 1.0))))
+    out["safe_final_rate_deg_s"] = math.degrees(float(np.linalg.norm(loop.sim.x[4:7])))
+    return out
 
 
 _SETUP: Setup | None = None
@@ -200,8 +235,8 @@ def _baseline(phase: str):
 
 
 def _case(args) -> dict:
-    name, phase, instant = args
-    return case(_SETUP, name, phase, instant, _REFERENCES.get(phase))
+    name, phase, instant, safe_hold_s = args
+    return case(_SETUP, name, phase, instant, _REFERENCES.get(phase), safe_hold_s)
 
 
 def _false_alarm_batch(args) -> list[dict]:
@@ -219,12 +254,13 @@ def _pool(workers: int):
     return multiprocessing.get_context("fork").Pool(workers)
 
 
-def cases(setup: Setup, names, instants: int, workers: int = 1) -> tuple[list[dict], dict]:
+def cases(setup: Setup, names, instants: int, workers: int = 1,
+          safe_hold_s: float = fault_flight.SAFE_HOLD_S) -> tuple[list[dict], dict]:
     """Every case of ``names`` (slew and hold, ``instants`` each), in ``workers`` processes, and the
     fault-free baselines' worst margins (deg)."""
     global _SETUP
-    jobs = [(n, "slew", f) for n in names for f in SLEW_FRACTIONS[:instants]] + \
-           [(n, "hold", h) for n in names for h in HOLD_AT_S[:instants]]
+    jobs = [(n, "slew", f, safe_hold_s) for n in names for f in SLEW_FRACTIONS[:instants]] + \
+           [(n, "hold", h, safe_hold_s) for n in names for h in HOLD_AT_S[:instants]]
     _SETUP = setup
     if workers <= 1:
         _REFERENCES.update({phase: baseline(setup, phase) for phase in ("slew", "hold")})
@@ -280,6 +316,10 @@ def summary(rows: list[dict]) -> list[dict]:
                         "zone_entered": sum(r["zone_entered_by_fault"] for r in rs),
                         "safe_mode_held": sum(r["safe_mode_held"] for r in rs),
                         "worst_margin_deg": min(r["worst_zone_margin_deg"] for r in rs),
+                        "safe_worst_margin_deg": min((r["safe_worst_zone_margin_deg"] for r in rs if r["safe_mode"]),
+                                                     default=math.nan),
+                        "safe_sun_error_max_deg": max((r["safe_sun_error_deg"] for r in rs if r["safe_mode"]),
+                                                      default=math.nan),
                         "final_error_max_deg": max(r["final_error_deg"] for r in rs),
                         "time_lost_max_s": max((r["time_lost_s"] for r in rs if r["completed"]), default=math.nan)})
     return out
@@ -292,6 +332,8 @@ def run(args) -> dict:
         raise SystemExit(f"att-bench faults: --faults: unknown {unknown}; known: {', '.join(FAULTS)}")
     if not 1 <= args.instants <= 3:
         raise SystemExit(f"att-bench faults: --instants must be 1 to 3, found {args.instants}")
+    if not (math.isfinite(args.safe_hold_s) and args.safe_hold_s >= 0.0):
+        raise SystemExit(f"att-bench faults: --safe-hold-s must be a finite number >= 0, found {args.safe_hold_s}")
     if args.runs < 0 or args.workers < 1 or args.batch < 1:
         raise SystemExit("att-bench faults: --runs must be >= 0, --workers and --batch >= 1; found "
                          f"{args.runs}, {args.workers}, {args.batch}")
@@ -301,16 +343,17 @@ def run(args) -> dict:
         setup = prepare(s)
     except (KeyError, ValueError) as err:
         raise SystemExit(f"att-bench faults: {err.args[0] if err.args else err}") from None
-    rows, base = cases(setup, names, args.instants, args.workers)
+    rows, base = cases(setup, names, args.instants, args.workers, args.safe_hold_s)
     alarms = (false_alarms(args.campaign, args.runs, args.batch, args.workers) if args.runs
               else {"runs": 0, "runs_with_a_report": 0})
     table = summary(rows)
     print(f"{'fault':24} {'phase':5} {'det':>4} {'<=T':>4} {'right':>5} {'lat max s':>9} {'done':>4} {'safe':>4} "
-          f"{'zone':>4} {'margin deg':>10} {'err deg':>8} {'lost s':>7}  response")
+          f"{'zone':>4} {'margin deg':>10} {'err deg':>8} {'lost s':>7} {'safe margin':>11} {'sun deg':>7}  response")
     for r in table:
         print(f"{r['fault']:24} {r['phase']:5} {r['detected']:>2}/{r['cases']} {r['in_time']:>4} {r['right']:>5} "
               f"{r['latency_max_s']:9.2f} {r['completed']:>4} {r['safe_mode']:>4} {r['zone_entered']:>4} "
-              f"{r['worst_margin_deg']:10.2f} {r['final_error_max_deg']:8.3f} {r['time_lost_max_s']:7.0f}  "
+              f"{r['worst_margin_deg']:10.2f} {r['final_error_max_deg']:8.3f} {r['time_lost_max_s']:7.0f} "
+              f"{r['safe_worst_margin_deg']:11.2f} {r['safe_sun_error_max_deg']:7.2f}  "
               f"{','.join(r['responses'])}")
     print(f"false alarms: {alarms['runs_with_a_report']} of {alarms['runs']} fault-free dispersed runs")
     met = {"detected_in_time_right": sum(r["in_time"] and r["right"] for r in rows), "cases": len(rows),
@@ -318,6 +361,7 @@ def run(args) -> dict:
     return {"study": "faults", "scenario": args.scenario, "table": str(fault_tables.DEFAULT_TABLE),
             "maneuver_seconds": setup.plan.duration, "method": setup.plan.method,
             "slew_fractions": list(SLEW_FRACTIONS[:args.instants]), "hold_at_s": list(HOLD_AT_S[:args.instants]),
+            "safe_hold_s": args.safe_hold_s,
             "baseline_zone_margin_deg": base, "cases": rows, "summary": table, "false_alarm_campaign": alarms,
             "met": met,
             "passed": met["detected_in_time_right"] == met["cases"] and not met["zone_entered"]

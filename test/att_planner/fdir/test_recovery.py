@@ -71,6 +71,7 @@ def test_safe_mode_switches_the_controller_and_puts_its_torque_on_the_coils_with
 
 def test_safe_mode_with_the_gyro_distrusted_damps_with_b_dot(loop):
     ctl = loop.controller
+    ctl.safe_zones = None                          # no zones known: the laws on what is left
     recovery.act(responses(safe=True, gyro=False), ctl, loop.estimator)
     for _ in range(2):                             # B-dot needs two fields
         ctl.next_control = -np.inf
@@ -80,8 +81,24 @@ def test_safe_mode_with_the_gyro_distrusted_damps_with_b_dot(loop):
 
 def test_safe_mode_on_healthy_wheels_is_the_controllers_own_law(loop):
     ctl = loop.controller
+    ctl.safe_zones = None                          # no zones known: the controller's own law
     recovery.act(responses((True, True, False, True), safe=True), ctl, loop.estimator)
     ctl.next_control = -np.inf
     out = step_controllers([ctl])[0]
     assert ctl.mode == ControlMode.SAFE and "what is left" not in (out.status.message or "")
     assert out.command.wheel_torques[2] == 0.0
+
+
+@pytest.mark.parametrize("gyro", [True, False])
+def test_safe_mode_with_the_scenarios_zones_flies_among_them_on_the_healthy_wheels(loop, gyro):
+    ctl = loop.controller
+    assert ctl.safe_zones is not None and ctl.safe_zones.names == [z.name for z in PYRAMID.zones]
+    recovery.act(responses((True, True, False, True), safe=True, gyro=gyro), ctl, loop.estimator)
+    assert ctl.safe_actuation.keeper is not None and ctl.safe_actuation.keeper.zones is ctl.safe_zones
+    ctl.next_control = -np.inf
+    out = step_controllers([ctl])[0]
+    assert "among_zones" in out.status.message and out.command.wheel_torques[2] == 0.0
+    assert np.all(out.command.dipole == 0.0)
+    keeper = ctl.safe_actuation.keeper
+    recovery.act(responses((True, True, False, True), safe=True, gyro=not gyro), ctl, loop.estimator)
+    assert ctl.safe_actuation.keeper is keeper                   # the momentum and the target are kept

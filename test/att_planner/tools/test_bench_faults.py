@@ -42,3 +42,6 @@ def test_unknown_faults_and_instants_are_refused():
         faults.run(args(faults="wheel melted"))
     with pytest.raises(SystemExit, match="--instants must be 1 to 3"):
         faults.run(args(instants=4))
+    for bad in (-1.0, math.nan, math.inf):
+        with pytest.raises(SystemExit, match="--safe-hold-s must be a finite number >= 0"):
+            faults.run(args(safe_hold_s=bad))
