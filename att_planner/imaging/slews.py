@@ -243,9 +243,10 @@ def verify(slew: Slew, spacecraft: dyn.Spacecraft, goal: Goal, limits: Limits, z
     q_end, omega_end = traj.q_BN[-1], traj.omega_BN_B[-1]
     attitude = float(rot.angle_between(q_end, q_goal))
     rate = float(np.linalg.norm(omega_end - rot.dcm_BN(q_end) @ rot.dcm_NB(q_goal) @ np.asarray(omega_goal, float)))
-    margin = math.inf
+    margin, zone = math.inf, ""
     if zones is not None and zones.zones:
-        margin = float(zones.margins(slew.t0_s + traj.t, traj.q_BN, true=True).min())
+        margins = zones.margins(slew.t0_s + traj.t, traj.q_BN, true=True).min(axis=0)
+        margin, zone = float(margins.min()), zones.names[int(np.argmin(margins))]
     torque_ratio = float(np.abs(plan.torque).max() / limits.torque_max_Nm)
     rate_ratio = float(np.abs(traj.omega_BN_B).max() / limits.rate_max_rad_s) if math.isfinite(
         limits.rate_max_rad_s) else 0.0
@@ -260,7 +261,7 @@ def verify(slew: Slew, spacecraft: dyn.Spacecraft, goal: Goal, limits: Limits, z
     elif not rate <= tol.arrival_rate:
         refusal = f"arrival rate {math.degrees(rate):.4f} deg/s from the site's rate"
     elif not margin >= -tol.cone_penetration:
-        refusal = f"enters a zone by {math.degrees(-margin):.3f} deg"
+        refusal = f"enters zone {zone} by {math.degrees(-margin):.3f} deg"
     elif not max(torque_ratio, rate_ratio, momentum_ratio) <= tol.limit_ratio:
         refusal = (f"limits: torque {torque_ratio:.4f}, rate {rate_ratio:.4f}, momentum {momentum_ratio:.4f} "
                    "x their bounds")

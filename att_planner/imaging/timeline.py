@@ -169,13 +169,20 @@ class Planner:
         q = np.array([law(float(s))[0] for s in t])
         return float(self.zones.margins(t, q, true=True).min())
 
-    def _leg(self, source: int, t0: float, target: int) -> Leg | str:
-        """The verified slew from ``source``'s law at ``t0`` onto ``target``'s, or why there is none."""
-        slew = slews.fastest(self.laws(source)(t0), t0, self.laws(target), self.limits)
+    def _slew(self, source: int, t0: float, target: int) -> slews.Slew | None:
+        return slews.fastest(self.laws(source)(t0), t0, self.laws(target), self.limits)
+
+    def _verified(self, slew: slews.Slew | None, source: int, target: int) -> Leg | str:
+        """The slew verified onto ``target``'s law, or why it is refused."""
         if slew is None:
             return "no slew within the bounds"
         check = slews.verify(slew, self.spacecraft, self.laws(target), self.limits, self.zones)
-        return Leg(target, slew, check) if check.refusal is None else check.refusal.split(" by ")[0]
+        return Leg(target, slew, check) if check.refusal is None else check.refusal.split(" by ")[0] + (
+            " (from nadir)" if source == NADIR else " (to nadir)" if target == NADIR else "")
+
+    def _leg(self, source: int, t0: float, target: int) -> Leg | str:
+        """The verified slew from ``source``'s law at ``t0`` onto ``target``'s, or why there is none."""
+        return self._verified(self._slew(source, t0, target), source, target)
 
     def attempt(self, source: int, t: float, window: int):
         """The legs and the image of window ``window`` from ``source``'s law at ``t`` (module
@@ -183,24 +190,26 @@ class Planner:
         site = int(self.windows.site[window])
         opening, closing = float(self.windows.open_s[window]), float(self.windows.close_s[window])
         legs, holds = [], []
-        leg = self._leg(source, t, site)
+        direct = self._slew(source, t, site)
+        if direct is None:
+            return "no slew within the bounds"
+        wait = opening - self.settle_s - direct.arrival_s
+        if wait <= 0.0:
+            leg = self._verified(direct, source, site)
+        elif wait <= HOLD_MAX_S:
+            holds.append((source, t, t + wait))
+            leg = self._leg(source, t + wait, site)
+        else:
+            first = self._leg(source, t, NADIR)
+            if isinstance(first, str):
+                return first
+            legs.append(first)
+            start = max(first.slew.arrival_s, opening - self.settle_s - direct.duration_s)
+            leg = self._leg(NADIR, start, site)
+            if not isinstance(leg, str):
+                holds.append((NADIR, first.slew.arrival_s, leg.slew.t0_s))
         if isinstance(leg, str):
             return leg
-        wait = opening - self.settle_s - leg.slew.arrival_s
-        if wait > 0.0:
-            if wait <= HOLD_MAX_S:
-                holds.append((source, t, t + wait))
-                leg = self._leg(source, t + wait, site)
-            else:
-                first = self._leg(source, t, NADIR)
-                if isinstance(first, str):
-                    return first
-                legs.append(first)
-                start = max(first.slew.arrival_s, opening - self.settle_s - leg.slew.duration_s)
-                leg = self._leg(NADIR, start, site)
-                holds.append((NADIR, first.slew.arrival_s, leg.slew.t0_s))
-            if isinstance(leg, str):
-                return leg
         legs.append(leg)
         image_s = max(leg.slew.arrival_s + self.settle_s, opening)
         end = image_s + self.dwell_s

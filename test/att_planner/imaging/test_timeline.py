@@ -8,37 +8,15 @@ import math
 import numpy as np
 import pytest
 
-from att_planner.guidance.ground_arrival import site_in_view
-from att_planner.guidance.laws import PointingGeometry
-from att_planner.imaging import access, sites, slews, timeline
-from att_planner.zones import FittedZones
-from att_sim.models import scenario as scen
-from att_sim.models import world
+from att_planner.imaging import timeline
 
-SCENARIO = scen.load("aeos")
-ENVIRONMENT = world.Environment.from_scenario(SCENARIO)
+from .conftest import SCENARIO
 
 
 def test_the_along_track_axis_puts_the_aeos_trackers_fore_and_aft():
     axes = [z.sensor_axis for z in SCENARIO.zones]
     assert np.allclose(timeline.along_track_axis([0.0, 0.0, 1.0], axes), [1.0, 0.0, 0.0])
     assert np.allclose(timeline.along_track_axis([0.0, 0.0, 1.0], []), [0.0, 1.0, 0.0])   # next_axis
-
-
-@pytest.fixture(scope="module")
-def planner():
-    geometry = PointingGeometry.of(ENVIRONMENT)
-    rows = []
-    for k, (t, off, az) in enumerate([(200.0, 15.0, 90.0), (215.0, 20.0, -90.0), (300.0, 10.0, 90.0),
-                                      (320.0, 25.0, -90.0), (330.0, 5.0, 0.0)]):
-        lat, lon = site_in_view(geometry, t, math.radians(off), math.radians(az))
-        rows.append(sites.ImagingSite(name=f"s{k}", lat_deg=math.degrees(lat), lon_deg=math.degrees(lon),
-                                      priority=0.2 * k))
-    targets = sites.SiteSet("test", tuple(rows))
-    windows = access.access_windows(ENVIRONMENT, targets, 0.0, 600.0)
-    limits = slews.Limits.of(SCENARIO.spacecraft, math.radians(5.0), 50.0)
-    zones = FittedZones(SCENARIO.zones, ENVIRONMENT.sky, 600.0)
-    return timeline.Planner(ENVIRONMENT, SCENARIO.spacecraft, targets, windows, [0.0, 0.0, 1.0], limits, zones)
 
 
 @pytest.mark.parametrize("policy", timeline.POLICIES)
