@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from att_planner.imaging import timeline
-from att_planner.tools.bench import aeos_flight, main
+from att_planner.tools.bench import aeos_flight, history, main
 from att_sim.models import rotations as rot
 
 from ..imaging.conftest import planner  # noqa: F401  (the shared planner fixture)
@@ -47,3 +47,24 @@ def test_bad_policies_are_refused(capsys):
         main(["aeos", "--targets", "uniform:5", "--orbits", "0.05", "--fly", "--policies", "random",
               "--json", "/dev/null"])
     assert exit_.value.code == 2 and "--policies" in capsys.readouterr().err
+
+
+def _policy(a: int, b: int, entries: int = 0, cpu: float = 2.0) -> dict:
+    return {"status": "flown", "planned_images": b + 1, "planner_cpu_s_per_orbit": cpu, "zone_entries": entries,
+            "flown_worst_zone_margin_deg": 12.0, "level_a": {"images": a, "lost": 1},
+            "level_b": {"images": b, "lost": 1}}
+
+
+@pytest.mark.parametrize("ours, met", [(_policy(120, 110), True), (_policy(120, 100), False),
+                                       (_policy(120, 110, entries=1), False), (_policy(120, 110, cpu=11.0), False)])
+def test_the_history_line_of_a_flown_day_judges_the_issue_s_criteria(ours, met):
+    payload = {"study": "aeos", "targets": "uniform:300", "seed": 0, "orbits": 1.0, "accessible": {"sites": 150},
+               "flown": {"greedy": _policy(100, 95), "ours": ours}}
+    line = history.line(payload, json_path=None, date="2026-01-01T00:00:00Z", commit=None, source="test")
+    assert line["met"] is met and line["value"] == ours["level_b"]["images"]
+    assert line["metrics"]["greedy_level_a"] == 100 and line["metrics"]["accessible_sites"] == 150
+    assert line["command"] == "att-bench aeos --targets uniform:300 --seed 0 --orbits 1 --fly --policies greedy,ours " \
+                              "--json PATH"
+    alone = history.line({**payload, "flown": {"ours": ours}}, json_path=None, date="2026-01-01T00:00:00Z",
+                         commit=None, source="test")
+    assert alone["met"] is None
