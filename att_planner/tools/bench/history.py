@@ -358,12 +358,19 @@ def _aeos_flown(p: dict, case: str | None) -> Summary:
     """A flown day: the headline is the last flown policy's level-(b) images (``ours`` when present)."""
     flown, accessible = _get(p, "flown"), _num(_get(p, "accessible"), "sites")
     policies = [k for k in ("greedy", "ours") if isinstance(flown.get(k), dict) and flown[k].get("status") == "flown"]
-    if not policies:
-        raise HistoryError("an aeos JSON whose 'flown' holds no flown policy")
+    planned_only = not policies
+    if planned_only:
+        policies = [k for k in ("greedy", "ours") if isinstance(flown.get(k), dict)]
+        if not policies:
+            raise HistoryError("an aeos JSON whose 'flown' holds no policy")
     head = policies[-1]
     metrics = {}
     for k in policies:
         e = flown[k]
+        if planned_only:
+            metrics.update({f"{k}_planned": _num(e, "planned_images"), f"{k}_priority": _num(e, "planned_priority"),
+                            f"{k}_cpu_s_per_orbit": _num(e, "planner_cpu_s_per_orbit")})
+            continue
         metrics.update({f"{k}_level_a": _num(e, "level_a", "images"), f"{k}_level_b": _num(e, "level_b", "images"),
                         f"{k}_lost_b": _num(e, "level_b", "lost"), f"{k}_planned": _num(e, "planned_images"),
                         f"{k}_cpu_s_per_orbit": _num(e, "planner_cpu_s_per_orbit"),
@@ -372,6 +379,11 @@ def _aeos_flown(p: dict, case: str | None) -> Summary:
     metrics["accessible_sites"] = accessible
     if isinstance(p.get("bound"), dict):
         metrics["bound_images"] = _num(p, "bound", "images")
+    if planned_only:
+        return Summary(case or f"{_get(p, 'targets')} seed {_get(p, 'seed')}, {_num(p, 'orbits'):g} orbits, planned "
+                               f"{'/'.join(policies)}",
+                       f"{head} images planned with verified slews (not flown)", _num(flown[head], "planned_images"),
+                       f"of {int(accessible)} accessible", "none (planned, not flown)", None, metrics)
     met = None
     if policies == ["greedy", "ours"]:
         g, o = flown["greedy"], flown["ours"]
@@ -456,6 +468,8 @@ STUDIES: tuple[Study, ...] = (
     Study("aeos", lambda p: p.get("study") == "aeos", _aeos,
           lambda p, path: f"att-bench aeos --targets {p['targets']} --seed {p['seed']} --orbits {p['orbits']:g} "
                           + (f"--fly --policies {','.join(p['flown'])} " if isinstance(p.get("flown"), dict) else "")
+                          + ("--plan-only " if isinstance(p.get("flown"), dict) and not any(
+                              isinstance(e, dict) and e.get("status") == "flown" for e in p["flown"].values()) else "")
                           + ("--bound " if "bound" in p else "") + f"--json {path}"),
 )
 BY_NAME = {s.name: s for s in STUDIES}

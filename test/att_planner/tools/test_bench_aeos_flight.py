@@ -68,3 +68,14 @@ def test_the_history_line_of_a_flown_day_judges_the_issue_s_criteria(ours, met):
     alone = history.line({**payload, "flown": {"ours": ours}}, json_path=None, date="2026-01-01T00:00:00Z",
                          commit=None, source="test")
     assert alone["met"] is None
+
+
+def test_the_history_line_of_a_planned_day_is_marked_not_flown():
+    planned = {"status": "planned, verified slews, not flown", "planned_images": 80, "planned_priority": 40.0,
+               "planner_cpu_s_per_orbit": 1.5}
+    payload = {"study": "aeos", "targets": "uniform:300", "seed": 2, "orbits": 5.0, "accessible": {"sites": 90},
+               "flown": {"greedy": planned, "ours": {**planned, "planned_images": 82}}, "bound": {"images": 88.0}}
+    line = history.line(payload, json_path=None, date="2026-01-01T00:00:00Z", commit=None, source="test")
+    assert line["met"] is None and line["value"] == 82 and "not flown" in line["metric"]
+    assert line["metrics"]["greedy_planned"] == 80 and line["metrics"]["bound_images"] == 88.0
+    assert "--plan-only --bound" in line["command"]
