@@ -9,9 +9,11 @@ with the rest-to-rest eigenaxis time from L's attitude at ``t`` (vectorised,
 image and dwell fit before the window closes are ranked by the **policy**:
 
 * ``greedy`` — bsk-rl's greedy policy: the window that closes first;
-* ``ours`` — the image that ends first, less :data:`PRIORITY_WEIGHT_S` per unit of the site's
-  priority (a site of priority 1 is worth waiting that much longer than one of priority 0): in a
-  dense field the nearest site in time keeps the spacecraft imaging instead of crossing the swath.
+* ``ours`` — insertion before the deadline: the image that ends first, less
+  :data:`PRIORITY_WEIGHT_S` per unit of the site's priority, provided the earliest-closing window
+  stays reachable after it on the estimates (slews scaled by :data:`SLEW_SCALE`); else the
+  earliest-closing window. In a dense field the nearest site in time keeps the spacecraft imaging
+  while the window about to close is still served.
 
 The first of the ranked windows (at most :data:`TRIES`) whose **exact** attempt succeeds is taken.
 An attempt (:meth:`Planner.attempt`) plans the slew from L's tracking state onto the site's law
@@ -52,6 +54,7 @@ HOLD_MAX_S = 60.0         # s: a longer wait for a window is spent on nadir
 ZONE_SAMPLE_S = 2.0       # s between the zone samples of a held stretch
 TRIES = 4                 # exact attempts per decision
 PRIORITY_WEIGHT_S = 10.0  # s of waiting one unit of priority is worth (policy ours)
+SLEW_SCALE = 1.6          # the track-to-track slews' time over the rest-to-rest estimate (policy ours)
 NADIR = -1                # the target index of nadir
 REFERENCE_STEP_S = 0.01   # s: the central difference of the nadir law's rate
 
@@ -221,16 +224,34 @@ class Planner:
             return "a held stretch enters a zone"
         return legs, Image(site, window, image_s, self.dwell_s, leg.slew.arrival_s), margin
 
-    def estimates(self, source: int, t: float, pending: np.ndarray) -> np.ndarray:
-        """Estimated image times of the windows ``pending`` from ``source``'s law at ``t`` (rest-to-rest)."""
+    def estimates(self, source: int, t: float, pending: np.ndarray, dcm: np.ndarray | None = None,
+                  scale: float = 1.0) -> np.ndarray:
+        """Estimated image times of the windows ``pending`` from ``source``'s law at ``t`` (or from the
+        attitude ``dcm``), the rest-to-rest slew times scaled by ``scale``."""
         w = self.windows
         site, opening = w.site[pending], w.open_s[pending]
-        q_now = self.laws(source)(t)[0]
-        dcm = rot.dcm_NB(q_now)
+        if dcm is None:
+            dcm = rot.dcm_NB(self.laws(source)(t)[0])
         arrival = np.maximum(opening - self.settle_s, t)
         axis, angle = rotation_between(dcm, self.pointing.dcm_NB(site, arrival))
         slew = rest_to_rest_time(self.spacecraft, axis, angle, self.limits.rate_max_rad_s, self.limits.momentum_max_Nms)
-        return np.maximum(t + slew + self.settle_s, opening)
+        return np.maximum(t + scale * slew + self.settle_s, opening)
+
+    def _insertion(self, pending: np.ndarray, image_s: np.ndarray, order: np.ndarray) -> np.ndarray:
+        """ours' order (module docstring): the earliest-finishing window (less :data:`PRIORITY_WEIGHT_S`
+        per unit of priority) that leaves the earliest-closing one reachable on the estimates, then the
+        earliest-closing order."""
+        w = self.windows
+        first = order[0]
+        for k in np.argsort(image_s - PRIORITY_WEIGHT_S * self.sites.priority[w.site[pending]], kind="stable"):
+            if k == first:
+                break
+            site, free = int(w.site[pending[k]]), float(image_s[k]) + self.dwell_s
+            dcm = self.pointing.dcm_NB(np.array([site]), np.array([free]))[0]
+            after = self.estimates(site, free, pending[[first]], dcm, SLEW_SCALE)[0]
+            if after + self.dwell_s <= w.close_s[pending[first]]:
+                return np.concatenate([[k], order[order != k]])
+        return order
 
     # -- the horizon -------------------------------------------------------------------------------
     def plan(self, policy: str) -> Timeline:
@@ -255,10 +276,9 @@ class Planner:
             pending, image_s = pending[fits], image_s[fits]
             if not len(pending):
                 continue
-            if policy == "greedy":
-                order = np.argsort(w.close_s[pending], kind="stable")
-            else:
-                order = np.argsort(image_s - PRIORITY_WEIGHT_S * self.sites.priority[w.site[pending]], kind="stable")
+            order = np.argsort(w.close_s[pending], kind="stable")
+            if policy == "ours":
+                order = self._insertion(pending, image_s, order)
             taken = None
             for k in order[:TRIES]:
                 timeline.attempts += 1

@@ -35,3 +35,24 @@ def test_a_short_horizon_is_planned_with_verified_slews_and_images_inside_their_
     assert times == sorted(times) and plan.worst_zone_margin > 0.0
     with pytest.raises(ValueError, match="policy"):
         planner.plan("random")
+
+
+def test_ours_inserts_an_earlier_image_only_when_the_closing_window_stays_reachable(planner):
+    w = planner.windows
+    pending = np.arange(len(w))
+    image_s = planner.estimates(timeline.NADIR, 150.0, pending)
+    order = np.argsort(w.close_s[pending], kind="stable")
+    chosen = planner._insertion(pending, image_s, order)
+    assert sorted(chosen.tolist()) == sorted(order.tolist())
+    assert list(chosen[1:]) == [k for k in order if k != chosen[0]]
+    if chosen[0] != order[0]:
+        k, first = chosen[0], order[0]
+        dcm = planner.pointing.dcm_NB(w.site[[k]], np.array([image_s[k] + planner.dwell_s]))[0]
+        after = planner.estimates(int(w.site[k]), image_s[k] + planner.dwell_s, pending[[first]], dcm,
+                                  timeline.SLEW_SCALE)[0]
+        assert after + planner.dwell_s <= w.close_s[first]
+    # with the closing window out of reach after anything else, the order is the earliest-closing one
+    hopeless = image_s.copy()
+    hopeless[order[0]] = w.close_s[order[0]] - planner.dwell_s
+    hopeless[order[1:]] = w.close_s[order[0]]
+    assert list(planner._insertion(pending, hopeless, order)) == list(order)
