@@ -75,13 +75,15 @@ class GreedyPlan:
 
 class Pointing:
     """The attitudes (body-to-inertial DCMs) that put ``boresight_B`` on sites, along-track axis
-    nearest the orbital velocity (module docstring)."""
+    ``along_B`` (default :func:`~att_planner.mission.targets.next_axis` of the boresight) nearest the
+    orbital velocity (module docstring)."""
 
-    def __init__(self, environment, geometry: SkyGeometry, boresight_B):
+    def __init__(self, environment, geometry: SkyGeometry, boresight_B, along_B=None):
         self.orbit, self.field, self.geometry = environment.orbit, environment.field, geometry
         s = np.asarray(boresight_B, float)
         s = s / np.linalg.norm(s)
-        x = next_axis(s)
+        x = next_axis(s) if along_B is None else np.asarray(along_B, float) - (np.asarray(along_B, float) @ s) * s
+        x = x / np.linalg.norm(x)
         self.body = np.column_stack([s, x, np.cross(s, x)])              # body basis, (3, 3)
 
     def dcm_NB(self, site: np.ndarray, t: np.ndarray) -> np.ndarray:

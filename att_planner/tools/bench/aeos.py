@@ -12,6 +12,16 @@ within 0.1 s), and reports:
   (rest-to-rest slew estimates, no verified slew, no flight, no image check);
 * the number of windows of each site, and the compute time of each part.
 
+With ``--fly``, the day of images: for each policy of :mod:`att_planner.imaging.timeline` (``greedy``,
+bsk-rl's rule, and ``ours``) the timeline planned with verified track-to-track slews
+(:mod:`att_planner.imaging.slews`), flown in process on the estimate with every sensor and imperfect
+actuator and each image checked at levels (a) and (b) on the flown truth
+(:mod:`att_planner.tools.bench.aeos_flight`): images at each level, their priority and fraction of the
+accessible sites, images lost (planned, failed on the truth), planner CPU per orbit, the worst zone
+margin and the zone entries on the truth, and every image (site, time, flown attitude and rate,
+errors, pass or fail per level). ``--plan-only`` plans the timelines without flying them.
+With ``--bound``, the relaxed bound of :mod:`att_planner.imaging.bound` on the images.
+
 The imager is the scenario's sensor (its demo's ``sensor_axis``), the slews' rate bound the planner's
 ``schedule_rate_max_rad_s`` and their momentum bound each wheel's ``wheel_inertia × wheel_speed_max``.
 The JSON lists every window and every planned image (site, time, slew) so that anyone can recheck them.
@@ -26,7 +36,7 @@ import time
 import numpy as np
 
 from att_msgs_py.errors import ConfigError
-from att_planner.imaging import access, baseline, sites
+from att_planner.imaging import access, baseline, sites, slews, timeline
 from att_sim.models import scenario as scen
 from att_sim.models import world
 
@@ -41,6 +51,10 @@ def configure(parser):
     parser.add_argument("--scenario", default="aeos", help="the scenario flown (spacecraft, orbit, epoch)")
     parser.add_argument("--dwell-s", type=float, default=0.0, help="s held on each site before the next slew")
     parser.add_argument("--lookahead", type=int, default=baseline.LOOKAHEAD, help="windows the greedy policy weighs")
+    parser.add_argument("--fly", action="store_true", help="plan both policies' timelines and fly them in process")
+    parser.add_argument("--plan-only", action="store_true", help="with --fly: plan the timelines, do not fly them")
+    parser.add_argument("--policies", default=",".join(timeline.POLICIES), help="the timelines' policies, by comma")
+    parser.add_argument("--bound", action="store_true", help="the relaxed (LP) bound on the images")
 
 
 def _refuse(message: str):
@@ -104,4 +118,78 @@ def run(args) -> dict:
                    "plan": [{"site": names[i.site], "time_s": round(i.time_s, 3), "slew_s": round(i.slew_s, 3),
                              "slew_angle_deg": round(math.degrees(i.slew_angle_rad), 4)} for i in plan.images]},
         "compute_s": {"access": access_s, "greedy": greedy_s},
+        **({"flown": _day(args, scenario, environment, targets, windows, boresight, rate_max, momentum_max, bound)}
+           if args.fly else {}),
+        **({"bound": _bound(args, scenario, environment, targets, windows, boresight, rate_max, momentum_max)}
+           if args.bound else {}),
     }
+
+
+def _planner(args, scenario, environment, targets, windows, boresight, rate_max, momentum_max):
+    from att_planner.zones import FittedZones
+
+    limits = slews.Limits.of(scenario.spacecraft, rate_max, momentum_max)
+    zones = FittedZones(scenario.zones, environment.sky, windows.t1_s) if scenario.zones else None
+    return timeline.Planner(environment, scenario.spacecraft, targets, windows, boresight, limits, zones,
+                            lookahead=args.lookahead)
+
+
+def _day(args, scenario, environment, targets, windows, boresight, rate_max, momentum_max, bound) -> dict:
+    """Each policy's timeline planned, flown and checked on the truth (module docstring)."""
+    from att_planner.tools.bench import aeos_flight
+
+    policies = [p for p in args.policies.split(",") if p]
+    unknown = sorted(set(policies) - set(timeline.POLICIES))
+    if unknown or not policies:
+        _refuse(f"--policies: expected names among {', '.join(timeline.POLICIES)}; found {args.policies!r}")
+    planner = _planner(args, scenario, environment, targets, windows, boresight, rate_max, momentum_max)
+    names, out = targets.names, {}
+    for policy in policies:
+        plan = planner.plan(policy)
+        entry = {"policy": policy, "planned_images": len(plan.images), "planned_priority": plan.priority(targets),
+                 "planner_cpu_s": plan.cpu_s, "planner_cpu_s_per_orbit": plan.cpu_s / args.orbits,
+                 "legs": len(plan.legs), "attempts": plan.attempts, "failed_attempts": plan.failures,
+                 "planned_worst_zone_margin_deg": math.degrees(plan.worst_zone_margin),
+                 "settle_s": planner.settle_s, "dwell_s": planner.dwell_s}
+        print(f"  {policy:6s} planned     {len(plan.images):6d} images, priority {entry['planned_priority']:.2f}, "
+              f"{100 * len(plan.images) / max(bound.sites, 1):.1f} % of the accessible, planner CPU "
+              f"{entry['planner_cpu_s_per_orbit']:.2f} s per orbit")
+        if not args.plan_only:
+            start = time.perf_counter()
+            flight = aeos_flight.fly(scenario, planner, plan, seed=args.seed)
+            checks = aeos_flight.check(planner, plan, flight)
+            margin, entries = aeos_flight.zone_margins(planner, flight)
+            for level in ("a", "b"):
+                ok = [c for c in checks if getattr(c, f"level_{level}")]
+                entry[f"level_{level}"] = {
+                    "images": len(ok), "priority": float(sum(targets.priority[c.site] for c in ok)),
+                    "fraction_of_accessible": len(ok) / bound.sites if bound.sites else 0.0,
+                    "lost": len(checks) - len(ok)}
+            entry.update({
+                "status": "flown", "flight_wall_s": time.perf_counter() - start, "flight_cpu_s": flight.cpu_s,
+                "sim_s": flight.sim_s, "legs_refused": {str(k): v for k, v in flight.refused.items()},
+                "flown_worst_zone_margin_deg": math.degrees(margin), "zone_entries": entries,
+                "images": [{"site": names[c.site], "time_s": round(c.time_s, 3),
+                            "q_BN": [round(float(v), 9) for v in c.q_BN],
+                            "omega_BN_B_rad_s": [round(float(v), 9) for v in c.omega_BN_B],
+                            "a_pointing_deg": c.a_pointing_deg, "a_rate_deg_s": c.a_rate_deg_s,
+                            "b_pointing_deg": c.b_pointing_deg, "b_rate_deg_s": c.b_rate_deg_s,
+                            "b_samples": c.samples, "level_a": c.level_a, "level_b": c.level_b} for c in checks]})
+            print(f"  {policy:6s} flown       level (a) {entry['level_a']['images']:5d}, level (b) "
+                  f"{entry['level_b']['images']:5d} images ({entry['level_b']['lost']} lost at (b)), "
+                  f"worst zone margin {entry['flown_worst_zone_margin_deg']:.2f} deg, {entries} zone entries")
+        else:
+            entry["status"] = "planned, verified slews, not flown"
+        out[policy] = entry
+    return out
+
+
+def _bound(args, scenario, environment, targets, windows, boresight, rate_max, momentum_max) -> dict:
+    from att_planner.imaging import bound as relaxed
+
+    start = time.perf_counter()
+    result = relaxed.relaxed_bound(windows, targets, _planner(args, scenario, environment, targets, windows,
+                                                              boresight, rate_max, momentum_max))
+    result["compute_s"] = time.perf_counter() - start
+    print(f"  relaxed bound       {result['images']:.1f} images ({result['method']}; {result['compute_s']:.1f} s)")
+    return result

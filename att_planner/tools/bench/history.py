@@ -348,7 +348,62 @@ def _rtf(p: dict, case: str | None) -> Summary:
                     "final_error_deg": _num(p, "final_error_deg"), "success": success})
 
 
+AEOS_GREEDY_RATIO = 1.1          # flown images at each level against the greedy policy's
+AEOS_LEVEL_A_FRACTION = 0.65     # flown level-(a) images, fraction of the accessible sites
+AEOS_LEVEL_B_FRACTION = 0.45     # flown level-(b) images
+AEOS_CPU_PER_ORBIT_S = 10.0      # planner CPU per simulated orbit
+
+
+def _aeos_flown(p: dict, case: str | None) -> Summary:
+    """A flown day: the headline is the last flown policy's level-(b) images (``ours`` when present)."""
+    flown, accessible = _get(p, "flown"), _num(_get(p, "accessible"), "sites")
+    policies = [k for k in ("greedy", "ours") if isinstance(flown.get(k), dict) and flown[k].get("status") == "flown"]
+    planned_only = not policies
+    if planned_only:
+        policies = [k for k in ("greedy", "ours") if isinstance(flown.get(k), dict)]
+        if not policies:
+            raise HistoryError("an aeos JSON whose 'flown' holds no policy")
+    head = policies[-1]
+    metrics = {}
+    for k in policies:
+        e = flown[k]
+        if planned_only:
+            metrics.update({f"{k}_planned": _num(e, "planned_images"), f"{k}_priority": _num(e, "planned_priority"),
+                            f"{k}_cpu_s_per_orbit": _num(e, "planner_cpu_s_per_orbit")})
+            continue
+        metrics.update({f"{k}_level_a": _num(e, "level_a", "images"), f"{k}_level_b": _num(e, "level_b", "images"),
+                        f"{k}_lost_b": _num(e, "level_b", "lost"), f"{k}_planned": _num(e, "planned_images"),
+                        f"{k}_cpu_s_per_orbit": _num(e, "planner_cpu_s_per_orbit"),
+                        f"{k}_zone_entries": _num(e, "zone_entries"),
+                        f"{k}_worst_zone_margin_deg": _num(e, "flown_worst_zone_margin_deg")})
+    metrics["accessible_sites"] = accessible
+    if isinstance(p.get("bound"), dict):
+        metrics["bound_images"] = _num(p, "bound", "images")
+    if planned_only:
+        return Summary(case or f"{_get(p, 'targets')} seed {_get(p, 'seed')}, {_num(p, 'orbits'):g} orbits, planned "
+                               f"{'/'.join(policies)}",
+                       f"{head} images planned with verified slews (not flown)", _num(flown[head], "planned_images"),
+                       f"of {int(accessible)} accessible", "none (planned, not flown)", None, metrics)
+    met = None
+    if policies == ["greedy", "ours"]:
+        g, o = flown["greedy"], flown["ours"]
+        met = all(_num(o, f"level_{x}", "images") >= AEOS_GREEDY_RATIO * _num(g, f"level_{x}", "images")
+                  for x in "ab") and _num(o, "level_a", "images") >= AEOS_LEVEL_A_FRACTION * accessible \
+            and _num(o, "level_b", "images") >= AEOS_LEVEL_B_FRACTION * accessible \
+            and all(_num(e, "zone_entries") == 0 and _num(e, "planner_cpu_s_per_orbit") <= AEOS_CPU_PER_ORBIT_S
+                    for e in (g, o))
+    return Summary(case or f"{_get(p, 'targets')} seed {_get(p, 'seed')}, {_num(p, 'orbits'):g} orbits, flown "
+                           f"{'/'.join(policies)}",
+                   f"{head} images flown at level (b), checked on the truth", _num(flown[head], "level_b", "images"),
+                   f"of {int(accessible)} accessible",
+                   f"each level >= {AEOS_GREEDY_RATIO:g}x greedy; (a) >= {AEOS_LEVEL_A_FRACTION:.0%}, (b) >= "
+                   f"{AEOS_LEVEL_B_FRACTION:.0%} of the accessible; 0 zone entries; planner CPU <= "
+                   f"{AEOS_CPU_PER_ORBIT_S:g} s per orbit", met, metrics)
+
+
 def _aeos(p: dict, case: str | None) -> Summary:
+    if isinstance(p.get("flown"), dict):
+        return _aeos_flown(p, case)
     greedy, accessible = _get(p, "greedy"), _get(p, "accessible")
     return Summary(case or f"{_get(p, 'targets')} seed {_get(p, 'seed')}, {_num(p, 'orbits'):g} orbits",
                    f"greedy images {_get(greedy, 'status')}", _num(greedy, "images"),
@@ -412,7 +467,10 @@ STUDIES: tuple[Study, ...] = (
           _cmd("att-bench faults --scenario {scenario} --runs {runs} --workers {workers} --json {path}")),
     Study("aeos", lambda p: p.get("study") == "aeos", _aeos,
           lambda p, path: f"att-bench aeos --targets {p['targets']} --seed {p['seed']} --orbits {p['orbits']:g} "
-                          f"--json {path}"),
+                          + (f"--fly --policies {','.join(p['flown'])} " if isinstance(p.get("flown"), dict) else "")
+                          + ("--plan-only " if isinstance(p.get("flown"), dict) and not any(
+                              isinstance(e, dict) and e.get("status") == "flown" for e in p["flown"].values()) else "")
+                          + ("--bound " if "bound" in p else "") + f"--json {path}"),
 )
 BY_NAME = {s.name: s for s in STUDIES}
 
