@@ -146,7 +146,7 @@ def test_a_tachometer_sample_meets_the_command_in_force_over_its_interval_whatev
     at_rest = np.zeros(4)
 
     def command(t, torque):
-        return SimpleNamespace(t=t, wheel_torques=[torque] * 4)
+        return SimpleNamespace(t=t, wheel_torques=[torque] * 4, dipole=[])
 
     def sample(t):
         return SimpleNamespace(t=t, speeds=at_rest)
