@@ -145,6 +145,10 @@ class FaultMonitor:
     def on_star_tracker(self, t: float, name: str, q_SN, valid: bool) -> list[FaultStatus]:
         """A measurement of tracker ``name`` taken at ``t``: its sensor attitude (sensor-to-inertial) and
         whether it is valid, judged against the gyro's propagation (:mod:`.tracker_gyro`)."""
+        gyro_failed = any(s.component == "gyro" for s in self.active.values())
+        for _, d in self.detectors.get("tracker_gyro", []):
+            if isinstance(d, TrackerStepDetector):
+                d.gyro_failed = gyro_failed
         return self._run("tracker_gyro", lambda d: d.on_tracker(t, name, q_SN, valid))
 
     def tick(self, t: float) -> list[FaultStatus]:

@@ -224,15 +224,20 @@ class _Detector:
 
 
 class TrackerStepDetector(_Detector):
-    """A tracker whose residual against the gyro steps (module docstring): that tracker is isolated."""
+    """A tracker whose residual against the gyro steps (module docstring): that tracker is isolated.
+    While :attr:`gyro_failed` (a gyro fault declared: the propagation is no reference) no tracker is judged."""
 
     def __init__(self, residuals: Residuals, threshold: float, persistence_s: float):
         super().__init__(residuals, threshold, persistence_s)
         self.persistence = {n: Persistence(persistence_s) for n in self.names}
         self.declared: set[str] = set()
+        self.gyro_failed = False
 
     def _judge(self, name: str, t: float, test: Test | None) -> list[Verdict]:
         if name not in self.persistence or name in self.declared:
+            return []
+        if self.gyro_failed:
+            self.persistence[name].update(False, t)
             return []
         holds = test is not None and test.clear(self.threshold, STEP)
         p = self.persistence[name]
