@@ -45,6 +45,7 @@ from att_planner.guidance.laws import (
 from att_sim.models import rotations as rot
 from att_sim.models.geomagnetic import EARTH_ROTATION_RATE
 
+MIN_ELEVATION_DEG = math.degrees(math.atan2(800.0, 500.0))   # an imager's default minimum elevation: bsk-rl's, 58.0 deg
 SECONDARY_STEP = 0.5          # s: the central difference of the secondary direction
 
 

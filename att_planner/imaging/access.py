@@ -3,7 +3,7 @@
 A site is *accessible* at time t when the spacecraft stands at least the instrument's minimum
 elevation above the site's horizon (bsk-rl's imaging condition: the target's elevation angle seen
 from the site), ``sin e ≥ sin e_min`` with ``sin e`` the one formula of
-:func:`att_planner.mission.ground.elevation_sines` (spacecraft position from the scenario's orbit,
+:func:`att_planner.guidance.ground_arrival.elevation_sines` (spacecraft position from the scenario's orbit,
 GCRS→ITRS from its epoch's Earth rotation table, sites on WGS-84).
 
 Computed for all sites at once:
@@ -28,10 +28,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from att_planner.guidance.ground_arrival import MIN_ELEVATION_DEG, elevation_sines
 from att_planner.imaging.sites import SiteSet
-from att_planner.mission.ground import elevation_sines
 
-MIN_ELEVATION_DEG = math.degrees(math.atan2(800.0, 500.0))   # bsk-rl's imager: 58.0 deg
 COARSE_STEP_S = 10.0          # s between the coarse samples
 TOLERANCE_S = 0.1             # s, the edges' bisection
 GRAZING_MARGIN = math.radians(10.0)   # rad below the threshold a sampled peak is searched

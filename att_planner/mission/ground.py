@@ -23,7 +23,7 @@ import numpy as np
 
 from att_msgs_py.types import PointingMode
 from att_planner.guidance import reference
-from att_planner.guidance.ground_arrival import elevation_sines as elevation_sines  # its users import it here too
+from att_planner.guidance.ground_arrival import elevation_sines
 from att_planner.guidance.laws import PointingGeometry, geodetic_to_itrs
 from att_planner.guidance.modes import law_of
 from att_sim.models import world

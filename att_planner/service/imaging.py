@@ -28,7 +28,7 @@ import numpy as np
 from att_msgs_py import validation
 from att_msgs_py.errors import ErrorCode, RequestError
 from att_msgs_py.types import PointingMode
-from att_planner.guidance.ground_arrival import earth_axis_N, elevation_sines, itrs_to_geodetic
+from att_planner.guidance.ground_arrival import MIN_ELEVATION_DEG, earth_axis_N, elevation_sines, itrs_to_geodetic
 from att_planner.guidance.laws import PointingGeometry, geodetic_to_itrs
 from att_planner.guidance.modes import MAX_ALTITUDE, MIN_ALTITUDE
 from att_planner.guidance.strip import MAX_STRIP_LENGTH_M, MIN_STRIP_LENGTH_M, Strip, tracking_demand
@@ -47,7 +47,6 @@ from att_sim.models import rotations as rot
 from att_sim.models.geomagnetic import EARTH_ROTATION_RATE
 
 BAD = ErrorCode.INVALID_SITE
-MIN_ELEVATION_DEG = math.degrees(math.atan2(800.0, 500.0))   # the instrument's default: bsk-rl's imager, 58.0 deg
 MAX_SCAN_SPEED_M_S = 20_000.0     # m/s: over twice a LEO ground track's speed
 VISIBILITY_STEP_S = 5.0           # s between the elevation samples over the planning window
 IMAGE_STEP_S = 1.0                # s between the elevation samples over a dwell or a scan ...
