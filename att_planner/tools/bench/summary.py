@@ -68,7 +68,7 @@ ROWS: tuple[tuple[str, str], ...] = (
     ("aeos", "uniform:3000 seed 0, 1 orbits, flown ours"),
     ("aeos", "uniform:3000 seed 1, 1 orbits, flown greedy"),
     ("aeos", "uniform:3000 seed 2, 1 orbits, flown greedy"),
-    ("faults", "leo_pyramid, 60 cases, 1000 fault-free runs"),
+    ("faults", "leo_pyramid, 66 cases, 1000 fault-free runs"),
     ("estimation", "swift_demo"),
     ("momentum", "15 orbits"),
     ("soak", "10 orbits"),
