@@ -35,6 +35,7 @@ import numpy as np
 
 from att_planner.fdir.persistence import Persistence
 from att_planner.fdir.status import Verdict
+from att_sim.models import rotations as rot
 
 DETECTOR = "coil_torque"
 JUDGE_PERIOD_S = 0.5   # s between two fits of the window
@@ -99,9 +100,8 @@ class CoilDetector:
             return []
         dt = t - self.last_t
         self.last_t = t
-        self.cross = self.cross + np.cross(w, H) * dt
-        self.commanded = self.commanded + np.array([self.dipole[i] * np.cross(np.eye(3)[i], self.field)
-                                                    for i in range(3)]) * dt
+        self.cross = self.cross + rot.cross(w, H) * dt
+        self.commanded = self.commanded + self.dipole[:, None] * rot.hat(self.field) * dt   # row i: m_i (e_i × B)
         self.samples.append((t, H, self.cross.copy(), self.commanded.copy()))
         while len(self.samples) > 1 and self.samples[1][0] <= t - self.window + 1e-9:
             self.samples.popleft()
