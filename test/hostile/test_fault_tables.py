@@ -83,13 +83,14 @@ EDITS = {
 }
 
 
-@pytest.mark.parametrize("name", sorted(EDITS))
-def test_hostile_fault_table_refused_with_file_line_and_field(name, tmp_path):
-    old, new, line, field, words = EDITS[name]
-    assert old in BASE, f"case {name}: {old!r} is not in the base"
+def refused_with_file_line_and_field(base, name, edit, tmp_path):
+    """``base`` with ``edit`` = (old, new, line, field, words) applied: the configuration checker
+    refuses it at that line and field with those words, and the runtime reader refuses it too."""
+    old, new, line, field, words = edit
+    assert old in base, f"case {name}: {old!r} is not in the base"
     path = tmp_path / "faults" / "hostile.yaml"
     path.parent.mkdir()
-    path.write_text(BASE.replace(old, new, 1))
+    path.write_text(base.replace(old, new, 1))
     kind, problems = config_cli.check_file(path)
     assert kind == "faults" and problems, f"{name}: accepted"
     mine = [p for p in problems if p.field == field]
@@ -99,6 +100,11 @@ def test_hostile_fault_table_refused_with_file_line_and_field(name, tmp_path):
     with pytest.raises(ConfigFileError) as err:      # the runtime reader refuses it the same way
         table.read(path)
     assert err.value.code == ErrorCode.INVALID_CONFIG and str(path) in str(err.value)
+
+
+@pytest.mark.parametrize("name", sorted(EDITS))
+def test_hostile_fault_table_refused_with_file_line_and_field(name, tmp_path):
+    refused_with_file_line_and_field(BASE, name, EDITS[name], tmp_path)
 
 
 def test_an_id_written_twice_is_refused_on_its_second_line(tmp_path):
@@ -185,20 +191,7 @@ GLR_EDITS = {
 
 @pytest.mark.parametrize("name", sorted(GLR_EDITS))
 def test_hostile_tracker_gyro_entry_refused_with_file_line_and_field(name, tmp_path):
-    old, new, line, field, words = GLR_EDITS[name]
-    assert old in GLR_BASE, f"case {name}: {old!r} is not in the base"
-    path = tmp_path / "faults" / "hostile.yaml"
-    path.parent.mkdir()
-    path.write_text(GLR_BASE.replace(old, new, 1))
-    kind, problems = config_cli.check_file(path)
-    assert kind == "faults" and problems, f"{name}: accepted"
-    mine = [p for p in problems if p.field == field]
-    assert mine, f"{name}: no problem at {field}: " + "\n".join(map(str, problems))
-    p = mine[0]
-    assert p.file == str(path) and p.line == line and words in p.expected + " " + p.found, str(p)
-    with pytest.raises(ConfigFileError) as err:
-        table.read(path)
-    assert err.value.code == ErrorCode.INVALID_CONFIG and str(path) in str(err.value)
+    refused_with_file_line_and_field(GLR_BASE, name, GLR_EDITS[name], tmp_path)
 
 
 def test_the_tracker_gyro_base_passes_with_its_defaults(tmp_path):
