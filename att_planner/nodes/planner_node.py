@@ -122,14 +122,7 @@ class PlannerNode(Node):
                                       default_budget=self._default_budget)
         except RequestError as err:
             return self.refuse(response, err, "request")
-        runner = run_method if valid.method.cheap else run_isolated
-        try:
-            outcome = plan_maneuver(valid, self._tolerances, self._cone_padding, runner)
-        except Exception as exc:  # a fault of the service itself is answered, never left hanging
-            outcome = self.internal_error(exc)
-        response.stage = str(outcome.stage)
-        response.stages = [convert.stage_msg(stage) for stage in outcome.stages]
-        response.slowdown = outcome.slowdown
+        outcome = self._planned(plan_maneuver, valid, valid.method, response)
         self.answer(response, outcome, valid.spacecraft, valid.method.name, sensor_axis=valid.problem.sensor_axis,
                     cones=valid.problem.cones, zones=valid.problem.zones, epoch=valid.problem.epoch,
                     spacecraft_digest=valid.spacecraft_digest)
@@ -202,14 +195,7 @@ class PlannerNode(Node):
 
     def _image(self, valid, request, response, what: str):
         """Plan an image (:func:`att_planner.service.imaging.plan_image`) and answer as a maneuver."""
-        runner = run_method if valid.maneuver.method.cheap else run_isolated
-        try:
-            outcome = plan_image(valid, self._tolerances, self._cone_padding, runner)
-        except Exception as exc:  # a fault of the service itself is answered, never left hanging
-            outcome = self.internal_error(exc)
-        response.stage = str(outcome.stage)
-        response.stages = [convert.stage_msg(stage) for stage in outcome.stages]
-        response.slowdown = outcome.slowdown
+        outcome = self._planned(plan_image, valid, valid.maneuver.method, response)
         for name in ("image_start", "image_end"):
             setattr(response, name, float(getattr(outcome, name, math.nan)))
         response.lowest_elevation_deg = math.degrees(getattr(outcome, "lowest_elevation", math.nan))
@@ -218,6 +204,20 @@ class PlannerNode(Node):
                     sensor_axis=problem.sensor_axis, cones=problem.cones, zones=problem.zones, epoch=problem.epoch,
                     spacecraft_digest=problem.spacecraft.digest)
         return response
+
+    def _planned(self, plan, valid, method, response) -> PlanOutcome:
+        """``plan(valid, tolerances, cone padding, runner)``, ``method`` run in a child process unless it
+        is cheap; a fault of the service itself answered as an internal error; the response's stages
+        filled from the outcome."""
+        runner = run_method if method.cheap else run_isolated
+        try:
+            outcome = plan(valid, self._tolerances, self._cone_padding, runner)
+        except Exception as exc:  # a fault of the service itself is answered, never left hanging
+            outcome = self.internal_error(exc)
+        response.stage = str(outcome.stage)
+        response.stages = [convert.stage_msg(stage) for stage in outcome.stages]
+        response.slowdown = outcome.slowdown
+        return outcome
 
     def internal_error(self, exc: Exception) -> PlanOutcome:
         self.get_logger().error(clip(f"planning failed unexpectedly: {type(exc).__name__}: {exc}"))
