@@ -6,9 +6,10 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 import pytest
 
-from att_msgs_py.types import FaultSource
+from att_msgs_py.types import FaultSource, Health
 from att_planner.fdir import table
 from att_planner.fdir.monitor import FaultMonitor
 from att_planner.fdir.tap import MonitorTap
@@ -87,3 +88,20 @@ def test_a_fault_mid_slew_is_isolated(name, demo_plan):
         x, truth = loop.estimator.state, loop.sim.x
         q_true = rot.propagate_constant_rate(truth[:4], truth[4:7], x.t - loop.sim.t)   # at the estimate's instant
         assert rot.angle_between(x.q_BN, q_true) < 30.0 * ARCSEC
+
+
+@pytest.mark.slow
+def test_a_jump_of_the_lone_tracker_is_isolated_before_the_estimate_is_lost():
+    """In the hold st1 is blinded by the Earth: st2 alone feeds the estimator, whose gate rejects a
+    jump's measurements and drops the estimate at the fifth. tracker_step isolates st2 first, so the
+    estimate is never lost and stays on the truth (gyro and vectors)."""
+    jump = ("star_tracker", 1, "bias_jump", {"bias_rad": (2e-4, -2e-4, 0.0)})
+    loop, monitor = fly(jump, 100.0)
+    isolated(monitor, "star_tracker", 1, 100.0, 1.0)
+    health = loop.trace.arrays("t", "health")
+    after = health["t"] > 100.0
+    assert after.any() and not np.any(health["health"][after] == Health.DIVERGED)
+    assert loop.estimator.excluded == {"st2"}
+    x, truth = loop.estimator.state, loop.sim.x
+    q_true = rot.propagate_constant_rate(truth[:4], truth[4:7], x.t - loop.sim.t)
+    assert rot.angle_between(x.q_BN, q_true) < math.radians(0.05)
