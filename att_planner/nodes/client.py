@@ -25,6 +25,7 @@ from datetime import datetime
 
 import rclpy
 from rclpy.action import ActionClient
+from rclpy.duration import Duration
 from rclpy.node import Node
 from std_srvs.srv import SetBool
 
@@ -209,6 +210,11 @@ class SuiteClient(Node):
     def hold_simulator(self, held: bool, timeout: float = 10.0) -> SetBool.Response:
         """Hold sim time (``held``) or let it run again (the simulator's ``/simulator/hold``)."""
         return self._call(self.hold_client, SetBool.Request(data=held), timeout)
+
+    def delivered(self, publisher, timeout: float = 10.0) -> bool:
+        """Whether every message ``publisher`` (reliable) sent was acknowledged by its subscribers within
+        ``timeout`` s of wall time: before the suite stops, its last messages reach the recorder."""
+        return publisher.wait_for_all_acked(Duration(seconds=timeout))
 
     @contextmanager
     def simulator_held(self, timeout: float = 10.0):

@@ -118,6 +118,8 @@ class MissionDriver:
                 if isinstance(action, (io.Report, io.Log)):
                     self.perform(action)
             if self.executive.done:
+                if not self.client.delivered(self.events):
+                    self.log("[mission] the last mission events were not acknowledged by every subscriber in 10 s")
                 return
             actions = self.deliver(self.perform(self.executive.awaiting))
 
