@@ -38,6 +38,7 @@ from rclpy.clock import Clock, ClockType
 from rclpy.exceptions import InvalidParameterTypeException, InvalidParameterValueException
 from rclpy.executors import Executor, ExternalShutdownException, SingleThreadedExecutor
 from rclpy.parameter import Parameter
+from rclpy.signals import SignalHandlerOptions
 
 from att_msgs_py import memory
 from att_msgs_py.errors import ConfigError, ErrorCode, RequestError, clip
@@ -253,10 +254,15 @@ def _check_params_files(args) -> None:
 
 
 def run_node(make_node: Callable, args=None, make_executor: Callable[[], Executor] = SingleThreadedExecutor,
-             loop: Callable | None = None) -> None:
+             loop: Callable | None = None, drain: Callable | None = None) -> None:
     """Create node and executor after ``rclpy.init`` and run ``loop(node, executor)`` (default:
     :func:`spin_until_shutdown`); the C allocator and the middleware set to give large blocks back
-    (:func:`memory.configure`, :func:`memory.middleware_env`)."""
+    (:func:`memory.configure`, :func:`memory.middleware_env`).
+
+    ``drain(node, executor)``: the node stops itself instead of rclpy. rclpy's signal handler is not
+    installed; the node spins until SIGINT/SIGTERM (this module's handler), then ``drain`` runs with the
+    context still up (the recorder takes what its subscriptions hold, see
+    :func:`att_msgs_py.log.recorder_node.drain`), then ``close()`` and the shutdown."""
     for signum in (signal.SIGINT, signal.SIGTERM):
         signal.signal(signum, _stop_requested)      # before rclpy.init, which chains to it
     memory.configure()                              # large blocks go back to the system when freed
@@ -265,7 +271,7 @@ def run_node(make_node: Callable, args=None, make_executor: Callable[[], Executo
     try:
         _check_params_files(args)
         try:
-            rclpy.init(args=args)
+            rclpy.init(args=args, signal_handler_options=None if drain is None else SignalHandlerOptions.NO)
         except Exception as exc:         # rcl's own parse errors (a params file that is not YAML, ...)
             raise ConfigError(ErrorCode.INVALID_CONFIG, f"ROS arguments refused: {clip(exc, 300)}") from None
         if _stop_signalled:
@@ -274,7 +280,11 @@ def run_node(make_node: Callable, args=None, make_executor: Callable[[], Executo
         executor = make_executor()
         executor.add_node(node)
         freeze_start_up()
-        if loop is None:
+        if drain is not None:
+            while executor.context.ok() and not _stop_signalled:
+                executor.spin_once(timeout_sec=0.2)
+            drain(node, executor)
+        elif loop is None:
             spin_until_shutdown(executor)
         else:
             loop(node, executor)

@@ -2,9 +2,10 @@
 
 Subscribes in raw (serialized CDR) form to :func:`att_msgs_py.qos.recorded_topics`, so messages
 are stored byte-for-byte as published. The file is flushed at least every ``flush_period_s`` s (a
-killed recorder loses at most that) and finalised (summary and index) on SIGINT/SIGTERM. A file
-left at ``output`` by a recorder that did not finish is first repaired to ``OUT.repaired.mcap``
-(``att-log repair``), so starting again on the same path loses nothing.
+killed recorder loses at most that) and finalised (summary and index) on SIGINT/SIGTERM, once what
+its subscriptions already hold is written (:func:`drain`). A file left at ``output`` by a recorder
+that did not finish is first repaired to ``OUT.repaired.mcap`` (``att-log repair``), so starting
+again on the same path loses nothing.
 
 Spun by rclpy's events executor: the recorder listens to every topic, and the default executor's
 per-message wait-set rebuild made it the busiest process of a fast run.
@@ -71,11 +72,25 @@ class RecorderNode(Node):
         print(f"recorder: closed {self.log.path} ({counts})", flush=True)
 
 
+def drain(node: RecorderNode, executor, quiet_s: float = 0.2, limit_s: float = 5.0) -> None:
+    """Write what the subscriptions already hold before the file is finalised: spin until no message
+    arrived for ``quiet_s`` s (at most ``limit_s``). A reliable publisher's message is acknowledged once
+    it is in the reader's queue, before the node takes it; a recorder stopped right after its publisher
+    saw the acknowledgement would otherwise close without it."""
+    end = time.monotonic() + limit_s
+    written, quiet_since = sum(node.log.counts.values()), time.monotonic()
+    while time.monotonic() < end and time.monotonic() - quiet_since < quiet_s and executor.context.ok():
+        executor.spin_once(timeout_sec=0.05)
+        now = sum(node.log.counts.values())
+        if now != written:
+            written, quiet_since = now, time.monotonic()
+
+
 def main(args=None):
     memory.reexec_with_c_allocator()
     # rclpy's events executor (C++): each message costs a callback, not a Python rebuild of the wait set
     # over every recorded topic; it serves raw subscriptions, timers and the parameter services
-    run_node(RecorderNode, args, make_executor=EventsExecutor)
+    run_node(RecorderNode, args, make_executor=EventsExecutor, drain=drain)
 
 
 if __name__ == "__main__":
