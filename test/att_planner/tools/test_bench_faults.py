@@ -30,6 +30,9 @@ def test_the_study_on_two_cases_and_three_fault_free_runs():
         assert c["detected"] and c["right"] and c["isolated"] == ["wheel", 1] and c["response"] == "exclude_wheel"
         assert c["latency_s"] > 0.0 and math.isfinite(c["final_error_deg"]) and c["healthy_wheels"][1] is False
         assert not c["report_before_onset"]
+        first = c["reports"][0]
+        assert first["active"] and first["t_s"] == first["detected_at_s"] and "wheel 1" in first["evidence"]
+        assert all(r["t_s"] >= r["detected_at_s"] >= c["onset_s"] for r in c["reports"])
     slew = p["cases"][0]
     assert slew["in_time"] and slew["latency_s"] <= 5.0 and not slew["zone_entered"]
     assert slew["completed"] and [r["verified"] for r in slew["replans"]] == [True] and slew["time_lost_s"] > 0
