@@ -22,7 +22,7 @@ from att_planner.tools.mission import fly_mission
 from att_sim.models import rotations as rot
 from helpers.independent import site_sight_from
 
-pytestmark = [pytest.mark.ros, pytest.mark.slow]     # 1257 s of sim time: about 3 min on the shared 2 cores
+pytestmark = [pytest.mark.ros, pytest.mark.slow]     # 900 s of sim time: 3-5 min on the shared 2 cores
 ACCESSIBLE = {"guadalajara", "chihuahua", "albuquerque", "salt_lake_city", "calgary"}
 
 
