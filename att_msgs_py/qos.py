@@ -26,6 +26,6 @@ CLOCK_QOS = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=1000, reliability=
 def recorded_topics() -> dict[str, tuple[str, QoSProfile]]:
     """Topic -> (ROS type name, QoS) for everything the recorder writes."""
     qos = {topics.CLOCK: CLOCK_QOS, topics.PLANS: LATCHED_QOS, topics.PLAN_MARKERS: LATCHED_QOS,
-           topics.MISSION_EVENTS: MISSION_QOS, topics.SIM_FAULTS: MISSION_QOS,
+           topics.MISSION_EVENTS: MISSION_QOS, topics.TARGET_FIX: MISSION_QOS, topics.SIM_FAULTS: MISSION_QOS,
            topics.CONTROLLER_FAULTS: MISSION_QOS, topics.ESTIMATOR_FAULTS: MISSION_QOS}
     return {topic: (type_name, qos.get(topic, STREAM_QOS)) for topic, type_name in topics.RECORDED.items()}

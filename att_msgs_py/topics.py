@@ -21,6 +21,9 @@ SIM_MARKERS = "/simulator/markers"           # zones, boresights, Sun/Moon/Earth
 ZONE_MARGINS = "/simulator/zone_margins"     # the zones' truth margins, for plots
 PLAN_MARKERS = "/planner/plan_markers"       # the latest plan's boresight path
 MISSION_EVENTS = "/mission/events"           # att-mission's decisions, slews, dwells and missed targets
+BORESIGHT_FIX = "/mission/boresight_fix"     # att-mission of ground sites: the boresight's ground point
+SUBSATELLITE_FIX = "/mission/subsatellite_fix"   # ... and the sub-satellite point, for a map
+TARGET_FIX = "/mission/target_fix"           # ... and the site slewed to or imaged
 SIM_FAULTS = "/simulator/faults"             # every hardware fault the truth started (evaluation only)
 CONTROLLER_FAULTS = "/controller/faults"     # the faults the controller's monitor detected and its responses
 ESTIMATOR_FAULTS = "/estimator/faults"       # the sensor faults the estimator's monitor detected
@@ -54,6 +57,9 @@ RECORDED = {
     ZONE_MARGINS: "att_msgs/msg/ZoneMargins",
     PLAN_MARKERS: "visualization_msgs/msg/MarkerArray",
     MISSION_EVENTS: "att_msgs/msg/MissionEvent",
+    BORESIGHT_FIX: "sensor_msgs/msg/NavSatFix",
+    SUBSATELLITE_FIX: "sensor_msgs/msg/NavSatFix",
+    TARGET_FIX: "sensor_msgs/msg/NavSatFix",
     SIM_FAULTS: "att_msgs/msg/FaultEvent",
     CONTROLLER_FAULTS: "att_msgs/msg/FaultStatus",
     ESTIMATOR_FAULTS: "att_msgs/msg/FaultStatus",
@@ -84,6 +90,11 @@ ABOUT = {
     ZONE_MARGINS: "each scenario zone's truth margin (rad, >= 0 clear) and the smallest, at `tf_rate_Hz`",
     PLAN_MARKERS: "the latest plan's boresight path (inertial frame, latched)",
     MISSION_EVENTS: "a mission's decisions, slews, dwells, parks and missed targets with why (latched)",
+    BORESIGHT_FIX: "`att-mission` of ground sites: where the sensor axis meets the WGS-84 ellipsoid (truth state; "
+                   "status NO_FIX while it misses the Earth), once per s of sim time, for a map",
+    SUBSATELLITE_FIX: "`att-mission` of ground sites: the sub-satellite point and the spacecraft's altitude (truth "
+                      "state), once per s of sim time, for a map",
+    TARGET_FIX: "`att-mission` of ground sites: the site of each slew and dwell as it is reported (latched)",
     SIM_FAULTS: "each hardware fault the truth started: component, index, kind, parameters, source (latched; "
                 "for evaluation only, no flight node reads it)",
     CONTROLLER_FAULTS: "each fault the controller's monitor declared or cleared (with `fault_table`): fault id, "

@@ -10,7 +10,7 @@ import pytest
 from att_msgs_py import topics
 
 LAYOUT = Path(__file__).parents[1] / "docs" / "foxglove_layout.json"
-PANELS = {"3D", "Plot", "StateTransitions", "RawMessages"}
+PANELS = {"3D", "Plot", "StateTransitions", "RawMessages", "map"}
 PATH = re.compile(r"^(/[\w/]+)((?:\.\w+(?:\[\d+\])?)*)$")
 
 
@@ -33,6 +33,8 @@ def referenced_paths(config: dict) -> list[str]:
             out += [p["value"] for p in panel["paths"]]
         elif kind == "RawMessages":
             out.append(panel["topicPath"])
+        elif kind == "map":                              # the NavSatFix topics it colours and follows
+            out += list(panel["topicColors"]) + [panel["followTopic"]]
     return out
 
 
@@ -64,6 +66,9 @@ def test_the_layout_is_a_classic_foxglove_layout_naming_each_panel_once():
     view = layout["configById"]["3D!attview"]
     assert view["followTf"] == "body"                   # every scenario's body_frame_id
     assert set(view["topics"]) == {topics.SIM_MARKERS, topics.PLAN_MARKERS}
+    ground = layout["configById"]["map!groundtrack"]     # a mission of ground sites on Foxglove's Map panel
+    assert set(ground["topicColors"]) == {topics.BORESIGHT_FIX, topics.SUBSATELLITE_FIX, topics.TARGET_FIX}
+    assert {topics.RECORDED[t] for t in ground["topicColors"]} == {"sensor_msgs/msg/NavSatFix"}
 
 
 def test_every_topic_and_message_path_of_the_layout_exists():

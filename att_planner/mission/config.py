@@ -17,6 +17,8 @@ the day is flown. One YAML file under ``config/missions/`` (read with ``yaml.saf
     secondary: velocity            # ground sites: the direction the secondary axis is kept nearest
     secondary_axis: [0, 0, 1]      # ground sites: that body axis (default: ``targets.next_axis`` of the sensor)
     handover_blend_s: 180          # ground sites: the controller's blend from rest into the site's law (s)
+    start_pointing: nadir          # the day starts with sensor_axis on the nadir (default: scenario, the
+                                   # simulator's initial_attitude)
 
 An inertial source is held at the attitude of :func:`~att_planner.mission.targets.pointing_attitude`;
 a ground site is tracked through its dwell with the controller's ``ground`` pointing mode
@@ -38,11 +40,14 @@ from pathlib import Path
 import numpy as np
 
 from att_msgs_py.errors import ConfigError, ErrorCode, clip
+from att_msgs_py.types import PointingMode
+from att_planner.guidance.laws import PointingGeometry
+from att_planner.guidance.modes import law_of
 from att_planner.mission import targets as target_lists
 from att_planner.mission.ground import GroundTrack, site_mode
 from att_planner.mission.scheduler import MissionTarget
 from att_planner.mission.schema import Mission
-from att_sim.models import config_files
+from att_sim.models import config_files, world
 from att_sim.models import scenario as scen
 
 GYROSCOPIC_SHARE = 0.8        # of the wheels' torque margin over the planning limit the gyroscopic torque may take
@@ -69,6 +74,7 @@ class MissionConfig:
     secondary: str                # ground sites: the pointing mode's secondary direction
     secondary_axis: np.ndarray    # ground sites: its body axis
     handover_blend: float         # s: the controller's blend into a site's law (its parameter handover_blend_s)
+    start_pointing: str = "scenario"   # "scenario" or "nadir" (:meth:`start_attitude`)
 
     def targets(self) -> dict:
         """Target name -> :class:`~att_planner.mission.scheduler.MissionTarget`, in the list's order."""
@@ -79,6 +85,18 @@ class MissionConfig:
         return {t.name: MissionTarget(t.name, t.dwell, track=GroundTrack(
             self.scenario, t, site_mode(t, self.sensor_axis, self.secondary_axis, self.secondary), tl.min_elevation))
             for t in tl.targets}
+
+
+    def start_attitude(self) -> np.ndarray | None:
+        """The attitude the simulator starts the day at ([x, y, z, w], body to inertial): None for the
+        scenario's ``initial_attitude``; ``nadir``: the controller's nadir pointing law at the epoch
+        (the sensor axis on the nadir, the secondary axis towards ``secondary``), at rest."""
+        if self.start_pointing != "nadir":
+            return None
+        mode = PointingMode("nadir", primary_axis=self.sensor_axis, secondary_axis=self.secondary_axis,
+                            secondary=self.secondary)
+        geometry = PointingGeometry.of(world.Environment.from_scenario(self.scenario))
+        return np.asarray(law_of(mode, geometry, 0.0, np.array([0.0, 0.0, 0.0, 1.0])).attitude(0.0), float)
 
 
 def gyroscopic_rate_limit(sc) -> float:
@@ -127,7 +145,7 @@ def load(name: str) -> MissionConfig:
     return MissionConfig(path, target_list, scenario, vec, m.horizon_s, math.radians(m.margin_deg), m.rate_Hz,
                          m.start_lead_s, m.time_budget_s, m.method, math.radians(m.pointing_tolerance_deg),
                          m.momentum_dumping, rate_max, _zones(path, m.zones, scenario), m.secondary, second,
-                         m.handover_blend_s)
+                         m.handover_blend_s, m.start_pointing)
 
 
 def _zones(path, names: list | None, scenario) -> list:

@@ -24,8 +24,9 @@ import numpy as np
 from att_msgs_py.types import PointingMode
 from att_planner.guidance import reference
 from att_planner.guidance.ground_arrival import elevation_sines
-from att_planner.guidance.laws import PointingGeometry, geodetic_to_itrs
+from att_planner.guidance.laws import WGS84_A, WGS84_E2, WGS84_F, PointingGeometry, geodetic_to_itrs
 from att_planner.guidance.modes import law_of
+from att_sim.models import rotations as rot
 from att_sim.models import world
 
 TORQUE_SHARE = 0.8             # of the planning torque limit a site's tracking may take
@@ -90,3 +91,56 @@ class GroundTrack:
         if ok.any():
             ok[ok] = self.torque(t[ok]) <= self.torque_limit
         return ok
+
+
+def geodetic_of(p_itrs) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Geodetic latitude, longitude (rad) and altitude (m) on WGS-84 of ITRS points ``p_itrs`` (K, 3)
+    (Bowring's closed form, a few mm below 1000 km); NaN for NaN rows."""
+    p = np.asarray(p_itrs, float).reshape(-1, 3)
+    x, y, z = p[:, 0], p[:, 1], p[:, 2]
+    b = WGS84_A * (1.0 - WGS84_F)
+    ep2 = (WGS84_A ** 2 - b ** 2) / b ** 2
+    rho = np.hypot(x, y)
+    beta = np.arctan2(WGS84_A * z, b * rho)
+    lat = np.arctan2(z + ep2 * b * np.sin(beta) ** 3, rho - WGS84_E2 * WGS84_A * np.cos(beta) ** 3)
+    n = WGS84_A / np.sqrt(1.0 - WGS84_E2 * np.sin(lat) ** 2)
+    alt = rho * np.cos(lat) + (z + WGS84_E2 * n * np.sin(lat)) * np.sin(lat) - n
+    return lat, np.arctan2(y, x), alt
+
+
+def ground_points(r_itrs, d_itrs) -> np.ndarray:
+    """Where the lines of sight ``d_itrs`` (K, 3) from the spacecraft at ``r_itrs`` (K, 3, m, ITRS) first
+    meet the WGS-84 ellipsoid: ITRS points (K, 3), NaN where a line misses the Earth (or looks away)."""
+    scale = np.array([1.0, 1.0, 1.0 / (1.0 - WGS84_F)]) / WGS84_A      # the ellipsoid as the unit sphere
+    r = np.asarray(r_itrs, float).reshape(-1, 3)
+    d = np.asarray(d_itrs, float).reshape(-1, 3)
+    rs, ds = r * scale, d * scale
+    a, b, c = (np.einsum("ki,ki->k", ds, ds), np.einsum("ki,ki->k", rs, ds), np.einsum("ki,ki->k", rs, rs) - 1.0)
+    disc = b * b - a * c
+    with np.errstate(invalid="ignore"):
+        s = (-b - np.sqrt(disc)) / a
+    s = np.where((disc >= 0.0) & (s > 0.0), s, np.nan)
+    return r + s[:, None] * d
+
+
+def ground_fixes(dcm_EN, r_N, q_BN, sensor_axis_B) -> dict:
+    """The sub-satellite point (``sub_lat``, ``sub_lon`` deg, ``sub_alt`` m: the spacecraft's altitude) and
+    the boresight's ground point (``bore_lat``, ``bore_lon`` deg; NaN where the sensor axis misses the
+    Earth) of spacecraft at GCRS positions ``r_N`` (K, 3, m) with attitudes ``q_BN`` (K, 4), the GCRS to
+    ITRS rotations ``dcm_EN`` (K, 3, 3)."""
+    R = np.asarray(dcm_EN, float).reshape(-1, 3, 3)
+    r = np.einsum("kij,kj->ki", R, np.asarray(r_N, float).reshape(-1, 3))
+    d_N = np.einsum("kij,j->ki", rot.dcm_NB(np.asarray(q_BN, float).reshape(-1, 4)), np.asarray(sensor_axis_B, float))
+    sub_lat, sub_lon, sub_alt = geodetic_of(r)
+    bore_lat, bore_lon, _ = geodetic_of(ground_points(r, np.einsum("kij,kj->ki", R, d_N)))
+    return {"sub_lat": np.degrees(sub_lat), "sub_lon": np.degrees(sub_lon), "sub_alt": sub_alt,
+            "bore_lat": np.degrees(bore_lat), "bore_lon": np.degrees(bore_lon)}
+
+
+def ground_track(environment, t, q_BN, sensor_axis_B) -> dict:
+    """:func:`ground_fixes` at times ``t`` (s past the epoch) with the attitudes ``q_BN`` (K, 4), the
+    spacecraft on ``environment``'s orbit (GCRS to ITRS by its field's table, as the controller's ground
+    law)."""
+    t = np.atleast_1d(np.asarray(t, float))
+    return ground_fixes(environment.field.itrs_rotation(t), np.asarray(environment.orbit.position(t), float),
+                        q_BN, sensor_axis_B)

@@ -62,6 +62,9 @@ class Mission(Schema):
                                                               "after the sensor's")
     handover_blend_s: float = number(60.0, ge=0.0, le=3600.0, unit="s", meaning="ground sites: the controller's "
                                                                                  "blend into the site's law")
+    start_pointing: Literal["scenario", "nadir"] = Field(
+        "scenario", description="the attitude the day starts at: the scenario's simulator initial_attitude, or "
+                                "nadir: sensor_axis on the nadir and secondary_axis towards secondary")
 
     @field_validator("method")
     @classmethod

@@ -10,7 +10,9 @@ answers) into its events and carries out its actions as service and action calls
 watchdogs (a wait for sim time gives up below :data:`MIN_WALL_RTF` times real time).
 
 Every decision, slew, dwell, park and miss is published on ``/mission/events``
-(``att_msgs/MissionEvent``) and recorded with everything else in one MCAP. At the end the day's
+(``att_msgs/MissionEvent``) and recorded with everything else in one MCAP; a mission of ground sites
+also publishes, for a map, the sub-satellite point, the boresight's ground point and the site of each
+slew and dwell as ``sensor_msgs/NavSatFix`` (:class:`GroundFixes`). At the end the day's
 figures are measured from that log (:func:`att_planner.mission.day.day_report`): the targets' dwells
 and pointing errors from the truth state, the zones' margins at their true positions, the wheels.
 The last line printed is ``MCAP: <path>``.
@@ -34,21 +36,28 @@ import time
 from datetime import UTC, datetime, timedelta
 from pathlib import Path
 
+import numpy as np
+from sensor_msgs.msg import NavSatFix, NavSatStatus
+
 from att_msgs.msg import AttitudeEstimate, MissionEvent
 from att_msgs_py import convert, qos
 from att_msgs_py.errors import ConfigError
-from att_msgs_py.topics import ESTIMATE, MISSION_EVENTS
+from att_msgs_py.topics import BORESIGHT_FIX, ESTIMATE, MISSION_EVENTS, SUBSATELLITE_FIX, TARGET_FIX
 from att_msgs_py.types import ControlMode, Health, PointingMode
+from att_msgs_py.types import MissionEventKind as Kind
 from att_planner.control.controller import ControllerConfig
 from att_planner.mission import config as mission_config
 from att_planner.mission import executive_io as io
 from att_planner.mission.day import day_report
 from att_planner.mission.executive import MissionExecutive
+from att_planner.mission.ground import ground_fixes
 from att_planner.nodes.client import client_session, maneuver_request
 from att_planner.tools.demo import SimClock, domain_line
 from att_planner.tools.launch import default_nodes, isolated_env, join_env, start_suite
+from att_sim.models import world
 
 MIN_WALL_RTF = 0.5             # waits for sim time give up below this real-time factor
+FIX_PERIOD = 1.0               # s of sim time between the ground points published for a map
 CONVERGENCE = {int(h) for h in Health}
 
 
@@ -56,15 +65,18 @@ class Telemetry(SimClock):
     """The spacecraft's latest state message (sim time, attitude, wheels) and the estimate's health,
     heard on the client's node."""
 
-    def __init__(self, node, estimator: bool):
+    def __init__(self, node, estimator: bool, on_state=None):
         super().__init__(node)
         self.msg, self.health = None, None if estimator else Health.CONVERGED
+        self.on_state = on_state
         if estimator:
             node.create_subscription(AttitudeEstimate, ESTIMATE, self._on_estimate, qos.STREAM_QOS)
 
     def _on_state(self, msg):
         super()._on_state(msg)
         self.msg = msg
+        if self.on_state is not None:
+            self.on_state(msg)
 
     def _on_estimate(self, msg):
         self.health = Health(msg.health) if msg.health in CONVERGENCE else Health.DIVERGED
@@ -85,6 +97,50 @@ class Telemetry(SimClock):
         return super().wait(until, timeout)
 
 
+def fix_msg(stamp, frame_id: str, lat_deg: float, lon_deg: float, alt_m: float) -> NavSatFix:
+    """A ``sensor_msgs/NavSatFix`` of a point (deg, deg, m above the ellipsoid); NO_FIX when it is NaN."""
+    msg = NavSatFix()
+    msg.header.stamp, msg.header.frame_id = stamp, frame_id
+    ok = bool(np.isfinite(lat_deg) and np.isfinite(lon_deg))
+    msg.status.status = NavSatStatus.STATUS_FIX if ok else NavSatStatus.STATUS_NO_FIX
+    msg.latitude, msg.longitude = (float(lat_deg), float(lon_deg)) if ok else (0.0, 0.0)
+    msg.altitude = float(alt_m) if ok else 0.0
+    msg.position_covariance_type = NavSatFix.COVARIANCE_TYPE_UNKNOWN
+    return msg
+
+
+class GroundFixes:
+    """The ground points of a mission of ground sites, for a map (Foxglove's Map panel reads
+    ``NavSatFix``): the sub-satellite point and the boresight's ground point of the truth state heard,
+    every :data:`FIX_PERIOD` s of sim time, and the site of each slew and dwell reported."""
+
+    def __init__(self, node, mission: mission_config.MissionConfig):
+        self.field = world.Environment.from_scenario(mission.scenario).field
+        self.sensor_axis, self.last = mission.sensor_axis, -math.inf
+        self.sites = {t.name: t for t in mission.target_list.targets}
+        self.boresight = node.create_publisher(NavSatFix, BORESIGHT_FIX, qos.STREAM_QOS)
+        self.subsatellite = node.create_publisher(NavSatFix, SUBSATELLITE_FIX, qos.STREAM_QOS)
+        self.target = node.create_publisher(NavSatFix, TARGET_FIX, qos.MISSION_QOS)
+
+    def on_state(self, msg) -> None:
+        t = msg.header.stamp.sec + 1e-9 * msg.header.stamp.nanosec
+        if t < self.last + FIX_PERIOD:
+            return
+        self.last = t
+        r_N = np.array([msg.position.x, msg.position.y, msg.position.z])
+        g = ground_fixes(self.field.itrs_rotation(np.array([t])), r_N, convert.from_quaternion(msg.attitude),
+                         self.sensor_axis)
+        self.subsatellite.publish(fix_msg(msg.header.stamp, "subsatellite", g["sub_lat"][0], g["sub_lon"][0],
+                                          g["sub_alt"][0]))
+        self.boresight.publish(fix_msg(msg.header.stamp, "boresight", g["bore_lat"][0], g["bore_lon"][0], 0.0))
+
+    def on_event(self, event) -> None:
+        site = self.sites.get(event.target)
+        if site is not None and event.event in (Kind.SLEW, Kind.DWELL):
+            self.target.publish(fix_msg(convert.time_msg(event.t), event.target, math.degrees(site.latitude),
+                                        math.degrees(site.longitude), site.altitude))
+
+
 class MissionDriver:
     """One mission flown through ``client`` (a :class:`~att_planner.nodes.client.SuiteClient`): the
     executive's events from the client's node, its actions as calls."""
@@ -95,7 +151,8 @@ class MissionDriver:
         controller = mission.scenario.node_params.get("controller", {})
         settle = float(controller.get("settle_time_s", ControllerConfig().settle_time))     # as the node reads it
         estimator = mission.scenario.sensors.gyro is not None
-        self.telemetry = Telemetry(client, estimator)
+        self.fixes = GroundFixes(client, mission) if mission.target_list.kind == "ground" else None
+        self.telemetry = Telemetry(client, estimator, self.fixes.on_state if self.fixes is not None else None)
         self.executive = MissionExecutive.of_mission(mission, settle, converged=not estimator)
         self.events = client.create_publisher(MissionEvent, MISSION_EVENTS, qos.MISSION_QOS)
 
@@ -128,6 +185,8 @@ class MissionDriver:
         if isinstance(action, io.Report):
             event = action.event
             self.events.publish(convert.mission_event_msg(dataclasses.replace(event, message=event.message[:400])))
+            if self.fixes is not None:
+                self.fixes.on_event(event)
             self.log(f"[mission] t = {event.t:8.1f} s  {event.event.value:9s} {event.target:14s} {event.message}")
             return None
         if isinstance(action, io.Log):
@@ -192,6 +251,9 @@ def fly_mission(mission: mission_config.MissionConfig, out: Path, log=print,
               "controller": {"control_rate_Hz": rate, "momentum_dumping": mission.momentum_dumping,
                              "handover_blend_s": mission.handover_blend},
               "estimator": {"publish_rate_Hz": rate}}
+    start = mission.start_attitude()
+    if start is not None:
+        params["simulator"]["initial_attitude"] = [float(x) for x in start]
     name = mission.scenario.name
     # the driver's telemetry listens to the state: one more subscriber for the simulator to wait for
     suite = start_suite(name, mcap_path, run_dir, env=env, nodes=default_nodes(name), params=params, state_listeners=1)

@@ -74,6 +74,19 @@ def margins(payload, t, q):
     return out
 
 
+def site_sight_from(epoch: str, r_N, latitude_deg: float, longitude_deg: float, altitude_m: float, t):
+    """Unit lines of sight (K, 3, GCRS) from the spacecraft at the positions ``r_N`` (K, 3, m, GCRS:
+    a log's truth states) to a WGS-84 ground site at times ``t`` (s past the UTC ``epoch``):
+    skyfield's ``wgs84.latlon`` carried by its own Earth rotation."""
+    from skyfield.api import wgs84
+
+    ts, _ = _skyfield()
+    e = datetime.fromisoformat(epoch.replace("Z", "+00:00"))
+    tt = ts.utc(e.year, e.month, e.day, e.hour, e.minute, e.second + e.microsecond * 1e-6 + np.asarray(t))
+    v = wgs84.latlon(latitude_deg, longitude_deg, elevation_m=altitude_m).at(tt).position.m.T - np.asarray(r_N)
+    return v / np.linalg.norm(v, axis=1, keepdims=True)
+
+
 def site_sight(epoch: str, tle, latitude_deg: float, longitude_deg: float, altitude_m: float, t):
     """Unit lines of sight (K, 3, GCRS) from the spacecraft of ``tle`` to a WGS-84 ground site at
     times ``t`` (s past the UTC ``epoch``): skyfield's ``wgs84.latlon`` and ``EarthSatellite``."""

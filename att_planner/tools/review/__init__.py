@@ -27,6 +27,9 @@ executed plan, else the last magnetorquer-PD run, else the whole log), and write
   mode), the zones' margins, wheel momentum and dipoles over the day, and the sky with the day's
   boresight track, the targets and the Sun, Moon and nadir tracks (:mod:`.mission`); the summary
   gains ``mission``: the table of targets observed (start, dwell, pointing error) and missed (why);
+  a mission of ground sites also ``mission_ground.png``: the ground track (sub-satellite point and
+  the boresight's ground point, slews and dwells marked), the sites imaged, refused and missed, each
+  image's pointing error (the summary's ``mission.sites``);
 * with faults (a log with ``/simulator/faults``, ``/controller/faults`` or ``/estimator/faults``):
   each fault injected, its detection (detector, evidence, latency) and the response, and each
   re-plan flown after it, marked on the time histories and listed in the summary (``faults``;
@@ -144,7 +147,13 @@ def review(log_path: str | Path, out_dir: str | Path | None = None, *, plan_id: 
     from att_planner.tools.review.estimation import estimation_of, estimation_summary, figure_estimation
     from att_planner.tools.review.faults import faults_summary, marks
     from att_planner.tools.review.figures import figure_overview, figure_sky, figure_time_histories
-    from att_planner.tools.review.mission import figure_mission, figure_mission_sky, mission_of, mission_summary
+    from att_planner.tools.review.mission import (
+        figure_mission,
+        figure_mission_ground,
+        figure_mission_sky,
+        mission_of,
+        mission_summary,
+    )
     from att_planner.tools.review.pointing import figure_pointing, pointing_of, pointing_summary
     from att_planner.tools.review.run import extract_run
     from att_planner.tools.review.summary import format_summary, notes, scenario_for, summary_of, zone_sky_for
@@ -179,6 +188,8 @@ def review(log_path: str | Path, out_dir: str | Path | None = None, *, plan_id: 
         summary["mission"] = mission_summary(mission)
         figures["mission"] = figure_mission(mission, out / "mission.png")
         figures["mission sky"] = figure_mission_sky(mission, out / "mission_sky.png")
+        if mission.ground is not None:
+            figures["mission ground track"] = figure_mission_ground(mission, out / "mission_ground.png")
     text = format_summary(summary)
     (out / "summary.txt").write_text(text + "\n")
     (out / "summary.json").write_text(json.dumps(summary, indent=2) + "\n")

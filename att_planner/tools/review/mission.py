@@ -8,7 +8,11 @@ of :func:`att_planner.mission.day.target_table` (dwell, observed, pointing error
 green when observed and red when not, parks; the controller's mode below), the zones' margins over
 the day, each wheel's momentum against its limit, the dipoles. :func:`figure_mission_sky` draws
 ``mission_sky.png``: the day's boresight track in right ascension and declination, the targets
-(observed, missed), and the tracks of the Sun, the Moon and the nadir (the Earth zone's axis).
+(observed, missed), and the tracks of the Sun, the Moon and the nadir (the Earth zone's axis). A
+mission of ground sites also gets :func:`figure_mission_ground`, ``mission_ground.png``: the ground
+track (the sub-satellite point and the boresight's ground point over the day, in geodetic latitude
+and longitude, the slews and dwells marked on the boresight's), the sites imaged, missed and refused,
+and each image's pointing error against the tolerance.
 """
 from __future__ import annotations
 
@@ -22,10 +26,12 @@ from att_msgs_py.log import TopicLog
 from att_msgs_py.topics import CONTROLLER_STATUS, MISSION_EVENTS, STATE
 from att_msgs_py.types import MissionEventKind as Kind
 from att_planner.mission.day import events_of, mission_zones, target_table
+from att_planner.mission.ground import ground_track
 from att_planner.tools.review.run import MODE_NAMES
 from att_planner.zones import FittedZones
 from att_sim.models import rotations as rot
 from att_sim.models import scenario as scen
+from att_sim.models import world
 from att_sim.models.ephemeris import Ephemeris
 
 TOPICS = [STATE, CONTROLLER_STATUS, MISSION_EVENTS]
@@ -47,6 +53,7 @@ class MissionLog:
     limit: float                   # N m s per wheel
     sky: Ephemeris
     sensor_axis: np.ndarray
+    ground: dict | None = None     # ground sites: :func:`att_planner.mission.ground.ground_track` at the states' times
 
 
 def mission_of(log: dict[str, TopicLog], scenario: scen.Scenario | None) -> MissionLog | None:
@@ -64,18 +71,41 @@ def mission_of(log: dict[str, TopicLog], scenario: scen.Scenario | None) -> Miss
     mode_t = np.asarray(status["header.stamp"], float) if status is not None else np.zeros(0)
     mode = np.asarray(status["mode"]) if status is not None else np.zeros(0)
     sensor_axis = next((e.sensor_axis for e in events if e.target), np.array([0.0, 0.0, 1.0]))
+    ground = None
+    if any(e.pointing is not None and e.pointing.kind == "ground" for e in events):
+        ground = ground_track(world.Environment.from_scenario(scenario), t, q, sensor_axis)
     return MissionLog(events, target_table(events, t, q, margins, scenario), t, q, margins, zones.names,
                       relative * sc.wheel_inertia, np.asarray(state["dipole"], float), mode_t, mode,
-                      sc.wheel_inertia * sc.wheel_speed_max, sky, sensor_axis)
+                      sc.wheel_inertia * sc.wheel_speed_max, sky, sensor_axis, ground)
+
+
+def site_outcomes(run: MissionLog) -> dict:
+    """Ground sites by outcome: ``imaged`` (observed within the tolerance on the truth), ``refused``
+    (not imaged, after at least one refusal: a plan, a slew or an arrival refused) and ``missed``
+    (the others: never reachable, or not reached before the horizon); name -> (latitude, longitude)
+    in deg, from the events' ground pointing modes."""
+    sites = {}
+    for e in run.events:
+        if e.target and e.pointing is not None and e.pointing.kind == "ground" and e.target not in sites:
+            sites[e.target] = (math.degrees(e.pointing.latitude), math.degrees(e.pointing.longitude))
+    observed = {r["name"] for r in run.rows if r["observed"]}
+    refused = {e.target for e in run.events if e.event == Kind.REFUSED and e.target}
+    out = {"imaged": {}, "refused": {}, "missed": {}}
+    for name, where in sites.items():
+        out["imaged" if name in observed else "refused" if name in refused else "missed"][name] = where
+    return out
 
 
 def mission_summary(run: MissionLog) -> dict:
     """Targets observed and missed (the table), the smallest zone margin, the peak wheel momentum."""
     observed = sum(r["observed"] for r in run.rows)
-    return {"observed": observed, "missed": len(run.rows) - observed, "targets": run.rows,
-            "min_zone_margin_deg": float(np.degrees(run.margins.min())) if run.margins.size else math.inf,
-            "peak_wheel_momentum_ratio": float(np.abs(run.wheel_momentum).max() / run.limit)
-            if run.wheel_momentum.size else 0.0}
+    out = {"observed": observed, "missed": len(run.rows) - observed, "targets": run.rows,
+           "min_zone_margin_deg": float(np.degrees(run.margins.min())) if run.margins.size else math.inf,
+           "peak_wheel_momentum_ratio": float(np.abs(run.wheel_momentum).max() / run.limit)
+           if run.wheel_momentum.size else 0.0}
+    if run.ground is not None:
+        out["sites"] = {k: sorted(v) for k, v in site_outcomes(run).items()}
+    return out
 
 
 def timeline_bars(events) -> list[tuple]:
@@ -184,4 +214,67 @@ def figure_mission_sky(run: MissionLog, path: Path) -> Path:
     ax.set_title("the day's boresight track; targets observed (o) and missed (x)", fontsize=9)
     ax.legend(fontsize=7, loc="lower left")
     ax.grid(alpha=0.3)
+    return _save(plt, fig, path)
+
+
+def _intervals(t: np.ndarray, spans) -> np.ndarray:
+    """Whether each time of ``t`` lies in one of the (start, end) ``spans``."""
+    inside = np.zeros(len(t), bool)
+    for start, end in spans:
+        inside |= (t >= start) & (t <= end)
+    return inside
+
+
+def _lon_track(ax, lon: np.ndarray, lat: np.ndarray, **kwargs) -> None:
+    """A lat/lon track, broken where it wraps through longitude ±180 or leaves the Earth (NaN)."""
+    lon = np.where(np.abs(np.diff(lon, prepend=lon[:1])) > 180.0, np.nan, lon)
+    ax.plot(lon, lat, **kwargs)
+
+
+def figure_mission_ground(run: MissionLog, path: Path) -> Path:
+    """``mission_ground.png``: the ground track (sub-satellite point, boresight's ground point with its
+    slews and dwells), the sites imaged, missed and refused, each image's pointing error."""
+    from att_planner.tools.review.figures import _figure, _save
+
+    g = run.ground
+    plt, fig = _figure(figsize=(12, 10))
+    ax, bars = fig.subplots(2, 1, gridspec_kw={"height_ratios": [3, 1]})
+    sites = site_outcomes(run)
+    _lon_track(ax, g["sub_lon"], g["sub_lat"], color="tab:blue", lw=0.8, label="sub-satellite point")
+    _lon_track(ax, g["bore_lon"], g["bore_lat"], color="k", lw=0.6, label="boresight's ground point")
+    bar_spans = timeline_bars(run.events)
+    for kind, colour, label in ((Kind.SLEW, "tab:orange", "slews"), (Kind.DWELL, "tab:green", "dwells")):
+        on = _intervals(run.t, [(s, e) for ev, s, e in bar_spans if ev.event == kind])
+        _lon_track(ax, np.where(on, g["bore_lon"], np.nan), g["bore_lat"], color=colour, lw=2.5, label=label)
+    errors = {r["name"]: r["pointing_error_deg"] for r in run.rows}
+    styles = {"imaged": ("o", "tab:green"), "refused": ("^", "tab:orange"), "missed": ("x", "tab:red")}
+    for outcome, found in sites.items():
+        marker, colour = styles[outcome]
+        for i, (name, (lat, lon)) in enumerate(found.items()):
+            ax.plot(lon, lat, marker, color=colour, ms=9, mfc="none" if marker == "o" else colour,
+                    label=f"{outcome} ({len(found)})" if i == 0 else None)
+            note = f"{name}\n{errors[name]:.3f} deg" if outcome == "imaged" and errors.get(name) is not None else name
+            ax.annotate(note, (lon, lat), fontsize=7, xytext=(5, 4), textcoords="offset points")
+    lats = np.concatenate([g["bore_lat"][np.isfinite(g["bore_lat"])], g["sub_lat"],
+                           [v[0] for f in sites.values() for v in f.values()]])
+    lons = np.concatenate([g["bore_lon"][np.isfinite(g["bore_lon"])], g["sub_lon"],
+                           [v[1] for f in sites.values() for v in f.values()]])
+    ax.set_xlim(max(-180.0, lons.min() - 5.0), min(180.0, lons.max() + 5.0))
+    ax.set_ylim(max(-90.0, lats.min() - 5.0), min(90.0, lats.max() + 5.0))
+    ax.set_xlabel("longitude (deg east)")
+    ax.set_ylabel("geodetic latitude (deg)")
+    ax.set_title("ground track: sub-satellite point and the boresight's ground point (WGS-84) with its slews "
+                 "and dwells; sites imaged (o, pointing error on the truth), refused (^), missed (x)", fontsize=8)
+    ax.legend(fontsize=7, loc="best")
+    ax.grid(alpha=0.3)
+    imaged = [r for r in run.rows if r["pointing_error_deg"] is not None]
+    tolerance = next((math.degrees(e.tolerance) for e in run.events if e.event == Kind.DWELL), None)
+    bars.bar(range(len(imaged)), [r["pointing_error_deg"] for r in imaged],
+             color=["tab:green" if r["observed"] else "tab:red" for r in imaged])
+    bars.set_xticks(range(len(imaged)), [r["name"] for r in imaged], fontsize=7)
+    if tolerance is not None:
+        bars.axhline(tolerance, color="r", ls="--", lw=0.8, label=f"tolerance {tolerance:g} deg")
+        bars.legend(fontsize=7)
+    bars.set_ylabel("largest pointing error\nover the dwell (deg, truth)")
+    bars.grid(alpha=0.3, axis="y")
     return _save(plt, fig, path)

@@ -47,10 +47,25 @@ def test_the_shipped_earth_observation_day_tracks_its_sites_without_the_payload_
     assert singapore.track.mode.kind == "ground" and singapore.track.mode.latitude == pytest.approx(math.radians(1.35))
 
 
+def test_the_shipped_aeos_orbit_starts_on_the_nadir_with_its_trackers_clear():
+    m = mc.load("aeos_orbit")
+    assert m.scenario.name == "aeos" and m.start_pointing == "nadir" and len(m.zones) == 6
+    assert m.target_list.min_elevation == pytest.approx(math.radians(58.0))
+    from att_planner.mission.executive import MissionExecutive
+    from att_sim.models import world
+    q0 = m.start_attitude()
+    r = np.asarray(world.Environment.from_scenario(m.scenario).orbit.position(0.0), float).reshape(3)
+    boresight = rot.dcm_NB(q0) @ m.sensor_axis
+    assert np.degrees(np.arccos(boresight @ -r / np.linalg.norm(r))) < 0.2      # geodetic nadir, not geocentric
+    executive = MissionExecutive.of_mission(m, 20.0, converged=True)
+    assert executive.scheduler.clear(q0, 0.0, m.start_lead)                    # a slew can start from it
+
+
 def test_defaults_fill_what_a_file_leaves_out(tmp_path):
     m = mc.load(write(tmp_path, yaml_of(GOOD)))
     assert (m.rate, m.start_lead, m.method, m.margin) == (5.0, 240.0, "", pytest.approx(math.radians(1.0)))
     assert np.array_equal(m.sensor_axis, [0.0, 1.0, 0.0])
+    assert m.start_pointing == "scenario" and m.start_attitude() is None
 
 
 @pytest.mark.parametrize("change, field", [
@@ -67,6 +82,8 @@ def test_defaults_fill_what_a_file_leaves_out(tmp_path):
     ({"handover_blend_s": -1}, "handover_blend_s"), ({"handover_blend_s": "long"}, "handover_blend_s"),
     ({"momentum_dumping": "yes"}, "momentum_dumping"), ({"colour": "red"}, "unknown key(s) colour"),
     ({"rate_max_deg_per_s": 0}, "rate_max_deg_per_s"), ({"rate_max_deg_per_s": "fast"}, "rate_max_deg_per_s"),
+    ({"start_pointing": "zenith"}, "start_pointing"), ({"start_pointing": 1}, "start_pointing"),
+    ({"start_pointing": ["nadir"]}, "start_pointing"),
 ])
 def test_a_bad_key_is_refused_with_the_file_and_the_key_named(tmp_path, change, field):
     doc = {**GOOD, **change}
