@@ -1,5 +1,5 @@
-"""An imaging pass through the nodes (issue 35, point 4): ``att-mission aeos_orbit`` (the agile aeos
-spacecraft on bsk-rl's orbit, five sites under its first ascending pass and one never accessible)
+"""An imaging pass through the nodes: the start of ``att-mission aeos_orbit`` (the agile aeos spacecraft
+on bsk-rl's orbit; its first two sites under the first ascending pass and one never accessible)
 flown by the simulator, estimator, controller and planner nodes on the estimate, recorded, then
 reviewed. The images are checked on the flown truth apart from the suite's own figures: the recorded
 truth attitude's boresight against skyfield's line of sight from the recorded truth position to each
@@ -9,9 +9,11 @@ from __future__ import annotations
 
 import math
 import time
+from pathlib import Path
 
 import numpy as np
 import pytest
+import yaml
 
 from att_msgs_py import convert
 from att_msgs_py.log import read_log
@@ -22,14 +24,24 @@ from att_planner.tools.mission import fly_mission
 from att_sim.models import rotations as rot
 from helpers.independent import site_sight_from
 
-pytestmark = [pytest.mark.ros, pytest.mark.slow]     # 900 s of sim time: 3-5 min on the shared 2 cores
-ACCESSIBLE = {"guadalajara", "chihuahua", "albuquerque", "salt_lake_city", "calgary"}
+pytestmark = [pytest.mark.ros, pytest.mark.slow]
+# the first two sites of the shipped pass (imaged by about 430 s) and the one never accessible: the whole
+# pass (att-mission aeos_orbit, 900 s) takes 3-4 min of wall time, this part about a minute
+ACCESSIBLE = {"guadalajara", "chihuahua"}
+HORIZON_S = 480.0
+CONFIG = Path(__file__).resolve().parents[2] / "config"
 
 
 @pytest.fixture(scope="module")
 def flown(tmp_path_factory):
     out = tmp_path_factory.mktemp("mission_imaging")
-    mission = mission_config.load("aeos_orbit")
+    shipped = yaml.safe_load((CONFIG / "targets" / "aeos_orbit.yaml").read_text())
+    shipped["targets"] = [t for t in shipped["targets"] if t["name"] in {*ACCESSIBLE, "toulouse"}]
+    (out / "targets.yaml").write_text(yaml.safe_dump(shipped))
+    day = yaml.safe_load((CONFIG / "missions" / "aeos_orbit.yaml").read_text())
+    (out / "mission.yaml").write_text(yaml.safe_dump({**day, "targets": str(out / "targets.yaml"),
+                                                      "horizon_s": HORIZON_S}))
+    mission = mission_config.load(str(out / "mission.yaml"))
     wall = time.monotonic()
     mcap, report = fly_mission(mission, out, log=print, rtf=0.0)
     print(f"[test] flown in {time.monotonic() - wall:.0f} s of wall time (RTF {report['rtf']:.1f})")
@@ -47,7 +59,7 @@ def test_the_accessible_sites_are_imaged_and_the_other_is_missed(flown):
     mission, _, report, _ = flown
     rows = {r["name"]: r for r in report["targets"]}
     imaged = {n for n, r in rows.items() if r["observed"]}
-    assert imaged <= ACCESSIBLE and len(imaged) >= 4, rows          # 5 of 5 measured
+    assert imaged == ACCESSIBLE, rows
     assert not rows["toulouse"]["observed"] and "never 58 deg above" in rows["toulouse"]["why"]
     assert all(rows[n]["pointing_error_deg"] <= math.degrees(mission.pointing_tolerance) for n in imaged)
     assert report["min_margin_deg"] > 0.0 and report["peak_wheel_ratio"] < 1.0
