@@ -48,7 +48,9 @@ is removed, over ``σ_m²``, ``GLR_i = max_j RSS(B̃_i − x_i) − RSS(B̃_i �
 freedom; a check of ``a m_max`` = 25 A m² at ``k`` = 20 nT per A m² gives 500 nT, ``GLR`` ≈ 96 from one
 sample). The magnetometer itself must still see: coil ``i`` is open only if another coil ``l`` was
 read back after that onset, ``RSS(B̃_l − x_l 1[t < t_j]) − RSS(B̃_l − x_l) > threshold`` (a stuck or
-lost magnetometer reads no coil back and blames none). Assumptions: ``k`` as declared (a 10 % error
+lost magnetometer reads no coil back and blames none). A field that changes between two samples by more than
+:data:`FIELD_JUMP_T` beyond the dipoles' read-back (the attitude reset, no slew turns it that fast) starts the
+window again. Assumptions: ``k`` as declared (a 10 % error
 leaves 1 % of the evidence), the field quadratic over the window, the dipole commanded the one applied
 (an open coil is the only way it is not).
 """
@@ -67,6 +69,7 @@ DETECTOR = "coil_torque"
 JUDGE_PERIOD_S = 0.5   # s between two fits of the window
 ONSET_STEP_S = 2.0     # s between two onsets tried for a coil opening within the window
 MIN_READBACK_SAMPLES = 8   # magnetometer samples in the window before the read-back is judged
+FIELD_JUMP_T = 3e-6        # T between two samples beyond the dipoles' read-back: the attitude reset, a new window
 
 
 def momentum_noise(inertia_kg_m2, wheel_axes, wheel_inertia_kg_m2: float, gyro_arw_rad_sqrt_s: float,
@@ -236,7 +239,13 @@ class Readback:
         while self.pending and self.pending[0][0] <= t_command + 1e-9:
             ts, f = self.pending.popleft()
             before = [d for tc, d in self.commands if tc < ts - 1e-9]
-            self.samples.append((ts, f, before[-1] if before else np.zeros(3)))
+            m = before[-1] if before else np.zeros(3)
+            if self.samples:
+                _, f0, m0 = self.samples[-1]
+                jump = np.abs(f - self.k * m - f0 + self.k * m0) > FIELD_JUMP_T + self.k * (np.abs(m) + np.abs(m0))
+                if jump.any():          # the field jumped (a simulation reset to another attitude): start again
+                    self.samples.clear()
+            self.samples.append((ts, f, m))
             moved = True
         if not moved or not self.samples:
             return []

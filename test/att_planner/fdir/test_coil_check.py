@@ -40,11 +40,13 @@ def field(t: float, rate_rad_s: float) -> np.ndarray:
     return rotated * (1.0 + 0.1 * math.sin(1.1e-3 * t))
 
 
-def fly(seed, duration_s=120.0, open_at=math.inf, coil=0, rate_rad_s=2.2e-3, dumping_Am2=0.0, stuck_at=math.inf):
+def fly(seed, duration_s=120.0, open_at=math.inf, coil=0, rate_rad_s=2.2e-3, dumping_Am2=0.0, stuck_at=math.inf,
+        reset_at=math.inf):
     """The controller's 20 Hz commands with the check (and a dumping dipole on the other steps, as the
     law commands it outside the blanking), the 2 Hz magnetometer with the datasheet's bias, noise,
     quantum and coupling to the applied dipole, coil ``coil`` open from ``open_at``, the magnetometer
-    stuck from ``stuck_at``; the read-back and its verdicts."""
+    stuck from ``stuck_at``, the attitude reset (the field turned by 60 deg) at ``reset_at``; the read-back and
+    its verdicts."""
     rng = np.random.default_rng(seed)
     d = Readback(K, SIGMA, THRESHOLD, WINDOW_S, PERSISTENCE_S)
     bias = rng.normal(0.0, 100.0 * NT, 3)
@@ -52,7 +54,8 @@ def fly(seed, duration_s=120.0, open_at=math.inf, coil=0, rate_rad_s=2.2e-3, dum
     for k in range(int(round(duration_s / CONTROL_S)) + 1):
         t = k * CONTROL_S
         if k % int(round(MAG_S / CONTROL_S)) == 0 and k:
-            b = field(t, rate_rad_s) + bias + K * applied + rng.normal(0.0, 50.0 * NT, 3)
+            b = field(t + (5e2 if t >= reset_at else 0.0), rate_rad_s) + bias + K * applied \
+                + rng.normal(0.0, 50.0 * NT, 3)
             b = np.round(b / (10.0 * NT)) * 10.0 * NT
             last = b if t < stuck_at or last is None else last
             out += d.on_field(t, last)
@@ -107,6 +110,13 @@ def test_healthy_coils_under_the_pattern_are_never_declared(seed):
     assert verdicts == []
     glr, _, _ = d.statistics()
     assert glr.max() < THRESHOLD / 3
+
+
+@pytest.mark.parametrize("reset_at", [30.2, 31.7, 33.4])
+def test_a_reset_of_the_attitude_starts_the_window_again(reset_at):
+    d, _ = fly(8, reset_at=reset_at, duration_s=reset_at + 6.0)
+    assert d.samples[0][0] >= reset_at
+    assert fly(8, reset_at=reset_at, duration_s=60.0)[1] == []
 
 
 def test_a_stuck_magnetometer_blames_no_coil():
