@@ -21,8 +21,11 @@ the line ``a + τ_d (t − t_0)`` of each axis free; its residual sum of squares
 Jones 1976); the coil with the largest, above ``threshold``, for the persistence, is open. A coil's torque
 is seen only through its variation against a line: a coil commanded a constant dipole in a constant
 field cannot be told from the disturbance, and **a coil never commanded cannot be seen at all**
-(``C_i = 0``: ``GLR_i = 0``). Assumptions: the disturbance constant over the window (its change over it far
-below the commanded torque's variation), the inertia and wheel axes as declared, the field
+(``C_i = 0``: ``GLR_i = 0``). A coil whose commanded momentum spans so little of the noise over the window
+that an open coil's own ``GLR ≈ ‖C_i − C_i(t_j)‖²/σ_H²`` stays below a quarter of the threshold
+(``N Σ_k span_k(C_i)²/σ_H,k² <`` :data:`VISIBLE` ``× threshold``: the active check's 0.05 s pulses) is
+not fitted: any GLR it would reach is not its own. Assumptions: the disturbance constant over the window
+(its change over it far below the commanded torque's variation), the inertia and wheel axes as declared, the field
 measured at the coils (the magnetometer's bias a constant fraction of it), the dipole commanded over
 each gyro interval the last one sent.
 
@@ -68,6 +71,7 @@ from att_sim.models import rotations as rot
 DETECTOR = "coil_torque"
 JUDGE_PERIOD_S = 0.5   # s between two fits of the window
 ONSET_STEP_S = 2.0     # s between two onsets tried for a coil opening within the window
+VISIBLE = 0.25         # a coil is fitted when N Σ_k (its C's span on axis k / σ_H,k)² reaches this × threshold
 MIN_READBACK_SAMPLES = 8   # magnetometer samples in the window before the read-back is judged
 FIELD_JUMP_T = 3e-6        # T between two samples beyond the dipoles' read-back: the attitude reset, a new window
 
@@ -148,8 +152,9 @@ class CoilDetector:
         self.next_judged = t + JUDGE_PERIOD_S - 1e-9
         return self._judge(t)
 
-    def ratios(self) -> np.ndarray:
-        """Each coil's GLR over the window (module docstring), the momenta whitened by ``σ_H``."""
+    def ratios(self, judged=None) -> np.ndarray:
+        """Each coil's GLR over the window (module docstring), the momenta whitened by ``σ_H``; ``judged``:
+        a mask of the coils fitted (default every one; the others 0)."""
         t = np.array([x[0] for x in self.samples])
         y = np.array([x[1] + x[2] for x in self.samples])
         C = np.array([x[3] for x in self.samples])                  # (M, coil, axis)
@@ -165,18 +170,20 @@ class CoilDetector:
         step = max(int(round(ONSET_STEP_S * (len(dt) - 1) / max(dt[-1] - dt[0], 1e-9))), 1)
         onsets = range(0, len(dt) - 1, step)
         for i in range(3):
-            if not np.any(C[-1, i]):
+            if not np.any(C[-1, i]) or judged is not None and not judged[i]:
                 continue                                             # never commanded in the window: not seen
             glr[i] = max(base - rss(healthy + np.where((np.arange(len(dt)) >= j)[:, None], C[:, i] - C[j, i], 0.0))
                          for j in onsets)
         return glr
 
     def _judge(self, t: float) -> list[Verdict]:
-        if not np.any(self.samples[-1][3] - self.samples[0][3]):
-            for p in self.persistence:                  # no coil commanded in the window: nothing to see
+        C = np.array([x[3] for x in self.samples]) / self.sigma_H            # (M, coil, axis)
+        visible = len(C) * np.sum(np.ptp(C, axis=0) ** 2, axis=1) >= VISIBLE * self.threshold
+        if not visible.any():
+            for p in self.persistence:                  # no coil commanded enough in the window: nothing to see
                 p.update(False, t)
             return []
-        glr = self.ratios()
+        glr = self.ratios(visible)
         best = int(np.argmax(glr))
         out = []
         for i in range(3):
