@@ -48,6 +48,7 @@ from att_msgs_py.types import (
     State,
 )
 from att_planner.control import momentum, safe, tracking, wheels
+from att_planner.control.coil_check import CoilCheck, feedforward
 from att_planner.control.controller_config import ControllerConfig
 from att_planner.control.magnetorquer import dipole_command
 from att_planner.control.maneuver import Maneuver, plan_zones
@@ -117,6 +118,7 @@ class Controller:
         self.healthy: tuple[bool, ...] | None = None   # the wheels the demand is allocated on (None: every one)
         self.safe_actuation = None                     # safe mode on what is left: state -> SafeActuation | None
         self.safe_zones = None                         # the zones safe mode keeps clear of (FittedZones), None: none
+        self.coil_check: CoilCheck | None = None       # the active magnetorquer check (None: none; .coil_check)
 
     @property
     def spacecraft(self) -> Spacecraft:
@@ -371,6 +373,11 @@ class Controller:
             cmd.wheel_torques = tracked
             status.message = "holding the final attitude of the last maneuver"
             status.reference_q, status.attitude_error = self.hold_q_RN, float(rot.angle_between(s.q, self.hold_q_RN))
+        holding = self.maneuver is not None or self.hold_q_RN is not None
+        if self.coil_check is not None and self.measured is not None and (
+                self.mode == ControlMode.POINTING and self.pointing is not None
+                or self.mode == ControlMode.PLAN_TRACKING and holding):
+            self._check_coils(cmd)
         status.dumping = self.dumping
         if self.measured is not None:
             self.measured.dipoles.record(s.t, cmd.dipole)
@@ -392,6 +399,20 @@ class Controller:
                                     s.wheel_speeds[None], c.null_space_speed, c.null_space_gain, self.friction,
                                     None if gyroscopic_speeds is None else gyroscopic_speeds[None],
                                     healthy=self.healthy)[0]
+
+    def _check_coils(self, cmd: Command) -> None:
+        """The active coil check's dipole (:mod:`.coil_check`) in place of the command's, when a check
+        sample follows within its dwell: the difference of their magnetic torques fed forward to the
+        healthy wheels (clipped at their limit)."""
+        s, sc = self.state, self.spacecraft
+        m = self.coil_check.dipole(s.t, self.config.control_period, self.m_max)
+        if m is None or not np.any(s.field_body) or not sc.n_wheels:
+            return
+        A = sc.wheel_axes_pinv if self.healthy is None else wheels.healthy_allocation(sc.wheel_axes, self.healthy)
+        u = np.asarray(cmd.wheel_torques, float) + feedforward(m - np.asarray(cmd.dipole, float), s.field_body, A)
+        u = np.clip(u, -sc.wheel_torque_max, sc.wheel_torque_max)
+        cmd.wheel_torques = u if self.healthy is None else u * np.asarray(self.healthy, bool)
+        cmd.dipole = m
 
     def _point(self, out: StepOutput, law) -> None:
         """Track ``law``'s reference (:func:`~.pointing.pointing_torque`) through the wheels, dumping

@@ -20,7 +20,7 @@ from att_msgs_py.types import FaultStatus, Health
 from att_planner.estimation.health import Innovation
 from att_planner.fdir import table as tables
 from att_planner.fdir.bias import BiasJumpDetector
-from att_planner.fdir.coils import CoilDetector, momentum_noise
+from att_planner.fdir.coils import CoilDetector, Readback, momentum_noise
 from att_planner.fdir.frozen import FrozenDetector
 from att_planner.fdir.innovations import InnovationDetector
 from att_planner.fdir.outage import OutageDetector
@@ -94,8 +94,13 @@ class FaultMonitor:
             tacho = specs.tachometer.noise if n else 0.0
             sigma_H = momentum_noise(sc.inertia, sc.wheel_axes, sc.wheel_inertia, specs.gyro.arw, specs.gyro.rate,
                                      tacho)
+            mag = specs.magnetometer
+            readback = None
+            if e.check is not None and mag is not None and mag.dipole_coupling > 0 and mag.noise > 0:
+                readback = Readback(mag.dipole_coupling, math.hypot(mag.noise, mag.quantization / math.sqrt(12.0)),
+                                    e.threshold, e.check.window_s, e.persistence_s)
             return "coils", CoilDetector(sc.inertia, sc.wheel_axes, sc.wheel_inertia, sigma_H, e.threshold, e.window_s,
-                                         e.persistence_s)
+                                         e.persistence_s, readback)
         if isinstance(e, tables.TrackerOutage):
             return "tick", OutageDetector(self.trackers, e.threshold_s, e.persistence_s) if self.trackers else None
         if isinstance(e, tables.AttitudeError):

@@ -19,6 +19,7 @@ from pathlib import Path
 from att_msgs_py import topics
 from att_msgs_py.errors import ConfigError, ErrorCode, RequestError, clip
 from att_msgs_py.types import FaultStatus, ManeuverResult
+from att_planner.control.coil_check import CoilCheck
 from att_planner.fdir import recovery
 from att_planner.fdir import table as tables
 from att_planner.fdir.monitor import FaultMonitor
@@ -49,6 +50,16 @@ def load_table(value: str) -> tables.FaultTable | None:
         raise ConfigError(ErrorCode.INVALID_CONFIG, f"parameter 'fault_table': {clip(err.message, 300)}") from None
 
 
+def coil_check(table: tables.FaultTable, specs) -> CoilCheck | None:
+    """The active coil check the table declares (its coil_torque entry's ``check``) for the sensors
+    ``specs``: None without one or without a magnetometer to read it back."""
+    entry = next((e for e in table.faults.values() if isinstance(e, tables.CoilTorque) and e.check is not None), None)
+    if entry is None or specs.magnetometer is None or not specs.magnetometer.dipole_coupling > 0:
+        return None
+    c = entry.check
+    return CoilCheck(c.period_s, c.dipole_fraction, c.dwell_s, 1.0 / specs.magnetometer.rate)
+
+
 class Onboard:
     """The monitor of ``table`` on ``scenario``'s spacecraft, acting on ``controller`` (None: in another
     process, as in the estimator node) and ``estimator`` (its exclusions, and the innovations the monitor
@@ -57,6 +68,8 @@ class Onboard:
 
     def __init__(self, table: tables.FaultTable, scenario, controller, estimator=None):
         self.monitor = FaultMonitor(table, scenario.spacecraft, scenario.sensors, scenario.body_frame_id)
+        if controller is not None:
+            controller.coil_check = coil_check(table, scenario.sensors)
         self.tap = MonitorTap(self.monitor, estimator, None if controller is None else controller.friction)
         self.controller, self.estimator = controller, estimator
         self.heard: dict[tuple[str, int], FaultStatus] = {}

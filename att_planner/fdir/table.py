@@ -198,10 +198,39 @@ class GyroRamp(_TrackerGyro):
     detector: Literal["gyro_ramp"]
 
 
+class CoilCheck(Schema):
+    """The active coil check (:mod:`att_planner.control.coil_check`): every ``period_s`` one magnetometer
+    sample is taken with one coil commanded ``dipole_fraction`` of the coils' limit for ``dwell_s`` before
+    it, the coils in turn, each one's sign alternating; its torque is fed forward to the wheels and the
+    magnetometer reads the dipole back (:mod:`att_planner.fdir.coils`)."""
+
+    period_s: float = number(1.0, gt=0.0, le=600.0, unit="s", meaning="sim time between two check samples (rounded "
+                                                                       "to the magnetometer's samples; each coil is "
+                                                                       "checked every 3 periods)")
+    dipole_fraction: float = number(0.5, gt=0.0, le=1.0, unit="", meaning="fraction of the coils' dipole limit "
+                                                                          "commanded on the coil checked")
+    dwell_s: float = number(0.05, gt=0.0, le=60.0, unit="s", meaning="sim time the check's dipole is held before "
+                                                                     "its magnetometer sample (the coil's settling)")
+    window_s: float = number(20.0, gt=0.0, le=3600.0, unit="s", meaning="span of the magnetometer samples fitted "
+                                                                        "(a line per axis and the check's read-back)")
+
+    @model_validator(mode="after")
+    def _a_visible_pattern(self):
+        if not self.dwell_s < self.period_s:
+            raise ValueError(f"dwell_s below period_s (the coils are off between two checks, so the other "
+                             f"magnetometer samples stay clean), got dwell_s {self.dwell_s:g} s and period_s "
+                             f"{self.period_s:g} s")
+        if not self.window_s >= 6.0 * self.period_s:
+            raise ValueError(f"window_s at least 6 period_s (each coil seen with both signs in a window), got "
+                             f"window_s {self.window_s:g} s and period_s {self.period_s:g} s")
+        return self
+
+
 class CoilTorque(Entry):
     """A magnetorquer coil whose commanded dipole does not turn the body: the momentum measured (gyro and
     tachometers) explained better with that coil open than with every coil healthy
-    (:mod:`att_planner.fdir.coils`); a coil never commanded cannot be seen."""
+    (:mod:`att_planner.fdir.coils`); a coil never commanded cannot be seen. With a ``check``, the coils
+    are pulsed in turn and the magnetometer's read-back of their dipole judged too."""
 
     component: ClassVar[str] = "magnetorquer"
     detector: Literal["coil_torque"]
@@ -210,6 +239,8 @@ class CoilTorque(Entry):
                                                                "of freedom)")
     window_s: float = number(60.0, gt=0.0, le=3600.0, unit="s", meaning="span of the momentum balance, the "
                                                                         "disturbance taken as constant over it")
+    check: CoilCheck | None = Field(None, description="the active coil check (none: the coils are judged only "
+                                                      "while a law commands them)")
 
 
 class TrackerOutage(Entry):
