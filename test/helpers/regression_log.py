@@ -11,10 +11,11 @@ from att_msgs_py import topics
 from att_sim.models import rotations as rot
 
 FIXTURE = Path(__file__).parents[1] / "data" / "swift_short.mcap"
-# the 3D view's topics, the mission events, the injected faults and the fault reports are recorded since
-# after the fixture was made (test_scene_ros, test_mission, test_simulator_faults and test_fault_recovery
-# check them)
+# the 3D view's topics, the mission events and map fixes, the injected faults and the fault reports are
+# recorded since after the fixture was made (test_scene_ros, test_mission, test_mission_imaging,
+# test_simulator_faults and test_fault_recovery check them)
 VIEW_TOPICS = {topics.TF, topics.SIM_MARKERS, topics.PLAN_MARKERS, topics.ZONE_MARGINS, topics.MISSION_EVENTS,
+               topics.BORESIGHT_FIX, topics.SUBSATELLITE_FIX, topics.TARGET_FIX,
                topics.SIM_FAULTS, topics.CONTROLLER_FAULTS, topics.ESTIMATOR_FAULTS}
 CHANNEL_TYPES = {t: name for t, name in topics.RECORDED.items() if t not in VIEW_TOPICS}   # a channel each
 TOPIC_TYPES = {t: name for t, name in CHANNEL_TYPES.items() if t != topics.SUN_SENSORS}   # with messages
