@@ -220,3 +220,44 @@ def test_a_wheel_whose_tachometer_is_declared_frozen_is_not_judged(leo):
     assert verdicts == [] and abs(det.residual_torque(200 * DT)[0]) == pytest.approx(0.05, rel=1e-6)
     det.unread = set()
     assert [v.index for k in range(200, 220) for v in det.update((k + 1) * DT, [50.0], [0.05])] == [0]
+
+
+def _old_window_means(det, samples, t):
+    """The window means as the detector computed them before its sample buffer (arrays rebuilt from a
+    list of (t, r, asked) each sample): the reference :meth:`window_means` must equal."""
+    if len(samples) < 4 or samples[0][0] > t - 2.0 * det.window + 1e-9:
+        return None
+    times = np.array([s[0] for s in samples])
+    now = times > t - det.window + 1e-9
+    if now.all() or not now.any():
+        return None
+    span = times[now].mean() - times[~now].mean()
+    values = np.array([s[1] for s in samples])
+    asked = np.array([s[2] for s in samples])
+    motor, net = (asked[now].mean(axis=0) - asked[~now].mean(axis=0)) / span
+    return det.inertia * (values[now].mean(axis=0) - values[~now].mean(axis=0)) / span, motor, net
+
+
+def test_the_sample_buffer_gives_the_old_window_means_exactly():
+    """Over 1200 samples at 20 Hz (the buffer moved to its start and grown) the window means equal, bit
+    for bit, the old formula on the same samples kept in a list."""
+    rng = np.random.default_rng(3)
+    det = WheelTorqueDetector(4, 0.2, 1.0, 0.25, 2.5, wheel_axes=PYRAMID, drive_gain_tolerance=0.1,
+                              wheel_inertia_tolerance=0.05)
+    det.samples = type(det.samples)(4, capacity=8)
+    kept, compared = [], 0
+    for k in range(1200):
+        t = (k + 1) * DT
+        det.update(t, rng.normal(0.0, 50.0, 4), rng.normal(0.0, 0.1, 4), rng.normal(0.0, 0.005, 4),
+                   rng.normal(0.0, 1e-3, 3))
+        times, values, asked = det.samples.views()
+        kept = [s for s in kept + [(times[-1], values[-1].copy(), asked[-1].copy())]
+                if not s[0] < t - 2.0 * det.window - 1e-9]           # the old deque's popleft rule
+        assert [s[0] for s in kept] == list(times)
+        new, old = det.window_means(t), _old_window_means(det, kept, t)
+        assert (new is None) == (old is None)
+        if new is not None:
+            compared += 1
+            for a, b in zip(new, old):
+                assert np.array_equal(a, b)
+    assert compared > 1000 and len(det.samples.t) > 8
