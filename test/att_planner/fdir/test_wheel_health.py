@@ -174,7 +174,7 @@ def test_a_wheel_fault_in_a_hold_is_isolated_within_5_s(leo, fault, scale, inert
 def test_a_seized_wheel_asked_less_than_the_bound_is_not_seen(leo, net_Nm):
     """The limit: a seized wheel holds its spin and feels no friction, so it misses only the net
     torque ``u − f`` it is asked. Asked none, it does what a healthy wheel does; asked 0.002 N m (the
-    leo_pyramid hold's first seconds) it stays under the bound ``0.0018 + 0.105 × 0.007 + 0.053 × 0.002``
+    leo_pyramid inertial hold's first seconds) it stays under the bound ``0.0018 + 0.105 × 0.007 + 0.053 × 0.002``
     N m, and is seen only once the controller asks more."""
     assert hold(leo, 60.0, "seized", 20.0, net_Nm=net_Nm) == []
 
