@@ -13,7 +13,7 @@ truth is reset onto the nadir law's attitude and rate (the wheels' spin rates ke
 is steady by the time the faults start.
 Per case: whether the fault was detected and its latency (s of sim time from the onset to the first
 report), the component the first report isolated and whether it is the faulty one, the response
-taken, and the outcome: final pointing error (truth to the goal, or to the held attitude), the
+taken, and the outcome: final pointing error (truth to the goal, or to the nadir law's attitude), the
 worst zone margin from the start (truth, the zones as they are in the sky), the time lost on the
 slew (its end against the nominal plan's), the slew completed, safe mode reached and held, and in
 safe mode (flown ``--safe-hold-s`` once reached) the worst zone margin at its entry and from then
