@@ -47,7 +47,7 @@ from att_planner.mission.targets import next_axis
 from att_planner.problem import rest_to_rest_time
 from att_sim.models import rotations as rot
 
-POLICIES = ("greedy", "ours")
+POLICIES = ("greedy", "ours", "rollout")
 SETTLE_S = 3.0            # s tracked between the arrival and the image (the hand-over settles)
 DWELL_S = 2.0             # s an image is held (level b)
 HOLD_MAX_S = 60.0         # s: a longer wait for a window is spent on nadir
@@ -55,6 +55,10 @@ ZONE_SAMPLE_S = 2.0       # s between the zone samples of a held stretch
 TRIES = 4                 # exact attempts per decision
 PRIORITY_WEIGHT_S = 10.0  # s of waiting one unit of priority is worth (policy ours)
 SLEW_SCALE = 1.6          # the track-to-track slews' time over the rest-to-rest estimate (policy ours)
+ROLLOUT_CANDIDATES = 3    # windows the rollout simulates at a decision (policy rollout)
+ROLLOUT_HORIZON_S = 300.0  # s each rollout is simulated ahead (policy rollout)
+ROLLOUT_SLEW_SCALE = 1.25  # the exact slews' time over the rest-to-rest estimate, fitted (policy rollout)
+ROLLOUT_LOST_WEIGHT = 1.0  # images one site lost for good is worth in a rollout's score (policy rollout)
 NADIR = -1                # the target index of nadir
 REFERENCE_STEP_S = 0.01   # s: the central difference of the nadir law's rate
 
@@ -161,6 +165,7 @@ class Planner:
         self.laws = Laws(environment, sites, boresight_B, along)
         self.pointing = Pointing(environment, SkyGeometry(environment, sites), boresight_B, along)
         self.lookahead, self.dwell_s, self.settle_s = lookahead, dwell_s, settle_s
+        self.rollout_base = "greedy"
 
     # -- the pieces --------------------------------------------------------------------------------
     def _held_margin(self, target: int, t0: float, t1: float) -> float:
@@ -253,6 +258,68 @@ class Planner:
                 return np.concatenate([[k], order[order != k]])
         return order
 
+    def _rollout(self, site: int, image_s: float, alive: np.ndarray, imaged: np.ndarray, until: float,
+                 base: str) -> tuple[float, float]:
+        """The score of imaging ``site`` at the estimate ``image_s`` and then following ``base`` on the
+        scaled estimates until ``until`` (module docstring): (images less the sites lost for good,
+        the time free at the end)."""
+        w = self.windows
+        alive, imaged = alive.copy(), imaged.copy()
+        imaged[site] = True
+        images, t, source = 1, image_s + self.dwell_s, site
+        dcm = self.pointing.dcm_NB(np.array([site]), np.array([t]))[0]
+        horizon = alive & (w.open_s < until)
+        alive &= horizon
+        while True:
+            alive &= (w.close_s - self.dwell_s > t) & ~imaged[w.site]
+            pending = np.flatnonzero(alive)[:self.lookahead]
+            if not len(pending):
+                break
+            est = self.estimates(source, t, pending, dcm, ROLLOUT_SLEW_SCALE)
+            fits = est + self.dwell_s <= w.close_s[pending]
+            alive[pending[~fits]] = False
+            pending, est = pending[fits], est[fits]
+            if not len(pending):
+                continue
+            order = np.argsort(w.close_s[pending], kind="stable")
+            if base == "ours":
+                order = self._insertion(pending, est, order)
+            k = order[0]
+            if est[k] + self.dwell_s > until:
+                break
+            source, t = int(w.site[pending[k]]), float(est[k]) + self.dwell_s
+            imaged[source] = True
+            images += 1
+            dcm = self.pointing.dcm_NB(np.array([source]), np.array([t]))[0]
+        # the sites whose last window closed in the rollout without an image
+        closed = horizon & (w.close_s - self.dwell_s <= t) & ~imaged[w.site]
+        later = np.zeros(w.n_sites, bool)
+        later[w.site[w.close_s - self.dwell_s > t]] = True
+        lost = len(np.setdiff1d(np.unique(w.site[closed]), np.flatnonzero(later)))
+        return images - ROLLOUT_LOST_WEIGHT * lost, t
+
+    def _rollout_order(self, source: int, t: float, pending: np.ndarray, image_s: np.ndarray, order: np.ndarray,
+                       alive: np.ndarray, imaged: np.ndarray) -> np.ndarray:
+        """rollout's order (module docstring): the candidate with the best rollout score first (ties to
+        the base's order), then the base's order."""
+        w = self.windows
+        scaled = self.estimates(source, t, pending, scale=ROLLOUT_SLEW_SCALE)
+        candidates = list(dict.fromkeys([*order[:ROLLOUT_CANDIDATES].tolist(),
+                                         *np.argsort(image_s, kind="stable")[:ROLLOUT_CANDIDATES].tolist()]))
+        until = t + ROLLOUT_HORIZON_S
+        best, best_score = None, None
+        for k in candidates:
+            if scaled[k] + self.dwell_s > w.close_s[pending[k]]:
+                continue
+            images, end = self._rollout(int(w.site[pending[k]]), float(scaled[k]), alive, imaged, until,
+                                        self.rollout_base)
+            score = (images, -end)
+            if best_score is None or score > best_score:
+                best, best_score = k, score
+        if best is None:
+            return order
+        return np.concatenate([[best], order[order != best]])
+
     # -- the horizon -------------------------------------------------------------------------------
     def plan(self, policy: str) -> Timeline:
         """The timeline of ``policy`` (:data:`POLICIES`) over the windows' horizon."""
@@ -277,8 +344,10 @@ class Planner:
             if not len(pending):
                 continue
             order = np.argsort(w.close_s[pending], kind="stable")
-            if policy == "ours":
+            if policy in ("ours", "rollout"):
                 order = self._insertion(pending, image_s, order)
+            if policy == "rollout":
+                order = self._rollout_order(source, t, pending, image_s, order, alive, imaged)
             taken = None
             for k in order[:TRIES]:
                 timeline.attempts += 1
