@@ -55,7 +55,7 @@ ZONE_SAMPLE_S = 2.0       # s between the zone samples of a held stretch
 TRIES = 4                 # exact attempts per decision
 PRIORITY_WEIGHT_S = 10.0  # s of waiting one unit of priority is worth (policy ours)
 SLEW_SCALE = 1.6          # the track-to-track slews' time over the rest-to-rest estimate (policy ours)
-ROLLOUT_CANDIDATES = 3    # windows the rollout simulates at a decision (policy rollout)
+ROLLOUT_CANDIDATES = 2    # windows the rollout simulates at a decision (policy rollout)
 ROLLOUT_HORIZON_S = 300.0  # s each rollout is simulated ahead (policy rollout)
 ROLLOUT_SLEW_SCALE = 1.25  # the exact slews' time over the rest-to-rest estimate, fitted (policy rollout)
 ROLLOUT_LOST_WEIGHT = 1.0  # images one site lost for good is worth in a rollout's score (policy rollout)
@@ -165,7 +165,7 @@ class Planner:
         self.laws = Laws(environment, sites, boresight_B, along)
         self.pointing = Pointing(environment, SkyGeometry(environment, sites), boresight_B, along)
         self.lookahead, self.dwell_s, self.settle_s = lookahead, dwell_s, settle_s
-        self.rollout_base = "greedy"
+        self.rollout_base = "ours"
 
     # -- the pieces --------------------------------------------------------------------------------
     def _held_margin(self, target: int, t0: float, t1: float) -> float:
@@ -283,7 +283,7 @@ class Planner:
                 continue
             order = np.argsort(w.close_s[pending], kind="stable")
             if base == "ours":
-                order = self._insertion(pending, est, order)
+                order = self._insertion_batch(pending, est, order)
             k = order[0]
             if est[k] + self.dwell_s > until:
                 break
@@ -319,6 +319,29 @@ class Planner:
         if best is None:
             return order
         return np.concatenate([[best], order[order != best]])
+
+    def _insertion_batch(self, pending: np.ndarray, image_s: np.ndarray, order: np.ndarray) -> np.ndarray:
+        """:meth:`_insertion` with its reachability checks in one batch (the rollouts' base ``ours``)."""
+        w = self.windows
+        first = int(order[0])
+        rank = np.argsort(image_s - PRIORITY_WEIGHT_S * self.sites.priority[w.site[pending]], kind="stable")
+        ahead = rank[:int(np.flatnonzero(rank == first)[0])]
+        if not len(ahead):
+            return order
+        f = pending[first]
+        free = image_s[ahead] + self.dwell_s
+        dcm = self.pointing.dcm_NB(w.site[pending[ahead]], free)
+        arrival = np.maximum(w.open_s[f] - self.settle_s, free)
+        rel = np.einsum("mji,mjk->mik", dcm, self.pointing.dcm_NB(np.full(len(ahead), w.site[f]), arrival))
+        axis, angle = rotation_between(np.eye(3), rel)
+        slew = rest_to_rest_time(self.spacecraft, axis, angle, self.limits.rate_max_rad_s,
+                                 self.limits.momentum_max_Nms)
+        after = np.maximum(free + SLEW_SCALE * slew + self.settle_s, w.open_s[f])
+        ok = np.flatnonzero(after + self.dwell_s <= w.close_s[f])
+        if not len(ok):
+            return order
+        k = ahead[ok[0]]
+        return np.concatenate([[k], order[order != k]])
 
     # -- the horizon -------------------------------------------------------------------------------
     def plan(self, policy: str) -> Timeline:
