@@ -13,7 +13,20 @@ image and dwell fit before the window closes are ranked by the **policy**:
   :data:`PRIORITY_WEIGHT_S` per unit of the site's priority, provided the earliest-closing window
   stays reachable after it on the estimates (slews scaled by :data:`SLEW_SCALE`); else the
   earliest-closing window. In a dense field the nearest site in time keeps the spacecraft imaging
-  while the window about to close is still served.
+  while the window about to close is still served;
+* ``rollout`` — a rollout of ours (Bertsekas, Tsitsiklis & Wu 1997, "Rollout algorithms for
+  combinatorial optimization", J. Heuristics 3; Bertsekas 2013, "Rollout algorithms for discrete
+  optimization: a survey"): the candidates are the first :data:`ROLLOUT_CANDIDATES` windows of
+  ours' order and the :data:`ROLLOUT_CANDIDATES` that image first. From each candidate c imaged
+  at its estimate, ours is simulated on the estimates, every slew the rest-to-rest time scaled by
+  :data:`ROLLOUT_SLEW_SCALE` (the exact track-to-track slews over their rest-to-rest estimate,
+  fitted: median 1.23, 5–95 % 1.20–1.38 on uniform:3000, seed 0, one orbit), until
+  ``t + ROLLOUT_HORIZON_S``. Its score is ``J(c) = n(c) − λ ℓ(c)``: n the images of the
+  simulation (c's included), ℓ the sites whose every window closes in it unimaged (lost for good),
+  λ = :data:`ROLLOUT_LOST_WEIGHT`; the largest J, then the earliest free time at the horizon, then
+  ours' order wins (a candidate whose scaled estimate ends after its window closes is not rolled out).
+  The winner is attempted first, then ours' order. The simulation is a model
+  (no zones, no exact slews): nothing it plans is kept but the choice of the next window.
 
 The first of the ranked windows (at most :data:`TRIES`) whose **exact** attempt succeeds is taken.
 An attempt (:meth:`Planner.attempt`) plans the slew from L's tracking state onto the site's law
@@ -47,7 +60,7 @@ from att_planner.mission.targets import next_axis
 from att_planner.problem import rest_to_rest_time
 from att_sim.models import rotations as rot
 
-POLICIES = ("greedy", "ours")
+POLICIES = ("greedy", "ours", "rollout")
 SETTLE_S = 3.0            # s tracked between the arrival and the image (the hand-over settles)
 DWELL_S = 2.0             # s an image is held (level b)
 HOLD_MAX_S = 60.0         # s: a longer wait for a window is spent on nadir
@@ -55,6 +68,10 @@ ZONE_SAMPLE_S = 2.0       # s between the zone samples of a held stretch
 TRIES = 4                 # exact attempts per decision
 PRIORITY_WEIGHT_S = 10.0  # s of waiting one unit of priority is worth (policy ours)
 SLEW_SCALE = 1.6          # the track-to-track slews' time over the rest-to-rest estimate (policy ours)
+ROLLOUT_CANDIDATES = 3    # windows the rollout simulates at a decision (policy rollout)
+ROLLOUT_HORIZON_S = 200.0  # s each rollout is simulated ahead (policy rollout)
+ROLLOUT_SLEW_SCALE = 1.25  # the exact slews' time over the rest-to-rest estimate, fitted (policy rollout)
+ROLLOUT_LOST_WEIGHT = 1.0  # images one site lost for good is worth in a rollout's score (policy rollout)
 NADIR = -1                # the target index of nadir
 REFERENCE_STEP_S = 0.01   # s: the central difference of the nadir law's rate
 
@@ -161,6 +178,7 @@ class Planner:
         self.laws = Laws(environment, sites, boresight_B, along)
         self.pointing = Pointing(environment, SkyGeometry(environment, sites), boresight_B, along)
         self.lookahead, self.dwell_s, self.settle_s = lookahead, dwell_s, settle_s
+        self.rollout_base = "ours"
 
     # -- the pieces --------------------------------------------------------------------------------
     def _held_margin(self, target: int, t0: float, t1: float) -> float:
@@ -253,6 +271,91 @@ class Planner:
                 return np.concatenate([[k], order[order != k]])
         return order
 
+    def _rollout(self, site: int, image_s: float, alive: np.ndarray, imaged: np.ndarray, until: float,
+                 base: str) -> tuple[float, float]:
+        """The score of imaging ``site`` at the estimate ``image_s`` and then following ``base`` on the
+        scaled estimates until ``until`` (module docstring): (images less the sites lost for good,
+        the time free at the end)."""
+        w = self.windows
+        alive, imaged = alive.copy(), imaged.copy()
+        imaged[site] = True
+        images, t, source = 1, image_s + self.dwell_s, site
+        dcm = self.pointing.dcm_NB(np.array([site]), np.array([t]))[0]
+        horizon = alive & (w.open_s < until)
+        alive &= horizon
+        while True:
+            alive &= (w.close_s - self.dwell_s > t) & ~imaged[w.site]
+            pending = np.flatnonzero(alive)[:self.lookahead]
+            if not len(pending):
+                break
+            est = self.estimates(source, t, pending, dcm, ROLLOUT_SLEW_SCALE)
+            fits = est + self.dwell_s <= w.close_s[pending]
+            alive[pending[~fits]] = False
+            pending, est = pending[fits], est[fits]
+            if not len(pending):
+                continue
+            order = np.argsort(w.close_s[pending], kind="stable")
+            if base == "ours":
+                order = self._insertion_batch(pending, est, order)
+            k = order[0]
+            if est[k] + self.dwell_s > until:
+                break
+            source, t = int(w.site[pending[k]]), float(est[k]) + self.dwell_s
+            imaged[source] = True
+            images += 1
+            dcm = self.pointing.dcm_NB(np.array([source]), np.array([t]))[0]
+        # the sites whose last window closed in the rollout without an image
+        closed = horizon & (w.close_s - self.dwell_s <= t) & ~imaged[w.site]
+        later = np.zeros(w.n_sites, bool)
+        later[w.site[w.close_s - self.dwell_s > t]] = True
+        lost = len(np.setdiff1d(np.unique(w.site[closed]), np.flatnonzero(later)))
+        return images - ROLLOUT_LOST_WEIGHT * lost, t
+
+    def _rollout_order(self, source: int, t: float, pending: np.ndarray, image_s: np.ndarray, order: np.ndarray,
+                       alive: np.ndarray, imaged: np.ndarray) -> np.ndarray:
+        """rollout's order (module docstring): the candidate with the best rollout score first (ties to
+        the base's order), then the base's order."""
+        w = self.windows
+        scaled = self.estimates(source, t, pending, scale=ROLLOUT_SLEW_SCALE)
+        candidates = list(dict.fromkeys([*order[:ROLLOUT_CANDIDATES].tolist(),
+                                         *np.argsort(image_s, kind="stable")[:ROLLOUT_CANDIDATES].tolist()]))
+        until = t + ROLLOUT_HORIZON_S
+        best, best_score = None, None
+        for k in candidates:
+            if scaled[k] + self.dwell_s > w.close_s[pending[k]]:
+                continue
+            images, end = self._rollout(int(w.site[pending[k]]), float(scaled[k]), alive, imaged, until,
+                                        self.rollout_base)
+            score = (images, -end)
+            if best_score is None or score > best_score:
+                best, best_score = k, score
+        if best is None:
+            return order
+        return np.concatenate([[best], order[order != best]])
+
+    def _insertion_batch(self, pending: np.ndarray, image_s: np.ndarray, order: np.ndarray) -> np.ndarray:
+        """:meth:`_insertion` with its reachability checks in one batch (the rollouts' base ``ours``)."""
+        w = self.windows
+        first = int(order[0])
+        rank = np.argsort(image_s - PRIORITY_WEIGHT_S * self.sites.priority[w.site[pending]], kind="stable")
+        ahead = rank[:int(np.flatnonzero(rank == first)[0])]
+        if not len(ahead):
+            return order
+        f = pending[first]
+        free = image_s[ahead] + self.dwell_s
+        dcm = self.pointing.dcm_NB(w.site[pending[ahead]], free)
+        arrival = np.maximum(w.open_s[f] - self.settle_s, free)
+        rel = np.einsum("mji,mjk->mik", dcm, self.pointing.dcm_NB(np.full(len(ahead), w.site[f]), arrival))
+        axis, angle = rotation_between(np.eye(3), rel)
+        slew = rest_to_rest_time(self.spacecraft, axis, angle, self.limits.rate_max_rad_s,
+                                 self.limits.momentum_max_Nms)
+        after = np.maximum(free + SLEW_SCALE * slew + self.settle_s, w.open_s[f])
+        ok = np.flatnonzero(after + self.dwell_s <= w.close_s[f])
+        if not len(ok):
+            return order
+        k = ahead[ok[0]]
+        return np.concatenate([[k], order[order != k]])
+
     # -- the horizon -------------------------------------------------------------------------------
     def plan(self, policy: str) -> Timeline:
         """The timeline of ``policy`` (:data:`POLICIES`) over the windows' horizon."""
@@ -277,8 +380,10 @@ class Planner:
             if not len(pending):
                 continue
             order = np.argsort(w.close_s[pending], kind="stable")
-            if policy == "ours":
+            if policy in ("ours", "rollout"):
                 order = self._insertion(pending, image_s, order)
+            if policy == "rollout":
+                order = self._rollout_order(source, t, pending, image_s, order, alive, imaged)
             taken = None
             for k in order[:TRIES]:
                 timeline.attempts += 1

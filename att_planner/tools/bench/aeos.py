@@ -13,7 +13,7 @@ within 0.1 s), and reports:
 * the number of windows of each site, and the compute time of each part.
 
 With ``--fly``, the day of images: for each policy of :mod:`att_planner.imaging.timeline` (``greedy``,
-bsk-rl's rule, and ``ours``) the timeline planned with verified track-to-track slews
+bsk-rl's rule, ``ours`` and ``rollout``, a rollout of ours) the timeline planned with verified track-to-track slews
 (:mod:`att_planner.imaging.slews`), flown in process on the estimate with every sensor and imperfect
 actuator and each image checked at levels (a) and (b) on the flown truth
 (:mod:`att_planner.tools.bench.aeos_flight`): images at each level, their priority and fraction of the
