@@ -338,13 +338,17 @@ AEOS_LEVEL_B_FRACTION = 0.45     # flown level-(b) images
 AEOS_CPU_PER_ORBIT_S = 10.0      # planner CPU per simulated orbit
 
 
+AEOS_POLICIES = ("greedy", "ours", "rollout")   # the baseline first, then ours from the simplest
+
+
 def _aeos_flown(p: dict, case: str | None) -> Summary:
-    """A flown day: the headline is the last flown policy's level-(b) images (``ours`` when present)."""
+    """A flown day: the headline is the last flown policy's level-(b) images (of :data:`AEOS_POLICIES`,
+    the last present), judged against the greedy baseline's."""
     flown, accessible = _get(p, "flown"), _num(_get(p, "accessible"), "sites")
-    policies = [k for k in ("greedy", "ours") if isinstance(flown.get(k), dict) and flown[k].get("status") == "flown"]
+    policies = [k for k in AEOS_POLICIES if isinstance(flown.get(k), dict) and flown[k].get("status") == "flown"]
     planned_only = not policies
     if planned_only:
-        policies = [k for k in ("greedy", "ours") if isinstance(flown.get(k), dict)]
+        policies = [k for k in AEOS_POLICIES if isinstance(flown.get(k), dict)]
         if not policies:
             raise HistoryError("an aeos JSON whose 'flown' holds no policy")
     head = policies[-1]
@@ -361,6 +365,9 @@ def _aeos_flown(p: dict, case: str | None) -> Summary:
                         f"{k}_zone_entries": _num(e, "zone_entries"),
                         f"{k}_worst_zone_margin_deg": _num(e, "flown_worst_zone_margin_deg")})
     metrics["accessible_sites"] = accessible
+    if head != "greedy" and "greedy" in policies:
+        keys = ("planned_images",) if planned_only else ("level_b", "images")
+        metrics[f"{head}_over_greedy"] = _num(flown[head], *keys) / _num(flown["greedy"], *keys)
     if isinstance(p.get("bound"), dict):
         metrics["bound_images"] = _num(p, "bound", "images")
     if planned_only:
@@ -369,8 +376,8 @@ def _aeos_flown(p: dict, case: str | None) -> Summary:
                        f"{head} images planned with verified slews (not flown)", _num(flown[head], "planned_images"),
                        f"of {int(accessible)} accessible", "none (planned, not flown)", None, metrics)
     met = None
-    if policies == ["greedy", "ours"]:
-        g, o = flown["greedy"], flown["ours"]
+    if head != "greedy" and "greedy" in policies:
+        g, o = flown["greedy"], flown[head]
         met = all(_num(o, f"level_{x}", "images") >= AEOS_GREEDY_RATIO * _num(g, f"level_{x}", "images")
                   for x in "ab") and _num(o, "level_a", "images") >= AEOS_LEVEL_A_FRACTION * accessible \
             and _num(o, "level_b", "images") >= AEOS_LEVEL_B_FRACTION * accessible \
