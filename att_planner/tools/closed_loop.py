@@ -125,6 +125,7 @@ class ClosedLoop:
             checks=Checks(body_frame_id=scenario.body_frame_id))
         self.trace = Trace(self.sim.sc)
         self.tracker_status = 0                 # of the latest tracker measurement (TrackerStatus)
+        self.tracker_valid: dict[str, list[float]] = {}   # tracker name -> the instants of its valid measurements
         self.refusals: list[RequestError] = []
         self.next_state = 0.0
         self.result: ManeuverResult | None = None
@@ -215,6 +216,8 @@ class ClosedLoop:
         if est is not None:
             for m in readings.star_trackers:
                 self.tracker_status = int(m.status)
+                if m.valid:
+                    self.tracker_valid.setdefault(m.name, []).append(m.t)
                 start = self._guard(est.take_star_tracker, m)
                 if start is not None:
                     yield Reprocessing(est, start)

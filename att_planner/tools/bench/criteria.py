@@ -407,9 +407,12 @@ def _aeos(p: dict, case: str | None) -> Summary:
 def _faults(p: dict, case: str | None) -> Summary:
     met, alarms = _get(p, "met"), _get(p, "false_alarm_campaign")
     right, cases = _num(met, "detected_in_time_right"), _num(met, "cases")
+    unseen = _num(met, "unobservable") if "unobservable" in met else 0.0
     runs, false = _num(alarms, "runs"), _num(alarms, "runs_with_a_report")
     return Summary(case or f"{_get(p, 'scenario')}, {int(cases)} cases, {int(runs)} fault-free runs",
-                   "faults detected in time and isolated right", right, f"of {int(cases)}",
+                   "faults detected in time and isolated right", right,
+                   f"of {int(cases - unseen)} observable ({int(unseen)} with no reading after the onset)"
+                   if "unobservable" in met else f"of {int(cases)}",
                    "every fault in <= 5 s (wheels, gyro) or <= 30 s, no zone entered, 0 false alarms in 1000 runs",
                    bool(_get(p, "passed")) and runs >= 1000,
                    {"zone_entered": _num(met, "zone_entered"), "false_alarm_runs": false, "fault_free_runs": runs,

@@ -54,3 +54,17 @@ def test_unknown_faults_and_instants_are_refused():
     for bad in (-1.0, math.nan, math.inf):
         with pytest.raises(SystemExit, match="--safe-hold-s must be a finite number >= 0"):
             faults.run(args(safe_hold_s=bad))
+
+
+def test_a_tracker_fault_is_observable_only_through_a_valid_measurement_after_its_onset():
+    from types import SimpleNamespace
+
+    from att_sim.models import scenario as scen
+
+    scenario = scen.load("leo_pyramid")
+    name = scenario.sensors.star_trackers[0].name
+    loop = SimpleNamespace(tracker_valid={name: [10.0, 10.2, 30.0]})
+    assert faults.readings_after(loop, scenario, ("star_tracker", 0, "bias_jump", {}), 10.1) == 2
+    assert faults.readings_after(loop, scenario, ("star_tracker", 0, "bias_jump", {}), 30.5) == 0
+    assert faults.readings_after(loop, scenario, ("star_tracker", 1, "outage", {}), 0.0) == 0
+    assert faults.readings_after(loop, scenario, ("wheel", 1, "seized", {}), 0.0) is None
