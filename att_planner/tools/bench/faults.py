@@ -19,8 +19,8 @@ slew (its end against the nominal plan's), the slew completed, safe mode reached
 safe mode (flown ``--safe-hold-s`` once reached) the worst zone margin at its entry and from then
 on, the Sun-pointing error and the body rate at the end.
 
-A star tracker's fault is *observable* only if the tracker gave a valid measurement from the onset
-on (:func:`readings_after`); a case without one (the tracker blinded to the end) is counted apart and
+A star tracker's bias jump is *observable* only if the tracker gave a valid measurement from the
+onset on (:func:`readings_after`); a case without one (the tracker blinded to the end) is counted apart and
 must be harmless (no zone entered, the slew completed, no safe mode); the others must be detected in
 time and isolated right.
 
@@ -210,11 +210,12 @@ def baseline(setup: Setup, phase: str) -> tuple[np.ndarray, np.ndarray, list[str
 
 
 def readings_after(loop: ClosedLoop, scenario: scen.Scenario, fault, onset: float) -> int | None:
-    """The valid measurements a faulty star tracker gave from the onset on (None: not a tracker's
-    fault). A tracker blinded (the Earth, the Sun or the Moon in its exclusion) from the onset to the
-    end gives none: its fault changes nothing the flight side reads, so nothing can detect it there."""
-    component, index = fault[0], fault[1]
-    if component != "star_tracker":
+    """The valid measurements a star tracker whose measured attitude is faulty (a bias jump) gave from
+    the onset on (None: another fault; an outage is seen through the messages that stop coming). A
+    tracker blinded (the Earth, the Sun or the Moon in its exclusion) from the onset to the end gives
+    none: its fault changes nothing the flight side reads, so nothing can detect it there."""
+    component, index, kind = fault[0], fault[1], fault[2]
+    if component != "star_tracker" or kind == "outage":
         return None
     name = scenario.sensors.star_trackers[index].name
     return sum(t >= onset for t in loop.tracker_valid.get(name, []))

@@ -66,5 +66,6 @@ def test_a_tracker_fault_is_observable_only_through_a_valid_measurement_after_it
     loop = SimpleNamespace(tracker_valid={name: [10.0, 10.2, 30.0]})
     assert faults.readings_after(loop, scenario, ("star_tracker", 0, "bias_jump", {}), 10.1) == 2
     assert faults.readings_after(loop, scenario, ("star_tracker", 0, "bias_jump", {}), 30.5) == 0
-    assert faults.readings_after(loop, scenario, ("star_tracker", 1, "outage", {}), 0.0) == 0
+    assert faults.readings_after(loop, scenario, ("star_tracker", 1, "bias_jump", {}), 0.0) == 0
+    assert faults.readings_after(loop, scenario, ("star_tracker", 0, "outage", {}), 0.0) is None
     assert faults.readings_after(loop, scenario, ("wheel", 1, "seized", {}), 0.0) is None
