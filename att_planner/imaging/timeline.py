@@ -255,22 +255,6 @@ class Planner:
         slew = rest_to_rest_time(self.spacecraft, axis, angle, self.limits.rate_max_rad_s, self.limits.momentum_max_Nms)
         return np.maximum(t + scale * slew + self.settle_s, opening)
 
-    def _insertion(self, pending: np.ndarray, image_s: np.ndarray, order: np.ndarray) -> np.ndarray:
-        """ours' order (module docstring): the earliest-finishing window (less :data:`PRIORITY_WEIGHT_S`
-        per unit of priority) that leaves the earliest-closing one reachable on the estimates, then the
-        earliest-closing order."""
-        w = self.windows
-        first = order[0]
-        for k in np.argsort(image_s - PRIORITY_WEIGHT_S * self.sites.priority[w.site[pending]], kind="stable"):
-            if k == first:
-                break
-            site, free = int(w.site[pending[k]]), float(image_s[k]) + self.dwell_s
-            dcm = self.pointing.dcm_NB(np.array([site]), np.array([free]))[0]
-            after = self.estimates(site, free, pending[[first]], dcm, SLEW_SCALE)[0]
-            if after + self.dwell_s <= w.close_s[pending[first]]:
-                return np.concatenate([[k], order[order != k]])
-        return order
-
     def _rollout(self, site: int, image_s: float, alive: np.ndarray, imaged: np.ndarray, until: float,
                  base: str) -> tuple[float, float]:
         """The score of imaging ``site`` at the estimate ``image_s`` and then following ``base`` on the
@@ -296,7 +280,7 @@ class Planner:
                 continue
             order = np.argsort(w.close_s[pending], kind="stable")
             if base == "ours":
-                order = self._insertion_batch(pending, est, order)
+                order = self._insertion(pending, est, order)
             k = order[0]
             if est[k] + self.dwell_s > until:
                 break
@@ -333,8 +317,10 @@ class Planner:
             return order
         return np.concatenate([[best], order[order != best]])
 
-    def _insertion_batch(self, pending: np.ndarray, image_s: np.ndarray, order: np.ndarray) -> np.ndarray:
-        """:meth:`_insertion` with its reachability checks in one batch (the rollouts' base ``ours``)."""
+    def _insertion(self, pending: np.ndarray, image_s: np.ndarray, order: np.ndarray) -> np.ndarray:
+        """ours' order (module docstring): the earliest-finishing window (less :data:`PRIORITY_WEIGHT_S`
+        per unit of priority) that leaves the earliest-closing one reachable on the estimates, then the
+        earliest-closing order; the reachability of every window ahead in one batch."""
         w = self.windows
         first = int(order[0])
         rank = np.argsort(image_s - PRIORITY_WEIGHT_S * self.sites.priority[w.site[pending]], kind="stable")
