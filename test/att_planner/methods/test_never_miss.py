@@ -27,6 +27,7 @@ from att_planner.verification import rejection, verify
 from att_sim.models import rotations as rot
 
 pytestmark = pytest.mark.slow
+BUDGET_S = 150.0           # s of wall time per slepian plan: what it may take, not how fast it is
 SETS = range(24)
 SLEPIAN_SETS = (2, 11, 15, 17, 18, 19)    # sets of SETS where the Slepian multistart finds no feasible start
 
@@ -77,13 +78,14 @@ def test_the_default_smooth_planner_plans_whenever_a_method_does():
 def test_slepian_plans_where_its_multistart_finds_no_feasible_start():
     # Whether a coarse start converges on these sets depends on the last bits of the solver's sums
     # (threaded BLAS reorders them): a set whose multistart found a start is planned again with one
-    # SQP iteration per start, so that every set goes through the graph_smooth-seeded path.
+    # SQP iteration per start, so that every set goes through the graph_smooth-seeded path. The budget
+    # is wall time: 15-35 s alone, but a loaded machine (a fresh clone beside other jobs) took over 60.
     for seed in SLEPIAN_SETS:
         problem = cone_set(seed)
         assert some_method_finds_a_path(problem), seed
-        plan = plan_slepian(replace(problem, deadline=time.monotonic() + 60))
+        plan = plan_slepian(replace(problem, deadline=time.monotonic() + BUDGET_S))
         assert verified(problem, plan), (seed, plan.message)
         if any(tf is not None for tf in plan.stats["explored"]):
-            plan = plan_slepian(replace(problem, deadline=time.monotonic() + 60), explore_maxiter=1)
+            plan = plan_slepian(replace(problem, deadline=time.monotonic() + BUDGET_S), explore_maxiter=1)
             assert all(tf is None for tf in plan.stats["explored"]), seed
             assert verified(problem, plan), (seed, plan.message)
