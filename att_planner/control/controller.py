@@ -49,7 +49,6 @@ from att_msgs_py.types import (
 )
 from att_planner.control import momentum, safe, tracking, wheels
 from att_planner.control.coil_check import CoilCheck, feedforward
-from att_planner.control.wheel_check import WheelCheck, excite
 from att_planner.control.controller_config import ControllerConfig
 from att_planner.control.magnetorquer import dipole_command
 from att_planner.control.maneuver import Maneuver, plan_zones
@@ -59,6 +58,7 @@ from att_planner.control.plan_cache import PlanCache
 from att_planner.control.plan_checks import PlanContext, check_start
 from att_planner.control.pointing import handover_law, law_reference, pointing_torque
 from att_planner.control.state_gate import GateConfig, StateGate
+from att_planner.control.wheel_check import WheelCheck, excite
 from att_planner.guidance import Reference, at_rest, stack
 from att_planner.guidance.laws import PointingGeometry
 from att_planner.guidance.modes import law_of

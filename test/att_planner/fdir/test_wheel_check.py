@@ -122,7 +122,8 @@ def test_the_table_refuses_thresholds_a_healthy_wheel_crosses():
                 friction_threshold=2.5, z=5.0, drive_gain_tolerance=0.1, wheel_inertia_tolerance=0.05,
                 persistence_s=0.5, response="exclude_wheel")
     table.FaultTable.model_validate({"faults": {"w": base}})
-    for bad, why in ((dict(threshold=0.9), "threshold below"), (dict(friction_threshold=1.02), "friction_threshold above"),
+    for bad, why in ((dict(threshold=0.9), "threshold below"),
+                     (dict(friction_threshold=1.02), "friction_threshold above"),
                      (dict(window_s=2.0), "window_s at least period_s")):
         with pytest.raises(ValueError, match=why):
             table.FaultTable.model_validate({"faults": {"w": {**base, **bad}}})
