@@ -22,10 +22,11 @@ The excitation is scaled down as a whole (:func:`excite`) to the headroom the de
 wheel's torque limit, so it never clips a wheel (a clipped null-space torque would leak onto the body)
 and a saturated demand keeps priority. What the body feels is what the drives do not deliver as
 commanded: a drive gain within ``1 ± a`` and a wheel axis tilted by ``δ`` leave at most
-``(a + δ) A Σ|n̂_i|`` (``a`` = 0.1: 0.02 N m for ``A`` = 0.1 N m on the pyramid), a square wave of
-period ``P`` the attitude law rejects: on the leo_pyramid body (3000 kg m² and more) its half period
-moves the rate by under ``0.02 · P/2 / 3000`` = 1.3e-5 rad/s, the attitude by a few arcsec at most
-(measured: docs/fdir.md). It is flown in the pointing modes and plan tracking (and the hold after it),
+``(a + δ) A Σ|n̂_i|`` (``a`` = 0.1: 0.04 N m for the shipped ``A`` = 0.2 N m on the pyramid, if every
+drive's error lined up), a square wave of period ``P`` the attitude law rejects: on the leo_pyramid body
+(3000 kg m² and more) its half period moves the rate by under ``0.04 · P/2 / 3000`` = 2.7e-5 rad/s, the
+attitude by a few arcsec before the feedback (measured in the faults bench's fault-free flights: the
+commit that shipped it). It is flown in the pointing modes and plan tracking (and the hold after it),
 never in safe mode, magnetorquer modes or idle.
 """
 from __future__ import annotations
