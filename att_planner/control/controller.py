@@ -58,6 +58,7 @@ from att_planner.control.plan_cache import PlanCache
 from att_planner.control.plan_checks import PlanContext, check_start
 from att_planner.control.pointing import handover_law, law_reference, pointing_torque
 from att_planner.control.state_gate import GateConfig, StateGate
+from att_planner.control.wheel_check import WheelCheck, excite
 from att_planner.guidance import Reference, at_rest, stack
 from att_planner.guidance.laws import PointingGeometry
 from att_planner.guidance.modes import law_of
@@ -119,6 +120,7 @@ class Controller:
         self.safe_actuation = None                     # safe mode on what is left: state -> SafeActuation | None
         self.safe_zones = None                         # the zones safe mode keeps clear of (FittedZones), None: none
         self.coil_check: CoilCheck | None = None       # the active magnetorquer check (None: none; .coil_check)
+        self.wheel_check: WheelCheck | None = None     # the null-space wheel excitation (None: none; .wheel_check)
 
     @property
     def spacecraft(self) -> Spacecraft:
@@ -378,6 +380,9 @@ class Controller:
                 self.mode == ControlMode.POINTING and self.pointing is not None
                 or self.mode == ControlMode.PLAN_TRACKING and holding):
             self._check_coils(cmd)
+        if self.wheel_check is not None and (self.mode == ControlMode.POINTING and self.pointing is not None
+                                             or self.mode == ControlMode.PLAN_TRACKING and holding):
+            self._check_wheels(cmd)
         status.dumping = self.dumping
         if self.measured is not None:
             self.measured.dipoles.record(s.t, cmd.dipole)
@@ -413,6 +418,16 @@ class Controller:
         u = np.clip(u, -sc.wheel_torque_max, sc.wheel_torque_max)
         cmd.wheel_torques = u if self.healthy is None else u * np.asarray(self.healthy, bool)
         cmd.dipole = m
+
+    def _check_wheels(self, cmd: Command) -> None:
+        """The active wheel check's null-space torques (:mod:`.wheel_check`) added to the command, scaled
+        to the headroom under the wheels' limit; nothing without a null space on the healthy wheels."""
+        sc = self.spacecraft
+        if sc.n_wheels < 4 or cmd.wheel_torques is None:
+            return
+        delta = self.wheel_check.torques(self.state.t, sc.wheel_axes, self.healthy)
+        if delta is not None:
+            cmd.wheel_torques = excite(cmd.wheel_torques, delta, sc.wheel_torque_max)
 
     def _point(self, out: StepOutput, law) -> None:
         """Track ``law``'s reference (:func:`~.pointing.pointing_torque`) through the wheels, dumping

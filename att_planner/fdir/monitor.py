@@ -28,6 +28,7 @@ from att_planner.fdir.responses import Responses, responses
 from att_planner.fdir.status import Verdict
 from att_planner.fdir.tracker_gyro import GyroRampDetector, Residuals, TrackerStepDetector
 from att_planner.fdir.watchdogs import Watchdog
+from att_planner.fdir.wheel_check import WheelCheckDetector
 from att_planner.fdir.wheel_health import WheelTorqueDetector
 from att_sim.models.dynamics import Spacecraft
 from att_sim.models.sensor_specs import SensorSpecs
@@ -58,6 +59,14 @@ class FaultMonitor:
                                                   sc.wheel_axes, e.drive_gain_tolerance,
                                                   e.wheel_inertia_tolerance)
                               if n and sc.wheel_inertia > 0 else None)
+        if isinstance(e, tables.WheelCheck):
+            tach = specs.tachometer
+            if not (n and sc.wheel_inertia > 0 and tach is not None and tach.noise > 0):
+                return "wheels", None
+            sigma = math.hypot(tach.noise, tach.quantization / math.sqrt(12.0))
+            return "wheels", WheelCheckDetector(n, sc.wheel_inertia, sigma, e.threshold, e.friction_threshold, e.z,
+                                                e.window_s, e.persistence_s, sc.wheel_axes, e.drive_gain_tolerance,
+                                                e.wheel_inertia_tolerance)
         if isinstance(e, tables.TachometerFrozen):
             noisy = specs.tachometer is not None and specs.tachometer.noise > 0
             return "tachometer", (FrozenDetector("wheel_tachometer", e.detector, n, e.threshold_rad_s, e.persistence_s,

@@ -20,6 +20,7 @@ from att_msgs_py import topics
 from att_msgs_py.errors import ConfigError, ErrorCode, RequestError, clip
 from att_msgs_py.types import FaultStatus, ManeuverResult
 from att_planner.control.coil_check import CoilCheck
+from att_planner.control.wheel_check import WheelCheck
 from att_planner.fdir import recovery
 from att_planner.fdir import table as tables
 from att_planner.fdir.monitor import FaultMonitor
@@ -60,6 +61,15 @@ def coil_check(table: tables.FaultTable, specs) -> CoilCheck | None:
     return CoilCheck(c.period_s, c.dipole_fraction, c.dwell_s, 1.0 / specs.magnetometer.rate)
 
 
+def wheel_check(table: tables.FaultTable, spacecraft) -> WheelCheck | None:
+    """The null-space wheel excitation the table declares (its wheel_check entry) for ``spacecraft``:
+    None without one or with fewer than four wheels (no null space)."""
+    entry = next((e for e in table.faults.values() if isinstance(e, tables.WheelCheck)), None)
+    if entry is None or spacecraft.n_wheels < 4:
+        return None
+    return WheelCheck(entry.amplitude_Nm, entry.period_s)
+
+
 class Onboard:
     """The monitor of ``table`` on ``scenario``'s spacecraft, acting on ``controller`` (None: in another
     process, as in the estimator node) and ``estimator`` (its exclusions, and the innovations the monitor
@@ -70,6 +80,7 @@ class Onboard:
         self.monitor = FaultMonitor(table, scenario.spacecraft, scenario.sensors, scenario.body_frame_id)
         if controller is not None:
             controller.coil_check = coil_check(table, scenario.sensors)
+            controller.wheel_check = wheel_check(table, scenario.spacecraft)
         self.tap = MonitorTap(self.monitor, estimator, None if controller is None else controller.friction)
         self.controller, self.estimator = controller, estimator
         self.heard: dict[tuple[str, int], FaultStatus] = {}

@@ -102,6 +102,52 @@ class WheelTorque(Entry):
         return self
 
 
+class WheelCheck(Entry):
+    """A wheel that does not follow the speed change it is commanded (:mod:`att_planner.fdir.wheel_check`):
+    the least-squares fraction ``θ`` of the commanded speed change it delivers below ``threshold``
+    (seized, off) or the multiple ``ψ`` of the expected friction it shows above ``friction_threshold``,
+    each judged only when its standard deviation over the window leaves a healthy wheel ``z`` of them
+    clear of its threshold. The controller excites the wheels for it: a ± square wave of ``amplitude_Nm``
+    and ``period_s`` along the healthy wheels' null space, no torque on the body
+    (:mod:`att_planner.control.wheel_check`; none with fewer than four healthy wheels, none in safe mode)."""
+
+    component: ClassVar[str] = "wheel"
+    detector: Literal["wheel_check"]
+    amplitude_Nm: float = number(gt=0.0, le=10.0, unit="N m", meaning="the null-space excitation's amplitude per "
+                                                                      "unit null vector (0.5 of it per wheel on a "
+                                                                      "four-wheel pyramid)")
+    period_s: float = number(gt=0.0, le=600.0, unit="s", meaning="period of the excitation's square wave")
+    window_s: float = number(gt=0.0, le=600.0, unit="s", meaning="span of the tachometer samples fitted")
+    threshold: float = number(gt=0.0, lt=1.0, unit="", meaning="fraction of the commanded speed change "
+                                                               "delivered below which a wheel is faulty")
+    friction_threshold: float = number(gt=1.0, le=1e3, unit="", meaning="multiple of the expected friction "
+                                                                        "above which a wheel is faulty")
+    z: float = number(gt=0.0, le=100.0, unit="", meaning="standard deviations a healthy wheel's statistic "
+                                                         "must stay clear of its threshold for it to be judged")
+    drive_gain_tolerance: float = number(0.0, ge=0.0, lt=1.0, unit="", meaning=(
+        "relative tolerance a of a healthy drive's torque gain: a healthy wheel delivers at least "
+        "(1 - a)/(1 + b) of its commanded speed change"))
+    wheel_inertia_tolerance: float = number(0.0, ge=0.0, lt=1.0, unit="", meaning=(
+        "relative tolerance b of the wheels' spin inertia: a healthy wheel shows at most 1/(1 - b) of "
+        "the expected friction"))
+
+    @model_validator(mode="after")
+    def _thresholds_clear_of_healthy(self):
+        a, b = self.drive_gain_tolerance, self.wheel_inertia_tolerance
+        theta_min, psi_max = (1.0 - a) / (1.0 + b), 1.0 / (1.0 - b)
+        if not self.threshold < theta_min:
+            raise ValueError(f"threshold below (1 - drive_gain_tolerance)/(1 + wheel_inertia_tolerance) = "
+                             f"{theta_min:.4g} (the least a healthy wheel delivers), got {self.threshold:g}")
+        if not self.friction_threshold > psi_max:
+            raise ValueError(f"friction_threshold above 1/(1 - wheel_inertia_tolerance) = {psi_max:.4g} (the "
+                             f"most friction a healthy wheel shows), got {self.friction_threshold:g}")
+        if not self.window_s >= self.period_s:
+            raise ValueError(f"window_s at least period_s (a whole period of the excitation in each window, "
+                             f"so no line explains it), got window_s {self.window_s:g} s and period_s "
+                             f"{self.period_s:g} s")
+        return self
+
+
 class TachometerFrozen(Entry):
     """A tachometer whose reading does not change by more than the threshold (a stuck counter)."""
 
@@ -276,7 +322,7 @@ class EstimateUncertain(Entry):
     threshold_deg: float = number(gt=0.0, le=180.0, unit="deg", meaning="attitude 3 sigma of the estimate")
 
 
-Detector = Annotated[WheelTorque | TachometerFrozen | GyroFrozen | MagnetometerFrozen | TrackerInnovation
+Detector = Annotated[WheelTorque | WheelCheck | TachometerFrozen | GyroFrozen | MagnetometerFrozen | TrackerInnovation
                      | GyroInnovation | GyroBiasJump | TrackerStep | GyroRamp | CoilTorque | TrackerOutage
                      | AttitudeError | RateError | EstimateUncertain,
                      Field(discriminator="detector")]

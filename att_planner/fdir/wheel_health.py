@@ -61,7 +61,8 @@ target, and its window residual (at most 4.4e-4 N m in the 10 s after the onset,
 near rest loses only the friction-sized torque ``c tanh(ν/ν_s)`` ≤ 1e-3 N m, which the wheel's own
 friction drives to zero within seconds. Seeing them in such a hold needs torque asked of the wheels
 that the body does not feel (a null-space excitation, an auxiliary signal for detection) or wheels
-biased away from rest.
+biased away from rest. The active wheel check does the former: :mod:`att_planner.control.wheel_check`
+excites the null space, :mod:`att_planner.fdir.wheel_check` fits ``θ`` (and the friction's multiple).
 """
 from __future__ import annotations
 

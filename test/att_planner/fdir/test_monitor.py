@@ -62,7 +62,7 @@ def test_quiet_then_a_wheel_off_then_a_tracker_jump_then_readmitted(leo):
     assert feed(m, 0.0, 300.0, rng) == [] and m.active == {}
     reports = feed(m, 300.0, 310.0, rng, wheel_off=1)
     assert [(s.fault_id, s.component, s.index, s.response, s.active) for s in reports] == [
-        ("wheel_torque", "wheel", 1, "exclude_wheel", True)]
+        ("wheel_check", "wheel", 1, "exclude_wheel", True), ("wheel_torque", "wheel", 1, "exclude_wheel", True)]
     assert 300.0 < reports[0].detected_at <= 305.0 and reports[0].frame_id == "body"
     r = m.responses()
     assert r.healthy_wheels == (True, False, True) and not r.wheels_controllable and r.safe_mode
@@ -72,8 +72,8 @@ def test_quiet_then_a_wheel_off_then_a_tracker_jump_then_readmitted(leo):
     assert m.responses().excluded_sensors == {"st1"}
     reports = feed(m, 340.0, 380.0, rng, excluded=("st1",))
     (back,) = reports
-    assert (back.fault_id, back.active, back.detected_at) == ("tracker_inconsistent", False, m.history[1].detected_at)
-    assert m.responses().excluded_sensors == frozenset() and set(m.active) == {("wheel_torque", 1)}
+    assert (back.fault_id, back.active, back.detected_at) == ("tracker_inconsistent", False, m.history[2].detected_at)
+    assert m.responses().excluded_sensors == frozenset() and set(m.active) == {("wheel_check", 1), ("wheel_torque", 1)}
 
 
 def test_a_lost_estimate_and_a_silent_tracker(leo):
@@ -101,7 +101,7 @@ def test_every_detector_of_the_table_is_built(leo):
     built = {type(d).__name__ for ds in m.detectors.values() for _, d in ds}
     assert built == {"WheelTorqueDetector", "FrozenDetector", "InnovationDetector", "BiasJumpDetector",
                      "OutageDetector", "Watchdog", "TrackerStepDetector", "GyroRampDetector",
-                     "CoilDetector"}
+                     "CoilDetector", "WheelCheckDetector"}
     assert sum(len(ds) for ds in m.detectors.values()) == len(table.read().faults) == len(table.DETECTORS)
 
 
