@@ -335,6 +335,16 @@ class FaultTable(Schema):
 
     faults: dict[FaultId, Detector] = Field(max_length=MAX_FAULTS, description="fault id -> its entry")
 
+    @model_validator(mode="after")
+    def _one_wheel_hardware(self):
+        """The wheels' tolerances describe one set of hardware: every entry that declares them agrees."""
+        for name in ("drive_gain_tolerance", "wheel_inertia_tolerance"):
+            seen = {fid: getattr(e, name) for fid, e in self.faults.items() if hasattr(e, name)}
+            if len(set(seen.values())) > 1:
+                raise ValueError(f"{name} differs between entries ({', '.join(f'{k}: {v:g}' for k, v in seen.items())})"
+                                 ": they describe the same wheels")
+        return self
+
 
 def read(path=DEFAULT_TABLE) -> FaultTable:
     """The fault table file ``path`` read by the one loader;

@@ -129,3 +129,13 @@ def test_the_table_refuses_thresholds_a_healthy_wheel_crosses():
             table.FaultTable.model_validate({"faults": {"w": {**base, **bad}}})
     with pytest.raises(ValueError):
         table.FaultTable.model_validate({"faults": {"w": {**base, "response": "exclude_sensor"}}})
+
+
+def test_the_table_refuses_two_entries_that_disagree_on_the_wheels_tolerances():
+    shipped = table.read().model_dump()["faults"]
+    table.FaultTable.model_validate({"faults": shipped})
+    for field in ("drive_gain_tolerance", "wheel_inertia_tolerance"):
+        edited = {k: dict(v) for k, v in shipped.items()}
+        edited["wheel_check"][field] = edited["wheel_torque"][field] / 2
+        with pytest.raises(ValueError, match=f"{field} differs between entries .*wheel_torque.*wheel_check"):
+            table.FaultTable.model_validate({"faults": edited})
