@@ -375,13 +375,13 @@ class Controller:
             cmd.wheel_torques = tracked
             status.message = "holding the final attitude of the last maneuver"
             status.reference_q, status.attitude_error = self.hold_q_RN, float(rot.angle_between(s.q, self.hold_q_RN))
-        holding = self.maneuver is not None or self.hold_q_RN is not None
-        if self.coil_check is not None and self.measured is not None and (
-                self.mode == ControlMode.POINTING and self.pointing is not None
-                or self.mode == ControlMode.PLAN_TRACKING and holding):
+        # the active checks run while a law or a plan (or its final attitude) is followed
+        following = (self.mode == ControlMode.POINTING and self.pointing is not None
+                     or self.mode == ControlMode.PLAN_TRACKING
+                     and (self.maneuver is not None or self.hold_q_RN is not None))
+        if following and self.coil_check is not None and self.measured is not None:
             self._check_coils(cmd)
-        if self.wheel_check is not None and (self.mode == ControlMode.POINTING and self.pointing is not None
-                                             or self.mode == ControlMode.PLAN_TRACKING and holding):
+        if following and self.wheel_check is not None:
             self._check_wheels(cmd)
         status.dumping = self.dumping
         if self.measured is not None:
