@@ -175,10 +175,23 @@ class MissionDriver:
                 if isinstance(action, (io.Report, io.Log)):
                     self.perform(action)
             if self.executive.done:
+                self.end_day()
                 if not self.client.delivered(self.events):
                     self.log("[mission] the last mission events were not acknowledged by every subscriber in 10 s")
                 return
             actions = self.deliver(self.perform(self.executive.awaiting))
+
+    def end_day(self) -> None:
+        """Hold sim time where the day ended: what the nodes fly after it (while the last events are
+        acknowledged and the suite stops, which at ``--rtf max`` is minutes of sim time) was never
+        decided by the mission and is not its day. The nodes stop held."""
+        try:
+            answer = self.client.hold_simulator(True)
+        except TimeoutError as error:
+            self.log(f"[mission] sim time could not be held at the end of the day: {error}")
+            return
+        if not answer.success:
+            self.log(f"[mission] sim time could not be held at the end of the day: {answer.message}")
 
     def perform(self, action):
         """Carry out one action; the event that answers it, or None."""
