@@ -173,7 +173,9 @@ def pointing_msg(p: types.PointingMode) -> PointingMode:
                         secondary_axis=vector3(p.secondary_axis), secondary=p.secondary,
                         secondary_direction=vector3(p.secondary_direction), yaw=float(p.yaw),
                         latitude=float(p.latitude), longitude=float(p.longitude), altitude=float(p.altitude),
-                        target_direction=vector3(p.target_direction))
+                        target_direction=vector3(p.target_direction), end_latitude=float(p.end_latitude),
+                        end_longitude=float(p.end_longitude), scan_speed=float(p.scan_speed),
+                        scan_start=time_msg(p.scan_start))
 
 
 def pointing_from_msg(msg) -> types.PointingMode:
@@ -182,7 +184,9 @@ def pointing_from_msg(msg) -> types.PointingMode:
                               secondary_axis=from_vector3(msg.secondary_axis), secondary=msg.secondary,
                               secondary_direction=from_vector3(msg.secondary_direction), yaw=float(msg.yaw),
                               latitude=float(msg.latitude), longitude=float(msg.longitude),
-                              altitude=float(msg.altitude), target_direction=from_vector3(msg.target_direction))
+                              altitude=float(msg.altitude), target_direction=from_vector3(msg.target_direction),
+                              end_latitude=float(msg.end_latitude), end_longitude=float(msg.end_longitude),
+                              scan_speed=float(msg.scan_speed), scan_start=from_time(msg.scan_start))
 
 
 # -- plans -------------------------------------------------------------------------------------
@@ -192,7 +196,7 @@ def verification_msg(v: types.Verification) -> PlanVerification:
         final_attitude_error=float(v.final_attitude_error), final_rate=float(v.final_rate),
         min_cone_margin=float(v.min_cone_margin), cone_margins=[float(m) for m in v.cone_margins],
         torque_ratio=float(v.torque_ratio), wheel_speed_ratio=float(v.wheel_speed_ratio),
-        rate_max=float(v.rate_max), dense_samples=int(v.dense_samples))
+        rate_max=float(v.rate_max), dense_samples=int(v.dense_samples), goal=v.goal)
 
 
 def verification_from_msg(msg) -> types.Verification:
@@ -200,7 +204,7 @@ def verification_from_msg(msg) -> types.Verification:
         final_attitude_error=float(msg.final_attitude_error), final_rate=float(msg.final_rate),
         min_cone_margin=float(msg.min_cone_margin), cone_margins=[float(m) for m in msg.cone_margins],
         torque_ratio=float(msg.torque_ratio), wheel_speed_ratio=float(msg.wheel_speed_ratio),
-        rate_max=float(msg.rate_max), dense_samples=int(msg.dense_samples))
+        rate_max=float(msg.rate_max), dense_samples=int(msg.dense_samples), goal=msg.goal)
 
 
 def plan_msg(plan: types.Plan) -> ManeuverPlan:

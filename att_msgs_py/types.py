@@ -120,6 +120,7 @@ class Verification:
     wheel_speed_ratio: float           # max |Ω_i| / limit over the dense grid (0 without wheels)
     rate_max: float                    # rad/s, largest ‖ω‖ over the dense grid
     dense_samples: int                 # integration samples the figures are taken over
+    goal: str = ""                     # the pointing kind of a moving goal ('' : at rest or semi-free)
     duration: float = math.nan         # s
     body_rate_ratio: float = 0.0       # max |ω_j| / the problem's rate bound (0 without one)
     wheel_momentum_ratio: float = 0.0  # max |h_w,i| / the problem's momentum bound (0 without one)
@@ -128,7 +129,6 @@ class Verification:
     zone_names: list = field(default_factory=list)                # name per entry of cone_margins
     zone_keep_in: list = field(default_factory=list)              # keep-in flag per entry of cone_margins
     boundary_arc: str = ""             # name of the cone a forced boundary arc rides ('' : none)
-    goal: str = ""                     # the pointing kind of a moving goal ('' : at rest or semi-free)
 
 
 class Stage(StrEnum):
@@ -405,7 +405,7 @@ class AttitudeEstimate:
 # Pointing modes
 # ---------------------------------------------------------------------------------------------
 
-POINTING_KINDS = ("inertial", "nadir", "sun", "ground", "inertial_target")
+POINTING_KINDS = ("inertial", "nadir", "sun", "ground", "inertial_target", "strip")
 SECONDARY_KINDS = ("velocity", "ground_velocity", "orbit_normal", "sun", "nadir", "north", "inertial")
 
 
@@ -424,6 +424,10 @@ class PointingMode:
     longitude: float = 0.0
     altitude: float = 0.0
     target_direction: np.ndarray = _empty(3)
+    end_latitude: float = 0.0                  # strip: its end, rad (latitude, longitude, altitude: its start)
+    end_longitude: float = 0.0
+    scan_speed: float = 0.0                    # strip: m/s along the ground
+    scan_start: float = 0.0                    # strip: sim time (s) the aim point leaves the start
 
 
 class ShapeKind(StrEnum):

@@ -47,6 +47,7 @@ from att_msgs_py.types import (
     PointingMode,
     State,
 )
+from att_msgs_py.validation import UNIX_EPOCH
 from att_planner.control import momentum, safe, tracking, wheels
 from att_planner.control.coil_check import CoilCheck, feedforward
 from att_planner.control.controller_config import ControllerConfig
@@ -291,7 +292,20 @@ class Controller:
         except ValueError as err:
             return RequestError(ErrorCode.INVALID_PLAN, f"plan '{plan.plan_id}': its zones cannot be placed in the "
                                                         f"sky now: {err}")
-        self.maneuver = Maneuver(plan, self.state.t, zones, after=law)
+        t0 = self.state.t
+        goal = plan.verification.goal if plan.verification is not None else ""
+        if goal:
+            # a plan onto a moving goal meets it at its planned instant only (sim time 0 without an
+            # epoch): it runs on its own clock, the steps between that instant and now flown from then
+            t0 = 0.0 if plan.epoch is None else (plan.epoch - (self.context.epoch or UNIX_EPOCH)).total_seconds()
+            lag = self.state.t - t0
+            if abs(lag) > self.context.max_start_epoch_error:
+                return RequestError(ErrorCode.PLAN_CONTEXT,
+                                    f"plan '{plan.plan_id}' ends on a moving {goal} goal at its "
+                                    f"planned instant, sim time {t0:.3f} s; it would start {abs(lag):.1f} s "
+                                    f"{'later' if lag > 0 else 'earlier'} (at most "
+                                    f"{self.context.max_start_epoch_error:g} s, parameter max_start_epoch_error_s)")
+        self.maneuver = Maneuver(plan, t0, zones, after=law)
         self.mode, self.pointing = ControlMode.PLAN_TRACKING, None
         return None
 
@@ -495,13 +509,13 @@ class Controller:
         if m.ticks % self.config.feedback_every == 0:
             span = max(plan.duration + self.config.settle_time, 1e-9)
             out.feedback = ManeuverFeedback(
-                elapsed=float(elapsed), progress=float(min(1.0, elapsed / span)),
+                elapsed=float(elapsed), progress=float(min(1.0, max(0.0, elapsed) / span)),
                 attitude_error=float(rot.angle_between(s.q, ref.q_RN)),
                 min_cone_margin=float(m.zones.margins(s.t, s.q, true=True).min()) if m.zones else math.inf)
         if cancel_requested:
             out.result = self.abort("cancelled")
             return
-        out.status.plan_progress = float(min(1.0, elapsed / max(plan.duration, 1e-9)))
+        out.status.plan_progress = float(min(1.0, max(0.0, elapsed) / max(plan.duration, 1e-9)))
         out.status.reference_q, out.status.reference_rate = ref.q_RN, ref.omega_RN_R
         out.status.attitude_error = float(rot.angle_between(s.q, ref.q_RN))
         if m.after is not None and elapsed >= plan.duration:

@@ -24,7 +24,7 @@ import numpy as np
 from att_msgs_py import signing, validation
 from att_msgs_py.errors import ErrorCode, RequestError
 from att_msgs_py.limits import MAX_CONES, MAX_ZONES
-from att_msgs_py.types import ControlKind, Interpolation, Plan, State, Status
+from att_msgs_py.types import POINTING_KINDS, ControlKind, Interpolation, Plan, State, Status
 from att_planner.control import pd
 from att_sim.models import epoch as epochs
 from att_sim.models import rotations as rot
@@ -110,6 +110,11 @@ def _fields(plan: Plan, sc: Spacecraft, frame_id: str) -> Plan:
         validation.unit_vector(c.direction, f"plan.cones[{i}].direction", code)
         if not (math.isfinite(c.half_angle) and 0.0 < c.half_angle < math.pi / 2):
             raise RequestError(code, f"plan.cones[{i}].half_angle = {c.half_angle!r} rad is outside (0, pi/2)")
+    goal = "" if plan.verification is None else plan.verification.goal
+    validation.text(goal, "plan.verification.goal", max_length=validation.MAX_NAME_LENGTH)
+    if goal not in ("", "moving", *POINTING_KINDS):
+        raise RequestError(code, f"plan.verification.goal '{goal}' is not a pointing kind "
+                                 f"({', '.join(POINTING_KINDS)}), 'moving' or empty")
     plan.zones, plan.epoch = _zones(plan)
     plan.t, plan.q, plan.omega, plan.torque, plan.sensor_axis = t, q, omega, torque, axis
     return plan

@@ -26,6 +26,7 @@ from att_planner.guidance.laws import (
     ground_line_of_sight,
     two_vector_attitude,
 )
+from att_planner.guidance.strip import MAX_SCAN_SPEED_M_S, Strip, StripLaw
 
 BAD = ErrorCode.INVALID_POINTING
 MIN_ALTITUDE = -500.0          # m: the shores of the Dead Sea are at -430 m
@@ -53,6 +54,8 @@ def law_of(mode: PointingMode, geometry: PointingGeometry, t: float, q_BN: np.nd
     primary_axis = _axis(mode.primary_axis, "pointing.primary_axis")
     secondary_axis = _axis(mode.secondary_axis, "pointing.secondary_axis")
     yaw = _angle(mode.yaw, "pointing.yaw", -math.pi, math.pi)
+    if kind == "strip":
+        return _strip_law(mode, geometry, t, primary_axis, secondary_axis, yaw)
     named = directions(geometry)
     if kind == "ground":
         primary = ground_line_of_sight(geometry,
@@ -73,6 +76,46 @@ def law_of(mode: PointingMode, geometry: PointingGeometry, t: float, q_BN: np.nd
     except ValueError as err:
         raise RequestError(BAD, f"pointing: {err} (primary {kind}, secondary {mode.secondary}) now") from None
     return law
+
+
+def _strip_law(mode: PointingMode, geometry: PointingGeometry, t: float, primary_axis, secondary_axis,
+               yaw: float) -> StripLaw:
+    """The law of a strip mode (the strip between its two points at the mode's altitude, scanned from
+    ``scan_start``), with an attitude at ``t``."""
+    start = [_angle(getattr(mode, f"{end}itude"), f"pointing.{end}itude", -limit, limit)
+             for end, limit in (("lat", math.pi / 2), ("long", math.pi))]
+    end = [_angle(getattr(mode, f"end_{end}itude"), f"pointing.end_{end}itude", -limit, limit)
+           for end, limit in (("lat", math.pi / 2), ("long", math.pi))]
+    altitude = _angle(mode.altitude, "pointing.altitude", MIN_ALTITUDE, MAX_ALTITUDE)
+    speed = validation.number(mode.scan_speed, "pointing.scan_speed", BAD, 0.0, MAX_SCAN_SPEED_M_S)
+    scan_start = validation.number(mode.scan_start, "pointing.scan_start", BAD, -math.inf, math.inf)
+    if speed == 0.0:
+        raise RequestError(BAD, "pointing.scan_speed: a strip is scanned at a speed > 0 m/s, not 0")
+    if yaw != 0.0:
+        raise RequestError(BAD, f"pointing.yaw: a strip's law keeps the detector along the strip; yaw is 0, "
+                                f"not {yaw:.6g} rad")
+    if np.linalg.norm(np.cross(primary_axis, secondary_axis)) < 1e-3:
+        raise RequestError(BAD, "pointing.secondary_axis is parallel to pointing.primary_axis: the detector's "
+                                "along-track axis must lie across the boresight")
+    try:
+        strip = Strip.between(*start, *end, altitude, speed)
+    except ValueError as err:
+        raise RequestError(BAD, f"pointing.end_latitude, pointing.end_longitude: {err}") from None
+    law = StripLaw(geometry, strip, primary_axis, secondary_axis, scan_start)
+    if not np.all(np.isfinite(law.attitude(t))):
+        raise RequestError(BAD, "pointing: the strip's aim point has no attitude now")
+    return law
+
+
+def strip_mode(strip: Strip, primary_axis, secondary_axis, scan_start: float) -> PointingMode:
+    """The pointing mode of ``strip`` scanned from sim time ``scan_start`` (s) with the boresight
+    ``primary_axis`` and the detector's along-track axis ``secondary_axis`` (body axes): what a
+    controller hands over to at the end of a slew onto the strip."""
+    (lat0, lon0), (lat1, lon1) = strip.geodetic(0.0), strip.geodetic(strip.length_m)
+    return PointingMode("strip", primary_axis=np.asarray(primary_axis, float),
+                        secondary_axis=np.asarray(secondary_axis, float), latitude=lat0, longitude=lon0,
+                        altitude=strip.altitude_m, end_latitude=lat1, end_longitude=lon1,
+                        scan_speed=strip.scan_speed_m_s, scan_start=float(scan_start))
 
 
 def _secondary(mode: PointingMode, named: dict):

@@ -61,6 +61,7 @@ TANGENT_STEP = 1e-5                          # rad of θ: the central difference
 RATE_STEP = 0.05                             # s: the central difference of the rate
 MAX_STRIP_LENGTH_M = 2_000_000.0             # m: a strip is imaged within one pass
 MIN_STRIP_LENGTH_M = 1.0                     # m: shorter is a point, not a strip
+MAX_SCAN_SPEED_M_S = 20_000.0                # m/s: over twice a LEO ground track's speed
 _NODES, _WEIGHTS = np.polynomial.legendre.leggauss(QUADRATURE_POINTS)
 _M = np.array([1.0 / WGS84_A**2, 1.0 / WGS84_A**2, 1.0 / WGS84_B**2])
 

@@ -199,6 +199,9 @@ class PlannerNode(Node):
         for name in ("image_start", "image_end"):
             setattr(response, name, float(getattr(outcome, name, math.nan)))
         response.lowest_elevation_deg = math.degrees(getattr(outcome, "lowest_elevation", math.nan))
+        after = getattr(outcome, "pointing_after", None)
+        if after is not None:
+            response.pointing_after = convert.pointing_msg(after)
         problem = valid.maneuver.problem
         self.answer(response, outcome, valid.maneuver.spacecraft, f"{what} ({valid.maneuver.method.name})",
                     sensor_axis=problem.sensor_axis, cones=problem.cones, zones=problem.zones, epoch=problem.epoch,

@@ -30,8 +30,14 @@ from att_msgs_py.errors import ErrorCode, RequestError
 from att_msgs_py.types import PointingMode
 from att_planner.guidance.ground_arrival import MIN_ELEVATION_DEG, earth_axis_N, elevation_sines, itrs_to_geodetic
 from att_planner.guidance.laws import PointingGeometry, geodetic_to_itrs
-from att_planner.guidance.modes import MAX_ALTITUDE, MIN_ALTITUDE
-from att_planner.guidance.strip import MAX_STRIP_LENGTH_M, MIN_STRIP_LENGTH_M, Strip, tracking_demand
+from att_planner.guidance.modes import MAX_ALTITUDE, MIN_ALTITUDE, strip_mode
+from att_planner.guidance.strip import (
+    MAX_SCAN_SPEED_M_S,
+    MAX_STRIP_LENGTH_M,
+    MIN_STRIP_LENGTH_M,
+    Strip,
+    tracking_demand,
+)
 from att_planner.service.moving_goal import onboard_geometry, strip_goal_law
 from att_planner.service.planning import PlanOutcome, plan_maneuver, run_method
 from att_planner.service.requests import (
@@ -47,7 +53,6 @@ from att_sim.models import rotations as rot
 from att_sim.models.geomagnetic import EARTH_ROTATION_RATE
 
 BAD = ErrorCode.INVALID_SITE
-MAX_SCAN_SPEED_M_S = 20_000.0     # m/s: over twice a LEO ground track's speed
 VISIBILITY_STEP_S = 5.0           # s between the elevation samples over the planning window
 IMAGE_STEP_S = 1.0                # s between the elevation samples over a dwell or a scan ...
 IMAGE_SAMPLES = 600               # ... at most this many
@@ -112,11 +117,14 @@ class ValidImage:
 @dataclass
 class ImageOutcome(PlanOutcome):
     """A planned image: the maneuver's outcome, and when the image starts and ends (s after the plan's
-    start) and the lowest elevation the site or strip is seen at through it (rad)."""
+    start), the lowest elevation the site or strip is seen at through it (rad) and the pointing mode
+    the controller hands over to at the slew's end (the site's ground mode, or the strip's scan from
+    the arrival)."""
 
     image_start: float = math.nan
     image_end: float = math.nan
     lowest_elevation: float = math.nan
+    pointing_after: PointingMode | None = None
 
 
 def _degrees(value, name: str, limit: float) -> float:
@@ -306,6 +314,7 @@ def plan_image(valid: ValidImage, tol: Tolerances = TOLERANCES, cone_padding: fl
     except RequestError as err:
         image.code, image.message = err.code, err.message
         return image
+    image.pointing_after = valid.mode if valid.strip is None else strip_mode(valid.strip, *valid.axes, start)
     image.message = (f"{outcome.message}; {'scan' if valid.strip else 'dwell'} from {arrival:.1f} s to "
                      f"{image.image_end:.1f} s, seen at {math.degrees(image.lowest_elevation):.1f} deg or higher")
     return image

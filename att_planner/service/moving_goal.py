@@ -20,6 +20,7 @@ from datetime import datetime
 
 import numpy as np
 
+from att_msgs_py.errors import ErrorCode, RequestError
 from att_msgs_py.types import PointingMode
 from att_msgs_py.validation import UNIX_EPOCH
 from att_planner.guidance import reference
@@ -40,6 +41,9 @@ def onboard_geometry(scenario: Scenario, epoch: datetime | None) -> tuple[Pointi
 def goal_law(mode: PointingMode, scenario: Scenario, epoch: datetime | None,
              q_start: np.ndarray) -> Callable[[float], tuple[np.ndarray, np.ndarray]]:
     """``t ↦ (q, ω)`` of ``mode``'s law at plan time ``t`` (RequestError 314 for a bad mode)."""
+    if mode.kind == "strip":
+        raise RequestError(ErrorCode.INVALID_POINTING, "end_pointing.kind strip: a slew onto a strip is asked "
+                                                       "with ImageStrip (its scan starts at the arrival)")
     geometry, offset = onboard_geometry(scenario, epoch)
     law = law_of(mode, geometry, offset, q_start)
     if mode.kind == "ground":

@@ -256,8 +256,16 @@ def plan_maneuver(valid: ValidRequest, tol: Tolerances = TOLERANCES, cone_paddin
     3. *fallback*: the smooth eigenaxis slew, when no stage's plan verified and it is safe.
 
     Every stage is reported (:class:`StageReport`) with its wall time, and the outcome names the
-    stage whose plan it returns.
+    stage whose plan it returns. The plan carries the problem's epoch (the instant of its t = 0).
     """
+    outcome = _plan_in_stages(valid, tol, cone_padding, runner)
+    if outcome.plan is not None:
+        outcome.plan.epoch = valid.problem.epoch
+    return outcome
+
+
+def _plan_in_stages(valid: ValidRequest, tol: Tolerances, cone_padding: float, runner: Callable) -> PlanOutcome:
+    """:func:`plan_maneuver`'s stages."""
     problem = valid.problem
     planned = padded(problem, cone_padding)
     rest_to_rest = problem.goal_motion is None          # a moving goal: the eigenaxis fallback cannot end on it

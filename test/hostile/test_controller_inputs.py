@@ -15,7 +15,7 @@ from cryptography.hazmat.primitives.asymmetric.ed25519 import Ed25519PrivateKey
 
 from att_msgs_py import convert, signing, validation
 from att_msgs_py.errors import ErrorCode
-from att_msgs_py.types import Cone, ControlKind, ControlMode, Plan, Status, Zone
+from att_msgs_py.types import Cone, ControlKind, ControlMode, Plan, Status, Verification, Zone
 from att_planner.control.controller import Controller, ControllerConfig
 from att_planner.methods.eigenaxis import plan_eigenaxis_smooth
 from att_planner.problem import ManeuverProblem
@@ -34,6 +34,10 @@ SUN = Zone("sun", "sun", [1.0, 0, 0], 0.8)
 def zoned(*zones, epoch=EPOCH):
     """A change of the plan: these zones (and the epoch of a real-sky plan)."""
     return lambda p: replace(p, zones=list(zones), epoch=epoch)
+
+
+def verified(**fields) -> Verification:
+    return Verification(0.0, 0.0, math.inf, [], 0.0, 0.0, 0.0, 101, **fields)
 
 
 def good_plan() -> Plan:
@@ -103,6 +107,10 @@ PLAN_CASES = [
     ("overlong message", lambda p: replace(p, message="m" * 5000), ErrorCode.SIZE_LIMIT, "plan.message"),
     ("method with a newline", lambda p: replace(p, method="eigenaxis\nrm"), ErrorCode.INVALID_TEXT, "plan.method"),
     ("zero sensor axis", lambda p: replace(p, sensor_axis=np.zeros(3)), ErrorCode.INVALID_PLAN, "sensor_axis"),
+    ("unknown moving goal", lambda p: replace(p, verification=verified(goal="sideways")), ErrorCode.INVALID_PLAN,
+     "plan.verification.goal 'sideways'"),
+    ("moving goal with an escape", lambda p: replace(p, verification=verified(goal="strip\x1b")),
+     ErrorCode.INVALID_TEXT, "plan.verification.goal"),
     ("non-unit sensor axis", lambda p: replace(p, sensor_axis=np.array([2.0, 0, 0])), ErrorCode.INVALID_PLAN,
      "sensor_axis has norm"),
     ("cone half-angle of 2 rad", lambda p: replace(p, cones=[Cone([1.0, 0, 0], 2.0, "sun")]), ErrorCode.INVALID_PLAN,

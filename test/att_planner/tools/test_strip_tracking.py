@@ -3,7 +3,10 @@ ground-site hand-over tests fly theirs (:mod:`test_ground_handover`): the first 
 strip's first point at the scan's rate, the controller hands over to the strip's law at the plan's
 end without a jump and follows the scan within 0.01 deg on the estimate, the wheels' torque within
 their limit at the hand-over. The strip runs 45 deg off north from a point 20 deg off nadir across
-the track (a strip with yaw), scanned at the sub-satellite point's ground speed."""
+the track (a strip with yaw), scanned at the sub-satellite point's ground speed. The controller is
+handed the strip's pointing mode as the planner answers it (``pointing_after``, the wire's form);
+a plan started half a second after its planned instant runs on its own clock and hands over just
+the same, one started later than ``max_start_epoch_error_s`` is refused."""
 from __future__ import annotations
 
 import math
@@ -11,6 +14,7 @@ import math
 import numpy as np
 import pytest
 
+from att_msgs_py.errors import ErrorCode
 from att_msgs_py.types import ControlMode
 from att_planner.guidance.ground_arrival import site_in_view
 from att_planner.guidance.laws import PointingGeometry
@@ -30,7 +34,8 @@ POINTING_TOLERANCE = math.radians(0.01)
 
 
 @pytest.mark.slow
-def test_a_slew_onto_a_strip_hands_over_and_follows_the_scan():
+@pytest.mark.parametrize("late", [0.0, 0.5])
+def test_a_slew_onto_a_strip_hands_over_and_follows_the_scan(late):
     loop = ClosedLoop(SWIFT, overrides={"controller": IMAGING_GAINS})
     loop.run(20.0)                                       # the estimate converges
     assert loop.estimator is not None and loop.controller.measured is not None     # flown on the estimate
@@ -53,12 +58,14 @@ def test_a_slew_onto_a_strip_hands_over_and_follows_the_scan():
     assert rot.angle_between(plan.q[-1], goal.q_RN) < 1e-5
     assert np.linalg.norm(plan.omega[-1] - goal.omega_RN_R) < 1e-6 < 0.05 * np.linalg.norm(goal.omega_RN_R)
 
-    assert loop.execute(plan, after=law) is None
+    assert outcome.pointing_after.kind == "strip" and outcome.pointing_after.scan_start == pytest.approx(end)
+    loop.run(late)
+    assert loop.execute(plan, after=outcome.pointing_after) is None
     scan = valid.strip.duration_s
-    loop.run(plan.duration + scan + 1.0)
+    loop.run(plan.duration + scan + 1.0 - late)
     trace = loop.trace.arrays()
     t, error, modes, torques = trace["t"], trace["attitude_error"], trace["mode"], trace["wheel_torques"]
-    assert loop.controller.pointing is law and np.all(modes[t > end + 0.06] == ControlMode.POINTING)
+    assert loop.controller.pointing.name == "strip" and np.all(modes[t > end + 0.06] == ControlMode.POINTING)
     handover = (t > end - 5.0) & (t < end + 5.0)
     scanning = (t >= end) & (t <= end + scan)
     print(f"t_f {plan.duration:.1f} s, arrival {np.degrees(ver.final_attitude_error):.2e} deg "
@@ -72,3 +79,22 @@ def test_a_slew_onto_a_strip_hands_over_and_follows_the_scan():
     truth = [rot.angle_between(q, law.attitude(tt)) for q, tt in zip(trace["q_true"][scanning], t[scanning])]
     assert max(truth) < 2 * POINTING_TOLERANCE, np.degrees(max(truth))
     assert np.abs(torques[(t > end - 1.0) & (t < end + 5.0)]).max() < SWIFT.spacecraft.wheel_torque_max
+
+
+def test_a_slew_onto_a_strip_started_too_late_is_refused():
+    loop = ClosedLoop(SWIFT, overrides={"controller": IMAGING_GAINS})
+    loop.run(20.0)
+    t0 = loop.controller.state.t
+    lat, lon = site_in_view(GEOMETRY, t0 + LEAD, math.radians(20.0), math.radians(90.0))
+    req = ImageStripRequest(SWIFT.frame_id, loop.controller.state.q, SENSOR, ALONG_TRACK, method="graph_smooth",
+                            time_budget=30.0, spacecraft=SWIFT.name, epoch=(int(t0), round(t0 % 1 * 1e9)),
+                            start_latitude_deg=math.degrees(lat), start_longitude_deg=math.degrees(lon),
+                            by_azimuth=True, azimuth_deg=45.0, length_m=150e3)
+    outcome = plan_image(validate_image_strip(req, frame_id=SWIFT.frame_id, default_spacecraft=SWIFT.name,
+                                              default_method="", default_budget=30.0, min_elevation_deg=45.0))
+    assert outcome.code == 0, outcome.message
+    late = loop.controller.context.max_start_epoch_error + 1.0
+    loop.run(late)
+    refused = loop.execute(outcome.plan, after=outcome.pointing_after)
+    assert refused is not None and refused.code == ErrorCode.PLAN_CONTEXT, refused
+    assert "max_start_epoch_error_s" in refused.message and f"{late:.1f} s later" in refused.message, refused.message
