@@ -14,9 +14,10 @@ from att_planner.nodes.client import SuiteClient, client_session
 from att_planner.tools.launch import Suite, default_nodes, fresh_domain_id, isolated_env, join_env, start_suite
 
 
-def wait_for_controller_step(client: SuiteClient, timeout: float = 30.0) -> None:
+def wait_for_controller_step(client: SuiteClient, timeout: float = 60.0) -> None:
     """Spin until the controller reports a step on a fresh state (a goal sent before its first state
-    is answered NO_STATE: a race, not what the tests are about)."""
+    is answered NO_STATE: a race, not what the tests are about), as long as the services get: the
+    nodes' imports on two busy cores took more than 30 s once."""
     import rclpy
 
     from att_msgs.msg import ControllerStatus
@@ -32,7 +33,7 @@ def wait_for_controller_step(client: SuiteClient, timeout: float = 30.0) -> None
     assert any(stepped), f"the controller did not step on a state within {timeout:g} s"
 
 
-def wait_for_converged_estimate(client: SuiteClient, timeout: float = 30.0) -> None:
+def wait_for_converged_estimate(client: SuiteClient, timeout: float = 60.0) -> None:
     """Spin until the estimator publishes a converged attitude (a goal sent before it is answered
     ESTIMATE_UNHEALTHY: a race, not what the tests are about)."""
     import rclpy

@@ -33,9 +33,9 @@ LEAD = 70.0             # s after the plan's start where the strip's start is pl
 POINTING_TOLERANCE = math.radians(0.01)
 
 
-@pytest.mark.slow
-@pytest.mark.parametrize("late", [0.0, 0.5])
-def test_a_slew_onto_a_strip_hands_over_and_follows_the_scan(late):
+def strip_from_the_estimate():
+    """A loop flown until its estimate converges, and the first plan onto the strip from there:
+    (loop, its time then, the checked request, the planned image)."""
     loop = ClosedLoop(SWIFT, overrides={"controller": IMAGING_GAINS})
     loop.run(20.0)                                       # the estimate converges
     assert loop.estimator is not None and loop.controller.measured is not None     # flown on the estimate
@@ -49,6 +49,13 @@ def test_a_slew_onto_a_strip_hands_over_and_follows_the_scan(late):
                                  default_budget=30.0, min_elevation_deg=45.0)
     outcome = plan_image(valid)
     assert outcome.code == 0, outcome.message
+    return loop, t0, valid, outcome
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("late", [0.0, 0.5])
+def test_a_slew_onto_a_strip_hands_over_and_follows_the_scan(late):
+    loop, t0, valid, outcome = strip_from_the_estimate()
     plan = outcome.plan
     ver = plan.verification
     assert ver.goal == "strip" and ver.final_attitude_error < math.radians(0.05) and ver.final_rate < math.radians(0.01)
@@ -82,17 +89,7 @@ def test_a_slew_onto_a_strip_hands_over_and_follows_the_scan(late):
 
 
 def test_a_slew_onto_a_strip_started_too_late_is_refused():
-    loop = ClosedLoop(SWIFT, overrides={"controller": IMAGING_GAINS})
-    loop.run(20.0)
-    t0 = loop.controller.state.t
-    lat, lon = site_in_view(GEOMETRY, t0 + LEAD, math.radians(20.0), math.radians(90.0))
-    req = ImageStripRequest(SWIFT.frame_id, loop.controller.state.q, SENSOR, ALONG_TRACK, method="graph_smooth",
-                            time_budget=30.0, spacecraft=SWIFT.name, epoch=(int(t0), round(t0 % 1 * 1e9)),
-                            start_latitude_deg=math.degrees(lat), start_longitude_deg=math.degrees(lon),
-                            by_azimuth=True, azimuth_deg=45.0, length_m=150e3)
-    outcome = plan_image(validate_image_strip(req, frame_id=SWIFT.frame_id, default_spacecraft=SWIFT.name,
-                                              default_method="", default_budget=30.0, min_elevation_deg=45.0))
-    assert outcome.code == 0, outcome.message
+    loop, _, _, outcome = strip_from_the_estimate()
     late = loop.controller.context.max_start_epoch_error + 1.0
     loop.run(late)
     refused = loop.execute(outcome.plan, after=outcome.pointing_after)
