@@ -47,7 +47,6 @@ from att_msgs_py.types import (
     PointingMode,
     State,
 )
-from att_msgs_py.validation import UNIX_EPOCH
 from att_planner.control import momentum, safe, tracking, wheels
 from att_planner.control.coil_check import CoilCheck, feedforward
 from att_planner.control.controller_config import ControllerConfig
@@ -56,7 +55,7 @@ from att_planner.control.maneuver import Maneuver, plan_zones
 from att_planner.control.measured_state import MeasuredState
 from att_planner.control.mode_authentication import ModeAuthentication
 from att_planner.control.plan_cache import PlanCache
-from att_planner.control.plan_checks import PlanContext, check_start
+from att_planner.control.plan_checks import PlanContext, check_start, plan_start
 from att_planner.control.pointing import handover_law, law_reference, pointing_torque
 from att_planner.control.state_gate import GateConfig, StateGate
 from att_planner.control.wheel_check import WheelCheck, excite
@@ -292,19 +291,9 @@ class Controller:
         except ValueError as err:
             return RequestError(ErrorCode.INVALID_PLAN, f"plan '{plan.plan_id}': its zones cannot be placed in the "
                                                         f"sky now: {err}")
-        t0 = self.state.t
-        goal = plan.verification.goal if plan.verification is not None else ""
-        if goal:
-            # a plan onto a moving goal meets it at its planned instant only (sim time 0 without an
-            # epoch): it runs on its own clock, the steps between that instant and now flown from then
-            t0 = 0.0 if plan.epoch is None else (plan.epoch - (self.context.epoch or UNIX_EPOCH)).total_seconds()
-            lag = self.state.t - t0
-            if abs(lag) > self.context.max_start_epoch_error:
-                return RequestError(ErrorCode.PLAN_CONTEXT,
-                                    f"plan '{plan.plan_id}' ends on a moving {goal} goal at its "
-                                    f"planned instant, sim time {t0:.3f} s; it would start {abs(lag):.1f} s "
-                                    f"{'later' if lag > 0 else 'earlier'} (at most "
-                                    f"{self.context.max_start_epoch_error:g} s, parameter max_start_epoch_error_s)")
+        t0 = plan_start(plan, self.state, self.context)
+        if isinstance(t0, RequestError):
+            return t0
         self.maneuver = Maneuver(plan, t0, zones, after=law)
         self.mode, self.pointing = ControlMode.PLAN_TRACKING, None
         return None

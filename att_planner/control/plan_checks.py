@@ -10,8 +10,9 @@ body, unit axes, half-angle range, an inertial zone's direction) and its epoch (
 configuration (name and :attr:`~att_sim.models.dynamics.Spacecraft.digest`) and signed by the configured
 key (:mod:`att_msgs_py.signing`). :func:`check_start` compares a plan's first sample with the
 current state, and the epoch of a plan with moving zones with the current instant (the scenario's
-epoch + sim time; UTC arithmetic, a leap second in between is a second off). Each returns
-``None`` or a :class:`RequestError` (code and sentence).
+epoch + sim time; UTC arithmetic, a leap second in between is a second off); :func:`plan_start`
+when a plan onto a moving goal starts (its own clock). Each returns ``None`` (:func:`plan_start`: the
+start's sim time) or a :class:`RequestError` (code and sentence).
 """
 from __future__ import annotations
 
@@ -25,6 +26,7 @@ from att_msgs_py import signing, validation
 from att_msgs_py.errors import ErrorCode, RequestError
 from att_msgs_py.limits import MAX_CONES, MAX_ZONES
 from att_msgs_py.types import POINTING_KINDS, ControlKind, Interpolation, Plan, State, Status
+from att_msgs_py.validation import UNIX_EPOCH
 from att_planner.control import pd
 from att_sim.models import epoch as epochs
 from att_sim.models import rotations as rot
@@ -208,3 +210,22 @@ def check_start(plan: Plan, state: State, ctx: PlanContext) -> RequestError | No
                                 f"{when} (at most {ctx.max_start_epoch_error:g} s, "
                                 "parameter max_start_epoch_error_s): request it with the start epoch")
     return None
+
+
+def plan_start(plan: Plan, state: State, ctx: PlanContext) -> float | RequestError:
+    """The sim time ``plan`` starts from when it starts at ``state``: now, or for a plan onto a moving
+    goal (``verification.goal``), which meets it at its planned instant only, that instant (its
+    epoch; sim time 0 without one): such a plan runs on its own clock, the steps between that instant
+    and now flown from then (before it, its first attitude is held). Why not, when that instant is
+    more than ``max_start_epoch_error`` s from now."""
+    goal = plan.verification.goal if plan.verification is not None else ""
+    if not goal:
+        return float(state.t)
+    t0 = 0.0 if plan.epoch is None else (plan.epoch - (ctx.epoch or UNIX_EPOCH)).total_seconds()
+    lag = float(state.t) - t0
+    if abs(lag) > ctx.max_start_epoch_error:
+        return RequestError(ErrorCode.PLAN_CONTEXT,
+                            f"plan '{plan.plan_id}' ends on a moving {goal} goal at its planned instant, sim time "
+                            f"{t0:.3f} s; it would start {abs(lag):.1f} s {'later' if lag > 0 else 'earlier'} (at "
+                            f"most {ctx.max_start_epoch_error:g} s, parameter max_start_epoch_error_s)")
+    return t0

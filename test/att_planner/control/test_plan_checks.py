@@ -1,12 +1,14 @@
-"""A plan starts near the current state: its first attitude, and its first rate compared in body axes."""
+"""A plan starts near the current state: its first attitude, and its first rate compared in body
+axes; a plan onto a moving goal at its planned instant."""
 import math
+from datetime import UTC, datetime, timedelta
 
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from att_msgs_py.errors import ErrorCode
-from att_msgs_py.types import Plan, State
-from att_planner.control.plan_checks import PlanContext, check_start
+from att_msgs_py.errors import ErrorCode, RequestError
+from att_msgs_py.types import Plan, State, Verification
+from att_planner.control.plan_checks import PlanContext, check_start, plan_start
 from att_sim.models import rotations as rot
 from att_sim.models import scenario
 
@@ -30,3 +32,27 @@ def test_the_start_rate_is_compared_in_body_axes():
     state.omega = omega_RN_R
     refused = check_start(plan, state, CTX)
     assert refused is not None and refused.code == ErrorCode.PLAN_CONTEXT and "rate" in refused.message
+
+
+def test_a_plan_onto_a_moving_goal_starts_at_its_planned_instant():
+    """A plan at rest starts now; one onto a moving goal at its epoch's sim time (epoch 100 s after the
+    scenario's; sim time 0 without an epoch), sent up to max_start_epoch_error early or late, and is
+    refused beyond, saying by how much."""
+    epoch = datetime(2025, 1, 1, tzinfo=UTC)
+    ctx = PlanContext(SC, "swift_demo", "eci", None, epoch=epoch, max_start_epoch_error=10.0)
+    moving = Verification(0.0, 0.0, math.inf, [], 0.0, 0.0, 0.0, 2, goal="ground")
+    plan = Plan(t=np.array([0.0, 10.0]), q=np.array([rot.IDENTITY] * 2), omega=np.zeros((2, 3)), plan_id="p",
+                epoch=epoch + timedelta(seconds=100.0))
+    state = State(t=104.5, q=rot.IDENTITY, omega=np.zeros(3), wheel_speeds=np.zeros(SC.n_wheels))
+    assert plan_start(plan, state, ctx) == 104.5                                 # at rest: now
+    plan.verification = moving
+    for t in (90.0, 104.5, 110.0):
+        state.t = t
+        assert plan_start(plan, state, ctx) == 100.0
+    state.t = 110.5
+    late = plan_start(plan, state, ctx)
+    assert isinstance(late, RequestError) and late.code == ErrorCode.PLAN_CONTEXT and "10.5 s later" in late.message
+    state.t = 89.0
+    assert "11.0 s earlier" in plan_start(plan, state, ctx).message
+    plan.epoch, state.t = None, 3.0
+    assert plan_start(plan, state, ctx) == 0.0
