@@ -139,8 +139,8 @@ MEANINGS: dict[ErrorCode, str] = {
     ErrorCode.PLAN_ID_REUSED: 'a plan whose id the controller already knows for a different plan',
     ErrorCode.WRONG_SPACECRAFT: 'a plan made for another spacecraft configuration (name or physical parameters)',
     ErrorCode.PLAN_CONTEXT: (
-        'a plan whose first attitude or rate is too far from the current state, or (moving zones) whose epoch '
-        'is more than `max_start_epoch_error_s` from the scenario epoch + sim time'
+        'a plan whose first attitude or rate is too far from the current state, or (moving zones, or a moving '
+        'goal at its end) whose epoch is more than `max_start_epoch_error_s` from the scenario epoch + sim time'
     ),
     ErrorCode.INVALID_STATE: (
         '(logged) a state with a bad field, the wrong frames, or from a second publisher while the held one '

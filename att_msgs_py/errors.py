@@ -49,7 +49,7 @@ class ErrorCode(IntEnum):
     PLAN_NOT_AUTHENTIC = 306      # no signature, an unknown key, or a signature that does not verify
     PLAN_ID_REUSED = 307          # a plan id already taken by a different plan
     WRONG_SPACECRAFT = 308        # a plan made for another spacecraft configuration
-    PLAN_CONTEXT = 309            # the plan starts far from the current attitude or rate
+    PLAN_CONTEXT = 309            # the plan starts far from the current attitude, rate or its instant
     INVALID_STATE = 310           # a state message with a bad field (discarded, reported)
     STATE_TIME_JUMP = 311         # a state stamp backward or far forward (discarded, reported)
     MODE_NOT_AUTHENTIC = 312      # a mode request unsigned, wrongly signed or replayed (require_signed_modes)
