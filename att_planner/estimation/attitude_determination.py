@@ -75,7 +75,10 @@ def _quest_once(b: np.ndarray, r: np.ndarray, w: np.ndarray) -> tuple[np.ndarray
     gamma = (lam + sigma) * alpha - delta
     x = (alpha * np.eye(3) + beta * S + S @ S) @ z
     q = np.append(x, gamma)
-    return q / np.linalg.norm(q), abs(gamma)
+    norm = float(np.linalg.norm(q))
+    if norm == 0.0:                     # this reference rotation's solution is 180 deg away: |γ| 0, never chosen
+        return q, 0.0
+    return q / norm, abs(gamma)
 
 
 def quest(observed_B, reference_N, weights) -> tuple[np.ndarray, np.ndarray]:
