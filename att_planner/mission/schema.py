@@ -81,6 +81,20 @@ class Mission(Schema):
         return zones
 
     @model_validator(mode="after")
+    def _method_takes_the_rate_bound(self):
+        from att_planner import methods
+
+        if not self.method:
+            return self
+        if self.method not in methods.METHODS:
+            raise ValueError(f"method: one of {', '.join(methods.METHODS)}, or empty for the planner's default")
+        if self.rate_max_deg_per_s is not None and "rate_max" not in methods.get(self.method).options:
+            takes = [m.name for m in methods.REGISTRY if "rate_max" in m.options]
+            raise ValueError(f"method {self.method} takes no rate bound, and rate_max_deg_per_s asks one: a method "
+                             f"that does ({', '.join(takes)}), or no rate_max_deg_per_s")
+        return self
+
+    @model_validator(mode="after")
     def _axes_apart(self):
         if self.secondary_axis is not None and np.linalg.norm(np.cross(self.sensor_axis, self.secondary_axis)) < 1e-3:
             raise ValueError("secondary_axis not parallel to sensor_axis")

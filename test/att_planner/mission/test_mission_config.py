@@ -83,7 +83,8 @@ def test_defaults_fill_what_a_file_leaves_out(tmp_path):
     ({"momentum_dumping": "yes"}, "momentum_dumping"), ({"colour": "red"}, "unknown key(s) colour"),
     ({"rate_max_deg_per_s": 0}, "rate_max_deg_per_s"), ({"rate_max_deg_per_s": "fast"}, "rate_max_deg_per_s"),
     ({"start_pointing": "zenith"}, "start_pointing"), ({"start_pointing": 1}, "start_pointing"),
-    ({"start_pointing": ["nadir"]}, "start_pointing"),
+    ({"start_pointing": ["nadir"]}, "start_pointing"), ({"method": "warp_drive"}, "method: one of"),
+    ({"method": "graph_smooth", "rate_max_deg_per_s": 3.0}, "method graph_smooth takes no rate bound"),
 ])
 def test_a_bad_key_is_refused_with_the_file_and_the_key_named(tmp_path, change, field):
     doc = {**GOOD, **change}
