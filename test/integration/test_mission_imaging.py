@@ -1,5 +1,5 @@
 """An imaging pass through the nodes: the start of ``att-mission aeos_orbit`` (the agile aeos spacecraft
-on bsk-rl's orbit; its first two sites under the first ascending pass and one never accessible)
+on bsk-rl's orbit; its first two cities under the first ascending pass and one never accessible)
 flown by the simulator, estimator, controller and planner nodes on the estimate, recorded, then
 reviewed. The images are checked on the flown truth apart from the suite's own figures: the recorded
 truth attitude's boresight against skyfield's line of sight from the recorded truth position to each
@@ -25,8 +25,8 @@ from att_sim.models import rotations as rot
 from helpers.independent import site_sight_from
 
 pytestmark = [pytest.mark.ros, pytest.mark.slow]
-# the first two sites of the shipped pass (imaged by about 430 s) and the one never accessible: the whole
-# pass (att-mission aeos_orbit, 900 s) takes 3-4 min of wall time, this part about a minute
+# the first two sites of the shipped orbit (imaged by about 430 s) and the one never accessible: the whole
+# orbit (att-mission aeos_orbit, 6043 s) takes 7-8 min of wall time, this part about a minute
 ACCESSIBLE = {"guadalajara", "chihuahua"}
 HORIZON_S = 480.0
 CONFIG = Path(__file__).resolve().parents[2] / "config"
