@@ -82,10 +82,10 @@ def _strip_law(mode: PointingMode, geometry: PointingGeometry, t: float, primary
                yaw: float) -> StripLaw:
     """The law of a strip mode (the strip between its two points at the mode's altitude, scanned from
     ``scan_start``), with an attitude at ``t``."""
-    start = [_angle(getattr(mode, f"{end}itude"), f"pointing.{end}itude", -limit, limit)
-             for end, limit in (("lat", math.pi / 2), ("long", math.pi))]
-    end = [_angle(getattr(mode, f"end_{end}itude"), f"pointing.end_{end}itude", -limit, limit)
-           for end, limit in (("lat", math.pi / 2), ("long", math.pi))]
+    lat0 = _angle(mode.latitude, "pointing.latitude", -math.pi / 2, math.pi / 2)
+    lon0 = _angle(mode.longitude, "pointing.longitude", -math.pi, math.pi)
+    lat1 = _angle(mode.end_latitude, "pointing.end_latitude", -math.pi / 2, math.pi / 2)
+    lon1 = _angle(mode.end_longitude, "pointing.end_longitude", -math.pi, math.pi)
     altitude = _angle(mode.altitude, "pointing.altitude", MIN_ALTITUDE, MAX_ALTITUDE)
     speed = validation.number(mode.scan_speed, "pointing.scan_speed", BAD, 0.0, MAX_SCAN_SPEED_M_S)
     scan_start = validation.number(mode.scan_start, "pointing.scan_start", BAD, -math.inf, math.inf)
@@ -98,7 +98,7 @@ def _strip_law(mode: PointingMode, geometry: PointingGeometry, t: float, primary
         raise RequestError(BAD, "pointing.secondary_axis is parallel to pointing.primary_axis: the detector's "
                                 "along-track axis must lie across the boresight")
     try:
-        strip = Strip.between(*start, *end, altitude, speed)
+        strip = Strip.between(lat0, lon0, lat1, lon1, altitude, speed)
     except ValueError as err:
         raise RequestError(BAD, f"pointing.end_latitude, pointing.end_longitude: {err}") from None
     law = StripLaw(geometry, strip, primary_axis, secondary_axis, scan_start)
