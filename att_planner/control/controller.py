@@ -509,7 +509,7 @@ class Controller:
         out.status.attitude_error = float(rot.angle_between(s.q, ref.q_RN))
         if m.after is not None and elapsed >= plan.duration:
             # the law takes over at this step: its reference, not the plan's held past its end
-            law = handover_law(m.after, plan, s.t, self.config.handover_blend)
+            law = handover_law(m.after, plan, m.t0 + plan.duration, s.t, self.config.handover_blend)
             out.result = self._end(True, ErrorCode.OK, f"maneuver complete; pointing {law.name}")
             self.mode, self.pointing, self.hold_q_RN = ControlMode.POINTING, law, None
             out.command.mode = out.status.mode = ControlMode.POINTING

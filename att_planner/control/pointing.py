@@ -48,12 +48,14 @@ def pointing_torque(sc: Spacecraft, q_BN, omega_BN_B, ref: Reference, kp: float,
     return feedforward + pd.pd_torque(q_BR, omega - omega_RN_B, kp, kd)
 
 
-def handover_law(law, plan: Plan, t: float, blend: float):
-    """The pointing law a plan hands over to at its end (at ``t``): the law itself when the plan ends
-    on the law's attitude at its rate (a slew planned to end on the moving target, flown when
-    planned), else the law entered through :class:`~att_planner.guidance.laws.BlendedLaw` over
-    ``blend`` s (a plan ending at rest)."""
-    ref = law_reference(law, t)
+def handover_law(law, plan: Plan, t_end: float, t: float, blend: float):
+    """The pointing law a plan ending at sim time ``t_end`` (its start plus its duration) hands over to
+    at ``t`` (the control step that sees the end, up to a step later): the law itself when the plan ends
+    on the law's attitude at its rate at ``t_end`` (a slew planned to end on the moving target, flown
+    when planned), else the law entered through :class:`~att_planner.guidance.laws.BlendedLaw` from
+    ``t`` over ``blend`` s (a plan ending at rest). The match is judged at ``t_end``, not ``t``: a site's
+    line of sight turns 0.1 deg in one 0.2 s step of an agile pass, twice the attitude match."""
+    ref = law_reference(law, t_end)
     matched = (float(np.linalg.norm(plan.omega[-1] - ref.omega_RN_R)) <= HANDOVER_RATE_MATCH
                and rot.angle_between(plan.q[-1], ref.q_RN) <= HANDOVER_ATTITUDE_MATCH)
     return law if matched or blend <= 0 else BlendedLaw(law, t, blend)

@@ -36,6 +36,27 @@ def test_the_blend_starts_at_rest_on_the_law_and_joins_it():
     assert np.linalg.norm(middle.omega_RN_R) == pytest.approx(4 / 3 * SWIFT.orbit.mean_motion, rel=1e-3)
 
 
+def test_a_plan_ending_on_the_law_is_matched_at_its_end_not_at_the_step_that_sees_it():
+    """The control step that sees a plan's end comes up to a step after it: the law has moved on by
+    then (2 s of LEO nadir: 0.13 deg, above the attitude match), so the match is judged at the plan's
+    end. A plan ending at rest there is entered through the blend, from the step's time."""
+    from types import SimpleNamespace
+
+    from att_planner.control.pointing import HANDOVER_ATTITUDE_MATCH, handover_law
+    law = law_of(PointingMode("nadir"), PointingGeometry.of(world.Environment.from_scenario(SWIFT)), 0.0, rot.IDENTITY)
+    t_end, t_step = 300.0, 302.0
+    end = reference(law.attitude, t_end)
+    assert rot.angle_between(end.q_RN, law.attitude(t_step)) > 2 * HANDOVER_ATTITUDE_MATCH
+    on_law = SimpleNamespace(q=[end.q_RN], omega=[end.omega_RN_R])
+    assert handover_law(law, on_law, t_end, t_step, 60.0) is law
+    at_rest = SimpleNamespace(q=[end.q_RN], omega=[np.zeros(3)])
+    blended = handover_law(law, at_rest, t_end, t_step, 60.0)
+    assert isinstance(blended, BlendedLaw) and (blended.start, blended.duration) == (t_step, 60.0)
+    late = SimpleNamespace(q=[law.attitude(t_end - 2.0)], omega=[end.omega_RN_R])     # on the law 2 s ago
+    assert isinstance(handover_law(law, late, t_end, t_step, 60.0), BlendedLaw)
+    assert handover_law(law, at_rest, t_end, t_step, 0.0) is law                        # no blend asked
+
+
 def test_the_controller_takes_a_law_built_onboard_and_refuses_anything_else():
     """A strip's law (no PointingMode on the wire carries it) is handed over as it is; what is neither a
     mode nor a law is refused naming what it found."""
