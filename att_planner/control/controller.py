@@ -324,12 +324,13 @@ class Controller:
         return step_controllers([self], [cancel_requested])[0]
 
     def tracking_reference(self) -> Reference | None:
-        """The reference the next step's plan tracking flies about (the plan's now, or the held
-        attitude), None when it flies none."""
+        """The reference the next step's plan tracking flies about (the plan's now, its torque the
+        mean over the control period the command is held for; or the held attitude), None when it
+        flies none."""
         if self.mode != ControlMode.PLAN_TRACKING:
             return None
         if self.maneuver is not None:
-            return self.references(self.maneuver.plan, self.state.t - self.maneuver.t0)
+            return self.references(self.maneuver.plan, self.state.t - self.maneuver.t0, self.config.control_period)
         return at_rest(self.hold_q_RN) if self.hold_q_RN is not None else None
 
     def tracks_body_torque(self) -> bool:

@@ -37,13 +37,19 @@ def rotation_vector_rate(phi, omega_RN_R) -> np.ndarray:
     return omega + 0.5 * turn + c * rot.cross(phi, turn)
 
 
-def plan_reference(plan: Plan, t: float) -> Reference:
+def plan_reference(plan: Plan, t: float, hold: float = 0.0) -> Reference:
     """The reference of ``plan`` at ``t`` s from its start (clamped to the plan; after the end:
     final attitude, zero rate and torque); the attitude is the Hermite interpolant of the module
-    docstring. ``torque_R`` is the plan's torque sample (per wheel for a plan of wheel torques)."""
+    docstring. ``torque_R`` is the plan's torque at ``t`` (per wheel for a plan of wheel torques),
+    or with ``hold`` > 0 its mean over ``[t, t + hold]`` (:func:`mean_torque`): a command held for a
+    control step puts that impulse on the body, where the torque sampled at ``t`` would leave the
+    body half a step's change of torque behind the plan at every step (zero-order-hold compensation)."""
     t_knots, q, omega, torque = plan.t, plan.q, plan.omega, plan.torque
     if t >= t_knots[-1]:
         return Reference(q[-1], np.zeros(3), np.zeros(3), np.zeros(3))
+    if hold > 0.0:
+        ref = plan_reference(plan, t)
+        return Reference(ref.q_RN, ref.omega_RN_R, ref.omega_dot_RN_R, mean_torque(plan, t, t + hold))
     t = max(t, t_knots[0])
     k = min(max(int(np.searchsorted(t_knots, t, side="right")) - 1, 0), len(t_knots) - 2)
     s = (t - t_knots[k]) / (t_knots[k + 1] - t_knots[k])
@@ -58,16 +64,33 @@ def plan_reference(plan: Plan, t: float) -> Reference:
     return Reference(q_RN, omega_RN_R, (omega[k + 1] - omega[k]) / h, tau)
 
 
+def mean_torque(plan: Plan, t0: float, t1: float) -> np.ndarray:
+    """The mean over ``[t0, t1]`` s from the plan's start (``t1 > t0``) of its torque: its samples
+    by its interpolation (held or linear between knots), zero outside the plan."""
+    t_knots, torque = plan.t, np.asarray(plan.torque, float)
+    a, b = max(t0, t_knots[0]), min(t1, t_knots[-1])
+    if not b > a:
+        return np.zeros(torque.shape[1])
+    ts = np.concatenate(([a], t_knots[(t_knots > a) & (t_knots < b)], [b]))
+    if plan.interpolation == Interpolation.ZOH:
+        k = np.clip(np.searchsorted(t_knots, ts[:-1], side="right") - 1, 0, len(t_knots) - 1)
+        area = (torque[k] * np.diff(ts)[:, None]).sum(axis=0)
+    else:
+        values = np.stack([np.interp(ts, t_knots, column) for column in torque.T], axis=1)
+        area = (0.5 * (values[1:] + values[:-1]) * np.diff(ts)[:, None]).sum(axis=0)
+    return area / (t1 - t0)
+
+
 class ReferenceMemo:
     """:func:`plan_reference` remembering its latest answer: controllers flying one plan object
     from one start (Monte Carlo runs of one task) share one and compute each instant's reference once."""
 
     def __init__(self):
-        self.plan, self.t, self.reference = None, math.nan, None
+        self.plan, self.t, self.hold, self.reference = None, math.nan, math.nan, None
 
-    def __call__(self, plan: Plan, t: float) -> Reference:
-        if plan is not self.plan or t != self.t:
-            self.plan, self.t, self.reference = plan, t, plan_reference(plan, t)
+    def __call__(self, plan: Plan, t: float, hold: float = 0.0) -> Reference:
+        if plan is not self.plan or t != self.t or hold != self.hold:
+            self.plan, self.t, self.hold, self.reference = plan, t, hold, plan_reference(plan, t, hold)
         return self.reference
 
 

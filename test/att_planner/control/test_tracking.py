@@ -91,3 +91,29 @@ def test_the_reference_rate_is_rotated_into_body_axes():
     feedback = tracking.tracking_torque(q_BN, locked, ref, kp, kd, feedforward=False)
     assert np.allclose(feedback, -2.0 * kp * e, rtol=0, atol=1e-12)
     assert np.linalg.norm(locked - omega_RN_R) > 0.1                      # what the unrotated form would damp
+
+
+@pytest.mark.parametrize("interpolation", ["linear", "zoh"])
+def test_the_feedforward_held_over_a_step_is_the_plan_s_mean_torque_over_it(interpolation):
+    """The mean torque over a control step, against a fine midpoint sum of the plan's torque at each
+    instant (plan_reference), for steps inside one knot interval, across knots, from before the
+    plan's start and past its end (zero there)."""
+    from att_msgs_py.types import Interpolation, Plan
+
+    rng = np.random.default_rng(4)
+    t = np.array([0.0, 0.3, 0.35, 1.0, 1.7])
+    torque = rng.normal(size=(t.size, 3))
+    q = np.tile(rot.IDENTITY, (t.size, 1))
+    plan = Plan(t=t, torque=torque, q=q, omega=np.zeros((t.size, 3)), interpolation=Interpolation(interpolation))
+
+    def at(x):
+        return tracking.plan_reference(plan, x).torque_R if 0.0 <= x < t[-1] else np.zeros(3)
+
+    for t0, hold in [(0.1, 0.1), (0.25, 0.2), (0.2, 1.0), (-0.1, 0.25), (1.6, 0.2), (1.8, 0.2)]:
+        n = 20_000
+        fine = np.mean([at(t0 + (k + 0.5) * hold / n) for k in range(n)], axis=0)
+        np.testing.assert_allclose(tracking.mean_torque(plan, t0, t0 + hold), fine, atol=2e-4)
+        if 0.0 <= t0 < t[-1]:
+            ref = tracking.plan_reference(plan, t0, hold)
+            np.testing.assert_allclose(ref.torque_R, tracking.mean_torque(plan, t0, t0 + hold))
+            assert np.array_equal(ref.q_RN, tracking.plan_reference(plan, t0).q_RN)
