@@ -390,6 +390,7 @@ class Controller:
         status.dumping = self.dumping
         if self.measured is not None:
             self.measured.dipoles.record(s.t, cmd.dipole)
+            self.measured.record_command(s.t, cmd.wheel_torques, cmd.dipole)
         return out
 
     def stale_command(self) -> tuple[Command, ControllerStatus]:

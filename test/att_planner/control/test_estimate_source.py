@@ -58,6 +58,41 @@ def test_the_state_is_the_estimate_with_the_measured_wheels_made_inertial_and_th
     assert core.estimate_health == Health.CONVERGED
 
 
+def test_the_rate_is_advanced_from_the_gyro_interval_s_mean_to_the_stamp_by_the_last_command():
+    """A constant command about a principal axis from rest: the gyro's mean rate over the interval
+    ending at the stamp is the true rate half an interval earlier; advanced with the command's
+    acceleration (Euler's equation recomputed here) it is the true rate at the stamp. No advance
+    on the first estimate, after a gap or without a command."""
+    core = controller()
+    sc = SWIFT.spacecraft
+    core.measured.on_wheel_speeds(wheels(0.0, speeds=(0.0, 0.0, 0.0)))
+    torque_B = np.array([0.0, 0.0, 0.05])                     # on the body, about its principal z axis
+    u = -np.linalg.pinv(sc.wheel_axes) @ torque_B              # the motor torques giving it (no spin yet)
+    assert np.allclose(-sc.wheel_axes @ u, torque_B)
+    alpha = torque_B / np.diag(sc.inertia)
+    dt = 0.2
+    assert core.accept_estimate(estimate(1.0)).refused is None
+    assert np.array_equal(core.state.omega, np.zeros(3))       # the first estimate: nothing to advance from
+    core.measured.record_command(1.0, u, np.zeros(3))
+    mean = alpha * (dt / 2.0)                                  # the mean rate over [1.0, 1.2] from rest
+    core.measured.on_wheel_speeds(wheels(1.2, speeds=-(sc.wheel_axes.T @ (alpha * dt))))   # the wheels spun up
+    assert core.accept_estimate(estimate(1.2, omega=mean)).refused is None
+    relative = -(sc.wheel_axes.T @ (alpha * dt))
+    h_B = sc.wheel_axes @ (sc.wheel_inertia * (relative + sc.wheel_axes.T @ mean))
+    euler = np.linalg.solve(sc.inertia, torque_B - np.cross(mean, sc.inertia @ mean + h_B))
+    np.testing.assert_allclose(core.state.omega, mean + dt / 2.0 * euler, rtol=1e-12, atol=1e-18)
+    np.testing.assert_allclose(core.state.omega, alpha * dt, rtol=1e-6)         # the true rate at the stamp
+    # the wheels' inertial spin is made with the advanced rate
+    np.testing.assert_allclose(core.state.wheel_speeds, relative + sc.wheel_axes.T @ core.state.omega, atol=1e-15)
+    # a gap longer than an interval, or a command older than it: the estimate's own rate
+    assert core.accept_estimate(estimate(1.2 + 2.0, omega=mean)).refused is None
+    assert np.array_equal(core.state.omega, mean)
+    core.measured.record_command(3.2, u, np.zeros(3))
+    core.measured.command = (1.0, u, np.zeros(3))
+    assert core.accept_estimate(estimate(3.4, omega=mean)).refused is None
+    assert np.array_equal(core.state.omega, mean)
+
+
 @pytest.mark.parametrize("bad, code", [
     (dict(health=7), ErrorCode.INVALID_STATE),
     (dict(q=(0.0, 0.0, 0.0, 2.0)), ErrorCode.INVALID_ATTITUDE),
