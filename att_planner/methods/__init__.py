@@ -169,6 +169,8 @@ REGISTRY = [
              _CELANI_BRUNI + ", the DFSP method"),
 ]
 METHODS = {m.name: m for m in REGISTRY}
+# the methods that end a slew on a moving pointing mode (graph_smooth: the first plan's construction)
+END_POINTING_METHODS = ("time_optimal", "smooth_collocation", "graph_smooth")
 
 
 def get(name: str) -> Method:

@@ -9,22 +9,25 @@ the day is flown. One YAML file under ``config/missions/`` (read with ``yaml.saf
     start_lead_s: 240              # s of sim time from a slew's request to its start (planning)
     time_budget_s: 10              # planner wall-time budget per slew (the day runs at most
                                    # start_lead_s / time_budget_s times real time: a plan is back in time)
-    method: ""                     # planning method ("": the planner's default)
+    method: ""                     # planning method ("": the planner's default; ground sites on_law: one
+                                   # that ends a slew on a pointing mode, END_POINTING_METHODS)
     pointing_tolerance_deg: 0.05   # a dwell counts as observed within this pointing error
     momentum_dumping: true         # the controller's magnetorquer dumping while it holds (pointing mode)
     rate_max_deg_per_s: 0.2        # per body axis, the slews' rate bound (default: :func:`gyroscopic_rate_limit`)
     zones: [sun, moon]             # the scenario's zones the mission keeps, by name (default: all of them)
     secondary: velocity            # ground sites: the direction the secondary axis is kept nearest
     secondary_axis: [0, 0, 1]      # ground sites: that body axis (default: ``targets.next_axis`` of the sensor)
-    handover_blend_s: 180          # ground sites: the controller's blend from rest into the site's law (s)
+    site_arrival: at_rest          # ground sites: slews end on the site's law (on_law, the default), or at
+                                   # rest on its attitude, the controller then blending into the law
+    handover_blend_s: 180          # ground sites at_rest: that blend (s)
     start_pointing: nadir          # the day starts with sensor_axis on the nadir (default: scenario, the
                                    # simulator's initial_attitude)
 
 An inertial source is held at the attitude of :func:`~att_planner.mission.targets.pointing_attitude`;
-a ground site is tracked through its dwell with the controller's ``ground`` pointing mode
-(:mod:`att_planner.mission.ground`) while the spacecraft stands ``min_elevation_deg`` (the target
-list's) above it. An Earth-observation mission drops the scenario's Earth-limb zone of the payload
-(``zones``): its payload looks at the Earth.
+a ground site is reached by a slew that ends on its law (or at rest, ``site_arrival``) and tracked
+through its dwell with the controller's ``ground`` pointing mode (:mod:`att_planner.mission.ground`)
+while the spacecraft stands ``min_elevation_deg`` (the target list's) above it. An Earth-observation
+mission drops the scenario's Earth-limb zone of the payload (``zones``): its payload looks at the Earth.
 
 Every key is checked against :class:`att_planner.mission.schema.Mission` (its ranges and defaults)
 by :mod:`att_sim.models.config_files`; a bad file is refused with a
@@ -43,6 +46,7 @@ from att_msgs_py.errors import ConfigError, ErrorCode, clip
 from att_msgs_py.types import PointingMode
 from att_planner.guidance.laws import PointingGeometry
 from att_planner.guidance.modes import law_of
+from att_planner.methods import END_POINTING_METHODS
 from att_planner.mission import targets as target_lists
 from att_planner.mission.ground import GroundTrack, site_mode
 from att_planner.mission.scheduler import MissionTarget
@@ -73,8 +77,9 @@ class MissionConfig:
     zones: list                   # att_msgs_py.types.Zone: those of the scenario the mission keeps
     secondary: str                # ground sites: the pointing mode's secondary direction
     secondary_axis: np.ndarray    # ground sites: its body axis
-    handover_blend: float         # s: the controller's blend into a site's law (its parameter handover_blend_s)
+    handover_blend: float         # s: the controller's blend into a site's law after a slew ending at rest
     start_pointing: str = "scenario"   # "scenario" or "nadir" (:meth:`start_attitude`)
+    site_arrival: str = "on_law"  # ground sites: "on_law" (a slew ends on the site's law) or "at_rest"
 
     def targets(self) -> dict:
         """Target name -> :class:`~att_planner.mission.scheduler.MissionTarget`, in the list's order."""
@@ -142,10 +147,15 @@ def load(name: str) -> MissionConfig:
                 else math.radians(m.rate_max_deg_per_s))
     if scenario.epoch is None:
         raise _invalid(path, f"scenario '{scenario.name}' has no epoch: a mission flies the real sky")
+    if target_list.kind == "ground" and m.site_arrival == "on_law" and m.method and \
+            m.method not in END_POINTING_METHODS:
+        raise _invalid(path, f"method {m.method}: site_arrival on_law ends each slew on the site's law, which "
+                             f"{', '.join(END_POINTING_METHODS)} plan (or empty: the planner's default); or "
+                             "site_arrival at_rest")
     return MissionConfig(path, target_list, scenario, vec, m.horizon_s, math.radians(m.margin_deg), m.rate_Hz,
                          m.start_lead_s, m.time_budget_s, m.method, math.radians(m.pointing_tolerance_deg),
                          m.momentum_dumping, rate_max, _zones(path, m.zones, scenario), m.secondary, second,
-                         m.handover_blend_s, m.start_pointing)
+                         m.handover_blend_s, m.start_pointing, m.site_arrival)
 
 
 def _zones(path, names: list | None, scenario) -> list:

@@ -17,15 +17,18 @@ The decisions, each from where the spacecraft holds at that moment:
 2. the first of the order's first three targets whose slew can wait for its start at the held
    attitude clear of the zones is planned ``start_lead`` s of sim time before its start (later when
    the target becomes visible later), planned again when it would arrive before the target is
-   visible (three plans at most; a ground site: its arrival fixed first, four plans at most);
+   visible (three plans at most; a ground site: planned again while it would not arrive when the
+   site is trackable, four plans at most);
 3. when none can wait there, the spacecraft parks at a source, or at one of the scheduler's sky
    park attitudes (:func:`~att_planner.mission.scheduler.sky_parks`: directions spread over the
    sky, so that a mission of few sources still has somewhere clear to go), clear until the first
    one's start (the nearest three tried), or holds for
    :data:`~att_planner.mission.holds.RECOVERY_STEP` s, and decides again;
-4. the controller flies the plan and holds the target for its dwell (a ground site after the
-   controller's blend into its law); then back to 1. A slew the planner or the controller refuses
-   counts as an attempt at its target when the held attitude can start another slew: after
+4. the controller flies the plan and holds the target for its dwell (a ground site: the plan ends
+   on the site's law, its attitude and rate, and hands over to it; or it ends at rest on the law's
+   attitude and the controller blends into the law first); then back to 1. A slew the
+   planner or the controller refuses counts as an attempt at its target when the held attitude can
+   start another slew: after
    :data:`MAX_ATTEMPTS` attempts the target is missed;
 5. a held attitude that cannot start a slew (estimate not converged, a zone or the trackers' blind
    sky within the lead) is recovered: left for a park when a zone is about to cover it and the
@@ -51,8 +54,8 @@ from att_planner.mission.holds import RECOVERY_STEP, Holds
 from att_planner.mission.scheduler import MissionScheduler, sky_parks
 from att_planner.mission.targets import CELESTIAL_NORTH, pointing_attitude
 
-SITE_DURATION_MATCH = 2.0      # s: a site's plan starts within this of the start its sky was planned for
 SITE_ARRIVAL_SLACK = 1.0       # s: a slew to a site must arrive within this of the site's visibility
+SITE_DURATION_MATCH = 2.0      # s: a slew ending at rest on a site's law arrives within this of its aim
 SLEW_FACTOR = 1.25             # planned slew / bang-coast-bang estimate (1.18 measured on the rate-bounded day)
 MAX_ATTEMPTS = 2               # slews refused per target before it is missed
 SOURCE_PLANS = 3               # plans of one slew to a source that arrive before it is visible, at most
@@ -63,16 +66,18 @@ class MissionExecutive(Holds):
     """The decisions of one mission (module docstring) over ``targets`` (name ->
     :class:`~att_planner.mission.scheduler.MissionTarget`) ordered by ``scheduler`` (what
     :class:`~att_planner.mission.scheduler.MissionScheduler` answers). ``settle``: the controller's
-    hold on a plan's end before it reports it done (s); ``blend``: its blend into a site's law (s);
+    hold on a plan's end before it reports it done (s); ``on_law``: slews to a ground site end on its
+    law (its attitude and rate), else at rest on its attitude, the controller then blending into the law
+    over ``blend`` s;
     ``converged``: the estimate's health before any :class:`~.executive_io.EstimateHealth` (True without
     an estimator)."""
 
     def __init__(self, scheduler, targets: dict, *, horizon: float, start_lead: float, time_budget: float,
-                 settle: float, blend: float, sensor_axis_B=None, pointing_tolerance: float = 0.0,
-                 frame_id: str = "", zone_names: tuple = (), converged: bool = False):
+                 settle: float, on_law: bool = True, blend: float = 0.0, sensor_axis_B=None,
+                 pointing_tolerance: float = 0.0, frame_id: str = "", zone_names: tuple = (), converged: bool = False):
         self.scheduler, self.targets = scheduler, targets
         self.horizon, self.start_lead, self.time_budget = horizon, start_lead, time_budget
-        self.settle, self.blend = settle, blend
+        self.settle, self.on_law, self.blend = settle, on_law, 0.0 if on_law else blend
         self.sensor_axis_B = np.zeros(3) if sensor_axis_B is None else np.asarray(sensor_axis_B, float)
         self.pointing_tolerance, self.frame_id, self.zone_names = pointing_tolerance, frame_id, tuple(zone_names)
         self.converged, self._health_t = converged, -math.inf
@@ -89,13 +94,15 @@ class MissionExecutive(Holds):
         """The executive of a :class:`~att_planner.mission.config.MissionConfig`, its scheduler as the
         mission file says (the controller's ``settle``; the estimate's health at the start)."""
         targets = mission.targets()
+        on_law = mission.site_arrival == "on_law"
+        blend = 0.0 if on_law else mission.handover_blend
         roll = getattr(mission.target_list, "roll_reference", CELESTIAL_NORTH)
         parks = sky_parks(mission.sensor_axis, lambda axis, d: pointing_attitude(axis, d, roll))
         scheduler = MissionScheduler(mission.scenario, targets, mission.horizon, zones=mission.zones,
                                      margin=mission.margin, lead=mission.start_lead, rate_max=mission.rate_max,
-                                     slew_factor=SLEW_FACTOR, settle=settle, blend=mission.handover_blend, parks=parks)
+                                     slew_factor=SLEW_FACTOR, settle=settle, blend=blend, parks=parks)
         return cls(scheduler, targets, horizon=mission.horizon, start_lead=mission.start_lead,
-                   time_budget=mission.time_budget, settle=settle, blend=mission.handover_blend,
+                   time_budget=mission.time_budget, settle=settle, on_law=on_law, blend=blend,
                    sensor_axis_B=mission.sensor_axis, pointing_tolerance=mission.pointing_tolerance,
                    frame_id=mission.scenario.frame_id, zone_names=tuple(z.name for z in mission.zones),
                    converged=converged)
@@ -248,7 +255,7 @@ class MissionExecutive(Holds):
                 self.q_hold_BN, self.t_day = q_BN, self.t
                 self._next()
             return self._hold(name, held)
-        if target.moving:                              # the controller blends into the site's law first
+        if target.moving:                              # on the site's law from the arrival, or after the blend
             return self._dwell(name, end + self.blend)
         self._hold(name, lambda _q_BN: self._dwell(name, start))
 
@@ -297,15 +304,18 @@ class MissionExecutive(Holds):
         zone until ``start_lead`` from now and the estimate converged."""
         return self.converged and self.scheduler.clear(q_hold_BN, t, t + self.start_lead)
 
-    def _plan(self, name: str, q_from_BN, q_to_BN, t_start: float, budget: float | None, then: Callable) -> None:
-        """Ask for the plan; ``then`` its :class:`PlanReturned`, or None after a refusal (reported)."""
+    def _plan(self, name: str, q_from_BN, q_to_BN, t_start: float, budget: float | None, then: Callable,
+              end_pointing=None) -> None:
+        """Ask for the plan (ending on ``end_pointing`` when given); ``then`` its :class:`PlanReturned`,
+        or None after a refusal (reported)."""
         def answered(event):
             if isinstance(event, io.PlanRefused):
                 self._report(Kind.REFUSED, name, message=f"planner: code {event.code}: {event.message}")
                 return then(None)
             then(event)
         budget = budget or self.time_budget
-        self._request(lambda number: io.RequestPlan(number, name, q_from_BN, q_to_BN, t_start, budget), "planning",
+        self._request(lambda number: io.RequestPlan(number, name, q_from_BN, q_to_BN, t_start, budget, end_pointing),
+                      "planning",
                       (io.PlanReturned, io.PlanRefused), answered)
 
     def _fly(self, name: str, q_from_BN, t_start: float, wait_for_visibility: bool, budget: float | None,
@@ -341,40 +351,57 @@ class MissionExecutive(Holds):
         self._plan(name, q_from_BN, q_to_BN, t_start, budget, planned)
 
     def _fly_to_site(self, name: str, q_from_BN, t_start: float, then: Callable) -> None:
-        """Plan a slew from ``q_from_BN``, starting at ``t_start`` or later, that arrives at rest on
-        ground site ``name``'s tracking attitude when the site is visible for its blend and dwell, and
-        fly it, handing over to the site's pointing mode; ``then`` the arrival time, or None. The
-        arrival ``T`` is fixed first (the site's law at ``T`` is the plan's goal), then the start
-        ``T - duration`` (planned again while the plan's duration moves its start's sky by more than
-        :data:`SITE_DURATION_MATCH` s)."""
+        """Plan a slew from ``q_from_BN``, starting at ``t_start`` or later, that reaches ground site
+        ``name`` when it is trackable for its dwell, and fly it, handing over to the site's pointing mode;
+        ``then`` the arrival time, or None.
+
+        The arrival aimed at first is the site's first visibility after ``t_start`` plus the scheduler's
+        slew estimate, the start that estimate before it. With :attr:`on_law` the plan ends on the
+        site's law (its attitude and rate) and fits when it arrives while the site is trackable (within
+        :data:`SITE_ARRIVAL_SLACK` s); else it ends at rest on the law's attitude at the aim and fits when
+        it arrives within :data:`SITE_DURATION_MATCH` s of it. A plan that does not fit is planned again,
+        aimed at the first visibility a slew of its duration reaches from ``t_start`` (half the slack
+        into it on the law), :data:`SITE_PLANS` plans at most."""
         target = self.targets[name]
         if not self.converged:
             return then(None)
-        arrival = self.scheduler.observable_from(name, t_start + self.scheduler.slew_to(name, q_from_BN, t_start))
-        duration, guess, plans = None, None, 0
+        guess = self.scheduler.slew_to(name, q_from_BN, t_start)
+        aim = self.scheduler.observable_from(name, t_start + guess)
+        if aim is None:
+            self._report(Kind.REFUSED, name, message="the slew cannot arrive before the site's last "
+                                                     "visibility before the horizon")
+            return then(None)
+        plans, mode = 0, target.track.mode
 
         def attempt():
-            nonlocal guess
-            if plans == SITE_PLANS:
-                self._report(Kind.REFUSED, name, message="four plans did not fit the site's visibility")
-                return then(None)
-            if arrival is None:
-                self._report(Kind.REFUSED, name, message="the slew cannot arrive before the site's last "
-                                                         "visibility before the horizon")
-                return then(None)
-            guess = duration or self.scheduler.slew_to(name, q_from_BN, t_start)
-            self._plan(name, q_from_BN, target.attitudes(arrival)[0], max(t_start, arrival - guess), None, planned)
+            start = max(t_start, aim - guess)
+            self._plan(name, q_from_BN, target.attitudes(aim)[0], start, None, lambda plan: planned(plan, start),
+                       end_pointing=mode if self.on_law else None)
 
-        def planned(plan):
-            nonlocal duration, arrival, plans
+        def planned(plan, start: float):
+            nonlocal plans, aim, guess
             if plan is None:
                 return then(None)
-            duration, plans = plan.duration, plans + 1
-            if arrival - duration < t_start:               # longer than estimated: a later visibility
-                arrival = self.scheduler.observable_from(name, t_start + duration)
-                return attempt()
-            if abs(duration - guess) <= SITE_DURATION_MATCH:
-                return self._execute(name, plan, arrival - duration, target.track.mode, then)
+            plans += 1
+            arrival = start + plan.duration
+            if self.on_law:
+                visible = self.scheduler.observable_from(name, arrival)
+                fits = visible is not None and visible <= arrival + SITE_ARRIVAL_SLACK
+            else:
+                fits = abs(arrival - aim) <= SITE_DURATION_MATCH
+            if fits:
+                return self._execute(name, plan, start, mode, then)
+            earliest = self.scheduler.observable_from(name, t_start + plan.duration)
+            if earliest is None:
+                self._report(Kind.REFUSED, name, message=f"a slew of {plan.duration:.0f} s from {t_start:.0f} s or "
+                                                         "later cannot arrive before the site's last visibility "
+                                                         "before the horizon")
+                return then(None)
+            if plans == SITE_PLANS:
+                self._report(Kind.REFUSED, name, message=f"{SITE_PLANS} plans did not fit the site's visibility "
+                                                         f"(the last arrived at {arrival:.0f} s)")
+                return then(None)
+            aim, guess = earliest + (SITE_ARRIVAL_SLACK / 2.0 if self.on_law else 0.0), plan.duration
             attempt()
         attempt()
 

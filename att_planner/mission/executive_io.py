@@ -106,7 +106,8 @@ class WaitUntil:
 class RequestPlan:
     """Plan the slew from ``q_from_BN`` to ``q_to_BN`` starting at sim time ``t_start`` among the
     mission's zones where they are then, in ``time_budget`` s of wall time; answer
-    :class:`PlanReturned` or :class:`PlanRefused`."""
+    :class:`PlanReturned` or :class:`PlanRefused`. With ``end_pointing`` the slew ends on that mode's
+    attitude and rate at its arrival (``q_to_BN``: where the mode points about then, a first guess)."""
 
     request: int
     target: str
@@ -114,6 +115,7 @@ class RequestPlan:
     q_to_BN: np.ndarray
     t_start: float
     time_budget: float
+    end_pointing: PointingMode | None = None
 
 
 @dataclass(frozen=True)

@@ -22,16 +22,17 @@ a target is lost. :class:`MissionScheduler` does that without ROS:
   covers it named.
 
 A ground site (:mod:`att_planner.mission.ground`) moves: its attitude is the tracking law's at each
-time. A slew to it ends at rest on the law's attitude and the controller blends into the law for
-``blend`` s (:class:`att_planner.guidance.laws.BlendedLaw`) before the dwell: a large spacecraft
-cannot reach a pass's line-of-sight rate (5-10 mrad/s) from rest in a minute, so the blend is long
-and starts low, where the line of sight turns slowly. The site counts as visible for an arrival when
-the law's attitude keeps the zones from the arrival to the dwell's end and the site is trackable (high
-enough, its tracking within the torque) through the dwell (not the trackers' sky: a pass lasts
-minutes, and the gyro carries the estimate through an outage; the next slew still starts on a
-converged estimate). It is held for blend + dwell, its leg has no settle, the leg away from it starts
-after the lead, held still; its legs are estimated to where the law is when the site is next
-visible. The mission never parks at a site.
+time. A slew to it ends on the law, its attitude and rate, and the dwell begins at the arrival
+(``blend`` 0); or, for a spacecraft whose slews cannot reach a pass's line-of-sight rate (5-10
+mrad/s against a large spacecraft's rate bound of a few mrad/s), at rest on the law's attitude, and
+the controller blends into the law for ``blend`` s (:class:`att_planner.guidance.laws.BlendedLaw`)
+before the dwell: a long blend that starts low, where the line of sight turns slowly. The site counts
+as visible for an arrival when the law's attitude keeps the zones from the arrival to the dwell's end
+and the site is trackable (high enough, its tracking within the torque) through the dwell (not the
+trackers' sky: a pass lasts minutes, and the gyro carries the estimate through an outage; the next
+slew still starts on a converged estimate). It is held for blend + dwell, its leg has no settle, the
+leg away from it starts after the lead, held still; its legs are estimated as rest-to-rest slews to
+where the law is when the site is next visible. The mission never parks at a site.
 """
 from __future__ import annotations
 
@@ -194,7 +195,7 @@ class MissionScheduler:
 
     def slew_to(self, name: str, q_from, t: float) -> float:
         """Estimated slew (s) from ``q_from`` to target ``name`` (a site: where its law is when it is
-        next visible after ``t``; no settle, the controller blends into the law)."""
+        next visible after ``t``; no settle: the controller hands over to the law)."""
         target = self.targets[name]
         return self.slew(q_from, self.attitude_near(name, t), settle=not target.moving)
 

@@ -60,8 +60,13 @@ class Mission(Schema):
                                                          "nearest")
     secondary_axis: UnitAxis | None = Field(None, description="ground sites: that body axis; none: the axis "
                                                               "after the sensor's")
+    site_arrival: Literal["on_law", "at_rest"] = Field(
+        "on_law", description="ground sites: a slew ends on the site's law, its attitude and rate (on_law: an "
+                              "agile spacecraft), or at rest on its attitude and the controller blends into the "
+                              "law (at_rest: a spacecraft whose rate bound is below a pass's rate)")
     handover_blend_s: float = number(60.0, ge=0.0, le=3600.0, unit="s", meaning="ground sites: the controller's "
-                                                                                 "blend into the site's law")
+                                                                                 "blend into the site's law after "
+                                                                                 "a slew that ends at rest")
     start_pointing: Literal["scenario", "nadir"] = Field(
         "scenario", description="the attitude the day starts at: the scenario's simulator initial_attitude, or "
                                 "nadir: sensor_axis on the nadir and secondary_axis towards secondary")

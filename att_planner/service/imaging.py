@@ -38,10 +38,10 @@ from att_planner.guidance.strip import (
     Strip,
     tracking_demand,
 )
+from att_planner.methods import END_POINTING_METHODS
 from att_planner.service.moving_goal import onboard_geometry, strip_goal_law
 from att_planner.service.planning import PlanOutcome, plan_maneuver, run_method
 from att_planner.service.requests import (
-    END_POINTING_METHODS,
     MAX_DWELL,
     ManeuverRequest,
     ValidRequest,

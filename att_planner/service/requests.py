@@ -29,7 +29,7 @@ from att_msgs_py.validation import MAX_NAME_LENGTH, finite_array, text, unit_qua
 from att_planner import methods
 from att_planner.cones import BOUNDARY_TOLERANCE, boundary_arc_issue, check_zones, endpoint_in_cone
 from att_planner.fdir.envelope import planning_spacecraft
-from att_planner.methods import Method
+from att_planner.methods import END_POINTING_METHODS, Method
 from att_planner.problem import ManeuverProblem, MovingGoal
 from att_planner.service.moving_goal import goal_law
 from att_planner.service.real_sky import RequestGeometry, check_orbit_window, resolve_sky
@@ -42,8 +42,6 @@ MAX_TIME_BUDGET = 600.0        # s
 MAX_DWELL = 86_400.0           # s: a schedule target's observation, at most a day
 MAX_WINDOW = 7 * 86_400.0      # s: a schedule target's window opens within a week of the start
 SAME_TARGET = 1e-6             # rad: schedule targets closer than this are one attitude (q and -q too)
-# the methods that end a slew on a moving pointing mode (graph_smooth: the first plan's construction)
-END_POINTING_METHODS = ("time_optimal", "smooth_collocation", "graph_smooth")
 
 
 @dataclass

@@ -230,7 +230,8 @@ class MissionDriver:
         options = {"rate_max": m.rate_max} if math.isfinite(m.rate_max) else {}
         request = maneuver_request(action.q_from_BN, action.q_to_BN, m.sensor_axis, [], method=m.method,
                                    options=options, time_budget=action.time_budget, frame_id=m.scenario.frame_id,
-                                   epoch=epoch, zones=list(m.zones), wheel_speeds=list(self.telemetry.msg.wheel_speeds))
+                                   epoch=epoch, zones=list(m.zones), wheel_speeds=list(self.telemetry.msg.wheel_speeds),
+                                   end_pointing=action.end_pointing)
         if self.hold_while_planning:
             with self.client.simulator_held():
                 response = self.client.plan(request)

@@ -29,7 +29,7 @@ def flown(tmp_path_factory):
                        {"sensor_axis": [0, 1, 0], "secondary": "velocity", "secondary_axis": [0, 0, 1],
                         "zones": ["sun", "moon"], "horizon_s": 1700, "start_lead_s": 240, "time_budget_s": 5,
                         "rate_Hz": 2.5,
-                        "pointing_tolerance_deg": 0.1, "handover_blend_s": 180}, rtf=0.0)
+                        "pointing_tolerance_deg": 0.1, "site_arrival": "at_rest", "handover_blend_s": 180}, rtf=0.0)
 
 
 def test_the_site_is_observed_within_the_tolerance_in_the_report(flown):

@@ -71,8 +71,9 @@ class Scheduler:
 class World:
     """Answers the executive's actions: sim time jumps to each wait's end, a plan takes
     ``plan_seconds`` of sim time and lasts ``duration(action)`` s (refused when ``refuse_plan(action)``),
-    a maneuver ends ``duration + SETTLE`` s after its start at the plan's goal (refused when
-    ``refuse_maneuver(action)``), a hold is refused while ``refuse_hold(t)``."""
+    a maneuver ends ``duration + SETTLE`` s after its start at the plan's goal (``duration`` s with a
+    mode to hand over to; refused when ``refuse_maneuver(action)``), a hold is refused while
+    ``refuse_hold(t)``."""
 
     def __init__(self, executive, duration=lambda a: 50.0, plan_seconds=0.0, refuse_plan=lambda a: False,
                  refuse_maneuver=lambda a: False, refuse_hold=lambda t: False, health=()):
@@ -107,7 +108,7 @@ class World:
             if self.refuse_maneuver(action):
                 return io.ManeuverEnded(t=self.t, q_BN=self.q_BN, request=action.request, success=False, code=4,
                                         message="aborted")
-            self.t += action.duration + SETTLE
+            self.t += action.duration + (SETTLE if action.pointing_after is None else 0.0)
             self.q_BN = self.goals[action.plan_id]
             return io.ManeuverEnded(t=self.t, q_BN=self.q_BN, request=action.request, success=True)
         if isinstance(action, io.SetPointing):
@@ -133,10 +134,11 @@ class World:
         return [a.text for a in self.actions if isinstance(a, io.Log)]
 
 
-def executive(scheduler, targets, horizon=3000.0, converged=True):
+def executive(scheduler, targets, horizon=3000.0, converged=True, on_law=True):
     return exe.MissionExecutive(scheduler, {t.name: t for t in targets}, horizon=horizon, start_lead=LEAD,
-                                time_budget=BUDGET, settle=SETTLE, blend=BLEND, sensor_axis_B=[0.0, 1.0, 0.0],
-                                pointing_tolerance=1e-3, frame_id="eci", zone_names=("sun",), converged=converged)
+                                time_budget=BUDGET, settle=SETTLE, on_law=on_law, blend=BLEND,
+                                sensor_axis_B=[0.0, 1.0, 0.0], pointing_tolerance=1e-3, frame_id="eci",
+                                zone_names=("sun",), converged=converged)
 
 
 def test_a_day_of_two_sources_slews_dwells_holds_to_the_horizon_and_ends():
@@ -295,29 +297,48 @@ def test_recovery_gives_up_after_its_limit_and_the_day_still_ends():
     assert not world.plans and world.reports()[-1].event == Kind.ENDED
 
 
-def test_a_ground_site_is_flown_to_its_arrival_dwelt_after_the_blend_and_its_hold_asked_again():
+def test_a_ground_site_is_flown_onto_its_law_dwelt_from_the_arrival_and_its_hold_asked_again():
     site = MissionTarget("site", 120.0, track=Site())
     visible_from = 800.0
     ex = executive(Scheduler({"site": 800.0}, visible={"site": visible_from}), [site], horizon=3000.0)
-    refused_until = 1025.0              # the hold after the dwell (which ends at 960 s) is refused until then
+    refused_until = 1025.0              # the hold after the dwell (which ends at 919 s) is refused until then
     world = World(ex, duration=lambda action: 59.0, refuse_hold=lambda t: 900.0 < t < refused_until).run()
-    plan = world.plans[0]
-    # arrival at the visibility, the plan's goal the law's attitude then, start = arrival - slew estimate
-    assert plan.t_start == visible_from - 60.0 and np.allclose(plan.q_to_BN, Site().attitudes(visible_from)[0])
+    (plan,) = world.plans
+    # start = visibility - slew estimate, ending on the site's law (first guess: its attitude then)
+    assert plan.t_start == visible_from - 60.0 and plan.end_pointing == Site.mode
+    assert np.allclose(plan.q_to_BN, Site().attitudes(visible_from)[0])
     slew = world.reports(Kind.SLEW)[0]
-    assert slew.start == visible_from - 59.0                   # the plan's duration within the match: flown
+    assert (slew.start, slew.end) == (740.0, 799.0)     # arrives 1 s before the site is trackable: flown
     maneuver = next(x for x in world.actions if isinstance(x, io.StartManeuver))
     assert maneuver.pointing_after == Site.mode
-    end = visible_from - 59.0 + 59.0 + SETTLE
     dwell = world.reports(Kind.DWELL)[0]
-    assert (dwell.start, dwell.end) == (end + BLEND, end + BLEND + 120.0)
-    assert dwell.pointing == Site.mode
+    assert (dwell.start, dwell.end) == (799.0, 799.0 + 120.0) and dwell.pointing == Site.mode
     # after the dwell the hold (the attitude of the moment) is asked every step until accepted
     after = [x for x in world.actions if isinstance(x, io.SetPointing)][1:]
-    t_dwell_end = end + BLEND + 120.0
     assert all(h.q_BN is None for h in after)
-    assert len(after) == 1 + math.ceil((refused_until - t_dwell_end) / exe.RECOVERY_STEP)
+    assert len(after) == 1 + math.ceil((refused_until - 919.0) / exe.RECOVERY_STEP)
     assert sum("refused the hold site" in text for text in world.logs()) == 1
+
+
+def test_a_ground_site_reached_at_rest_is_dwelt_after_the_blend():
+    site = MissionTarget("site", 120.0, track=Site())
+    ex = executive(Scheduler({"site": 800.0}, visible={"site": 800.0}), [site], on_law=False)
+    world = World(ex, duration=lambda action: 59.0).run()
+    (plan,) = world.plans
+    # aimed at the visibility: the goal the law's attitude then, at rest; start = aim - slew estimate
+    assert plan.t_start == 800.0 - 60.0 and plan.end_pointing is None
+    assert np.allclose(plan.q_to_BN, Site().attitudes(800.0)[0])
+    slew = world.reports(Kind.SLEW)[0]
+    assert (slew.start, slew.end) == (740.0, 799.0)              # within the match of the aim: flown
+    maneuver = next(x for x in world.actions if isinstance(x, io.StartManeuver))
+    assert maneuver.pointing_after == Site.mode
+    end = 799.0
+    dwell = world.reports(Kind.DWELL)[0]
+    assert (dwell.start, dwell.end) == (end + BLEND, end + BLEND + 120.0)
+    # a plan 10 s shorter than the estimate misses the aim: planned again from its own duration
+    world = World(executive(Scheduler({"site": 800.0}, visible={"site": 800.0}), [site], on_law=False),
+                  duration=lambda action: 50.0).run()
+    assert [p.t_start for p in world.plans] == [740.0, 750.0] and world.reports(Kind.DWELL)[0].start == 800.0 + BLEND
 
 
 def test_no_target_left_holds_to_the_horizon_and_missed_ones_are_reported():
@@ -400,26 +421,46 @@ class Site:
         return np.array([[1.0, 0.0, 0.0]])
 
 
-def test_a_site_plan_whose_duration_moves_its_start_is_planned_again_four_times_at_most():
+def test_a_site_plan_arriving_before_the_site_is_trackable_is_planned_again_four_times_at_most():
     site = MissionTarget("site", 120.0, track=Site())
     ex = executive(Scheduler({"site": 800.0}, visible={"site": 800.0}), [site])
     world = World(ex, duration=lambda action: 50.0).run()
-    # the arrival fixed at the visibility (800 s); the start from the estimate (60 s), then from the
-    # first plan's duration (50 s, 10 s off): the second plan fits
-    assert [p.t_start for p in world.plans] == [800.0 - 60.0, 800.0 - 50.0]
-    assert world.reports(Kind.SLEW)[0].start == 800.0 - 50.0
-    # a plan longer than the estimate cannot arrive at 800 s from its start: the arrival moves to the
-    # visibility after start + duration and the start stays
+    # the first start from the estimate (60 s): arrives at 790 s, 10 s early; planned again to arrive
+    # half the slack after the visibility, by its own duration
+    assert [p.t_start for p in world.plans] == [800.0 - 60.0, 800.0 - 50.0 + exe.SITE_ARRIVAL_SLACK / 2.0]
+    assert world.reports(Kind.SLEW)[0].start == world.plans[1].t_start
+    assert world.reports(Kind.DWELL)[0].start == world.plans[1].t_start + 50.0
+    # a plan that arrives after the visibility's start, inside it, is flown as planned
     ex = executive(Scheduler({"site": 800.0}, visible={"site": 800.0}), [site])
     world = World(ex, duration=lambda action: 70.0).run()
-    assert [p.t_start for p in world.plans] == [740.0, 740.0]
-    assert np.allclose(world.plans[1].q_to_BN, Site().attitudes(740.0 + 70.0)[0])
+    assert [p.t_start for p in world.plans] == [740.0] and world.reports(Kind.DWELL)[0].start == 810.0
+    # each plan shorter than the last: never on time, refused after four
     durations = iter([50.0, 40.0, 30.0, 20.0] * exe.MAX_ATTEMPTS)
     ex = executive(Scheduler({"site": 800.0}, visible={"site": 800.0}), [site])
     world = World(ex, duration=lambda action: next(durations)).run()
     refused = [e.message for e in world.reports(Kind.REFUSED)]
-    assert refused == ["four plans did not fit the site's visibility"] * exe.MAX_ATTEMPTS
+    assert refused == ["4 plans did not fit the site's visibility (the last arrived at 790 s)"] * exe.MAX_ATTEMPTS
     assert len(world.plans) == exe.SITE_PLANS * exe.MAX_ATTEMPTS and not world.reports(Kind.SLEW)
+    assert all(p.end_pointing == Site.mode for p in world.plans)
+
+
+def test_a_site_slew_arriving_too_late_is_planned_earlier_or_refused_and_counted():
+    site = MissionTarget("site", 120.0, track=Site())
+    last = {"site": lambda t: max(800.0, t) if t <= 850.0 else None}     # arrivals from 800 to 850 s
+    # decided for 300 s (so a start at 240 s at the earliest), aimed at 800 s: a 160 s slew from 740 s
+    # arrives at 900 s, too late; it starts earlier, to arrive half the slack after 800 s
+    world = World(executive(Scheduler({"site": 300.0}, visible=last), [site]), duration=lambda a: 160.0).run()
+    assert [p.t_start for p in world.plans] == [740.0, 800.0 - 160.0 + exe.SITE_ARRIVAL_SLACK / 2.0]
+    assert world.reports(Kind.DWELL)[0].start == 800.0 + exe.SITE_ARRIVAL_SLACK / 2.0
+    # a slew too long to arrive by 850 s from the earliest start (740 s, the decision's) is refused
+    world = World(executive(Scheduler({"site": 800.0}, visible=last), [site]), duration=lambda a: 120.0).run()
+    refused = [e.message for e in world.reports(Kind.REFUSED)]
+    assert refused[0] == ("a slew of 120 s from 740 s or later cannot arrive before the site's last visibility "
+                          "before the horizon")
+    assert not world.reports(Kind.SLEW) and world.reports(Kind.MISSED)[0].target == "site"
+    world = World(executive(Scheduler({"site": 800.0}, visible={"site": None}), [site])).run()
+    assert world.reports(Kind.REFUSED)[0].message.startswith("the slew cannot arrive before the site's last")
+    assert not world.plans
 
 
 def test_a_zone_about_to_cover_the_start_attitude_is_escaped_by_a_quick_park():

@@ -37,6 +37,7 @@ def test_the_shipped_day_loads_with_its_targets_pointed():
 def test_the_shipped_earth_observation_day_tracks_its_sites_without_the_payload_earth_zone():
     m = mc.load("earth_observation_day")
     assert [z.name for z in m.zones] == ["sun", "moon"] and m.secondary == "velocity"
+    assert m.site_arrival == "at_rest" and m.handover_blend == 180.0
     targets = m.targets()
     assert len(targets) == 10 and all(t.moving for t in targets.values())
     singapore = targets["singapore"]
@@ -84,6 +85,7 @@ def test_defaults_fill_what_a_file_leaves_out(tmp_path):
     ({"rate_max_deg_per_s": 0}, "rate_max_deg_per_s"), ({"rate_max_deg_per_s": "fast"}, "rate_max_deg_per_s"),
     ({"start_pointing": "zenith"}, "start_pointing"), ({"start_pointing": 1}, "start_pointing"),
     ({"start_pointing": ["nadir"]}, "start_pointing"), ({"method": "warp_drive"}, "method: one of"),
+    ({"site_arrival": "blended"}, "site_arrival"), ({"site_arrival": True}, "site_arrival"),
     ({"method": "graph_smooth", "rate_max_deg_per_s": 3.0}, "method graph_smooth takes no rate bound"),
 ])
 def test_a_bad_key_is_refused_with_the_file_and_the_key_named(tmp_path, change, field):
@@ -94,6 +96,22 @@ def test_a_bad_key_is_refused_with_the_file_and_the_key_named(tmp_path, change, 
         mc.load(path)
     assert err.value.code == ErrorCode.INVALID_CONFIG
     assert path in str(err.value) and field in str(err.value)
+
+
+@pytest.mark.parametrize("method", ["eigenaxis", "mssa", "constrained_axis"])
+def test_a_ground_mission_whose_method_plans_rest_to_rest_only_is_refused(tmp_path, method):
+    """Every slew to a site ends on the site's law: a method that cannot is refused when the file loads,
+    not at each slew of the day; an end-pointing method and the planner's default load."""
+    ground = {"targets": "earth_observation", "sensor_axis": [0.0, 1.0, 0.0], "horizon_s": 3600}
+    path = write(tmp_path, yaml_of({**ground, "method": method}))
+    with pytest.raises(ConfigError, match=f"method {method}: site_arrival on_law ends each slew") as err:
+        mc.load(path)
+    assert err.value.code == ErrorCode.INVALID_CONFIG and path in str(err.value)
+    for fine in ("time_optimal", ""):
+        assert mc.load(write(tmp_path, yaml_of({**ground, "method": fine}))).site_arrival == "on_law"
+    at_rest = mc.load(write(tmp_path, yaml_of({**ground, "method": method, "site_arrival": "at_rest"})))
+    assert at_rest.method == method and at_rest.site_arrival == "at_rest"
+    assert mc.load(write(tmp_path, yaml_of({**GOOD, "method": method}))).method == method     # sources: any
 
 
 @pytest.mark.parametrize("text", ["", "[1, 2]", "just a string", "targets: [unclosed"])
