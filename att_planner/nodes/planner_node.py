@@ -288,7 +288,8 @@ def _image_common(request) -> dict:
                 sensor_axis=convert.from_vector3(request.sensor_axis),
                 along_track_axis=convert.from_vector3(request.along_track_axis), method=request.method,
                 time_budget=request.time_budget, spacecraft=request.spacecraft,
-                epoch=convert.epoch_parts(request.epoch), wheel_speeds=list(request.wheel_speeds))
+                epoch=convert.epoch_parts(request.epoch), wheel_speeds=list(request.wheel_speeds),
+                zones=[convert.zone_from_msg(z) for z in request.zones])
 
 
 def main(args=None):

@@ -74,6 +74,7 @@ class ImageCommon:
     spacecraft: str = ""
     epoch: tuple = (0, 0)
     wheel_speeds: list = field(default_factory=list)
+    zones: list = field(default_factory=list)     # kept by the slew (att_msgs_py.types.Zone), as PlanManeuver's
 
 
 @dataclass
@@ -141,7 +142,8 @@ def _maneuver(req: ImageCommon, end_pointing=None, end_goal=None, *, frame_id: s
     return validate_maneuver(
         ManeuverRequest(req.frame_id, req.q_initial, req.q_initial, req.sensor_axis, [], method=req.method,
                         time_budget=req.time_budget, spacecraft=req.spacecraft, epoch=req.epoch,
-                        wheel_speeds=list(req.wheel_speeds), end_pointing=end_pointing, end_goal=end_goal),
+                        wheel_speeds=list(req.wheel_speeds), zones=list(req.zones), end_pointing=end_pointing,
+                        end_goal=end_goal),
         frame_id=frame_id, default_spacecraft=default_spacecraft, default_method=method,
         default_budget=default_budget)
 

@@ -56,3 +56,32 @@ def test_a_site_too_low_at_the_arrival_is_refused_as_not_visible():
     assert outcome.code == ErrorCode.SITE_NOT_VISIBLE, outcome.message
     assert "the slew arrives at" in outcome.message and "below the instrument's 58.0 deg" in outcome.message
     assert outcome.lowest_elevation < math.radians(MIN_ELEVATION_DEG)
+
+
+def test_the_request_s_zones_are_kept_by_the_slew_and_a_hostile_zone_is_refused():
+    """A keep-out zone of a star tracker's axis (body −z) about the direction it sees at the start:
+    the slew leaves it, the problem carries it and its margin over the plan's samples, recomputed here,
+    is what the verification says (≥ 0). A zone with a NaN half-angle is refused naming it."""
+    from att_msgs_py.errors import RequestError
+    from att_msgs_py.types import Zone
+
+    tracker = np.array([0.0, 0.0, -1.0])
+    seen = rot.dcm_NB(rot.IDENTITY) @ tracker
+    zone = Zone("tracker_keep_out", "inertial", tracker, math.radians(5.0), direction=seen)
+    lat, lon = site_in_view(GEOMETRY, 100.0, math.radians(20.0), math.radians(90.0))
+    common = dict(method="graph_smooth", latitude_deg=math.degrees(lat), longitude_deg=math.degrees(lon), dwell_s=DWELL)
+    q0 = rot.from_axis_angle([1.0, 0.0, 0.0], math.radians(8.0))       # 8 deg from the zone's axis: outside it
+    req = ImageTargetRequest("", q0, SENSOR, ALONG, zones=[zone], **common)
+    valid = validate_image_target(req, frame_id=SWIFT.frame_id, default_spacecraft=SWIFT.name, default_method="",
+                                  default_budget=20.0, min_elevation_deg=MIN_ELEVATION_DEG)
+    outcome = plan_image(valid)
+    assert outcome.code == ErrorCode.OK, outcome.message
+    plan = outcome.plan
+    assert [z.name for z in valid.maneuver.problem.zones] == ["tracker_keep_out"]        # the node signs them in
+    margins = [math.acos(np.clip((rot.dcm_NB(q) @ tracker) @ seen, -1, 1)) - zone.half_angle for q in plan.q]
+    assert min(margins) >= plan.verification.min_cone_margin - 1e-6 and plan.verification.min_cone_margin >= 0.0
+    bad = ImageTargetRequest("", q0, SENSOR, ALONG, zones=[Zone("bad", "inertial", tracker, math.nan, direction=seen)],
+                             **common)
+    with pytest.raises(RequestError, match="bad"):
+        validate_image_target(bad, frame_id=SWIFT.frame_id, default_spacecraft=SWIFT.name, default_method="",
+                              default_budget=20.0, min_elevation_deg=MIN_ELEVATION_DEG)
