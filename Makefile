@@ -14,7 +14,7 @@ PYTEST_ARGS ?=
 # made them 4-5x slower (the benchmarks are run the same way, see BENCHMARKS.md)
 export OMP_NUM_THREADS ?= 1
 
-.PHONY: setup test test-fast lint demo clean
+.PHONY: setup test test-fast test-long lint demo clean
 
 setup: $(VENV)/.stamp-package
 
@@ -51,11 +51,16 @@ $(VENV)/.stamp-package: setup.py package.xml pyproject.toml $(VENV)/.stamp-inter
 # the habits first (seconds): ruff's rules and the import contracts (pyproject.toml), then every test:
 # the ROS-free ones on both cores (pytest-xdist), then the ones that start nodes or a DDS participant one
 # at a time (each on its own random ROS domain; timing-sensitive). Both parts run; either failing fails.
+# The `long` tests (minutes each) are left to `make test-long`.
 test: lint
 	status=0; \
-	$(PY) -m pytest test -m "not ros" -n 2 $(PYTEST_ARGS) || status=$$?; \
-	$(PY) -m pytest test -m ros $(PYTEST_ARGS) || status=$$?; \
+	$(PY) -m pytest test -m "not ros and not long" -n 2 $(PYTEST_ARGS) || status=$$?; \
+	$(PY) -m pytest test -m "ros and not long" $(PYTEST_ARGS) || status=$$?; \
 	exit $$status
+
+# the tests that take minutes each (a whole imaging orbit through the nodes), apart from `make test`
+test-long: lint
+	$(PY) -m pytest test -m long $(PYTEST_ARGS)
 
 # the ROS-free unit tests only: no nodes, no DDS, nothing slow (a quick check while working)
 test-fast: lint
