@@ -276,3 +276,7 @@ class StripLaw:
 
     def reference(self, t: float) -> Reference:
         return strip_reference(self.geometry, self.strip, self.primary_B, self.secondary_B, self.t_start, t)
+
+    def primary_N(self, t: float) -> np.ndarray:
+        """The unit line of sight to the aim point at ``t`` (inertial): where the law puts the boresight."""
+        return rot.dcm_NB(self.attitude(t)) @ np.asarray(self.primary_B, float)

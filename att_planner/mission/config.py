@@ -48,7 +48,7 @@ from att_planner.guidance.laws import PointingGeometry
 from att_planner.guidance.modes import law_of
 from att_planner.methods import END_POINTING_METHODS
 from att_planner.mission import targets as target_lists
-from att_planner.mission.ground import GroundTrack, site_mode
+from att_planner.mission.ground import site_track
 from att_planner.mission.scheduler import MissionTarget
 from att_planner.mission.schema import Mission
 from att_sim.models import config_files, world
@@ -87,8 +87,8 @@ class MissionConfig:
         if tl.kind == "inertial":
             return {t.name: MissionTarget(t.name, t.dwell, target_lists.pointing_attitude(
                 self.sensor_axis, t.direction, tl.roll_reference), t.direction) for t in tl.targets}
-        return {t.name: MissionTarget(t.name, t.dwell, track=GroundTrack(
-            self.scenario, t, site_mode(t, self.sensor_axis, self.secondary_axis, self.secondary), tl.min_elevation))
+        return {t.name: MissionTarget(t.name, t.dwell, track=site_track(
+            self.scenario, t, self.sensor_axis, self.secondary_axis, self.secondary, tl.min_elevation))
             for t in tl.targets}
 
 
@@ -147,6 +147,11 @@ def load(name: str) -> MissionConfig:
                 else math.radians(m.rate_max_deg_per_s))
     if scenario.epoch is None:
         raise _invalid(path, f"scenario '{scenario.name}' has no epoch: a mission flies the real sky")
+    strips = [t.name for t in target_list.targets if getattr(t, "strip", None) is not None]
+    if strips and m.site_arrival != "on_law":
+        raise _invalid(path, f"site_arrival {m.site_arrival}: the target list's strips "
+                             f"({clip(', '.join(strips), 80)}) are scanned from the slew's arrival: "
+                             "site_arrival on_law")
     if target_list.kind == "ground" and m.site_arrival == "on_law" and m.method and \
             m.method not in END_POINTING_METHODS:
         raise _invalid(path, f"method {m.method}: site_arrival on_law ends each slew on the site's law, which "

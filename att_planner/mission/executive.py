@@ -86,6 +86,7 @@ class MissionExecutive(Holds):
         self.remaining, self.observed, self.attempts = list(targets), 0, Counter()
         self.phase, self.done, self.ignored = "starting", False, []
         self._awaited: io.Awaited | None = None
+        self.flown_mode: tuple | None = None             # (target, the mode its slew flown last hands over to)
         self._numbers = itertools.count(1)
         self._out: list = []
 
@@ -158,10 +159,16 @@ class MissionExecutive(Holds):
             at = start or self.t
             reported = self._target(target)
             q_BN, direction_N = reported.attitudes(at)[0], reported.direction_at(at)
-            pointing = reported.track.mode if reported.moving else None
+            pointing = self._pointing_of(target, at) if reported.moving else None
         self._out.append(io.Report(MissionEvent(
             self.t, kind, target, start, end, q_BN, direction_N, self.sensor_axis_B if target else np.zeros(3),
             self.pointing_tolerance if target else 0.0, plan_id, message, self.frame_id, pointing, self.zone_names)))
+
+    def _pointing_of(self, name: str, t: float):
+        """Moving target ``name``'s pointing mode: the one its slew flown last hands over to (a strip's
+        scan from that slew's arrival), else its track's for an arrival at ``t``."""
+        flown = self.flown_mode
+        return flown[1] if flown is not None and flown[0] == name else self.targets[name].track.mode_at(t)
 
     def _log(self, t: float, text: str) -> None:
         self._out.append(io.Log(t, text))
@@ -371,15 +378,15 @@ class MissionExecutive(Holds):
             self._report(Kind.REFUSED, name, message="the slew cannot arrive before the site's last "
                                                      "visibility before the horizon")
             return then(None)
-        plans, mode = 0, target.track.mode
+        plans = 0
 
         def attempt():
             start = max(t_start, aim - guess)
             self._plan(name, q_from_BN, target.attitudes(aim)[0], start, None, lambda plan: planned(plan, start),
-                       end_pointing=mode if self.on_law else None)
+                       end_pointing=target.track.mode_at(aim) if self.on_law else None)
 
         def planned(plan, start: float):
-            nonlocal plans, aim, guess
+            nonlocal plans
             if plan is None:
                 return then(None)
             plans += 1
@@ -389,8 +396,16 @@ class MissionExecutive(Holds):
                 fits = visible is not None and visible <= arrival + SITE_ARRIVAL_SLACK
             else:
                 fits = abs(arrival - aim) <= SITE_DURATION_MATCH
-            if fits:
-                return self._execute(name, plan, start, mode, then)
+            if not fits:
+                return replan(plan, arrival)
+            after = plan.pointing_after or target.track.mode_at(arrival)     # a strip's: from the arrival
+            if not self.on_law:
+                return self._execute(name, plan, start, after, then)
+            # on the law from the plan's end, whichever later step reports it: the dwell starts there
+            self._execute(name, plan, start, after, lambda end: then(None if end is None else arrival))
+
+        def replan(plan, arrival: float):
+            nonlocal aim, guess
             earliest = self.scheduler.observable_from(name, t_start + plan.duration)
             if earliest is None:
                 self._report(Kind.REFUSED, name, message=f"a slew of {plan.duration:.0f} s from {t_start:.0f} s or "
@@ -414,6 +429,8 @@ class MissionExecutive(Holds):
                          message=f"planning ended {late:.1f} s of sim time after the slew's start ({plan.method}, "
                                  f"planned in {plan.solve_seconds:.2f} s): start_lead is too short")
             return then(None)
+        if pointing_after is not None:
+            self.flown_mode = (name, pointing_after)
         self._report(Kind.SLEW, name, t_start, t_start + plan.duration, plan.plan_id,
                      f"{plan.method} {plan.duration:.1f} s, {math.degrees(plan.min_cone_margin):.2f} deg "
                      f"from the zones, planned in {plan.solve_seconds:.2f} s")

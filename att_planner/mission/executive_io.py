@@ -47,6 +47,7 @@ class PlanReturned(ExecutiveEvent):
     method: str = ""
     solve_seconds: float = 0.0
     min_cone_margin: float = 0.0
+    pointing_after: PointingMode | None = None     # a strip's scan from the arrival, when the planner says it
 
 
 @dataclass(frozen=True, kw_only=True)

@@ -16,6 +16,12 @@ an array of times (s past the scenario's epoch):
 A site is *trackable* at a time when it stands ``min_elevation`` above its horizon and that torque
 stays within ``torque_share`` of the planning limit (the rest is the feedback's): passes nearly
 overhead turn the line of sight faster than a large spacecraft can follow.
+
+A strip (:class:`StripTrack`) is scanned from the slew's arrival: its law depends on that instant
+(:meth:`StripTrack.mode_at`). An arrival ``A`` can scan it when the spacecraft stands ``min_elevation``
+above the strip's start at ``A`` and above its end at ``A + duration``, and the scan's body torque
+(:func:`att_planner.guidance.strip.tracking_demand`) stays within the same share; its attitudes at ``A``
+are the strip's first point at the scan's rate (:func:`att_planner.guidance.strip.strip_start_goal`).
 """
 from __future__ import annotations
 
@@ -25,11 +31,20 @@ from att_msgs_py.types import PointingMode
 from att_planner.guidance import reference
 from att_planner.guidance.ground_arrival import elevation_sines
 from att_planner.guidance.laws import WGS84_A, WGS84_E2, WGS84_F, PointingGeometry, geodetic_to_itrs
-from att_planner.guidance.modes import law_of
+from att_planner.guidance.modes import law_of, strip_mode
+from att_planner.guidance.strip import StripLaw, strip_start_goal, tracking_demand
 from att_sim.models import rotations as rot
 from att_sim.models import world
 
 TORQUE_SHARE = 0.8             # of the planning torque limit a site's tracking may take
+
+
+def site_track(scenario, site, sensor_axis, secondary_axis, secondary: str, min_elevation: float):
+    """The track of target list site ``site``: a :class:`StripTrack` for a strip, else a
+    :class:`GroundTrack` of its :func:`site_mode`."""
+    if site.strip is not None:
+        return StripTrack(scenario, site, sensor_axis, secondary_axis, min_elevation)
+    return GroundTrack(scenario, site, site_mode(site, sensor_axis, secondary_axis, secondary), min_elevation)
 
 
 def site_mode(site, sensor_axis, secondary_axis, secondary: str) -> PointingMode:
@@ -90,6 +105,78 @@ class GroundTrack:
         ok = self.elevation(t) >= self.min_elevation
         if ok.any():
             ok[ok] = self.torque(t[ok]) <= self.torque_limit
+        return ok
+
+    def mode_at(self, arrival: float) -> PointingMode:
+        """The pointing mode a slew arriving at ``arrival`` hands over to: the site's, whenever."""
+        return self.mode
+
+
+class StripTrack:
+    """Strip ``site.strip`` scanned from a slew's arrival by ``scenario``'s spacecraft, boresight
+    ``sensor_axis`` and the detector's along-track axis ``secondary_axis`` (body axes): the
+    :class:`GroundTrack` interface, whose times are arrivals (module docstring)."""
+
+    def __init__(self, scenario, site, sensor_axis, secondary_axis, min_elevation: float,
+                 torque_share: float = TORQUE_SHARE):
+        self.site, self.strip, self.min_elevation = site, site.strip, float(min_elevation)
+        self.primary_B, self.secondary_B = np.asarray(sensor_axis, float), np.asarray(secondary_axis, float)
+        self.environment = world.Environment.from_scenario(scenario)
+        self.geometry = PointingGeometry.of(self.environment)
+        self.spacecraft = scenario.spacecraft
+        self.torque_limit = torque_share * self.spacecraft.body_torque_max
+        self.start_goal = strip_start_goal(self.geometry, self.strip, self.primary_B, self.secondary_B)
+        ends = [self.strip.point(self.strip.theta_of(s))[0] for s in (0.0, self.strip.length_m)]
+        self.ends_itrs = np.array(ends)
+        self.ups_itrs = np.array([geodetic_up(*geodetic_of(p)[:2])[0] for p in ends])
+
+    @property
+    def duration(self) -> float:
+        """The scan's duration (s): the strip's length at its scan speed."""
+        return self.strip.duration_s
+
+    def mode_at(self, arrival: float) -> PointingMode:
+        """The strip's pointing mode scanned from ``arrival`` (s past the epoch)."""
+        return strip_mode(self.strip, self.primary_B, self.secondary_B, arrival)
+
+    def _elevation_of(self, end: int, t: np.ndarray) -> np.ndarray:
+        R = self.environment.field.itrs_rotation(t)
+        r = np.asarray(self.environment.orbit.position(t), float).reshape(-1, 3)
+        sines = elevation_sines(np.einsum("kij,kj->ki", R, r), self.ends_itrs[end], self.ups_itrs[end])[0]
+        return np.arcsin(np.clip(sines, -1.0, 1.0))
+
+    def elevation(self, t) -> np.ndarray:
+        """The spacecraft's elevation (rad) above the strip's start at each time of ``t``."""
+        return self._elevation_of(0, np.atleast_1d(np.asarray(t, float)))
+
+    def attitudes(self, t) -> np.ndarray:
+        """The attitude on the strip's first point, a scan starting there, at each time of ``t``, (K, 4)."""
+        return np.array([self.start_goal(float(x))[0] for x in np.atleast_1d(t)])
+
+    def scan_attitudes(self, arrivals, fraction: float) -> np.ndarray:
+        """The attitude ``fraction`` of the way through the scan started at each of ``arrivals``, (K, 4)."""
+        law = [StripLaw(self.geometry, self.strip, self.primary_B, self.secondary_B, float(a))
+               for a in np.atleast_1d(arrivals)]
+        return np.array([x.attitude(x.t_start + fraction * self.duration) for x in law])
+
+    def line_of_sight(self, t) -> np.ndarray:
+        """The unit line of sight from the spacecraft to the strip's start at each time of ``t``, (K, 3)."""
+        out = []
+        for x in np.atleast_1d(t):
+            q = self.start_goal(float(x))[0]
+            out.append(rot.dcm_NB(q) @ self.primary_B)
+        return np.array(out)
+
+    def trackable(self, t) -> np.ndarray:
+        """Whether a scan from each arrival of ``t`` sees the strip's start and end ``min_elevation`` high
+        and asks a body torque within the share."""
+        t = np.atleast_1d(np.asarray(t, float))
+        ok = (self.elevation(t) >= self.min_elevation) & \
+            (self._elevation_of(1, t + self.duration) >= self.min_elevation)
+        for k in np.flatnonzero(ok):
+            _, torque = tracking_demand(self.spacecraft, self.geometry, self.strip, self.primary_B,
+                                           self.secondary_B, float(t[k]), samples=3)
+            ok[k] = torque <= self.torque_limit
         return ok
 
 

@@ -57,7 +57,8 @@ SKY_PARKS = 64                # directions of the sky the spacecraft may park at
 @dataclass(frozen=True)
 class MissionTarget:
     """A target of the mission: an inertial source held at ``attitude`` (its ``direction`` inertial),
-    or a ground site followed along ``track`` (a :class:`~att_planner.mission.ground.GroundTrack`)."""
+    or a ground site followed along ``track`` (a :class:`~att_planner.mission.ground.GroundTrack`; a
+    strip's :class:`~att_planner.mission.ground.StripTrack`, scanned from the arrival)."""
 
     name: str
     dwell: float
@@ -163,11 +164,20 @@ class MissionScheduler:
         return (self.zones.margins(self.grid, q, true=True).min(axis=1) >= margin) & self.tracked(q, self.grid)
 
     def _site_spans(self, target: MissionTarget, margin: float) -> list[tuple]:
-        """A site's spans ``(a, b)``: a slew arriving at ``A`` in ``[a, b − blend − dwell]`` is followed
+        """A site's spans ``(a, b)`` (a strip's: the arrivals from which its scan is seen high enough, within
+        the torque and keeping the zones at its start, middle and end, then ``b`` + its scan): a slew
+        arriving at ``A`` in ``[a, b − blend − dwell]`` is followed
         by the blend into the site's law and the dwell, with the law's attitude clear of the zones from
         ``A`` to the dwell's end and the site trackable through the dwell (the blend starts where the
         site rises, its line of sight slow; so ``held`` = blend + dwell as for a source's dwell)."""
         t, held = self.grid, self.blend + target.dwell
+        if hasattr(target.track, "scan_attitudes"):     # a strip: each arrival scans it from there
+            ok = target.observable(t)
+            for fraction in (0.0, 0.5, 1.0):            # the zones kept at the scan's start, middle and end
+                at = t[ok] + fraction * target.dwell
+                ok[ok] = self.zones.margins(at, target.track.scan_attitudes(t[ok], fraction),
+                                            true=True).min(axis=1) >= margin
+            return [(a, b + held) for a, b in spans(t, ok)]
         clear = self.zones.margins(t, target.attitudes(t), true=True).min(axis=1) >= margin
         trackable = target.observable(t) & clear
         out = []
@@ -238,7 +248,7 @@ class MissionScheduler:
         t_first = t_now + self.lead
         longest = max((b - max(a, t_first) for a, b in self.visible[name] if b > t_first), default=0.0)
         return (f"its visibility before the horizon lasts {longest:g} s at most" if longest > 0.0 else
-                "no time left before the horizon") + held
+                "no visibility left before the horizon") + held
 
     def held(self, name: str) -> float:
         """How long target ``name`` must stay visible once reached (s): a source its dwell, then the

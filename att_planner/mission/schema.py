@@ -116,13 +116,35 @@ class Source(Schema):
 
 
 class Site(Schema):
-    """A ground target: geodetic latitude, longitude and altitude."""
+    """A ground target: geodetic latitude, longitude and altitude; a site tracked for ``dwell_s``, or a
+    strip from there to its end scanned at ``scan_speed_m_s`` (its dwell is its scan)."""
 
     name: Name
-    lat_deg: float = number(ge=-90.0, le=90.0, unit="deg", meaning="geodetic latitude")
-    lon_deg: float = number(ge=-180.0, le=360.0, unit="deg", meaning="longitude, east")
+    lat_deg: float = number(ge=-90.0, le=90.0, unit="deg", meaning="geodetic latitude (a strip: its start's)")
+    lon_deg: float = number(ge=-180.0, le=360.0, unit="deg", meaning="longitude, east (a strip: its start's)")
     alt_m: float = number(0.0, ge=-500.0, le=9000.0, unit="m", meaning="altitude above the ellipsoid")
-    dwell_s: float = number(ge=0.0, le=MAX_DWELL_S, unit="s", meaning="time the site is tracked")
+    dwell_s: float | None = number(None, ge=0.0, le=MAX_DWELL_S, unit="s", meaning="time the site is tracked "
+                                                                                    "(a site's; none for a strip)")
+    end_lat_deg: float | None = number(None, ge=-90.0, le=90.0, unit="deg", meaning="a strip: its end's geodetic "
+                                                                                     "latitude")
+    end_lon_deg: float | None = number(None, ge=-180.0, le=360.0, unit="deg", meaning="a strip: its end's "
+                                                                                       "longitude, east")
+    scan_speed_m_s: float | None = number(None, gt=0.0, le=20_000.0, unit="m/s", meaning="a strip: the ground "
+                                                                                         "speed of its scan")
+
+    @model_validator(mode="after")
+    def _site_or_strip(self):
+        strip = (self.end_lat_deg, self.end_lon_deg, self.scan_speed_m_s)
+        if all(v is None for v in strip):
+            if self.dwell_s is None:
+                raise ValueError("dwell_s: a site's time tracked (or end_lat_deg, end_lon_deg and scan_speed_m_s: "
+                                 "a strip)")
+            return self
+        if any(v is None for v in strip):
+            raise ValueError("a strip needs end_lat_deg, end_lon_deg and scan_speed_m_s, all three")
+        if self.dwell_s is not None:
+            raise ValueError("dwell_s: a strip's dwell is its scan (its length / scan_speed_m_s): give none")
+        return self
 
 
 class InertialTargets(Schema):

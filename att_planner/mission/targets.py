@@ -9,16 +9,20 @@ Two kinds, one file each (``config/targets/``; read by the one loader,
     targets:
       - {name: crab, ra_deg: 83.633, dec_deg: 22.015, dwell_s: 600}
 
-    kind: ground                   # Earth observation: sites tracked through the dwell
+    kind: ground                   # Earth observation: sites tracked through the dwell, strips scanned
     scenario: leo_observatory
     min_elevation_deg: 30          # a site is observable while the spacecraft is this high in its sky
     targets:
       - {name: toulouse, lat_deg: 43.60, lon_deg: 1.44, alt_m: 150, dwell_s: 60}
+      - {name: garonne, lat_deg: 44.0, lon_deg: 0.0, end_lat_deg: 44.5, end_lon_deg: 0.5, scan_speed_m_s: 7000}
 
 An inertial source becomes a schedule target attitude (:func:`pointing_attitude`): the scenario's
 sensor axis on the source, the body axis after it (x → z → y → x) as near ``roll_reference`` as the
 pointing allows (the vernal equinox where the source lies within a degree of the reference). A
-ground site stays a site: the pointing modes track it through its dwell. Every field is
+ground site stays a site: the pointing modes track it through its dwell. A strip (``end_lat_deg``,
+``end_lon_deg``, ``scan_speed_m_s``; no ``dwell_s``) is the great-ellipse segment from its start to
+its end (:class:`~att_planner.guidance.strip.Strip`), scanned at that ground speed: its dwell is its
+scan. Every field is
 checked; a bad file is refused with a :class:`~att_msgs_py.errors.ConfigError` (``INVALID_CONFIG``)
 listing every problem as ``file:line: targets[i].field: expected ...; found ...``.
 """
@@ -30,7 +34,8 @@ from pathlib import Path
 
 import numpy as np
 
-from att_msgs_py.errors import clip
+from att_msgs_py.errors import ConfigError, ErrorCode, clip
+from att_planner.guidance.strip import Strip
 from att_planner.mission import schema
 from att_sim.models import config_files
 from att_sim.models import rotations as rot
@@ -50,13 +55,15 @@ class Source:
 
 @dataclass(frozen=True)
 class Site:
-    """A ground target: geodetic latitude and longitude (rad), altitude (m) and its dwell (s)."""
+    """A ground target: geodetic latitude and longitude (rad), altitude (m) and its dwell (s); a strip
+    (:class:`~att_planner.guidance.strip.Strip`) starts there and its dwell is its scan."""
 
     name: str
     latitude: float
     longitude: float
     altitude: float
     dwell: float
+    strip: Strip | None = None
 
 
 @dataclass(frozen=True)
@@ -77,7 +84,12 @@ def _target(kind: str, entry: schema.Source | schema.Site) -> Source | Site:
         ra, dec = math.radians(entry.ra_deg), math.radians(entry.dec_deg)
         return Source(entry.name, np.array([math.cos(dec) * math.cos(ra), math.cos(dec) * math.sin(ra),
                                             math.sin(dec)]), entry.dwell_s)
-    return Site(entry.name, math.radians(entry.lat_deg), math.radians(entry.lon_deg), entry.alt_m, entry.dwell_s)
+    lat, lon = math.radians(entry.lat_deg), math.radians(entry.lon_deg)
+    if entry.end_lat_deg is None:
+        return Site(entry.name, lat, lon, entry.alt_m, entry.dwell_s)
+    strip = Strip.between(lat, lon, math.radians(entry.end_lat_deg), math.radians(entry.end_lon_deg), entry.alt_m,
+                          entry.scan_speed_m_s)
+    return Site(entry.name, lat, lon, entry.alt_m, strip.duration_s, strip)
 
 
 def config_file(folder: str, name: str, what: str) -> Path:
@@ -119,7 +131,14 @@ def load(name: str) -> TargetList:
     m = read(path).model
     extra = ({"roll_reference": np.asarray(m.roll_reference, float) / np.linalg.norm(m.roll_reference)}
              if m.kind == "inertial" else {"min_elevation": math.radians(m.min_elevation_deg)})
-    return TargetList(path, m.kind, m.scenario, [_target(m.kind, t) for t in m.targets], **extra)
+    targets = []
+    for i, entry in enumerate(m.targets):
+        try:
+            targets.append(_target(m.kind, entry))
+        except ValueError as err:          # a strip with no plane, shorter than 1 m or longer than a pass
+            raise ConfigError(ErrorCode.INVALID_CONFIG, f"target list {clip(path, 200)}: targets[{i}] "
+                                                        f"({clip(entry.name, 40)}): {err}") from None
+    return TargetList(path, m.kind, m.scenario, targets, **extra)
 
 
 def pointing_attitude(sensor_axis, direction, roll_reference=CELESTIAL_NORTH) -> np.ndarray:

@@ -70,6 +70,28 @@ def check_strings(msg, name: str = "", nul_only: bool = False) -> None:
                     check_strings(item, f"{label}[{i}]", nul_only)
 
 
+def strip_request(q_initial, strip: PointingMode, *, method: str = "", time_budget: float = 0.0,
+                  frame_id: str = "eci", epoch: datetime | None = None, zones: list[Zone] = (),
+                  wheel_speeds=()) -> ImageStrip.Request:
+    """The ImageStrip request of the strip of pointing mode ``strip`` (kind ``strip``: its start,
+    end, altitude and scan speed, its boresight and along-track axes; its ``scan_start`` is the
+    planner's to set, the arrival) from ``q_initial`` at ``epoch``, keeping ``zones``; ValueError as
+    :func:`maneuver_request`."""
+    req = ImageStrip.Request()
+    req.header.frame_id = frame_id
+    req.initial_attitude = convert.quaternion(q_initial)
+    req.start_latitude_deg, req.start_longitude_deg = math.degrees(strip.latitude), math.degrees(strip.longitude)
+    req.end_latitude_deg, req.end_longitude_deg = math.degrees(strip.end_latitude), math.degrees(strip.end_longitude)
+    req.altitude_m, req.scan_speed_m_s = float(strip.altitude), float(strip.scan_speed)
+    req.sensor_axis, req.along_track_axis = convert.vector3(strip.primary_axis), convert.vector3(strip.secondary_axis)
+    req.method, req.time_budget = method, float(time_budget)
+    req.epoch = convert.epoch_msg(epoch)
+    req.zones = [convert.zone_msg(z) for z in zones]
+    req.wheel_speeds = [float(v) for v in wheel_speeds]
+    check_strings(req)
+    return req
+
+
 def maneuver_request(q_initial, q_final, sensor_axis, cones: list[Cone], *, method: str = "",
                      time_budget: float = 0.0, spacecraft: str = "", frame_id: str = "eci",
                      options: dict | None = None, epoch: datetime | None = None, zones: list[Zone] = (),

@@ -51,7 +51,7 @@ from att_planner.mission import executive_io as io
 from att_planner.mission.day import day_report
 from att_planner.mission.executive import MissionExecutive
 from att_planner.mission.ground import ground_fixes
-from att_planner.nodes.client import client_session, maneuver_request
+from att_planner.nodes.client import client_session, maneuver_request, strip_request
 from att_planner.tools.demo import SimClock, domain_line
 from att_planner.tools.launch import default_nodes, isolated_env, join_env, start_suite
 from att_sim.models import world
@@ -224,26 +224,32 @@ class MissionDriver:
 
     def plan(self, action: io.RequestPlan):
         """The planner's answer to ``action`` among the mission's zones where they are at its start
-        (sim time held meanwhile when the driver holds it)."""
+        (sim time held meanwhile when the driver holds it): ``PlanManeuver``, or for a slew onto a
+        strip ``ImageStrip``, whose answer says the scan the controller hands over to."""
         m = self.mission
         epoch = m.scenario.epoch + timedelta(seconds=action.t_start)
-        options = {"rate_max": m.rate_max} if math.isfinite(m.rate_max) else {}
-        request = maneuver_request(action.q_from_BN, action.q_to_BN, m.sensor_axis, [], method=m.method,
-                                   options=options, time_budget=action.time_budget, frame_id=m.scenario.frame_id,
-                                   epoch=epoch, zones=list(m.zones), wheel_speeds=list(self.telemetry.msg.wheel_speeds),
-                                   end_pointing=action.end_pointing)
+        common = dict(method=m.method, time_budget=action.time_budget, frame_id=m.scenario.frame_id, epoch=epoch,
+                      zones=list(m.zones), wheel_speeds=list(self.telemetry.msg.wheel_speeds))
+        if action.end_pointing is not None and action.end_pointing.kind == "strip":
+            request, ask = strip_request(action.q_from_BN, action.end_pointing, **common), self.client.image_strip
+        else:
+            options = {"rate_max": m.rate_max} if math.isfinite(m.rate_max) else {}
+            request = maneuver_request(action.q_from_BN, action.q_to_BN, m.sensor_axis, [], options=options,
+                                       end_pointing=action.end_pointing, **common)
+            ask = self.client.plan
         if self.hold_while_planning:
             with self.client.simulator_held():
-                response = self.client.plan(request)
+                response = ask(request)
         else:
-            response = self.client.plan(request)
+            response = ask(request)
         if not response.success:
             return self.heard(io.PlanRefused, request=action.request, code=int(response.error_code),
                               message=response.message)
         plan = response.plan
+        after = convert.pointing_from_msg(response.pointing_after) if ask == self.client.image_strip else None
         return self.heard(io.PlanReturned, request=action.request, plan_id=plan.plan_id, duration=plan.duration,
                           method=plan.method, solve_seconds=plan.solve_seconds,
-                          min_cone_margin=plan.verification.min_cone_margin)
+                          min_cone_margin=plan.verification.min_cone_margin, pointing_after=after)
 
 
 def fly_mission(mission: mission_config.MissionConfig, out: Path, log=print,

@@ -87,6 +87,21 @@ def site_sight_from(epoch: str, r_N, latitude_deg: float, longitude_deg: float, 
     return v / np.linalg.norm(v, axis=1, keepdims=True)
 
 
+def strip_sight_from(epoch: str, r_N, start_deg: tuple, end_deg: tuple, altitude_m: float, scan_start: float,
+                     duration: float, t):
+    """Unit lines of sight (K, 3, GCRS) from the spacecraft at ``r_N`` (K, 3, m, GCRS) at times ``t`` (s
+    past the UTC ``epoch``) to a strip's aim point, scanned from ``scan_start`` for ``duration`` s:
+    the point a fraction ``(t − scan_start) / duration`` of the way from the start to the end
+    (geodetic (lat, lon) deg) in latitude and longitude, on skyfield's WGS-84; a strip under 200 km
+    is within tens of metres of its great ellipse so."""
+    rows = []
+    for k, tk in enumerate(np.atleast_1d(t)):
+        f = (tk - scan_start) / duration
+        lat, lon = (start_deg[i] + f * (end_deg[i] - start_deg[i]) for i in (0, 1))
+        rows.append(site_sight_from(epoch, np.asarray(r_N)[k:k + 1], lat, lon, altitude_m, np.array([tk]))[0])
+    return np.array(rows)
+
+
 def site_sight(epoch: str, tle, latitude_deg: float, longitude_deg: float, altitude_m: float, t):
     """Unit lines of sight (K, 3, GCRS) from the spacecraft of ``tle`` to a WGS-84 ground site at
     times ``t`` (s past the UTC ``epoch``): skyfield's ``wgs84.latlon`` and ``EarthSatellite``."""

@@ -56,6 +56,9 @@ class MissionLog:
     ground: dict | None = None     # ground sites: :func:`att_planner.mission.ground.ground_track` at the states' times
 
 
+GROUND_KINDS = ("ground", "strip")    # pointing modes of a mission's ground sites and strips
+
+
 def mission_of(log: dict[str, TopicLog], scenario: scen.Scenario | None) -> MissionLog | None:
     """The mission review's data of a log with mission events and a real-sky scenario (else None)."""
     events = events_of(log)
@@ -72,21 +75,29 @@ def mission_of(log: dict[str, TopicLog], scenario: scen.Scenario | None) -> Miss
     mode = np.asarray(status["mode"]) if status is not None else np.zeros(0)
     sensor_axis = next((e.sensor_axis for e in events if e.target), np.array([0.0, 0.0, 1.0]))
     ground = None
-    if any(e.pointing is not None and e.pointing.kind == "ground" for e in events):
+    if any(e.pointing is not None and e.pointing.kind in GROUND_KINDS for e in events):
         ground = ground_track(world.Environment.from_scenario(scenario), t, q, sensor_axis)
     return MissionLog(events, target_table(events, t, q, margins, scenario), t, q, margins, zones.names,
                       relative * sc.wheel_inertia, np.asarray(state["dipole"], float), mode_t, mode,
                       sc.wheel_inertia * sc.wheel_speed_max, sky, sensor_axis, ground)
 
 
+def strip_ends(run: MissionLog) -> dict:
+    """The strips of the mission's events: name -> ((start latitude, longitude), (end latitude,
+    longitude)) in deg."""
+    return {e.target: tuple((math.degrees(a), math.degrees(b)) for a, b in (
+        (e.pointing.latitude, e.pointing.longitude), (e.pointing.end_latitude, e.pointing.end_longitude)))
+        for e in run.events if e.target and e.pointing is not None and e.pointing.kind == "strip"}
+
+
 def site_outcomes(run: MissionLog) -> dict:
     """Ground sites by outcome: ``imaged`` (observed within the tolerance on the truth), ``refused``
     (not imaged, after at least one refusal: a plan, a slew or an arrival refused) and ``missed``
     (the others: never reachable, or not reached before the horizon); name -> (latitude, longitude)
-    in deg, from the events' ground pointing modes."""
+    in deg (a strip's start), from the events' ground and strip pointing modes."""
     sites = {}
     for e in run.events:
-        if e.target and e.pointing is not None and e.pointing.kind == "ground" and e.target not in sites:
+        if e.target and e.pointing is not None and e.pointing.kind in GROUND_KINDS and e.target not in sites:
             sites[e.target] = (math.degrees(e.pointing.latitude), math.degrees(e.pointing.longitude))
     observed = {r["name"] for r in run.rows if r["observed"]}
     refused = {e.target for e in run.events if e.event == Kind.REFUSED and e.target}
@@ -248,8 +259,12 @@ def figure_mission_ground(run: MissionLog, path: Path) -> Path:
         _lon_track(ax, np.where(on, g["bore_lon"], np.nan), g["bore_lat"], color=colour, lw=2.5, label=label)
     errors = {r["name"]: r["pointing_error_deg"] for r in run.rows}
     styles = {"imaged": ("o", "tab:green"), "refused": ("^", "tab:orange"), "missed": ("x", "tab:red")}
+    strips = strip_ends(run)
     for outcome, found in sites.items():
         marker, colour = styles[outcome]
+        for name in found.keys() & strips.keys():           # a strip: its segment, from its start's marker
+            (lat0, lon0), (lat1, lon1) = strips[name]
+            ax.plot([lon0, lon1], [lat0, lat1], "-", color=colour, lw=3.0, alpha=0.6)
         for i, (name, (lat, lon)) in enumerate(found.items()):
             ax.plot(lon, lat, marker, color=colour, ms=9, mfc="none" if marker == "o" else colour,
                     label=f"{outcome} ({len(found)})" if i == 0 else None)

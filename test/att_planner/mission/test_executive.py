@@ -76,8 +76,8 @@ class World:
     ``refuse_hold(t)``."""
 
     def __init__(self, executive, duration=lambda a: 50.0, plan_seconds=0.0, refuse_plan=lambda a: False,
-                 refuse_maneuver=lambda a: False, refuse_hold=lambda t: False, health=()):
-        self.ex, self.duration, self.plan_seconds = executive, duration, plan_seconds
+                 refuse_maneuver=lambda a: False, refuse_hold=lambda t: False, health=(), after=lambda a, d: None):
+        self.ex, self.duration, self.plan_seconds, self.after = executive, duration, plan_seconds, after
         self.refuse_plan, self.refuse_maneuver, self.refuse_hold = refuse_plan, refuse_maneuver, refuse_hold
         self.health = sorted(health)            # (sim time, converged) changes of the estimate
         self.t, self.q_BN, self.goals = 0.0, IDENTITY, {}
@@ -101,9 +101,10 @@ class World:
                 return io.PlanRefused(t=self.t, q_BN=self.q_BN, request=action.request, code=7, message="no path")
             plan_id = f"p{len(self.plans)}"
             self.goals[plan_id] = action.q_to_BN
+            duration = self.duration(action)
             return io.PlanReturned(t=self.t, q_BN=self.q_BN, request=action.request, plan_id=plan_id,
-                                   duration=self.duration(action), method="toy", solve_seconds=0.5,
-                                   min_cone_margin=math.radians(3.0))
+                                   duration=duration, method="toy", solve_seconds=0.5,
+                                   min_cone_margin=math.radians(3.0), pointing_after=self.after(action, duration))
         if isinstance(action, io.StartManeuver):
             if self.refuse_maneuver(action):
                 return io.ManeuverEnded(t=self.t, q_BN=self.q_BN, request=action.request, success=False, code=4,
@@ -420,6 +421,9 @@ class Site:
     def line_of_sight(self, t):
         return np.array([[1.0, 0.0, 0.0]])
 
+    def mode_at(self, arrival):
+        return self.mode
+
 
 def test_a_site_plan_arriving_before_the_site_is_trackable_is_planned_again_four_times_at_most():
     site = MissionTarget("site", 120.0, track=Site())
@@ -502,3 +506,30 @@ def test_a_refusal_while_the_held_attitude_cannot_start_a_slew_is_not_counted():
     # decided again at the first check clear of the zone (200 s), a's start its arrival - slew or a lead on
     assert [p.t_start for p in world.plans] == [300.0 - 60.0, max(300.0 - 60.0, 200.0 + LEAD)]
     assert [e.target for e in world.reports(Kind.DWELL)] == ["a"]
+
+
+class Strip(Site):
+    """A strip's track: its mode scans it from the arrival."""
+
+    def mode_at(self, arrival):
+        return PointingMode("strip", scan_start=arrival)
+
+
+def test_a_strip_is_planned_onto_its_start_and_scanned_from_the_arrival_the_planner_says():
+    """The plan asks for the strip (end_pointing of kind strip); the planner's answer says the scan
+    from the arrival (pointing_after), which the controller is handed and the dwell event carries."""
+    strip = MissionTarget("strip", 14.0, track=Strip())
+    answered = PointingMode("strip", scan_start=123.0)        # whatever the planner says, flown as said
+    world = World(executive(Scheduler({"strip": 800.0}, visible={"strip": 800.0}), [strip]),
+                  duration=lambda action: 59.5, after=lambda action, d: answered).run()
+    (plan,) = world.plans
+    assert plan.end_pointing.kind == "strip" and plan.end_pointing.scan_start == 800.0     # the aim
+    maneuver = next(x for x in world.actions if isinstance(x, io.StartManeuver))
+    assert maneuver.pointing_after is answered
+    dwell = world.reports(Kind.DWELL)[0]
+    assert dwell.pointing is answered and (dwell.start, dwell.end) == (740.0 + 59.5, 740.0 + 59.5 + 14.0)
+    assert world.reports(Kind.SLEW)[0].pointing is answered
+    # without the planner's word, the track's mode from the arrival
+    world = World(executive(Scheduler({"strip": 800.0}, visible={"strip": 800.0}), [strip]),
+                  duration=lambda action: 59.5).run()
+    assert world.reports(Kind.DWELL)[0].pointing.scan_start == 740.0 + 59.5

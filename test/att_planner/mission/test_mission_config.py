@@ -114,6 +114,19 @@ def test_a_ground_mission_whose_method_plans_rest_to_rest_only_is_refused(tmp_pa
     assert mc.load(write(tmp_path, yaml_of({**GOOD, "method": method}))).method == method     # sources: any
 
 
+def test_strips_scanned_from_a_rest_arrival_are_refused(tmp_path):
+    """A strip is scanned from the slew's arrival, on its law: site_arrival at_rest is refused naming
+    the strips; the shipped orbit (on_law) loads them."""
+    path = write(tmp_path, yaml_of({"targets": "aeos_orbit", "sensor_axis": [0.0, 0.0, 1.0], "horizon_s": 600,
+                                    "site_arrival": "at_rest"}))
+    with pytest.raises(ConfigError, match=r"site_arrival at_rest: the target list's strips \(rio_grande, kashgar\)") \
+            as err:
+        mc.load(path)
+    assert err.value.code == ErrorCode.INVALID_CONFIG
+    assert {n for n, t in mc.load("aeos_orbit").targets().items() if t.track.mode_at(0.0).kind == "strip"} == \
+        {"rio_grande", "kashgar"}
+
+
 @pytest.mark.parametrize("text", ["", "[1, 2]", "just a string", "targets: [unclosed"])
 def test_a_file_that_is_not_a_mapping_is_refused(tmp_path, text):
     with pytest.raises(ConfigError):

@@ -185,3 +185,47 @@ def test_sky_parks_spread_over_the_sky_and_are_parks_when_no_source_is_clear():
         arrive = t_now + scheduler.leg(rot.IDENTITY, q)
         held = np.linspace(arrive, until, 20)
         assert scheduler.zones.margins(held, q, true=True).min() >= -np.deg2rad(0.5), name
+
+
+def test_a_strip_s_spans_are_the_arrivals_that_scan_it_high_enough_clear_of_the_zones():
+    """The shipped orbit's strips: from every first and last arrival of a span the strip's start is
+    58 deg high at the arrival and its end at the scan's end (each recomputed as a site there), the
+    scan's torque within the share and every zone kept at the scan's start, middle and end; a grid
+    step before a span's start, one of those fails."""
+    from att_planner.mission import config as mc
+    from att_planner.mission.executive import MissionExecutive
+    from att_planner.mission.ground import GroundTrack, geodetic_of
+    from att_planner.mission.targets import Site
+
+    m = mc.load("aeos_orbit")
+    scheduler = MissionExecutive.of_mission(m, 20.0, converged=True).scheduler
+    step = scheduler.grid[1] - scheduler.grid[0]
+    for name in ("rio_grande", "kashgar"):
+        target = scheduler.targets[name]
+        track, strip = target.track, target.track.strip
+        assert target.dwell == strip.duration_s and scheduler.held(name) == target.dwell
+        lat1, lon1, _ = geodetic_of(strip.point(strip.theta_of(strip.length_m))[0][None])
+        ends = [GroundTrack(m.scenario, Site(name, lat, lon, strip.altitude_m, 0.0), track.mode_at(0.0), 0.0)
+                for lat, lon in ((track.site.latitude, track.site.longitude), (lat1[0], lon1[0]))]
+
+        (span,) = scheduler.visible[name]               # one pass over each
+        a, b = span
+        for arrival in (a, b - scheduler.held(name)):
+            assert _scans(m, scheduler, track, ends, arrival), (name, arrival)
+        assert not _scans(m, scheduler, track, ends, a - step), name
+
+
+def _scans(m, scheduler, track, ends, arrival: float) -> bool:
+    """Whether strip ``track`` scanned from ``arrival`` is seen high enough at both ``ends`` (GroundTracks
+    of its start and end), within the torque share and clear of the zones at its start, middle and end."""
+    from att_planner.guidance.strip import StripLaw, tracking_demand
+
+    strip = track.strip
+    law = StripLaw(track.geometry, strip, track.primary_B, track.secondary_B, arrival)
+    high = ends[0].elevation(arrival)[0] >= track.min_elevation - 1e-9 and \
+        ends[1].elevation(arrival + strip.duration_s)[0] >= track.min_elevation - 1e-9
+    torque = tracking_demand(m.scenario.spacecraft, track.geometry, strip, track.primary_B, track.secondary_B,
+                             arrival, samples=3)[1]
+    clear = all(scheduler.zones.margins([arrival + f * strip.duration_s], law.attitude(arrival + f * strip.duration_s),
+                                        true=True).min() >= m.margin - 1e-9 for f in (0.0, 0.5, 1.0))
+    return high and torque <= track.torque_limit and clear

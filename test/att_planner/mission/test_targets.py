@@ -91,7 +91,54 @@ HOSTILE = {
     "ground elevation 90": ({"kind": "ground", "min_elevation_deg": 90, "targets": [
         {"name": "x", "lat_deg": 0, "lon_deg": 0, "dwell_s": 1}]},
         "min_elevation_deg: expected less than or equal to 89; found 90"),
+    "ground site without a dwell": ({"kind": "ground", "targets": [{"name": "x", "lat_deg": 0, "lon_deg": 0}]},
+        "dwell_s: a site's time tracked (or end_lat_deg, end_lon_deg and scan_speed_m_s: a strip)"),
+    "strip without a speed": ({"kind": "ground", "targets": [{"name": "s", "lat_deg": 0, "lon_deg": 0, "end_lat_deg": 1,
+                                                              "end_lon_deg": 0}]},
+        "a strip needs end_lat_deg, end_lon_deg and scan_speed_m_s, all three"),
+    "strip with a dwell": ({"kind": "ground", "targets": [{"name": "s", "lat_deg": 0, "lon_deg": 0, "end_lat_deg": 1,
+                                                           "end_lon_deg": 0, "scan_speed_m_s": 7000, "dwell_s": 5}]},
+        "dwell_s: a strip's dwell is its scan"),
+    "strip speed zero": ({"kind": "ground", "targets": [{"name": "s", "lat_deg": 0, "lon_deg": 0, "end_lat_deg": 1,
+                                                         "end_lon_deg": 0, "scan_speed_m_s": 0}]},
+        "targets[0].scan_speed_m_s: expected greater than 0; found 0"),
+    "strip speed nan": ({"kind": "ground", "targets": [{"name": "s", "lat_deg": 0, "lon_deg": 0, "end_lat_deg": 1,
+                                                        "end_lon_deg": 0, "scan_speed_m_s": float("nan")}]},
+        "targets[0].scan_speed_m_s"),
+    "strip end latitude 91": ({"kind": "ground", "targets": [{"name": "s", "lat_deg": 0, "lon_deg": 0,
+                                                              "end_lat_deg": 91, "end_lon_deg": 0,
+                                                              "scan_speed_m_s": 7}]},
+        "targets[0].end_lat_deg: expected less than or equal to 90; found 91"),
+    "strip ending at its start": ({"kind": "ground", "targets": [{"name": "s", "lat_deg": 10, "lon_deg": 20,
+                                                                  "end_lat_deg": 10, "end_lon_deg": 20,
+                                                                  "scan_speed_m_s": 7000}]},
+        "targets[0] (s): the end is the start"),
+    "strip longer than a pass": ({"kind": "ground", "targets": [{"name": "s", "lat_deg": 0, "lon_deg": 0,
+                                                                 "end_lat_deg": 0, "end_lon_deg": 30,
+                                                                 "scan_speed_m_s": 7000}]},
+        "targets[0] (s): "),
 }
+
+
+def test_a_strip_loads_with_its_scan_as_its_dwell():
+    """A strip's dwell is its length at its scan speed, the length recomputed here on the sphere of the
+    mean radius (within 0.5 % of the ellipsoid's over 100 km)."""
+    import math
+
+    from att_planner.mission import config as mc
+
+    m = mc.load("aeos_orbit")
+    (strip,) = [t for t in m.target_list.targets if t.name == "rio_grande"]
+    assert strip.strip is not None and strip.dwell == pytest.approx(strip.strip.length_m / 7000.0)
+    lat0, lon0, lat1, lon1 = (math.radians(v) for v in (31.76, -106.49, 32.6, -106.8))
+    arc = math.acos(math.sin(lat0) * math.sin(lat1) + math.cos(lat0) * math.cos(lat1) * math.cos(lon1 - lon0))
+    assert strip.strip.length_m == pytest.approx(6_371_000.0 * arc, rel=5e-3)
+    assert (strip.latitude, strip.longitude) == (pytest.approx(lat0), pytest.approx(lon0))
+    target = m.targets()["rio_grande"]
+    assert target.moving and target.dwell == strip.dwell
+    mode = target.track.mode_at(500.0)
+    assert mode.kind == "strip" and mode.scan_start == 500.0 and mode.scan_speed == 7000.0
+    assert (mode.end_latitude, mode.end_longitude) == (pytest.approx(lat1, abs=1e-9), pytest.approx(lon1, abs=1e-9))
 
 
 @pytest.mark.parametrize("name", sorted(HOSTILE))
