@@ -26,10 +26,9 @@ The decisions, each from where the spacecraft holds at that moment:
    :data:`~att_planner.mission.holds.RECOVERY_STEP` s, and decides again;
 4. the controller flies the plan and holds the target for its dwell (a ground site: the plan ends
    on the site's law, its attitude and rate, and hands over to it; or it ends at rest on the law's
-   attitude and the controller blends into the law first); then back to 1. A slew the
-   planner or the controller refuses counts as an attempt at its target when the held attitude can
-   start another slew: after
-   :data:`MAX_ATTEMPTS` attempts the target is missed;
+   attitude and the controller blends into the law first); then back to 1. A slew the planner or the
+   controller refuses counts as an attempt at its target when the held attitude can start another
+   slew: after :data:`MAX_ATTEMPTS` attempts the target is missed;
 5. a held attitude that cannot start a slew (estimate not converged, a zone or the trackers' blind
    sky within the lead) is recovered: left for a park when a zone is about to cover it and the
    estimate is converged, else held until a slew can start (checked every
@@ -322,8 +321,7 @@ class MissionExecutive(Holds):
             then(event)
         budget = budget or self.time_budget
         self._request(lambda number: io.RequestPlan(number, name, q_from_BN, q_to_BN, t_start, budget, end_pointing),
-                      "planning",
-                      (io.PlanReturned, io.PlanRefused), answered)
+                      "planning", (io.PlanReturned, io.PlanRefused), answered)
 
     def _fly(self, name: str, q_from_BN, t_start: float, wait_for_visibility: bool, budget: float | None,
              then: Callable) -> None:

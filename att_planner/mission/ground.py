@@ -161,11 +161,7 @@ class StripTrack:
 
     def line_of_sight(self, t) -> np.ndarray:
         """The unit line of sight from the spacecraft to the strip's start at each time of ``t``, (K, 3)."""
-        out = []
-        for x in np.atleast_1d(t):
-            q = self.start_goal(float(x))[0]
-            out.append(rot.dcm_NB(q) @ self.primary_B)
-        return np.array(out)
+        return np.array([rot.dcm_NB(q) @ self.primary_B for q in self.attitudes(t)])
 
     def trackable(self, t) -> np.ndarray:
         """Whether a scan from each arrival of ``t`` sees the strip's start and end ``min_elevation`` high
@@ -174,8 +170,8 @@ class StripTrack:
         ok = (self.elevation(t) >= self.min_elevation) & \
             (self._elevation_of(1, t + self.duration) >= self.min_elevation)
         for k in np.flatnonzero(ok):
-            _, torque = tracking_demand(self.spacecraft, self.geometry, self.strip, self.primary_B,
-                                           self.secondary_B, float(t[k]), samples=3)
+            _, torque = tracking_demand(self.spacecraft, self.geometry, self.strip, self.primary_B, self.secondary_B,
+                                        float(t[k]), samples=3)
             ok[k] = torque <= self.torque_limit
         return ok
 

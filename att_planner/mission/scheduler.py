@@ -44,6 +44,7 @@ import numpy as np
 from att_msgs_py.types import Zone
 from att_planner.methods.axis_rotations import axis_acceleration
 from att_planner.methods.schedule.order_search import observed_prefix, orders_by_lower_bound, spans, visibility_grid
+from att_planner.mission.ground import StripTrack
 from att_planner.zones import FittedZones
 from att_sim.models import rotations as rot
 from att_sim.models import scenario as scen
@@ -171,7 +172,7 @@ class MissionScheduler:
         ``A`` to the dwell's end and the site trackable through the dwell (the blend starts where the
         site rises, its line of sight slow; so ``held`` = blend + dwell as for a source's dwell)."""
         t, held = self.grid, self.blend + target.dwell
-        if hasattr(target.track, "scan_attitudes"):     # a strip: each arrival scans it from there
+        if isinstance(target.track, StripTrack):        # a strip: each arrival scans it from there
             ok = target.observable(t)
             for fraction in (0.0, 0.5, 1.0):            # the zones kept at the scan's start, middle and end
                 at = t[ok] + fraction * target.dwell
