@@ -51,7 +51,8 @@ PLAN_MANEUVER = {**_HEADER, "cones": MAX_CONES, "cones[].name": MAX_NAME_LENGTH,
 PLAN_SCHEDULE = {**_HEADER, "target_names": MAX_TARGETS, "targets": MAX_TARGETS, "target_names[]": MAX_NAME_LENGTH,
                  "spacecraft": MAX_NAME_LENGTH, **_ZONES, "tle_line1": MAX_TLE_LENGTH, "tle_line2": MAX_TLE_LENGTH,
                  "dwell_times": MAX_TARGETS, "window_opens": MAX_TARGETS, "window_closes": MAX_TARGETS}
-IMAGE_TARGET = {**_HEADER, "method": MAX_NAME_LENGTH, "spacecraft": MAX_NAME_LENGTH, "wheel_speeds": MAX_WHEELS}
+IMAGE_TARGET = {**_HEADER, "method": MAX_NAME_LENGTH, "spacecraft": MAX_NAME_LENGTH, "wheel_speeds": MAX_WHEELS,
+                **_ZONES}
 IMAGE_STRIP = IMAGE_TARGET
 MANEUVER_PLAN = {**_HEADER, "plan_id": MAX_NAME_LENGTH, "method": MAX_NAME_LENGTH, "status": MAX_NAME_LENGTH,
                  "message": MAX_TEXT_LENGTH, "spacecraft": MAX_NAME_LENGTH, "control_kind": MAX_NAME_LENGTH,

@@ -41,3 +41,22 @@ def test_a_request_at_the_caps_is_read_field_by_field():
     assert len(read.zones) == limits.MAX_ZONES and read.zones[3].name == "z3" and read.zones[3].body == "sun"
     np.testing.assert_array_equal(read.q_initial, [0, 0, 0, 1])
     assert read.wheel_speeds == [0.5] * limits.MAX_WHEELS
+
+
+@pytest.mark.parametrize("service", ["ImageTarget", "ImageStrip"])
+def test_an_imaging_request_s_zones_are_capped_then_read(service):
+    """The imaging requests' zones: 100,000 refused by their count (SIZE_LIMIT naming the field), the
+    cap's 16 read into the request the service core validates."""
+    from att_msgs import srv
+    from att_planner.nodes.planner_node import _image_common
+
+    table = {"ImageTarget": limits.IMAGE_TARGET, "ImageStrip": limits.IMAGE_STRIP}[service]
+    req = getattr(srv, service).Request()
+    req.zones = [Zone(name=f"z{i}", body="sun", half_angle=0.3) for i in range(100_000)]
+    err = limits.issue(req, table)
+    assert err is not None and err.code == ErrorCode.SIZE_LIMIT
+    assert err.message == f"zones has 100000 entries; at most {limits.MAX_ZONES}"
+    req.zones = req.zones[:limits.MAX_ZONES]
+    assert limits.issue(req, table) is None
+    read = _image_common(req)["zones"]
+    assert len(read) == limits.MAX_ZONES and read[5].name == "z5" and read[5].half_angle == pytest.approx(0.3)
