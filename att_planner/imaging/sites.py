@@ -57,7 +57,7 @@ class ImagingSite(schema.Site):
     end_lon_deg: float | None = FieldInfo.merge_field_infos(schema.Site.model_fields["lon_deg"], default=None)
 
     @model_validator(mode="after")
-    def _strip_end(self):
+    def _site_or_strip(self):          # in place of the mission site's: a row's dwell and scan come from the study
         if (self.end_lat_deg is None) != (self.end_lon_deg is None):
             raise ValueError("both end_latitude_deg and end_longitude_deg (a strip's end) or neither")
         return self
