@@ -198,7 +198,7 @@ class Controller:
         the gate; an estimate that cannot be flown (initialising, diverged) ends a maneuver and the
         attitude modes in safe mode (rate damping on the gyro's rate)."""
         try:
-            state = self.measured.compose(estimate)
+            state = self.measured.compose(estimate, None if self.state is None else self.state.t)
         except RequestError as err:
             return StateOutcome(refused=err)
         out = self.accept_state(state, wall, None, source)

@@ -11,7 +11,7 @@ commands no dipole over the control period that ends at a magnetometer sample.
 The estimate's rate is the gyro's, less its bias: the mean body rate over the gyro's interval
 ending at the stamp (:mod:`att_sim.truth.sensors.gyro`), to first order the rate half an interval
 earlier. The state's rate is the rate at the stamp: the mean advanced by half the interval
-``Δt`` (since the previous estimate, the estimator publishing one per gyro sample) with the body
+``Δt`` (since the previous estimate flown, the estimator publishing one per gyro sample) with the body
 acceleration of the latest command, held over that interval (Euler's equation with the wheels)::
 
     ω(t) = ω̄ + (Δt / 2) J⁻¹ (−G u + m × B − ω̄ × (J ω̄ + G J_s Ω))
@@ -49,7 +49,6 @@ class MeasuredState:
         self.field_B = np.zeros(3)                      # T, body axes: the latest clean sample
         self.magnetometer_period = 1.0 / specs.magnetometer.rate if specs.magnetometer else None
         self.command: tuple | None = None               # (t, wheel torques, dipole) the latest command
-        self.estimate_t: float | None = None            # the previous estimate's stamp
 
     def record_command(self, t: float, wheel_torques, dipole_B) -> None:
         """The command issued at ``t`` (held until the next): what turns the body until the next estimate."""
@@ -81,10 +80,9 @@ class MeasuredState:
             return False
         return (math.floor(t / p + 1e-9) + 1) * p <= t + period + 1e-9
 
-    def rate_at_stamp(self, t: float, omega_mean_B: np.ndarray) -> np.ndarray:
+    def rate_at_stamp(self, t: float, omega_mean_B: np.ndarray, previous: float | None) -> np.ndarray:
         """The body rate at the estimate's stamp ``t`` from its rate, the gyro's mean over the interval
-        ending there (module docstring)."""
-        previous, self.estimate_t = self.estimate_t, float(t)
+        ending there since ``previous``, the stamp of the estimate flown before (module docstring)."""
         command = self.command
         if previous is None or command is None or not 0.0 < t - previous <= MAX_ADVANCE_INTERVAL \
                 or not 0.0 < t - command[0] <= MAX_ADVANCE_INTERVAL:
@@ -98,8 +96,9 @@ class MeasuredState:
         omega_dot = np.linalg.solve(sc.inertia, torque_B - np.cross(w, sc.inertia @ w))
         return w + 0.5 * (t - previous) * omega_dot
 
-    def compose(self, estimate: AttitudeEstimate) -> State:
-        """The state of ``estimate`` with the measured wheel speeds (made inertial) and field; an
+    def compose(self, estimate: AttitudeEstimate, previous: float | None = None) -> State:
+        """The state of ``estimate`` with the measured wheel speeds (made inertial) and field, its rate
+        at its stamp (``previous``: the stamp of the estimate flown before, None for none); an
         estimate of a health the message does not define is refused (310)."""
         if estimate.health not in HEALTHS:
             raise RequestError(ErrorCode.INVALID_STATE, f"estimate health {estimate.health!r} is not one of "
@@ -107,7 +106,7 @@ class MeasuredState:
         n = self.spacecraft.n_wheels
         if n and self.wheel_speeds is None:
             raise RequestError(ErrorCode.NO_STATE, "no wheel speed measurement yet")
-        omega = self.rate_at_stamp(estimate.t, np.asarray(estimate.omega, float))
+        omega = self.rate_at_stamp(estimate.t, np.asarray(estimate.omega, float), previous)
         relative = self.wheel_speeds if n else np.zeros(0)
         inertial = relative + self.spacecraft.wheel_axes.T @ omega if n else relative
         return State(t=estimate.t, q=np.asarray(estimate.q, float), omega=omega, wheel_speeds=inertial,
