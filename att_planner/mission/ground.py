@@ -39,6 +39,17 @@ from att_sim.models import world
 TORQUE_SHARE = 0.8             # of the planning torque limit a site's tracking may take
 
 
+def elevation_above(environment, t, p_itrs, up_itrs) -> np.ndarray:
+    """The elevation (rad) of the spacecraft on ``environment``'s orbit above the horizon of the ITRS
+    point ``p_itrs`` (its unit up ``up_itrs``) at each time of ``t``: ``sin e = û · (r − s) / |r − s|``,
+    GCRS to ITRS through the field's table, as the controller's ground law."""
+    t = np.atleast_1d(np.asarray(t, float))
+    R = environment.field.itrs_rotation(t)                                 # GCRS -> ITRS, (K, 3, 3)
+    r = np.asarray(environment.orbit.position(t), float).reshape(-1, 3)    # GCRS, as the law's
+    sines = elevation_sines(np.einsum("kij,kj->ki", R, r), p_itrs, up_itrs)[0]
+    return np.arcsin(np.clip(sines, -1.0, 1.0))
+
+
 def site_track(scenario, site, sensor_axis, secondary_axis, secondary: str, min_elevation: float):
     """The track of target list site ``site``: a :class:`StripTrack` for a strip, else a
     :class:`GroundTrack` of its :func:`site_mode`."""
@@ -75,11 +86,7 @@ class GroundTrack:
 
     def elevation(self, t) -> np.ndarray:
         """The spacecraft's elevation (rad) above the site's horizon at each time of ``t``."""
-        t = np.atleast_1d(np.asarray(t, float))
-        R = self.environment.field.itrs_rotation(t)                       # GCRS -> ITRS, (K, 3, 3)
-        r = np.asarray(self.environment.orbit.position(t), float).reshape(-1, 3)    # GCRS, as the law's
-        sines = elevation_sines(np.einsum("kij,kj->ki", R, r), self.r_itrs, self.up_itrs)[0]
-        return np.arcsin(np.clip(sines, -1.0, 1.0))
+        return elevation_above(self.environment, t, self.r_itrs, self.up_itrs)
 
     def attitudes(self, t) -> np.ndarray:
         """The law's attitude (body-to-inertial) at each time of ``t``, (K, 4)."""
@@ -139,15 +146,9 @@ class StripTrack:
         """The strip's pointing mode scanned from ``arrival`` (s past the epoch)."""
         return strip_mode(self.strip, self.primary_B, self.secondary_B, arrival)
 
-    def _elevation_of(self, end: int, t: np.ndarray) -> np.ndarray:
-        R = self.environment.field.itrs_rotation(t)
-        r = np.asarray(self.environment.orbit.position(t), float).reshape(-1, 3)
-        sines = elevation_sines(np.einsum("kij,kj->ki", R, r), self.ends_itrs[end], self.ups_itrs[end])[0]
-        return np.arcsin(np.clip(sines, -1.0, 1.0))
-
-    def elevation(self, t) -> np.ndarray:
-        """The spacecraft's elevation (rad) above the strip's start at each time of ``t``."""
-        return self._elevation_of(0, np.atleast_1d(np.asarray(t, float)))
+    def elevation(self, t, end: int = 0) -> np.ndarray:
+        """The spacecraft's elevation (rad) above the strip's start (``end`` 1: its end) at each time of ``t``."""
+        return elevation_above(self.environment, t, self.ends_itrs[end], self.ups_itrs[end])
 
     def attitudes(self, t) -> np.ndarray:
         """The attitude on the strip's first point, a scan starting there, at each time of ``t``, (K, 4)."""
@@ -167,8 +168,7 @@ class StripTrack:
         """Whether a scan from each arrival of ``t`` sees the strip's start and end ``min_elevation`` high
         and asks a body torque within the share."""
         t = np.atleast_1d(np.asarray(t, float))
-        ok = (self.elevation(t) >= self.min_elevation) & \
-            (self._elevation_of(1, t + self.duration) >= self.min_elevation)
+        ok = (self.elevation(t) >= self.min_elevation) & (self.elevation(t + self.duration, 1) >= self.min_elevation)
         for k in np.flatnonzero(ok):
             _, torque = tracking_demand(self.spacecraft, self.geometry, self.strip, self.primary_B, self.secondary_B,
                                         float(t[k]), samples=3)

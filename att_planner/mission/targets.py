@@ -22,9 +22,8 @@ pointing allows (the vernal equinox where the source lies within a degree of the
 ground site stays a site: the pointing modes track it through its dwell. A strip (``end_lat_deg``,
 ``end_lon_deg``, ``scan_speed_m_s``; no ``dwell_s``) is the great-ellipse segment from its start to
 its end (:class:`~att_planner.guidance.strip.Strip`), scanned at that ground speed: its dwell is its
-scan. Every field is
-checked; a bad file is refused with a :class:`~att_msgs_py.errors.ConfigError` (``INVALID_CONFIG``)
-listing every problem as ``file:line: targets[i].field: expected ...; found ...``.
+scan. Every field is checked; a bad file is refused with a :class:`~att_msgs_py.errors.ConfigError`
+(``INVALID_CONFIG``) listing every problem as ``file:line: targets[i].field: expected ...; found ...``.
 """
 from __future__ import annotations
 
