@@ -319,6 +319,11 @@ def main(argv=None) -> int:
     except (KeyError, ConfigError) as err:
         print(f"att-mission: {err.args[0] if isinstance(err, KeyError) else err}", file=sys.stderr)
         return 2
+    try:
+        isolated_env(inherit=True)      # a malformed domain or discovery range: refused before any node starts
+    except ValueError as err:
+        print(f"att-mission: {err}", file=sys.stderr)
+        return 2
     mcap_path, report = fly_mission(mission, Path(args.out), rtf=args.rtf)
     for target in report["targets"]:
         print(f"[mission]   {target['name']:14s} {'observed' if target['observed'] else 'missed  '} "

@@ -100,7 +100,7 @@ def test_a_killed_recorders_log_is_refused_raw_and_decoded_whole_once_repaired(t
         suite.stop()
 
 
-# -- att-demo's domain ---------------------------------------------------------------------------
+# -- the tools' domain -------------------------------------------------------------------------
 
 def test_a_domain_the_user_set_is_kept_and_localhost_stays_the_default():
     from att_planner.tools.demo import domain_line
@@ -134,6 +134,19 @@ def test_att_demo_refuses_a_malformed_domain_in_one_line(tmp_path, monkeypatch, 
     err = capsys.readouterr().err
     name = "ROS_DOMAIN_ID" if not discovery else "ROS_AUTOMATIC_DISCOVERY_RANGE"
     assert err.count("\n") == 1 and err.startswith(f"att-demo: {name} is '") and "expected" in err, err
+    assert list(tmp_path.iterdir()) == []                 # nothing started, nothing written
+
+
+@pytest.mark.parametrize("variable, value", [("ROS_DOMAIN_ID", "233"), ("ROS_DOMAIN_ID", "abc"),
+                                             ("ROS_AUTOMATIC_DISCOVERY_RANGE", "EVERYWHERE")])
+def test_att_mission_refuses_a_malformed_domain_in_one_line(tmp_path, monkeypatch, capsys, variable, value):
+    from att_planner.tools import mission
+
+    monkeypatch.delenv("ROS_DOMAIN_ID", raising=False)
+    monkeypatch.setenv(variable, value)
+    assert mission.main(["aeos_orbit", "--out", str(tmp_path)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and err.startswith(f"att-mission: {variable} is '{value}'") and "expected" in err, err
     assert list(tmp_path.iterdir()) == []                 # nothing started, nothing written
 
 
