@@ -2,7 +2,8 @@
 
 ``att-bench history --append PATH [--study NAME] [--case NAME] [--command CMD]`` reads the JSON a
 study wrote (``att-bench <study> --json PATH``, or ``att-mc ... --json PATH`` for the Monte Carlo
-campaign), recognises the study from its keys (or takes ``--study``), and appends one line:
+campaign), recognises the study from its keys (or takes ``--study``), and adds one line, in date
+order (after the last line dated no later: runs that overlapped can be added in any order):
 
 ``study``, ``case``, ``metric`` (the headline figure's name), ``value`` and ``unit``, ``target`` (the
 criterion in words) and ``met`` (``true``/``false``, ``null`` where the study states none),
@@ -88,10 +89,26 @@ def read(path: str | Path = HISTORY) -> list[dict]:
 
 
 def append(row: dict, path: str | Path = HISTORY) -> None:
-    """Append ``row`` as one JSON line (keys in :data:`FIELDS` order; NaN and infinity refused)."""
+    """Add ``row`` as one JSON line (keys in :data:`FIELDS` order; NaN and infinity refused), after the
+    last line dated no later than it: the history stays in date order when runs that overlapped are
+    added in another order (a line that is not JSON, or a row without a date, stops the search)."""
     text = json.dumps({k: row[k] for k in FIELDS}, ensure_ascii=False, allow_nan=False)
-    with open(path, "a") as fh:
-        fh.write(text + "\n")
+    path = Path(path)
+    lines = path.read_text().splitlines() if path.exists() else []
+    at = len(lines)
+    while at and isinstance(row["date"], str) and _date(lines[at - 1]) > row["date"]:
+        at -= 1
+    lines.insert(at, text)
+    path.write_text("".join(line + "\n" for line in lines))
+
+
+def _date(text: str) -> str:
+    """A history line's date ('' when it has none to compare)."""
+    try:
+        date = json.loads(text).get("date")
+    except (json.JSONDecodeError, AttributeError):
+        return ""
+    return date if isinstance(date, str) else ""
 
 
 def latest(rows: list[dict]) -> dict[tuple[str, str], dict]:

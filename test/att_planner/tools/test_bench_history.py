@@ -39,7 +39,7 @@ def test_append_writes_the_study_line_from_its_json(tmp_path, capsys):
     assert list(row) == list(hist.FIELDS)
 
     payload["tf"] = 6.0
-    payload["machine"].update(date="2026-12-05T01:02:03Z", commit="abc1234")
+    payload["machine"].update(date="2030-12-05T01:02:03Z", commit="abc1234")   # after the first run
     run.write_text(json.dumps(payload))
     assert main(["history", "--append", str(run), "--history", str(history), "--case", "swift",
                  "--command", "by hand", "--no-json"]) == 0
@@ -47,7 +47,7 @@ def test_append_writes_the_study_line_from_its_json(tmp_path, capsys):
     first, second = _lines(history)
     assert first == row and second["value"] == 6.0 and second["met"] is False
     assert second["json"] is None and second["command"] == "by hand"
-    assert second["date"] == "2026-12-05T01:02:03Z" and second["commit"] == "abc1234"   # the run's, not the append's
+    assert second["date"] == "2030-12-05T01:02:03Z" and second["commit"] == "abc1234"   # the run's, not the append's
     assert hist.latest(_lines(history))[("smooth", "swift")] == second
 
 
@@ -121,6 +121,22 @@ def test_the_committed_history_holds_each_kept_json_as_its_latest_line():
         assert row["met"] in (True, False, None) and row["study"] in hist.BY_NAME
         assert row["json"] or row["source"] != "json"
     assert [r["date"] for r in rows] == sorted(r["date"] for r in rows)
+
+
+def test_a_line_is_added_after_the_last_one_dated_no_later(tmp_path):
+    history = tmp_path / "history.jsonl"
+    rows = [dict(r) for r in hist.read(BENCHMARKS / "history.jsonl")[-3:]]
+    for row, date in zip(rows, ("2026-12-06T09:47:20Z", "2026-12-06T10:30:12Z", "2026-12-06T10:29:24Z")):
+        row["date"] = date
+        hist.append(row, history)
+    assert [r["date"] for r in hist.read(history)] == ["2026-12-06T09:47:20Z", "2026-12-06T10:29:24Z",
+                                                      "2026-12-06T10:30:12Z"]
+    early = dict(rows[0], date="2026-01-01T00:00:00Z", case="first")
+    hist.append(early, history)
+    assert hist.read(history)[0]["case"] == "first" and len(hist.read(history)) == 4
+    same = dict(rows[0], case="same date")                   # equal dates: after the line already there
+    hist.append(same, history)
+    assert [r["case"] for r in hist.read(history)][1:3] == [rows[0]["case"], "same date"]
 
 
 def test_a_study_json_without_a_machine_gets_one(tmp_path, monkeypatch):
