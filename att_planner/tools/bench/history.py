@@ -18,6 +18,7 @@ summary table from the latest line of each study and case.
 from __future__ import annotations
 
 import json
+import os
 import subprocess
 from datetime import UTC, datetime
 from pathlib import Path
@@ -99,7 +100,9 @@ def append(row: dict, path: str | Path = HISTORY) -> None:
     while at and isinstance(row["date"], str) and _date(lines[at - 1]) > row["date"]:
         at -= 1
     lines.insert(at, text)
-    path.write_text("".join(line + "\n" for line in lines))
+    partial = path.with_name(path.name + ".partial")      # replaced whole: an interrupted write loses no line
+    partial.write_text("".join(line + "\n" for line in lines))
+    os.replace(partial, path)
 
 
 def _date(text: str) -> str:

@@ -137,6 +137,7 @@ def test_a_line_is_added_after_the_last_one_dated_no_later(tmp_path):
     same = dict(rows[0], case="same date")                   # equal dates: after the line already there
     hist.append(same, history)
     assert [r["case"] for r in hist.read(history)][1:3] == [rows[0]["case"], "same date"]
+    assert list(tmp_path.iterdir()) == [history]                # replaced whole, nothing left beside it
 
 
 def test_a_study_json_without_a_machine_gets_one(tmp_path, monkeypatch):
