@@ -253,13 +253,14 @@ class MissionDriver:
 
 
 def fly_mission(mission: mission_config.MissionConfig, out: Path, log=print,
-                rtf: float | None = None) -> tuple[Path, dict]:
+                rtf: float | None = None, env: dict | None = None) -> tuple[Path, dict]:
     """Start the nodes, fly ``mission``, stop them; the MCAP's path and the day's report. ``rtf``:
     None, the planner races the flight (module docstring); 0, as fast as possible and sim time held
-    while the planner plans; X > 0, the same at most at X × real time."""
+    while the planner plans; X > 0, the same at most at X × real time. ``env``: the nodes' environment
+    (default: :func:`isolated_env` of this process's, a domain and discovery range set kept)."""
     run_dir = out / f"{mission.path.stem}_{datetime.now(UTC).strftime('%Y%m%d_%H%M%S')}"
     mcap_path = run_dir / "run.mcap"
-    env = isolated_env(inherit=True)
+    env = isolated_env(inherit=True) if env is None else env
     log(f"[mission] {domain_line(env)}")
     join_env(env)
     rate = mission.rate
@@ -320,11 +321,11 @@ def main(argv=None) -> int:
         print(f"att-mission: {err.args[0] if isinstance(err, KeyError) else err}", file=sys.stderr)
         return 2
     try:
-        isolated_env(inherit=True)      # a malformed domain or discovery range: refused before any node starts
+        env = isolated_env(inherit=True)    # a malformed domain or discovery range: refused before any node starts
     except ValueError as err:
         print(f"att-mission: {err}", file=sys.stderr)
         return 2
-    mcap_path, report = fly_mission(mission, Path(args.out), rtf=args.rtf)
+    mcap_path, report = fly_mission(mission, Path(args.out), rtf=args.rtf, env=env)
     for target in report["targets"]:
         print(f"[mission]   {target['name']:14s} {'observed' if target['observed'] else 'missed  '} "
               f"{target.get('why', '')}")
