@@ -3,10 +3,12 @@ as possible: the real-time factor, messages dropped, memory, and with ``--profil
 time went."""
 from __future__ import annotations
 
+import math
 import tempfile
 
 from att_planner.tools.review.run import SETTLING_THRESHOLD
 from att_planner.tools.soak import run_soak
+from att_sim.models import scenario as scen
 
 RTF_TARGET = 50.0        # a day of the real sky through the nodes at least this many times real time
 
@@ -22,7 +24,23 @@ def configure(parser):
     parser.add_argument("--out", default=None, help="directory for the log (default: a temporary one)")
 
 
+def _refuse(args) -> str | None:
+    """Why the arguments cannot be flown (None when they can): a scenario not shipped, a length or
+    rate that is not a finite number > 0."""
+    try:
+        scen.load(args.scenario)
+    except KeyError as err:
+        return err.args[0]
+    for flag, value in (("--orbits", args.orbits), ("--hours", args.hours), ("--rate-Hz", args.rate_Hz)):
+        if value is not None and not (math.isfinite(value) and value > 0.0):
+            return f"{flag} must be a finite number > 0, found {value:g}"
+    return None
+
+
 def run(args) -> dict:
+    refused = _refuse(args)
+    if refused:
+        raise SystemExit(f"att-bench soak: {refused}")
     out = args.out or tempfile.mkdtemp(prefix="att_soak_")
     orbits = 10.0 if args.orbits is None and args.hours is None else args.orbits
     r = run_soak(args.scenario, orbits, out, hours=args.hours, rate_Hz=args.rate_Hz, profile_dir=args.profile)
