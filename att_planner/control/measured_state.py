@@ -32,6 +32,7 @@ from att_msgs_py import validation
 from att_msgs_py.errors import ErrorCode, RequestError
 from att_msgs_py.types import AttitudeEstimate, Health, MagnetometerMeasurement, State, WheelSpeedMeasurement
 from att_planner.estimation.inputs import DipoleLog, InputChecks
+from att_sim.models import rotations as rot
 from att_sim.models.dynamics import Spacecraft
 from att_sim.models.sensor_specs import SensorSpecs
 
@@ -89,11 +90,11 @@ class MeasuredState:
             return omega_mean_B
         sc, (_, u, m_B) = self.spacecraft, command
         w = omega_mean_B
-        torque_B = np.cross(m_B, self.field_B) if m_B.size else np.zeros(3)
+        torque_B = rot.cross(m_B, self.field_B) if m_B.size else np.zeros(3)
         if sc.n_wheels and self.wheel_speeds is not None and u.size == sc.n_wheels:
             spin = self.wheel_speeds + sc.wheel_axes.T @ w
-            torque_B = torque_B - sc.wheel_axes @ u - np.cross(w, sc.wheel_axes @ (sc.wheel_inertia * spin))
-        omega_dot = np.linalg.solve(sc.inertia, torque_B - np.cross(w, sc.inertia @ w))
+            torque_B = torque_B - sc.wheel_axes @ u - rot.cross(w, sc.wheel_axes @ (sc.wheel_inertia * spin))
+        omega_dot = np.linalg.solve(sc.inertia, torque_B - rot.cross(w, sc.inertia @ w))
         return w + 0.5 * (t - previous) * omega_dot
 
     def compose(self, estimate: AttitudeEstimate, previous: float | None = None) -> State:
