@@ -6,6 +6,7 @@ from __future__ import annotations
 import math
 import tempfile
 
+from att_msgs_py.errors import ConfigError
 from att_planner.tools.review.run import SETTLING_THRESHOLD
 from att_planner.tools.soak import run_soak
 from att_sim.models import scenario as scen
@@ -25,12 +26,14 @@ def configure(parser):
 
 
 def _refuse(args) -> str | None:
-    """Why the arguments cannot be flown (None when they can): a scenario not shipped, a length or
-    rate that is not a finite number > 0."""
+    """Why the arguments cannot be flown (None when they can): a scenario not shipped or a file that
+    is not a valid one, a length or rate that is not a finite number > 0."""
     try:
         scen.load(args.scenario)
     except KeyError as err:
         return err.args[0]
+    except ConfigError as err:
+        return str(err)
     for flag, value in (("--orbits", args.orbits), ("--hours", args.hours), ("--rate-Hz", args.rate_Hz)):
         if value is not None and not (math.isfinite(value) and value > 0.0):
             return f"{flag} must be a finite number > 0, found {value:g}"

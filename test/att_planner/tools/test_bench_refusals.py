@@ -12,11 +12,16 @@ from att_planner.tools.bench import main
     (["day"], {"ROS_AUTOMATIC_DISCOVERY_RANGE": "EVERYWHERE"},
      "att-bench day: ROS_AUTOMATIC_DISCOVERY_RANGE is 'EVERYWHERE': expected"),
     (["soak", "--scenario", "no_such_scenario"], {}, "att-bench soak: unknown spacecraft/scenario 'no_such_scenario'"),
+    (["soak", "--scenario", "broken.yaml"], {}, "att-bench soak: broken.yaml:2: (file): expected valid YAML"),
+    (["day", "--mission", "broken.yaml"], {}, "att-bench day: broken.yaml:2: (file): expected valid YAML"),
     (["soak", "--orbits", "-1"], {}, "att-bench soak: --orbits must be a finite number > 0, found -1"),
     (["soak", "--hours", "nan"], {}, "att-bench soak: --hours must be a finite number > 0, found nan"),
     (["soak", "--rate-Hz", "0"], {}, "att-bench soak: --rate-Hz must be a finite number > 0, found 0"),
 ])
 def test_a_study_that_starts_nodes_refuses_in_one_sentence(tmp_path, monkeypatch, argv, env, says):
+    (tmp_path / "broken.yaml").write_text("spacecraft: [\n")
+    argv = [str(tmp_path / a) if a == "broken.yaml" else a for a in argv]
+    says = says.replace("broken.yaml", str(tmp_path / "broken.yaml"))
     monkeypatch.delenv("ROS_DOMAIN_ID", raising=False)
     monkeypatch.delenv("ROS_AUTOMATIC_DISCOVERY_RANGE", raising=False)
     for name, value in env.items():
