@@ -24,6 +24,10 @@ from att_planner.tools.monte_carlo.run import Setup, fly_batch
 QUIET = {"distributed.admin.tick.interval": "1s", "distributed.admin.system-monitor.interval": "5s",
          "distributed.worker.memory.monitor-interval": "1s", "distributed.worker.profile.enabled": False}
 
+# no dashboard, and the scheduler's own HTTP server (health, metrics) on a free port rather than Dask's
+# 8787, which a second cluster on the machine would find taken (a warning, the port moved)
+HTTP_ON_A_FREE_PORT = {"dashboard_address": ":0"}
+
 
 class ClusterError(RuntimeError):
     """A cluster that cannot be reached or started (one sentence)."""
@@ -90,7 +94,8 @@ def client_for(scheduler: str | None, workers: int, timeout: float):
 
     with environment_kept(), dask.config.set(QUIET), \
             LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None,
-                         silence_logs=40, env={"OMP_NUM_THREADS": "1"}) as cluster, Client(cluster) as client:
+                         scheduler_kwargs=HTTP_ON_A_FREE_PORT, silence_logs=40,
+                         env={"OMP_NUM_THREADS": "1"}) as cluster, Client(cluster) as client:
         yield client
 
 

@@ -76,7 +76,8 @@ def dask_processes(folder: Path, workers: int, timeout: float = 60.0, preload: l
     file = folder / "scheduler.json"
     file.unlink(missing_ok=True)
     scheduler = start([sys.executable, "-m", "distributed.cli.dask_scheduler", "--host", "127.0.0.1", "--port", "0",
-                       "--no-dashboard", "--scheduler-file", str(file)], env, folder / "scheduler.log")
+                       "--no-dashboard", "--dashboard-address", ":0", "--scheduler-file", str(file)], env,
+                      folder / "scheduler.log")
     cluster = Processes("", scheduler)
     try:
         end = time.monotonic() + timeout

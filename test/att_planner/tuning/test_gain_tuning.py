@@ -11,6 +11,7 @@ from att_planner.control.magnetorquer import control_torque, dipole_command
 from att_planner.reference.bruni_celani import PUBLISHED_GAINS, PUBLISHED_ICS, robust_seeds
 from att_planner.tools import config_cli
 from att_planner.tools import tune as tune_cli
+from att_planner.tools.monte_carlo.cluster import HTTP_ON_A_FREE_PORT
 from att_planner.tuning.settling import _BatchModel
 from att_sim.models import dynamics as dyn
 from att_sim.models import environment as env
@@ -238,8 +239,8 @@ def test_dask_executor_on_a_local_two_worker_cluster():
     serial = gt.BatchEvaluator(CASE, settings).settling(kp, kd, h)
     # in-process workers start in a second instead of ~20 s on a loaded machine; the client path
     # (map, gather, scheduler address) is the one a remote cluster uses
-    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=False,
-                                  dashboard_address=None) as cluster:
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=False, dashboard_address=None,
+                                  scheduler_kwargs=HTTP_ON_A_FREE_PORT) as cluster:
         ex = gt.make_executor(scheduler=cluster.scheduler_address)
         try:
             assert ex.workers == 2
