@@ -18,6 +18,9 @@ message) and the final pointing error (truth against the goal), the 1-min load b
 and the top rows of a profile (cProfile) of a second, separate run of the same flight (``profile``: by
 ``tottime`` and by ``cumtime``, rows of function, calls, tottime, cumtime). The
 target is :data:`TARGET_RTF` × real time with a successful maneuver (``met``, ``passed``).
+
+A scenario that is not shipped, or a file that is not a valid scenario (its line and what is
+expected), is refused in one sentence before any flight, as ``att-bench soak`` refuses it.
 """
 from __future__ import annotations
 
@@ -30,7 +33,7 @@ from datetime import timedelta
 
 import numpy as np
 
-from att_msgs_py.errors import RequestError
+from att_msgs_py.errors import ConfigError, RequestError
 from att_planner.service.warm import maneuver_from_scenario
 from att_planner.tools.closed_loop import ClosedLoop, plan_in_process
 from att_sim.models import rotations as rot
@@ -111,14 +114,27 @@ def profile_rows(profiler: cProfile.Profile, rows: int) -> dict[str, list[dict]]
     return out
 
 
-def run(args) -> dict:
+def _refuse(args) -> str | None:
+    """Why the arguments cannot be flown (None when they can): fewer than one profile row, a scenario
+    not shipped or a file that is not a valid one (the file's line and what is expected)."""
     if args.profile_rows < 1:
-        raise SystemExit(f"att-bench rtf: --profile-rows must be at least 1, found {args.profile_rows}")
+        return f"--profile-rows must be at least 1, found {args.profile_rows}"
+    try:
+        scen.load(args.scenario)
+    except KeyError as err:
+        return err.args[0]
+    except ConfigError as err:
+        return str(err)
+    return None
+
+
+def run(args) -> dict:
+    refused = _refuse(args)
+    if refused:
+        raise SystemExit(f"att-bench rtf: {refused}")
     load_before = os.getloadavg()[0]
     try:
         figures = fly(args.scenario)
-    except KeyError as err:
-        raise SystemExit(f"att-bench rtf: {err.args[0] if err.args else err}") from None
     except RequestError as err:         # the planner's refusal (a ValueError too)
         raise SystemExit(f"att-bench rtf: the demo maneuver of '{args.scenario}' was not planned: "
                          f"code {int(err.code)}: {err.message}") from None

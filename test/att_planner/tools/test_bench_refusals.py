@@ -1,5 +1,6 @@
 """The studies that start nodes (``att-bench day``, ``att-bench soak``) refuse what they cannot fly
-in one sentence naming the argument or variable, before any node starts or any file is written."""
+in one sentence naming the argument or variable, before any node starts or any file is written; so
+does ``att-bench rtf``, which flies in process, before any flight."""
 import pytest
 
 from att_planner.tools.bench import main
@@ -32,3 +33,19 @@ def test_a_study_that_starts_nodes_refuses_in_one_sentence(tmp_path, monkeypatch
     message = str(exc.value.code)
     assert message.startswith(says) and "\n" not in message, message
     assert not out.exists()                               # nothing started, nothing written
+
+
+@pytest.mark.parametrize("text, says", [
+    ("spacecraft: [\n", "scenario.yaml:2: (file): expected valid YAML"),
+    ("spacecraft: aeos\nno_such_key: 1\n", "scenario.yaml:2: no_such_key: expected one of the keys"),
+])
+def test_rtf_blames_a_scenario_file_that_does_not_read_not_the_plan(tmp_path, text, says):
+    path = tmp_path / "scenario.yaml"
+    path.write_text(text)
+    out = tmp_path / "rtf.json"
+    with pytest.raises(SystemExit) as exc:
+        main(["rtf", "--in-process", "--scenario", str(path), "--no-profile", "--json", str(out)])
+    message = str(exc.value.code)
+    assert message.startswith(f"att-bench rtf: {tmp_path / says}") and "\n" not in message, message
+    assert "planned" not in message, message
+    assert not out.exists()                               # nothing flown, nothing written
