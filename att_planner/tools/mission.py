@@ -41,7 +41,6 @@ from sensor_msgs.msg import NavSatFix, NavSatStatus
 
 from att_msgs.msg import AttitudeEstimate, MissionEvent
 from att_msgs_py import convert, qos
-from att_msgs_py.errors import ConfigError
 from att_msgs_py.topics import BORESIGHT_FIX, ESTIMATE, MISSION_EVENTS, SUBSATELLITE_FIX, TARGET_FIX
 from att_msgs_py.types import ControlMode, Health, PointingMode
 from att_msgs_py.types import MissionEventKind as Kind
@@ -252,6 +251,19 @@ class MissionDriver:
                           min_cone_margin=plan.verification.min_cone_margin, pointing_after=after)
 
 
+def mission_and_env(name: str) -> tuple[mission_config.MissionConfig, dict]:
+    """The mission file ``name`` (:func:`att_planner.mission.config.load`) and the nodes' environment
+    (:func:`isolated_env` of this process's, a domain and discovery range set kept), both checked
+    before any node starts. ValueError, one sentence naming what is refused: a mission not shipped,
+    a file that is not a valid mission (its line and what is expected), or a malformed
+    ``ROS_DOMAIN_ID`` / ``ROS_AUTOMATIC_DISCOVERY_RANGE``."""
+    try:
+        mission = mission_config.load(name)
+    except KeyError as err:
+        raise ValueError(err.args[0]) from None
+    return mission, isolated_env(inherit=True)
+
+
 def fly_mission(mission: mission_config.MissionConfig, out: Path, log=print,
                 rtf: float | None = None, env: dict | None = None) -> tuple[Path, dict]:
     """Start the nodes, fly ``mission``, stop them; the MCAP's path and the day's report. ``rtf``:
@@ -316,12 +328,7 @@ def main(argv=None) -> int:
                              "while the spacecraft flies, at start_lead_s / time_budget_s x real time")
     args = parser.parse_args(argv)
     try:
-        mission = mission_config.load(args.mission)
-    except (KeyError, ConfigError) as err:
-        print(f"att-mission: {err.args[0] if isinstance(err, KeyError) else err}", file=sys.stderr)
-        return 2
-    try:
-        env = isolated_env(inherit=True)    # a malformed domain or discovery range: refused before any node starts
+        mission, env = mission_and_env(args.mission)
     except ValueError as err:
         print(f"att-mission: {err}", file=sys.stderr)
         return 2

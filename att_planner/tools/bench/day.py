@@ -12,10 +12,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from att_msgs_py.errors import ConfigError
-from att_planner.mission import config as mission_config
-from att_planner.tools.launch import isolated_env
-from att_planner.tools.mission import fly_mission, real_time_factor
+from att_planner.tools.mission import fly_mission, mission_and_env, real_time_factor
 
 
 def configure(parser) -> None:
@@ -28,10 +25,9 @@ def configure(parser) -> None:
 
 def run(args) -> dict:
     try:
-        mission = mission_config.load(args.mission)
-        env = isolated_env(inherit=True)    # a malformed domain or discovery range: refused before any node starts
-    except (KeyError, ConfigError, ValueError) as err:
-        raise SystemExit(f"att-bench day: {err.args[0] if isinstance(err, KeyError) else err}") from None
+        mission, env = mission_and_env(args.mission)
+    except ValueError as err:
+        raise SystemExit(f"att-bench day: {err}") from None
     _, report = fly_mission(mission, Path(args.out), rtf=args.rtf, env=env)
     report["mission"] = mission.path.stem
     report["rtf_mode"] = "paced by the planner's budget" if args.rtf is None else (
