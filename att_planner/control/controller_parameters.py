@@ -91,6 +91,9 @@ CONTROLLER = ParameterTable("controller", (
               low_open=True),
     Parameter("wall_timeout_s", float, 2.0, "wall time without a state after which the command is zero and "
                                           "state_stale is reported", "s", 0.0, 3600.0, low_open=True),
+    Parameter("plan_wait_s", float, 5.0, "wall time an execute goal waits for a plan it names that has not been "
+                                        "received yet (0: refused at once, UNKNOWN_PLAN; kept below SuiteClient's "
+                                        "15 s stall timeout)", "s", 0.0, 10.0),
     Parameter("wait_for_subscribers", int, 0, "subscribers to the commands that must listen before the controller "
                                               "takes its inputs", "", 0, 1000),
     Parameter("start_timeout_s", float, 60.0, "wall time waited for those subscribers before taking inputs anyway",

@@ -267,12 +267,12 @@ class SuiteClient(Node):
         return self._call(self.mode_client, request, timeout)
 
     def execute(self, plan_id: str = "", plan=None, timeout: float = 600.0, on_feedback=None,
-                retries: int = 10, stall_timeout: float = STALL_TIMEOUT, pointing_after=None) -> ExecuteManeuver.Result:
+                stall_timeout: float = STALL_TIMEOUT, pointing_after=None) -> ExecuteManeuver.Result:
         """Run a plan on the controller and wait for the result (``pointing_after``: a
         :class:`att_msgs_py.types.PointingMode` the controller hands over to at the plan's end). A
-        plan just published may not have reached the controller yet: UNKNOWN_PLAN is retried
-        ``retries`` times, 0.5 s apart. A controller that falls silent (no feedback for
-        ``stall_timeout`` s of wall time) gives an ABORTED result (:meth:`_await_result`)."""
+        plan just published that has not reached the controller yet is waited for by the controller
+        (its ``plan_wait_s``). A controller that falls silent (no feedback for ``stall_timeout`` s of
+        wall time) gives an ABORTED result (:meth:`_await_result`)."""
         goal = ExecuteManeuver.Goal(plan_id=plan_id, use_inline_plan=plan is not None,
                                     point_after=pointing_after is not None)
         if plan is not None:
@@ -280,27 +280,23 @@ class SuiteClient(Node):
         if pointing_after is not None:
             goal.pointing_after = convert.pointing_msg(pointing_after)
         check_strings(goal, "goal", nul_only=True)
-        for _ in range(retries + 1):
-            heard = [time.monotonic(), None]            # wall time of the last sign of life, last feedback
+        heard = [time.monotonic(), None]            # wall time of the last sign of life, last feedback
 
-            def feedback(msg, heard=heard):
-                heard[0], heard[1] = time.monotonic(), msg.feedback
-                if on_feedback is not None:
-                    on_feedback(msg)
+        def feedback(msg):
+            heard[0], heard[1] = time.monotonic(), msg.feedback
+            if on_feedback is not None:
+                on_feedback(msg)
 
-            send = self.execute_client.send_goal_async(goal, feedback_callback=feedback)
-            rclpy.spin_until_future_complete(self, send, timeout_sec=GOAL_ANSWER_TIMEOUT)
-            if not send.done():
-                raise TimeoutError(f"the controller did not answer the goal within {GOAL_ANSWER_TIMEOUT:g} s")
-            handle = send.result()
-            if handle is None or not handle.accepted:
-                raise RuntimeError("the controller rejected the goal (another maneuver is executing)")
-            heard[0] = time.monotonic()
-            result = self._await_result(handle, heard, timeout, stall_timeout)
-            if result.error_code != ErrorCode.UNKNOWN_PLAN:
-                return result
-            time.sleep(0.5)
-        return result
+        send = self.execute_client.send_goal_async(goal, feedback_callback=feedback)
+        rclpy.spin_until_future_complete(self, send, timeout_sec=GOAL_ANSWER_TIMEOUT)
+        if not send.done():
+            raise TimeoutError(f"the controller did not answer the goal within {GOAL_ANSWER_TIMEOUT:g} s")
+        handle = send.result()
+        if handle is None or not handle.accepted:
+            raise RuntimeError("the controller rejected the goal (another maneuver is executing or waiting for "
+                               "its plan)")
+        heard[0] = time.monotonic()
+        return self._await_result(handle, heard, timeout, stall_timeout)
 
     def _await_result(self, handle, heard: list, timeout: float, stall_timeout: float) -> ExecuteManeuver.Result:
         """The goal's result; ABORTED when nothing was heard from the controller for

@@ -6,7 +6,9 @@ computed when a state at or after the next control instant arrives, and stamped 
 time (the simulator waits for it before it advances); serves ``/controller/set_mode`` and the
 ``/controller/execute`` action (ExecuteManeuver), which runs for the maneuver's duration plus
 ``settle_time_s`` and reports progress as feedback (the zone margins of the feedback are taken
-on the scenario's sky: its epoch and orbit).
+on the scenario's sky: its epoch and orbit). The planner publishes a plan before it answers, but DDS
+does not order a topic before an action: a goal naming a plan not heard yet waits up to
+``plan_wait_s`` of wall time for it (then UNKNOWN_PLAN), so a client sends each goal once.
 
 Nothing received is trusted (the size caps of :mod:`att_msgs_py.limits`, checked before a message is
 read, SIZE_LIMIT; the core's checks, :mod:`att_planner.control.plan_checks` and
@@ -106,6 +108,7 @@ class ControllerNode(Node):
         self._core.gate.hold.live = live_publishers(self, topics.STATE if self._core.measured is None
                                                     else topics.ESTIMATE)
         self._wall_timeout = param("wall_timeout_s")
+        self._plan_wait = param("plan_wait_s")
         wait_for_subscribers = param("wait_for_subscribers")
         start_timeout = param("start_timeout_s")
         signed = param("require_signed_modes")
@@ -126,6 +129,7 @@ class ControllerNode(Node):
         self._stale = False
         self._refusals = RefusalLog(self.get_logger())   # refused inputs, logged once a second per kind
         self._goal = None                     # the goal handle of the running maneuver
+        self._awaited: tuple[str, Future] | None = None   # (plan id, heard) of a goal waiting for its plan
         self._waiting = None                  # (estimate, source) that came before any wheel speed
         self._sources = Sources({"wheel speed measurement": live_publishers(self, topics.WHEEL_SPEEDS),
                                  "magnetometer measurement": live_publishers(self, topics.MAGNETOMETER)})
@@ -148,7 +152,7 @@ class ControllerNode(Node):
             self.create_subscription(FaultStatus, topics.ESTIMATOR_FAULTS, self.on_estimator_fault, qos.MISSION_QOS)
         self.create_timer(0.5, self.on_wall_watchdog, clock=Clock(clock_type=ClockType.STEADY_TIME))
         self._action = ActionServer(self, ExecuteManeuver, topics.EXECUTE_MANEUVER, execute_callback=self.execute,
-                                    goal_callback=self.on_goal, cancel_callback=lambda _: CancelResponse.ACCEPT)
+                                    goal_callback=self.on_goal, cancel_callback=self.on_cancel)
         c = self._core.config
         source = "truth" if self._core.measured is None else "estimate"
         self.get_logger().info(f"scenario '{self._scenario.name}', state from the {source}, mode {self._core.mode}, "
@@ -359,6 +363,8 @@ class ControllerNode(Node):
                    or self._core.receive_plan(convert.plan_from_msg(msg), signing.payload(msg)))
         if refused is not None:
             self._refusals("published plan", refused)
+        elif self._awaited is not None and self._awaited[0] == msg.plan_id:
+            self._wake()
 
     def on_set_mode(self, request, response):
         refused = limits.issue(request, limits.SET_CONTROLLER_MODE) or self._core.authorize_mode(
@@ -384,8 +390,30 @@ class ControllerNode(Node):
 
     # -- action -----------------------------------------------------------------------------------
     def on_goal(self, goal: ExecuteManeuver.Goal):
-        busy = self._core.maneuver is not None or self._replan_of is not None
+        busy = self._core.maneuver is not None or self._replan_of is not None or self._awaited is not None
         return GoalResponse.REJECT if busy else GoalResponse.ACCEPT
+
+    def on_cancel(self, _goal_handle):
+        self._wake()          # a goal waiting for its plan ends now, cancelled
+        return CancelResponse.ACCEPT
+
+    async def _wait_for_plan(self, plan_id: str) -> None:
+        """Return once plan ``plan_id`` was received, the goal was cancelled or ``plan_wait_s`` of
+        wall time passed, whichever is first; the executor serves every other callback meanwhile."""
+        heard = Future(executor=self.executor)
+        self._awaited = (plan_id, heard)
+        self.get_logger().info(f"execute goal for plan '{clip(plan_id, 80)}' waits up to {self._plan_wait:g} s "
+                               "for the plan")
+        timer = self.create_timer(self._plan_wait, self._wake, clock=Clock(clock_type=ClockType.STEADY_TIME))
+        try:
+            await heard
+        finally:
+            self.destroy_timer(timer)
+            self._awaited = None
+
+    def _wake(self) -> None:
+        if self._awaited is not None and not self._awaited[1].done():
+            self._awaited[1].set_result(None)
 
     async def execute(self, goal_handle):
         """Start tracking and wait (without blocking the executor) until the control loop ends
@@ -397,6 +425,15 @@ class ControllerNode(Node):
         if refused is None:
             inline = convert.plan_from_msg(goal.plan) if goal.use_inline_plan else None
             plan, refused = self._core.resolve(goal.plan_id, inline, signing.payload(goal.plan) if inline else b"")
+            if refused is not None and refused.code == ErrorCode.UNKNOWN_PLAN and self._plan_wait > 0:
+                await self._wait_for_plan(goal.plan_id)
+                if goal_handle.is_cancel_requested:
+                    self._to_client("goal status", goal_handle.canceled)
+                    return convert.result_msg(ManeuverResult(False, int(ErrorCode.ABORTED),
+                                                             "cancelled while waiting for its plan"))
+                plan, refused = self._core.resolve(goal.plan_id)
+                if refused is not None and refused.code == ErrorCode.UNKNOWN_PLAN:
+                    refused = RequestError(refused.code, f"{refused.message} (waited {self._plan_wait:g} s for it)")
         goal.plan = ManeuverPlan()       # read or refused: the goal handle, kept until its result expires, drops it
         if plan is not None:
             refused = self._core.start(plan, convert.pointing_from_msg(goal.pointing_after) if goal.point_after

@@ -245,6 +245,9 @@ NODE_CASES = {
     "controller estimate without tachometers": ("controller", ["-p", "scenario:=olivares_staffetti", "-p",
                                                                "state_source:=estimate"], P,
                                                 ["'state_source'", "wheel_tachometer"]),
+    "controller plan_wait beyond the client's stall timeout": ("controller", ["-p", "plan_wait_s:=30.0"], P,
+                                                              ["'plan_wait_s'", "[0, 10]"]),
+    "controller plan_wait NaN": ("controller", ["-p", "plan_wait_s:=.nan"], P, ["'plan_wait_s'"]),
     # a campaign's dispersed truth
     "simulator campaign without run_seed": (SIM, ["-p", "campaign:={tmp}/campaign.yaml"], P,
                                             ["'campaign'", "'run_seed'"]),

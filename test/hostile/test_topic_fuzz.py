@@ -209,8 +209,6 @@ class Monitor(Node):
         return max((b - a, a) for a, b in zip(t, t[1:]))
 
 
-UNKNOWN_PLAN_RETRIES = 10      # as SuiteClient.execute: a plan published may reach the controller after the goal
-
 @pytest.fixture(scope="module")
 def fuzzed(ros_suite):
     with ros_suite("swift_demo", params={"simulator": {"real_time_factor": 4.0}}, name="fuzz_test") as s:
@@ -248,20 +246,14 @@ def in_flight(fuzzed):
                                             [], method="eigenaxis_smooth"))
     assert response.success, response.message
     fed_back = []
-    # the plan is published before the planner answers, but DDS does not order a topic before an action:
-    # a goal that reaches the controller before the plan is refused UNKNOWN_PLAN, and sent again 0.5 s
-    # later, as the suite's client does (SuiteClient.execute)
-    for _ in range(UNKNOWN_PLAN_RETRIES + 1):
-        send = client.execute_client.send_goal_async(ExecuteManeuver.Goal(plan_id=response.plan.plan_id),
-                                                     feedback_callback=fed_back.append)
-        rclpy.spin_until_future_complete(client, send, timeout_sec=20)
-        goal = send.result()
-        assert goal is not None and goal.accepted
-        answer = goal.get_result_async()
-        wait_until(lambda answer=answer: fed_back or answer.done(), 30, "feedback on the maneuver", node=client)
-        if fed_back or answer.result().result.error_code != ErrorCode.UNKNOWN_PLAN:
-            break
-        time.sleep(0.5)     # wait-ok: the client's retry period for a plan not yet heard
+    # sent once: a goal that reaches the controller before the plan waits for it (plan_wait_s)
+    send = client.execute_client.send_goal_async(ExecuteManeuver.Goal(plan_id=response.plan.plan_id),
+                                                 feedback_callback=fed_back.append)
+    rclpy.spin_until_future_complete(client, send, timeout_sec=20)
+    goal = send.result()
+    assert goal is not None and goal.accepted
+    answer = goal.get_result_async()
+    wait_until(lambda: fed_back or answer.done(), 30, "feedback on the maneuver", node=client)
     assert fed_back, f"the maneuver was answered before it flew: {answer.result().result.message}"
     fuzzed["goal"] = goal, answer
     return goal, answer

@@ -11,15 +11,16 @@ import numpy as np
 import psutil
 import pytest
 import rclpy
+from action_msgs.msg import GoalStatus
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from mcap.reader import make_reader
 from rclpy.executors import MultiThreadedExecutor
 
 from att_msgs.action import ExecuteManeuver
-from att_msgs.msg import ActuatorCommand, ControllerStatus, KeepOutCone, SpacecraftState
+from att_msgs.msg import ActuatorCommand, ControllerStatus, KeepOutCone, ManeuverPlan, SpacecraftState
 from att_msgs.srv import PlanManeuver
-from att_msgs_py import convert, qos, topics
+from att_msgs_py import convert, qos, signing, topics
 from att_msgs_py.errors import ErrorCode
 from att_msgs_py.log import read_log
 from att_msgs_py.log.repair import LogFileError, Scan, scan_records
@@ -41,6 +42,19 @@ def suite(ros_suite):
                    params={"simulator": {"real_time_factor": 4.0}, "controller": {"state_source": "truth"}},
                    name="reliability_test") as s:
         yield s.suite, s.client, s.mcap.parent
+
+
+def slew_from_here(client) -> PlanManeuver.Response:
+    """A plan of a GOAL-sized slew from the simulator's latest state (the tests of this module share
+    one spacecraft and run in any order)."""
+    got = []
+    sub = client.create_subscription(SpacecraftState, topics.STATE, got.append, qos.STREAM_QOS)
+    wait_until(lambda: got, 20, "a state from the simulator", node=client)
+    client.destroy_subscription(sub)
+    q0 = convert.state_from_msg(got[-1]).q
+    response = client.plan(maneuver_request(q0, rot.multiply(q0, GOAL), [1, 0, 0], [], method="eigenaxis_smooth"))
+    assert response.success, response.message
+    return response
 
 
 finite = st.floats(allow_nan=False, allow_infinity=False, width=64)
@@ -139,10 +153,11 @@ def test_long_solve_does_not_block_a_quick_request(suite):
 
 def test_controller_refuses_unknown_plan_and_mode_change_mid_maneuver(suite):
     s, client, _ = suite
-    result = client.execute("no_such_plan", retries=0)
+    result = client.execute("no_such_plan")
     assert not result.success and result.error_code == ErrorCode.UNKNOWN_PLAN and "no_such_plan" in result.message
+    assert "waited 5 s" in result.message, result.message
     assert client.set_mode(42).error_code == ErrorCode.INVALID_MODE
-    plan = client.plan(maneuver_request(rot.IDENTITY, GOAL, [1, 0, 0], [], method="eigenaxis_smooth")).plan
+    plan = slew_from_here(client).plan
     goal = client.execute_client.send_goal_async(
         ExecuteManeuver.Goal(plan_id=plan.plan_id))
     rclpy.spin_until_future_complete(client, goal, timeout_sec=20)
@@ -159,6 +174,46 @@ def test_controller_refuses_unknown_plan_and_mode_change_mid_maneuver(suite):
     rclpy.spin_until_future_complete(client, done, timeout_sec=120)
     assert done.result().result.success
     assert client.set_mode(ControlMode.IDLE).success
+
+
+def test_a_goal_that_reaches_the_controller_before_its_plan_waits_for_it(suite):
+    """DDS does not order the plans' topic before the action: a goal naming a plan not received yet
+    waits for it (``plan_wait_s``) and flies it once it comes; a goal cancelled while it waits ends
+    cancelled at once, and the controller takes the next goal."""
+    s, client, _ = suite
+    key = signing.load_private_key(signing.default_key_dir() / signing.PRIVATE_NAME)
+    plan = slew_from_here(client).plan
+    late = ManeuverPlan()
+    for name in plan.get_fields_and_field_types():
+        setattr(late, name, getattr(plan, name))
+    late.plan_id = f"late_{time.monotonic_ns()}"
+    signing.sign(late, key)
+    pub = client.create_publisher(ManeuverPlan, topics.PLANS, qos.LATCHED_QOS)
+
+    def waiting_goal(plan_id: str):
+        mark = LogMark(s, "controller")
+        send = client.execute_client.send_goal_async(ExecuteManeuver.Goal(plan_id=plan_id))
+        rclpy.spin_until_future_complete(client, send, timeout_sec=20)
+        assert send.result() is not None and send.result().accepted
+        wait_until(lambda: f"goal for plan '{plan_id}' waits up to 5 s" in mark.text(), 20,
+                   "the controller waiting for the plan", node=client)
+        return send.result()
+
+    # cancelled while it waits: answered at once, not after the wait
+    handle = waiting_goal("never_published")
+    began = time.monotonic()
+    rclpy.spin_until_future_complete(client, handle.cancel_goal_async(), timeout_sec=20)
+    done = handle.get_result_async()
+    rclpy.spin_until_future_complete(client, done, timeout_sec=20)
+    assert done.result().status == GoalStatus.STATUS_CANCELED and time.monotonic() - began < 4.0
+    # the plan published after the goal was taken: flown
+    handle = waiting_goal(late.plan_id)
+    pub.publish(late)
+    done = handle.get_result_async()
+    rclpy.spin_until_future_complete(client, done, timeout_sec=120)
+    client.destroy_publisher(pub)
+    assert done.done() and done.result().status == GoalStatus.STATUS_SUCCEEDED, done.result().result.message
+    assert done.result().result.final_attitude_error < math.radians(0.5)
 
 
 def test_simulator_rejects_nan_commands_and_state_stays_finite(suite):
