@@ -293,8 +293,7 @@ class SuiteClient(Node):
             raise TimeoutError(f"the controller did not answer the goal within {GOAL_ANSWER_TIMEOUT:g} s")
         handle = send.result()
         if handle is None or not handle.accepted:
-            raise RuntimeError("the controller rejected the goal (another maneuver is executing or waiting for "
-                               "its plan)")
+            raise RuntimeError("the controller rejected the goal (another maneuver is executing)")
         heard[0] = time.monotonic()
         return self._await_result(handle, heard, timeout, stall_timeout)
 

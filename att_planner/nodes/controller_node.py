@@ -97,6 +97,8 @@ from att_planner.fdir.replan import REPLAN, SAFE, Brake
 from att_planner.nodes.client import maneuver_request
 from att_sim.models import scenario as scen
 
+MAX_WAITING_GOALS = 8     # execute goals waiting for their plans at once; a goal beyond them is refused at once
+
 
 class ControllerNode(Node):
     def __init__(self):
@@ -129,7 +131,7 @@ class ControllerNode(Node):
         self._stale = False
         self._refusals = RefusalLog(self.get_logger())   # refused inputs, logged once a second per kind
         self._goal = None                     # the goal handle of the running maneuver
-        self._awaited: tuple[str, Future] | None = None   # (plan id, heard) of a goal waiting for its plan
+        self._awaiting: list[tuple[str, object, Future]] = []   # (plan id, goal handle, heard): goals waiting
         self._waiting = None                  # (estimate, source) that came before any wheel speed
         self._sources = Sources({"wheel speed measurement": live_publishers(self, topics.WHEEL_SPEEDS),
                                  "magnetometer measurement": live_publishers(self, topics.MAGNETOMETER)})
@@ -363,8 +365,8 @@ class ControllerNode(Node):
                    or self._core.receive_plan(convert.plan_from_msg(msg), signing.payload(msg)))
         if refused is not None:
             self._refusals("published plan", refused)
-        elif self._awaited is not None and self._awaited[0] == msg.plan_id:
-            self._wake()
+        else:
+            self._wake(lambda plan_id, _: plan_id == msg.plan_id)
 
     def on_set_mode(self, request, response):
         refused = limits.issue(request, limits.SET_CONTROLLER_MODE) or self._core.authorize_mode(
@@ -390,30 +392,35 @@ class ControllerNode(Node):
 
     # -- action -----------------------------------------------------------------------------------
     def on_goal(self, goal: ExecuteManeuver.Goal):
-        busy = self._core.maneuver is not None or self._replan_of is not None or self._awaited is not None
+        busy = self._core.maneuver is not None or self._replan_of is not None
         return GoalResponse.REJECT if busy else GoalResponse.ACCEPT
 
-    def on_cancel(self, _goal_handle):
-        self._wake()          # a goal waiting for its plan ends now, cancelled
+    def on_cancel(self, goal_handle):
+        self._wake(lambda _, handle: handle is goal_handle)   # a goal waiting for its plan ends now, cancelled
         return CancelResponse.ACCEPT
 
-    async def _wait_for_plan(self, plan_id: str) -> None:
+    async def _wait_for_plan(self, plan_id: str, goal_handle) -> None:
         """Return once plan ``plan_id`` was received, the goal was cancelled or ``plan_wait_s`` of
-        wall time passed, whichever is first; the executor serves every other callback meanwhile."""
+        wall time passed, whichever is first; the executor serves every other callback meanwhile
+        (other goals too: a waiting goal does not hold the controller)."""
         heard = Future(executor=self.executor)
-        self._awaited = (plan_id, heard)
+        entry = (plan_id, goal_handle, heard)
+        self._awaiting.append(entry)
         self.get_logger().info(f"execute goal for plan '{clip(plan_id, 80)}' waits up to {self._plan_wait:g} s "
                                "for the plan")
-        timer = self.create_timer(self._plan_wait, self._wake, clock=Clock(clock_type=ClockType.STEADY_TIME))
+        timer = self.create_timer(self._plan_wait, lambda: heard.done() or heard.set_result(None),
+                                  clock=Clock(clock_type=ClockType.STEADY_TIME))
         try:
             await heard
         finally:
             self.destroy_timer(timer)
-            self._awaited = None
+            self._awaiting.remove(entry)
 
-    def _wake(self) -> None:
-        if self._awaited is not None and not self._awaited[1].done():
-            self._awaited[1].set_result(None)
+    def _wake(self, which) -> None:
+        """End the wait of every waiting goal for which ``which(plan_id, goal_handle)`` holds."""
+        for plan_id, handle, heard in self._awaiting:
+            if which(plan_id, handle) and not heard.done():
+                heard.set_result(None)
 
     async def execute(self, goal_handle):
         """Start tracking and wait (without blocking the executor) until the control loop ends
@@ -425,8 +432,9 @@ class ControllerNode(Node):
         if refused is None:
             inline = convert.plan_from_msg(goal.plan) if goal.use_inline_plan else None
             plan, refused = self._core.resolve(goal.plan_id, inline, signing.payload(goal.plan) if inline else b"")
-            if refused is not None and refused.code == ErrorCode.UNKNOWN_PLAN and self._plan_wait > 0:
-                await self._wait_for_plan(goal.plan_id)
+            if (refused is not None and refused.code == ErrorCode.UNKNOWN_PLAN and self._plan_wait > 0
+                    and len(self._awaiting) < MAX_WAITING_GOALS):
+                await self._wait_for_plan(goal.plan_id, goal_handle)
                 if goal_handle.is_cancel_requested:
                     self._to_client("goal status", goal_handle.canceled)
                     return convert.result_msg(ManeuverResult(False, int(ErrorCode.ABORTED),
@@ -434,6 +442,9 @@ class ControllerNode(Node):
                 plan, refused = self._core.resolve(goal.plan_id)
                 if refused is not None and refused.code == ErrorCode.UNKNOWN_PLAN:
                     refused = RequestError(refused.code, f"{refused.message} (waited {self._plan_wait:g} s for it)")
+                elif self._core.maneuver is not None or self._replan_of is not None:
+                    plan, refused = None, RequestError(ErrorCode.BUSY, "another maneuver started while this goal "
+                                                                       "waited for its plan")
         goal.plan = ManeuverPlan()       # read or refused: the goal handle, kept until its result expires, drops it
         if plan is not None:
             refused = self._core.start(plan, convert.pointing_from_msg(goal.pointing_after) if goal.point_after

@@ -178,17 +178,22 @@ def test_controller_refuses_unknown_plan_and_mode_change_mid_maneuver(suite):
 
 def test_a_goal_that_reaches_the_controller_before_its_plan_waits_for_it(suite):
     """DDS does not order the plans' topic before the action: a goal naming a plan not received yet
-    waits for it (``plan_wait_s``) and flies it once it comes; a goal cancelled while it waits ends
-    cancelled at once, and the controller takes the next goal."""
+    waits for it (``plan_wait_s``) and flies it once it comes. A goal cancelled while it waits ends
+    cancelled at once; waiting goals do not hold the controller (another goal flies meanwhile, and a
+    waiting goal whose plan comes during that maneuver is refused BUSY); an id never published is
+    refused after the wait."""
     s, client, _ = suite
     key = signing.load_private_key(signing.default_key_dir() / signing.PRIVATE_NAME)
-    plan = slew_from_here(client).plan
-    late = ManeuverPlan()
-    for name in plan.get_fields_and_field_types():
-        setattr(late, name, getattr(plan, name))
-    late.plan_id = f"late_{time.monotonic_ns()}"
-    signing.sign(late, key)
     pub = client.create_publisher(ManeuverPlan, topics.PLANS, qos.LATCHED_QOS)
+
+    def renamed(plan: ManeuverPlan) -> ManeuverPlan:
+        """``plan`` under a new id, signed: a plan the controller has not received."""
+        late = ManeuverPlan()
+        for name in plan.get_fields_and_field_types():
+            setattr(late, name, getattr(plan, name))
+        late.plan_id = f"late_{time.monotonic_ns()}"
+        signing.sign(late, key)
+        return late
 
     def waiting_goal(plan_id: str):
         mark = LogMark(s, "controller")
@@ -199,21 +204,47 @@ def test_a_goal_that_reaches_the_controller_before_its_plan_waits_for_it(suite):
                    "the controller waiting for the plan", node=client)
         return send.result()
 
+    def outcome(handle, timeout=120.0):
+        done = handle.get_result_async()
+        rclpy.spin_until_future_complete(client, done, timeout_sec=timeout)
+        assert done.done(), "the goal was never answered"
+        return done.result().status, done.result().result
+
     # cancelled while it waits: answered at once, not after the wait
     handle = waiting_goal("never_published")
     began = time.monotonic()
     rclpy.spin_until_future_complete(client, handle.cancel_goal_async(), timeout_sec=20)
-    done = handle.get_result_async()
-    rclpy.spin_until_future_complete(client, done, timeout_sec=20)
-    assert done.result().status == GoalStatus.STATUS_CANCELED and time.monotonic() - began < 4.0
+    assert outcome(handle, 20)[0] == GoalStatus.STATUS_CANCELED and time.monotonic() - began < 4.0
+    # two goals waiting (one for a plan never published) do not hold the controller: a third flies
+    plan = slew_from_here(client).plan
+    late = renamed(plan)
+    never = waiting_goal("never_published_either")
+    busy = waiting_goal(late.plan_id)
+    send = client.execute_client.send_goal_async(ExecuteManeuver.Goal(plan_id=plan.plan_id))
+    rclpy.spin_until_future_complete(client, send, timeout_sec=20)
+    assert send.result() is not None and send.result().accepted
+    flying = send.result()
+    pub.publish(late)                           # comes while the third goal's maneuver flies
+    status, result = outcome(busy)
+    assert status == GoalStatus.STATUS_ABORTED and result.error_code == ErrorCode.BUSY, result.message
+    status, result = outcome(never)
+    assert result.error_code == ErrorCode.UNKNOWN_PLAN and "waited 5 s" in result.message, result.message
+    status, result = outcome(flying)
+    assert status == GoalStatus.STATUS_SUCCEEDED, result.message
     # the plan published after the goal was taken: flown
+    late = renamed(slew_from_here(client).plan)
     handle = waiting_goal(late.plan_id)
     pub.publish(late)
-    done = handle.get_result_async()
-    rclpy.spin_until_future_complete(client, done, timeout_sec=120)
+    status, result = outcome(handle)
     client.destroy_publisher(pub)
-    assert done.done() and done.result().status == GoalStatus.STATUS_SUCCEEDED, done.result().result.message
-    assert done.result().result.final_attitude_error < math.radians(0.5)
+    assert status == GoalStatus.STATUS_SUCCEEDED, result.message
+    assert result.final_attitude_error < math.radians(0.5)
+    # a flood of goals for unknown plans: eight wait, the ninth is refused at once
+    sends = [client.execute_client.send_goal_async(ExecuteManeuver.Goal(plan_id=f"flood_{i}")) for i in range(9)]
+    wait_until(lambda: all(f.done() for f in sends), 20, "the flood's goals answered", node=client)
+    results = [outcome(f.result(), 30)[1] for f in sends]
+    assert all(r.error_code == ErrorCode.UNKNOWN_PLAN for r in results), [r.message for r in results]
+    assert sorted("waited 5 s" in r.message for r in results) == [False] + [True] * 8, [r.message for r in results]
 
 
 def test_simulator_rejects_nan_commands_and_state_stays_finite(suite):
