@@ -424,6 +424,14 @@ def _cmd(template: str) -> Callable[[dict, str], str]:
                                                                                  if isinstance(v, str | int | float)})
 
 
+def _day_command(p: dict, path: str) -> str:
+    """``att-bench day`` with the mission and the ``--rtf`` of its ``rtf_mode`` (none: paced)."""
+    mode = str(p.get("rtf_mode", ""))
+    rtf = "max" if mode.startswith("max") else mode.split()[2].rstrip(",") if mode.startswith("at most") else None
+    return ("att-bench day" + (f" --mission {p['mission']}" if "mission" in p else "")
+            + (f" --rtf {rtf}" if rtf else "") + f" --json {path}")
+
+
 STUDIES: tuple[Study, ...] = (
     Study("monte-carlo", lambda p: "runs_per_second" in p and "campaign" in p, _monte_carlo,
           lambda p, path: f"att-mc {p['campaign']} --runs {p['requested']} --workers {p['workers']} "
@@ -441,14 +449,17 @@ STUDIES: tuple[Study, ...] = (
     Study("momentum", lambda p: "dumping" in p and "no_dumping" in p, _momentum,
           _cmd("att-bench momentum --in-process --orbits {orbits:g} --json {path}")),
     Study("observe", lambda p: "zone_cost_ratio" in p, _observe, _cmd("att-bench observe --json {path}")),
-    Study("day", lambda p: "observed" in p and "missed" in p, _day, _cmd("att-bench day --json {path}")),
+    Study("day", lambda p: "observed" in p and "missed" in p, _day, _day_command),
     Study("timing", lambda p: "closed_sky" in p, _timing, _cmd("att-bench timing --json {path}")),
     Study("logtools", lambda p: "tools" in p and "allowed_exits" in p, _logtools,
           _cmd("att-bench logtools --json {path}")),
     Study("flood", lambda p: "growth_mib" in p, _flood, _cmd("att-bench flood --messages {messages} --json {path}")),
     Study("gains", lambda p: p.get("mode") in ("fixed", "robust") and "kp" in p, _gains,
           _cmd("att-bench gains --mode {mode} --json {path}")),
-    Study("soak", lambda p: "dropped_state" in p, _soak, _cmd("att-bench soak --json {path}")),
+    Study("soak", lambda p: "dropped_state" in p, _soak,
+          lambda p, path: f"att-bench soak --scenario {p['scenario']} "
+                          + (f"--hours {p['hours']:g} --rate-Hz {p['rate_Hz']:g} " if "rtf_target" in p
+                             else f"--orbits {p['orbits']:g} ") + f"--json {path}"),
     Study("cluster", lambda p: "throughput_ratio" in p, _cluster,
           _cmd("att-bench cluster --campaign {campaign} --runs {runs} --workers {workers} --json {path}")),
     Study("rtf", lambda p: "target_rtf" in p and p.get("in_process") is True, _rtf,

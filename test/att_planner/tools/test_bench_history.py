@@ -192,3 +192,19 @@ def test_benchmarks_md_tables_are_the_historys(tmp_path, capsys):
         summary.render([r for r in rows if (r["study"], r["case"]) != ("smooth", "swift")])
     md.write_text("# no tables\n")
     assert main(["summary", "--history", str(history), "--markdown", str(md), "--write"]) == 2
+
+
+@pytest.mark.parametrize("name, flags", [
+    ("soak_leo_observatory.json", "--scenario leo_observatory --hours 6 --rate-Hz 5"),
+    ("day_rtf_max.json", "--mission observatory_day --rtf max"),
+])
+def test_the_command_of_a_kept_json_carries_the_options_that_made_it(tmp_path, name, flags):
+    """A line's command re-makes its figure: the scenario, length and rate of a soak, the mission and
+    --rtf of a day (their defaults would fly another scenario or pace the day)."""
+    run = tmp_path / name
+    shutil.copy(BENCHMARKS / name, run)
+    history = tmp_path / "history.jsonl"
+    assert main(["history", "--append", str(run), "--history", str(history)]) == 0
+    (row,) = _lines(history)
+    study = name.split("_")[0]
+    assert row["command"] == f"att-bench {study} {flags} --json {run}"
