@@ -290,6 +290,19 @@ def load(name: str) -> Scenario:
     return build.scenario(build.epoch())
 
 
+def refusal(name: str) -> str | None:
+    """Why scenario ``name`` cannot be loaded, in one sentence, or None when it can: the
+    :func:`load` message of a scenario not shipped or of a file that is not a valid scenario (its
+    line and what is expected). For tools that refuse their arguments before any work starts."""
+    try:
+        load(name)
+    except KeyError as err:
+        return err.args[0]
+    except ConfigError as err:
+        return str(err)
+    return None
+
+
 def with_epoch(scenario: Scenario, epoch: datetime) -> Scenario:
     """``scenario`` with another epoch: everything its file builds from the epoch (orbit, field
     model, environment, zones, sensors and actuators) rebuilt from that file for ``epoch``."""

@@ -33,7 +33,7 @@ from datetime import timedelta
 
 import numpy as np
 
-from att_msgs_py.errors import ConfigError, RequestError
+from att_msgs_py.errors import RequestError
 from att_planner.service.warm import maneuver_from_scenario
 from att_planner.tools.closed_loop import ClosedLoop, plan_in_process
 from att_sim.models import rotations as rot
@@ -119,12 +119,9 @@ def _refuse(args) -> str | None:
     not shipped or a file that is not a valid one (the file's line and what is expected)."""
     if args.profile_rows < 1:
         return f"--profile-rows must be at least 1, found {args.profile_rows}"
-    try:
-        scen.load(args.scenario)
-    except KeyError as err:
-        return err.args[0]
-    except ConfigError as err:
-        return str(err)
+    unreadable = scen.refusal(args.scenario)
+    if unreadable:
+        return unreadable
     return None
 
 

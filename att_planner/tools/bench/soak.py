@@ -6,7 +6,6 @@ from __future__ import annotations
 import math
 import tempfile
 
-from att_msgs_py.errors import ConfigError
 from att_planner.tools.review.run import SETTLING_THRESHOLD
 from att_planner.tools.soak import run_soak
 from att_sim.models import scenario as scen
@@ -28,12 +27,9 @@ def configure(parser):
 def _refuse(args) -> str | None:
     """Why the arguments cannot be flown (None when they can): a scenario not shipped or a file that
     is not a valid one, a length or rate that is not a finite number > 0."""
-    try:
-        scen.load(args.scenario)
-    except KeyError as err:
-        return err.args[0]
-    except ConfigError as err:
-        return str(err)
+    unreadable = scen.refusal(args.scenario)
+    if unreadable:
+        return unreadable
     for flag, value in (("--orbits", args.orbits), ("--hours", args.hours), ("--rate-Hz", args.rate_Hz)):
         if value is not None and not (math.isfinite(value) and value > 0.0):
             return f"{flag} must be a finite number > 0, found {value:g}"

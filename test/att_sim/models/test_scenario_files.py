@@ -85,3 +85,16 @@ def test_a_bad_demo_is_refused_naming_it(tree):
     path = tree / "scenarios" / "swift_demo.demo.yaml"
     path.write_text(path.read_text().replace("sensor_axis: [1.0, 0.0, 0.0]", "sensor_axis: [2.0, 0.0, 0.0]"))
     assert "demo.sensor_axis: expected a unit vector" in refused("swift_demo")
+
+
+def test_refusal_is_the_one_sentence_of_what_load_raises(tmp_path):
+    """A shipped scenario loads (no refusal); an unknown name and a file that is not valid YAML are
+    each refused with the sentence :func:`scenario.load` raises, naming the name or the file's line."""
+    assert scenario.refusal("swift_demo") is None
+    with pytest.raises(KeyError) as unknown:
+        scenario.load("no_such_scenario")
+    assert scenario.refusal("no_such_scenario") == unknown.value.args[0] and "no_such_scenario" in unknown.value.args[0]
+    broken = tmp_path / "broken.yaml"
+    broken.write_text("name: x\n  spacecraft: [\n")
+    why = scenario.refusal(str(broken))
+    assert why is not None and why.startswith(f"{broken}:2: ") and "expected valid YAML" in why, why
