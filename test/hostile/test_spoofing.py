@@ -18,12 +18,11 @@ from att_msgs_py.errors import ErrorCode
 from att_msgs_py.types import State
 from att_planner.nodes.client import maneuver_request
 from att_sim.models import rotations as rot
+from helpers.from_here import SENSOR, latest_state, plan_from_here
 from helpers.node_logs import LogMark
 from helpers.waiting import wait_until
 
 pytestmark = pytest.mark.ros
-
-SENSOR = [1.0, 0.0, 0.0]
 
 
 @pytest.fixture(scope="module")
@@ -33,26 +32,6 @@ def suite(ros_suite):
                            "controller": {"settle_time_s": 5.0, "state_source": "truth"}},
                    name="spoofing_test") as s:
         yield s
-
-
-def latest_state(client, timeout=10.0) -> State:
-    got = []
-    sub = client.create_subscription(SpacecraftState, topics.STATE, got.append, qos.STREAM_QOS)
-    try:
-        end = time.monotonic() + timeout
-        while not got and time.monotonic() < end:
-            rclpy.spin_once(client, timeout_sec=0.05)
-        return convert.state_from_msg(got[-1])
-    finally:
-        client.destroy_subscription(sub)
-
-
-def plan_from_here(client, angle, axis=(0, 0, 1), **kw):
-    q0 = latest_state(client).q
-    goal = rot.multiply(q0, rot.from_axis_angle(axis, angle))
-    response = client.plan(maneuver_request(q0, goal, SENSOR, [], method="eigenaxis_smooth", **kw))
-    assert response.success, response.message
-    return response.plan, goal
 
 
 def publish_plans(client, msgs, settle=1.0):

@@ -28,12 +28,14 @@ from att_msgs_py.types import ControlMode
 from att_planner.nodes.client import SuiteClient, maneuver_request
 from att_planner.tools.launch import Suite, isolated_env
 from att_sim.models import rotations as rot
+from helpers.from_here import plan_from_here
 from helpers.node_logs import LogMark
 from helpers.waiting import wait_until
 
 pytestmark = pytest.mark.ros
 
-GOAL = rot.from_axis_angle([0, 0, 1], 0.4)
+GOAL_ANGLE = 0.4                          # rad about the body z axis
+GOAL = rot.from_axis_angle([0, 0, 1], GOAL_ANGLE)
 
 
 @pytest.fixture(scope="module")
@@ -42,19 +44,6 @@ def suite(ros_suite):
                    params={"simulator": {"real_time_factor": 4.0}, "controller": {"state_source": "truth"}},
                    name="reliability_test") as s:
         yield s.suite, s.client, s.mcap.parent
-
-
-def slew_from_here(client) -> PlanManeuver.Response:
-    """A plan of a GOAL-sized slew from the simulator's latest state (the tests of this module share
-    one spacecraft and run in any order)."""
-    got = []
-    sub = client.create_subscription(SpacecraftState, topics.STATE, got.append, qos.STREAM_QOS)
-    wait_until(lambda: got, 20, "a state from the simulator", node=client)
-    client.destroy_subscription(sub)
-    q0 = convert.state_from_msg(got[-1]).q
-    response = client.plan(maneuver_request(q0, rot.multiply(q0, GOAL), [1, 0, 0], [], method="eigenaxis_smooth"))
-    assert response.success, response.message
-    return response
 
 
 finite = st.floats(allow_nan=False, allow_infinity=False, width=64)
@@ -157,7 +146,7 @@ def test_controller_refuses_unknown_plan_and_mode_change_mid_maneuver(suite):
     assert not result.success and result.error_code == ErrorCode.UNKNOWN_PLAN and "no_such_plan" in result.message
     assert "waited 5 s" in result.message, result.message
     assert client.set_mode(42).error_code == ErrorCode.INVALID_MODE
-    plan = slew_from_here(client).plan
+    plan = plan_from_here(client, GOAL_ANGLE)[0]
     goal = client.execute_client.send_goal_async(
         ExecuteManeuver.Goal(plan_id=plan.plan_id))
     rclpy.spin_until_future_complete(client, goal, timeout_sec=20)
@@ -216,7 +205,7 @@ def test_a_goal_that_reaches_the_controller_before_its_plan_waits_for_it(suite):
     rclpy.spin_until_future_complete(client, handle.cancel_goal_async(), timeout_sec=20)
     assert outcome(handle, 20)[0] == GoalStatus.STATUS_CANCELED and time.monotonic() - began < 4.0
     # two goals waiting (one for a plan never published) do not hold the controller: a third flies
-    plan = slew_from_here(client).plan
+    plan = plan_from_here(client, GOAL_ANGLE)[0]
     late = renamed(plan)
     never = waiting_goal("never_published_either")
     busy = waiting_goal(late.plan_id)
@@ -232,7 +221,7 @@ def test_a_goal_that_reaches_the_controller_before_its_plan_waits_for_it(suite):
     status, result = outcome(flying)
     assert status == GoalStatus.STATUS_SUCCEEDED, result.message
     # the plan published after the goal was taken: flown
-    late = renamed(slew_from_here(client).plan)
+    late = renamed(plan_from_here(client, GOAL_ANGLE)[0])
     handle = waiting_goal(late.plan_id)
     pub.publish(late)
     status, result = outcome(handle)
