@@ -119,10 +119,7 @@ def _refuse(args) -> str | None:
     not shipped or a file that is not a valid one (the file's line and what is expected)."""
     if args.profile_rows < 1:
         return f"--profile-rows must be at least 1, found {args.profile_rows}"
-    unreadable = scen.refusal(args.scenario)
-    if unreadable:
-        return unreadable
-    return None
+    return scen.refusal(args.scenario)
 
 
 def run(args) -> dict:
