@@ -18,7 +18,6 @@ from collections import deque
 
 import foxglove
 from foxglove.websocket import ServerListener
-from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy
 
 from att_msgs_py import memory, qos, topics
@@ -26,6 +25,7 @@ from att_msgs_py.errors import ConfigError, ErrorCode, clip
 from att_msgs_py.log.definitions import message_definition
 from att_msgs_py.log.log_parameters import BRIDGE
 from att_msgs_py.node_runner import ParameterReader, run_node
+from att_msgs_py.suite_node import SuiteNode
 
 
 class Latch(ServerListener):
@@ -55,7 +55,7 @@ class Latch(ServerListener):
                 self.channels[channel.id].log(data, log_time=log_time)
 
 
-class BridgeNode(Node):
+class BridgeNode(SuiteNode):
     def __init__(self):
         super().__init__("bridge")
         param = ParameterReader(self, BRIDGE, {})

@@ -58,7 +58,6 @@ from datetime import timedelta
 from rclpy.action import ActionServer, CancelResponse, GoalResponse
 from rclpy.clock import Clock, ClockType
 from rclpy.impl.implementation_singleton import rclpy_implementation as _rclpy
-from rclpy.node import Node
 from rclpy.task import Future
 from rosgraph_msgs.msg import Clock as ClockMsg
 from sensor_msgs.msg import JointState, MagneticField
@@ -85,6 +84,7 @@ from att_msgs_py.node_runner import (
     run_node,
     subscribe_when_heard,
 )
+from att_msgs_py.suite_node import SuiteNode
 from att_msgs_py.types import ControlKind, ControlMode, ManeuverResult
 from att_planner import methods
 from att_planner.control.controller_from_scenario import controller_from_scenario, public_key
@@ -100,7 +100,7 @@ from att_sim.models import scenario as scen
 MAX_WAITING_GOALS = 8     # execute goals waiting for their plans at once; a goal beyond them is refused at once
 
 
-class ControllerNode(Node):
+class ControllerNode(SuiteNode):
     def __init__(self):
         super().__init__("controller")
         self._scenario = scen.load_checked(read_scenario(self))

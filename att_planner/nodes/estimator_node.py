@@ -26,7 +26,6 @@ from __future__ import annotations
 import math
 import time
 
-from rclpy.node import Node
 from sensor_msgs.msg import Imu, MagneticField
 
 from att_msgs.msg import ActuatorCommand, AttitudeEstimate, CoarseSunSensors, FaultStatus, StarTracker
@@ -41,6 +40,7 @@ from att_msgs_py.node_runner import (
     run_node,
     subscribe_when_heard,
 )
+from att_msgs_py.suite_node import SuiteNode
 from att_planner.estimation.estimator_from_scenario import estimator_from_scenario
 from att_planner.estimation.estimator_parameters import ESTIMATOR
 from att_planner.estimation.inputs import Sources
@@ -53,7 +53,7 @@ INPUTS = {"gyro sample": topics.IMU, "star tracker measurement": topics.STAR_TRA
           "actuator command": topics.COMMAND}      # each input's topic, by the name its refusals give
 
 
-class EstimatorNode(Node):
+class EstimatorNode(SuiteNode):
     def __init__(self):
         super().__init__("estimator")
         s = scen.load_checked(read_scenario(self))

@@ -31,7 +31,6 @@ import uuid
 
 from rclpy.callback_groups import ReentrantCallbackGroup
 from rclpy.executors import MultiThreadedExecutor
-from rclpy.node import Node
 from visualization_msgs.msg import MarkerArray
 
 from att_msgs.msg import ManeuverPlan
@@ -39,6 +38,7 @@ from att_msgs.srv import ImageStrip, ImageTarget, PlanManeuver, PlanSchedule
 from att_msgs_py import convert, limits, markers, memory, qos, signing, topics
 from att_msgs_py.errors import ConfigError, ErrorCode, RequestError, clip
 from att_msgs_py.node_runner import ParameterReader, read_scenario, run_node
+from att_msgs_py.suite_node import SuiteNode
 from att_msgs_py.types import Plan
 from att_planner import methods
 from att_planner.methods.schedule import plan_schedule
@@ -59,7 +59,7 @@ from att_sim.models import scenario as scen
 from att_sim.models import scene
 
 
-class PlannerNode(Node):
+class PlannerNode(SuiteNode):
     def __init__(self):
         super().__init__("planner")
         scenario = scen.load_checked(read_scenario(self))

@@ -64,7 +64,6 @@ import time
 
 import numpy as np
 import rclpy
-from rclpy.node import Node
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import Imu, JointState, MagneticField
 from std_srvs.srv import SetBool
@@ -91,6 +90,7 @@ from att_msgs_py.node_runner import (
     run_node,
     spin_until_shutdown,
 )
+from att_msgs_py.suite_node import SuiteNode
 from att_sim.models import scenario as scen
 from att_sim.models import scene
 from att_sim.truth import dispersions
@@ -100,7 +100,7 @@ from att_sim.truth.simulator_parameters import SIMULATOR
 FREE_RUN_PACE = 1.0        # real-time factor of a free-running simulator whose real_time_factor is 0 (max)
 
 
-class SimulatorNode(Node):
+class SimulatorNode(SuiteNode):
     def __init__(self):
         super().__init__("simulator")
         self.scenario = scen.load_checked(read_scenario(self))
