@@ -47,7 +47,6 @@ from datetime import timedelta
 from pathlib import Path
 
 import numpy as np
-from scipy.special import ndtr, ndtri
 
 from att_sim.models import config_files
 from att_sim.models import rotations as rot
@@ -89,6 +88,8 @@ class Distribution:
 
     def draw(self, rng: np.random.Generator, n: int) -> np.ndarray:
         """``n`` independent draws (inverse CDF of one uniform each)."""
+        from scipy.special import ndtr, ndtri  # here: the simulator node imports this module at start
+
         u = rng.random(n)
         if self.kind == "uniform":
             return self.a + (self.b - self.a) * u
@@ -104,6 +105,8 @@ class Distribution:
         if math.isinf(k):
             return self.a, self.b
         phi = math.exp(-0.5 * k * k) / math.sqrt(2.0 * math.pi)
+        from scipy.special import ndtr
+
         return self.a, self.b * math.sqrt(1.0 - 2.0 * k * phi / (2.0 * ndtr(k) - 1.0))
 
 
