@@ -56,7 +56,7 @@ def marker_msg(shape: Shape, t: float) -> Marker:
                     else Vector3(x=1.0, y=1.0, z=1.0))
     r, g, b, a = (float(c) for c in shape.rgba)
     marker.color = ColorRGBA(r=r, g=g, b=b, a=a)
-    marker.points = [Point(x=float(x), y=float(y), z=float(z)) for x, y, z in np.asarray(shape.points, float)]
+    marker.points = [Point(x=x, y=y, z=z) for x, y, z in np.asarray(shape.points, float).tolist()]
     return marker
 
 
