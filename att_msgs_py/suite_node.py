@@ -4,9 +4,9 @@ event handlers unless a caller asks for some.
 rclpy gives every publisher and subscription, by default, two event handlers (incompatible QoS and
 incompatible type), each of which only logs a warning. Both are waitables: the default executor
 rebuilds its wait set before every wait, visiting each one, so they are most of a flight node's
-entities (14 of the estimator's 40) and cost it some 4 µs each per message it takes. A QoS or type
-mismatch with a suite topic is still reported: by the other side's handler (a user's rclpy node
-keeps its defaults), and the suite's QoS of each topic is in its node's README.
+entities (14 of the 26 the estimator's executor visits) and cost it some 4 µs each per message it
+takes. A QoS or type mismatch with a suite topic is still reported: by the other side's handler (a
+user's rclpy node keeps its defaults), and the suite's QoS of each topic is on its node's page.
 
 >>> import rclpy
 >>> from std_msgs.msg import Float64

@@ -1,5 +1,6 @@
 """SuiteNode: its publishers and subscriptions carry no QoS event handler unless one is asked for, so
-the executor's wait set holds only the node's own entities; messages still flow."""
+the executor's wait set holds only the node's own entities; messages still flow; every node the suite
+starts is one."""
 from __future__ import annotations
 
 import time
@@ -54,3 +55,15 @@ def test_event_callbacks_given_are_kept(context):
                                    event_callbacks=SubscriptionEventCallbacks(incompatible_qos=lambda e: None))
     assert len(pub.event_handlers) >= 1 and len(sub.event_handlers) >= 1
     node.destroy_node()
+
+
+def test_every_node_the_suite_starts_is_a_suite_node():
+    import importlib
+    import inspect
+
+    from att_planner.tools.launch import NODE_MODULES
+
+    for name, module in NODE_MODULES.items():
+        classes = [c for _, c in inspect.getmembers(importlib.import_module(module), inspect.isclass)
+                   if issubclass(c, Node) and c.__module__ == module]
+        assert classes and all(issubclass(c, SuiteNode) for c in classes), (name, classes)
