@@ -1,5 +1,5 @@
-"""The base of every suite node: an rclpy ``Node`` whose publishers and subscriptions carry no QoS
-event handlers unless a caller asks for some.
+"""The base of every suite node spun by rclpy's default executor: an rclpy ``Node`` whose publishers
+and subscriptions carry no QoS event handlers unless a caller asks for some.
 
 rclpy gives every publisher and subscription, by default, two event handlers (incompatible QoS and
 incompatible type), each of which only logs a warning. Both are waitables: the default executor

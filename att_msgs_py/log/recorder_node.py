@@ -19,16 +19,16 @@ from datetime import UTC, datetime
 from pathlib import Path
 
 from rclpy.experimental import EventsExecutor
+from rclpy.node import Node
 
 from att_msgs_py import memory, qos, topics
 from att_msgs_py.log.log_parameters import RECORDER
 from att_msgs_py.log.repair import LogFileError, Scan, repair, scan_records
 from att_msgs_py.log.writer import LogWriter
 from att_msgs_py.node_runner import ParameterReader, run_node
-from att_msgs_py.suite_node import SuiteNode
 
 
-class RecorderNode(SuiteNode):
+class RecorderNode(Node):
     def __init__(self):
         super().__init__("recorder")
         stamp = datetime.now(UTC).strftime("%Y%m%d_%H%M%S")

@@ -1,6 +1,6 @@
 """SuiteNode: its publishers and subscriptions carry no QoS event handler unless one is asked for, so
 the executor's wait set holds only the node's own entities; messages still flow; every node the suite
-starts is one."""
+starts on the default executor is one."""
 from __future__ import annotations
 
 import time
@@ -57,13 +57,16 @@ def test_event_callbacks_given_are_kept(context):
     node.destroy_node()
 
 
-def test_every_node_the_suite_starts_is_a_suite_node():
+def test_every_node_on_the_default_executor_is_a_suite_node():
     import importlib
     import inspect
 
     from att_planner.tools.launch import NODE_MODULES
 
+    # the recorder spins on rclpy's events executor, which rebuilds no wait set: it keeps rclpy's defaults
     for name, module in NODE_MODULES.items():
+        if name == "recorder":
+            continue
         classes = [c for _, c in inspect.getmembers(importlib.import_module(module), inspect.isclass)
                    if issubclass(c, Node) and c.__module__ == module]
         assert classes and all(issubclass(c, SuiteNode) for c in classes), (name, classes)
