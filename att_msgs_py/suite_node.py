@@ -1,8 +1,9 @@
-"""The base of every suite node spun by rclpy's default executor: an rclpy ``Node`` whose publishers
-and subscriptions carry no QoS event handlers unless a caller asks for some.
+"""The base of every suite node spun by one of rclpy's wait-set executors (single- or multi-threaded):
+an rclpy ``Node`` whose publishers and subscriptions carry no QoS event handlers unless a caller asks
+for some.
 
 rclpy gives every publisher and subscription, by default, two event handlers (incompatible QoS and
-incompatible type), each of which only logs a warning. Both are waitables: the default executor
+incompatible type), each of which only logs a warning. Both are waitables: a wait-set executor
 rebuilds its wait set before every wait, visiting each one, so they are most of a flight node's
 entities (14 of the 26 the estimator's executor visits) and cost it some 4 µs each per message it
 takes. A QoS or type mismatch with a suite topic is still reported: by the other side's handler (a

@@ -1,6 +1,6 @@
 """SuiteNode: its publishers and subscriptions carry no QoS event handler unless one is asked for, so
 the executor's wait set holds only the node's own entities; messages still flow; every node the suite
-starts on the default executor is one."""
+starts on a wait-set executor is one."""
 from __future__ import annotations
 
 import time
@@ -57,7 +57,7 @@ def test_event_callbacks_given_are_kept(context):
     node.destroy_node()
 
 
-def test_every_node_on_the_default_executor_is_a_suite_node():
+def test_every_node_on_a_wait_set_executor_is_a_suite_node():
     import importlib
     import inspect
 
