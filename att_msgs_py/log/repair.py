@@ -58,6 +58,8 @@ _OPCODES = frozenset(int(o) for o in Opcode)
 _SUMMARY_OPCODES = frozenset(int(o) for o in (Opcode.SCHEMA, Opcode.CHANNEL, Opcode.CHUNK_INDEX,
                                                Opcode.ATTACHMENT_INDEX, Opcode.METADATA_INDEX, Opcode.STATISTICS,
                                                Opcode.SUMMARY_OFFSET, Opcode.FOOTER))
+# what a chunked data section holds only inside its chunks
+_CHUNKED_OPCODES = frozenset(int(o) for o in (Opcode.SCHEMA, Opcode.CHANNEL, Opcode.MESSAGE))
 
 
 class LogFileError(ValueError):
@@ -110,19 +112,27 @@ class Scan:
 
 
 class _StrictReader(StreamReader):
-    """mcap's stream reader that refuses a record of an unknown opcode instead of skipping it, and
-    after the data end any record the summary section cannot hold (a flipped opcode there would
-    turn a summary's channel into a message outside any CRC)."""
+    """mcap's stream reader that refuses a record of an unknown opcode instead of skipping it; after
+    the data end, any record the summary section cannot hold (a flipped opcode there would turn a
+    summary's channel into a message outside any CRC); and, once the data section has held a chunk,
+    a schema, channel or message outside one (a chunked writer puts every one inside a chunk, so
+    one outside is a damaged opcode: a message index's flipped to a message would pass its bytes
+    on as a message no CRC covers). A file without chunks (another writer's flat layout) keeps its
+    top-level messages."""
 
     _in_summary = False
+    _chunked = False
 
     def _read_record(self, opcode: int, length: int):
         if opcode not in _OPCODES:
             raise ValueError(f"record of unknown opcode 0x{opcode:02x}")
         if self._in_summary and opcode not in _SUMMARY_OPCODES:
             raise ValueError(f"a {Opcode(opcode).name.lower()} record after the data end")
+        if self._chunked and not self._in_summary and opcode in _CHUNKED_OPCODES:
+            raise ValueError(f"a {Opcode(opcode).name.lower()} record outside a chunk, after chunks")
         record = super()._read_record(opcode, length)
         self._in_summary = self._in_summary or isinstance(record, DataEnd)
+        self._chunked = self._chunked or isinstance(record, Chunk)
         return record
 
 

@@ -162,6 +162,7 @@ RECORD_KINDS = ("header", "schema", "channel", "chunk header", "chunk payload", 
 @settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
 @given(kind=st.sampled_from(RECORD_KINDS), which=st.floats(0.0, 1.0), cut=st.floats(0.05, 1.0),
        flips=st.lists(st.tuples(st.floats(0.0, 1.0), st.integers(1, 255)), min_size=1, max_size=4))
+@example(kind="message index", which=0.0, cut=1.0, flips=[(0.0, 2)])       # 0x07 -> 0x05: a message
 def test_flips_inside_any_record_kind_repair_to_a_prefix_of_its_messages(finished, tmp_path, kind, which, cut,
                                                                            flips):
     """Bytes flipped inside one record of a chosen kind (header, schema, channel, chunk header, chunk
@@ -185,6 +186,26 @@ def test_flips_inside_any_record_kind_repair_to_a_prefix_of_its_messages(finishe
         return
     got = records_of(done.output)
     assert got == original[:len(got)], (kind, start, end, flips)
+
+
+@pytest.mark.parametrize("opcode", [0x03, 0x04, 0x05])
+def test_a_message_index_turned_schema_channel_or_message_ends_the_recovery_before_it(finished, tmp_path, opcode):
+    """A chunked log holds its schemas, channels and messages inside chunks; a message index whose
+    opcode reads as one of them is a damaged byte outside any chunk CRC, so the recovery keeps the
+    chunks before it and stops there instead of passing the index's bytes on as a record."""
+    path, original = finished
+    data = bytearray(path.read_bytes())
+    ranges = record_ranges(bytes(data))
+    index = ranges["message index"][0][0]
+    chunks_before = sum(pos < index for pos, _ in ranges["chunk header"])
+    assert data[index] == 0x07
+    data[index] = opcode
+    damaged = tmp_path / "damaged.mcap"
+    damaged.write_bytes(bytes(data))
+    done = repair(damaged, tmp_path / "out.mcap")
+    assert done.source.damaged and f"byte {index}" in done.source.problem, done.source.problem
+    assert "outside a chunk" in done.source.problem
+    assert records_of(done.output) == original[:chunks_before * PER_CHUNK]
 
 
 @pytest.mark.parametrize("opcode", [0x00, 0x10, 0x80, 0xFF])
