@@ -5,9 +5,11 @@ A recorder killed with SIGKILL leaves its file without data end, summary, footer
 perhaps with its last chunk cut short; ``rosbags`` and ``mcap``'s seeking reader refuse such a file.
 :func:`scan_records` reads it with ``mcap``'s :class:`~mcap.stream_reader.StreamReader` (every read
 bounded by what is left of the file, so a damaged length field cannot allocate more) and stops
-at the first record that is cut, fails its CRC or has an opcode the MCAP specification does not
+at the first record that is cut, fails its CRC, has an opcode the MCAP specification does not
 define (the specification lets a reader skip such a record; a suite log holds none, so one is a
-damaged byte: a chunk's opcode flipped would otherwise drop that chunk and go on after it). Every
+damaged byte: a chunk's opcode flipped would otherwise drop that chunk and go on after it) or is of
+a kind that cannot be where it is (a second header, a summary record before the data end, a data
+record after it, a schema, channel or message outside the chunks of a chunked file). Every
 CRC of the file is checked: each chunk's (a chunk whose CRC reads 0 is refused: nothing could tell
 its damaged payload from the recorded one), the data section's in the data end (the header and the
 message indexes, which no chunk CRC covers) and the summary's in the footer (the summary's
@@ -54,7 +56,10 @@ DAMAGE = (McapError, ValueError, EOFError, struct.error, zstandard.ZstdError, Ru
           KeyError, IndexError, OverflowError)
 KEPT = (Header, Schema, Channel, Message, Attachment, Metadata)
 _OPCODES = frozenset(int(o) for o in Opcode)
-# what the summary section (after the data end) may hold; a data record there is a damaged opcode
+# what each section may hold (MCAP specification): a record of another kind there is a damaged opcode
+_DATA_OPCODES = frozenset(int(o) for o in (Opcode.HEADER, Opcode.SCHEMA, Opcode.CHANNEL, Opcode.MESSAGE,
+                                            Opcode.CHUNK, Opcode.MESSAGE_INDEX, Opcode.ATTACHMENT,
+                                            Opcode.METADATA, Opcode.DATA_END))
 _SUMMARY_OPCODES = frozenset(int(o) for o in (Opcode.SCHEMA, Opcode.CHANNEL, Opcode.CHUNK_INDEX,
                                                Opcode.ATTACHMENT_INDEX, Opcode.METADATA_INDEX, Opcode.STATISTICS,
                                                Opcode.SUMMARY_OFFSET, Opcode.FOOTER))
@@ -112,25 +117,31 @@ class Scan:
 
 
 class _StrictReader(StreamReader):
-    """mcap's stream reader that refuses a record of an unknown opcode instead of skipping it; after
-    the data end, any record the summary section cannot hold (a flipped opcode there would turn a
-    summary's channel into a message outside any CRC); and, once the data section has held a chunk,
-    a schema, channel or message outside one (a chunked writer puts every one inside a chunk, so
-    one outside is a damaged opcode: a message index's flipped to a message would pass its bytes
-    on as a message no CRC covers). A file without chunks (another writer's flat layout) keeps its
-    top-level messages."""
+    """mcap's stream reader that refuses, instead of skipping or taking it, a record that cannot be
+    where it is: one of an unknown opcode; a second header; in the data section, a record only the
+    summary holds (a chunk whose opcode read as a summary offset would be skipped and the reading
+    go on after it); after the data end, a data record (a summary's channel flipped to a message
+    outside any CRC); and, once the data section has held a chunk, a schema, channel or message
+    outside one (a chunked writer puts every one inside a chunk: a message index flipped to a
+    message would pass its bytes on as a message no CRC covers). A file without chunks (another
+    writer's flat layout) keeps its top-level messages."""
 
     _in_summary = False
     _chunked = False
+    _header = False
 
     def _read_record(self, opcode: int, length: int):
         if opcode not in _OPCODES:
             raise ValueError(f"record of unknown opcode 0x{opcode:02x}")
-        if self._in_summary and opcode not in _SUMMARY_OPCODES:
-            raise ValueError(f"a {Opcode(opcode).name.lower()} record after the data end")
+        name = Opcode(opcode).name.lower().replace("_", " ")
+        if opcode not in (_SUMMARY_OPCODES if self._in_summary else _DATA_OPCODES):
+            raise ValueError(f"a {name} record {'after' if self._in_summary else 'before'} the data end")
+        if opcode == Opcode.HEADER and self._header:
+            raise ValueError("a second header record")
         if self._chunked and not self._in_summary and opcode in _CHUNKED_OPCODES:
-            raise ValueError(f"a {Opcode(opcode).name.lower()} record outside a chunk, after chunks")
+            raise ValueError(f"a {name} record outside a chunk, after chunks")
         record = super()._read_record(opcode, length)
+        self._header = self._header or isinstance(record, Header)
         self._in_summary = self._in_summary or isinstance(record, DataEnd)
         self._chunked = self._chunked or isinstance(record, Chunk)
         return record

@@ -208,6 +208,41 @@ def test_a_message_index_turned_schema_channel_or_message_ends_the_recovery_befo
     assert records_of(done.output) == original[:chunks_before * PER_CHUNK]
 
 
+@pytest.mark.parametrize("kind", ["header", "chunk header", "message index", "schema", "channel", "summary"])
+def test_a_record_whose_opcode_reads_as_any_other_defined_kind_repairs_to_a_prefix(finished, tmp_path, kind):
+    """The first, middle and last record of a kind, its opcode turned into each other opcode MCAP
+    defines (0x01-0x0F): whatever that record then parses as, what is recovered is a prefix of the
+    recorded messages, or nothing (unknown opcodes: the test below)."""
+    path, original = finished
+    data = path.read_bytes()
+    starts = [pos for pos, _ in record_ranges(data)[kind]]
+    for start in sorted({starts[0], starts[len(starts) // 2], starts[-1]}):
+        for opcode in set(range(0x01, 0x10)) - {data[start]}:
+            damaged = tmp_path / "damaged.mcap"
+            damaged.write_bytes(data[:start] + bytes([opcode]) + data[start + 1:])
+            try:
+                got = records_of(repair(damaged, tmp_path / "out.mcap").output)
+            except LogFileError as err:
+                assert "nothing to recover" in str(err), (start, opcode, str(err))
+                continue
+            assert got == original[:len(got)], (kind, start, hex(opcode))
+
+
+def test_a_second_header_ends_the_recovery_before_it(finished, tmp_path):
+    """A header record anywhere but first (a well-formed one, inserted before the second chunk) is
+    damage: the recovery keeps the first chunk and stops there, instead of starting a second log."""
+    path, original = finished
+    data = path.read_bytes()
+    second = record_ranges(data)["chunk header"][1][0]
+    body = (0).to_bytes(4, "little") * 2                       # empty profile and library strings
+    header = bytes([0x01]) + len(body).to_bytes(8, "little") + body
+    damaged = tmp_path / "damaged.mcap"
+    damaged.write_bytes(data[:second] + header + data[second:])
+    done = repair(damaged, tmp_path / "out.mcap")
+    assert "a second header record" in done.source.problem and f"byte {second}" in done.source.problem
+    assert records_of(done.output) == original[:PER_CHUNK]
+
+
 @pytest.mark.parametrize("opcode", [0x00, 0x10, 0x80, 0xFF])
 def test_a_chunk_whose_opcode_was_flipped_ends_the_recovery_before_it(finished, tmp_path, opcode):
     """MCAP lets a reader skip a record of unknown opcode; in a suite log that is a damaged byte, and
