@@ -4,8 +4,10 @@ Subscribes in raw (serialized CDR) form to :func:`att_msgs_py.qos.recorded_topic
 are stored byte-for-byte as published. The file is flushed at least every ``flush_period_s`` s (a
 killed recorder loses at most that) and finalised (summary and index) on SIGINT/SIGTERM, once what
 its subscriptions already hold is written (:func:`drain`). A file left at ``output`` by a recorder
-that did not finish is first repaired to ``OUT.repaired.mcap`` (``att-log repair``), so starting
-again on the same path loses nothing.
+that did not finish is first repaired to ``OUT.repaired.mcap`` (``att-log repair``; ``OUT.repaired.N.mcap``
+when that is taken), so starting again on the same path, as often as it happens, loses nothing. A
+file there that is not an MCAP log, or a leftover that cannot be repaired, stops the node (exit 2)
+and is left as it is.
 
 Spun by rclpy's events executor: the recorder listens to every topic, and the default executor's
 per-message wait-set rebuild made it the busiest process of a fast run.
@@ -22,8 +24,9 @@ from rclpy.experimental import EventsExecutor
 from rclpy.node import Node
 
 from att_msgs_py import memory, qos, topics
+from att_msgs_py.errors import ConfigError, ErrorCode
 from att_msgs_py.log.log_parameters import RECORDER
-from att_msgs_py.log.repair import LogFileError, Scan, repair, scan_records
+from att_msgs_py.log.repair import MAGIC, LogFileError, Scan, repair, scan_records, unused_output
 from att_msgs_py.log.writer import LogWriter
 from att_msgs_py.node_runner import ParameterReader, run_node
 
@@ -48,18 +51,35 @@ class RecorderNode(Node):
         self.get_logger().info(f"recording {len(self.log.counts)} topics to {output}")
 
     def keep_leftover(self, path: Path) -> None:
-        """Repair an unfinished log at ``path`` aside before it is recorded over."""
+        """Keep what a file already at ``path`` holds before it is recorded over: an unfinished log is
+        repaired aside; a complete log, or a file that holds no message, is recorded over (logged); a
+        file that is not an MCAP log, or an unfinished log that cannot be repaired, stops the node
+        (:class:`ConfigError`) and is left as it is."""
+        def refuse(why: str) -> ConfigError:
+            return ConfigError(ErrorCode.INVALID_CONFIG, f"output: {path} {why}; it is left as it is: move it or "
+                                                         "choose another output")
+
+        with open(path, "rb") as fh:
+            start = fh.read(len(MAGIC))
+        if start != MAGIC[:len(start)]:
+            raise refuse("is a file that is not an MCAP log")
         scan = Scan(path, 0)
         try:
             for _ in scan_records(path, scan):
                 pass
-        except LogFileError as err:
+        except LogFileError as err:                 # empty, or cut inside the magic: nothing was recorded
             self.get_logger().warning(f"recording over {path}: {err}")
             return
         if scan.complete:
             self.get_logger().warning(f"recording over the complete log {path} ({scan.messages} messages)")
             return
-        done = repair(path)
+        if scan.messages == 0:
+            self.get_logger().warning(f"recording over {path}: it holds no message ({scan.problem})")
+            return
+        try:
+            done = repair(path, unused_output(path))
+        except LogFileError as err:
+            raise refuse(f"holds an unfinished log that could not be repaired aside ({err})") from None
         self.get_logger().warning(f"{path} was left unfinished ({scan.problem}): repaired into {done.output} "
                                   f"({done.result.messages} messages) before recording over it")
 

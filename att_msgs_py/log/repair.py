@@ -22,6 +22,7 @@ short is dropped: the recorder flushes a chunk at least every 0.5 s, so that is 
 from __future__ import annotations
 
 import io
+import itertools
 import os
 import struct
 import zlib
@@ -386,6 +387,15 @@ def default_output(path: str | Path) -> Path:
     return path.with_name(f"{stem}.repaired.mcap")
 
 
+def unused_output(path: str | Path) -> Path:
+    """:func:`default_output` of ``path``, or ``IN.repaired.N.mcap`` with the smallest N ≥ 2 that no
+    file takes: a recorder restarted more than once on one path keeps every leftover it repairs."""
+    first = default_output(path)
+    stem = first.name[:-len(".mcap")]
+    candidates = itertools.chain([first], (first.with_name(f"{stem}.{n}.mcap") for n in itertools.count(2)))
+    return next(c for c in candidates if not c.exists() and not c.is_symlink())
+
+
 def _copy(src: Path, stream) -> Scan:
     """Write every record :func:`scan_records` reads from ``src`` to ``stream`` as a new MCAP."""
     scan = Scan(src, 0)
@@ -432,8 +442,8 @@ def repair(path: str | Path, output: str | Path | None = None, *, in_place: bool
         for _ in scan_records(tmp, result):
             pass
         if not result.indexed or result.messages != source.messages:
-            raise RuntimeError(f"the rewritten file did not read back whole ({result.messages} of "
-                               f"{source.messages} messages; {result.problem or 'no index'})")
+            raise LogFileError(f"{src}: the rewritten file did not read back whole ({result.messages} of "
+                               f"{source.messages} messages; {result.problem or 'no index'}); nothing was written")
         os.replace(tmp, dst)
     finally:
         tmp.unlink(missing_ok=True)

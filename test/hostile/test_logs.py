@@ -90,14 +90,45 @@ def test_a_killed_recorders_log_is_refused_raw_and_decoded_whole_once_repaired(t
             pytest.approx(list(salvaged["/spacecraft/state"]["header.stamp"]), abs=1e-9)
         last = max(message.log_time for _, _, message, _ in decoded) * 1e-9
         assert killed_at - last < 2 * FLUSH_PERIOD, f"{killed_at - last:.2f} s lost (flush every {FLUSH_PERIOD} s)"
-        # the recorder started again on the same path repairs the leftover aside before recording
+        # the recorder started again on the same path repairs the leftover aside before recording, to a
+        # name no file takes: the earlier repair stays as it was
         repaired_bytes = repaired.read_bytes()
-        repaired.unlink()
         suite.start("recorder", {"output": str(killed)})
-        assert suite.wait_for_output("recorder", "repaired into", 30), suite.log_text("recorder")
-        assert repaired.read_bytes() == repaired_bytes
+        again = tmp_path / "killed.repaired.2.mcap"
+        assert suite.wait_for_output("recorder", f"repaired into {again}", 30), suite.log_text("recorder")
+        assert again.read_bytes() == repaired_bytes and repaired.read_bytes() == repaired_bytes
     finally:
         suite.stop()
+
+
+@pytest.mark.ros
+def test_a_recorder_keeps_a_file_at_its_output_unless_it_holds_no_message(tmp_path):
+    """A file at ``output`` that is not an MCAP log stops the recorder (exit 2, one line naming
+    ``output``) and is left byte for byte; a log killed before its first message is recorded over
+    (warned), with no repaired copy made."""
+    from att_msgs_py.log.repair import MAGIC
+    from att_msgs_py.qos import recorded_topics
+
+    suite = Suite(isolated_env(), tmp_path)
+    notes = tmp_path / "notes.mcap"
+    notes.write_bytes(b"orbit: 550 km\n")
+    empty = tmp_path / "empty.mcap"
+    empty.write_bytes(MAGIC + b"\x01\xff\xff")             # killed while writing its header
+    try:
+        proc = suite.start("recorder", {"output": str(notes)})
+        assert proc.wait(60) == 2, suite.log_text("recorder")
+        lines = [line for line in suite.log_text("recorder").splitlines() if line.strip()]
+        assert len(lines) == 1 and "INVALID_CONFIG" in lines[0] and f"output: {notes}" in lines[0], lines
+        assert notes.read_bytes() == b"orbit: 550 km\n"
+        suite.start("recorder", {"output": str(empty)})
+        assert suite.wait_for_output("recorder", f"recording {len(recorded_topics())} topics", 60), \
+            suite.log_text("recorder")
+        assert f"recording over {empty}: it holds no message" in suite.log_text("recorder")
+    finally:
+        codes = suite.stop()
+    assert codes["recorder"] == 0
+    read_log(empty)                                         # the new recording, readable (LogFileError if not)
+    assert not list(tmp_path.glob("*repaired*"))
 
 
 # -- the tools' domain -------------------------------------------------------------------------

@@ -243,6 +243,39 @@ def test_a_second_header_ends_the_recovery_before_it(finished, tmp_path):
     assert records_of(done.output) == original[:PER_CHUNK]
 
 
+def test_each_repair_aside_takes_a_name_no_file_takes(tmp_path):
+    from att_msgs_py.log.repair import unused_output
+
+    log = tmp_path / "run.mcap"
+    assert unused_output(log) == tmp_path / "run.repaired.mcap"
+    (tmp_path / "run.repaired.mcap").write_bytes(b"")
+    (tmp_path / "run.repaired.3.mcap").write_bytes(b"")
+    assert unused_output(log) == tmp_path / "run.repaired.2.mcap"
+    (tmp_path / "run.repaired.2.mcap").symlink_to(tmp_path / "nowhere")      # a dangling link is taken too
+    assert unused_output(log) == tmp_path / "run.repaired.4.mcap"
+
+
+def test_a_rewrite_that_does_not_read_back_whole_is_an_error_and_leaves_no_file(finished, tmp_path, monkeypatch):
+    """The rewrite is read back before it replaces the target: one that lost a message is refused
+    with a :class:`LogFileError` (one line from ``att-log``) and neither the target nor a temporary
+    file is left."""
+    from mcap.writer import Writer
+
+    path, _ = finished
+    add = Writer.add_message
+    seen = []
+
+    def losing(self, channel_id, **kw):            # drops the tenth message it is given
+        seen.append(1)
+        if len(seen) != 10:
+            add(self, channel_id, **kw)
+
+    monkeypatch.setattr(Writer, "add_message", losing)
+    with pytest.raises(LogFileError, match="did not read back whole .399 of 400 messages"):
+        repair(path, tmp_path / "out.mcap")
+    assert list(tmp_path.iterdir()) == []
+
+
 @pytest.mark.parametrize("opcode", [0x00, 0x10, 0x80, 0xFF])
 def test_a_chunk_whose_opcode_was_flipped_ends_the_recovery_before_it(finished, tmp_path, opcode):
     """MCAP lets a reader skip a record of unknown opcode; in a suite log that is a damaged byte, and
