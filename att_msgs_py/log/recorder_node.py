@@ -39,9 +39,13 @@ class RecorderNode(Node):
         output = param("output", f"runs/run_{stamp}.mcap")
         flush_period = param("flush_period_s")
         param.refuse_unknown()
-        if Path(output).is_file():
-            self.keep_leftover(Path(output))
-        self.log = LogWriter(output, flush_period=flush_period)
+        try:
+            if Path(output).is_file():
+                self.keep_leftover(Path(output))
+            self.log = LogWriter(output, flush_period=flush_period)
+        except OSError as err:              # a directory, a path under a file, no permission, a full disk
+            raise ConfigError(ErrorCode.INVALID_CONFIG, f"output: {output} cannot be written "
+                                                        f"({err.strerror or err})") from None
         for topic, (type_name, profile) in qos.recorded_topics().items():
             self.log.add_topic(topic, type_name, profile)
             self.create_subscription(topics.message_class(type_name), topic,
