@@ -4,10 +4,10 @@ Subscribes in raw (serialized CDR) form to :func:`att_msgs_py.qos.recorded_topic
 are stored byte-for-byte as published. The file is flushed at least every ``flush_period_s`` s (a
 killed recorder loses at most that) and finalised (summary and index) on SIGINT/SIGTERM, once what
 its subscriptions already hold is written (:func:`drain`). A file left at ``output`` by a recorder
-that did not finish is first repaired to ``OUT.repaired.mcap`` (``att-log repair``; ``OUT.repaired.N.mcap``
-when that is taken), so starting again on the same path, as often as it happens, loses nothing. A
-file there that is not an MCAP log, or a leftover that cannot be repaired, stops the node (exit 2)
-and is left as it is.
+that did not finish is first repaired to ``OUT.repaired.mcap`` (``att-log repair``), and a complete
+log there is moved to ``OUT.previous.mcap`` (each ``.N.mcap`` when the name is taken), so starting
+again on the same path, as often as it happens, loses nothing. A file there that is not an MCAP log,
+or a leftover that cannot be repaired, stops the node (exit 2) and is left as it is.
 
 Spun by rclpy's events executor: the recorder listens to every topic, and the default executor's
 per-message wait-set rebuild made it the busiest process of a fast run.
@@ -16,6 +16,7 @@ Usage: ``att-recorder --ros-args -p output:=runs/demo.mcap``
 """
 from __future__ import annotations
 
+import os
 import time
 from datetime import UTC, datetime
 from pathlib import Path
@@ -55,10 +56,11 @@ class RecorderNode(Node):
         self.get_logger().info(f"recording {len(self.log.counts)} topics to {output}")
 
     def keep_leftover(self, path: Path) -> None:
-        """Keep what a file already at ``path`` holds before it is recorded over: an unfinished log is
-        repaired aside; a complete log, or a file that holds no message, is recorded over (logged); a
-        file that is not an MCAP log, or an unfinished log that cannot be repaired, stops the node
-        (:class:`ConfigError`) and is left as it is."""
+        """Keep what a file already at ``path`` holds before it is recorded over: a complete log is
+        moved aside to ``OUT.previous.mcap`` and an unfinished one repaired aside to
+        ``OUT.repaired.mcap`` (each ``.N`` when the name is taken); a file that holds no message is
+        recorded over (logged); a file that is not an MCAP log, or an unfinished log that cannot be
+        repaired, stops the node (:class:`ConfigError`) and is left as it is."""
         def refuse(why: str) -> ConfigError:
             return ConfigError(ErrorCode.INVALID_CONFIG, f"output: {path} {why}; it is left as it is: move it or "
                                                          "choose another output")
@@ -74,8 +76,10 @@ class RecorderNode(Node):
         except LogFileError as err:                 # empty, or cut inside the magic: nothing was recorded
             self.get_logger().warning(f"recording over {path}: {err}")
             return
-        if scan.complete:
-            self.get_logger().warning(f"recording over the complete log {path} ({scan.messages} messages)")
+        if scan.complete and scan.messages:
+            aside = unused_output(path, "previous")
+            os.replace(path, aside)
+            self.get_logger().warning(f"{path} holds a complete log ({scan.messages} messages): kept as {aside}")
             return
         if scan.messages == 0:
             self.get_logger().warning(f"recording over {path}: it holds no message ({scan.problem})")

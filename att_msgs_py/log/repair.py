@@ -387,12 +387,14 @@ def default_output(path: str | Path) -> Path:
     return path.with_name(f"{stem}.repaired.mcap")
 
 
-def unused_output(path: str | Path) -> Path:
-    """:func:`default_output` of ``path``, or ``IN.repaired.N.mcap`` with the smallest N ≥ 2 that no
-    file takes: a recorder restarted more than once on one path keeps every leftover it repairs."""
-    first = default_output(path)
-    stem = first.name[:-len(".mcap")]
-    candidates = itertools.chain([first], (first.with_name(f"{stem}.{n}.mcap") for n in itertools.count(2)))
+def unused_output(path: str | Path, kind: str = "repaired") -> Path:
+    """``IN.KIND.mcap`` beside ``IN.mcap`` (:func:`default_output` for ``repaired``), or
+    ``IN.KIND.N.mcap`` with the smallest N ≥ 2 that no file takes: a recorder restarted more than
+    once on one path keeps every file it sets aside."""
+    path = Path(path)
+    stem = path.name[:-len(".mcap")] if path.name.endswith(".mcap") else path.name
+    candidates = itertools.chain([path.with_name(f"{stem}.{kind}.mcap")],
+                                 (path.with_name(f"{stem}.{kind}.{n}.mcap") for n in itertools.count(2)))
     return next(c for c in candidates if not c.exists() and not c.is_symlink())
 
 

@@ -105,7 +105,8 @@ def test_a_killed_recorders_log_is_refused_raw_and_decoded_whole_once_repaired(t
 def test_a_recorder_keeps_a_file_at_its_output_unless_it_holds_no_message(tmp_path):
     """A file at ``output`` that is not an MCAP log stops the recorder (exit 2, one line naming
     ``output``) and is left byte for byte; a log killed before its first message is recorded over
-    (warned), with no repaired copy made."""
+    (warned), with no copy made; a complete log is moved aside, byte for byte."""
+    from att_msgs_py.log import LogWriter
     from att_msgs_py.log.repair import MAGIC
     from att_msgs_py.qos import recorded_topics
 
@@ -124,11 +125,23 @@ def test_a_recorder_keeps_a_file_at_its_output_unless_it_holds_no_message(tmp_pa
         assert suite.wait_for_output("recorder", f"recording {len(recorded_topics())} topics", 60), \
             suite.log_text("recorder")
         assert f"recording over {empty}: it holds no message" in suite.log_text("recorder")
+        assert suite.stop()["recorder"] == 0
+        read_log(empty)                                     # the new recording, readable (LogFileError if not)
+        assert not list(tmp_path.glob("*repaired*"))
+        kept = tmp_path / "kept.mcap"                         # a complete log of three messages
+        writer = LogWriter(kept)
+        writer.add_topic("/spacecraft/state", recorded_topics()["/spacecraft/state"][0])
+        for i in range(3):
+            writer.write("/spacecraft/state", bytes([0, 1, 0, 0, i]), log_time_ns=i)
+        writer.close()
+        complete = kept.read_bytes()
+        suite.start("recorder", {"output": str(kept)})
+        aside = tmp_path / "kept.previous.mcap"
+        assert suite.wait_for_output("recorder", f"holds a complete log (3 messages): kept as {aside}", 60), \
+            suite.log_text("recorder")
+        assert aside.read_bytes() == complete
     finally:
-        codes = suite.stop()
-    assert codes["recorder"] == 0
-    read_log(empty)                                         # the new recording, readable (LogFileError if not)
-    assert not list(tmp_path.glob("*repaired*"))
+        suite.stop()
 
 
 # -- the tools' domain -------------------------------------------------------------------------
