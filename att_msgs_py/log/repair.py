@@ -380,22 +380,23 @@ class Repair:
     result: Scan
 
 
+def _beside(path: Path, suffix: str) -> Path:
+    """``IN.SUFFIX.mcap`` next to ``IN.mcap`` (or next to ``IN``, a name without ``.mcap``)."""
+    stem = path.name[:-len(".mcap")] if path.name.endswith(".mcap") else path.name
+    return path.with_name(f"{stem}.{suffix}.mcap")
+
+
 def default_output(path: str | Path) -> Path:
     """``IN.repaired.mcap`` next to ``IN.mcap``."""
-    path = Path(path)
-    stem = path.name[:-len(".mcap")] if path.name.endswith(".mcap") else path.name
-    return path.with_name(f"{stem}.repaired.mcap")
+    return _beside(Path(path), "repaired")
 
 
 def unused_output(path: str | Path, kind: str = "repaired") -> Path:
     """``IN.KIND.mcap`` beside ``IN.mcap`` (:func:`default_output` for ``repaired``), or
     ``IN.KIND.N.mcap`` with the smallest N ≥ 2 that no file takes: a recorder restarted more than
     once on one path keeps every file it sets aside."""
-    path = Path(path)
-    stem = path.name[:-len(".mcap")] if path.name.endswith(".mcap") else path.name
-    candidates = itertools.chain([path.with_name(f"{stem}.{kind}.mcap")],
-                                 (path.with_name(f"{stem}.{kind}.{n}.mcap") for n in itertools.count(2)))
-    return next(c for c in candidates if not c.exists() and not c.is_symlink())
+    names = itertools.chain([kind], (f"{kind}.{n}" for n in itertools.count(2)))
+    return next(c for c in (_beside(Path(path), name) for name in names) if not c.exists() and not c.is_symlink())
 
 
 def _copy(src: Path, stream) -> Scan:

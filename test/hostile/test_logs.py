@@ -128,7 +128,7 @@ def test_a_recorder_keeps_a_file_at_its_output_unless_it_holds_no_message(tmp_pa
         assert suite.stop()["recorder"] == 0
         read_log(empty)                                     # the new recording, readable (LogFileError if not)
         assert not list(tmp_path.glob("*repaired*"))
-        kept = tmp_path / "kept.mcap"                         # a complete log of three messages
+        kept = tmp_path / "kept.mcap"                       # a complete log of three messages
         writer = LogWriter(kept)
         writer.add_topic("/spacecraft/state", recorded_topics()["/spacecraft/state"][0])
         for i in range(3):
