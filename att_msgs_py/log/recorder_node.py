@@ -27,7 +27,7 @@ from rclpy.node import Node
 from att_msgs_py import memory, qos, topics
 from att_msgs_py.errors import ConfigError, ErrorCode
 from att_msgs_py.log.log_parameters import RECORDER
-from att_msgs_py.log.repair import MAGIC, LogFileError, Scan, repair, scan_records, unused_output
+from att_msgs_py.log.repair import LogFileError, NotMcapError, Scan, repair, scan_records, unused_output
 from att_msgs_py.log.writer import LogWriter
 from att_msgs_py.node_runner import ParameterReader, run_node
 
@@ -65,14 +65,12 @@ class RecorderNode(Node):
             return ConfigError(ErrorCode.INVALID_CONFIG, f"output: {path} {why}; it is left as it is: move it or "
                                                          "choose another output")
 
-        with open(path, "rb") as fh:
-            start = fh.read(len(MAGIC))
-        if start != MAGIC[:len(start)]:
-            raise refuse("is a file that is not an MCAP log")
         scan = Scan(path, 0)
         try:
             for _ in scan_records(path, scan):
                 pass
+        except NotMcapError:
+            raise refuse("is a file that is not an MCAP log") from None
         except LogFileError as err:                 # empty, or cut inside the magic: nothing was recorded
             self.get_logger().warning(f"recording over {path}: {err}")
             return

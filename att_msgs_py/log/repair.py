@@ -72,6 +72,10 @@ class LogFileError(ValueError):
     """A file that is not an MCAP log, or holds nothing that can be recovered."""
 
 
+class NotMcapError(LogFileError):
+    """A file whose first bytes are not the MCAP magic (not a log cut short: another kind of file)."""
+
+
 def printable(text: str, limit: int = 200) -> str:
     """``text`` safe to print to a terminal: control characters (C0, DEL, C1) and other
     non-printable ones escaped as ``\\xNN``/``\\uNNNN``, at most ``limit`` characters kept."""
@@ -162,7 +166,8 @@ class _Bounded:
 
 
 def check_magic(path: str | Path) -> int:
-    """Size of the file; :class:`LogFileError` if it is missing, empty or not an MCAP file."""
+    """Size of the file; :class:`LogFileError` if it is missing or empty, :class:`NotMcapError` if it
+    is not an MCAP file."""
     path = Path(path)
     if not path.is_file():
         raise LogFileError(f"{path}: {'not a regular file' if path.exists() else 'no such file'}")
@@ -172,7 +177,7 @@ def check_magic(path: str | Path) -> int:
     if size == 0:
         raise LogFileError(f"{path}: the file is empty (0 bytes: its writer stopped before writing anything)")
     if start != MAGIC[:len(start)]:
-        raise LogFileError(f"{path}: not an MCAP file (it does not start with the MCAP magic bytes)")
+        raise NotMcapError(f"{path}: not an MCAP file (it does not start with the MCAP magic bytes)")
     if len(start) < len(MAGIC):
         raise LogFileError(f"{path}: only {size} bytes, cut inside the MCAP magic: nothing to recover")
     return size
