@@ -22,6 +22,10 @@ the filter, their propagations and updates as stacks (a single estimator is a ba
   no tracker measurement was accepted for ``vector_fallback_after`` s. A magnetometer sample taken
   while the magnetorquers were commanded (the command before its stamp had a dipole) is not used:
   the controller blanks its coils before each sample (duty cycling).
+* **Catching up**: a measurement is kept when it arrives (``take_*``) and applied by the next
+  reprocessing (:meth:`Estimator.reprocess`, which the next gyro sample makes): the measurements
+  that came between two gyro samples are applied in one replay, in time order. ``on_*`` keep and
+  reprocess at once.
 * **Gating**: a measurement with ``d² > χ²_k(gate_probability)`` is rejected and counted; each is
   gated once, when it first arrives, and replayed with the same decision.
 * **Initialisation** without a prior: the first valid star tracker measurement (``P₀`` = its noise
@@ -123,6 +127,8 @@ class Estimator:
         self.next_publish = -math.inf
         self.last_wall = -math.inf                # when the last gyro sample arrived (monotonic s)
         self.excluded: set[str] = set()           # sensors not used (a fault monitor's exclusion)
+        self.pending: int | None = None           # the oldest state a measurement kept since the last
+                                                  # reprocessing sends the filter back to
 
     @staticmethod
     def default_config(specs: SensorSpecs, publish_period: float = 0.05) -> EstimatorConfig:
@@ -191,28 +197,49 @@ class Estimator:
     def _restart(self) -> None:
         """Forget every state, sample and measurement (a new timeline): initialising again."""
         self.history.clear()
+        self.pending = None
         self.monitor.restart()
         self.next_publish = -math.inf
 
     def on_star_tracker(self, m: StarTrackerMeasurement) -> None:
         """Apply a valid tracker measurement at its instant (an invalid one says only that)."""
-        self.reprocess(self.take_star_tracker(m))
+        self.take_star_tracker(m)
+        self.reprocess(self.newest)
 
-    def take_star_tracker(self, m: StarTrackerMeasurement) -> int | None:
-        """Check and keep a tracker measurement; the state to :meth:`reprocess` from (None: none)."""
+    def take_star_tracker(self, m: StarTrackerMeasurement) -> None:
+        """Check and keep a tracker measurement for the next :meth:`reprocess`."""
         q_SN = self.checks.star_tracker(m)
-        return None if q_SN is None else self.history.insert(Record(m.t, "tracker", (m.name, q_SN)))
+        if q_SN is not None:
+            self._keep(Record(m.t, "tracker", (m.name, q_SN)))
 
     def on_magnetometer(self, m: MagnetometerMeasurement) -> None:
+        """Apply a magnetometer sample at its instant (one taken while the coils were on is not used)."""
+        self.take_magnetometer(m)
+        self.reprocess(self.newest)
+
+    def take_magnetometer(self, m: MagnetometerMeasurement) -> None:
+        """Check and keep a magnetometer sample for the next :meth:`reprocess`."""
         field_B = self.checks.magnetometer(m)
         if self.dipoles.clean(m.t):
-            self.reprocess(self.history.insert(Record(m.t, "magnetometer", field_B)))
+            self._keep(Record(m.t, "magnetometer", field_B))
 
     def on_sun_sensors(self, m: SunSensorMeasurement) -> None:
+        """Apply the sun vector of the coarse sun sensors at its instant (none when the Sun is not seen)."""
+        self.take_sun_sensors(m)
+        self.reprocess(self.newest)
+
+    def take_sun_sensors(self, m: SunSensorMeasurement) -> None:
+        """Check the coarse sun sensors' outputs and keep their sun vector for the next :meth:`reprocess`."""
         values = self.checks.sun_sensors(m)
         sun_B = sun_vector(values, self.specs.sun_sensors.normals, self.config.sun_threshold)
         if sun_B is not None:
-            self.reprocess(self.history.insert(Record(m.t, "sun", sun_B)))
+            self._keep(Record(m.t, "sun", sun_B))
+
+    def _keep(self, record: Record) -> None:
+        """Keep ``record``; :attr:`pending` goes back to the state before it when that is older."""
+        start = self.history.insert(record)
+        if start is not None and (self.pending is None or start < self.pending):
+            self.pending = start
 
     def on_dipole_command(self, t: float, dipole: np.ndarray) -> None:
         """The controller's magnetorquer command stamped ``t`` (for the magnetometer's blanking)."""
@@ -250,8 +277,8 @@ class Estimator:
 
     # -- the filter over its history ---------------------------------------------------------------
     def reprocess(self, start: int | None) -> None:
-        """Rebuild every state after snapshot ``start`` from it (None: nothing to do): :func:`replay`
-        of this estimator alone."""
+        """Rebuild every state after snapshot ``start`` (None: nothing to do), or after the older
+        :attr:`pending`, from it: :func:`replay` of this estimator alone."""
         replay([(self, start)])
 
     def interval(self, x: mekf.FilterState, t: float, saturated: bool) -> tuple[float, float]:
@@ -356,7 +383,8 @@ class _Replay:
 
 
 def replay(jobs) -> None:
-    """:meth:`Estimator.reprocess` of each ``(estimator, start)`` of a batch (start None: nothing to do).
+    """:meth:`Estimator.reprocess` of each ``(estimator, start)`` of a batch (from its :attr:`~Estimator.pending`
+    state when that is older; start None and nothing pending: nothing to do).
 
     Each estimator's history says the steps from its state ``start`` (:class:`~.history.Step`); the
     estimators take their k-th steps together: the propagations of the estimators of one tuning as
@@ -366,6 +394,8 @@ def replay(jobs) -> None:
     (:meth:`.health.HealthMonitor.keep_largest_attitude_variance`)."""
     runs = []
     for e, start in jobs:
+        if e.pending is not None:
+            start, e.pending = e.pending if start is None else min(start, e.pending), None
         if start is not None:
             runs.append(_Replay(e, *e.history.replay_from(start)))
     live, k = [run for run in runs if run.steps], 0

@@ -137,20 +137,20 @@ class EstimatorNode(SuiteNode):
         if self._oversized(msg, limits.STAR_TRACKER, "star tracker measurement", "star_tracker"):
             return
         measurement = convert.star_tracker_from_msg(msg)
-        self._guarded("star tracker measurement", info, self._core.on_star_tracker, measurement,
+        self._guarded("star tracker measurement", info, self._core.take_star_tracker, measurement,
                       watch=(topics.STAR_TRACKER, measurement))
 
     def on_magnetometer(self, msg: MagneticField, info: dict):
         if self._oversized(msg, limits.HEADER_ONLY, "magnetometer measurement", "magnetometer"):
             return
         measurement = convert.magnetometer_from_msg(msg)
-        self._guarded("magnetometer measurement", info, self._core.on_magnetometer, measurement,
+        self._guarded("magnetometer measurement", info, self._core.take_magnetometer, measurement,
                       watch=(topics.MAGNETOMETER, measurement))
 
     def on_sun_sensors(self, msg: CoarseSunSensors, info: dict):
         if self._oversized(msg, limits.SUN_SENSORS, "sun sensor measurement", "sun_sensors"):
             return
-        self._guarded("sun sensor measurement", info, self._core.on_sun_sensors, convert.sun_sensors_from_msg(msg))
+        self._guarded("sun sensor measurement", info, self._core.take_sun_sensors, convert.sun_sensors_from_msg(msg))
 
     def on_command(self, msg: ActuatorCommand, info: dict):
         if self._oversized(msg, limits.ACTUATOR_COMMAND, "actuator command", "command"):

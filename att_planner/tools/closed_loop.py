@@ -218,14 +218,12 @@ class ClosedLoop:
                 self.tracker_status = int(m.status)
                 if m.valid:
                     self.tracker_valid.setdefault(m.name, []).append(m.t)
-                start = self._guard(est.take_star_tracker, m)
-                if start is not None:
-                    yield Reprocessing(est, start)
+                self._guard(est.take_star_tracker, m)
             if readings.magnetometer is not None:
-                self._guard(est.on_magnetometer, readings.magnetometer)
+                self._guard(est.take_magnetometer, readings.magnetometer)
                 self._guard(ctl.measured.on_magnetometer, readings.magnetometer)
             if readings.sun_sensors is not None:
-                self._guard(est.on_sun_sensors, readings.sun_sensors)
+                self._guard(est.take_sun_sensors, readings.sun_sensors)
             if readings.wheel_speeds is not None:
                 self._guard(ctl.measured.on_wheel_speeds, readings.wheel_speeds)
             omega = self._guard(est.take_gyro, readings.gyro) if readings.gyro is not None else None

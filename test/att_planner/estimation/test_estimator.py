@@ -93,6 +93,49 @@ def test_a_late_tracker_measurement_is_applied_at_its_instant():
     assert rot.angle_between(a.q_BN, truth(5.0)) < 1e-9 and late.health(5.0) == Health.CONVERGED
 
 
+@pytest.mark.parametrize("trackers", [2, 0], ids=["two trackers", "vectors alone"])
+def test_measurements_kept_between_gyro_samples_are_applied_by_one_replay_as_if_each_at_once(monkeypatch, trackers):
+    """The measurements of a gyro interval (two trackers, one of them once wrong; or a field sample and
+    a sun vector, without trackers), arriving 0.1–0.2 s late: kept (``take_*``), they change nothing
+    until the next gyro sample, whose one replay leaves every estimate bit for bit as applying each
+    measurement when it came (``on_*``), the gate's decisions included."""
+    spec = StarTrackerSpec(name="a", mounting=MOUNT, cross_boresight=5 * ARCSEC, about_boresight=30 * ARCSEC)
+    specs = replace(SPECS, star_trackers=(spec, replace(spec, name="b"))[:trackers])
+    config = EstimatorConfig(publish_period=0.05, arw=GYRO.arw, rrw=GYRO.rrw, initial_bias_sigma=GYRO.initial_bias)
+    at_once, kept = (Estimator(specs, config, FixedEnvironment(), "eci", "body") for _ in range(2))
+    replays = []
+    monkeypatch.setattr(Estimator, "reprocess", lambda self, start: replays.append(self) or replay([(self, start)]))
+    rng = np.random.default_rng(7)
+    wrong = rot.multiply(rot.from_axis_angle([1, 0, 0], 0.2), Q)
+    for k in range(60):
+        t = 0.05 * k
+        arriving = []
+        if k >= 4:
+            taken = t - 0.05 * rng.integers(2, 5)
+            if trackers:
+                arriving = [tracker(taken, wrong if k == 30 else truth(taken), name="b"),
+                            tracker(taken, truth(taken), name="a")]
+            else:
+                arriving = [MagnetometerMeasurement(taken, rot.dcm_BN(truth(taken)) @ FIELD_N, np.eye(3), "body"),
+                            SunSensorMeasurement(taken, np.clip(SPECS.sun_sensors.normals @ rot.dcm_BN(truth(taken))
+                                                                @ SUN_N, 0.0, None), 0.0, "body")]
+        before = kept.state
+        for m in arriving:
+            kind = {StarTrackerMeasurement: "star_tracker", MagnetometerMeasurement: "magnetometer",
+                    SunSensorMeasurement: "sun_sensors"}[type(m)]
+            getattr(at_once, f"on_{kind}")(m)
+            getattr(kept, f"take_{kind}")(m)
+        assert kept.state is before
+        del replays[:]
+        a, b = at_once.on_gyro(gyro(t, OMEGA)), kept.on_gyro(gyro(t, OMEGA))
+        assert replays == [at_once, kept]
+        for x, y in ((a.q, b.q), (a.attitude_covariance, b.attitude_covariance), (a.gyro_bias, b.gyro_bias)):
+            assert np.array_equal(x, y), k
+        assert (a.rejected, a.health, a.time_since_update) == (b.rejected, b.health, b.time_since_update)
+    assert b.health == (Health.CONVERGED if trackers else Health.PROPAGATING) and b.rejected == trackers // 2
+    assert rot.angle_between(kept.state.q_BN, truth(t)) < (1e-7 if trackers else 1e-3)
+
+
 def test_initialisation_from_the_first_tracker_or_from_quest_on_sun_and_field():
     est = estimator()
     assert est.on_gyro(gyro(0.0)).health == Health.INITIALISING
