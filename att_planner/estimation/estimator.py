@@ -18,10 +18,11 @@ the filter, their propagations and updates as stacks (a single estimator is a ba
   datasheet spread (:func:`.mekf.propagate`): the covariance grows with the rotation the gyro
   measures, not only with time, so a filter blind through a slew stays honest.
 * **Updates**: every valid star tracker measurement (mounting ``q_SB``: the body attitude is
-  ``q_SN ⊗ q_SB*``, noise ``R_B = C R_S Cᵀ``); magnetometer and sun-sensor vector updates only while
-  no tracker measurement was accepted for ``vector_fallback_after`` s. A magnetometer sample taken
-  while the magnetorquers were commanded (the command before its stamp had a dipole) is not used:
-  the controller blanks its coils before each sample (duty cycling).
+  ``q_SN ⊗ q_SB*``, noise ``R_B = C R_S Cᵀ``); magnetometer and sun-sensor vector updates only when
+  no tracker measurement taken in the ``vector_fallback_after`` s before the vector's instant was
+  accepted (:meth:`Estimator.last_tracker_at`). A magnetometer sample taken while the magnetorquers
+  were commanded (the command before its stamp had a dipole) is not used: the controller blanks its
+  coils before each sample (duty cycling).
 * **Catching up**: a measurement is kept when it arrives (``take_*``) and applied by the next
   reprocessing (:meth:`Estimator.reprocess`, which the next gyro sample makes): the measurements
   that came between two gyro samples are applied in one replay, in time order. ``on_*`` keep and
@@ -295,7 +296,7 @@ class Estimator:
             dcm_BS = rot.dcm_NB(q_SB)
             y = mekf.attitude_residual(x.q_BN, rot.multiply(q_SN, rot.conjugate(q_SB)))
             H, R = mekf.attitude_sensitivity(), dcm_BS @ self.trackers[name].covariance @ dcm_BS.T
-        elif (r.t - self.monitor.last_tracker <= self.config.vector_fallback_after or self.environment is None
+        elif (r.t - self.last_tracker_at(r.t) <= self.config.vector_fallback_after or self.environment is None
               or self.is_excluded(r)):
             return None
         else:
@@ -304,6 +305,13 @@ class Estimator:
         if r.accepted is None and self.is_excluded(r):
             return mekf.Correction(x, y, H, R, -math.inf)          # its innovation only
         return mekf.Correction(x, y, H, R, self.gates[3] if r.accepted is None else math.inf)
+
+    def last_tracker_at(self, t: float) -> float:
+        """Instant of the newest accepted tracker measurement taken at or before ``t`` (-inf: none):
+        a replay decides whether a vector is used from the trackers before it, not from a later one
+        that arrived first."""
+        last = self.monitor.last_tracker
+        return last if last <= t else self.history.last_accepted("tracker", t)
 
     def corrected(self, x: mekf.FilterState, r: Record, update: mekf.Update,
                   correction: mekf.Correction | None = None) -> mekf.FilterState | None:

@@ -62,6 +62,7 @@ class MeasurementHistory:
         self.gyro: deque[tuple[float, np.ndarray, bool]] = deque()
         self.snapshots: deque[tuple[float, FilterState | None]] = deque([(-math.inf, None)])
         self.records: list[Record] = []
+        self.forgotten: dict[str, float] = {}      # kind: instant of the newest accepted record forgotten
 
     @property
     def state(self) -> FilterState | None:
@@ -121,7 +122,7 @@ class MeasurementHistory:
         if t > self.snapshots[0][0]:
             while len(self.snapshots) > 1 and self.snapshots[0][0] < t:
                 self.snapshots.popleft()
-            self.records = self.records_after(self.snapshots[0][0])
+            self._forget_records()
 
     def records_after(self, t: float) -> list[Record]:
         """The records later than ``t`` (kept sorted by time)."""
@@ -147,4 +148,19 @@ class MeasurementHistory:
             self.snapshots.popleft()
         while self.gyro and self.gyro[0][0] <= self.snapshots[0][0]:
             self.gyro.popleft()
-        self.records = self.records_after(self.snapshots[0][0])
+        self._forget_records()
+
+    def _forget_records(self) -> None:
+        """Drop the records up to the oldest state, keeping the instant of the newest accepted one of each kind."""
+        i = bisect_right(self.records, self.snapshots[0][0], key=_instant)
+        for r in self.records[:i]:
+            if r.accepted:
+                self.forgotten[r.kind] = max(self.forgotten.get(r.kind, -math.inf), r.t)
+        del self.records[:i]
+
+    def last_accepted(self, kind: str, t: float) -> float:
+        """Instant of the newest accepted record of ``kind`` taken at or before ``t``, kept or forgotten
+        since :meth:`clear` (-inf: none)."""
+        i = bisect_right(self.records, t, key=_instant)
+        return next((r.t for r in reversed(self.records[:i]) if r.kind == kind and r.accepted),
+                    self.forgotten.get(kind, -math.inf))

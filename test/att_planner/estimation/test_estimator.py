@@ -136,6 +136,44 @@ def test_measurements_kept_between_gyro_samples_are_applied_by_one_replay_as_if_
     assert rot.angle_between(kept.state.q_BN, truth(t)) < (1e-7 if trackers else 1e-3)
 
 
+@pytest.mark.parametrize("kind, history, fix", [("magnetometer", 2.0, 3.5), ("sun_sensors", 2.0, 3.5),
+                                                ("magnetometer", 1.0, 2.5), ("sun_sensors", 1.0, 2.5)],
+                         ids=["field after the fallback", "sun after the fallback",
+                              "field within the fallback, the last tracker forgotten",
+                              "sun within the fallback, the last tracker forgotten"])
+def test_whether_a_vector_is_used_depends_on_the_trackers_before_it_not_on_a_later_one_that_came_first(
+        kind, history, fix):
+    """Trackers until t = 1 s, then none until a fix at ``fix``; a vector taken 0.05 s before the fix
+    and arriving after it (0.1 s late) is used or not as if it had come in time order: by the newest
+    tracker measurement before its instant (the one at 1 s, which a 1 s history has forgotten), not
+    by the fix. With ``vector_fallback_after`` = 2 s it is used after a 3.5 s fix, not after a 2.5 s one."""
+    def vector(t):
+        if kind == "magnetometer":
+            return MagnetometerMeasurement(t, rot.dcm_BN(truth(t)) @ FIELD_N, np.eye(3), "body")
+        return SunSensorMeasurement(t, np.clip(SPECS.sun_sensors.normals @ rot.dcm_BN(truth(t)) @ SUN_N, 0.0, None),
+                                    0.0, "body")
+
+    in_order, late, without = (estimator(history=history) for _ in range(3))
+    for est in (in_order, late, without):
+        converged(est, until=1.0)
+    taken = fix - 0.05
+    for k in range(21, int(round(fix / 0.05)) + 5):
+        t = 0.05 * k
+        if abs(t - taken) < 1e-9:
+            getattr(in_order, f"on_{kind}")(vector(taken))
+        if abs(t - fix) < 1e-9:
+            for est in (in_order, late, without):
+                est.on_star_tracker(tracker(fix, truth(fix)))
+        if abs(t - taken - 0.1) < 1e-9:
+            getattr(late, f"on_{kind}")(vector(taken))
+        for est in (in_order, late, without):
+            est.on_gyro(gyro(t, OMEGA))
+    a, b = in_order.state, late.state
+    for name in ("t", "q_BN", "bias_B", "P"):
+        np.testing.assert_array_equal(getattr(a, name), getattr(b, name))
+    assert np.array_equal(a.P, without.state.P) == (taken - 1.0 <= 2.0)     # used only after the fallback
+
+
 def test_initialisation_from_the_first_tracker_or_from_quest_on_sun_and_field():
     est = estimator()
     assert est.on_gyro(gyro(0.0)).health == Health.INITIALISING
