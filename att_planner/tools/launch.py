@@ -82,6 +82,7 @@ class Suite:
     log_dir: Path
     procs: dict = field(default_factory=dict)
     profile_dir: Path | None = None      # run every node under cProfile, writing NAME.prof here
+    cpu_dir: Path | None = None          # run every node with its CPU timed by layer, writing NAME.json here
 
     def __enter__(self) -> Suite:
         return self
@@ -93,8 +94,14 @@ class Suite:
     def start(self, name: str, params: dict | None = None, params_files: tuple = ()) -> subprocess.Popen:
         """Start node ``name`` with ``-p key:=value`` parameters and ``--params-file`` files
         (both override the scenario defaults; between them rcl's rule applies, see docs/running.md)."""
-        profile = [] if self.profile_dir is None else ["-m", "cProfile", "-o", str(self.profile_dir / f"{name}.prof")]
-        args = [sys.executable, *profile, "-m", NODE_MODULES[name], "--ros-args"]
+        module = NODE_MODULES[name]
+        if self.cpu_dir is not None:            # att_planner.tools.cpu_layers runs the node module itself
+            runner = ["-m", "att_planner.tools.cpu_layers", str(self.cpu_dir / f"{name}.json"), module]
+        elif self.profile_dir is not None:
+            runner = ["-m", "cProfile", "-o", str(self.profile_dir / f"{name}.prof"), "-m", module]
+        else:
+            runner = ["-m", module]
+        args = [sys.executable, *runner, "--ros-args"]
         for path in params_files:
             args += ["--params-file", str(path)]
         for key, value in (params or {}).items():
@@ -150,11 +157,13 @@ def default_nodes(scenario: str) -> tuple[str, ...]:
 
 def start_suite(scenario: str, mcap_path: str | Path, log_dir: str | Path, *, env: dict | None = None,
                 nodes=None, params: dict | None = None, state_listeners: int = 0,
-                profile_dir: str | Path | None = None) -> Suite:
+                profile_dir: str | Path | None = None, cpu_dir: str | Path | None = None) -> Suite:
     """Start ``nodes`` (default: :func:`default_nodes`) for ``scenario``; ``params`` maps node name ->
     extra ROS parameters; ``state_listeners``: the caller's own nodes that will subscribe to the
     state (a mission driver), which the simulator counts among its subscribers too; ``profile_dir``:
-    every node runs under cProfile and writes ``NAME.prof`` there when it stops.
+    every node runs under cProfile and writes ``NAME.prof`` there when it stops; ``cpu_dir``: every
+    node runs with its CPU timed by layer (:mod:`att_planner.tools.cpu_layers`) and writes
+    ``NAME.json`` there when it stops.
 
     The simulator holds sim time at zero until the recorder, the controller and the estimator
     (those started), and the caller's ``state_listeners``, subscribe to its state or sensors; the
@@ -164,7 +173,8 @@ def start_suite(scenario: str, mcap_path: str | Path, log_dir: str | Path, *, en
     for a late recorder).
     """
     nodes = default_nodes(scenario) if nodes is None else nodes
-    suite = Suite(env or isolated_env(), Path(log_dir), profile_dir=None if profile_dir is None else Path(profile_dir))
+    suite = Suite(env or isolated_env(), Path(log_dir), profile_dir=None if profile_dir is None else Path(profile_dir),
+                  cpu_dir=None if cpu_dir is None else Path(cpu_dir))
     recorder = "recorder" in nodes
     listeners = {"simulator": sum(n in nodes for n in ("recorder", "controller", "estimator")) + state_listeners,
                  "controller": ("simulator" in nodes) + int(recorder),

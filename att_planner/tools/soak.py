@@ -6,7 +6,9 @@ process's resident memory while it runs, then replays the log and counts message
 configured rates imply. Reports the real-time factor reached (sim time over the wall time from the
 simulator's first state to its ``end_time``). ``rate_Hz`` sets the step, the state, /clock, the
 control and the estimate alike, as a mission does. With ``profile_dir`` every node runs under
-cProfile and the report lists, per node, where its time went (:func:`profile_rows`). Used by
+cProfile and the report lists, per node, where its time went (:func:`profile_rows`); with
+``cpu_dir`` every node's CPU is timed by layer (:mod:`att_planner.tools.cpu_layers`) and the
+report gives, per node, each layer's CPU per second of sim time (:func:`cpu_rows`). Used by
 ``att-bench soak`` and by the tests (a shorter run). The lockstep waits up to ``LOCKSTEP_TIMEOUT`` s
 for each command: a controller starved of CPU for half a second on a loaded machine is not what a
 soak measures (the watchdog tests cover a dead one); every suspension of the lockstep is still
@@ -22,6 +24,7 @@ import numpy as np
 
 from att_msgs_py.log import read_log
 from att_msgs_py.topics import COMMAND, STATE
+from att_planner.tools import cpu_layers
 from att_planner.tools.launch import default_nodes, isolated_env, start_suite
 from att_planner.tools.review.run import settling_time
 from att_sim.models import scenario as scen
@@ -60,7 +63,7 @@ def soak_nodes(scenario: str) -> tuple[str, ...]:
 
 def run_soak(scenario: str, orbits: float | None, out_dir: str | Path, sample_period: float = 1.0,
              timeout: float = 3600.0, *, hours: float | None = None, rate_Hz: float | None = None,
-             profile_dir: str | Path | None = None) -> dict:
+             profile_dir: str | Path | None = None, cpu_dir: str | Path | None = None) -> dict:
     """Fly ``scenario`` for ``orbits`` orbits (or ``hours`` h) of sim time through its nodes as fast as
     they go; the figures of the module docstring. ``rate_Hz``: step, state, clock, control and
     estimate rate (default: the scenario's)."""
@@ -75,10 +78,11 @@ def run_soak(scenario: str, orbits: float | None, out_dir: str | Path, sample_pe
         params = {"simulator": {**params["simulator"], **rates}, "controller": {"control_rate_Hz": rate_Hz},
                   "estimator": {"publish_rate_Hz": rate_Hz}}
         sim_params.update(rates)
-    if profile_dir is not None:
-        Path(profile_dir).mkdir(parents=True, exist_ok=True)
+    for directory in (profile_dir, cpu_dir):
+        if directory is not None:
+            Path(directory).mkdir(parents=True, exist_ok=True)
     suite = start_suite(scenario, out / "soak.mcap", out, env=isolated_env(), nodes=nodes, params=params,
-                        profile_dir=profile_dir)
+                        profile_dir=profile_dir, cpu_dir=cpu_dir)
     memory = {name: [] for name in suite.procs}
     cpu = {name: [] for name in suite.procs}
     start = time.monotonic()
@@ -125,7 +129,26 @@ def run_soak(scenario: str, orbits: float | None, out_dir: str | Path, sample_pe
     report["cpu_seconds"] = {name: float(np.nanmax(c) - c[0]) if len(c) > 1 else 0.0 for name, c in cpu.items()}
     if profile_dir is not None:
         report["profile"] = {name: profile_rows(Path(profile_dir) / f"{name}.prof") for name in nodes}
+    if cpu_dir is not None:
+        report["cpu_layers"] = {name: cpu_rows(Path(cpu_dir) / f"{name}.json", sim_time) for name in nodes}
     return report
+
+
+def cpu_rows(path: Path, sim_time: float) -> dict:
+    """A node's CPU by layer (:func:`att_planner.tools.cpu_layers.read`) in ms per second of sim
+    time: ``process`` (every thread), ``main_thread``, each layer's ms and calls per second of sim
+    time, ``other (main thread)`` (the main thread's CPU outside the layers: the node's own code
+    around them) and ``other threads`` (the middleware's); ``{}`` when the node wrote none."""
+    if not path.is_file():
+        return {}
+    got = cpu_layers.read(path)
+    per_s = 1e3 / sim_time
+    layers = {name: {"ms_per_sim_s": v["cpu_s"] * per_s, "calls_per_sim_s": v["calls"] / sim_time}
+              for name, v in sorted(got["layers"].items(), key=lambda kv: -kv[1]["cpu_s"])}
+    inside = sum(v["cpu_s"] for v in got["layers"].values())
+    return {"process_ms_per_sim_s": got["process_s"] * per_s, "main_thread_ms_per_sim_s": got["main_thread_s"] * per_s,
+            "layers": layers, "other_main_thread_ms_per_sim_s": (got["main_thread_s"] - inside) * per_s,
+            "other_threads_ms_per_sim_s": (got["process_s"] - got["main_thread_s"]) * per_s}
 
 
 def profile_rows(path: Path, rows: int = PROFILE_ROWS) -> dict:

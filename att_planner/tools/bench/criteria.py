@@ -277,18 +277,38 @@ def _gains(p: dict, case: str | None) -> Summary:
                    {"kp": _num(p, "kp"), "kd": _num(p, "kd"), "ts_orbits": ts, "solve_s": secs})
 
 
+def _cpu_split(p: dict) -> dict[str, float]:
+    """The CPU per second of sim time of every node of a soak timed by layer, summed in four parts:
+    the nodes' own work (models, log writing), message conversion, rclpy and DDS (publish, take, the
+    executor's wait, the middleware's threads) and the rest of the nodes' own code."""
+    from att_planner.tools.cpu_layers import OWN_WORK
+
+    split = dict.fromkeys(("own work", "message conversion", "rclpy and DDS", "node code"), 0.0)
+    for name, node in _get(p, "cpu_layers").items():
+        if not node:                # a node that wrote no timings (it did not exit cleanly)
+            continue
+        for layer in _get(p, "cpu_layers", name, "layers"):
+            part = "own work" if layer in OWN_WORK else layer if layer == "message conversion" else "rclpy and DDS"
+            split[part] += _num(p, "cpu_layers", name, "layers", layer, "ms_per_sim_s")
+        split["rclpy and DDS"] += _num(p, "cpu_layers", name, "other_threads_ms_per_sim_s")
+        split["node code"] += _num(p, "cpu_layers", name, "other_main_thread_ms_per_sim_s")
+    return split
+
+
 def _soak(p: dict, case: str | None) -> Summary:
     dropped = int(_num(p, "dropped_state"))
     clean = dropped == 0 and not any(_get(p, "exit_codes").values())
     if "rtf_target" in p:          # a real-time factor study: the scenario, its length and rate name the case
         rtf, target = _num(p, "real_time_factor"), _num(p, "rtf_target")
         estimator = ", with the estimator" if "estimator" in p["nodes"] else ""
+        figures = {"rtf": rtf, "dropped_state": dropped, "sim_s": _num(p, "sim_time"),
+                   "loop_wall_s": _num(p, "loop_wall_seconds"),
+                   "cpu_ms_per_sim_s": {k: v / _num(p, "sim_time") * 1e3 for k, v in p["cpu_seconds"].items()}}
+        if "cpu_layers" in p:
+            figures["cpu_by_layer_ms_per_sim_s"] = _cpu_split(p)
         return Summary(case or f"{p['scenario']}, {_num(p, 'hours'):g} h at {_num(p, 'rate_Hz'):g} Hz{estimator}",
                        "real-time factor through the nodes", rtf, "×",
-                       f"≥ {target:g}, every state recorded, every process exits 0", rtf >= target and clean,
-                       {"rtf": rtf, "dropped_state": dropped, "sim_s": _num(p, "sim_time"),
-                        "loop_wall_s": _num(p, "loop_wall_seconds"),
-                        "cpu_ms_per_sim_s": {k: v / _num(p, "sim_time") * 1e3 for k, v in p["cpu_seconds"].items()}})
+                       f"≥ {target:g}, every state recorded, every process exits 0", rtf >= target and clean, figures)
     return Summary(case or f"{_num(p, 'orbits'):g} orbits", "state messages dropped", dropped, "",
                    "none dropped, every process exits 0", dropped == 0 and not any(_get(p, "exit_codes").values()),
                    {"rtf": _num(p, "real_time_factor"), "state_messages": _num(p, "state_messages"),
@@ -459,7 +479,8 @@ STUDIES: tuple[Study, ...] = (
     Study("soak", lambda p: "dropped_state" in p, _soak,
           lambda p, path: f"att-bench soak --scenario {p['scenario']} "
                           + (f"--hours {p['hours']:g} --rate-Hz {p['rate_Hz']:g} " if "rtf_target" in p
-                             else f"--orbits {p['orbits']:g} ") + f"--json {path}"),
+                             else f"--orbits {p['orbits']:g} ") + ("--cpu bench_out/soak_cpu " if "cpu_layers" in p
+                                                                   else "") + f"--json {path}"),
     Study("cluster", lambda p: "throughput_ratio" in p, _cluster,
           _cmd("att-bench cluster --campaign {campaign} --runs {runs} --workers {workers} --json {path}")),
     Study("rtf", lambda p: "target_rtf" in p and p.get("in_process") is True, _rtf,

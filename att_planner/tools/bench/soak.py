@@ -1,6 +1,6 @@
 """Soak: the flight loop's nodes (recorder, simulator, estimator, controller) for a long sim time as fast
-as possible: the real-time factor, messages dropped, memory, and with ``--profile`` where each node's
-time went."""
+as possible: the real-time factor, messages dropped, memory, and where each node's time went: with
+``--profile`` its functions under cProfile (wall clock), with ``--cpu`` its CPU by layer."""
 from __future__ import annotations
 
 import math
@@ -20,7 +20,10 @@ def configure(parser):
     length.add_argument("--hours", type=float, default=None, help="sim time in hours")
     parser.add_argument("--rate-Hz", type=float, default=None,
                         help="step, state, clock, control and estimate rate (default: the scenario's)")
-    parser.add_argument("--profile", default=None, help="run every node under cProfile, its file in this directory")
+    how = parser.add_mutually_exclusive_group()
+    how.add_argument("--profile", default=None, help="run every node under cProfile, its file in this directory")
+    how.add_argument("--cpu", default=None, metavar="DIR",
+                     help="time every node's CPU by layer (conversion, publish, executor, models), its file in DIR")
     parser.add_argument("--out", default=None, help="directory for the log (default: a temporary one)")
 
 
@@ -42,7 +45,8 @@ def run(args) -> dict:
         raise SystemExit(f"att-bench soak: {refused}")
     out = args.out or tempfile.mkdtemp(prefix="att_soak_")
     orbits = 10.0 if args.orbits is None and args.hours is None else args.orbits
-    r = run_soak(args.scenario, orbits, out, hours=args.hours, rate_Hz=args.rate_Hz, profile_dir=args.profile)
+    r = run_soak(args.scenario, orbits, out, hours=args.hours, rate_Hz=args.rate_Hz, profile_dir=args.profile,
+                 cpu_dir=args.cpu)
     r["rtf_target"] = RTF_TARGET
     print(f"soak {r['scenario']} ({', '.join(r['nodes'])}; {r['rate_Hz']:g} Hz): {r['hours']:.3g} h = "
           f"{r['orbits']:.3g} orbits = {r['sim_time']:.0f} s of sim time in {r['loop_wall_seconds']:.1f} s wall "
@@ -62,5 +66,13 @@ def run(args) -> dict:
             for row in prof["functions"][:8]:
                 print(f"    {row['own_s']:7.2f} s own {row['cumulative_s']:7.2f} s cum {row['calls']:8d} calls  "
                       f"{row['function']}")
+    for name, cpu in r.get("cpu_layers", {}).items():
+        if cpu:
+            print(f"  CPU {name}: {cpu['process_ms_per_sim_s']:.2f} ms per s of sim (main thread "
+                  f"{cpu['main_thread_ms_per_sim_s']:.2f}, other threads {cpu['other_threads_ms_per_sim_s']:.2f})")
+            for layer, row in cpu["layers"].items():
+                print(f"    {layer:20s} {row['ms_per_sim_s']:6.2f} ms  {row['calls_per_sim_s']:6.1f} calls "
+                      f"per s of sim")
+            print(f"    {'other (main thread)':20s} {cpu['other_main_thread_ms_per_sim_s']:6.2f} ms")
     print(f"  log: {out}/soak.mcap")
     return r
