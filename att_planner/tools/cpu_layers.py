@@ -23,8 +23,8 @@ import sys
 import time
 from pathlib import Path
 
-# layer: the functions it times, "module:attribute" or "module:Class.method"; a module's functions
-# named "*_msg", "*_from_msg" or "marker_array" with "module:*_msg"
+# layer: the functions it times, "module:function" or "module:Class.method"; "module:*_msg" names the
+# module's public functions whose names end in "_msg" (the "*_from_msg" ones too) and marker_array
 COMMON = {
     "message conversion": ("att_msgs_py.convert:*_msg", "att_msgs_py.markers:*_msg"),
     "publish": ("rclpy.publisher:Publisher.publish",),

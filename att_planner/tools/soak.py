@@ -78,6 +78,8 @@ def run_soak(scenario: str, orbits: float | None, out_dir: str | Path, sample_pe
         params = {"simulator": {**params["simulator"], **rates}, "controller": {"control_rate_Hz": rate_Hz},
                   "estimator": {"publish_rate_Hz": rate_Hz}}
         sim_params.update(rates)
+    if profile_dir is not None and cpu_dir is not None:
+        raise ValueError("a soak runs its nodes under cProfile (profile_dir) or timed by layer (cpu_dir), not both")
     for directory in (profile_dir, cpu_dir):
         if directory is not None:
             Path(directory).mkdir(parents=True, exist_ok=True)
