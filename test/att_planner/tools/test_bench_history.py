@@ -195,12 +195,13 @@ def test_benchmarks_md_tables_are_the_historys(tmp_path, capsys):
 
 
 @pytest.mark.parametrize("name, flags", [
-    ("soak_leo_observatory.json", "--scenario leo_observatory --hours 6 --rate-Hz 5"),
+    ("soak_leo_observatory.json", "--scenario leo_observatory --hours 6 --rate-Hz 5 --cpu bench_out/soak_cpu"),
     ("day_rtf_max.json", "--mission observatory_day --rtf max"),
 ])
 def test_the_command_of_a_kept_json_carries_the_options_that_made_it(tmp_path, name, flags):
-    """A line's command re-makes its figure: the scenario, length and rate of a soak, the mission and
-    --rtf of a day (their defaults would fly another scenario or pace the day)."""
+    """A line's command re-makes its figure: the scenario, length and rate of a soak (and --cpu when it
+    was timed by layer), the mission and --rtf of a day (their defaults would fly another scenario or
+    pace the day)."""
     run = tmp_path / name
     shutil.copy(BENCHMARKS / name, run)
     history = tmp_path / "history.jsonl"
