@@ -18,6 +18,7 @@ from __future__ import annotations
 import atexit
 import importlib
 import json
+import math
 import runpy
 import sys
 import time
@@ -54,6 +55,32 @@ LAYERS = {
 
 
 OWN_WORK = frozenset(layer for layers in LAYERS.values() for layer in layers)    # each node's own job
+
+
+PARTS = ("own work", "message conversion", "rclpy and DDS", "node code")
+
+
+def parts(nodes: dict) -> dict[str, float]:
+    """The CPU of the nodes of a soak timed by layer (node: its ``att_planner.tools.soak.cpu_rows``,
+    ``{}`` for a node that wrote none), in ms per second of sim time, summed in :data:`PARTS`: the
+    nodes' own work (:data:`OWN_WORK`), message conversion, rclpy and DDS (``publish``, take, the
+    executor's wait, the middleware's threads) and the rest of the nodes' code. ValueError for a
+    figure that is not a finite number."""
+    def finite(value, what: str) -> float:
+        if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
+            raise ValueError(f"{what} must be a finite number, found {value!r}")
+        return float(value)
+
+    split = dict.fromkeys(PARTS, 0.0)
+    for name, node in nodes.items():
+        if not node:
+            continue
+        for layer, row in node["layers"].items():
+            part = "own work" if layer in OWN_WORK else layer if layer == "message conversion" else "rclpy and DDS"
+            split[part] += finite(row["ms_per_sim_s"], f"{name}: {layer}")
+        split["rclpy and DDS"] += finite(node["other_threads_ms_per_sim_s"], f"{name}: other threads")
+        split["node code"] += finite(node["other_main_thread_ms_per_sim_s"], f"{name}: other (main thread)")
+    return split
 
 
 class _Clock:

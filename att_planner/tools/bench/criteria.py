@@ -13,6 +13,8 @@ import math
 from collections.abc import Callable
 from dataclasses import dataclass
 
+from att_planner.tools.cpu_layers import parts as cpu_parts
+
 MC_TARGET_RUNS = 1000            # runs of the demo maneuver ...
 MC_TARGET_RUNS_PER_S = 3.3       # ... in 5 minutes on the 2-core machine
 SMOOTH_COMPUTE_S = 10.0          # compute of the default smooth plan
@@ -277,24 +279,6 @@ def _gains(p: dict, case: str | None) -> Summary:
                    {"kp": _num(p, "kp"), "kd": _num(p, "kd"), "ts_orbits": ts, "solve_s": secs})
 
 
-def _cpu_split(p: dict) -> dict[str, float]:
-    """The CPU per second of sim time of every node of a soak timed by layer, summed in four parts:
-    the nodes' own work (models, log writing), message conversion, rclpy and DDS (publish, take, the
-    executor's wait, the middleware's threads) and the rest of the nodes' own code."""
-    from att_planner.tools.cpu_layers import OWN_WORK
-
-    split = dict.fromkeys(("own work", "message conversion", "rclpy and DDS", "node code"), 0.0)
-    for name, node in _get(p, "cpu_layers").items():
-        if not node:                # a node that wrote no timings (it did not exit cleanly)
-            continue
-        for layer in _get(p, "cpu_layers", name, "layers"):
-            part = "own work" if layer in OWN_WORK else layer if layer == "message conversion" else "rclpy and DDS"
-            split[part] += _num(p, "cpu_layers", name, "layers", layer, "ms_per_sim_s")
-        split["rclpy and DDS"] += _num(p, "cpu_layers", name, "other_threads_ms_per_sim_s")
-        split["node code"] += _num(p, "cpu_layers", name, "other_main_thread_ms_per_sim_s")
-    return split
-
-
 def _soak(p: dict, case: str | None) -> Summary:
     dropped = int(_num(p, "dropped_state"))
     clean = dropped == 0 and not any(_get(p, "exit_codes").values())
@@ -305,7 +289,10 @@ def _soak(p: dict, case: str | None) -> Summary:
                    "loop_wall_s": _num(p, "loop_wall_seconds"),
                    "cpu_ms_per_sim_s": {k: v / _num(p, "sim_time") * 1e3 for k, v in p["cpu_seconds"].items()}}
         if "cpu_layers" in p:
-            figures["cpu_by_layer_ms_per_sim_s"] = _cpu_split(p)
+            try:
+                figures["cpu_by_layer_ms_per_sim_s"] = cpu_parts(_get(p, "cpu_layers"))
+            except (KeyError, TypeError, AttributeError, ValueError) as err:
+                raise HistoryError(f"'cpu_layers' is not a soak's CPU by layer ({err!r})") from None
         return Summary(case or f"{p['scenario']}, {_num(p, 'hours'):g} h at {_num(p, 'rate_Hz'):g} Hz{estimator}",
                        "real-time factor through the nodes", rtf, "×",
                        f"≥ {target:g}, every state recorded, every process exits 0", rtf >= target and clean, figures)

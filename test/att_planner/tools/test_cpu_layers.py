@@ -2,6 +2,7 @@
 module run through it writes each layer's CPU and calls at exit, from the first timed call on; the
 soak's summary splits the nodes' CPU into parts that add up to it."""
 import json
+import math
 import os
 import subprocess
 import sys
@@ -74,3 +75,10 @@ def test_the_soak_summary_splits_every_nodes_cpu_into_four_parts_that_add_up(tmp
     assert split == pytest.approx({"own work": 11.0, "message conversion": 4.0, "rclpy and DDS": 5.0 + 8.0 + 2.0 + 1.0,
                                    "node code": 9.0 + 10.0})
     assert sum(split.values()) == pytest.approx((0.3 + 0.2) / 10.0 * 1e3)      # every node's process CPU
+    for damaged in (math.nan, "1.0", None):
+        p["cpu_layers"]["controller"]["layers"]["take"] = {"ms_per_sim_s": damaged, "calls_per_sim_s": 1.0}
+        with pytest.raises(criteria.HistoryError, match="'cpu_layers' is not a soak's CPU by layer"):
+            criteria._soak(p, None)
+    p["cpu_layers"]["controller"] = {"layers": []}
+    with pytest.raises(criteria.HistoryError, match="cpu_layers"):
+        criteria._soak(p, None)
